@@ -1,0 +1,41 @@
+# quadimpact: one-command entry points.
+#   make run    set up .venv (once) and simulate the paper's example with both model variants
+#   make test   set up .venv (once) and run the test suite
+#   make lint   ruff check
+#   make bench  timing benchmark of the compiled core
+
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.quadimpact-installed
+
+EXAMPLE := --heading 45 --inclination 15 --speed 0.75
+
+.PHONY: setup run test lint bench clean
+
+setup: $(STAMP)
+
+# Create the virtual environment if missing and install quadimpact (editable)
+# with the development tools; redone only when pyproject.toml changes. Without
+# network access for the build backend, fall back to the venv's own setuptools.
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -e ".[dev]" \
+	  || $(BIN)/python -m pip install --no-build-isolation --no-deps -e .
+	touch $(STAMP)
+
+run: $(STAMP)
+	$(BIN)/quadimpact run $(EXAMPLE) --model paper-replica --out results/paper-example-replica
+	$(BIN)/quadimpact run $(EXAMPLE) --model default --out results/paper-example-default
+
+test: $(STAMP)
+	$(BIN)/python -m pytest
+
+lint: $(STAMP)
+	$(BIN)/ruff check src tests
+
+bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_run.py
+
+clean:
+	rm -rf results build dist src/*.egg-info .pytest_cache .ruff_cache

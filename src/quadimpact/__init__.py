@@ -1,0 +1,43 @@
+"""quadimpact: simulator of bumper-protected quadrotors colliding with walls.
+
+The public names are imported lazily, so that ``import quadimpact`` (and the
+command line's ``--help``) stays fast until the simulator is actually used.
+
+Examples
+--------
+>>> from quadimpact import WallApproach, simulate
+>>> result = simulate(WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75))
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+__version__ = "0.1.0"
+
+_EXPORTS = {
+    "WallApproach": "quadimpact.config",
+    "FlightScenario": "quadimpact.config",
+    "Plane": "quadimpact.config",
+    "ModelOptions": "quadimpact.config",
+    "load_scenario_file": "quadimpact.config",
+    "Vehicle": "quadimpact.vehicle",
+    "load_vehicle": "quadimpact.vehicle",
+    "InputError": "quadimpact.errors",
+    "simulate": "quadimpact.simulate",
+}
+
+__all__ = ["__version__", *_EXPORTS]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(import_module(_EXPORTS[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'quadimpact' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -1,0 +1,90 @@
+"""Validated number and array types shared by the input models.
+
+``Real`` is a finite float that refuses booleans and strings (TOML ``true`` or
+``"1.0"`` are mistakes, not numbers); NumPy scalars are accepted. Fixed-size
+vectors and matrices check their shape first, so that a wrong length is
+reported as one clear rule instead of one error per missing element. NumPy
+arrays are accepted wherever a list is.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+from pydantic import BeforeValidator
+
+__all__ = ["Real", "Sign", "SignVec4", "Vec2", "Vec3", "Vec4", "Mat3", "Mat4x3"]
+
+
+def _real(value: Any) -> Any:
+    if hasattr(value, "item") and not isinstance(value, (list, tuple)):
+        value = value.item()
+    if isinstance(value, (bool, str)):
+        raise ValueError("must be a number")
+    return value
+
+
+def _int_sign(value: Any) -> Any:
+    if hasattr(value, "item") and not isinstance(value, (list, tuple)):
+        value = value.item()
+    if isinstance(value, (bool, str)):
+        raise ValueError("must be +1 or -1")
+    return value
+
+
+def _vector(n: int):
+    def check(value: Any) -> Any:
+        if hasattr(value, "tolist"):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)):
+            raise ValueError(f"must be a list of {n} numbers")
+        if len(value) != n:
+            raise ValueError(f"must have exactly {n} numbers (got {len(value)})")
+        return value
+
+    return check
+
+
+def _matrix(rows: int, cols: int, row_name: str = "rows"):
+    def check(value: Any) -> Any:
+        if hasattr(value, "tolist"):
+            value = value.tolist()
+        if not isinstance(value, (list, tuple)) or not all(
+            isinstance(row, (list, tuple)) for row in value
+        ):
+            raise ValueError(f"must be a list of {rows} rows of {cols} numbers")
+        if len(value) != rows:
+            raise ValueError(f"must have exactly {rows} {row_name} (got {len(value)})")
+        for i, row in enumerate(value):
+            if len(row) != cols:
+                raise ValueError(f"row {i + 1} must have exactly {cols} numbers (got {len(row)})")
+        return value
+
+    return check
+
+
+Real = Annotated[float, BeforeValidator(_real)]
+"""A finite float (finiteness is enforced by ``allow_inf_nan=False`` on the models)."""
+
+Sign = Annotated[int, BeforeValidator(_int_sign)]
+"""An integer, meant to be +1 or -1 (checked by the model)."""
+
+Vec2 = Annotated[tuple[Real, Real], BeforeValidator(_vector(2))]
+Vec3 = Annotated[tuple[Real, Real, Real], BeforeValidator(_vector(3))]
+Vec4 = Annotated[tuple[Real, Real, Real, Real], BeforeValidator(_vector(4))]
+SignVec4 = Annotated[tuple[Sign, Sign, Sign, Sign], BeforeValidator(_vector(4))]
+"""Four integers, meant to be +1 or -1 (checked by the model)."""
+
+Mat3 = Annotated[
+    tuple[tuple[Real, Real, Real], tuple[Real, Real, Real], tuple[Real, Real, Real]],
+    BeforeValidator(_matrix(3, 3)),
+]
+Mat4x3 = Annotated[
+    tuple[
+        tuple[Real, Real, Real],
+        tuple[Real, Real, Real],
+        tuple[Real, Real, Real],
+        tuple[Real, Real, Real],
+    ],
+    BeforeValidator(_matrix(4, 3, "rows (one per rotor)")),
+]

@@ -1,0 +1,413 @@
+"""Post-processing of a compiled run: tables, impact grouping and metrics.
+
+Everything here is a pure function of plain arrays or pandas tables, so it
+can be tested on hand-made inputs. Definitions follow STUDIES.md section 2;
+frames and units follow MODEL.md section 1 (inertial NED, body FRD, SI).
+
+Raw arrays come from the compiled kernel with the layout of
+:mod:`quadimpact.core.layout` (``OUT_*`` time-series columns, ``E_*``
+episode columns).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from quadimpact.core import layout as L
+from quadimpact.frames import (
+    body_to_inertial,
+    euler_zyx_to_quat,
+    quat_to_euler_zyx,
+    quat_to_matrix,
+    wrap_angle_rad,
+)
+
+__all__ = [
+    "BUMPERS",
+    "EPISODE_COLUMNS",
+    "TIMESERIES_COLUMNS",
+    "attitude_excursion_deg",
+    "episodes_frame",
+    "group_impacts",
+    "impact_metrics",
+    "timeseries_frame",
+]
+
+#: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
+BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
+
+#: Columns of the episodes table, in order (docs/CONTRACT.md).
+EPISODE_COLUMNS: tuple[str, ...] = (
+    "bumper",
+    "surface",
+    "t_start_s",
+    "t_end_s",
+    "v_i_m_s",
+    "peak_delta_m",
+    "t_peak_s",
+    "peak_force_n",
+    "t_peak_force_s",
+    "open",
+)
+
+#: Columns of the time-series table, in order (docs/CONTRACT.md).
+TIMESERIES_COLUMNS: tuple[str, ...] = (
+    "t_s",
+    "x_m",
+    "y_m",
+    "z_m",
+    "u_m_s",
+    "v_m_s",
+    "w_m_s",
+    "vx_m_s",
+    "vy_m_s",
+    "vz_m_s",
+    "q0",
+    "q1",
+    "q2",
+    "q3",
+    "p_rad_s",
+    "q_rad_s",
+    "r_rad_s",
+    *(f"omega{j}_rad_s" for j in BUMPERS),
+    *(f"omega_cmd{j}_rad_s" for j in BUMPERS),
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "altitude_m",
+    *(f"delta{j}_m" for j in BUMPERS),
+    *(f"force{j}_n" for j in BUMPERS),
+)
+
+# Raw episode columns -> table columns (float-valued ones).
+_EPISODE_FLOAT_SOURCES: tuple[tuple[str, int], ...] = (
+    ("t_start_s", L.E_T_START),
+    ("t_end_s", L.E_T_END),
+    ("v_i_m_s", L.E_V_I),
+    ("peak_delta_m", L.E_PEAK_DELTA),
+    ("t_peak_s", L.E_T_PEAK),
+    ("peak_force_n", L.E_PEAK_FORCE),
+    ("t_peak_force_s", L.E_T_PEAK_FORCE),
+)
+
+
+def _rows(raw: np.ndarray, n: int, width: int, what: str) -> np.ndarray:
+    """First ``n`` rows of a 2-D raw kernel array, checked against its layout width."""
+    a = np.asarray(raw, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] < width:
+        raise ValueError(f"{what}: expected a 2-D array with {width} columns (got {a.shape})")
+    n = int(n)
+    if not 0 <= n <= a.shape[0]:
+        raise ValueError(f"{what}: row count must be in [0, {a.shape[0]}] (got {n})")
+    return a[:n]
+
+
+def _empty_episodes() -> pd.DataFrame:
+    data: dict[str, Any] = {
+        "bumper": pd.Series([], dtype="int64"),
+        "surface": pd.Series([], dtype=object).astype(str),
+    }
+    for name, _ in _EPISODE_FLOAT_SOURCES:
+        data[name] = pd.Series([], dtype="float64")
+    data["open"] = pd.Series([], dtype=bool)
+    return pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
+
+
+def episodes_frame(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> pd.DataFrame:
+    """Contact-episode table from the kernel's episode array.
+
+    Parameters
+    ----------
+    raw : numpy.ndarray, shape (max_episodes, NEP)
+        Episode records with the ``E_*`` columns of :mod:`quadimpact.core.layout`
+        (bumper 0-based, surface as an index into the run's surfaces).
+    n : int
+        Number of valid rows (``stats[ST_N_EPISODES]``, capped by the buffer).
+    surface_names : sequence of str
+        Name of each surface, in the order of the kernel's surface array.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`EPISODE_COLUMNS`: ``bumper`` (1-4), ``surface`` (name),
+        times in s, ``v_i_m_s`` (penetration rate at onset, m/s),
+        ``peak_delta_m`` (m), ``peak_force_n`` (N), ``open`` (bool: still in
+        contact when the run stopped; ``t_end_s`` is then the run end).
+        Sorted by ``t_start_s`` then ``bumper``, with a fresh 0..n-1 index.
+    """
+    rows = _rows(raw, n, L.NEP, "episodes")
+    if rows.shape[0] == 0:
+        return _empty_episodes()
+    bumper_idx = np.rint(rows[:, L.E_BUMPER]).astype(np.int64)
+    if np.any((bumper_idx < 0) | (bumper_idx > 3)):
+        raise ValueError(f"episodes: bumper index outside 0..3 (got {sorted(set(bumper_idx))})")
+    surf_idx = np.rint(rows[:, L.E_SURFACE]).astype(np.int64)
+    names = list(surface_names)
+    if np.any((surf_idx < 0) | (surf_idx >= len(names))):
+        raise ValueError(
+            f"episodes: surface index outside 0..{len(names) - 1} (got {sorted(set(surf_idx))})"
+        )
+    data: dict[str, Any] = {
+        "bumper": bumper_idx + 1,
+        "surface": [str(names[i]) for i in surf_idx],
+    }
+    for name, col in _EPISODE_FLOAT_SOURCES:
+        data[name] = rows[:, col].copy()
+    data["open"] = rows[:, L.E_OPEN] > 0.5
+    df = pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
+    df = df.sort_values(["t_start_s", "bumper"], kind="mergesort").reset_index(drop=True)
+    return df
+
+
+def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
+    """Time-series table from the kernel's output samples.
+
+    Parameters
+    ----------
+    raw : numpy.ndarray, shape (max_out, NOUT)
+        Output samples with the ``OUT_*`` columns of :mod:`quadimpact.core.layout`.
+    n : int
+        Number of valid rows (``stats[ST_N_OUT]``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`TIMESERIES_COLUMNS`: time (s); CM position ``x/y/z_m``
+        (inertial NED, m); CM velocity in body axes ``u/v/w_m_s`` and in
+        inertial axes ``vx/vy/vz_m_s`` (m/s, ``C(q) [u, v, w]``); quaternion
+        ``q0..q3`` (scalar first, body -> inertial, as integrated); body rates
+        ``p/q/r_rad_s``; rotor speeds and commands (rad/s); ZYX Euler angles
+        ``roll/pitch/yaw_deg`` (degrees; roll and yaw wrapped to (-180, 180],
+        pitch in [-90, 90]; not unwrapped); ``altitude_m = -z_m``; per-bumper
+        deflection ``delta1..4_m`` (m, max over surfaces) and normal force
+        ``force1..4_n`` (N, sum over surfaces).
+    """
+    rows = _rows(raw, n, L.NOUT, "timeseries")
+    x0 = L.OUT_X
+    pos = rows[:, x0 + L.X_POS : x0 + L.X_POS + 3]
+    vel_b = rows[:, x0 + L.X_VEL : x0 + L.X_VEL + 3]
+    quat = rows[:, x0 + L.X_QUAT : x0 + L.X_QUAT + 4]
+    omega = rows[:, x0 + L.X_OMEGA : x0 + L.X_OMEGA + 3]
+    rotor = rows[:, x0 + L.X_ROTOR : x0 + L.X_ROTOR + 4]
+    if rows.shape[0] > 0:
+        vel_i = body_to_inertial(quat, vel_b)
+        roll, pitch, yaw = quat_to_euler_zyx(quat)
+    else:
+        vel_i = np.empty((0, 3))
+        roll = pitch = yaw = np.empty(0)
+    data: dict[str, np.ndarray] = {
+        "t_s": rows[:, L.OUT_T],
+        "x_m": pos[:, 0],
+        "y_m": pos[:, 1],
+        "z_m": pos[:, 2],
+        "u_m_s": vel_b[:, 0],
+        "v_m_s": vel_b[:, 1],
+        "w_m_s": vel_b[:, 2],
+        "vx_m_s": vel_i[:, 0],
+        "vy_m_s": vel_i[:, 1],
+        "vz_m_s": vel_i[:, 2],
+        "q0": quat[:, 0],
+        "q1": quat[:, 1],
+        "q2": quat[:, 2],
+        "q3": quat[:, 3],
+        "p_rad_s": omega[:, 0],
+        "q_rad_s": omega[:, 1],
+        "r_rad_s": omega[:, 2],
+    }
+    for j in BUMPERS:
+        data[f"omega{j}_rad_s"] = rotor[:, j - 1]
+    for j in BUMPERS:
+        data[f"omega_cmd{j}_rad_s"] = rows[:, L.OUT_CMD + j - 1]
+    data["roll_deg"] = np.degrees(roll)
+    data["pitch_deg"] = np.degrees(pitch)
+    data["yaw_deg"] = np.degrees(yaw)
+    data["altitude_m"] = -pos[:, 2]
+    for j in BUMPERS:
+        data[f"delta{j}_m"] = rows[:, L.OUT_DELTA + j - 1]
+    for j in BUMPERS:
+        data[f"force{j}_n"] = rows[:, L.OUT_FORCE + j - 1]
+    return pd.DataFrame({k: np.array(v, dtype=np.float64) for k, v in data.items()})
+
+
+def group_impacts(episodes: pd.DataFrame) -> list[list[int]]:
+    """Group contact episodes into impacts (STUDIES.md section 2).
+
+    Episodes are taken in order of ``t_start_s`` (ties by ``bumper``). An
+    impact starts with the earliest episode not yet grouped; every following
+    episode that starts no later than the group's end so far (the largest
+    ``t_end_s`` of its members) joins it, and may extend that end, so a chain
+    of overlapping episodes is one impact even when a member starts after the
+    first one ended. Open episodes count as lasting to their ``t_end_s`` (the
+    run end).
+
+    Intervals are closed: an episode starting exactly when the group ends
+    (``t_start_s == end``) joins it, so a zero-length grazing contact still
+    groups with an episode starting at the same instant.
+
+    Parameters
+    ----------
+    episodes : pandas.DataFrame
+        Table with at least ``t_start_s``, ``t_end_s`` (s) and ``bumper``.
+
+    Returns
+    -------
+    list of list of int
+        Row positions (``iloc``) in ``episodes``, one list per impact, impacts
+        in time order and members in start order.
+    """
+    if len(episodes) == 0:
+        return []
+    start = episodes["t_start_s"].to_numpy(dtype=np.float64)
+    end = episodes["t_end_s"].to_numpy(dtype=np.float64)
+    if np.any(~np.isfinite(start)) or np.any(np.isnan(end)):
+        raise ValueError("episodes: t_start_s must be finite and t_end_s not NaN")
+    if "bumper" in episodes.columns:
+        bumper = episodes["bumper"].to_numpy(dtype=np.float64)
+        order = np.lexsort((bumper, start))
+    else:
+        order = np.argsort(start, kind="stable")
+    groups: list[list[int]] = []
+    current: list[int] = []
+    group_end = -math.inf
+    for pos in order:
+        i = int(pos)
+        if current and start[i] <= group_end:
+            current.append(i)
+            group_end = max(group_end, end[i])
+        else:
+            if current:
+                groups.append(current)
+            current = [i]
+            group_end = max(end[i], start[i])
+    groups.append(current)
+    return groups
+
+
+def impact_metrics(
+    episodes: pd.DataFrame, exclude_surfaces: Sequence[str] = ("ground",)
+) -> dict[str, Any]:
+    """Initial-impact metrics and counts of subsequent impacts (STUDIES.md section 2).
+
+    Parameters
+    ----------
+    episodes : pandas.DataFrame
+        Episodes table (:func:`episodes_frame`).
+    exclude_surfaces : sequence of str
+        Surfaces whose episodes are ignored (by default the ground, when it is
+        a contact surface: touching down is not an impact with the obstacle).
+
+    Returns
+    -------
+    dict
+        ``delta_init_m`` (m): largest peak deflection in the initial impact.
+        ``peak_force_n`` (N): largest peak normal force in the initial impact.
+        ``initial_impact_start_s``, ``initial_impact_end_s``,
+        ``initial_impact_duration_s`` (s).
+        ``leading_bumpers``: sorted bumper numbers of the initial impact.
+        ``aft_bumpers``: the other bumpers among 1-4 (empty when there is no
+        impact at all).
+        ``n_episodes``: episodes on non-excluded surfaces.
+        ``n_subsequent_impacts``: impacts (groups) after the initial one.
+        ``n_subsequent_episodes``: episodes in those impacts.
+        ``subsequent_impacts``: one list per subsequent impact with the bumper
+        numbers of its episodes in start order (a bumper appears twice if it
+        has two episodes in that impact).
+        Floats are NaN and lists empty when there is no episode.
+    """
+    if len(episodes) and len(exclude_surfaces):
+        keep = ~episodes["surface"].astype(str).isin([str(s) for s in exclude_surfaces])
+        eps = episodes.loc[keep.to_numpy()].reset_index(drop=True)
+    else:
+        eps = episodes.reset_index(drop=True)
+    groups = group_impacts(eps)
+    out: dict[str, Any] = {
+        "delta_init_m": math.nan,
+        "peak_force_n": math.nan,
+        "initial_impact_start_s": math.nan,
+        "initial_impact_end_s": math.nan,
+        "initial_impact_duration_s": math.nan,
+        "leading_bumpers": [],
+        "aft_bumpers": [],
+        "n_episodes": len(eps),
+        "n_subsequent_impacts": 0,
+        "n_subsequent_episodes": 0,
+        "subsequent_impacts": [],
+    }
+    if not groups:
+        return out
+    first = eps.iloc[groups[0]]
+    start = float(first["t_start_s"].min())
+    end = float(max(first["t_end_s"].max(), start))
+    leading = sorted({int(b) for b in first["bumper"]})
+    bumper_col = eps["bumper"].to_numpy()
+    out.update(
+        {
+            "delta_init_m": float(first["peak_delta_m"].max()),
+            "peak_force_n": float(first["peak_force_n"].max()),
+            "initial_impact_start_s": start,
+            "initial_impact_end_s": end,
+            "initial_impact_duration_s": end - start,
+            "leading_bumpers": leading,
+            "aft_bumpers": [b for b in BUMPERS if b not in leading],
+            "n_subsequent_impacts": len(groups) - 1,
+            "n_subsequent_episodes": sum(len(g) for g in groups[1:]),
+            "subsequent_impacts": [[int(bumper_col[i]) for i in g] for g in groups[1:]],
+        }
+    )
+    return out
+
+
+def attitude_excursion_deg(ts: pd.DataFrame, refs: Mapping[str, float]) -> dict[str, float]:
+    """Largest attitude departure from the reference over a run (degrees).
+
+    Parameters
+    ----------
+    ts : pandas.DataFrame
+        Time-series table (:func:`timeseries_frame`): uses ``roll_deg``,
+        ``pitch_deg``, ``yaw_deg`` and, for the tilt, ``q0..q3`` (falling back
+        to the Euler angles when the quaternion columns are absent).
+    refs : mapping
+        ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (ZYX reference attitude,
+        radians); other keys (``altitude_m``) are ignored.
+
+    Returns
+    -------
+    dict
+        ``roll_excursion_deg``: max ``|wrap(roll - roll_ref)|``;
+        ``pitch_excursion_deg``: max ``|pitch - pitch_ref|``;
+        ``yaw_excursion_deg``: max ``|wrap(yaw - yaw_ref)|``;
+        ``tilt_max_deg``: max angle between the body z axis and the reference
+        body z axis (both in the inertial frame), in [0, 180].
+        Roll and yaw differences are wrapped to (-180, 180] since both angles
+        are reported wrapped. All NaN for an empty table.
+    """
+    keys = ("roll_excursion_deg", "pitch_excursion_deg", "yaw_excursion_deg", "tilt_max_deg")
+    if len(ts) == 0:
+        return dict.fromkeys(keys, math.nan)
+    roll_ref = float(refs["roll_rad"])
+    pitch_ref = float(refs["pitch_rad"])
+    yaw_ref = float(refs["yaw_rad"])
+    roll = np.radians(ts["roll_deg"].to_numpy(dtype=np.float64))
+    pitch = np.radians(ts["pitch_deg"].to_numpy(dtype=np.float64))
+    yaw = np.radians(ts["yaw_deg"].to_numpy(dtype=np.float64))
+    d_roll = np.abs(wrap_angle_rad(roll - roll_ref))
+    d_pitch = np.abs(pitch - pitch_ref)
+    d_yaw = np.abs(wrap_angle_rad(yaw - yaw_ref))
+    if all(c in ts.columns for c in ("q0", "q1", "q2", "q3")):
+        quat = ts[["q0", "q1", "q2", "q3"]].to_numpy(dtype=np.float64)
+    else:
+        quat = euler_zyx_to_quat(roll, pitch, yaw)
+    z_body = quat_to_matrix(quat)[:, :, 2]
+    z_ref = quat_to_matrix(euler_zyx_to_quat(roll_ref, pitch_ref, yaw_ref))[:, 2]
+    tilt = np.arccos(np.clip(z_body @ z_ref, -1.0, 1.0))
+    return {
+        "roll_excursion_deg": float(np.degrees(np.max(d_roll))),
+        "pitch_excursion_deg": float(np.degrees(np.max(d_pitch))),
+        "yaw_excursion_deg": float(np.degrees(np.max(d_yaw))),
+        "tilt_max_deg": float(np.degrees(np.max(tilt))),
+    }

@@ -1,0 +1,98 @@
+"""Event functions and their location on the integrator's dense output.
+
+Events of a run (MODEL.md section 7):
+
+* ``EV_GAP``: penetration ``delta`` of one bumper-surface pair crosses 0
+  (contact onset upward, contact end downward);
+* ``EV_RATE``: ``delta_dot`` of an active contact crosses 0 downward (the
+  peak deflection of the episode: located, not sampled);
+* ``EV_ALTITUDE``: the CM altitude ``h = -Z`` crosses the crash level.
+
+Roots are found on the dense output of the accepted step with the Illinois
+variant of regula falsi, bracketing all along, to ``EVENT_TOL`` in time.
+"""
+
+import numpy as np
+from numba import njit
+
+from .contact import bumper_plane_contact
+from .integrator import dense_eval
+from .layout import X_POS, X_QUAT
+from .quaternion import rotation_matrix
+
+EV_GAP = 0
+EV_RATE = 1
+EV_ALTITUDE = 2
+
+
+@njit(cache=True)
+def event_value(
+    kind: int,
+    c: int,
+    xs: np.ndarray,
+    C: np.ndarray,
+    veh: np.ndarray,
+    surf: np.ndarray,
+    level: float,
+) -> float:
+    """Value of event function ``kind`` for contact ``c = 4 s + j`` at state ``xs``."""
+    if kind == EV_ALTITUDE:
+        return -xs[X_POS + 2] - level
+    rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
+    d, dd, _, _, _, _, _, _ = bumper_plane_contact(xs, C, veh, c % 4, surf, c // 4)
+    if kind == EV_GAP:
+        return d
+    return dd
+
+
+@njit(cache=True)
+def locate(
+    kind: int,
+    c: int,
+    x_old: np.ndarray,
+    Q: np.ndarray,
+    h: float,
+    ga: float,
+    gb: float,
+    sb: float,
+    tol: float,
+    xs: np.ndarray,
+    C: np.ndarray,
+    veh: np.ndarray,
+    surf: np.ndarray,
+    level: float,
+) -> float:
+    """Root of an event function on ``[0, sb]`` (fractions of the step ``h``).
+
+    ``ga`` is its value at 0 and ``gb`` at ``sb``, of opposite "sides"
+    (``ga <= 0 < gb`` or ``ga > 0 >= gb``). Returns the fraction of the step at
+    the root, on the side where the event has happened (the sign of ``gb``),
+    within ``tol`` seconds.
+    """
+    sa = 0.0
+    side_b = gb > 0.0
+    fa = ga
+    fb = gb
+    last = 0
+    for _ in range(200):
+        if (sb - sa) * h <= tol:
+            break
+        denom = fb - fa
+        s = sb - fb * (sb - sa) / denom if denom != 0.0 else 0.5 * (sa + sb)
+        if not (sa < s < sb):
+            s = 0.5 * (sa + sb)
+        dense_eval(x_old, Q, h, s, xs)
+        fs = event_value(kind, c, xs, C, veh, surf, level)
+        if (fs > 0.0) == side_b:
+            sb = s
+            fb = fs
+            if last == 1:
+                fa *= 0.5
+            last = 1
+        else:
+            sa = s
+            fa = fs
+            if last == -1:
+                fb *= 0.5
+            last = -1
+    return sb

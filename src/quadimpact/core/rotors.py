@@ -1,0 +1,61 @@
+"""Rotor forces and moments (MODEL.md section 2, paper eqs. 5-7).
+
+Physically consistent form (the default):
+
+* thrust of rotor j: ``F_Tj = -kt Omega_j^2 e_z`` (body);
+* moments ``sum_j r_Tj x F_Tj - s_j (dt Omega_j^2 + Jr Omega_dot_j) e_z``;
+* gyroscopic moment ``-Jr (sum_j s_j Omega_j) (omega x e_z)``.
+
+The paper replica (``O_YAW_REACTION_PAPER``) uses the authors' yaw reaction
+instead: ``+s_j dt Omega_j^2`` and ``-Jr sum_j Omega_dot_j`` (MODEL.md 8.1).
+"""
+
+import numpy as np
+from numba import njit
+
+from .layout import V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
+
+
+@njit(cache=True)
+def rotor_wrench(
+    x: np.ndarray, omega_dot: np.ndarray, veh: np.ndarray, yaw_paper: bool
+) -> tuple[float, float, float, float]:
+    """Total rotor thrust and moments, body frame.
+
+    Parameters
+    ----------
+    x : state; rotor speeds ``Omega_j`` (rad/s) at ``X_ROTOR``.
+    omega_dot : rotor accelerations ``Omega_dot_j`` (rad/s^2), shape (4,).
+    veh : packed vehicle.
+    yaw_paper : use the paper replica's yaw reaction.
+
+    Returns
+    -------
+    fz : thrust force along z_B (N, negative = up).
+    mx, my, mz : moment about the CM (N m).
+    """
+    kt = veh[V_KT]
+    dt = veh[V_DT]
+    jr = veh[V_JR]
+    fz = 0.0
+    mx = 0.0
+    my = 0.0
+    mz = 0.0
+    spin_sum = 0.0
+    for j in range(4):
+        w = x[X_ROTOR + j]
+        s = veh[V_SPIN + j]
+        t = kt * w * w
+        fz -= t
+        # r_Tj x (0, 0, -t)
+        mx -= veh[V_ROTOR_POS + 3 * j + 1] * t
+        my += veh[V_ROTOR_POS + 3 * j] * t
+        if yaw_paper:
+            mz += s * dt * w * w - jr * omega_dot[j]
+        else:
+            mz -= s * (dt * w * w + jr * omega_dot[j])
+        spin_sum += s * w
+    # gyroscopic: -Jr S (omega x e_z) = -Jr S (q, -p, 0)
+    mx -= jr * spin_sum * x[X_OMEGA + 1]
+    my += jr * spin_sum * x[X_OMEGA]
+    return fz, mx, my, mz

@@ -1,0 +1,132 @@
+"""The result of one simulation run and how it is written to a folder."""
+
+from __future__ import annotations
+
+import math
+import numbers
+import os
+import sys
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from quadimpact import io as qio
+
+__all__ = ["FIG5_PNG", "FIG6_PNG", "SimulationResult"]
+
+FIG5_PNG = "fig5.png"
+FIG6_PNG = "fig6.png"
+
+
+@dataclass
+class SimulationResult:
+    """Everything one run produced.
+
+    Attributes
+    ----------
+    summary : dict
+        Run summary, the content of ``summary.json`` (metrics, status, ...).
+    episodes : pandas.DataFrame
+        Contact episodes (columns in docs/CONTRACT.md).
+    timeseries : pandas.DataFrame
+        Sampled states (columns in docs/CONTRACT.md; inertial NED, body FRD, SI,
+        Euler angles in degrees).
+    references : dict
+        Controller references: ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (rad,
+        ZYX Euler) and ``altitude_m`` (m).
+    scenario : object
+        The input scenario (``None`` when read back from a folder).
+    stats : dict
+        Integrator counters (steps, rejected steps, right-hand-side calls, ...).
+    """
+
+    summary: dict[str, Any]
+    episodes: pd.DataFrame
+    timeseries: pd.DataFrame
+    references: dict[str, Any] = field(default_factory=dict)
+    scenario: object = None
+    stats: dict[str, Any] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------
+    def _scenario_value(self, key: str) -> Any:
+        """``key`` from the scenario object, else from ``summary['scenario']``."""
+        if self.scenario is not None and hasattr(self.scenario, key):
+            return getattr(self.scenario, key)
+        sc = self.summary.get("scenario")
+        if isinstance(sc, Mapping):
+            return sc.get(key)
+        return None
+
+    def wall_x_m(self) -> float | None:
+        """Inertial X of the wall plane (m), if known (wall-approach runs)."""
+        for value in (
+            self.summary.get("wall_x_m"),
+            self.summary.get("wall_distance_m"),
+            self._scenario_value("wall_distance_m"),
+        ):
+            if isinstance(value, numbers.Real) and math.isfinite(float(value)):
+                return float(value)
+        return None
+
+    def plot_title(self) -> str | None:
+        """Short title naming the approach (heading, speed, inclination), if known."""
+        heading = self._scenario_value("heading_deg")
+        speed = self._scenario_value("speed_m_s")
+        incl = self._scenario_value("inclination_deg")
+        if any(not isinstance(v, numbers.Real) for v in (heading, speed, incl)):
+            return None
+        return f"ψ = {heading:g}°, V_c = {speed:g} m/s, inclination = {incl:g}°"
+
+    # ------------------------------------------------------------------
+    def write(self, out_dir: str | os.PathLike[str]) -> Path:
+        """Write the result folder and return its path.
+
+        Files, in this order so that a plotting failure loses no data:
+        ``summary.json`` (the summary plus ``references`` and ``stats`` unless
+        it already has those keys), ``episodes.csv``, ``timeseries.parquet``,
+        ``fig5.png``, ``fig6.png``. A figure that fails is not written (a stale
+        one from an earlier write is removed); the failure is printed as a
+        one-line warning on stderr and listed under ``plot_errors`` in
+        ``summary.json`` (and in ``self.summary``).
+        """
+        d = Path(out_dir)
+        d.mkdir(parents=True, exist_ok=True)
+        summary = dict(self.summary)
+        summary.pop("plot_errors", None)
+        summary.setdefault("references", dict(self.references))
+        summary.setdefault("stats", dict(self.stats))
+        qio.write_summary_json(summary, d / qio.SUMMARY_JSON)
+        qio.write_episodes_csv(self.episodes, d / qio.EPISODES_CSV)
+        qio.write_timeseries_parquet(self.timeseries, d / qio.TIMESERIES_PARQUET)
+
+        from quadimpact import plots  # matplotlib only when figures are wanted
+
+        title = self.plot_title()
+        jobs: tuple[tuple[str, Callable[[Path], Path]], ...] = (
+            (FIG5_PNG, lambda p: plots.plot_fig5(self.timeseries, p, title=title)),
+            (
+                FIG6_PNG,
+                lambda p: plots.plot_fig6(
+                    self.timeseries, self.references, p, wall_x_m=self.wall_x_m(), title=title
+                ),
+            ),
+        )
+        errors: list[str] = []
+        for name, job in jobs:
+            try:
+                job(d / name)
+            except Exception as exc:  # keep the data; report the figure failure
+                (d / name).unlink(missing_ok=True)
+                msg = f"{name}: {type(exc).__name__}: {exc}".replace("\n", " ")
+                errors.append(msg)
+                print(f"quadimpact: warning: plot failed: {msg}", file=sys.stderr)
+        if errors:
+            summary["plot_errors"] = errors
+            self.summary["plot_errors"] = list(errors)
+            qio.write_summary_json(summary, d / qio.SUMMARY_JSON)
+        else:
+            self.summary.pop("plot_errors", None)
+        return d

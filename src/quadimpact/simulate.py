@@ -1,0 +1,231 @@
+"""Front end: one scenario in, one :class:`~quadimpact.result.SimulationResult` out.
+
+``simulate`` prepares the packed inputs (``scenario.prepare``), runs the
+compiled loop once, and reads its raw record with the pure functions of
+``analysis`` into tables and the summary of STUDIES.md section 2.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from . import __version__
+from .analysis import attitude_excursion_deg, episodes_frame, impact_metrics, timeseries_frame
+from .config import FlightScenario, WallApproach
+from .core import layout as L
+from .core.run import execute
+from .frames import quat_to_euler_zyx, quat_to_matrix
+from .result import SimulationResult
+from .scenario import RunSetup, inclination_deg_of, prepare
+
+STATUS_NAMES = {
+    L.STATUS_COMPLETED: "completed",
+    L.STATUS_CRASHED: "crashed",
+    L.STATUS_FAILED: "failed",
+}
+SPEED_CHECK_TOL_M_S = 1e-6  # reached impact speed vs request, warn beyond
+ONSET_TIME_TOL_S = 1e-6  # first contact time vs T_c, warn beyond
+
+
+def simulate(
+    scenario: WallApproach | FlightScenario,
+    *,
+    max_episodes: int = 1024,
+    kernel: Callable | None = None,
+) -> SimulationResult:
+    """Run one scenario.
+
+    Parameters
+    ----------
+    scenario : WallApproach or FlightScenario
+        Validated input (``quadimpact.config``).
+    max_episodes : int
+        Size of the episode buffer; episodes beyond it are counted and reported.
+    kernel : callable, optional
+        A run loop from ``quadimpact.core.run.make_kernel`` (plug-in controller);
+        default: the cached kernel with the built-in controllers.
+
+    Returns
+    -------
+    SimulationResult
+        ``.summary`` (dict of summary.json), ``.episodes`` and ``.timeseries``
+        (pandas DataFrames, SI units, inertial NED / body FRD).
+    """
+    setup = prepare(scenario)
+    return run_setup(setup, scenario, max_episodes=max_episodes, kernel=kernel)
+
+
+def run_setup(
+    setup: RunSetup,
+    scenario: Any = None,
+    *,
+    max_episodes: int = 1024,
+    kernel: Callable | None = None,
+) -> SimulationResult:
+    """Run a prepared setup through the compiled loop and analyse the record."""
+    t_out = setup.output_times()
+    wall_start = time.perf_counter()
+    out, ep, st = execute(
+        setup.x0,
+        setup.t0,
+        setup.tf,
+        setup.veh,
+        setup.surf,
+        setup.opts,
+        setup.ctrl,
+        t_out,
+        max_episodes=max_episodes,
+        kernel=kernel,
+    )
+    wall_s = time.perf_counter() - wall_start
+    ts = timeseries_frame(out, out.shape[0])
+    episodes = episodes_frame(ep, ep.shape[0], setup.surface_names)
+    summary = build_summary(setup, scenario, ts, episodes, st)
+    stats = {
+        "steps": int(st[L.ST_N_STEPS]),
+        "rejected_steps": int(st[L.ST_N_REJECTED]),
+        "rhs_evaluations": int(st[L.ST_N_RHS]),
+        "control_ticks": int(st[L.ST_N_TICKS]),
+        "output_rows": int(st[L.ST_N_OUT]),
+        "wall_time_s": wall_s,
+    }
+    summary["integrator"] = stats
+    return SimulationResult(
+        summary=summary,
+        episodes=episodes,
+        timeseries=ts,
+        references=dict(setup.references),
+        scenario=scenario,
+        stats=stats,
+    )
+
+
+def _nan_to_none(v: float) -> float | None:
+    return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
+
+
+def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) -> dict[str, Any]:
+    """The summary of STUDIES.md section 2 from the raw stats and the tables."""
+    status_code = int(st[L.ST_STATUS])
+    status = STATUS_NAMES[status_code]
+    warnings = list(setup.warnings)
+    reason = L.REASON_TEXT[int(st[L.ST_REASON])]
+    metrics = impact_metrics(episodes)
+    rb = setup.vehicle.bumper_radius_m
+
+    onset_t = float(st[L.ST_ONSET_T])
+    speed = heading = incl = math.nan
+    if not math.isnan(onset_t):
+        xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
+        q = xo[L.X_QUAT : L.X_QUAT + 4]
+        vel = quat_to_matrix(q) @ xo[L.X_VEL : L.X_VEL + 3]
+        normal = (
+            setup.surf[0, L.S_NORMAL : L.S_NORMAL + 3] if setup.surf.shape[0] else -np.eye(3)[0]
+        )
+        speed = float(-vel @ normal)
+        heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
+        incl = inclination_deg_of(q)
+
+    crash_t = float(st[L.ST_CRASH_T])
+    crash_pos = st[L.ST_CRASH_X : L.ST_CRASH_X + 3]
+    max_pen = float(st[L.ST_MAX_DELTA])
+    if max_pen > rb:
+        warnings.append(
+            f"penetration {max_pen * 1e3:.1f} mm exceeds the bumper radius {rb * 1e3:.0f} mm: "
+            "the body itself would be in the surface, beyond what the bumper model covers"
+        )
+    if st[L.ST_MISSED_ONSETS] > 0:
+        warnings.append(
+            f"{int(st[L.ST_MISSED_ONSETS])} contact(s) found already penetrating "
+            "(onset not located; v_i taken at first sight)"
+        )
+    if st[L.ST_EPISODES_DROPPED] > 0:
+        warnings.append(
+            f"{int(st[L.ST_EPISODES_DROPPED])} episodes beyond the buffer were not recorded"
+        )
+
+    summary: dict[str, Any] = {
+        "status": status,
+        "reason": reason,
+        "warnings": warnings,
+        "model": getattr(scenario, "model", None),
+        "model_options": setup.options.model_dump(),
+        "controller": getattr(scenario, "controller", None),
+        "vehicle": setup.vehicle.name,
+        "delta_init_m": _nan_to_none(metrics["delta_init_m"]),
+        "peak_force_n": _nan_to_none(metrics["peak_force_n"]),
+        "initial_impact_duration_s": _nan_to_none(metrics["initial_impact_duration_s"]),
+        "first_contact_s": _nan_to_none(onset_t),
+        "impact_speed_m_s": _nan_to_none(speed),
+        "inclination_deg": _nan_to_none(incl),
+        "heading_deg": _nan_to_none(heading),
+        "leading_bumpers": metrics["leading_bumpers"],
+        "aft_bumpers": metrics["aft_bumpers"],
+        "n_episodes": int(metrics["n_episodes"]),
+        "n_subsequent_impacts": int(metrics["n_subsequent_impacts"]),
+        "n_subsequent_episodes": int(metrics["n_subsequent_episodes"]),
+        "subsequent_impacts": metrics["subsequent_impacts"],
+        "crash_time_s": _nan_to_none(crash_t),
+        "crash_position_m": None if math.isnan(crash_t) else [float(c) for c in crash_pos],
+        "max_penetration_m": max_pen,
+        "t_start_s": float(setup.t0),
+        "t_final_s": float(st[L.ST_T_END]),
+        "references": {k: float(v) for k, v in setup.references.items()},
+        "quadimpact_version": __version__,
+    }
+    if setup.wall is not None:
+        d = setup.wall.point_m[0]
+        summary["wall_distance_m"] = d
+        summary["crash_distance_from_wall_m"] = (
+            None if math.isnan(crash_t) else float(d - crash_pos[0])
+        )
+        summary["approach"] = setup.approach
+    if isinstance(scenario, WallApproach):
+        summary["requested"] = {
+            "heading_deg": scenario.heading_deg,
+            "inclination_deg": scenario.inclination_deg,
+            "speed_m_s": scenario.speed_m_s,
+            "impact_time_s": scenario.impact_time_s,
+        }
+        if math.isnan(onset_t):
+            warnings.append("the vehicle never touched the wall")
+        else:
+            if abs(onset_t - scenario.impact_time_s) > ONSET_TIME_TOL_S:
+                warnings.append(
+                    f"first contact at {onset_t:.6f} s, "
+                    f"not at the requested {scenario.impact_time_s} s"
+                )
+            if abs(speed - scenario.speed_m_s) > SPEED_CHECK_TOL_M_S:
+                warnings.append(
+                    f"impact speed {speed:.6f} m/s differs from the requested {scenario.speed_m_s}"
+                )
+    if len(ts):
+        summary["attitude_excursion"] = attitude_excursion_deg(ts, setup.references)
+    summary["outcome"] = describe_outcome(summary)
+    return summary
+
+
+def describe_outcome(s: dict[str, Any]) -> str:
+    """One sentence saying what the run did after the first impact."""
+    if s["status"] == "failed":
+        return f"failed at t = {s['t_final_s']:.3f} s: {s['reason']}"
+    if s["delta_init_m"] is None:
+        first = "no contact"
+    else:
+        lead = ", ".join(str(b) for b in s["leading_bumpers"])
+        first = (
+            f"initial impact on bumper(s) {lead} (delta_init {s['delta_init_m'] * 1e3:.2f} mm), "
+            f"then {s['n_subsequent_impacts']} subsequent impact(s) "
+            f"({s['n_subsequent_episodes']} episode(s))"
+        )
+    if s["crash_time_s"] is not None:
+        where = ""
+        if s.get("crash_distance_from_wall_m") is not None:
+            where = f", {s['crash_distance_from_wall_m']:.2f} m from the wall"
+        return f"{first}; crashed at t = {s['crash_time_s']:.3f} s{where}"
+    return f"{first}; still flying at t = {s['t_final_s']:.3f} s"

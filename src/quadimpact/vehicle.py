@@ -1,0 +1,333 @@
+"""Vehicle parameters: a validated, immutable description of a quadrotor with bumpers.
+
+Vehicles are data: the Spiri of the paper ships as ``vehicles/spiri.toml``
+and a user can write another file with the same keys (see that file for
+units and sources). Frames and conventions are those of MODEL.md section 1:
+body frame FRD (x forward, y right, z down) with its origin at the centre of
+mass; SI units, rotor speeds in rad/s.
+
+Examples
+--------
+>>> from quadimpact.vehicle import load_vehicle
+>>> spiri = load_vehicle()                      # the bundled Spiri
+>>> round(spiri.hover_speed_rad_s, 1)
+598.1
+>>> stiff = spiri.with_overrides(contact_stiffness=80.0)
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+
+from quadimpact._types import Mat3, Mat4x3, Real, SignVec4, Vec2, Vec4
+from quadimpact.errors import InputError, input_error_from_validation
+
+__all__ = ["Vehicle", "load_vehicle", "bundled_vehicles"]
+
+_SYMMETRY_RTOL = 1e-9
+
+
+class Vehicle(BaseModel):
+    """A quadrotor with four bumpers: mass properties, rotors, bumpers and contact law.
+
+    All vectors are in the body frame (FRD: x forward, y right, z down, origin
+    at the centre of mass). Rotor ``j`` (1-4) is row ``j-1`` of
+    ``rotor_positions_m`` and bumper ``j`` is centred on rotor ``j``. The model
+    is frozen; derive variants with :meth:`with_overrides`.
+
+    Attributes
+    ----------
+    name : str
+        Label of the vehicle (e.g. ``"spiri"``).
+    mass_kg : float
+        Total mass m, kg.
+    inertia_kg_m2 : tuple of 3 tuples of 3 floats
+        Inertia tensor about the CM in body axes, kg m^2; symmetric positive definite.
+    rotor_positions_m : tuple of 4 tuples of 3 floats
+        Rotor hub positions r_Tj from the CM, body FRD, m.
+    spin_directions : tuple of 4 ints
+        Spin sense s_j of each rotor about +z_B (down): +1 or -1, two of each.
+    thrust_coefficient : float
+        kt, thrust per rotor ``kt Omega^2``, N/(rad/s)^2.
+    drag_torque_coefficient : float
+        dt, aerodynamic drag torque per rotor ``dt Omega^2``, N m/(rad/s)^2.
+    rotor_inertia_kg_m2 : float
+        Jr, rotor and propeller inertia about the spin axis, kg m^2.
+    gravity_m_s2 : float
+        Gravitational acceleration g, m/s^2 (along +Z of the NED inertial frame).
+    bumper_radius_m : float
+        Rb, radius of each bumper circle, m.
+    bumper_tilt_deg : float
+        alpha, tilt of the bumper circles, deg in [0, 90): the outer rim is raised.
+    bumper_directions_deg : tuple of 4 floats
+        psi_j, outward direction of bumper j in the body x-y plane, deg from +x_B
+        toward +y_B.
+    contact_stiffness : float
+        k, Hunt-Crossley stiffness, N/m^n.
+    contact_exponent : float
+        n, Hunt-Crossley exponent, dimensionless.
+    restitution : float
+        e, coefficient of restitution in (0, 1].
+    rotor_speed_range_rpm : tuple of 2 floats
+        Hardware rotor speed range [min, max], rpm (documentation and optional limits).
+    motor_time_constant_s : float
+        tau_m, motor time constant, s (first-order rotor mode only).
+    """
+
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+
+    name: str = Field(min_length=1, description="Label of the vehicle.")
+    mass_kg: Real = Field(gt=0, description="Total mass m, kg.")
+    inertia_kg_m2: Mat3 = Field(
+        description="Inertia tensor about the CM, body FRD axes, kg m^2 (symmetric, PD)."
+    )
+    rotor_positions_m: Mat4x3 = Field(
+        description="Rotor hub positions from the CM, body FRD, m; row j-1 is rotor j."
+    )
+    spin_directions: SignVec4 = Field(
+        description="Spin sense of each rotor about +z_B (down): +1 or -1, summing to 0."
+    )
+    thrust_coefficient: Real = Field(gt=0, description="kt: thrust = kt Omega^2, N/(rad/s)^2.")
+    drag_torque_coefficient: Real = Field(
+        gt=0, description="dt: rotor drag torque = dt Omega^2, N m/(rad/s)^2."
+    )
+    rotor_inertia_kg_m2: Real = Field(
+        gt=0, description="Jr: rotor + propeller inertia about the spin axis, kg m^2."
+    )
+    gravity_m_s2: Real = Field(gt=0, description="Gravitational acceleration g, m/s^2.")
+    bumper_radius_m: Real = Field(gt=0, description="Rb: bumper circle radius, m.")
+    bumper_tilt_deg: Real = Field(
+        ge=0, lt=90, description="alpha: bumper tilt, deg; the outer rim is raised."
+    )
+    bumper_directions_deg: Vec4 = Field(
+        (45.0, 135.0, 225.0, 315.0),
+        description="Outward direction of each bumper in the body x-y plane, deg from +x_B.",
+    )
+    contact_stiffness: Real = Field(gt=0, description="k: Hunt-Crossley stiffness, N/m^n.")
+    contact_exponent: Real = Field(gt=0, description="n: Hunt-Crossley exponent.")
+    restitution: Real = Field(gt=0, le=1, description="e: coefficient of restitution, (0, 1].")
+    rotor_speed_range_rpm: Vec2 = Field(
+        (3000.0, 8000.0), description="Hardware rotor speed range [min, max], rpm."
+    )
+    motor_time_constant_s: Real = Field(
+        0.02, gt=0, description="tau_m: motor time constant, s (first-order rotor mode)."
+    )
+
+    # ------------------------------------------------------------------ checks
+    @field_validator("inertia_kg_m2")
+    @classmethod
+    def _check_inertia(cls, value: tuple) -> tuple:
+        mat = np.asarray(value, dtype=float)
+        scale = float(np.max(np.abs(mat)))
+        if scale == 0.0 or np.max(np.abs(mat - mat.T)) > _SYMMETRY_RTOL * scale:
+            raise ValueError("must be symmetric positive definite (not symmetric)")
+        eig = np.linalg.eigvalsh(0.5 * (mat + mat.T))
+        if eig[0] <= 0.0:
+            raise ValueError(
+                "must be symmetric positive definite "
+                f"(not positive definite: smallest eigenvalue {eig[0]:.4g})"
+            )
+        return value
+
+    @field_validator("spin_directions")
+    @classmethod
+    def _check_spins(cls, value: tuple) -> tuple:
+        if any(s not in (1, -1) for s in value):
+            raise ValueError("each entry must be +1 or -1")
+        if sum(value) != 0:
+            raise ValueError("must sum to 0 (two rotors each way, for balanced yaw)")
+        return value
+
+    @field_validator("rotor_speed_range_rpm")
+    @classmethod
+    def _check_range(cls, value: tuple) -> tuple:
+        lo, hi = value
+        if lo <= 0:
+            raise ValueError("minimum must be > 0")
+        if not lo < hi:
+            raise ValueError("must be [min, max] with min < max")
+        return value
+
+    # ------------------------------------------------------------ derived data
+    @property
+    def inertia(self) -> np.ndarray:
+        """Inertia tensor about the CM, body FRD axes, kg m^2, shape (3, 3)."""
+        return np.array(self.inertia_kg_m2, dtype=float)
+
+    @property
+    def rotor_positions(self) -> np.ndarray:
+        """Rotor hub positions from the CM, body FRD, m, shape (4, 3); row j-1 is rotor j."""
+        return np.array(self.rotor_positions_m, dtype=float)
+
+    @property
+    def spins(self) -> np.ndarray:
+        """Spin senses s_j about +z_B as floats (+1.0 or -1.0), shape (4,)."""
+        return np.array(self.spin_directions, dtype=float)
+
+    @property
+    def hover_speed_rad_s(self) -> float:
+        """Level-hover rotor speed ``sqrt(m g / (4 kt))``, rad/s (about 598 for the Spiri)."""
+        return math.sqrt(self.mass_kg * self.gravity_m_s2 / (4.0 * self.thrust_coefficient))
+
+    def bumper_frames(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Geometry of the four bumper circles in the body frame (MODEL.md section 4).
+
+        With ``d_j = (cos psi_j, sin psi_j, 0)``, ``a`` the tilt and ``e_z`` the
+        body z axis (down)::
+
+            u_j = cos(a) d_j - sin(a) e_z     in-plane outward unit vector (rim raised)
+            n_j = -sin(a) d_j - cos(a) e_z    unit normal of the circle plane (up, inward)
+
+        Returns
+        -------
+        centres : numpy.ndarray, shape (4, 3)
+            Circle centres, body FRD, m (the rotor positions).
+        u : numpy.ndarray, shape (4, 3)
+            In-plane outward unit vectors, body FRD.
+        n : numpy.ndarray, shape (4, 3)
+            Plane unit normals, body FRD.
+        """
+        psi = np.deg2rad(np.asarray(self.bumper_directions_deg, dtype=float))
+        a = math.radians(self.bumper_tilt_deg)
+        d = np.stack([np.cos(psi), np.sin(psi), np.zeros(4)], axis=1)
+        e_z = np.array([0.0, 0.0, 1.0])
+        u = math.cos(a) * d - math.sin(a) * e_z
+        n = -math.sin(a) * d - math.cos(a) * e_z
+        return self.rotor_positions, u, n
+
+    # ---------------------------------------------------------------- variants
+    def with_overrides(self, **fields: Any) -> Vehicle:
+        """Return a copy with some fields replaced, validated again.
+
+        Parameters
+        ----------
+        **fields
+            Field name to new value, e.g. ``restitution=0.5``.
+
+        Returns
+        -------
+        Vehicle
+            The new vehicle.
+
+        Raises
+        ------
+        InputError
+            For an unknown field or a value that breaks a rule.
+        """
+        return self.apply_overrides(fields, where=f"vehicle {self.name} overrides")
+
+    def apply_overrides(
+        self, fields: dict[str, Any], where: str, prefix: tuple[str, ...] = ()
+    ) -> Vehicle:
+        """Like :meth:`with_overrides`, with the error location given explicitly.
+
+        Parameters
+        ----------
+        fields : dict
+            Field name to new value.
+        where : str
+            Start of any error message (e.g. ``"scenario.toml"``).
+        prefix : tuple of str, optional
+            Field-path prefix in error messages (e.g. ``("vehicle_overrides",)``).
+
+        Returns
+        -------
+        Vehicle
+            The new vehicle.
+        """
+        if not fields:
+            return self
+        for key in fields:
+            if key not in type(self).model_fields:
+                field = ".".join((*prefix, str(key)))
+                known = ", ".join(type(self).model_fields)
+                raise InputError(f"{where}: {field}: unknown vehicle field (known: {known})")
+        data = self.model_dump()
+        data.update(fields)
+        try:
+            return type(self).model_validate(data)
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, where, prefix=prefix) from None
+
+
+# -------------------------------------------------------------------- loading
+def bundled_vehicles() -> list[str]:
+    """Names of the vehicles shipped with quadimpact (files ``vehicles/*.toml``).
+
+    Returns
+    -------
+    list of str
+        Sorted names, e.g. ``["spiri"]``.
+    """
+    folder = _vehicle_folder()
+    return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
+
+
+def _vehicle_folder() -> Any:
+    """The package folder of bundled vehicle files (an importlib.resources Traversable)."""
+    return resources.files("quadimpact").joinpath("vehicles")
+
+
+def _parse_vehicle(text: str, where: str, default_name: str) -> Vehicle:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{where}: invalid TOML: {exc}") from None
+    data.setdefault("name", default_name)
+    try:
+        return Vehicle.model_validate(data)
+    except ValidationError as exc:
+        raise input_error_from_validation(exc, where, model=Vehicle) from None
+
+
+def load_vehicle(name_or_path: str | Path | None = None) -> Vehicle:
+    """Load a vehicle by bundled name or from a TOML file.
+
+    Parameters
+    ----------
+    name_or_path : str or pathlib.Path or None, optional
+        ``None`` or ``"spiri"`` loads the bundled Spiri; any other bundled name
+        (see :func:`bundled_vehicles`) loads that file; otherwise the path of a
+        TOML file with the keys of :class:`Vehicle` (``name`` defaults to the
+        file's stem).
+
+    Returns
+    -------
+    Vehicle
+        The validated vehicle.
+
+    Raises
+    ------
+    InputError
+        Unknown name, missing or unreadable file, invalid TOML, unknown key or
+        a value that breaks a rule; the one-line message names the file and field.
+    """
+    if name_or_path is None:
+        name_or_path = "spiri"
+    if isinstance(name_or_path, str) and name_or_path in bundled_vehicles():
+        resource = _vehicle_folder().joinpath(f"{name_or_path}.toml")
+        where = f"vehicle {name_or_path}.toml"
+        return _parse_vehicle(resource.read_text(encoding="utf-8"), where, name_or_path)
+    path = Path(name_or_path)
+    where = f"vehicle {path}"
+    if not path.is_file():
+        if path.suffix == "" and len(path.parts) == 1:
+            known = ", ".join(bundled_vehicles())
+            raise InputError(
+                f"vehicle {str(name_or_path)!r}: unknown vehicle name "
+                f"(bundled: {known}; or give the path of a .toml file)"
+            )
+        reason = "is a directory, not a file" if path.is_dir() else "file not found"
+        raise InputError(f"{where}: {reason}")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError(f"{where}: cannot read file ({exc})") from None
+    return _parse_vehicle(text, where, path.stem)

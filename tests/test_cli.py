@@ -1,0 +1,176 @@
+"""The command line: one-line errors with exit status 2, and a complete run."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import quadimpact.errors
+
+SRC = Path(quadimpact.errors.__file__).resolve().parents[1]
+SPIRI_TOML = SRC / "quadimpact/vehicles/spiri.toml"
+
+SUMMARY_KEYS = (
+    "status reason warnings model controller delta_init_m peak_force_n impact_speed_m_s "
+    "inclination_deg heading_deg leading_bumpers n_episodes crash_time_s t_start_s t_final_s"
+).split()
+OUTPUT_FILES = ("summary.json", "timeseries.parquet", "episodes.csv", "fig5.png", "fig6.png")
+
+
+def run_cli(*args: str, cwd: Path, timeout: float = 60) -> subprocess.CompletedProcess:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+    env.pop("QUADIMPACT_DEBUG", None)
+    return subprocess.run(
+        [sys.executable, "-m", "quadimpact.cli", *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def assert_input_error(proc: subprocess.CompletedProcess, *fragments: str) -> None:
+    assert proc.returncode == 2, proc.stderr
+    assert "Traceback" not in proc.stdout + proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("quadimpact: error: ")
+    for fragment in fragments:
+        assert fragment in lines[0], f"{fragment!r} not in {lines[0]!r}"
+
+
+def test_help_and_version(tmp_path: Path) -> None:
+    proc = run_cli("--help", cwd=tmp_path)
+    assert proc.returncode == 0 and "run" in proc.stdout and "NED" in proc.stdout
+    proc = run_cli("run", "--help", cwd=tmp_path)
+    assert proc.returncode == 0
+    for text in ("--heading DEG", "--inclination DEG", "--speed M/S", "--model", "results/run"):
+        assert text in proc.stdout
+    proc = run_cli("--version", cwd=tmp_path)
+    assert proc.returncode == 0 and proc.stdout.startswith("quadimpact ")
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["run", "--model", "best"], ["'--model'", "'best' is not one of"]),
+        (["run", "--controller", "lqr"], ["'--controller'", "'lqr'"]),
+        (["run", "--heading", "abc"], ["'--heading'", "'abc' is not a valid float"]),
+        (["run", "--heading", "500"], ["--heading: must be <= 180 (got 500.0)"]),
+        (["run", "--inclination", "-75"], ["--inclination: must be >= -60 (got -75.0)"]),
+        (["run", "--speed", "0"], ["--speed: must be > 0 (got 0.0)"]),
+        (["run", "--impact-time", "4"], ["--impact-time: must be < final_time_s (3)"]),
+        (["run", "--rtol", "0.5"], ["--rtol: must be < 0.1 (got 0.5)"]),
+        (["run", "--option", "crash_rule=never"], ["--option: crash_rule: must be one of"]),
+        (["run", "--frobnicate"], ["No such option", "--frobnicate"]),
+        (["run", "missing.toml"], ["missing.toml: file not found"]),
+        (["run", "--vehicle", "spirit"], ["vehicle 'spirit': unknown vehicle name"]),
+        (["launch"], ["No such command 'launch'"]),
+    ],
+)
+def test_bad_flags_exit_2_with_one_line(tmp_path: Path, args: list[str], fragments) -> None:
+    assert_input_error(run_cli(*args, cwd=tmp_path), *fragments)
+
+
+@pytest.mark.parametrize(
+    ("text", "fragments"),
+    [
+        ("heading_deg = 500\n", ["scenario.toml: heading_deg: must be <= 180 (got 500)"]),
+        ("heading_deg = = 5\n", ["scenario.toml: invalid TOML", "line 1"]),
+        ("speed = 0.5\n", ["scenario.toml: speed: unknown key; did you mean 'speed_m_s'?"]),
+        (
+            'kind = "flight"\n',
+            ["--heading: applies to wall-approach scenarios only"],
+        ),
+    ],
+)
+def test_bad_scenario_file_exits_2(tmp_path: Path, text: str, fragments) -> None:
+    (tmp_path / "scenario.toml").write_text(text)
+    proc = run_cli("run", "scenario.toml", "--heading", "10", cwd=tmp_path)
+    assert_input_error(proc, *fragments)
+
+
+def test_bad_vehicle_file_exits_2(tmp_path: Path) -> None:
+    bad = SPIRI_TOML.read_text().replace("restitution = 0.9", "restitution = 0")
+    (tmp_path / "bad.toml").write_text(bad)
+    proc = run_cli("run", "--vehicle", "bad.toml", cwd=tmp_path)
+    assert_input_error(proc, "vehicle bad.toml: restitution: must be > 0 (got 0)")
+    (tmp_path / "extra.toml").write_text(bad.replace("restitution = 0", "restitution = 0.9\nfoo=1"))
+    proc = run_cli("run", "--vehicle", "extra.toml", cwd=tmp_path)
+    assert_input_error(proc, "vehicle extra.toml: foo: unknown key")
+
+
+def test_flags_override_file_values(tmp_path: Path) -> None:
+    from quadimpact.cli import build_scenario
+
+    path = tmp_path / "scenario.toml"
+    path.write_text('heading_deg = 45\nspeed_m_s = 0.5\nmodel = "paper-replica"\n')
+    flags = {"heading": None, "speed": 1.0, "controller": "cascade-pid"}
+    scenario = build_scenario(path, flags, ("crash_rule=cm-ground", "bumper1_yaw_twice=false"))
+    assert (scenario.heading_deg, scenario.speed_m_s) == (45.0, 1.0)
+    assert (scenario.model, scenario.controller) == ("paper-replica", "cascade-pid")
+    options = scenario.resolved_model_options()
+    assert options.crash_rule == "cm-ground" and options.bumper1_yaw_twice is False
+    assert options.yaw_reaction == "paper"
+
+
+def test_valid_run_writes_all_outputs(tmp_path: Path) -> None:
+    proc = run_cli(
+        "run",
+        "--heading",
+        "45",
+        "--inclination",
+        "15",
+        "--speed",
+        "0.75",
+        "--model",
+        "paper-replica",
+        "--out",
+        "out",
+        cwd=tmp_path,
+        timeout=600,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert "Traceback" not in proc.stderr
+    out = tmp_path / "out"
+    for name in OUTPUT_FILES:
+        assert (out / name).is_file(), name
+    summary = json.loads((out / "summary.json").read_text())
+    missing = [key for key in SUMMARY_KEYS if key not in summary]
+    assert not missing, missing
+    assert summary["model"] == "paper-replica"
+    assert summary["heading_deg"] == pytest.approx(45.0)
+    assert "delta_init" in proc.stdout and "out" in proc.stdout
+
+
+def test_format_summary_for_people() -> None:
+    from quadimpact.cli import format_summary
+
+    summary = {
+        "status": "crashed",
+        "reason": "CM reached the ground",
+        "warnings": ["penetration larger than the bumper radius"],
+        "delta_init_m": 0.012345,
+        "peak_force_n": 3.21,
+        "leading_bumpers": [4],
+        "n_episodes": 5,
+        "crash_time_s": 1.875,
+    }
+    text = format_summary(summary, Path("results/run"))
+    assert "status         crashed (CM reached the ground)" in text
+    assert "delta_init     12.35 mm" in text
+    assert "peak force     3.21 N" in text
+    assert "leading bumper 4" in text
+    assert "episodes       5" in text
+    assert "crash time     1.875 s" in text
+    assert "warning        penetration larger than the bumper radius" in text
+    assert text.splitlines()[-1].startswith("output         results/run (summary.json")
+    quiet = format_summary({"status": "completed", "crash_time_s": None}, Path("o"))
+    assert "crash time     no crash" in quiet and "delta_init     n/a" in quiet

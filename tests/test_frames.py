@@ -1,0 +1,137 @@
+"""Frame conversions: quaternion <-> rotation matrix <-> ZYX Euler (MODEL.md section 1)."""
+
+import numpy as np
+import pytest
+
+from quadimpact.frames import (
+    body_to_inertial,
+    euler_zyx_to_quat,
+    quat_to_euler_zyx,
+    quat_to_matrix,
+    wrap_angle_rad,
+)
+
+D = np.pi / 180.0
+
+
+def rx(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def ry(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def rz(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def test_identity_quaternion_is_identity_matrix() -> None:
+    c = quat_to_matrix(np.array([[1.0, 0.0, 0.0, 0.0]]))
+    assert c.shape == (1, 3, 3)
+    np.testing.assert_allclose(c[0], np.eye(3), atol=1e-15)
+
+
+def test_yaw_90_maps_body_x_to_inertial_y() -> None:
+    q = euler_zyx_to_quat(0.0, 0.0, 90 * D)
+    np.testing.assert_allclose(body_to_inertial(q, [1.0, 0.0, 0.0]), [0.0, 1.0, 0.0], atol=1e-15)
+    np.testing.assert_allclose(body_to_inertial(q, [0.0, 1.0, 0.0]), [-1.0, 0.0, 0.0], atol=1e-15)
+
+
+def test_negative_pitch_tilts_body_z_toward_minus_x() -> None:
+    # Inclination 15 deg toward the wall (+X) at psi = 0 is pitch -15 deg: the body
+    # z axis (down) leans to -X, so the thrust (-z_B) has a +X component.
+    q = euler_zyx_to_quat(0.0, -15 * D, 0.0)
+    z_i = body_to_inertial(q, [0.0, 0.0, 1.0])
+    np.testing.assert_allclose(z_i, [-np.sin(15 * D), 0.0, np.cos(15 * D)], atol=1e-15)
+    thrust_dir = body_to_inertial(q, [0.0, 0.0, -1.0])
+    assert thrust_dir[0] > 0.25
+
+
+def test_positive_roll_lowers_right_side() -> None:
+    # Roll +30 deg about x (FRD): body y (right) gains a +Z (down) component.
+    q = euler_zyx_to_quat(30 * D, 0.0, 0.0)
+    np.testing.assert_allclose(
+        body_to_inertial(q, [0.0, 1.0, 0.0]), [0.0, np.cos(30 * D), np.sin(30 * D)], atol=1e-15
+    )
+
+
+def test_matrix_matches_zyx_product() -> None:
+    rng = np.random.default_rng(1)
+    roll = rng.uniform(-np.pi, np.pi, 50)
+    pitch = rng.uniform(-1.5, 1.5, 50)
+    yaw = rng.uniform(-np.pi, np.pi, 50)
+    c = quat_to_matrix(euler_zyx_to_quat(roll, pitch, yaw))
+    for k in range(50):
+        expected = rz(yaw[k]) @ ry(pitch[k]) @ rx(roll[k])
+        np.testing.assert_allclose(c[k], expected, atol=1e-14)
+
+
+def test_euler_quaternion_round_trip() -> None:
+    rng = np.random.default_rng(2)
+    roll = rng.uniform(-np.pi, np.pi, 200)
+    pitch = rng.uniform(-np.pi / 2 + 1e-3, np.pi / 2 - 1e-3, 200)
+    yaw = rng.uniform(-np.pi, np.pi, 200)
+    r2, p2, y2 = quat_to_euler_zyx(euler_zyx_to_quat(roll, pitch, yaw))
+    np.testing.assert_allclose(wrap_angle_rad(r2 - roll), 0.0, atol=1e-9)
+    np.testing.assert_allclose(p2, pitch, atol=1e-12)
+    np.testing.assert_allclose(wrap_angle_rad(y2 - yaw), 0.0, atol=1e-9)
+
+
+def test_quaternion_euler_round_trip_preserves_rotation() -> None:
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(100, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    q2 = euler_zyx_to_quat(*quat_to_euler_zyx(q))
+    # Same rotation: q2 = +-q.
+    np.testing.assert_allclose(np.abs(np.sum(q * q2, axis=1)), 1.0, atol=1e-12)
+
+
+def test_known_euler_angles() -> None:
+    roll, pitch, yaw = quat_to_euler_zyx(euler_zyx_to_quat(10 * D, -15 * D, 45 * D))
+    assert float(roll) == pytest.approx(10 * D, abs=1e-14)
+    assert float(pitch) == pytest.approx(-15 * D, abs=1e-14)
+    assert float(yaw) == pytest.approx(45 * D, abs=1e-14)
+
+
+def test_unnormalised_quaternion_is_normalised() -> None:
+    q = 3.0 * euler_zyx_to_quat(0.0, 0.0, 90 * D)
+    c = quat_to_matrix(q)
+    np.testing.assert_allclose(c @ c.T, np.eye(3), atol=1e-14)
+    assert float(quat_to_euler_zyx(q)[2]) == pytest.approx(np.pi / 2, abs=1e-14)
+
+
+@pytest.mark.parametrize("pitch_deg", [90.0, -90.0])
+def test_gimbal_lock_is_finite_and_consistent(pitch_deg: float) -> None:
+    q = euler_zyx_to_quat(20 * D, pitch_deg * D, 50 * D)
+    roll, pitch, yaw = quat_to_euler_zyx(q)
+    assert np.all(np.isfinite([roll, pitch, yaw]))
+    assert float(pitch) == pytest.approx(pitch_deg * D, abs=1e-7)
+    # Whatever split of roll/yaw is reported, it must represent the same rotation.
+    np.testing.assert_allclose(
+        quat_to_matrix(euler_zyx_to_quat(roll, pitch, yaw)), quat_to_matrix(q), atol=1e-7
+    )
+
+
+def test_slightly_denormal_quaternion_near_lock_does_not_nan() -> None:
+    # Rounding can push |C31| a hair above 1: pitch must stay finite (no asin domain error).
+    q = np.array([np.sqrt(0.5), 0.0, np.sqrt(0.5) * (1 + 1e-16), 0.0])
+    roll, pitch, yaw = quat_to_euler_zyx(q)
+    assert np.isfinite(pitch) and float(pitch) == pytest.approx(np.pi / 2, abs=1e-7)
+
+
+def test_yaw_wrapped_to_half_open_interval() -> None:
+    _, _, yaw = quat_to_euler_zyx(euler_zyx_to_quat(0.0, 0.0, np.array([np.pi, -np.pi, 3.5])))
+    np.testing.assert_allclose(yaw, [np.pi, np.pi, 3.5 - 2 * np.pi], atol=1e-12)
+    assert np.all(yaw > -np.pi)
+
+
+def test_body_to_inertial_batched() -> None:
+    q = euler_zyx_to_quat(np.zeros(3), np.zeros(3), np.array([0.0, 90 * D, 180 * D]))
+    v = np.tile([1.0, 0.0, 0.0], (3, 1))
+    np.testing.assert_allclose(
+        body_to_inertial(q, v), [[1, 0, 0], [0, 1, 0], [-1, 0, 0]], atol=1e-15
+    )

@@ -1,0 +1,181 @@
+"""Result folder: writers, readers and SimulationResult.write."""
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+from quadimpact.analysis import TIMESERIES_COLUMNS, episodes_frame
+from quadimpact.core import layout as L
+from quadimpact.io import (
+    EPISODES_LEADING_COLUMNS,
+    UNITS_METADATA_KEY,
+    column_unit,
+    read_result,
+    read_timeseries_units,
+    to_jsonable,
+    write_episodes_csv,
+    write_summary_json,
+    write_timeseries_parquet,
+)
+from quadimpact.result import SimulationResult
+
+
+def make_timeseries(n: int = 50) -> pd.DataFrame:
+    t = np.linspace(0.0, 1.0, n)
+    data = {c: np.zeros(n) for c in TIMESERIES_COLUMNS}
+    data["t_s"] = t
+    data["x_m"] = 1.2 + 0.1 * t
+    data["altitude_m"] = 2.0 - 0.5 * t**2
+    data["z_m"] = -data["altitude_m"]
+    data["q0"] = np.ones(n)
+    data["yaw_deg"] = 45.0 + 10.0 * np.sin(6.0 * t)
+    data["delta4_m"] = np.clip(0.03 * np.sin(20.0 * (t - 0.5)), 0.0, None)
+    return pd.DataFrame(data)
+
+
+def make_episodes() -> pd.DataFrame:
+    raw = np.zeros((3, L.NEP))
+    raw[0, [L.E_BUMPER, L.E_SURFACE, L.E_T_START, L.E_T_END]] = [3, 0, 0.5, 0.52]
+    raw[0, [L.E_V_I, L.E_PEAK_DELTA, L.E_PEAK_FORCE]] = [0.75, 0.0312345678901234, 50.5]
+    raw[1, [L.E_BUMPER, L.E_SURFACE, L.E_T_START, L.E_T_END, L.E_OPEN]] = [1, 1, 0.9, 1.0, 1]
+    raw[1, L.E_V_I] = np.nan
+    return episodes_frame(raw, 2, ["wall", "ground"])
+
+
+def make_result(**kw: object) -> SimulationResult:
+    summary = {
+        "status": "completed",
+        "delta_init_m": np.float64(0.0312345678901234),
+        "crash_time_s": float("nan"),
+        "n_episodes": np.int64(2),
+        "leading_bumpers": [4],
+        "flags": np.array([True, False]),
+    }
+    refs = {"roll_rad": 0.1, "pitch_rad": -0.2, "yaw_rad": math.pi / 4, "altitude_m": 2.0}
+    args = {
+        "summary": summary,
+        "episodes": make_episodes(),
+        "timeseries": make_timeseries(),
+        "references": refs,
+        "scenario": None,
+        "stats": {"n_steps": np.int64(1234), "n_rejected": 5},
+    }
+    args.update(kw)
+    return SimulationResult(**args)  # type: ignore[arg-type]
+
+
+def test_summary_json_nan_to_null_and_numpy_scalars(tmp_path: Path) -> None:
+    p = write_summary_json(
+        {"a": np.float64("nan"), "b": np.int32(3), "c": [1.5, float("inf")], "d": np.bool_(True)},
+        tmp_path / "summary.json",
+    )
+    text = p.read_text()
+    assert "NaN" not in text and "Infinity" not in text
+    assert json.loads(text) == {"a": None, "b": 3, "c": [1.5, None], "d": True}
+    assert text.startswith("{\n  ")  # indent 2
+    assert [f.name for f in tmp_path.iterdir()] == ["summary.json"]  # no temp file left
+
+
+def test_summary_json_rejects_unknown_objects(tmp_path: Path) -> None:
+    with pytest.raises(TypeError, match="object"):
+        write_summary_json({"x": object()}, tmp_path / "s.json")
+    assert not (tmp_path / "s.json").exists()
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_to_jsonable_nested() -> None:
+    assert to_jsonable({"a": (np.float32(0.5), {1, 2}), 3: np.arange(2)}) == {
+        "a": [0.5, [1, 2]],
+        "3": [0, 1],
+    }
+
+
+def test_episodes_csv_column_order(tmp_path: Path) -> None:
+    df = make_episodes()[["open", "t_peak_force_s", *reversed(EPISODES_LEADING_COLUMNS)]]
+    write_episodes_csv(df, tmp_path / "e.csv")
+    header = (tmp_path / "e.csv").read_text().splitlines()[0].split(",")
+    assert header[:8] == list(EPISODES_LEADING_COLUMNS)
+    assert header[8:] == ["open", "t_peak_force_s"]
+
+
+def test_column_units() -> None:
+    assert column_unit("t_s") == "s"
+    assert column_unit("x_m") == "m"
+    assert column_unit("vx_m_s") == "m/s"
+    assert column_unit("p_rad_s") == "rad/s"
+    assert column_unit("omega_cmd1_rad_s") == "rad/s"
+    assert column_unit("force3_n") == "N"
+    assert column_unit("roll_deg") == "deg"
+    assert column_unit("q0") == "1"
+    assert column_unit("q_rad_s") == "rad/s"
+
+
+def test_parquet_units_metadata(tmp_path: Path) -> None:
+    ts = make_timeseries(10)
+    p = write_timeseries_parquet(ts, tmp_path / "ts.parquet")
+    meta = pq.read_schema(p).metadata
+    units = json.loads(meta[UNITS_METADATA_KEY.encode()])
+    assert set(units) == set(TIMESERIES_COLUMNS)
+    assert units["t_s"] == "s" and units["vz_m_s"] == "m/s" and units["force2_n"] == "N"
+    assert read_timeseries_units(p) == units
+
+
+def test_write_read_round_trip(tmp_path: Path) -> None:
+    res = make_result()
+    out = res.write(tmp_path / "run")
+    names = {f.name for f in out.iterdir()}
+    assert names == {"summary.json", "episodes.csv", "timeseries.parquet", "fig5.png", "fig6.png"}
+    back = read_result(out)
+    assert back.scenario is None
+    assert back.summary["delta_init_m"] == 0.0312345678901234
+    assert back.summary["crash_time_s"] is None  # NaN -> null
+    assert back.summary["n_episodes"] == 2
+    assert back.summary["flags"] == [True, False]
+    assert "plot_errors" not in back.summary
+    assert back.references == pytest.approx(res.references)
+    assert back.stats == {"n_steps": 1234, "n_rejected": 5}
+    pd.testing.assert_frame_equal(back.timeseries, res.timeseries)
+    pd.testing.assert_frame_equal(back.episodes, res.episodes, check_dtype=False)
+    assert back.episodes["bumper"].tolist() == [4, 2]
+    assert back.episodes["open"].tolist() == [False, True]
+    assert math.isnan(back.episodes["v_i_m_s"].iloc[1])
+    # The read-back result can be written again (re-plot a folder).
+    again = back.write(tmp_path / "again")
+    assert (again / "fig6.png").stat().st_size > 10_000
+
+
+def test_round_trip_without_episodes(tmp_path: Path) -> None:
+    res = make_result(episodes=episodes_frame(np.zeros((1, L.NEP)), 0, ["wall"]))
+    back = read_result(res.write(tmp_path))
+    assert len(back.episodes) == 0
+    assert list(back.episodes.columns) == list(res.episodes.columns)
+
+
+def test_plot_failure_keeps_data_and_is_reported(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    ts = make_timeseries().drop(columns=["delta3_m"])  # Figure 5 cannot be drawn
+    (tmp_path / "fig5.png").write_bytes(b"stale")
+    res = make_result(timeseries=ts)
+    out = res.write(tmp_path)
+    err = capsys.readouterr().err
+    assert "warning" in err and "fig5.png" in err and "delta3_m" in err
+    assert len(err.strip().splitlines()) == 1
+    assert not (out / "fig5.png").exists()  # stale figure removed
+    assert (out / "fig6.png").exists()
+    summary = json.loads((out / "summary.json").read_text())
+    assert len(summary["plot_errors"]) == 1 and "KeyError" in summary["plot_errors"][0]
+    assert res.summary["plot_errors"] == summary["plot_errors"]
+    back = read_result(out)
+    pd.testing.assert_frame_equal(back.timeseries, ts)
+    assert len(back.episodes) == 2
+
+
+def test_read_result_missing_folder(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        read_result(tmp_path / "nope")
