@@ -18,7 +18,8 @@ Built-ins:
   ``cos(phi) cos(theta)``, no limits;
 * ``cascade-pid``: the same loops with running trapezoidal integrals,
   conditional integration (anti-windup) while the rotors saturate, thrust
-  divided by ``cos(phi) cos(theta)`` floored, rotor speeds limited.
+  divided by ``cos(phi) cos(theta)`` down to a floor and faded to zero beyond
+  it (``tilt_compensation``), rotor speeds limited to the vehicle's range.
 """
 
 import math
@@ -207,6 +208,23 @@ def _pid(
 
 
 @njit(cache=True)
+def tilt_compensation(c: float, floor: float) -> float:
+    """Collective-thrust factor for ``c = cos(phi) cos(theta)`` (cascade-pid).
+
+    ``1/c`` while ``c >= floor`` (the vertical thrust component stays
+    ``m (g + a)``); below the floor it fades linearly, ``c / floor^2``, to zero
+    at 90 deg of tilt, and stays zero upside down: a vehicle on its side gets no
+    push from the altitude loop, so the attitude is recovered first instead of
+    the thrust driving it into whatever it is leaning on.
+    """
+    if c >= floor:
+        return 1.0 / c
+    if c <= 0.0:
+        return 0.0
+    return c / (floor * floor)
+
+
+@njit(cache=True)
 def cascade_pid_step(
     x: np.ndarray, ctrl: np.ndarray, mem: np.ndarray, veh: np.ndarray, dt: float, cmd: np.ndarray
 ) -> None:
@@ -214,11 +232,19 @@ def cascade_pid_step(
     g = ctrl[C_GAINS : C_GAINS + 15]
     roll, pitch, yaw, h, hdot = _measure(x)
     started = mem[M_STARTED] > 0.5
-    integrate = mem[M_SATURATED] < 0.5  # conditional integration
-    v_des = _pid(ctrl[C_H_REF] - h, M_E_H, M_I_H, mem, g, G_ALT, dt, started, integrate, False)
-    acc = _pid(v_des - hdot, M_E_V, M_I_V, mem, g, G_CLIMB, dt, started, integrate, False)
-    tilt = max(math.cos(roll) * math.cos(pitch), ctrl[C_THRUST_COS_FLOOR])
-    thrust = veh[V_MASS] * (veh[V_GRAVITY] + acc) / tilt
+    # conditional integration: frozen while the rotors saturated at the last
+    # tick (anti-windup); the altitude loop's also while the tilt is beyond the
+    # compensation floor (its output is faded out then)
+    integrate = mem[M_SATURATED] < 0.5
+    roll_pitch_c = math.cos(roll) * math.cos(pitch)
+    integrate_alt = integrate and roll_pitch_c >= ctrl[C_THRUST_COS_FLOOR]
+    v_des = _pid(ctrl[C_H_REF] - h, M_E_H, M_I_H, mem, g, G_ALT, dt, started, integrate_alt, False)
+    acc = _pid(v_des - hdot, M_E_V, M_I_V, mem, g, G_CLIMB, dt, started, integrate_alt, False)
+    thrust = (
+        veh[V_MASS]
+        * (veh[V_GRAVITY] + acc)
+        * tilt_compensation(roll_pitch_c, ctrl[C_THRUST_COS_FLOOR])
+    )
     e_psi = wrap_pi(ctrl[C_PSI_REF] - yaw)
     r_des = _pid(e_psi, M_E_PSI, M_I_PSI, mem, g, G_HEADING, dt, started, integrate, True)
     e_phi = wrap_pi(ctrl[C_PHI_REF] - roll)
