@@ -2,11 +2,12 @@
 
 import numpy as np
 
-from helpers import run_packed, states
 from quadimpact.config import FlightScenario
 from quadimpact.core import layout as L
 from quadimpact.frames import quat_to_matrix
 from quadimpact.scenario import prepare
+
+from helpers import run_packed, states
 
 
 def tumble(final_time_s: float = 10.0, **kw):

@@ -46,7 +46,8 @@ def test_mirrored_scenario_gives_mirrored_result(heading):
         np.testing.assert_allclose(tb[f"delta{MIRROR[j] + 1}_m"], ta[f"delta{j + 1}_m"], atol=1e-8)
     ea, eb = a.episodes, b.episodes
     assert len(ea) == len(eb) >= 2
-    np.testing.assert_array_equal(eb["bumper"].to_numpy(), [MIRROR[b - 1] + 1 for b in ea["bumper"]])
+    mirrored = [MIRROR[b - 1] + 1 for b in ea["bumper"]]
+    np.testing.assert_array_equal(eb["bumper"].to_numpy(), mirrored)
     np.testing.assert_allclose(eb["t_start_s"], ea["t_start_s"], atol=1e-9)
     np.testing.assert_allclose(eb["peak_delta_m"], ea["peak_delta_m"], rtol=1e-7, atol=1e-9)
 
