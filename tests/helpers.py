@@ -14,8 +14,14 @@ def run_packed(setup: RunSetup, **changes: np.ndarray) -> tuple[np.ndarray, np.n
     arrays = {k: getattr(setup, k) for k in ("x0", "veh", "surf", "opts", "ctrl")}
     arrays.update(changes)
     return execute(
-        arrays["x0"], setup.t0, setup.tf, arrays["veh"], arrays["surf"], arrays["opts"],
-        arrays["ctrl"], setup.output_times(),
+        arrays["x0"],
+        setup.t0,
+        setup.tf,
+        arrays["veh"],
+        arrays["surf"],
+        arrays["opts"],
+        arrays["ctrl"],
+        setup.output_times(),
     )
 
 

@@ -54,8 +54,11 @@ def test_cascade_pid_never_pushes_beyond_a_bumper_radius():
     stored_at_rb = v.contact_stiffness * rb ** (v.contact_exponent + 1) / (v.contact_exponent + 1)
     deepest = []
     for h, incl, speed in itertools.product((0, 45), range(-20, 21), (0.5, 0.75, 1.0)):
-        r = simulate(WallApproach(heading_deg=h, inclination_deg=incl, speed_m_s=speed,
-                                  controller="cascade-pid"))
+        r = simulate(
+            WallApproach(
+                heading_deg=h, inclination_deg=incl, speed_m_s=speed, controller="cascade-pid"
+            )
+        )
         assert r.summary["status"] in ("completed", "crashed")
         deepest.append(r.summary["max_penetration_m"])
         for _, ep in r.episodes[r.episodes["peak_delta_m"] > rb].iterrows():

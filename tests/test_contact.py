@@ -82,8 +82,11 @@ def test_level_heading_45_bumper_4_leads_with_hand_computed_point():
 )
 @pytest.mark.parametrize(
     "plane",
-    [((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0)), ((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)),
-     ((0.3, -0.2, -1.0), (0.3, -0.5, 0.8))],
+    [
+        ((1.0, 0.0, 0.0), (-1.0, 0.0, 0.0)),
+        ((0.0, 0.0, 0.0), (0.0, 0.0, -1.0)),
+        ((0.3, -0.2, -1.0), (0.3, -0.5, 0.8)),
+    ],
 )
 def test_closed_form_matches_brute_force(euler_deg, plane):
     p0 = np.array(plane[0])
@@ -121,12 +124,18 @@ def test_penetration_rate_is_the_time_derivative_of_penetration():
         C = quat_to_matrix(x[6:10])
         xp[0:3] += h * C @ x[3:6]
         w = x[10:13]
-        dq = 0.5 * h * np.array([
-            -x[7] * w[0] - x[8] * w[1] - x[9] * w[2],
-            x[6] * w[0] + x[8] * w[2] - x[9] * w[1],
-            x[6] * w[1] + x[9] * w[0] - x[7] * w[2],
-            x[6] * w[2] + x[7] * w[1] - x[8] * w[0],
-        ])
+        dq = (
+            0.5
+            * h
+            * np.array(
+                [
+                    -x[7] * w[0] - x[8] * w[1] - x[9] * w[2],
+                    x[6] * w[0] + x[8] * w[2] - x[9] * w[1],
+                    x[6] * w[1] + x[9] * w[0] - x[7] * w[2],
+                    x[6] * w[2] + x[7] * w[1] - x[8] * w[0],
+                ]
+            )
+        )
         xm = x.copy()
         xm[0:3] -= h * C @ x[3:6]
         xp[6:10] += dq
@@ -150,8 +159,16 @@ def one_dof_restitution(k, n, e, mass, v_i):
 
     back.terminal = True
     back.direction = -1
-    sol = solve_ivp(f, (0.0, 10.0), [1e-15, v_i], events=back, rtol=1e-12, atol=1e-15,
-                    method="DOP853", max_step=1e-3)
+    sol = solve_ivp(
+        f,
+        (0.0, 10.0),
+        [1e-15, v_i],
+        events=back,
+        rtol=1e-12,
+        atol=1e-15,
+        method="DOP853",
+        max_step=1e-3,
+    )
     return -sol.y_events[0][0][1] / v_i
 
 

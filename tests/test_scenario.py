@@ -67,8 +67,9 @@ def test_delta_init_converges_under_tighter_tolerances(model):
 
 
 def test_paper_example_replica_reproduces_figure_5():
-    r = simulate(WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75,
-                              model="paper-replica"))
+    r = simulate(
+        WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75, model="paper-replica")
+    )
     s, ep = r.summary, r.episodes
     assert s["status"] == "crashed" and s["crash_time_s"] is not None
     assert s["leading_bumpers"] == [4]

@@ -21,14 +21,24 @@ def mirrored_vehicle_overrides(v):
     r = v.rotor_positions[MIRROR] * np.array([1.0, -1.0, 1.0])
     inertia = v.inertia * np.array([[1, -1, 1], [-1, 1, -1], [1, -1, 1]])
     spins = [-int(v.spins[k]) for k in MIRROR]
-    return {"rotor_positions_m": r.tolist(), "inertia_kg_m2": inertia.tolist(),
-            "spin_directions": spins}
+    return {
+        "rotor_positions_m": r.tolist(),
+        "inertia_kg_m2": inertia.tolist(),
+        "spin_directions": spins,
+    }
 
 
 def run(heading, overrides=None, **kw):
-    return simulate(WallApproach(heading_deg=heading, inclination_deg=kw.pop("incl", 12.0),
-                                 speed_m_s=kw.pop("speed", 0.9), final_time_s=1.5,
-                                 vehicle_overrides=overrides or {}, **kw))
+    return simulate(
+        WallApproach(
+            heading_deg=heading,
+            inclination_deg=kw.pop("incl", 12.0),
+            speed_m_s=kw.pop("speed", 0.9),
+            final_time_s=1.5,
+            vehicle_overrides=overrides or {},
+            **kw,
+        )
+    )
 
 
 @pytest.mark.parametrize("heading", [30.0, 45.0])
