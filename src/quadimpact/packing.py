@@ -143,7 +143,6 @@ def pack_controller(
         gains = DEFAULT_GAINS.get(kind, PAPER_GAINS)
     ctrl[L.C_GAINS : L.C_GAINS + 15] = gains
     ctrl[L.C_THRUST_COS_FLOOR] = CASCADE_THRUST_COS_FLOOR
-    ctrl[L.C_YAW_ROW_PAPER] = 1.0 if yaw_paper else 0.0
     ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = np.linalg.inv(
         allocation_matrix(v, yaw_paper)
     ).ravel()

@@ -175,6 +175,7 @@ def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) 
         "crash_time_s": _nan_to_none(crash_t),
         "crash_position_m": None if math.isnan(crash_t) else [float(c) for c in crash_pos],
         "max_penetration_m": max_pen,
+        "bumper_model_valid": bool(max_pen <= rb),
         "t_start_s": float(setup.t0),
         "t_final_s": float(st[L.ST_T_END]),
         "references": {k: float(v) for k, v in setup.references.items()},

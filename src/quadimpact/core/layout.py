@@ -93,11 +93,10 @@ C_THETA_REF = 3  # rad
 C_PSI_REF = 4  # rad
 C_GAINS = 5  # 15 gains: (P, I, D) for altitude, climb, heading, roll/pitch, yaw rate
 C_THRUST_COS_FLOOR = 20  # cascade-pid: floor of cos(phi) cos(theta)
-C_YAW_ROW_PAPER = 21  # 1: allocation yaw row +s dt (replica)
-C_ALLOC_INV = 22  # 16: inverse allocation matrix, row-major
-C_OMEGA_MIN = 38  # rad/s, controller's own rotor limits (cascade-pid)
-C_OMEGA_MAX = 39
-NCTRL = 40
+C_ALLOC_INV = 21  # 16: inverse allocation matrix, row-major
+C_OMEGA_MIN = 37  # rad/s, controller's own rotor limits (cascade-pid)
+C_OMEGA_MAX = 38
+NCTRL = 39
 
 CTRL_NONE = 0  # rotors held at their initial speeds (no controller)
 CTRL_PAPER = 1
