@@ -30,6 +30,8 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from quadimpact.analysis import EPISODE_COLUMNS
+
 if TYPE_CHECKING:
     from quadimpact.result import SimulationResult
 
@@ -60,16 +62,7 @@ TIMESERIES_PARQUET = "timeseries.parquet"
 UNITS_METADATA_KEY = "quadimpact.units"
 
 #: Columns written first in episodes.csv, in this order; the rest follow.
-EPISODES_LEADING_COLUMNS: tuple[str, ...] = (
-    "bumper",
-    "surface",
-    "t_start_s",
-    "t_end_s",
-    "v_i_m_s",
-    "peak_delta_m",
-    "t_peak_s",
-    "peak_force_n",
-)
+EPISODES_LEADING_COLUMNS: tuple[str, ...] = EPISODE_COLUMNS[:8]
 
 # Unit suffixes of column names, longest first.
 _UNIT_SUFFIXES: tuple[tuple[str, str], ...] = (

@@ -23,6 +23,8 @@ from .quaternion import rotation_matrix
 EV_GAP = 0
 EV_RATE = 1
 EV_ALTITUDE = 2
+NO_EVENT = 2.0  # "no event in this step" (fractions of a step are in [0, 1])
+NEAR_GRAZE_SAMPLES = 3  # interior dense-output checks of near-grazing contacts
 
 
 @njit(cache=True)
@@ -96,3 +98,48 @@ def locate(
                 fb *= 0.5
             last = -1
     return sb
+
+
+@njit(cache=True)
+def contact_event(
+    c: int,
+    active: bool,
+    ga: float,
+    gb: float,
+    gda: float,
+    gdb: float,
+    x_old: np.ndarray,
+    Q: np.ndarray,
+    h: float,
+    tol: float,
+    xs: np.ndarray,
+    C: np.ndarray,
+    veh: np.ndarray,
+    surf: np.ndarray,
+) -> float:
+    """Fraction of the step at which contact ``c`` begins or ends (``NO_EVENT``: neither).
+
+    ``ga``/``gb`` are its penetration at the step's start and end, ``gda``/``gdb``
+    the rates there. An inactive contact begins where ``delta`` rises through 0;
+    if both ends are negative but within the distance the contact point can
+    travel in the step, the dense output is also sampled inside the step so that
+    a graze is not stepped over. An active contact ends where ``delta`` falls
+    through 0 (at once if it never penetrated after its onset).
+    """
+    if not active:
+        if gb > 0.0:
+            return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, 0.0)
+        band = h * (abs(gda) + abs(gdb))
+        if -ga < band or -gb < band:
+            for m in range(1, NEAR_GRAZE_SAMPLES + 1):
+                sm = m / (NEAR_GRAZE_SAMPLES + 1.0)
+                dense_eval(x_old, Q, h, sm, xs)
+                gm = event_value(EV_GAP, c, xs, C, veh, surf, 0.0)
+                if gm > 0.0:
+                    return locate(EV_GAP, c, x_old, Q, h, ga, gm, sm, tol, xs, C, veh, surf, 0.0)
+        return NO_EVENT
+    if gb > 0.0:
+        return NO_EVENT
+    if ga > 0.0:
+        return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, 0.0)
+    return 0.0  # touched and left at once (a graze)

@@ -27,7 +27,7 @@ from numba import njit
 from .contact import bumper_plane_contact, damping_coefficient, normal_force
 from .control import builtin_step
 from .dynamics import state_derivative
-from .events import EV_ALTITUDE, EV_GAP, EV_RATE, event_value, locate
+from .events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
 from .integrator import dense_coefficients, dense_eval, error_norm, stage_state, step_factor
 from .layout import (
     CRASH_CM_GROUND,
@@ -102,9 +102,7 @@ from .layout import (
 )
 from .quaternion import normalise_quaternion, rotation_matrix
 
-NEAR_GRAZE_SAMPLES = 3  # interior dense-output checks of near-grazing contacts
 MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
-NO_EVENT = 2.0
 
 
 @njit(cache=True)
@@ -148,6 +146,33 @@ def _write_sample(
             out[row, OUT_DELTA + j] = d
         if c_active[c] > 0.5:
             out[row, OUT_FORCE + j] += normal_force(veh, d, dd, c_lam[c])
+
+
+@njit(cache=True)
+def _observe(
+    episodes: np.ndarray,
+    e: int,
+    c: int,
+    sigma: float,
+    t_old: float,
+    h: float,
+    x_old: np.ndarray,
+    Q: np.ndarray,
+    xs: np.ndarray,
+    C: np.ndarray,
+    veh: np.ndarray,
+    surf: np.ndarray,
+    lam: float,
+) -> float:
+    """Track episode ``e``'s peaks with contact ``c`` at ``t_old + sigma h`` (dense output).
+
+    Returns the penetration rate there.
+    """
+    dense_eval(x_old, Q, h, sigma, xs)
+    rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
+    d, dd, _, _, _, _, _, _ = bumper_plane_contact(xs, C, veh, c % 4, surf, c // 4)
+    _track_peak(episodes, e, t_old + sigma * h, d, normal_force(veh, d, dd, lam))
+    return dd
 
 
 @njit(cache=True)
@@ -344,70 +369,10 @@ def integrate(
                 _contact_values(x_new, C, veh, surf, g_b, gd_b)
                 sig_min = NO_EVENT
                 for c in range(nc):
-                    sig = NO_EVENT
-                    if c_active[c] < 0.5:
-                        if g_b[c] > 0.0:
-                            sig = locate(
-                                EV_GAP,
-                                c,
-                                x,
-                                Q,
-                                h_try,
-                                g_a[c],
-                                g_b[c],
-                                1.0,
-                                ev_tol,
-                                xs,
-                                C,
-                                veh,
-                                surf,
-                                0.0,
-                            )
-                        else:
-                            band = h_try * (abs(gd_a[c]) + abs(gd_b[c]))
-                            if -g_a[c] < band or -g_b[c] < band:
-                                for m in range(1, NEAR_GRAZE_SAMPLES + 1):
-                                    sm = m / (NEAR_GRAZE_SAMPLES + 1.0)
-                                    dense_eval(x, Q, h_try, sm, xs)
-                                    gm = event_value(EV_GAP, c, xs, C, veh, surf, 0.0)
-                                    if gm > 0.0:
-                                        sig = locate(
-                                            EV_GAP,
-                                            c,
-                                            x,
-                                            Q,
-                                            h_try,
-                                            g_a[c],
-                                            gm,
-                                            sm,
-                                            ev_tol,
-                                            xs,
-                                            C,
-                                            veh,
-                                            surf,
-                                            0.0,
-                                        )
-                                        break
-                    elif g_b[c] <= 0.0:
-                        if g_a[c] > 0.0:
-                            sig = locate(
-                                EV_GAP,
-                                c,
-                                x,
-                                Q,
-                                h_try,
-                                g_a[c],
-                                g_b[c],
-                                1.0,
-                                ev_tol,
-                                xs,
-                                C,
-                                veh,
-                                surf,
-                                0.0,
-                            )
-                        else:
-                            sig = 0.0  # touched and left at once (grazing onset)
+                    sig = contact_event(
+                        c, c_active[c] > 0.5, g_a[c], g_b[c], gd_a[c], gd_b[c],
+                        x, Q, h_try, ev_tol, xs, C, veh, surf,
+                    )  # fmt: skip
                     ev_sig[c] = sig
                     if sig < sig_min:
                         sig_min = sig
@@ -416,22 +381,8 @@ def integrate(
                     ha = -x[X_POS + 2] - crash_level
                     hb = -x_new[X_POS + 2] - crash_level
                     if ha > 0.0 and hb <= 0.0:
-                        sig_crash = locate(
-                            EV_ALTITUDE,
-                            0,
-                            x,
-                            Q,
-                            h_try,
-                            ha,
-                            hb,
-                            1.0,
-                            ev_tol,
-                            xs,
-                            C,
-                            veh,
-                            surf,
-                            crash_level,
-                        )
+                        sig_crash = locate(EV_ALTITUDE, 0, x, Q, h_try, ha, hb, 1.0, ev_tol,
+                                           xs, C, veh, surf, crash_level)  # fmt: skip
                         if sig_crash < sig_min:
                             sig_min = sig_crash
                 if sig_min <= 1.0:
@@ -454,56 +405,19 @@ def integrate(
                     _write_sample(i_out, t_out[i_out], xs, C, veh, surf, c_active, c_lam, rin, out)
                     i_out += 1
                 # ---- peaks of the active contacts over (t, t_b] ----
-                rotation_matrix(x_b[X_QUAT : X_QUAT + 4], C)
                 for c in range(nc):
-                    if c_active[c] < 0.5:
+                    if c_active[c] < 0.5 or c_ep[c] < 0:
                         continue
-                    d, dd, _, _, _, _, _, _ = bumper_plane_contact(x_b, C, veh, c % 4, surf, c // 4)
-                    _track_peak(episodes, c_ep[c], t_b, d, normal_force(veh, d, dd, c_lam[c]))
-                    if gd_a[c] > 0.0 and dd <= 0.0 and sig_min > 0.0:
-                        sp = locate(
-                            EV_RATE,
-                            c,
-                            x,
-                            Q,
-                            h_try,
-                            gd_a[c],
-                            dd,
-                            sig_min,
-                            ev_tol,
-                            xs,
-                            C,
-                            veh,
-                            surf,
-                            0.0,
-                        )
-                        dense_eval(x, Q, h_try, sp, xs)
-                        rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
-                        dp, ddp, _, _, _, _, _, _ = bumper_plane_contact(
-                            xs, C, veh, c % 4, surf, c // 4
-                        )
-                        _track_peak(
-                            episodes,
-                            c_ep[c],
-                            t + sp * h_try,
-                            dp,
-                            normal_force(veh, dp, ddp, c_lam[c]),
-                        )
-                        rotation_matrix(x_b[X_QUAT : X_QUAT + 4], C)
-                    # force peak: also look half-way through the step
-                    dense_eval(x, Q, h_try, 0.5 * sig_min, xs)
-                    rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
-                    dm, ddm, _, _, _, _, _, _ = bumper_plane_contact(
-                        xs, C, veh, c % 4, surf, c // 4
-                    )
-                    _track_peak(
-                        episodes,
-                        c_ep[c],
-                        t + 0.5 * sig_min * h_try,
-                        dm,
-                        normal_force(veh, dm, ddm, c_lam[c]),
-                    )
-                    rotation_matrix(x_b[X_QUAT : X_QUAT + 4], C)
+                    e = c_ep[c]
+                    rate_end = _observe(episodes, e, c, sig_min, t, h_try, x, Q, xs, C, veh, surf,
+                                        c_lam[c])  # fmt: skip
+                    # the force peaks before the deflection: look half-way too
+                    _observe(episodes, e, c, 0.5 * sig_min, t, h_try, x, Q, xs, C, veh, surf,
+                             c_lam[c])  # fmt: skip
+                    if gd_a[c] > 0.0 and rate_end <= 0.0 and sig_min > 0.0:
+                        sp = locate(EV_RATE, c, x, Q, h_try, gd_a[c], rate_end, sig_min, ev_tol,
+                                    xs, C, veh, surf, 0.0)  # fmt: skip
+                        _observe(episodes, e, c, sp, t, h_try, x, Q, xs, C, veh, surf, c_lam[c])
                 if sig_crash <= sig_min:
                     stats[ST_CRASH_T] = t_b
                     for i in range(3):
