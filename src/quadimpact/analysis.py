@@ -41,7 +41,7 @@ __all__ = [
 #: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
 BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
 
-#: Columns of the episodes table, in order (docs/CONTRACT.md).
+#: Columns of the episodes table, in order (docs/RESULTS.md).
 EPISODE_COLUMNS: tuple[str, ...] = (
     "bumper",
     "surface",
@@ -55,7 +55,7 @@ EPISODE_COLUMNS: tuple[str, ...] = (
     "open",
 )
 
-#: Columns of the time-series table, in order (docs/CONTRACT.md).
+#: Columns of the time-series table, in order (docs/RESULTS.md).
 TIMESERIES_COLUMNS: tuple[str, ...] = (
     "t_s",
     "x_m",

@@ -5,7 +5,7 @@ A result folder holds:
 - ``summary.json``: the run summary (NaN and infinities written as ``null``),
   plus the attitude/altitude ``references`` and integrator ``stats`` so the
   folder can be re-plotted;
-- ``episodes.csv``: one row per contact episode (see docs/CONTRACT.md);
+- ``episodes.csv``: one row per contact episode (see docs/RESULTS.md);
 - ``timeseries.parquet``: the sampled states, with the unit of every column
   as JSON in the schema metadata key ``quadimpact.units``;
 - ``fig5.png``, ``fig6.png``: the plots.

@@ -30,9 +30,9 @@ class SimulationResult:
     summary : dict
         Run summary, the content of ``summary.json`` (metrics, status, ...).
     episodes : pandas.DataFrame
-        Contact episodes (columns in docs/CONTRACT.md).
+        Contact episodes (columns in docs/RESULTS.md).
     timeseries : pandas.DataFrame
-        Sampled states (columns in docs/CONTRACT.md; inertial NED, body FRD, SI,
+        Sampled states (columns in docs/RESULTS.md; inertial NED, body FRD, SI,
         Euler angles in degrees).
     references : dict
         Controller references: ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (rad,
