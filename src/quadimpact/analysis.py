@@ -289,7 +289,9 @@ def group_impacts(episodes: pd.DataFrame) -> list[list[int]]:
 
 
 def impact_metrics(
-    episodes: pd.DataFrame, exclude_surfaces: Sequence[str] = ("ground",)
+    episodes: pd.DataFrame,
+    exclude_surfaces: Sequence[str] = ("ground",),
+    min_peak_delta_m: float = 0.0,
 ) -> dict[str, Any]:
     """Initial-impact metrics and counts of subsequent impacts (STUDIES.md section 2).
 
@@ -300,6 +302,9 @@ def impact_metrics(
     exclude_surfaces : sequence of str
         Surfaces whose episodes are ignored (by default the ground, when it is
         a contact surface: touching down is not an impact with the obstacle).
+    min_peak_delta_m : float
+        Episodes whose peak deflection is below this (m) are grazes: left out
+        of the impacts and their counts (``GRAZE_DELTA_M`` in the summary).
 
     Returns
     -------
@@ -324,6 +329,9 @@ def impact_metrics(
         eps = episodes.loc[keep.to_numpy()].reset_index(drop=True)
     else:
         eps = episodes.reset_index(drop=True)
+    n_all = len(eps)
+    if n_all and min_peak_delta_m > 0.0:
+        eps = eps.loc[(eps["peak_delta_m"] >= min_peak_delta_m).to_numpy()].reset_index(drop=True)
     groups = group_impacts(eps)
     out: dict[str, Any] = {
         "delta_init_m": math.nan,
@@ -333,7 +341,8 @@ def impact_metrics(
         "initial_impact_duration_s": math.nan,
         "leading_bumpers": [],
         "aft_bumpers": [],
-        "n_episodes": len(eps),
+        "n_episodes": n_all,
+        "n_grazes": n_all - len(eps),
         "n_subsequent_impacts": 0,
         "n_subsequent_episodes": 0,
         "subsequent_impacts": [],
@@ -411,3 +420,57 @@ def attitude_excursion_deg(ts: pd.DataFrame, refs: Mapping[str, float]) -> dict[
         "yaw_excursion_deg": float(np.degrees(np.max(d_yaw))),
         "tilt_max_deg": float(np.degrees(np.max(tilt))),
     }
+
+
+# ------------------------------------------------------------ response types
+#: Contacts shallower than this (m) are grazes, not impacts: they do not start,
+#: join or count as impacts for the metrics and the response type.
+GRAZE_DELTA_M = 1e-3
+
+RESPONSE_TYPES: tuple[str, ...] = ("A", "B", "C", "D", "Other")
+
+
+def classify_response(
+    leading_bumpers: Sequence[int],
+    subsequent_impacts: Sequence[Sequence[int]],
+    crashed: bool,
+) -> str:
+    """Post-impact response type (STUDIES.md section 3, the paper's Table II).
+
+    A pure function of the impacts (:func:`impact_metrics`) and the crash.
+
+    Parameters
+    ----------
+    leading_bumpers : sequence of int
+        Bumpers of the initial impact (empty: the obstacle was never hit).
+    subsequent_impacts : sequence of sequence of int
+        For each later impact, its episodes' bumpers in start order.
+    crashed : bool
+        Whether a crash was recorded before the final time.
+
+    Returns
+    -------
+    str
+        ``"A"``: no crash (bounces away and stays up, whatever else happened).
+        ``"B"``: crash with no subsequent impact.
+        ``"C"``: crash; the first subsequent impact involves a leading bumper
+        and an aft-bumper episode starts after that leading bumper's (in the
+        same impact or a later one): the D pattern after an extra
+        leading-bumper hit.
+        ``"D"``: crash; the first subsequent impact involves only aft bumpers
+        and there are at least two subsequent episodes.
+        ``"Other"``: any other crash, including a crash without any impact.
+    """
+    if not crashed:
+        return "A"
+    if len(leading_bumpers) == 0:
+        return "Other"
+    if len(subsequent_impacts) == 0:
+        return "B"
+    leading = set(int(b) for b in leading_bumpers)
+    first = [int(b) for b in subsequent_impacts[0]]
+    later = [int(b) for impact in subsequent_impacts for b in impact]  # start order
+    if any(b in leading for b in first):
+        k = next(i for i, b in enumerate(later) if b in leading)
+        return "C" if any(b not in leading for b in later[k + 1 :]) else "Other"
+    return "D" if len(later) >= 2 else "Other"

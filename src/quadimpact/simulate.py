@@ -15,7 +15,14 @@ from typing import Any
 import numpy as np
 
 from . import __version__
-from .analysis import attitude_excursion_deg, episodes_frame, impact_metrics, timeseries_frame
+from .analysis import (
+    GRAZE_DELTA_M,
+    attitude_excursion_deg,
+    classify_response,
+    episodes_frame,
+    impact_metrics,
+    timeseries_frame,
+)
 from .config import FlightScenario, WallApproach
 from .core import layout as L
 from .core.run import execute
@@ -115,7 +122,7 @@ def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) 
     status = STATUS_NAMES[status_code]
     warnings = list(setup.warnings)
     reason = L.REASON_TEXT[int(st[L.ST_REASON])]
-    metrics = impact_metrics(episodes)
+    metrics = impact_metrics(episodes, min_peak_delta_m=GRAZE_DELTA_M)
     rb = setup.vehicle.bumper_radius_m
 
     onset_t = float(st[L.ST_ONSET_T])
@@ -168,7 +175,13 @@ def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) 
         "impact_inclination_deg": _nan_to_none(incl),
         "leading_bumpers": metrics["leading_bumpers"],
         "aft_bumpers": metrics["aft_bumpers"],
+        "response_type": None
+        if status == "failed"
+        else classify_response(
+            metrics["leading_bumpers"], metrics["subsequent_impacts"], not math.isnan(crash_t)
+        ),
         "n_episodes": int(metrics["n_episodes"]),
+        "n_grazes": int(metrics["n_grazes"]),
         "n_subsequent_impacts": int(metrics["n_subsequent_impacts"]),
         "n_subsequent_episodes": int(metrics["n_subsequent_episodes"]),
         "subsequent_impacts": metrics["subsequent_impacts"],
