@@ -383,6 +383,15 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
     return "\n".join(lines)
 
 
+# ---- subcommands defined in their own modules: one registration line each ----
+# (import inside a function keeps `quadimpact --help` fast and avoids cycles)
+def _register_subcommands() -> None:
+    pass
+
+
+_register_subcommands()
+
+
 def _fail(message: str, code: int) -> None:
     click.echo(f"quadimpact: error: {one_line(message)}", err=True)
     sys.exit(code)
