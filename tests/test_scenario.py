@@ -118,3 +118,11 @@ def test_heading_zero_two_bumpers_touch_together():
     assert r.summary["leading_bumpers"] == [1, 4]
     # the two peak deflections are nearly equal (the vehicle is nearly symmetric)
     assert first["peak_delta_m"].iloc[0] == pytest.approx(first["peak_delta_m"].iloc[1], rel=0.02)
+
+
+def test_public_simulate_is_the_function_after_submodule_imports():
+    import quadimpact
+    import quadimpact.simulation  # noqa: F401  (the module must not shadow the function)
+    from quadimpact import simulate as sim
+
+    assert callable(sim) and sim is quadimpact.simulation.simulate

@@ -25,7 +25,7 @@ _EXPORTS = {
     "Vehicle": "quadimpact.vehicle",
     "load_vehicle": "quadimpact.vehicle",
     "InputError": "quadimpact.errors",
-    "simulate": "quadimpact.simulate",
+    "simulate": "quadimpact.simulation",
 }
 
 __all__ = ["__version__", *_EXPORTS]

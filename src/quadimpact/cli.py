@@ -233,7 +233,7 @@ def run(scenario: Path | None, out: Path, options: tuple[str, ...], **flags: Any
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
 
-    from quadimpact.simulate import simulate
+    from quadimpact.simulation import simulate
 
     result = simulate(built)
     out.mkdir(parents=True, exist_ok=True)
