@@ -60,6 +60,7 @@ __all__ = [
     "MODEL_VARIANTS",
     "resolve_model_options",
     "Plane",
+    "PowerOff",
     "RunSettings",
     "WallApproach",
     "FlightScenario",
@@ -240,6 +241,55 @@ class Plane(BaseModel):
         return (value[0] / norm, value[1] / norm, value[2] / norm)
 
 
+# --------------------------------------------------------------- power-off
+class PowerOff(BaseModel):
+    """Motor power-off: from a trigger, each motor's speed follows a schedule.
+
+    Over segment k, from ``trigger + segment_start_s[k]`` to the next start,
+    motor j changes at ``rates_rpm_per_s[k][j]`` (rpm/s, motors 1-4) and never
+    goes below zero, whatever the controller commands (the paper's
+    experiments: the motors' safety power-off after impact).
+
+    Attributes
+    ----------
+    trigger : "first-contact" or float
+        When the schedule starts: the first contact with an obstacle (the
+        default), or a time in s.
+    segment_start_s : tuple of float
+        Segment starts after the trigger, s; the first is 0, increasing.
+    rates_rpm_per_s : tuple of 4-tuples
+        Per segment, the rate of change of motors 1-4, rpm/s.
+    """
+
+    model_config = _CONFIG
+
+    trigger: Literal["first-contact"] | Real = Field(
+        "first-contact", description="'first-contact' or a start time in s."
+    )
+    segment_start_s: tuple[Real, ...] = Field(
+        min_length=1, description="Segment starts after the trigger, s (first 0, increasing)."
+    )
+    rates_rpm_per_s: tuple[Vec4, ...] = Field(
+        min_length=1, description="Per segment, the rates of motors 1-4, rpm/s."
+    )
+
+    @model_validator(mode="after")
+    def _consistent(self) -> PowerOff:
+        starts = self.segment_start_s
+        if starts[0] != 0.0:
+            raise ValueError("segment_start_s: the first segment must start at 0")
+        if any(b <= a for a, b in zip(starts, starts[1:], strict=False)):
+            raise ValueError("segment_start_s: must be strictly increasing")
+        if len(self.rates_rpm_per_s) != len(starts):
+            raise ValueError(
+                f"rates_rpm_per_s: must have one row per segment ({len(starts)}) "
+                f"(got {len(self.rates_rpm_per_s)})"
+            )
+        if not isinstance(self.trigger, str) and self.trigger < 0:
+            raise ValueError(f"trigger: a time must be >= 0 s (got {self.trigger:g})")
+        return self
+
+
 # ---------------------------------------------------------------- settings
 class RunSettings(BaseModel):
     """Settings common to every scenario: model, controller, vehicle, rotors, integrator.
@@ -281,6 +331,8 @@ class RunSettings(BaseModel):
         Integrator tolerances (Dormand-Prince 5(4)); ``None``: the kernel's defaults.
     final_time_s : float
         End of the simulation, s.
+    power_off : PowerOff or None
+        Motor power-off schedule (the paper's experiments); ``None``: none.
     """
 
     model_config = _CONFIG
@@ -325,6 +377,9 @@ class RunSettings(BaseModel):
         None, gt=0, description="Integrator absolute tolerance; None: kernel default."
     )
     final_time_s: Real = Field(3.0, gt=0, le=600, description="End of the simulation, s.")
+    power_off: PowerOff | None = Field(
+        None, description="Motor power-off schedule after a trigger (the experiments)."
+    )
 
     @field_validator("vehicle_overrides")
     @classmethod
@@ -429,7 +484,15 @@ class WallApproach(RunSettings):
     wall_distance_m : float
         Position of the wall along inertial X, m.
     altitude_m : float
-        Altitude set-point and initial altitude ``h = -Z``, m, > 0.
+        Altitude set-point (and initial altitude unless ``start_altitude_m``),
+        ``h = -Z``, m, > 0.
+    roll_deg, pitch_deg : float or None
+        An explicit attitude instead of the inclination (both or neither):
+        ZYX roll and pitch, deg, with yaw = ``heading_deg``; the body z axis
+        may then leave the X-Z plane (the experiments' measured attitudes).
+        ``inclination_deg`` is ignored and reported as reached.
+    start_altitude_m : float or None
+        Initial altitude, m, when it differs from the set-point.
     """
 
     kind: Literal["wall-approach"] = Field("wall-approach", description="Scenario kind tag.")
@@ -445,10 +508,21 @@ class WallApproach(RunSettings):
     impact_time_s: Real = Field(0.5, gt=0, description="Time of the first contact, s.")
     wall_distance_m: Real = Field(1.5, description="Wall position along inertial X (NED), m.")
     altitude_m: Real = Field(2.0, gt=0, description="Altitude set-point and initial altitude, m.")
+    roll_deg: Real | None = Field(
+        None, ge=-60, le=60, description="Explicit roll (with pitch_deg), deg."
+    )
+    pitch_deg: Real | None = Field(
+        None, ge=-60, le=60, description="Explicit pitch (with roll_deg), deg."
+    )
+    start_altitude_m: Real | None = Field(
+        None, gt=0, description="Initial altitude if not the set-point, m."
+    )
 
     @model_validator(mode="after")
     def _impact_before_end(self) -> WallApproach:
         _check_before_final(self, "impact_time_s")
+        if (self.roll_deg is None) != (self.pitch_deg is None):
+            raise ValueError("roll_deg, pitch_deg: give both or neither")
         return self
 
 

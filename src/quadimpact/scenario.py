@@ -69,6 +69,8 @@ class RunSetup:
     wall: Surface | None = None
     approach: dict[str, Any] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
+    sched_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sched_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
 
     def output_times(self) -> np.ndarray:
         """Output grid: ``t0``, the multiples of 1/rate inside (t0, tf), and ``tf`` (s)."""
@@ -143,7 +145,7 @@ def _packed_options(
     if s.rotor_speed_limits_rpm is not None:
         lo, hi = s.rotor_speed_limits_rpm
         limits = (lo * RPM, hi * RPM)
-    return pack_options(
+    opts = pack_options(
         yaw_paper=o.yaw_reaction == "paper",
         bumper1_yaw_twice=bool(o.bumper1_yaw_twice),
         crash_rule=crash_rule,
@@ -156,6 +158,20 @@ def _packed_options(
         rtol=s.rtol,
         atol=s.atol,
         duration_s=duration_s,
+    )
+    if s.power_off is not None:
+        trigger = s.power_off.trigger
+        opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
+    return opts
+
+
+def _schedule(s: WallApproach | FlightScenario) -> tuple[np.ndarray, np.ndarray]:
+    """The power-off schedule as the kernel's arrays (s; rad/s^2)."""
+    if s.power_off is None:
+        return np.zeros(0), np.zeros((0, 4))
+    return (
+        np.asarray(s.power_off.segment_start_s, dtype=float),
+        np.asarray(s.power_off.rates_rpm_per_s, dtype=float) * RPM,
     )
 
 
@@ -224,6 +240,8 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
         vehicle=v,
         options=o,
         output_rate_hz=float(s.output_rate_hz),
+        sched_t=_schedule(s)[0],
+        sched_rate=_schedule(s)[1],
     )
 
 
@@ -267,7 +285,10 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
     v = _resolve_vehicle(s)
     o = resolve_model_options(s.model, s.model_options)
     yaw_paper = o.yaw_reaction == "paper"
-    roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
+    if s.roll_deg is not None and s.pitch_deg is not None:
+        roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.heading_deg))
+    else:
+        roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
     q = euler_zyx_to_quat(roll, pitch, yaw)
     rotors = _initial_speeds(v, roll, pitch, o.initial_rotor_speeds, yaw_paper)
     refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
@@ -289,10 +310,13 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         options=o,
         output_rate_hz=float(s.output_rate_hz),
         wall=wall,
+        sched_t=_schedule(s)[0],
+        sched_rate=_schedule(s)[1],
     )
     free_opts = _packed_options(s, o, tc, free=True)
     wall_only = pack_surfaces([wall])
-    start = np.array([0.0, 0.0, -float(s.altitude_m)])
+    h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
+    start = np.array([0.0, 0.0, -float(h0)])
 
     def shoot(t0: float, v0: float, x_start: float) -> tuple[np.ndarray, np.ndarray]:
         pos = start + np.array([x_start, 0.0, 0.0])

@@ -88,6 +88,8 @@ def run_setup(
         t_out,
         max_episodes=max_episodes,
         kernel=kernel,
+        sched_t=setup.sched_t,
+        sched_rate=setup.sched_rate,
     )
     wall_s = time.perf_counter() - wall_start
     ts = timeseries_frame(out, out.shape[0])
@@ -186,6 +188,7 @@ def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) 
         "n_subsequent_episodes": int(metrics["n_subsequent_episodes"]),
         "subsequent_impacts": metrics["subsequent_impacts"],
         "crash_time_s": _nan_to_none(crash_t),
+        "power_off_time_s": _nan_to_none(float(st[L.ST_POWER_OFF_T])),
         "crash_position_m": None if math.isnan(crash_t) else [float(c) for c in crash_pos],
         "max_penetration_m": max_pen,
         "bumper_model_valid": bool(max_pen <= rb),

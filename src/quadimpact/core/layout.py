@@ -71,10 +71,9 @@ O_ATOL = 13
 O_H_MAX = 14  # s, largest step (<= 0: the control period)
 O_MAX_STEPS = 15  # total accepted+rejected step budget
 O_EVENT_TOL = 16  # s, event time tolerance
-O_POWER_OFF_T = 17  # s, power-off trigger time (< 0: trigger at first contact; inf: never)
-O_POWER_OFF_ON = 18  # 1: a power-off schedule is given
-O_STOP_ON_CRASH = 19  # 1: end the run at the crash
-NOPT = 20
+O_POWER_OFF_T = 17  # s, power-off trigger time (< 0: at the first contact; inf: never)
+O_STOP_ON_CRASH = 18  # 1: end the run at the crash
+NOPT = 19
 
 CRASH_CM_GROUND = 0  # event: CM altitude crosses O_CRASH_ALTITUDE (default 0)
 CRASH_PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at control ticks only

@@ -18,6 +18,7 @@ is located on the dense output, the step is cut there, every contact is
 re-examined at that instant (simultaneous onsets) and integration restarts.
 """
 
+import math
 import types
 from collections.abc import Callable
 
@@ -57,6 +58,7 @@ from .layout import (
     O_MAX_STEPS,
     O_OMEGA_MAX,
     O_OMEGA_MIN,
+    O_POWER_OFF_T,
     O_ROTOR_MODE,
     O_RTOL,
     O_SLEW_MAX,
@@ -101,6 +103,7 @@ from .layout import (
     X_ROTOR,
 )
 from .quaternion import normalise_quaternion, rotation_matrix
+from .schedule import apply_segment, next_boundary, segment_at
 
 MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
 
@@ -201,12 +204,18 @@ def integrate(
     opts: np.ndarray,
     ctrl: np.ndarray,
     mem: np.ndarray,
+    sched_t: np.ndarray,
+    sched_rate: np.ndarray,
     t_out: np.ndarray,
     out: np.ndarray,
     episodes: np.ndarray,
     stats: np.ndarray,
 ) -> None:
-    """Integrate one scenario from ``t0`` to ``tf`` (s); see the module docstring."""
+    """Integrate one scenario from ``t0`` to ``tf`` (s); see the module docstring.
+
+    ``sched_t`` (K,) and ``sched_rate`` (K, 4) are the power-off schedule
+    (segment starts after the trigger, s; rates, rad/s^2); K = 0: none.
+    """
     nc = 4 * surf.shape[0]
     x = x0.copy()
     x_new = np.empty(NX)
@@ -254,6 +263,14 @@ def integrate(
     slew = opts[O_SLEW_MAX]
     max_episodes = episodes.shape[0]
     n_out_max = t_out.shape[0]
+    # power-off schedule: inactive until its trigger (a time, or the first contact)
+    has_schedule = sched_t.shape[0] > 0
+    po_active = False
+    po_t = math.inf  # trigger time once known
+    po_seg = 0
+    t_sched = math.inf  # next instant the rotor inputs change
+    if has_schedule and opts[O_POWER_OFF_T] >= 0.0:
+        t_sched = max(opts[O_POWER_OFF_T], t0)
 
     status = STATUS_COMPLETED
     reason = 0
@@ -298,7 +315,9 @@ def integrate(
             if w < 0.0:
                 w = 0.0
             rin[RIN_CMD + j] = w
-            if first_order:
+            if po_active:  # the schedule overrides the controller
+                pass
+            elif first_order:
                 rin[RIN_RATE + j] = 0.0
                 rin[RIN_FF + j] = 0.0
             else:
@@ -308,8 +327,23 @@ def integrate(
             prev_cmd[j] = w
         _contact_values(x, C, veh, surf, g_a, gd_a)
         fsal = False
-        # ---- integrate [t_k, t_next] ----
-        while t < t_next and not done:
+        # ---- integrate [t_k, t_next], cut at schedule boundaries ----
+        tiny = 1e-12 * max(1.0, abs(t_next))  # boundaries closer than this coincide
+        while not done:
+            if t_next - t <= tiny:
+                t = t_next
+                break
+            if t_sched - t <= tiny:
+                # the rotor inputs change here: trigger, next segment or a motor stopping
+                if not po_active:
+                    po_active = True
+                    po_t = t
+                    stats[ST_POWER_OFF_T] = t
+                po_seg = segment_at(t + tiny, po_t, sched_t)
+                apply_segment(x, sched_rate, po_seg, rin)
+                t_sched = next_boundary(t, x, po_t, sched_t, po_seg, rin)
+                fsal = False
+            t_stop = min(t_next, t_sched)
             # contacts already penetrating without a located onset
             for c in range(nc):
                 if c_active[c] < 0.5 and g_a[c] > 0.0:
@@ -322,10 +356,10 @@ def integrate(
                 status = STATUS_FAILED
                 reason = REASON_MAX_STEPS
                 break
-            h_try = min(h, h_max, t_next - t)
-            if t + 1.01 * h_try >= t_next:
-                h_try = t_next - t
-            if h_try <= 16.0 * 2.2e-16 * max(1.0, abs(t)) and t_next - t > h_try:
+            h_try = min(h, h_max, t_stop - t)
+            if t + 1.01 * h_try >= t_stop:
+                h_try = t_stop - t
+            if h_try <= 16.0 * 2.2e-16 * max(1.0, abs(t)) and t_stop - t > h_try:
                 status = STATUS_FAILED
                 reason = REASON_STEP_TOO_SMALL
                 break
@@ -396,8 +430,8 @@ def integrate(
                         x_b[i] = x_new[i]
                     K[0, :] = K[6, :]
                     fsal = True
-                if t_next - t_b < 1e-12 * max(1.0, abs(t_next)):
-                    t_b = t_next
+                if t_stop - t_b < tiny:
+                    t_b = t_stop
                 # ---- output samples in (t, t_b] ----
                 while i_out < n_out_max and t_out[i_out] <= t_b:
                     sm = (t_out[i_out] - t) / h_try
@@ -473,6 +507,8 @@ def integrate(
                         stats[ST_ONSET_T] = t
                         for i in range(NX):
                             stats[ST_ONSET_X + i] = x[i]
+                        if has_schedule and opts[O_POWER_OFF_T] < 0.0 and not po_active:
+                            t_sched = t  # power-off triggered by the first contact
                 else:
                     # end of the episode
                     c_active[c] = 0.0
@@ -534,11 +570,15 @@ def execute(
     t_out: np.ndarray,
     max_episodes: int = 1024,
     kernel: Callable | None = None,
+    sched_t: np.ndarray | None = None,
+    sched_rate: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Allocate the outputs, run the compiled loop, return the filled parts.
 
     Returns ``(out[:n_out], episodes[:n_episodes], stats)`` (layout ``OUT_*``,
-    ``E_*``, ``ST_*``).
+    ``E_*``, ``ST_*``). ``sched_t``/``sched_rate``: the power-off schedule
+    (``core/schedule.py``), triggered at ``opts[O_POWER_OFF_T]`` (< 0: the first
+    contact).
     """
     out = np.zeros((t_out.shape[0], NOUT))
     episodes = np.zeros((max_episodes, NEP))
@@ -553,6 +593,8 @@ def execute(
         opts,
         ctrl,
         mem,
+        np.zeros(0) if sched_t is None else np.ascontiguousarray(sched_t, dtype=np.float64),
+        np.zeros((0, 4)) if sched_rate is None else np.ascontiguousarray(sched_rate, np.float64),
         np.ascontiguousarray(t_out, dtype=np.float64),
         out,
         episodes,
