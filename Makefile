@@ -1,6 +1,6 @@
 # quadimpact: one-command entry points.
 #   make run    set up .venv (once) and simulate the paper's example with both model variants
-#   make test   set up .venv (once) and run the test suite
+#   make test   set up .venv (once), install headless Chromium if missing (root only), run the tests
 #   make lint   ruff check
 #   make bench  timing benchmark of the compiled core
 
@@ -11,7 +11,7 @@ STAMP  := $(VENV)/.quadimpact-installed
 
 EXAMPLE := --heading 45 --inclination 15 --speed 0.75
 
-.PHONY: setup run test lint bench clean
+.PHONY: setup run test lint bench clean browser
 
 setup: $(STAMP)
 
@@ -20,15 +20,24 @@ setup: $(STAMP)
 # network access for the build backend, fall back to the venv's own setuptools.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -e ".[dev]" \
+	$(BIN)/python -m pip install -e ".[dev,viz]" \
 	  || $(BIN)/python -m pip install --no-build-isolation --no-deps -e .
 	touch $(STAMP)
 
 run: $(STAMP)
-	$(BIN)/quadimpact run $(EXAMPLE) --model paper-replica --out results/paper-example-replica
-	$(BIN)/quadimpact run $(EXAMPLE) --model default --out results/paper-example-default
+	$(BIN)/quadimpact run $(EXAMPLE) --model paper-replica --out results/paper-example-replica --viz
+	$(BIN)/quadimpact run $(EXAMPLE) --model default --out results/paper-example-default --viz
 
-test: $(STAMP)
+# Headless Chromium for the viewer's browser tests (tests/test_viz.py), from
+# Debian's packages, only when it is missing and we are root (as in CI);
+# otherwise those tests skip and say why. Idempotent.
+browser:
+	@if [ ! -x /usr/bin/chromium ] && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null; then \
+	  (apt-get update && DEBIAN_FRONTEND=noninteractive apt-get install -y chromium chromium-driver) \
+	  || echo "make: could not install chromium; the browser tests will skip"; \
+	fi
+
+test: $(STAMP) browser
 	$(BIN)/python -m pytest
 
 lint: $(STAMP)

@@ -63,7 +63,7 @@ def test_help_and_version(tmp_path: Path) -> None:
         (["run", "--model", "best"], ["'--model'", "'best' is not one of"]),
         (["run", "--controller", "lqr"], ["'--controller'", "'lqr'"]),
         (["run", "--heading", "abc"], ["'--heading'", "'abc' is not a valid float"]),
-        (["run", "--heading", "500"], ["--heading: must be <= 180 (got 500.0)"]),
+        (["run", "--heading", "500"], ["--heading: must be <= 360 (got 500.0)"]),
         (["run", "--inclination", "-75"], ["--inclination: must be >= -60 (got -75.0)"]),
         (["run", "--speed", "0"], ["--speed: must be > 0 (got 0.0)"]),
         (["run", "--impact-time", "4"], ["--impact-time: must be < final_time_s (3)"]),
@@ -82,7 +82,7 @@ def test_bad_flags_exit_2_with_one_line(tmp_path: Path, args: list[str], fragmen
 @pytest.mark.parametrize(
     ("text", "fragments"),
     [
-        ("heading_deg = 500\n", ["scenario.toml: heading_deg: must be <= 180 (got 500)"]),
+        ("heading_deg = 500\n", ["scenario.toml: heading_deg: must be <= 360 (got 500)"]),
         ("heading_deg = = 5\n", ["scenario.toml: invalid TOML", "line 1"]),
         ("speed = 0.5\n", ["scenario.toml: speed: unknown key; did you mean 'speed_m_s'?"]),
         (

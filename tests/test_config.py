@@ -90,8 +90,8 @@ def test_models_are_frozen_and_forbid_extras() -> None:
 @pytest.mark.parametrize(
     ("fields", "expected"),
     [
-        ({"heading_deg": 500}, "s.toml: heading_deg: must be <= 180 (got 500)"),
-        ({"heading_deg": -181}, "heading_deg: must be >= -180 (got -181)"),
+        ({"heading_deg": 500}, "s.toml: heading_deg: must be <= 360 (got 500)"),
+        ({"heading_deg": -361}, "heading_deg: must be >= -360 (got -361)"),
         ({"inclination_deg": 61}, "inclination_deg: must be <= 60 (got 61)"),
         ({"inclination_deg": -60.5}, "inclination_deg: must be >= -60 (got -60.5)"),
         ({"speed_m_s": 0}, "speed_m_s: must be > 0 (got 0)"),
@@ -281,7 +281,7 @@ def test_vehicle_path_relative_to_scenario_file(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
-        ("heading_deg = 500\n", "scenario.toml: heading_deg: must be <= 180 (got 500)"),
+        ("heading_deg = 500\n", "scenario.toml: heading_deg: must be <= 360 (got 500)"),
         (
             "hedding_deg = 5\n",
             "scenario.toml: hedding_deg: unknown key; did you mean 'heading_deg'",

@@ -102,7 +102,7 @@ def cli() -> None:
     "--heading",
     type=float,
     metavar="DEG",
-    help="Yaw relative to the wall normal, deg in [-180, 180]; 0 points the nose at the "
+    help="Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
     "wall (bumpers 1 and 4 lead). [default: 0]",
 )
 @click.option(
@@ -211,7 +211,15 @@ def cli() -> None:
     show_default=True,
     help="Output folder (created if needed).",
 )
-def run(scenario: Path | None, out: Path, options: tuple[str, ...], **flags: Any) -> None:
+@click.option(
+    "--viz",
+    is_flag=True,
+    help="Also write the pictures: snapshots.png/.pdf, animation.mp4 and viewer.html "
+    "(as 'quadimpact snapshots', 'animate' and 'view' do).",
+)
+def run(
+    scenario: Path | None, out: Path, options: tuple[str, ...], viz: bool, **flags: Any
+) -> None:
     """Simulate one scenario and write its results to --out.
 
     Without SCENARIO.toml this is the paper's wall approach: the Spiri holds
@@ -239,6 +247,11 @@ def run(scenario: Path | None, out: Path, options: tuple[str, ...], **flags: Any
     out.mkdir(parents=True, exist_ok=True)
     result.write(out)
     click.echo(format_summary(result.summary, out))
+    if viz:
+        from quadimpact.viz.cli import make_all
+
+        for path in make_all(out, result):
+            click.echo(f"picture        {path}")
 
 
 def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
@@ -386,7 +399,23 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
 # ---- subcommands defined in their own modules: one registration line each ----
 # (import inside a function keeps `quadimpact --help` fast and avoids cycles)
 def _register_subcommands() -> None:
-    pass
+    from quadimpact.viz.cli import animate, snapshots, view
+
+    cli.add_command(animate)
+    cli.add_command(snapshots)
+    cli.add_command(view)
+
+    from quadimpact.cli_sweep import sweep
+
+    cli.add_command(sweep)
+
+    from quadimpact.cli_study import reproduce
+
+    cli.add_command(reproduce)
+
+    from quadimpact.cli_experiments import experiments
+
+    cli.add_command(experiments)
 
 
 _register_subcommands()

@@ -22,9 +22,22 @@ import click
     is_flag=True,
     help="Skip the replica reruns with one difference switched off at a time.",
 )
+@click.option("--no-experiments", is_flag=True, help="Skip the seven crashes of Table III.")
+@click.option(
+    "--data",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
+    "../shared/data beside the project]; without it the comparisons are left out.",
+)
 @click.option("--no-progress", is_flag=True, help="No progress bar.")
 def reproduce(
-    out: Path, workers: int | None, scheduler: str | None, no_ablation: bool, no_progress: bool
+    out: Path,
+    workers: int | None,
+    scheduler: str | None,
+    no_ablation: bool,
+    no_experiments: bool,
+    data: Path | None,
+    no_progress: bool,
 ) -> None:
     """Reproduce the paper's study: Figure 4, Table II, Figures 5-6, findings.
 
@@ -39,7 +52,7 @@ def reproduce(
 
     result = run_study(
         out, workers=workers, scheduler=scheduler, progress=not no_progress,
-        ablation=not no_ablation,
+        ablation=not no_ablation, experiments=not no_experiments, data_dir=data,
     )  # fmt: skip
     f = result.findings
     click.echo(f"report         {result.report}")

@@ -259,6 +259,9 @@ class PowerOff(BaseModel):
         Segment starts after the trigger, s; the first is 0, increasing.
     rates_rpm_per_s : tuple of 4-tuples
         Per segment, the rate of change of motors 1-4, rpm/s.
+    stopped_motors : tuple of int
+        Motors (1-4) that stall at the trigger: their speed drops to zero at
+        once (the logs show them stopped with no measurable ramp).
     """
 
     model_config = _CONFIG
@@ -271,6 +274,9 @@ class PowerOff(BaseModel):
     )
     rates_rpm_per_s: tuple[Vec4, ...] = Field(
         min_length=1, description="Per segment, the rates of motors 1-4, rpm/s."
+    )
+    stopped_motors: tuple[int, ...] = Field(
+        (), description="Motors (1-4) that stall at the trigger: speed 0 at once."
     )
 
     @model_validator(mode="after")
@@ -285,6 +291,10 @@ class PowerOff(BaseModel):
                 f"rates_rpm_per_s: must have one row per segment ({len(starts)}) "
                 f"(got {len(self.rates_rpm_per_s)})"
             )
+        if any(m not in (1, 2, 3, 4) for m in self.stopped_motors) or len(
+            set(self.stopped_motors)
+        ) != len(self.stopped_motors):
+            raise ValueError("stopped_motors: distinct motor numbers 1-4")
         if not isinstance(self.trigger, str) and self.trigger < 0:
             raise ValueError(f"trigger: a time must be >= 0 s (got {self.trigger:g})")
         return self
@@ -472,8 +482,9 @@ class WallApproach(RunSettings):
     kind : "wall-approach"
         Scenario kind tag (as in scenario files).
     heading_deg : float
-        Yaw of the vehicle relative to the wall normal, deg in [-180, 180];
-        0: body x axis pointing at the wall (bumpers 1 and 4 lead).
+        Yaw of the vehicle relative to the wall normal, deg in [-360, 360]
+        (any turn; sweeps may cross +-180); 0: body x axis pointing at the wall
+        (bumpers 1 and 4 lead), 180: flying in rear first (bumpers 2 and 3 lead).
     inclination_deg : float
         Tilt of the body z axis from the inertial Z axis within the X-Z plane,
         deg in [-60, 60], positive toward the wall.
@@ -497,7 +508,7 @@ class WallApproach(RunSettings):
 
     kind: Literal["wall-approach"] = Field("wall-approach", description="Scenario kind tag.")
     heading_deg: Real = Field(
-        0.0, ge=-180, le=180, description="Yaw relative to the wall normal, deg."
+        0.0, ge=-360, le=360, description="Yaw relative to the wall normal, deg."
     )
     inclination_deg: Real = Field(
         0.0, ge=-60, le=60, description="Tilt toward the wall in the inertial X-Z plane, deg."

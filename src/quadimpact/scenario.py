@@ -71,6 +71,15 @@ class RunSetup:
     warnings: list[str] = field(default_factory=list)
     sched_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     sched_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    sched_stop: np.ndarray = field(default_factory=lambda: np.zeros(4))
+
+    def schedule(self) -> dict[str, np.ndarray]:
+        """The power-off schedule as keyword arguments of ``core.run.execute``."""
+        return {
+            "sched_t": self.sched_t,
+            "sched_rate": self.sched_rate,
+            "sched_stop": self.sched_stop,
+        }
 
     def output_times(self) -> np.ndarray:
         """Output grid: ``t0``, the multiples of 1/rate inside (t0, tf), and ``tf`` (s)."""
@@ -165,14 +174,18 @@ def _packed_options(
     return opts
 
 
-def _schedule(s: WallApproach | FlightScenario) -> tuple[np.ndarray, np.ndarray]:
-    """The power-off schedule as the kernel's arrays (s; rad/s^2)."""
+def _schedule(s: WallApproach | FlightScenario) -> dict[str, np.ndarray]:
+    """The power-off schedule as the kernel's arrays (s; rad/s^2; stall flags)."""
     if s.power_off is None:
-        return np.zeros(0), np.zeros((0, 4))
-    return (
-        np.asarray(s.power_off.segment_start_s, dtype=float),
-        np.asarray(s.power_off.rates_rpm_per_s, dtype=float) * RPM,
-    )
+        return {}
+    stop = np.zeros(4)
+    for m in s.power_off.stopped_motors:
+        stop[m - 1] = 1.0
+    return {
+        "sched_t": np.asarray(s.power_off.segment_start_s, dtype=float),
+        "sched_rate": np.asarray(s.power_off.rates_rpm_per_s, dtype=float) * RPM,
+        "sched_stop": stop,
+    }
 
 
 def _ground(s: WallApproach | FlightScenario) -> list[Surface]:
@@ -240,8 +253,7 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
         vehicle=v,
         options=o,
         output_rate_hz=float(s.output_rate_hz),
-        sched_t=_schedule(s)[0],
-        sched_rate=_schedule(s)[1],
+        **_schedule(s),
     )
 
 
@@ -260,6 +272,7 @@ def _free_flight_end(
         setup.ctrl,
         np.array([t_end]),
         max_episodes=1,
+        **setup.schedule(),
     )
     if stats[L.ST_STATUS] == L.STATUS_FAILED or out.shape[0] != 1:
         raise RuntimeError(
@@ -310,8 +323,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         options=o,
         output_rate_hz=float(s.output_rate_hz),
         wall=wall,
-        sched_t=_schedule(s)[0],
-        sched_rate=_schedule(s)[1],
+        **_schedule(s),
     )
     free_opts = _packed_options(s, o, tc, free=True)
     wall_only = pack_surfaces([wall])

@@ -88,8 +88,7 @@ def run_setup(
         t_out,
         max_episodes=max_episodes,
         kernel=kernel,
-        sched_t=setup.sched_t,
-        sched_rate=setup.sched_rate,
+        **setup.schedule(),
     )
     wall_s = time.perf_counter() - wall_start
     ts = timeseries_frame(out, out.shape[0])

@@ -206,6 +206,7 @@ def integrate(
     mem: np.ndarray,
     sched_t: np.ndarray,
     sched_rate: np.ndarray,
+    sched_stop: np.ndarray,
     t_out: np.ndarray,
     out: np.ndarray,
     episodes: np.ndarray,
@@ -215,6 +216,7 @@ def integrate(
 
     ``sched_t`` (K,) and ``sched_rate`` (K, 4) are the power-off schedule
     (segment starts after the trigger, s; rates, rad/s^2); K = 0: none.
+    ``sched_stop`` (4,): 1 for the motors that stall at the trigger (speed 0 at once).
     """
     nc = 4 * surf.shape[0]
     x = x0.copy()
@@ -339,6 +341,9 @@ def integrate(
                     po_active = True
                     po_t = t
                     stats[ST_POWER_OFF_T] = t
+                    for j in range(4):
+                        if sched_stop[j] > 0.5:
+                            x[X_ROTOR + j] = 0.0
                 po_seg = segment_at(t + tiny, po_t, sched_t)
                 apply_segment(x, sched_rate, po_seg, rin)
                 t_sched = next_boundary(t, x, po_t, sched_t, po_seg, rin)
@@ -572,6 +577,7 @@ def execute(
     kernel: Callable | None = None,
     sched_t: np.ndarray | None = None,
     sched_rate: np.ndarray | None = None,
+    sched_stop: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Allocate the outputs, run the compiled loop, return the filled parts.
 
@@ -595,6 +601,7 @@ def execute(
         mem,
         np.zeros(0) if sched_t is None else np.ascontiguousarray(sched_t, dtype=np.float64),
         np.zeros((0, 4)) if sched_rate is None else np.ascontiguousarray(sched_rate, np.float64),
+        np.zeros(4) if sched_stop is None else np.ascontiguousarray(sched_stop, np.float64),
         np.ascontiguousarray(t_out, dtype=np.float64),
         out,
         episodes,

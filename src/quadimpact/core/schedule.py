@@ -5,6 +5,8 @@ speed follows a prescribed piecewise-linear schedule, whatever the controller
 commands: over segment ``k``, ``[t_p + start_k, t_p + start_{k+1})``, motor
 ``j`` changes at ``rate[k, j]`` (rad/s^2), and never goes below zero (a motor
 that reaches zero stays there until a later segment's rate is positive).
+Motors marked as stalling stop at the trigger (their speed jumps to zero; the
+spin-down torque of that jump is not modelled).
 
 The rotor speeds are states whose derivative is the current rate, so the
 integrator reproduces the schedule exactly (a linear function); the run loop

@@ -1,0 +1,1 @@
+"""The paper's experiments (section V): the seven crashes, flight logs, comparisons."""

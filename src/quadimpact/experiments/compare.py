@@ -1,0 +1,667 @@
+"""Compare a simulated run with a flight log, aligned at the impact.
+
+:func:`compare` puts both on the time since impact, ``tau = t - t_impact``
+(the simulation's first contact, the log's :attr:`FlightLog.impact_time_s`),
+interpolates the simulation (1 kHz) onto the log's own sample times (the log
+is the reference) and reports, over ``[0, w]`` for each window ``w``, the RMS
+and largest absolute error per quantity and per group:
+
+========  ===============================================  =====
+group     quantities                                       unit
+========  ===============================================  =====
+position  X, Y, altitude: displacement since the impact    m
+attitude  roll, pitch, yaw (differences wrapped to +-180)  deg
+rates     body rates p, q, r                               rad/s
+motors    rotor speeds 1-4 (log samples with the motor on) rad/s
+========  ===============================================  =====
+
+Positions are compared as displacements from each one's own position at the
+impact (``relative_position=True``): the log's motion-capture origin and the
+simulated wall distance and altitude differ by construction.
+
+:func:`log_response` classifies the log's response type (STUDIES.md section
+3) from the log's own motion, where the motion capture allows it, and says
+why not otherwise. :func:`synthetic_log` turns a simulated run into a
+:class:`FlightLog` (for tests: a run compared with itself has zero error).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import textwrap
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from quadimpact.analysis import classify_response
+from quadimpact.experiments.logs import (
+    MOCAP_GAP_S,
+    POWER_OFF_RPM,
+    FlightLog,
+    PreImpact,
+    bumper_rim_extent,
+    rpm_to_rad_s,
+)
+
+__all__ = [
+    "CONTACT_TOL_M",
+    "GROUPS",
+    "LANDING_DROP_M",
+    "LANDING_HOLD_S",
+    "LANDING_TOL_M",
+    "SEPARATION_M",
+    "Comparison",
+    "LogResponse",
+    "SyntheticLog",
+    "compare",
+    "log_response",
+    "synthetic_log",
+]
+
+#: Quantity groups: group -> (unit, [(quantity, column, wrapped)]).
+GROUPS: dict[str, tuple[str, list[tuple[str, str, bool]]]] = {
+    "position": ("m", [("X", "x_m", False), ("Y", "y_m", False),
+                       ("altitude", "altitude_m", False)]),
+    "attitude": ("deg", [("roll", "roll_deg", True), ("pitch", "pitch_deg", False),
+                         ("yaw", "yaw_deg", True)]),
+    "rates": ("rad/s", [("p", "p_rad_s", False), ("q", "q_rad_s", False),
+                        ("r", "r_rad_s", False)]),
+    "motors": ("rad/s", [(f"omega{j}", f"omega{j}_rad_s", False) for j in range(1, 5)]),
+}  # fmt: skip
+
+#: Log response: a bumper touches the wall when its rim is within CONTACT_TOL_M
+#: of the wall plane; an impact ends when every rim is SEPARATION_M away.
+CONTACT_TOL_M = 0.01
+SEPARATION_M = 0.02
+#: A crash (landing) is seen when the altitude falls this much below the impact's.
+LANDING_DROP_M = 0.3
+#: The landing: the first time the altitude is within this of its post-impact minimum,
+#: that minimum followed by at least LANDING_HOLD_S of tracking (or the log ending
+#: at rest with the motors off).
+LANDING_TOL_M = 0.05
+LANDING_HOLD_S = 0.2
+
+
+# ------------------------------------------------------------------ log response
+@dataclass(frozen=True)
+class LogResponse:
+    """The response type of a logged crash, from its own motion.
+
+    Attributes
+    ----------
+    type : str
+        ``"A"``, ``"B"``, ``"C"``, ``"D"``, ``"Other"`` (STUDIES.md section 3)
+        or ``"unknown"`` when the motion capture does not cover the impact to
+        the landing.
+    crashed : bool or None
+        Whether the vehicle came down (None: not decidable).
+    landing_time_s : float or None
+        Reference clock.
+    leading_bumpers : tuple of int
+        Bumpers of the initial impact (log numbering).
+    subsequent_impacts : tuple of tuple of int
+        Later impacts seen before the tracking ended, bumpers in start order.
+    tracked_until_s : float or None
+        End of the continuous motion capture after the impact.
+    notes : tuple of str
+        What was and was not observable.
+    """
+
+    type: str
+    crashed: bool | None = None
+    landing_time_s: float | None = None
+    leading_bumpers: tuple[int, ...] = ()
+    subsequent_impacts: tuple[tuple[int, ...], ...] = ()
+    tracked_until_s: float | None = None
+    notes: tuple[str, ...] = ()
+
+
+def _crashed_from_motors(log: FlightLog) -> bool | None:
+    """All motors off after the impact and the vehicle at rest: it came down."""
+    try:
+        mot = log.motors()
+    except (KeyError, NotImplementedError):
+        return None
+    after = mot[mot["t_s"] > log.impact_time_s]
+    if after.empty:
+        return None
+    offs = after[[f"off{j}" for j in range(1, 5)]].to_numpy().all(axis=1)
+    rest = log.rest_time_s
+    if offs.any() and rest is not None:
+        return True
+    return None
+
+
+def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> LogResponse:
+    """Classify a log's response type from its own motion (see the module docstring).
+
+    Observable: the wall contacts of the bumper rims (motion-capture pose,
+    the bumper geometry of the Spiri, the wall plane found at the contact) and
+    the landing (altitude dropping :data:`LANDING_DROP_M` below the impact's
+    and settling). Not observable: contacts after the motion capture loses the
+    vehicle (common: it tumbles), contacts of parts other than the bumper rims,
+    contacts shallower than the wall-plane uncertainty (~1-2 cm). The type is
+    ``"unknown"`` unless the tracking is continuous (gaps <= ``MOCAP_GAP_S``)
+    from the impact to the landing or, without a landing, to the log's end.
+    The on-board signals (15 Hz, saturating during the tumble) cannot separate
+    later impacts from the tumble itself, so they only decide the crash.
+    """
+    notes: list[str] = []
+    crashed_motors = _crashed_from_motors(log)
+    pose = log.pose()
+    t0 = log.impact_time_s
+    wall = log.wall_x_m
+    if pose.empty or not math.isfinite(wall):
+        notes.append("no motion capture of the impact (or no wall plane): contacts not observable")
+        return LogResponse("unknown", crashed=crashed_motors, notes=tuple(notes))
+    t = pose["t_s"].to_numpy()
+    post = t >= t0 - 0.02
+    if not post.any():
+        notes.append("motion capture ends before the impact")
+        return LogResponse("unknown", crashed=crashed_motors, notes=tuple(notes))
+    idx = np.flatnonzero(post)
+    tp = t[idx]
+    gaps = np.flatnonzero(np.diff(tp) > MOCAP_GAP_S)
+    end = int(gaps[0]) + 1 if gaps.size else len(idx)
+    if tp[0] > t0 + MOCAP_GAP_S:
+        notes.append(f"motion capture resumes only {tp[0] - t0:.3f} s after the impact")
+        return LogResponse("unknown", crashed=crashed_motors, notes=tuple(notes))
+    idx, tp = idx[:end], tp[:end]
+    tracked_until = float(tp[-1])
+    q = pose[["q0", "q1", "q2", "q3"]].to_numpy()[idx]
+    from quadimpact.frames import quat_to_matrix
+
+    C = quat_to_matrix(q)
+    reach = bumper_rim_extent(C, np.array([1.0, 0.0, 0.0]))
+    rim = pose["x_m"].to_numpy()[idx][:, None] + reach  # (n, 4)
+    touching = rim >= wall - contact_tol_m
+    # impacts: runs of touching samples separated by full separation
+    separated = (rim < wall - SEPARATION_M).all(axis=1)
+    impacts: list[list[int]] = []
+    current: list[int] | None = None
+    for k in range(len(tp)):
+        if touching[k].any():
+            if current is None:
+                current = []
+                impacts.append(current)
+            for b in np.flatnonzero(touching[k]) + 1:
+                if int(b) not in current:
+                    current.append(int(b))
+        elif separated[k]:
+            current = None
+    if not impacts:
+        pi = log.pre_impact()
+        lead = [pi.leading_bumper] if isinstance(pi, PreImpact) and pi.leading_bumper else []
+        impacts = [lead]
+        notes.append("no rim within the contact tolerance after the impact; leading bumper "
+                     "taken from the pre-impact estimate")  # fmt: skip
+    leading = tuple(impacts[0])
+    subsequent = tuple(tuple(i) for i in impacts[1:])
+    # landing
+    alt = pose["altitude_m"].to_numpy()[idx]
+    alt0 = float(alt[0])
+    landing: float | None = None
+    crashed: bool | None = None
+    if alt.min() < alt0 - LANDING_DROP_M:
+        k = int(np.argmax(alt <= alt.min() + LANDING_TOL_M))
+        settled = tp[-1] - tp[int(np.argmin(alt))] >= LANDING_HOLD_S
+        if settled or crashed_motors:
+            landing = float(tp[k])
+            crashed = True
+    observed_to_end = end == len(np.flatnonzero(post)) and tracked_until >= t[-1] - 1e-9
+    if landing is None:
+        if crashed_motors:
+            notes.append(f"motion capture lost at {tracked_until - t0:+.3f} s after the "
+                         "impact, before the landing; the motors are off and the vehicle "
+                         "ends at rest, so it crashed")  # fmt: skip
+            return LogResponse("unknown", crashed=True, leading_bumpers=leading,
+                               subsequent_impacts=subsequent, tracked_until_s=tracked_until,
+                               notes=tuple(notes))  # fmt: skip
+        if not observed_to_end:
+            notes.append(f"motion capture lost at {tracked_until - t0:+.3f} s after the impact")
+            return LogResponse("unknown", crashed=None, leading_bumpers=leading,
+                               subsequent_impacts=subsequent, tracked_until_s=tracked_until,
+                               notes=tuple(notes))  # fmt: skip
+        crashed = False
+    # contacts after the landing are not subsequent impacts
+    if landing is not None:
+        kept = []
+        starts = _impact_starts(touching, separated, tp)
+        for imp, ts in zip(impacts[1:], starts[1:], strict=False):
+            if ts <= landing:
+                kept.append(tuple(imp))
+        subsequent = tuple(kept)
+    kind = classify_response(leading, subsequent, bool(crashed))
+    notes.append("contacts from the bumper rims in the motion capture; the landing from "
+                 "the altitude")  # fmt: skip
+    return LogResponse(kind, crashed=crashed, landing_time_s=landing, leading_bumpers=leading,
+                       subsequent_impacts=subsequent, tracked_until_s=tracked_until,
+                       notes=tuple(notes))  # fmt: skip
+
+
+def _impact_starts(touching: np.ndarray, separated: np.ndarray, t: np.ndarray) -> list[float]:
+    starts: list[float] = []
+    inside = False
+    for k in range(len(t)):
+        if touching[k].any():
+            if not inside:
+                starts.append(float(t[k]))
+                inside = True
+        elif separated[k]:
+            inside = False
+    return starts
+
+
+# ------------------------------------------------------------------ synthetic log
+class SyntheticLog(FlightLog):
+    """A :class:`FlightLog` made of a simulated run (see :func:`synthetic_log`)."""
+
+    def __init__(
+        self,
+        timeseries: pd.DataFrame,
+        impact_time_s: float,
+        *,
+        wall_x_m: float = math.nan,
+        name: str = "synthetic",
+        time_shift_s: float = 0.0,
+        offsets: dict[str, float] | None = None,
+    ) -> None:
+        ts = timeseries.copy()
+        ts["t_s"] = ts["t_s"] + time_shift_s
+        for col, value in (offsets or {}).items():
+            ts[col] = ts[col] + value
+        self._ts = ts.reset_index(drop=True)
+        self._impact = float(impact_time_s)
+        self._wall = float(wall_x_m)
+        self.name = name
+
+    @property
+    def signals(self) -> dict[str, pd.DataFrame]:
+        return {"pose": self.pose(), "motors": self.motors()}
+
+    @property
+    def impact_time_s(self) -> float:
+        return self._impact
+
+    def pose(self) -> pd.DataFrame:
+        cols = ["t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "roll_deg", "pitch_deg",
+                "yaw_deg", "altitude_m", "vx_m_s", "vy_m_s", "vz_m_s", "p_rad_s", "q_rad_s",
+                "r_rad_s"]  # fmt: skip
+        return self._ts[[c for c in cols if c in self._ts.columns]].copy()
+
+    def motors(self) -> pd.DataFrame:
+        data: dict[str, Any] = {"t_s": self._ts["t_s"].to_numpy()}
+        omega = self._ts[[f"omega{j}_rad_s" for j in range(1, 5)]].to_numpy()
+        off = omega <= float(rpm_to_rad_s(POWER_OFF_RPM))
+        for j in range(4):
+            data[f"omega{j + 1}_rad_s"] = np.where(off[:, j], np.nan, omega[:, j])
+        for j in range(4):
+            data[f"off{j + 1}"] = off[:, j]
+        return pd.DataFrame(data)
+
+    def pre_impact(self) -> PreImpact:
+        ts, t0 = self._ts, self._impact
+
+        def at(col: str) -> float:
+            return float(np.interp(t0, ts["t_s"], ts[col]))
+
+        from quadimpact.frames import quat_to_matrix
+
+        q = np.array([at(c) for c in ("q0", "q1", "q2", "q3")])
+        C = quat_to_matrix(q)
+        incl = math.degrees(math.atan2(-C[0, 2], C[2, 2]))
+        yaw = float(np.degrees(np.arctan2(C[1, 0], C[0, 0])))
+        rear = abs(yaw) > 90.0
+        equiv = (yaw - 180.0 if yaw > 0 else yaw + 180.0) if rear else yaw
+        reach = bumper_rim_extent(C[None], np.array([1.0, 0.0, 0.0]))[0]
+        return PreImpact(
+            heading_deg=yaw,
+            speed_m_s=at("vx_m_s"),
+            inclination_deg=incl,
+            roll_deg=float(np.degrees(np.arctan2(C[2, 1], C[2, 2]))),
+            pitch_deg=float(np.degrees(np.arctan2(-C[2, 0], np.hypot(C[0, 0], C[1, 0])))),
+            yaw_deg=yaw,
+            altitude_m=at("altitude_m"),
+            uncertainty={},
+            time_s=t0,
+            velocity_m_s=(at("vx_m_s"), at("vy_m_s"), at("vz_m_s")),
+            heading_front_equiv_deg=equiv,
+            rear_first=rear,
+            leading_bumper=int(np.argmax(reach)) + 1,
+            wall_x_m=self._wall,
+            contact_observed=True,
+            method="simulation",
+        )
+
+    @property
+    def wall_x_m(self) -> float:
+        return self._wall
+
+    @property
+    def rest_time_s(self) -> float | None:
+        return None
+
+
+def synthetic_log(
+    result: Any,
+    *,
+    time_shift_s: float = 0.0,
+    offsets: dict[str, float] | None = None,
+) -> SyntheticLog:
+    """A flight log made of a simulated run (same interface as a real one).
+
+    Parameters
+    ----------
+    result : SimulationResult
+        A run (``timeseries``, ``summary["first_contact_s"]``, ``wall_x_m``).
+    time_shift_s : float
+        Delay every sample by this much while keeping the impact time: a
+        deliberately misaligned copy.
+    offsets : dict, optional
+        Constants added to time-series columns (e.g. ``{"roll_deg": 2.0}``).
+    """
+    t0 = result.summary.get("first_contact_s")
+    if t0 is None:
+        raise ValueError("the run has no first contact: nothing to align on")
+    wall = getattr(result, "wall_x_m", None)
+    if callable(wall):
+        wall = wall()
+    if wall is None:
+        wall = result.summary.get("wall_distance_m")
+    return SyntheticLog(
+        result.timeseries,
+        float(t0),
+        wall_x_m=float(wall) if wall is not None else math.nan,
+        time_shift_s=time_shift_s,
+        offsets=offsets,
+    )
+
+
+# ------------------------------------------------------------------ comparison
+def _wrap_deg(a: np.ndarray) -> np.ndarray:
+    return np.mod(np.asarray(a, dtype=float) + 180.0, 360.0) - 180.0
+
+
+def _interp_segments(t_new: np.ndarray, t: np.ndarray, y: np.ndarray, gap: float) -> np.ndarray:
+    """Linear interpolation that gives nan inside gaps longer than ``gap`` and outside."""
+    out = np.interp(t_new, t, y, left=np.nan, right=np.nan)
+    if len(t) > 1:
+        k = np.clip(np.searchsorted(t, t_new), 1, len(t) - 1)
+        bad = (t[k] - t[k - 1] > gap) & (t_new > t[k - 1]) & (t_new < t[k])
+        out[bad] = np.nan
+    return out
+
+
+@dataclass
+class Comparison:
+    """A simulated run against a log, aligned at the impact (see :func:`compare`).
+
+    Attributes
+    ----------
+    errors : pandas.DataFrame
+        ``group, quantity, unit, window_s, rms, max_abs, n``; per quantity and
+        per group (``quantity == "all"``: all the group's samples together).
+    sim : pandas.DataFrame
+        The simulation on ``tau_s`` (its own samples), relative positions.
+    log_pose, log_motors : pandas.DataFrame
+        The log on ``tau_s`` (its own samples), relative positions.
+    sim_response : str or None
+        The run's response type (``summary["response_type"]``).
+    log_response : LogResponse or None
+    """
+
+    name: str
+    windows: tuple[float, ...]
+    errors: pd.DataFrame
+    sim: pd.DataFrame
+    log_pose: pd.DataFrame
+    log_motors: pd.DataFrame
+    t_impact_sim: float
+    t_impact_log: float
+    sim_response: str | None = None
+    log_response: LogResponse | None = None
+    notes: list[str] = field(default_factory=list)
+
+    def table(self) -> pd.DataFrame:
+        """The error table (a copy), one row per (group, quantity, window)."""
+        return self.errors.copy()
+
+    def error(self, group: str, window_s: float, quantity: str = "all",
+              stat: str = "rms") -> float:  # fmt: skip
+        """One number of the table, e.g. ``error("attitude", 0.3)``."""
+        e = self.errors
+        row = e[(e.group == group) & (e.quantity == quantity) & np.isclose(e.window_s, window_s)]
+        if row.empty:
+            raise KeyError((group, quantity, window_s))
+        return float(row[stat].iloc[0])
+
+    def plot(self, path: str | os.PathLike[str], title: str | None = None) -> Path:
+        """Side-by-side panels (sim lines, log markers) written as a PNG; returns the path."""
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        from matplotlib.figure import Figure
+
+        fig = Figure(figsize=(15, 13), layout="constrained")
+        FigureCanvasAgg(fig)
+        axes = fig.subplots(4, 3)
+        tmax = max(self.windows) + 0.2
+        tmin = -0.2
+        panels = [
+            ("x_m", "X - X(impact) (m)"), ("y_m", "Y - Y(impact) (m)"),
+            ("altitude_m", "altitude - at impact (m)"),
+            ("roll_deg", "roll (deg)"), ("pitch_deg", "pitch (deg)"), ("yaw_deg", "yaw (deg)"),
+            ("p_rad_s", "p (rad/s)"), ("q_rad_s", "q (rad/s)"), ("r_rad_s", "r (rad/s)"),
+        ]  # fmt: skip
+        sim = self.sim[(self.sim.tau_s >= tmin) & (self.sim.tau_s <= tmax)]
+        lp = self.log_pose[(self.log_pose.tau_s >= tmin) & (self.log_pose.tau_s <= tmax)]
+        lm = self.log_motors[(self.log_motors.tau_s >= tmin) & (self.log_motors.tau_s <= tmax)]
+        from quadimpact.plots import break_wraps
+
+        for ax, (col, label) in zip(axes.flat[:9], panels, strict=True):
+            wrapped = col in ("roll_deg", "yaw_deg")
+            if col in sim:
+                x, y = sim.tau_s.to_numpy(), sim[col].to_numpy()
+                if wrapped:
+                    x, y = break_wraps(x, _wrap_deg(y))
+                ax.plot(x, y, "-", color="tab:blue", lw=1.2, label="simulation")
+            if col in lp:
+                y = _wrap_deg(lp[col].to_numpy()) if wrapped else lp[col]
+                ax.plot(lp.tau_s, y, "o", color="tab:red", ms=3, label="log")
+            ax.set_ylabel(label)
+        colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+        for ax, motors in zip(axes.flat[9:11], ((1, 2), (3, 4)), strict=True):
+            for j in motors:
+                c = colors[j - 1]
+                col = f"omega{j}_rad_s"
+                if col in sim:
+                    ax.plot(sim.tau_s, sim[col], "-", color=c, lw=1.2, label=f"sim {j}")
+                if col in lm:
+                    ax.plot(lm.tau_s, lm[col], "o", color=c, ms=3, label=f"log {j}")
+            ax.set_ylabel("rotor speed (rad/s)")
+            ax.legend(fontsize=7, ncol=2)
+        for ax in axes.flat[:11]:
+            ax.set_xlim(tmin, tmax)
+            ax.axvline(0.0, color="k", lw=0.8)
+            for w in self.windows:
+                ax.axvline(w, color="0.6", lw=0.8, ls=":")
+            ax.grid(alpha=0.3)
+            ax.set_xlabel("time since impact (s)")
+        axes.flat[0].legend(fontsize=8)
+        text = axes.flat[11]
+        text.axis("off")
+        e = self.errors[self.errors.quantity.isin(["all", "rotation"])]
+        lines = ["RMS / max error after impact"]
+        for _, r in e.iterrows():
+            name = "rotation" if r.quantity == "rotation" else r.group
+            lines.append(f"{name:9s} [0,{r.window_s:g}] s: {r.rms:.3g} / {r.max_abs:.3g} "
+                         f"{r.unit} (n={r.n})")  # fmt: skip
+        lr = self.log_response.type if self.log_response else "n/a"
+        lines.append("")
+        lines.append(f"response type: simulation {self.sim_response}, log {lr}")
+        for note in self.notes:
+            lines.append(textwrap.fill(note, 60))
+        text.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=8)
+        fig.suptitle(title or f"{self.name}: simulation vs log, aligned at impact")
+        from quadimpact.plots import save_figure
+
+        return save_figure(fig, path)
+
+
+def _sim_table(result_or_timeseries: Any) -> tuple[pd.DataFrame, float | None, str | None]:
+    if isinstance(result_or_timeseries, pd.DataFrame):
+        return result_or_timeseries, None, None
+    ts = result_or_timeseries.timeseries
+    summary = getattr(result_or_timeseries, "summary", {}) or {}
+    return ts, summary.get("first_contact_s"), summary.get("response_type")
+
+
+def compare(
+    result_or_timeseries: Any,
+    log: FlightLog,
+    t_impact_sim: float | None = None,
+    windows: tuple[float, ...] = (0.3, 0.5),
+    *,
+    relative_position: bool = True,
+    classify_log: bool = True,
+) -> Comparison:
+    """Compare a simulated run with a flight log, aligned at the impact.
+
+    Parameters
+    ----------
+    result_or_timeseries : SimulationResult or pandas.DataFrame
+        The run, or its time series (then ``t_impact_sim`` is required).
+    log : FlightLog
+        The reference.
+    t_impact_sim : float, optional
+        The run's impact time (default: ``summary["first_contact_s"]``).
+    windows : tuple of float
+        Error windows after the impact, s: errors over ``[0, w]``.
+    relative_position : bool
+        Compare X, Y and altitude as displacements since the impact.
+    classify_log : bool
+        Also classify the log's response type (:func:`log_response`).
+
+    Returns
+    -------
+    Comparison
+        Errors: the simulation interpolated linearly onto the log's samples
+        with ``0 <= tau <= w`` (angles unwrapped before interpolating, angle
+        differences wrapped to +-180 deg); samples where either side is nan
+        (log tracking gaps, powered-off motors, outside the run) are left out
+        and counted in ``n`` only when used.
+    """
+    ts, t_sim_default, sim_type = _sim_table(result_or_timeseries)
+    if t_impact_sim is None:
+        t_impact_sim = t_sim_default
+    if t_impact_sim is None:
+        raise ValueError("t_impact_sim is required (the run has no first contact)")
+    t_impact_sim = float(t_impact_sim)
+    t_log0 = float(log.impact_time_s)
+    notes: list[str] = []
+
+    sim = pd.DataFrame({"tau_s": ts["t_s"].to_numpy(dtype=float) - t_impact_sim})
+    for _, (_, quantities) in GROUPS.items():
+        for _, col, wrapped in quantities:
+            if col in ts:
+                v = ts[col].to_numpy(dtype=float)
+                sim[col] = np.degrees(np.unwrap(np.radians(v))) if wrapped else v
+    quats = ["q0", "q1", "q2", "q3"]
+    for c in quats:
+        if c in ts:
+            sim[c] = ts[c].to_numpy(dtype=float)
+    pose = log.pose().copy()
+    pose.insert(0, "tau_s", pose["t_s"].to_numpy(dtype=float) - t_log0)
+    have_quats = all(c in sim for c in quats) and all(c in pose for c in quats)
+    if "yaw_deg" in sim and "yaw_deg" in pose and len(pose):
+        y_sim0 = float(np.interp(0.0, sim["tau_s"], sim["yaw_deg"]))
+        k0 = int(np.argmin(np.abs(pose["tau_s"].to_numpy())))
+        dyaw = float(_wrap_deg(np.array(y_sim0 - pose["yaw_deg"].iloc[k0])))
+        if abs(dyaw) > 90.0:
+            notes.append(
+                f"headings at the impact differ by {dyaw:.0f} deg: the log approaches "
+                "rear-first and the run front-first (or the reverse); read the log with "
+                "front_first=True to compare like with like"
+            )
+    motors = log.motors().copy()
+    motors.insert(0, "tau_s", motors["t_s"].to_numpy(dtype=float) - t_log0)
+
+    if relative_position:
+        for col in ("x_m", "y_m", "altitude_m"):
+            if col in sim:
+                sim[col] = sim[col] - np.interp(0.0, sim["tau_s"], sim[col])
+            if col in pose and len(pose):
+                tp = pose["tau_s"].to_numpy()
+                ref = _interp_segments(np.array([0.0]), tp, pose[col].to_numpy(), MOCAP_GAP_S)[0]
+                if not math.isfinite(ref):
+                    k = int(np.argmin(np.abs(tp)))
+                    ref = float(pose[col].iloc[k])
+                    notes.append(f"{col}: no log sample around the impact; reference taken "
+                                 f"at tau = {tp[k]:+.3f} s")  # fmt: skip
+                pose[col] = pose[col] - ref
+
+    rows: list[dict[str, Any]] = []
+    for w in windows:
+        for group, (unit, quantities) in GROUPS.items():
+            src = motors if group == "motors" else pose
+            sel = src[(src["tau_s"] >= 0.0) & (src["tau_s"] <= w)]
+            all_err: list[np.ndarray] = []
+            for qname, col, wrapped in quantities:
+                if col not in sel or col not in sim:
+                    continue
+                y_log = sel[col].to_numpy(dtype=float)
+                y_sim = np.interp(sel["tau_s"].to_numpy(), sim["tau_s"], sim[col],
+                                  left=np.nan, right=np.nan)  # fmt: skip
+                err = y_sim - y_log
+                if wrapped:
+                    err = _wrap_deg(err)
+                err = err[np.isfinite(err)]
+                all_err.append(err)
+                rows.append(_row(group, qname, unit, w, err))
+            cat = np.concatenate(all_err) if all_err else np.zeros(0)
+            rows.append(_row(group, "all", unit, w, cat))
+            if group == "attitude" and have_quats:
+                rows.append(_row(group, "rotation", unit, w, _rotation_error(sim, sel)))
+    errors = pd.DataFrame(rows, columns=["group", "quantity", "unit", "window_s", "rms",
+                                         "max_abs", "n"])  # fmt: skip
+    resp = log_response(log) if classify_log else None
+    return Comparison(
+        name=getattr(log, "name", "") or "log",
+        windows=tuple(float(w) for w in windows),
+        errors=errors,
+        sim=sim,
+        log_pose=pose,
+        log_motors=motors,
+        t_impact_sim=t_impact_sim,
+        t_impact_log=t_log0,
+        sim_response=sim_type,
+        log_response=resp,
+        notes=notes,
+    )
+
+
+def _rotation_error(sim: pd.DataFrame, sel: pd.DataFrame) -> np.ndarray:
+    """Angle (deg) of the rotation between the simulated and logged attitudes."""
+    tau = sel["tau_s"].to_numpy()
+    qs = np.column_stack([np.interp(tau, sim["tau_s"], sim[c], left=np.nan, right=np.nan)
+                          for c in ("q0", "q1", "q2", "q3")])  # fmt: skip
+    ql = sel[["q0", "q1", "q2", "q3"]].to_numpy(dtype=float)
+    qs = qs / np.linalg.norm(qs, axis=1, keepdims=True)
+    ql = ql / np.linalg.norm(ql, axis=1, keepdims=True)
+    # relative rotation conj(q_log) * q_sim; angle = 2 atan2(|vector|, |scalar|) (stable near 0)
+    w1, v1 = ql[:, 0], -ql[:, 1:]
+    w2, v2 = qs[:, 0], qs[:, 1:]
+    w = w1 * w2 - np.sum(v1 * v2, axis=1)
+    v = w1[:, None] * v2 + w2[:, None] * v1 + np.cross(v1, v2)
+    err = np.degrees(2.0 * np.arctan2(np.linalg.norm(v, axis=1), np.abs(w)))
+    return err[np.isfinite(err)]
+
+
+def _row(group: str, quantity: str, unit: str, w: float, err: np.ndarray) -> dict[str, Any]:
+    n = int(err.size)
+    rms = float(np.sqrt(np.mean(err**2))) if n else math.nan
+    mx = float(np.max(np.abs(err))) if n else math.nan
+    return {"group": group, "quantity": quantity, "unit": unit, "window_s": float(w),
+            "rms": rms, "max_abs": mx, "n": n}  # fmt: skip

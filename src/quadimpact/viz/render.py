@@ -1,0 +1,318 @@
+"""Drawing a :class:`~quadimpact.viz.scene.Scene` on a matplotlib Axes.
+
+:class:`SceneArtists` creates every artist once (lines, patches, texts) and
+:meth:`SceneArtists.update` moves them to another instant by changing their
+data in place, which is what makes animations fast (no artist is created or
+removed per frame). Coordinates on the Axes are the camera's screen
+coordinates in metres with ``aspect = "equal"``, so scaling is equal in every
+direction; altitude is up.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import LineCollection
+from matplotlib.lines import Line2D
+from matplotlib.patches import FancyArrowPatch, Polygon
+
+from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene, plane_axes, plane_grid
+
+__all__ = ["FORCE_COLOR", "GROUND_COLOR", "SceneArtists", "WALL_COLOR", "wall_range"]
+
+WALL_COLOR = "#9aa5b1"
+GROUND_COLOR = "#c8b48a"
+FORCE_COLOR = "#7b2cbf"
+BODY_COLOR = "#222222"
+AXIS_COLORS = ("#444444", "#444444", "#444444")
+MAX_CONTACTS = 8  # drawn at once (4 bumpers x 2 surfaces)
+WALL_WIDTH_M = 1.0  # walls: a panel this wide, from the view centre away from the camera
+
+
+def wall_range(normal: np.ndarray, forward: np.ndarray) -> tuple[float, float] | None:
+    """Extent of a wall panel along its horizontal axis, from the view centre.
+
+    A wall (a steep plane) is drawn cut by the vertical plane through the view
+    centre that contains the wall normal: only the part beyond it, seen from
+    the camera, is drawn, so the cut edge is where the vehicle meets the wall
+    and nothing of the wall hides the vehicle. Flat planes (the ground): ``None``
+    (a square around the centre).
+    """
+    m = np.asarray(normal, dtype=float)
+    if abs(m[2]) / np.linalg.norm(m) > 0.7:
+        return None
+    e1, _ = plane_axes(m)
+    return (0.0, WALL_WIDTH_M) if float(e1 @ forward) > 0.0 else (-WALL_WIDTH_M, 0.0)
+
+
+class SceneArtists:
+    """The artists of one view of a scene, updated in place.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        Axes to draw on (its limits, aspect and frame are set here).
+    scene : Scene
+        The run.
+    camera : Camera
+        View direction, following mode and picture height.
+    aspect : float
+        Width / height of the picture (sets the x limits).
+    labels : bool
+        Draw the bumper numbers and body axis names.
+    compass : bool
+        Draw the small inertial triad (X, Y, up) in a corner.
+    linewidth : float
+        Width of the bumper rims (others scale with it).
+    """
+
+    def __init__(
+        self,
+        ax: Axes,
+        scene: Scene,
+        camera: Camera,
+        aspect: float = 1.0,
+        labels: bool = True,
+        compass: bool = True,
+        linewidth: float = 2.0,
+    ) -> None:
+        self.ax = ax
+        self.scene = scene
+        self.camera = camera
+        self.half_h = 0.5 * camera.span_m
+        self.half_w = self.half_h * aspect
+        ax.set_xlim(-self.half_w, self.half_w)
+        ax.set_ylim(-self.half_h, self.half_h)
+        ax.set_aspect("equal", adjustable="box")
+        ax.set_xticks([])
+        ax.set_yticks([])
+        for spine in ax.spines.values():
+            spine.set_color("#bbbbbb")
+        ax.set_facecolor("white")
+        right, up, forward = camera.basis()
+        self._forward = forward
+        lw = linewidth
+
+        # planes: the contact surfaces, and the ground plane for reference
+        self.planes: list[tuple[np.ndarray, np.ndarray, float | None, Polygon, LineCollection]] = []
+        planes = [(s.point_m, s.normal, s.name) for s in scene.surfaces]
+        if not any(s.is_ground for s in scene.surfaces):
+            planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), "ground"))
+        for point, normal, name in planes:
+            p = np.asarray(point, float)
+            m = np.asarray(normal, float) / np.linalg.norm(normal)
+            color = GROUND_COLOR if name == "ground" else WALL_COLOR
+            # a camera on the free side of the plane sees it behind the vehicle
+            in_front = float(-forward @ m) < 0.0
+            z = 10 if in_front else 0.5
+            poly = Polygon(
+                np.zeros((4, 2)),
+                closed=True,
+                facecolor=color,
+                edgecolor="#59636e",
+                linewidth=0.8 * lw / 2,
+                alpha=0.3 if in_front else 0.45,
+                zorder=z,
+            )
+            grid = LineCollection(
+                [], colors="#6b7785", linewidths=0.4 * lw / 2, alpha=0.35, zorder=z
+            )
+            ax.add_patch(poly)
+            ax.add_collection(grid)
+            self.planes.append((p, m, wall_range(m, forward), poly, grid))
+
+        self.discs = [
+            Polygon(
+                np.zeros((2, 2)),
+                closed=True,
+                facecolor="#888888",
+                edgecolor="#777777",
+                alpha=0.18,
+                linewidth=0.5 * lw / 2,
+                zorder=3,
+            )
+            for _ in range(4)
+        ]
+        for p in self.discs:
+            ax.add_patch(p)
+        self.arms = LineCollection([], colors=BODY_COLOR, linewidths=1.6 * lw / 2, zorder=4)
+        ax.add_collection(self.arms)
+        (self.hub,) = ax.plot([], [], color=BODY_COLOR, linewidth=1.2 * lw / 2, zorder=4)
+        self.axes_lines = [
+            ax.plot([], [], color=AXIS_COLORS[k], linewidth=1.0 * lw / 2, zorder=6)[0]
+            for k in range(3)
+        ]
+        self.axes_text = [
+            ax.text(
+                0,
+                0,
+                name,
+                fontsize=7,
+                color="#444444",
+                ha="center",
+                va="center",
+                zorder=7,
+                visible=labels,
+            )
+            for name in ("x", "y", "z")
+        ]
+        self.circles = [
+            ax.plot(
+                [], [], color=BUMPER_COLORS_HEX[j], linewidth=lw, zorder=5, solid_capstyle="round"
+            )[0]
+            for j in (1, 2, 3, 4)
+        ]
+        self.labels = [
+            ax.text(
+                0,
+                0,
+                str(j),
+                fontsize=9,
+                fontweight="bold",
+                color=BUMPER_COLORS_HEX[j],
+                ha="center",
+                va="center",
+                zorder=7,
+                visible=labels,
+            )
+            for j in (1, 2, 3, 4)
+        ]
+        # contacts: deepest point, deflection segment, force arrow, force value
+        self.points: list[Line2D] = []
+        self.deflections: list[Line2D] = []
+        self.arrows: list[FancyArrowPatch] = []
+        self.force_texts = []
+        for _ in range(MAX_CONTACTS):
+            (pt,) = ax.plot(
+                [],
+                [],
+                "o",
+                markersize=3.5 * lw / 2,
+                markerfacecolor="black",
+                markeredgecolor="white",
+                markeredgewidth=0.6,
+                zorder=12,
+            )
+            (dl,) = ax.plot([], [], color="black", linewidth=2.2 * lw / 2, zorder=11)
+            arrow = FancyArrowPatch(
+                (0, 0),
+                (0, 0),
+                arrowstyle="-|>",
+                mutation_scale=10 * lw / 2,
+                color=FORCE_COLOR,
+                linewidth=1.6 * lw / 2,
+                shrinkA=0.0,
+                shrinkB=0.0,
+                zorder=12,
+            )
+            ax.add_patch(arrow)
+            txt = ax.text(0, 0, "", fontsize=7, color=FORCE_COLOR, zorder=12)
+            self.points.append(pt)
+            self.deflections.append(dl)
+            self.arrows.append(arrow)
+            self.force_texts.append(txt)
+        self.show_force_text = labels
+
+        self.compass: list = []
+        if compass:
+            self._draw_compass(right, up)
+
+    # ------------------------------------------------------------ static parts
+    def _draw_compass(self, right: np.ndarray, up: np.ndarray) -> None:
+        """Inertial directions X (to the wall), Y (right) and up, in the lower left corner."""
+        ax = self.ax
+        size = 0.09 * 2 * self.half_h
+        origin = np.array([-self.half_w + 1.3 * size, -self.half_h + 1.3 * size])
+        dirs = {
+            "X": np.array([1.0, 0.0, 0.0]),
+            "Y": np.array([0.0, 1.0, 0.0]),
+            "up": np.array([0.0, 0.0, -1.0]),
+        }
+        for name, v in dirs.items():
+            s = np.array([v @ right, v @ up])
+            tip = origin + size * s
+            arrow = ax.annotate(
+                "",
+                xy=tip,
+                xytext=origin,
+                arrowprops={
+                    "arrowstyle": "-|>",
+                    "color": "#555555",
+                    "lw": 0.8,
+                    "mutation_scale": 7,
+                },
+                zorder=13,
+            )
+            self.compass.append(arrow)
+            if np.hypot(*s) > 0.15:
+                label = origin + size * s + 0.4 * size * s / np.hypot(*s)
+                self.compass.append(
+                    ax.text(
+                        label[0],
+                        label[1],
+                        name,
+                        fontsize=6.5,
+                        color="#555555",
+                        ha="center",
+                        va="center",
+                        zorder=13,
+                    )
+                )
+
+    # ------------------------------------------------------------ per frame
+    def update(self, t: float) -> list:
+        """Move every artist to time ``t``; return the artists changed."""
+        scene, cam = self.scene, self.camera
+        fr = scene.frame(t)
+        target = scene.target(t, cam)
+
+        def P(points: np.ndarray) -> np.ndarray:
+            return cam.project(points, target)
+
+        half = 2.5 * max(self.half_w, self.half_h)
+        for p, m, width, poly, grid in self.planes:
+            outline, segs = plane_grid(p, m, target, half, step=0.1, range1=width)
+            poly.set_xy(P(outline[:4]))
+            grid.set_segments(list(P(segs)) if len(segs) else [])
+
+        depth = cam.depth(fr.circles.mean(axis=1), target)
+        order = np.argsort(-depth)  # far first
+        for rank, j in enumerate(order):
+            self.circles[j].set_data(*P(fr.circles[j]).T)
+            self.circles[j].set_zorder(5 + 0.1 * rank)
+            self.discs[j].set_xy(P(fr.discs[j]))
+            self.labels[j].set_position(P(fr.label_points[j]))
+        self.arms.set_segments(list(P(fr.arms)))
+        self.hub.set_data(*P(fr.hub).T)
+        for k in range(3):
+            seg = P(fr.axes[k])
+            self.axes_lines[k].set_data(*seg.T)
+            tip = seg[1] + 0.18 * (seg[1] - seg[0])
+            self.axes_text[k].set_position(tip)
+
+        n = min(len(fr.contacts), MAX_CONTACTS)
+        for i in range(MAX_CONTACTS):
+            on = i < n
+            for art in (self.points[i], self.deflections[i], self.arrows[i], self.force_texts[i]):
+                art.set_visible(on)
+            if not on:
+                continue
+            c = fr.contacts[i]
+            pc, ps, tip = P(c.point), P(c.surface_point), P(c.arrow_tip)
+            self.points[i].set_data([pc[0]], [pc[1]])
+            self.deflections[i].set_data([pc[0], ps[0]], [pc[1], ps[1]])
+            self.deflections[i].set_color(BUMPER_COLORS_HEX[c.bumper])
+            self.arrows[i].set_positions(tuple(ps), tuple(tip))
+            self.force_texts[i].set_position(tip + 0.01 * 2 * self.half_h)
+            show = self.show_force_text and c.force_n >= 0.05
+            self.force_texts[i].set_text(f"{c.force_n:.1f} N" if show else "")
+        return self.artists()
+
+    def artists(self) -> list:
+        """Every artist this view draws (for blitting: all change between frames
+        or lie over ones that do), in drawing order (by zorder)."""
+        arts = [a for _p, _m, _r, poly, grid in self.planes for a in (poly, grid)]
+        arts += [*self.discs, self.arms, self.hub, *self.axes_lines, *self.axes_text]
+        arts += [*self.circles, *self.labels, *self.points, *self.deflections, *self.arrows]
+        arts += [*self.force_texts, *self.compass]
+        return sorted(arts, key=lambda a: a.get_zorder())

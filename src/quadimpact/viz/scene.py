@@ -1,0 +1,586 @@
+"""Geometry of the 3D scene of an impact, in NumPy (no drawing here).
+
+Everything is computed in the inertial NED frame (X toward the wall, Y right,
+Z down) from the vehicle's parameter file and the sampled states of a run:
+
+* the vehicle (:class:`VehicleDrawing`): the four bumper circles exactly as the
+  contact law defines them (MODEL.md 4: circle ``j`` of radius ``Rb`` centred
+  on rotor ``j``, in-plane outward ``u_j``, normal ``n_j``), the rotor discs,
+  the hub, the arms and the body axes, as body-frame polylines;
+* the contact surfaces (the wall at ``X = wall_distance_m``; the ground when it
+  was a contact surface) and the ground plane ``altitude = 0`` for reference;
+* during contact, per bumper and surface, the deepest rim point given by the
+  compiled contact function :func:`quadimpact.core.contact.bumper_plane_contact`
+  (so the drawing shows the point the simulation pushed on), the deflection
+  (the segment from that point to the surface, of length delta) and the normal
+  force as an arrow along the surface normal;
+* the camera (:class:`Camera`): an orthographic view from a given azimuth and
+  elevation, altitude always up on screen and one metre the same length in
+  every direction (equal scaling), following the vehicle or fixed at the
+  impact point on the wall.
+
+A :class:`Scene` holds one run; :meth:`Scene.frame` gives every polyline and
+contact of one instant, and :meth:`Camera.project` puts points on the screen.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+import pandas as pd
+
+from quadimpact.core import layout as L
+from quadimpact.frames import quat_to_matrix
+from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.vehicle import Vehicle, load_vehicle
+
+__all__ = [
+    "AXIS_LENGTH_M",
+    "BUMPER_COLORS_HEX",
+    "BUMPER_NAMES",
+    "FORCE_SCALE_M_PER_N",
+    "ROTOR_DISC_FRACTION",
+    "Camera",
+    "ContactMark",
+    "Scene",
+    "SceneFrame",
+    "VehicleDrawing",
+    "contact_points",
+    "plane_axes",
+    "plane_grid",
+    "rim_points",
+    "scene_surfaces",
+    "to_inertial",
+]
+
+#: Where each bumper sits on the Spiri (rotor j, body FRD).
+BUMPER_NAMES = {1: "starboard front", 2: "starboard rear", 3: "port rear", 4: "port front"}
+
+#: Bumper colours, the same as the plots' ``BUMPER_COLORS`` (matplotlib tab10).
+BUMPER_COLORS_HEX = {1: "#1f77b4", 2: "#ff7f0e", 3: "#2ca02c", 4: "#d62728"}
+
+#: Rotor discs are drawn with this fraction of the bumper radius (a drawing
+#: choice: the parameter file has no propeller radius).
+ROTOR_DISC_FRACTION = 0.8
+
+#: Length of the force arrows, m per N (10 N is drawn 10 cm long).
+FORCE_SCALE_M_PER_N = 0.01
+
+#: Length of the drawn body axes, m.
+AXIS_LENGTH_M = 0.09
+
+#: Half size of the drawn hub square, m.
+HUB_HALF_M = 0.035
+
+
+def to_inertial(points_b: np.ndarray, position: np.ndarray, C: np.ndarray) -> np.ndarray:
+    """Body-frame points (..., 3) to inertial NED: ``p + C r``."""
+    return np.asarray(position, dtype=float) + np.asarray(points_b, dtype=float) @ C.T
+
+
+def rim_points(
+    centre: np.ndarray, u: np.ndarray, n: np.ndarray, radius: float, beta: np.ndarray
+) -> np.ndarray:
+    """Points ``c + R (cos b u + sin b (n x u))`` of a circle (MODEL.md 4), shape (len(beta), 3)."""
+    w = np.cross(n, u)
+    b = np.asarray(beta, dtype=float)[:, None]
+    return centre + radius * (np.cos(b) * u + np.sin(b) * w)
+
+
+@dataclass(frozen=True)
+class VehicleDrawing:
+    """Body-frame polylines of a vehicle, built from its parameters.
+
+    Attributes
+    ----------
+    vehicle : Vehicle
+        The vehicle drawn.
+    centres, u, n : numpy.ndarray, shape (4, 3)
+        Bumper circle centres, in-plane outward and normal unit vectors
+        (:meth:`Vehicle.bumper_frames`), body FRD.
+    radius_m : float
+        Bumper radius Rb, m.
+    circles : numpy.ndarray, shape (4, N + 1, 3)
+        Closed bumper rims (last point = first), body FRD, m.
+    discs : numpy.ndarray, shape (4, N + 1, 3)
+        Closed rotor discs (in the body x-y plane through each hub).
+    hub : numpy.ndarray, shape (5, 3)
+        Closed hub square.
+    arms : numpy.ndarray, shape (4, 2, 3)
+        Segments from the CM to each rotor.
+    axes : numpy.ndarray, shape (3, 3)
+        Tips of the body x, y, z axes (rows).
+    label_points : numpy.ndarray, shape (4, 3)
+        Where the bumper numbers go (outside each rim, along ``u_j``).
+    packed : numpy.ndarray
+        The vehicle as the compiled core's ``V_*`` vector.
+    """
+
+    vehicle: Vehicle
+    centres: np.ndarray
+    u: np.ndarray
+    n: np.ndarray
+    radius_m: float
+    circles: np.ndarray
+    discs: np.ndarray
+    hub: np.ndarray
+    arms: np.ndarray
+    axes: np.ndarray
+    label_points: np.ndarray
+    packed: np.ndarray
+
+    @classmethod
+    def from_vehicle(cls, vehicle: Vehicle, n_points: int = 72) -> VehicleDrawing:
+        """Build the drawing of ``vehicle`` with ``n_points`` segments per circle."""
+        centres, u, n = vehicle.bumper_frames()
+        rb = float(vehicle.bumper_radius_m)
+        beta = np.linspace(0.0, 2.0 * math.pi, n_points + 1)
+        circles = np.stack([rim_points(centres[j], u[j], n[j], rb, beta) for j in range(4)])
+        e_z = np.array([0.0, 0.0, 1.0])
+        e_x = np.array([1.0, 0.0, 0.0])
+        discs = np.stack(
+            [rim_points(centres[j], e_x, -e_z, ROTOR_DISC_FRACTION * rb, beta) for j in range(4)]
+        )
+        z_hub = float(np.mean(centres[:, 2]))
+        h = HUB_HALF_M
+        hub = np.array(
+            [[h, h, z_hub], [-h, h, z_hub], [-h, -h, z_hub], [h, -h, z_hub], [h, h, z_hub]]
+        )
+        arms = np.stack([np.stack([np.zeros(3), centres[j]]) for j in range(4)])
+        axes = AXIS_LENGTH_M * np.eye(3)
+        label_points = centres + 1.3 * rb * u
+        return cls(
+            vehicle=vehicle,
+            centres=centres,
+            u=u,
+            n=n,
+            radius_m=rb,
+            circles=circles,
+            discs=discs,
+            hub=hub,
+            arms=arms,
+            axes=axes,
+            label_points=label_points,
+            packed=pack_vehicle(vehicle),
+        )
+
+
+def scene_surfaces(
+    summary: Mapping[str, Any], episodes: pd.DataFrame | None = None
+) -> list[Surface]:
+    """The contact surfaces of a run, from its summary (and episodes).
+
+    A ``surfaces`` list in the summary (``name``, ``point_m``, ``normal``) is
+    used when present; otherwise the wall ``X = wall_distance_m`` (normal -X)
+    of a wall approach. The ground (altitude 0, normal up) is added when an
+    episode touched it (it was then a contact surface).
+    """
+    out: list[Surface] = []
+    listed = summary.get("surfaces")
+    if isinstance(listed, Sequence) and listed:
+        for s in listed:
+            out.append(
+                Surface(
+                    str(s["name"]),
+                    tuple(float(c) for c in s["point_m"]),
+                    tuple(float(c) for c in s["normal"]),
+                    bool(s.get("is_ground", s["name"] == "ground")),
+                )
+            )
+    elif summary.get("wall_distance_m") is not None:
+        d = float(summary["wall_distance_m"])
+        out.append(Surface("wall", (d, 0.0, 0.0), (-1.0, 0.0, 0.0)))
+    names = {s.name for s in out}
+    touched = set()
+    if episodes is not None and len(episodes) and "surface" in episodes:
+        touched = {str(x) for x in episodes["surface"]}
+    if "ground" in touched and "ground" not in names:
+        out.append(Surface("ground", (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True))
+    return out
+
+
+def contact_points(
+    x: np.ndarray, drawing: VehicleDrawing, surf: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Deepest rim point of every bumper against every surface, by the compiled contact law.
+
+    Parameters
+    ----------
+    x : numpy.ndarray, shape (NX,)
+        State (layout ``X_*``).
+    drawing : VehicleDrawing
+        The vehicle.
+    surf : numpy.ndarray
+        Packed surfaces (:func:`quadimpact.packing.pack_surfaces`).
+
+    Returns
+    -------
+    points : numpy.ndarray, shape (4, n_surfaces, 3)
+        Deepest rim points, inertial NED, m.
+    depths : numpy.ndarray, shape (4, n_surfaces)
+        Penetrations delta, m (positive in contact).
+    """
+    from quadimpact.core.contact import bumper_plane_contact
+
+    xq = np.ascontiguousarray(x, dtype=float)
+    C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
+    ns = surf.shape[0]
+    points = np.zeros((4, ns, 3))
+    depths = np.zeros((4, ns))
+    for j in range(4):
+        for s in range(ns):
+            d, _dd, rx, ry, rz, *_ = bumper_plane_contact(xq, C, drawing.packed, j, surf, s)
+            points[j, s] = xq[L.X_POS : L.X_POS + 3] + C @ np.array([rx, ry, rz])
+            depths[j, s] = d
+    return points, depths
+
+
+def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors spanning a plane: ``e1`` horizontal (for a non-horizontal
+    plane), ``e2 = m x e1`` its steepest direction."""
+    m = np.asarray(normal, dtype=float)
+    m = m / np.linalg.norm(m)
+    ref = np.array([0.0, 0.0, 1.0]) if abs(m[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    e1 = np.cross(m, ref)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(m, e1)
+
+
+def plane_grid(
+    point: np.ndarray,
+    normal: np.ndarray,
+    centre: np.ndarray,
+    half_size: float,
+    step: float = 0.1,
+    range1: tuple[float, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """A rectangular patch of a plane around ``centre`` and grid lines fixed in space.
+
+    Parameters
+    ----------
+    point, normal : array_like
+        The plane (NED).
+    centre : array_like
+        Point whose projection onto the plane is the patch's reference.
+    half_size : float
+        Extent each way along ``e2`` (:func:`plane_axes`), m.
+    step : float
+        Grid spacing, m; the lines sit at multiples of ``step`` from ``point``.
+    range1 : (float, float), optional
+        Extent along ``e1`` from the reference, m; default ``(-half_size, half_size)``.
+        A wall drawn with ``(-w, 0)`` or ``(0, w)`` is cut by the vertical plane
+        through ``centre``, so the cut edge shows where the vehicle meets it.
+
+    Returns
+    -------
+    outline : numpy.ndarray, shape (5, 3)
+        Closed rectangle in the plane.
+    segments : numpy.ndarray, shape (k, 2, 3)
+        Grid lines inside it.
+    """
+    p0 = np.asarray(point, dtype=float)
+    e1, e2 = plane_axes(normal)
+    rel = np.asarray(centre, dtype=float) - p0
+    a0, b0 = float(rel @ e1), float(rel @ e2)
+    lo1, hi1 = (-half_size, half_size) if range1 is None else range1
+    ranges = ((a0 + lo1, a0 + hi1), (b0 - half_size, b0 + half_size))
+    (a_lo, a_hi), (b_lo, b_hi) = ranges
+    corners = [(a_lo, b_lo), (a_hi, b_lo), (a_hi, b_hi), (a_lo, b_hi), (a_lo, b_lo)]
+    outline = np.array([p0 + a * e1 + b * e2 for a, b in corners])
+    segs = []
+    for axis, other, (lo, hi), (olo, ohi) in ((e1, e2, *ranges), (e2, e1, *ranges[::-1])):
+        for k in range(math.ceil(lo / step - 1e-9), math.floor(hi / step + 1e-9) + 1):
+            base = p0 + k * step * axis
+            segs.append([base + olo * other, base + ohi * other])
+    return outline, np.array(segs, dtype=float).reshape(-1, 2, 3)
+
+
+@dataclass(frozen=True)
+class Camera:
+    """An orthographic camera: altitude up on screen, equal scaling.
+
+    Attributes
+    ----------
+    azimuth_deg : float
+        Direction from the target to the camera seen from above, deg from +X
+        (toward the wall) toward +Y (right); 90 looks from the starboard side
+        (the wall on the right of the picture), 180 from behind.
+    elevation_deg : float
+        Height of the camera above the horizontal through the target, deg in
+        [-89, 89]; positive looks down on the vehicle.
+    follow : {"vehicle", "wall"}
+        ``"vehicle"``: centred on the CM at every instant; ``"wall"``: fixed,
+        centred on the CM at the first contact (the impact point on the wall).
+    span_m : float
+        Height of the picture, m (the width follows from the aspect ratio).
+    """
+
+    azimuth_deg: float = 120.0
+    elevation_deg: float = 20.0
+    follow: Literal["vehicle", "wall"] = "vehicle"
+    span_m: float = 0.9
+
+    def __post_init__(self) -> None:
+        if self.follow not in ("vehicle", "wall"):
+            raise ValueError(f"follow must be 'vehicle' or 'wall' (got {self.follow!r})")
+        if not -89.0 <= self.elevation_deg <= 89.0:
+            raise ValueError("elevation_deg must lie in [-89, 89]")
+        if not self.span_m > 0:
+            raise ValueError("span_m must be > 0")
+
+    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Screen right, screen up and viewing direction (into the screen), NED unit vectors."""
+        az = math.radians(self.azimuth_deg)
+        el = math.radians(self.elevation_deg)
+        to_camera = np.array(
+            [math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), -math.sin(el)]
+        )
+        forward = -to_camera
+        world_up = np.array([0.0, 0.0, -1.0])  # NED: up is -Z
+        right = np.cross(forward, world_up)
+        right /= np.linalg.norm(right)
+        up = np.cross(right, forward)
+        return right, up, forward
+
+    def project(self, points: np.ndarray, target: np.ndarray) -> np.ndarray:
+        """Screen coordinates (m, right and up from the picture centre) of NED points (..., 3)."""
+        right, up, _ = self.basis()
+        rel = np.asarray(points, dtype=float) - np.asarray(target, dtype=float)
+        return np.stack([rel @ right, rel @ up], axis=-1)
+
+    def depth(self, points: np.ndarray, target: np.ndarray) -> np.ndarray:
+        """Distance along the viewing direction (larger = farther from the camera), m."""
+        _, _, forward = self.basis()
+        return (np.asarray(points, dtype=float) - np.asarray(target, dtype=float)) @ forward
+
+
+@dataclass
+class ContactMark:
+    """One bumper touching one surface at one instant (inertial NED, SI)."""
+
+    bumper: int  # 1-4
+    surface: str
+    delta_m: float
+    point: np.ndarray  # deepest rim point (inside the surface)
+    surface_point: np.ndarray  # its projection on the surface: point + delta m
+    normal: np.ndarray  # surface unit normal (out of the obstacle)
+    force_n: float
+    arrow_tip: np.ndarray  # surface_point + FORCE_SCALE_M_PER_N * force * normal
+
+
+@dataclass
+class SceneFrame:
+    """Everything drawn at one instant: inertial NED polylines and contacts."""
+
+    t: float
+    position: np.ndarray
+    C: np.ndarray
+    circles: np.ndarray  # (4, N+1, 3)
+    discs: np.ndarray  # (4, N+1, 3)
+    hub: np.ndarray  # (5, 3)
+    arms: np.ndarray  # (4, 2, 3)
+    axes: np.ndarray  # (3, 2, 3): CM -> tip of body x, y, z
+    label_points: np.ndarray  # (4, 3)
+    contacts: list[ContactMark] = field(default_factory=list)
+    deltas: np.ndarray = field(default_factory=lambda: np.zeros(4))
+    forces: np.ndarray = field(default_factory=lambda: np.zeros(4))
+
+
+_STATE_COLUMNS = (
+    ["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3"]
+    + ["p_rad_s", "q_rad_s", "r_rad_s"]
+    + [f"omega{j}_rad_s" for j in (1, 2, 3, 4)]
+)
+
+
+class Scene:
+    """One run, ready to be drawn at any instant.
+
+    Parameters
+    ----------
+    timeseries : pandas.DataFrame
+        The run's samples (``timeseries.parquet``).
+    summary : mapping
+        The run's summary (``summary.json``).
+    episodes : pandas.DataFrame, optional
+        The run's episodes (to know whether the ground was a contact surface).
+    vehicle : Vehicle, optional
+        Default: ``load_vehicle(summary["vehicle"])``.
+    surfaces : list of Surface, optional
+        Default: :func:`scene_surfaces`.
+    n_points : int
+        Segments per drawn circle.
+    """
+
+    def __init__(
+        self,
+        timeseries: pd.DataFrame,
+        summary: Mapping[str, Any],
+        episodes: pd.DataFrame | None = None,
+        vehicle: Vehicle | None = None,
+        surfaces: list[Surface] | None = None,
+        n_points: int = 72,
+    ) -> None:
+        if len(timeseries) == 0:
+            raise ValueError("the run has no samples to draw")
+        self.summary = dict(summary)
+        if vehicle is None:
+            vehicle = load_vehicle(summary.get("vehicle") or None)
+        self.drawing = VehicleDrawing.from_vehicle(vehicle, n_points)
+        self.surfaces = scene_surfaces(summary, episodes) if surfaces is None else list(surfaces)
+        self.surf = pack_surfaces(self.surfaces) if self.surfaces else np.zeros((0, L.NSURF))
+        ts = timeseries
+        self.t = ts["t_s"].to_numpy(dtype=float)
+        self.states = np.zeros((len(ts), L.NX))
+        for k, col in enumerate(_STATE_COLUMNS):
+            if col in ts:
+                self.states[:, k] = ts[col].to_numpy(dtype=float)
+        self.deltas = np.stack([ts[f"delta{j}_m"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
+        self.forces = np.stack([ts[f"force{j}_n"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
+        self.euler_deg = np.stack(
+            [ts[c].to_numpy(dtype=float) for c in ("roll_deg", "pitch_deg", "yaw_deg")], 1
+        )
+        self.altitude = -self.states[:, 2]
+        fc = summary.get("first_contact_s")
+        self.first_contact_s: float | None = None if fc is None else float(fc)
+        crash = summary.get("crash_time_s")
+        self.crash_time_s: float | None = None if crash is None else float(crash)
+        wall = summary.get("wall_distance_m")
+        self.wall_x_m: float | None = None if wall is None else float(wall)
+        self.anchor = self.state_at(
+            self.t[0] if self.first_contact_s is None else self.first_contact_s
+        )[0:3].copy()
+
+    @classmethod
+    def from_result(cls, result: Any, vehicle: Vehicle | None = None, **kw: Any) -> Scene:
+        """Scene of a :class:`~quadimpact.result.SimulationResult`."""
+        return cls(result.timeseries, result.summary, result.episodes, vehicle=vehicle, **kw)
+
+    @classmethod
+    def from_dir(cls, directory: Any, vehicle: Vehicle | None = None, **kw: Any) -> Scene:
+        """Scene of a result folder (``quadimpact.io.read_result``)."""
+        from quadimpact.io import read_result
+
+        return cls.from_result(read_result(directory), vehicle=vehicle, **kw)
+
+    # ------------------------------------------------------------ time
+    @property
+    def t_start(self) -> float:
+        return float(self.t[0])
+
+    @property
+    def t_end(self) -> float:
+        return float(self.t[-1])
+
+    @property
+    def t_ref(self) -> float:
+        """Origin of "time after impact": the first contact, else the first sample."""
+        return self.t_start if self.first_contact_s is None else self.first_contact_s
+
+    def _interp(self, table: np.ndarray, t: float) -> np.ndarray:
+        tt = self.t
+        if t <= tt[0]:
+            return table[0].copy()
+        if t >= tt[-1]:
+            return table[-1].copy()
+        k = int(np.searchsorted(tt, t, side="right")) - 1
+        w = (t - tt[k]) / (tt[k + 1] - tt[k])
+        return (1.0 - w) * table[k] + w * table[k + 1]
+
+    def state_at(self, t: float) -> np.ndarray:
+        """State (layout ``X_*``) at time ``t``: linear between samples, quaternion normalised."""
+        x = self._interp(self.states, float(t))
+        q = x[L.X_QUAT : L.X_QUAT + 4]
+        x[L.X_QUAT : L.X_QUAT + 4] = q / np.linalg.norm(q)
+        return x
+
+    def values_at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Deflections (m), forces (N) and Euler angles (deg) at time ``t`` (linear)."""
+        return (
+            self._interp(self.deltas, t),
+            self._interp(self.forces, t),
+            self._interp(self.euler_deg, t),
+        )
+
+    # ------------------------------------------------------------ geometry
+    def frame(self, t: float) -> SceneFrame:
+        """Every polyline and contact of the scene at time ``t`` (inertial NED)."""
+        x = self.state_at(t)
+        pos = x[0:3]
+        C = quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4])
+        d = self.drawing
+        deltas, forces, _ = self.values_at(t)
+        tips = to_inertial(d.axes, pos, C)
+        frame = SceneFrame(
+            t=float(t),
+            position=pos,
+            C=C,
+            circles=to_inertial(d.circles, pos, C),
+            discs=to_inertial(d.discs, pos, C),
+            hub=to_inertial(d.hub, pos, C),
+            arms=to_inertial(d.arms, pos, C),
+            axes=np.stack([np.stack([pos, tips[k]]) for k in range(3)]),
+            label_points=to_inertial(d.label_points, pos, C),
+            deltas=deltas,
+            forces=forces,
+        )
+        if self.surf.shape[0]:
+            frame.contacts = self._contacts(x, deltas, forces)
+        return frame
+
+    def _contacts(self, x: np.ndarray, deltas: np.ndarray, forces: np.ndarray) -> list[ContactMark]:
+        points, depths = contact_points(x, self.drawing, self.surf)
+        n_exp = float(self.drawing.vehicle.contact_exponent)
+        marks: list[ContactMark] = []
+        for j in range(4):
+            if not (deltas[j] > 0.0 or forces[j] > 0.0):
+                continue  # the simulation had no active contact on this bumper
+            touching = [s for s in range(self.surf.shape[0]) if depths[j, s] > 0.0]
+            if not touching:
+                continue
+            weights = np.array([depths[j, s] ** n_exp for s in touching])
+            weights = weights / weights.sum()
+            for w, s in zip(weights, touching, strict=True):
+                m = self.surf[s, L.S_NORMAL : L.S_NORMAL + 3]
+                delta = float(depths[j, s])
+                f = float(forces[j] * w)
+                on_surface = points[j, s] + delta * m
+                marks.append(
+                    ContactMark(
+                        bumper=j + 1,
+                        surface=self.surfaces[s].name,
+                        delta_m=delta,
+                        point=points[j, s].copy(),
+                        surface_point=on_surface,
+                        normal=m.copy(),
+                        force_n=f,
+                        arrow_tip=on_surface + FORCE_SCALE_M_PER_N * f * m,
+                    )
+                )
+        return marks
+
+    def target(self, t: float, camera: Camera) -> np.ndarray:
+        """Point at the picture centre at time ``t`` for ``camera``."""
+        if camera.follow == "vehicle":
+            return self.state_at(t)[0:3]
+        return self.anchor
+
+    def describe(self) -> str:
+        """One line naming the run (heading, inclination, speed, model, outcome type)."""
+        s = self.summary
+        parts = []
+        if s.get("heading_deg") is not None:
+            parts.append(f"heading {s['heading_deg']:g}°")
+        if s.get("inclination_deg") is not None:
+            parts.append(f"inclination {s['inclination_deg']:g}°")
+        if s.get("impact_speed_m_s") is not None:
+            parts.append(f"{s['impact_speed_m_s']:.2f} m/s")
+        if s.get("model"):
+            parts.append(str(s["model"]))
+        if s.get("response_type"):
+            parts.append(f"type {s['response_type']}")
+        return ", ".join(parts) or "quadimpact run"

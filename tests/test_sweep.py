@@ -1,0 +1,563 @@
+"""Sweeps: value parsing, spec validation, identical tables on every backend
+(in-process, local processes, a real Dask cluster on loopback), resume after
+SIGKILL, failed runs as rows, the command line and the plots."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+import quadimpact
+from quadimpact.errors import InputError
+from quadimpact.sweep import (
+    SUMMARY_COLUMNS,
+    SweepSpec,
+    flatten_summary,
+    load_sweep_file,
+    parse_values,
+    read_runs,
+    run_sweep,
+)
+
+SRC = Path(quadimpact.__file__).resolve().parents[1]
+BASE = {"model": "paper-replica", "final_time_s": 1.0}
+SMALL_GRID = {"heading_deg": [0, 45], "inclination_deg": [-5, 10], "speed_m_s": [0.75]}
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+    env.pop("QUADIMPACT_DEBUG", None)
+    return env
+
+
+def _cli(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "quadimpact.cli", *args],
+        cwd=cwd,
+        env=_env(),
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+# ------------------------------------------------------------------ values
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("0,45", [0, 45]),
+        ("-20:20:1", list(range(-20, 21))),
+        ("0:0.3:0.1", [0.0, 0.1, 0.2, 0.3]),
+        ("0.5:1:0.25", [0.5, 0.75, 1.0]),
+        ("1:0:-0.5", [1.0, 0.5, 0.0]),
+        ("0:1:0.3", [0.0, 0.3, 0.6, 0.9]),
+        ("-20:-10:5, 0, 10:20:10", [-20, -15, -10, 0, 10, 20]),
+        ("1e-3,2.5", [0.001, 2.5]),
+        ("paper-replica,default", ["paper-replica", "default"]),
+        ("true", [True]),
+        ("45", [45]),
+    ],
+)
+def test_parse_values(text, expected):
+    values = parse_values(text)
+    assert values == expected
+    assert [type(v) for v in values] == [type(v) for v in expected]
+
+
+def test_parse_values_no_float_drift():
+    values = parse_values("-2:2:0.1")
+    assert len(values) == 41
+    assert values == [round(-2 + 0.1 * k, 10) for k in range(41)]
+    assert values[-1] == 2.0 and values[23] == 0.3  # exact decimals, not 0.30000000000000004
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("", "empty value"),
+        ("0,,45", "empty value"),
+        ("1:2", "start:stop:step"),
+        ("a:b:c", "must be numbers"),
+        ("0:10:0", "step must not be 0"),
+        ("10:0:1", "empty range"),
+    ],
+)
+def test_parse_values_errors(text, fragment):
+    with pytest.raises(InputError, match=fragment):
+        parse_values(text, "inclination_deg")
+
+
+# ------------------------------------------------------------------- specs
+def test_spec_enumeration_and_vehicle_fields():
+    spec = SweepSpec(
+        base={"vehicle_overrides": {"mass_kg": 1.0}},
+        grid={"heading_deg": [0, 45], "inclination_deg": "-1:1:1", "restitution": [0.5]},
+    )
+    assert spec.n_runs == 6
+    assert spec.inputs(0) == {"heading_deg": 0.0, "inclination_deg": -1.0, "restitution": 0.5}
+    assert spec.inputs(4) == {"heading_deg": 45.0, "inclination_deg": 0.0, "restitution": 0.5}
+    data = spec.scenario_dict(4)
+    assert data["vehicle_overrides"] == {"mass_kg": 1.0, "restitution": 0.5}
+    assert "restitution" not in data
+    assert spec.columns == {"heading_deg": "f", "inclination_deg": "f", "restitution": "f"}
+    spec.validate()
+    # grid x runs: every grid point with every run
+    spec = SweepSpec(grid={"heading_deg": [0, 45]}, runs=[{"speed_m_s": 1}, {"model": "default"}])
+    assert spec.n_runs == 4
+    assert spec.inputs(3) == {"heading_deg": 45.0, "model": "default"}
+    assert spec.input_columns(spec.inputs(3)) == {
+        "heading_deg": 45.0,
+        "speed_m_s": None,
+        "model": "default",
+    }
+
+
+def test_sample_is_seeded():
+    def make(seed):
+        return SweepSpec(
+            sample={
+                "n": 50,
+                "seed": seed,
+                "ranges": {"inclination_deg": [-20, 20]},
+                "choices": {"heading_deg": [0, 45]},
+            }
+        )
+
+    a, b, c = make(3), make(3), make(4)
+    assert [a.inputs(i) for i in range(50)] == [b.inputs(i) for i in range(50)]
+    assert a.fingerprint() == b.fingerprint() != c.fingerprint()
+    values = [a.inputs(i)["inclination_deg"] for i in range(50)]
+    assert all(-20 <= v <= 20 for v in values) and len(set(values)) == 50
+    assert {a.inputs(i)["heading_deg"] for i in range(50)} == {0.0, 45.0}
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "fragment"),
+    [
+        ({"grid": {"headng_deg": [0]}}, "headng_deg: unknown field.*did you mean 'heading_deg'"),
+        ({"grid": {"inclination_deg": "-20:20:0"}}, "inclination_deg: range step must not be 0"),
+        ({"grid": {"inclination_deg": "20:-20:1"}}, "empty range"),
+        ({"grid": {}}, "empty sweep"),
+        ({"grid": {"heading_deg": []}}, "heading_deg: no values"),
+        ({"grid": {"heading_deg": [0, 0.0]}}, "listed twice"),
+        ({"grid": {"kind": ["flight"]}}, "kind: cannot be swept"),
+        (
+            {"grid": {"heading_deg": [0]}, "runs": [{"heading_deg": 1}]},
+            "both in the grid and in runs",
+        ),
+        ({"sample": {"n": 0, "ranges": {"heading_deg": [0, 1]}}}, r"n: must be an integer"),
+        ({"sample": {"n": 5, "ranges": {"heading_deg": [1, 0]}}}, "low < high"),
+        ({"base": {"modle": "default"}, "grid": {"heading_deg": [0]}}, "base: modle: unknown key"),
+    ],
+)
+def test_spec_errors(kwargs, fragment):
+    with pytest.raises(InputError, match=fragment) as info:
+        SweepSpec(**kwargs).validate()
+    assert "\n" not in str(info.value)
+
+
+def test_bad_values_rejected_before_anything_runs(tmp_path):
+    spec = SweepSpec(grid={"inclination_deg": [0, 70]})
+    with pytest.raises(
+        InputError, match=r"run 1 \(inclination_deg=70.0\): inclination_deg: must be <= 60"
+    ):
+        run_sweep(spec, tmp_path / "out", workers=1)
+    spec = SweepSpec(grid={"restitution": [0.5, 1.5]})
+    with pytest.raises(InputError, match=r"vehicle_overrides.restitution: must be <= 1"):
+        run_sweep(spec, tmp_path / "out", workers=1)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("[grid\nheading_deg = [0]\n", "invalid TOML"),
+        ("[grd]\nheading_deg = [0]\n", "grd: unknown key; did you mean 'grid'"),
+        ("[grid]\nheading_deg = '0:10:0'\n", "range step must not be 0"),
+        ("[grid]\nspeed_m_s = [0.5, 'fast']\n", r"speed_m_s: must be a number"),
+        ("base = 'missing.toml'\n[grid]\nheading_deg = [0]\n", "missing.toml: file not found"),
+        ("[sample]\nn = 5\n", "give ranges and/or choices"),
+    ],
+)
+def test_bad_sweep_files(tmp_path, text, fragment):
+    path = tmp_path / "sweep.toml"
+    path.write_text(text)
+    with pytest.raises(InputError, match=fragment) as info:
+        run_sweep(load_sweep_file(path), tmp_path / "out", workers=1)
+    assert str(info.value).startswith(str(path) if "missing" not in text else "")
+    assert not (tmp_path / "out").exists()
+
+
+def test_sweep_file(tmp_path):
+    (tmp_path / "base.toml").write_text('model = "paper-replica"\nfinal_time_s = 1.0\n')
+    path = tmp_path / "sweep.toml"
+    path.write_text(
+        'base = "base.toml"\n[grid]\nheading_deg = "0,45"\ninclination_deg = [-5, 10]\n'
+        "speed_m_s = 0.75\n"
+    )
+    spec = load_sweep_file(path)
+    assert spec == SweepSpec(base=BASE, grid=SMALL_GRID)
+    assert spec.with_grid({"speed_m_s": [1.0]}).inputs(0)["speed_m_s"] == 1.0
+
+
+def test_flatten_covers_the_summary():
+    """Every key of a real summary has its column (update SUMMARY_COLUMNS otherwise)."""
+    summary = quadimpact.simulate(
+        quadimpact.WallApproach(heading_deg=45, inclination_deg=15, final_time_s=1.5)
+    ).summary
+    row = flatten_summary(summary)
+    assert row["summary_extra"] is None, f"summary keys without a column: {row['summary_extra']}"
+    assert "integrator__wall_time_s" not in row
+    assert set(row) == {name for name, _ in SUMMARY_COLUMNS}
+    assert json.loads(row["leading_bumpers"]) == summary["leading_bumpers"]
+    assert row["approach__start_time_s"] == summary["approach"]["start_time_s"]
+
+
+# ------------------------------------------------------------- backends
+@pytest.fixture(scope="module")
+def serial_table(tmp_path_factory):
+    out = tmp_path_factory.mktemp("serial")
+    return run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), out, workers=1)
+
+
+def test_serial_table(serial_table):
+    t = serial_table
+    assert list(t["run_id"]) == [0, 1, 2, 3]
+    assert list(t.columns[:4]) == ["run_id", "heading_deg", "inclination_deg", "speed_m_s"]
+    assert list(t["heading_deg"]) == [0.0, 0.0, 45.0, 45.0]
+    assert list(t["inclination_deg"]) == [-5.0, 10.0, -5.0, 10.0]
+    assert set(t["status"]) <= {"completed", "crashed"}
+    assert set(t["response_type"]) <= {"A", "B", "C", "D", "Other"}
+    assert t["delta_init_m"].between(0.005, 0.1).all()
+    assert str(t["n_subsequent_impacts"].dtype) == "Int64"
+    assert "integrator__wall_time_s" not in t.columns
+
+
+def test_parallel_table_is_identical(serial_table, tmp_path):
+    table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "p", workers=2)
+    assert table.attrs["sweep"]["backend"] == "2 processes"
+    pd.testing.assert_frame_equal(table, serial_table)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _stop(procs: list[subprocess.Popen]) -> None:
+    for p in procs:
+        if p.poll() is None:
+            os.killpg(p.pid, signal.SIGTERM)
+    for p in procs:
+        try:
+            p.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def dask_cluster(tmp_path_factory):
+    """A real scheduler and two one-thread workers, separate processes on loopback."""
+    distributed = pytest.importorskip("distributed")
+    tmp = tmp_path_factory.mktemp("dask")
+    address = f"tcp://127.0.0.1:{_free_port()}"
+    procs: list[subprocess.Popen] = []
+
+    def start(name: str, *args: str) -> None:
+        log = open(tmp / f"{name}.log", "w")  # noqa: SIM115 - closed with the process
+        procs.append(
+            subprocess.Popen(
+                [sys.executable, "-m", *args],
+                cwd=tmp,
+                env=_env(),
+                stdout=log,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+        )
+
+    try:
+        port = address.rsplit(":", 1)[1]
+        start(
+            "scheduler",
+            "distributed.cli.dask_scheduler",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            port,
+            "--no-dashboard",
+        )
+        for i in range(2):
+            start(
+                f"worker{i}",
+                "distributed.cli.dask_worker",
+                address,
+                "--nworkers",
+                "1",
+                "--nthreads",
+                "1",
+                "--no-dashboard",
+                "--host",
+                "127.0.0.1",
+                "--local-directory",
+                str(tmp),
+            )
+        with distributed.Client(address, timeout="30s", set_as_default=False) as client:
+            client.wait_for_workers(2, timeout=60)
+        yield address
+    finally:
+        _stop(procs)
+
+
+def test_dask_table_is_identical(serial_table, dask_cluster, tmp_path):
+    table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "d", scheduler=dask_cluster)
+    assert table.attrs["sweep"]["backend"].startswith("dask")
+    pd.testing.assert_frame_equal(table, serial_table)
+
+
+def test_bad_scheduler(tmp_path):
+    pytest.importorskip("distributed")
+    with pytest.raises(InputError, match="must be an address like tcp://HOST:PORT"):
+        run_sweep(SweepSpec(grid={"heading_deg": [0]}), tmp_path / "o", scheduler="nowhere")
+    assert not (tmp_path / "o").exists()
+
+
+# ------------------------------------------------------ failures, resume
+def test_impossible_run_is_a_failed_row(serial_table, tmp_path):
+    """A bumper so stiff that the step size collapses (two-bumper impact at heading 0):
+    that run is a failed row with the kernel's reason; the sweep goes on."""
+    spec = SweepSpec(
+        base=BASE,
+        grid={"heading_deg": [0, 45], "inclination_deg": [-5], "contact_stiffness": [40.0, 1e15]},
+    )
+    table = run_sweep(spec, tmp_path / "f", workers=2)
+    assert len(table) == 4
+    failed = table[table["status"] == "failed"]
+    assert list(failed["run_id"]) == [1]  # heading 0, stiffness 1e15
+    assert failed["reason"].iloc[0] == "step size fell below the floor (stiff or singular dynamics)"
+    assert failed["response_type"].isna().all()
+    ok = table.drop(index=failed.index)
+    assert set(ok["status"]) <= {"completed", "crashed"} and ok["reason"].eq("").all()
+    # the unchanged runs have the same numbers as in the other sweep
+    ref = serial_table[serial_table["inclination_deg"] == -5.0]
+    assert list(table.loc[table["contact_stiffness"] == 40.0, "delta_init_m"]) == list(
+        ref["delta_init_m"]
+    )
+    common = [c for c in serial_table.columns if c in table.columns]
+    assert (table.dtypes[common] == serial_table.dtypes[common]).all()
+
+
+def test_exception_in_a_run_is_a_failed_row(monkeypatch, serial_table, tmp_path):
+    real = quadimpact.simulate
+
+    def fake(scenario, **kwargs):
+        if scenario.inclination_deg == 10:
+            raise RuntimeError("approach shooting run failed: test")
+        return real(scenario, **kwargs)
+
+    monkeypatch.setattr(quadimpact, "simulate", fake)
+    table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "x", workers=1)
+    bad = table[table["inclination_deg"] == 10.0]
+    assert list(bad["status"]) == ["failed", "failed"]
+    assert list(bad["reason"]) == ["RuntimeError: approach shooting run failed: test"] * 2
+    assert bad["delta_init_m"].isna().all() and bad["n_episodes"].isna().all()
+    good = table[table["inclination_deg"] == -5.0]
+    pd.testing.assert_frame_equal(good, serial_table[serial_table["inclination_deg"] == -5.0])
+    assert (table.dtypes == serial_table.dtypes).all()
+
+
+CRASH_SCRIPT = """
+import os
+import quadimpact
+
+real = quadimpact.simulate
+
+
+def crashing(scenario, **kwargs):  # imported again in each worker (forkserver/spawn)
+    if scenario.inclination_deg == 7:
+        os._exit(3)  # the worker dies, as in a crash in native code
+    return real(scenario, **kwargs)
+
+
+quadimpact.simulate = crashing
+
+if __name__ == "__main__":
+    from quadimpact.sweep import SweepSpec, run_sweep
+
+    spec = SweepSpec(base={"final_time_s": 1.0}, grid={"inclination_deg": "0:10:1"})
+    run_sweep(spec, "out", workers=2)
+"""
+
+
+def test_worker_crash_is_a_failed_row(tmp_path):
+    """A run that kills its worker process: that run failed, every other run done."""
+    (tmp_path / "crash.py").write_text(CRASH_SCRIPT)
+    proc = subprocess.run(
+        [sys.executable, "crash.py"], cwd=tmp_path, env=_env(), capture_output=True, text=True,
+        timeout=120,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    table = read_runs(tmp_path / "out")
+    assert list(table.loc[table["status"] == "failed", "inclination_deg"]) == [7.0]
+    assert table.loc[7, "reason"].startswith("worker process died")
+    assert len(table) == 11 and table["delta_init_m"].notna().sum() == 10
+
+
+def test_rerun_and_other_sweep_in_the_folder(serial_table, tmp_path):
+    out = tmp_path / "r"
+    spec = SweepSpec(base=BASE, grid=SMALL_GRID)
+    run_sweep(spec, out, workers=1)
+    again = run_sweep(spec, out, workers=1)
+    assert again.attrs["sweep"]["n_ran"] == 0
+    pd.testing.assert_frame_equal(again, serial_table)
+    # an interrupted sweep: drop two rows, the rerun does only those
+    full = read_runs(out)
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(out / "runs.parquet")
+    pq.write_table(table.filter(pa.array([True, False, True, False])), out / "runs.parquet")
+    resumed = run_sweep(spec, out, workers=1)
+    assert resumed.attrs["sweep"]["n_ran"] == 2
+    pd.testing.assert_frame_equal(resumed, full)
+    with pytest.raises(InputError, match="holds a different sweep.*grid"):
+        run_sweep(SweepSpec(base=BASE, grid={"heading_deg": [0]}), out, workers=1)
+
+
+def _wait_for_part(out: Path, proc: subprocess.Popen, timeout: float) -> None:
+    end = time.monotonic() + timeout
+    while time.monotonic() < end:
+        if list((out / "parts").glob("part-*.parquet")):
+            return
+        if proc.poll() is not None:
+            raise AssertionError(f"sweep ended before any part was written: {proc.returncode}")
+        time.sleep(0.01)
+    raise AssertionError("no part file appeared")
+
+
+def test_sigkill_and_resume(tmp_path):
+    grid = [
+        "--grid=heading_deg=0,45",
+        "--grid=inclination_deg=-20:20:1",
+        "--grid=speed_m_s=0.5,0.75,1.0,1.25",
+        "--grid=model=paper-replica",
+    ]
+    out = tmp_path / "killed"
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "quadimpact.cli",
+            "sweep",
+            *grid,
+            "--out",
+            str(out),
+            "--workers",
+            "2",
+            "--no-progress",
+            "--no-plots",
+        ],  # fmt: skip
+        cwd=tmp_path,
+        env=_env(),
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+    try:
+        _wait_for_part(out, proc, timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)  # the CLI, its forkserver and workers
+        proc.wait(timeout=10)
+    assert proc.returncode == -signal.SIGKILL
+    assert not (out / "runs.parquet").exists()
+    n_parts_rows = sum(len(pd.read_parquet(p)) for p in (out / "parts").glob("part-*.parquet"))
+    assert 0 < n_parts_rows < 328
+
+    done = _cli("sweep", *grid, "--out", str(out), "--workers", "2", "--no-progress",
+                "--no-plots", cwd=tmp_path)  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert f"{n_parts_rows} done before" in done.stdout
+
+    spec = SweepSpec(
+        grid={
+            "heading_deg": [0, 45],
+            "inclination_deg": "-20:20:1",
+            "speed_m_s": [0.5, 0.75, 1.0, 1.25],
+            "model": ["paper-replica"],
+        },
+    )
+    reference = run_sweep(spec, tmp_path / "reference", workers=2)
+    assert len(reference) == 328
+    pd.testing.assert_frame_equal(read_runs(out), reference)
+    assert not list((out / "parts").iterdir())
+
+
+# -------------------------------------------------------------------- CLI
+def test_cli_sweep(tmp_path):
+    proc = _cli(
+        "sweep",
+        "--grid", "heading_deg=0,45", "--grid", "inclination_deg=-5,0,10",
+        "--grid", "final_time_s=1", "--grid", "model=paper-replica",
+        "--out", "o", "--workers", "1", "--no-progress",
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "runs    6 (0 failed" in proc.stdout
+    assert "types   A" in proc.stdout
+    table = read_runs(tmp_path / "o")
+    assert len(table) == 6 and table["final_time_s"].eq(1.0).all()
+    plots = sorted(p.name for p in (tmp_path / "o" / "plots").iterdir())
+    assert plots == ["delta_init_m_vs_inclination_deg.png", "types_inclination_deg_heading_deg.png"]
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (["--grid", "headng_deg=0"], "headng_deg: unknown field"),
+        (["--grid", "inclination_deg=0:1"], "start:stop:step"),
+        (["--grid", "inclination"], "must be FIELD=VALUES"),
+        ([], "give a sweep file or at least one --grid"),
+        (["missing.toml"], "missing.toml: file not found"),
+    ],
+)
+def test_cli_sweep_errors(tmp_path, args, fragment):
+    proc = _cli("sweep", *args, "--out", "o", cwd=tmp_path)
+    assert proc.returncode == 2
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("quadimpact: error:"), proc.stderr
+    assert fragment in lines[0]
+    assert not (tmp_path / "o").exists()
+
+
+# ------------------------------------------------------------------ plots
+def test_plots(serial_table, tmp_path):
+    from quadimpact.sweep_plots import choose_plot_fields, plot_metric, plot_type_map
+
+    fig = plot_metric(serial_table, "inclination_deg", by="heading_deg", path=tmp_path / "m.png")
+    assert len(fig.axes) == 1 and len(fig.axes[0].lines) == 2
+    fig = plot_metric(serial_table, "inclination_deg", facet="heading_deg")
+    assert len(fig.axes) == 2
+    fig = plot_type_map(
+        serial_table, "inclination_deg", "speed_m_s", path=tmp_path / "t.png", facet="heading_deg"
+    )
+    assert len(fig.axes) == 2
+    assert len(fig.axes[0].texts) == 2  # n_subsequent_impacts in each cell
+    assert (tmp_path / "m.png").stat().st_size > 0 and (tmp_path / "t.png").stat().st_size > 0
+    with pytest.raises(InputError, match="nope: no such column"):
+        plot_metric(serial_table, "nope")
+    fig4 = {"heading_deg": [0, 45], "inclination_deg": list(range(-20, 21)), "speed_m_s": [1, 2, 3]}
+    kinds = dict.fromkeys(fig4, "f")
+    assert choose_plot_fields(kinds, fig4) == ("inclination_deg", "speed_m_s", "heading_deg")

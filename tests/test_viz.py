@@ -1,0 +1,404 @@
+"""Pictures of a run: scene geometry, snapshots, movies, the HTML viewer, the commands.
+
+One short run of the paper's example (1 s, 200 Hz output) feeds every test.
+The browser tests need headless Chromium (``make test`` installs it from
+Debian's packages when run as root) and skip, saying so, without it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import quadimpact.errors
+from quadimpact import WallApproach, load_vehicle, simulate
+from quadimpact.core import layout as L
+from quadimpact.core.contact import bumper_plane_contact
+from quadimpact.frames import euler_zyx_to_quat, quat_to_matrix
+from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.viz.render import SceneArtists
+from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial
+
+SRC = Path(quadimpact.errors.__file__).resolve().parents[1]
+SPIRI = load_vehicle()
+WALL_D = 1.5
+FINAL_T = 1.0
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The paper's example (replica), 1 s at 200 Hz: bumper 4 hits the wall at t = 0.5 s."""
+    out = tmp_path_factory.mktemp("viz") / "example"
+    result = simulate(
+        WallApproach(
+            heading_deg=45,
+            inclination_deg=15,
+            speed_m_s=0.75,
+            model="paper-replica",
+            final_time_s=FINAL_T,
+            output_rate_hz=200,
+            wall_distance_m=WALL_D,
+        )
+    )
+    result.write(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def fine_scene(run_dir: Path) -> Scene:
+    """Circles drawn with 7200 segments: the drawn rim is the exact rim to < 0.1 mm."""
+    return Scene.from_dir(run_dir, n_points=7200)
+
+
+def copy_run(run_dir: Path, tmp_path: Path) -> Path:
+    target = tmp_path / "run"
+    shutil.copytree(run_dir, target)
+    return target
+
+
+# ------------------------------------------------------------------ scene geometry
+def test_drawn_circles_are_the_contact_laws_circles(fine_scene: Scene) -> None:
+    """Centre on rotor j, radius Rb, in the plane of normal n_j (MODEL.md 4)."""
+    sc = fine_scene
+    t = sc.first_contact_s + 0.05
+    fr = sc.frame(t)
+    x = sc.state_at(t)
+    C = quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4])
+    centres, _u, n = SPIRI.bumper_frames()
+    for j in range(4):
+        c_i = x[0:3] + C @ centres[j]
+        rel = fr.circles[j] - c_i
+        np.testing.assert_allclose(np.linalg.norm(rel, axis=1), SPIRI.bumper_radius_m, atol=1e-12)
+        np.testing.assert_allclose(rel @ (C @ n[j]), 0.0, atol=1e-12)
+
+
+def test_drawn_deepest_point_is_the_computed_contact_point(fine_scene: Scene) -> None:
+    sc = fine_scene
+    wall = pack_surfaces([Surface("wall", (WALL_D, 0.0, 0.0), (-1.0, 0.0, 0.0))])
+    veh = pack_vehicle(SPIRI)
+    t = float(sc.t[np.searchsorted(sc.t, sc.first_contact_s + 0.08)])  # a sample, in contact
+    fr = sc.frame(t)
+    x = np.ascontiguousarray(sc.state_at(t))
+    C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
+    computed = {}
+    for j in range(4):
+        d, _dd, rx, ry, rz, *_ = bumper_plane_contact(x, C, veh, j, wall, 0)
+        p_c = x[0:3] + C @ np.array([rx, ry, rz])
+        computed[j + 1] = (d, p_c)
+        # the deepest point of the drawn rim (brute force over its points)
+        depth = fr.circles[j][:, 0] - WALL_D
+        k = int(np.argmax(depth))
+        assert depth[k] == pytest.approx(d, abs=1e-7)
+        np.testing.assert_allclose(fr.circles[j][k], p_c, atol=2e-4)
+    # only bumper 4 touches, and the mark is the compiled contact point
+    assert [c.bumper for c in fr.contacts] == [4]
+    mark = fr.contacts[0]
+    d4, p4 = computed[4]
+    np.testing.assert_allclose(mark.point, p4, atol=1e-12)
+    assert mark.delta_m == pytest.approx(d4, abs=1e-12)
+    ts_delta = sc.deltas[np.searchsorted(sc.t, t), 3]
+    assert mark.delta_m == pytest.approx(ts_delta, rel=1e-6)  # the simulation's own deflection
+    assert mark.surface_point[0] == pytest.approx(WALL_D, abs=1e-12)  # on the wall
+    np.testing.assert_allclose(mark.normal, [-1.0, 0.0, 0.0])
+    assert mark.force_n == pytest.approx(sc.forces[np.searchsorted(sc.t, t), 3], rel=1e-9)
+    # the force arrow points out of the wall, 1 cm per N
+    assert mark.arrow_tip[0] == pytest.approx(WALL_D - 0.01 * mark.force_n, abs=1e-12)
+
+    # and the drawn marker sits at the camera's projection of that point
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure()
+    FigureCanvasAgg(fig)
+    cam = Camera(follow="wall")
+    art = SceneArtists(fig.add_subplot(), sc, cam)
+    art.update(t)
+    xs, ys = art.points[0].get_data()
+    np.testing.assert_allclose([xs[0], ys[0]], cam.project(mark.point, sc.anchor), atol=1e-12)
+    assert art.points[0].get_visible() and not art.points[1].get_visible()
+
+
+def test_first_contact_is_bumper_4_on_the_wall(fine_scene: Scene) -> None:
+    sc = fine_scene
+    fr = sc.frame(sc.first_contact_s + 1e-3)
+    assert [c.bumper for c in fr.contacts] == [4]
+    assert sc.surfaces[0].point_m[0] == WALL_D and sc.wall_x_m == WALL_D
+
+
+def test_numbering_frames_and_camera() -> None:
+    """Bumper 1 starboard front, 2 starboard rear, 3 port rear, 4 port front; altitude up."""
+    d = VehicleDrawing.from_vehicle(SPIRI)
+    C = quat_to_matrix(euler_zyx_to_quat(0.0, 0.0, 0.0))
+    pos = np.array([0.0, 0.0, -2.0])
+    centres = to_inertial(d.centres, pos, C)
+    signs = np.sign(centres[:, :2])
+    np.testing.assert_array_equal(signs, [[1, 1], [-1, 1], [-1, -1], [1, -1]])
+    assert np.all(-centres[:, 2] > 2.0)  # rotors above the CM (altitude = -Z)
+    # heading 90 deg (nose to +Y): bumper 1 is then toward -X? no: starboard of +Y is -X
+    C90 = quat_to_matrix(euler_zyx_to_quat(0.0, 0.0, math.pi / 2))
+    c90 = to_inertial(d.centres, pos, C90)
+    assert c90[0, 1] > 0 and c90[0, 0] < 0  # starboard front: ahead (+Y) and to the right (-X)
+    # side camera from starboard: +X to the right, up is up, +Y toward the viewer
+    cam = Camera(azimuth_deg=90.0, elevation_deg=0.0)
+    right, up, fwd = cam.basis()
+    np.testing.assert_allclose(right, [1, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(up, [0, 0, -1], atol=1e-12)
+    np.testing.assert_allclose(fwd, [0, -1, 0], atol=1e-12)
+    # from behind: +Y to the right (NED: Y is the right of X)
+    right, up, _ = Camera(azimuth_deg=180.0, elevation_deg=0.0).basis()
+    np.testing.assert_allclose(right, [0, 1, 0], atol=1e-12)
+    # equal scaling: an orthonormal basis for any view, altitude never down on screen
+    for az, el in [(110, 20), (-37, 65), (200, -30)]:
+        cam = Camera(azimuth_deg=az, elevation_deg=el)
+        basis = np.array(cam.basis())
+        np.testing.assert_allclose(basis @ basis.T, np.eye(3), atol=1e-12)
+        assert cam.project(np.array([0.0, 0.0, -1.0]), np.zeros(3))[1] > 0
+    with pytest.raises(ValueError):
+        Camera(follow="ceiling")  # type: ignore[arg-type]
+
+
+# ------------------------------------------------------------------ snapshots
+def test_snapshots_png_and_pdf(run_dir: Path, tmp_path: Path) -> None:
+    from PIL import Image
+
+    from quadimpact.viz.snapshots import PAPER_FIGURE_TIMES, make_snapshots, write_snapshots
+
+    d = copy_run(run_dir, tmp_path)
+    png, pdf, warnings = write_snapshots(d)
+    assert png == d / "snapshots.png" and pdf == d / "snapshots.pdf" and warnings == []
+    assert pdf.read_bytes()[:5] == b"%PDF-"
+    with Image.open(png) as im:
+        assert im.width > 4 * im.height  # a strip
+    sc = Scene.from_dir(d)
+    fig = make_snapshots(sc, PAPER_FIGURE_TIMES[8])
+    labels = [ax.get_xlabel() for ax in fig.axes]
+    assert labels == ["0.000 s", "0.070 s", "0.100 s", "0.130 s", "0.215 s", "0.250 s"]
+    # times outside the run are skipped with a warning; Figure 7's times fit in 1 s
+    _, _, warnings = write_snapshots(d, times=[0.0, 0.1, 0.9])
+    assert len(warnings) == 1 and "0.9" in warnings[0]
+    _, _, warnings = write_snapshots(d, paper_figure=7)
+    assert warnings == []
+
+
+# ------------------------------------------------------------------ movies
+def test_movie_frame_count_and_size(run_dir: Path, tmp_path: Path) -> None:
+    imageio_ffmpeg = pytest.importorskip("imageio_ffmpeg", reason="pip install 'quadimpact[viz]'")
+    from PIL import Image
+
+    from quadimpact.viz.animation import frame_times, write_animation
+
+    d = copy_run(run_dir, tmp_path)
+    info = write_animation(
+        d, fps=10, slow=2.0, start=0.4, end=0.9, size=(320, 240), gif=True, gif_fps=5
+    )
+    expected = int(round((0.9 - 0.4) * 10 * 2.0)) + 1  # 11 frames, 0.05 s of simulation apart
+    assert info.n_frames == expected == len(frame_times(0.4, 0.9, 10, 2.0))
+    assert info.mp4 == d / "animation.mp4" and info.gif == d / "animation.gif"
+    reader = imageio_ffmpeg.read_frames(str(info.mp4))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (320, 240)
+    frames = [np.frombuffer(f, np.uint8) for f in reader]
+    assert len(frames) == expected
+    assert frames[0].size == 320 * 240 * 3
+    assert np.abs(frames[0].astype(int) - frames[-1].astype(int)).mean() > 0.5  # it moves
+    with Image.open(info.gif) as gif:
+        assert gif.n_frames == math.ceil(expected / 2) and gif.width == 640
+
+
+def test_render_time_per_frame_is_small(run_dir: Path) -> None:
+    """A 3-s run at 30 fps is 91 frames: well under a minute means well under 0.6 s a frame."""
+    import time
+
+    from quadimpact.viz.animation import DEFAULT_ANIMATION_CAMERA, AnimationFigure
+
+    fig = AnimationFigure(Scene.from_dir(run_dir), DEFAULT_ANIMATION_CAMERA, 1280, 720)
+    fig.render(0.5)
+    start = time.perf_counter()
+    for t in np.linspace(0.0, FINAL_T, 10):
+        px = fig.render(float(t))
+    per_frame = (time.perf_counter() - start) / 10
+    assert px.shape == (720, 1280, 3)
+    assert per_frame < 0.5, f"{per_frame:.3f} s per frame"
+
+
+# ------------------------------------------------------------------ viewer
+def test_viewer_is_one_self_contained_file(run_dir: Path, tmp_path: Path) -> None:
+    import json
+
+    from quadimpact.viz.viewer import write_viewer
+
+    d = copy_run(run_dir, tmp_path)
+    path = write_viewer(d)
+    html = path.read_text(encoding="utf-8")
+    assert path == d / "viewer.html"
+    assert "://" not in html  # nothing fetched: no URL at all
+    assert not re.search(r"<(script|link|img|iframe)[^>]*(src|href)=", html, re.I)
+    assert "@import" not in html and "url(" not in html
+    data = json.loads(re.search(r'type="application/json">(.*?)</script>', html, re.S).group(1))
+    frames = data["frames"]
+    assert len(frames["t"]) == len(frames["pos"]) == len(frames["contacts"]) > 100
+    # contacts in the page are those of the scene (bumper 4 first, on the wall)
+    k = next(i for i, c in enumerate(frames["contacts"]) if c)
+    assert frames["contacts"][k][0][0] == 4
+    assert frames["contacts"][k][0][4] == pytest.approx(WALL_D, abs=1e-5)
+
+
+def chromium() -> str | None:
+    for name in ("/usr/bin/chromium", "/usr/bin/chromium-browser"):
+        if os.access(name, os.X_OK):
+            return name
+    return shutil.which("chromium")
+
+
+CHROMIUM_FLAGS = [
+    "--headless",
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--hide-scrollbars",
+    "--force-device-scale-factor=1",
+    "--window-size=1200,760",
+]
+
+
+def browse(url: str, tmp_path: Path, *action: str) -> subprocess.CompletedProcess:
+    profile = tmp_path / f"profile-{len(list(tmp_path.glob('profile-*')))}"
+    return subprocess.run(
+        [chromium(), *CHROMIUM_FLAGS, f"--user-data-dir={profile}", *action, url],
+        capture_output=True,
+        text=True,
+        timeout=90,
+    )
+
+
+needs_chromium = pytest.mark.skipif(
+    chromium() is None,
+    reason="headless Chromium not installed (make test installs it as root: "
+    "apt-get install chromium chromium-driver)",
+)
+
+
+@needs_chromium
+def test_viewer_renders_in_headless_chromium(run_dir: Path, tmp_path: Path) -> None:
+    from PIL import Image
+
+    from quadimpact.viz.viewer import write_viewer
+
+    d = copy_run(run_dir, tmp_path)
+    url = write_viewer(d).resolve().as_uri()
+    shots, attrs = [], []
+    for t in (0.3, 0.9):
+        page = f"{url}#t={t}&follow=wall"
+        shot = tmp_path / f"shot-{t}.png"
+        proc = browse(page, tmp_path, f"--screenshot={shot}")
+        assert shot.is_file(), proc.stderr[-2000:]
+        dom = browse(page, tmp_path, "--dump-dom").stdout
+        body = re.search(r"<body([^>]*)>", dom).group(1)
+        attrs.append(dict(re.findall(r'data-([a-z-]+)="([^"]*)"', body)))
+        with Image.open(shot) as im:
+            shots.append(np.asarray(im.convert("RGB")).astype(int))
+    a0, a1 = attrs
+    assert float(a0["t"]) == pytest.approx(0.3) and float(a1["t"]) == pytest.approx(0.9)
+    left, top, width, height = (int(v) for v in a0["canvas"].split(","))
+    assert width > 300 and height > 300
+    crops = [s[top : top + height, left : left + width] for s in shots]
+    for crop in crops:  # a drawn canvas: many colours (lines, antialiasing), not blank
+        colours = np.unique(crop.reshape(-1, 3), axis=0)
+        assert len(colours) > 100, len(colours)
+        assert (crop.sum(axis=2) < 600).mean() > 0.002  # dark pixels: lines are drawn
+    # the vehicle moved: the drawn CM moved and the canvas pixels changed
+    moved = math.hypot(float(a1["cm-x"]) - float(a0["cm-x"]), float(a1["cm-y"]) - float(a0["cm-y"]))
+    assert moved > 20, (a0, a1)
+    assert np.abs(crops[0] - crops[1]).max(axis=2).astype(bool).mean() > 0.01
+
+
+# ------------------------------------------------------------------ commands
+def run_cli(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+    env.pop("QUADIMPACT_DEBUG", None)
+    return subprocess.run(
+        [sys.executable, "-m", "quadimpact.cli", *args],
+        cwd=cwd,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def test_commands_write_their_files(run_dir: Path, tmp_path: Path) -> None:
+    pytest.importorskip("imageio_ffmpeg", reason="pip install 'quadimpact[viz]'")
+    d = copy_run(run_dir, tmp_path)
+    proc = run_cli("view", str(d), cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.strip() == str((d / "viewer.html").resolve())
+    proc = run_cli("snapshots", str(d), "--times", "0,0.05,0.1", "--azimuth", "100", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert (d / "snapshots.png").is_file() and (d / "snapshots.pdf").is_file()
+    proc = run_cli(
+        "animate",
+        str(d),
+        "--fps",
+        "5",
+        "--size",
+        "160x120",
+        "--gif",
+        "--start",
+        "0.4",
+        "--end",
+        "0.8",
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    assert (d / "animation.mp4").stat().st_size > 0 and (d / "animation.gif").is_file()
+
+
+@pytest.mark.parametrize(
+    ("args", "fragment"),
+    [
+        (("view", "no-such-dir"), "result folder not found"),
+        (("snapshots", "{d}", "--times", "0,abc"), "--times"),
+        (("snapshots", "{d}", "--times", "5,6"), "outside the run"),
+        (("snapshots", "{d}", "--times", "0", "--paper-figure", "7"), "not both"),
+        (("animate", "{d}", "--size", "321x240"), "--size"),
+        (("view", "{d}", "--elevation", "95"), "elevation"),
+    ],
+)
+def test_command_errors_are_one_line(run_dir: Path, tmp_path: Path, args, fragment) -> None:
+    proc = run_cli(*(a.format(d=run_dir) for a in args), cwd=tmp_path)
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("quadimpact: error: "), proc.stderr
+    assert fragment in lines[0]
+
+
+def test_run_viz_flag(tmp_path: Path) -> None:
+    pytest.importorskip("imageio_ffmpeg", reason="pip install 'quadimpact[viz]'")
+    out = tmp_path / "r"
+    proc = run_cli(
+        "run",
+        "--final-time",
+        "0.8",
+        "--output-rate",
+        "100",
+        "--viz",
+        "--out",
+        str(out),
+        cwd=tmp_path,
+    )
+    assert proc.returncode == 0, proc.stderr
+    for name in ("snapshots.png", "snapshots.pdf", "animation.mp4", "viewer.html"):
+        assert (out / name).is_file(), name
