@@ -1,5 +1,5 @@
 # quadimpact: one-command entry points.
-#   make run    set up .venv (once) and simulate the paper's example with both model variants
+#   make run    set up .venv (once) and reproduce the paper's study (report in results/paper)
 #   make test   set up .venv (once), install headless Chromium if missing (root only), run the tests
 #   make lint   ruff check
 #   make bench  timing benchmark of the compiled core
@@ -9,7 +9,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.quadimpact-installed
 
-EXAMPLE := --heading 45 --inclination 15 --speed 0.75
+OUT := results/paper
 
 .PHONY: setup run test lint bench clean browser
 
@@ -20,13 +20,17 @@ setup: $(STAMP)
 # network access for the build backend, fall back to the venv's own setuptools.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -e ".[dev,viz]" \
+	$(BIN)/python -m pip install -e ".[dev,viz,distributed]" \
 	  || $(BIN)/python -m pip install --no-build-isolation --no-deps -e .
 	touch $(STAMP)
 
+# The paper's whole study (Figure 4, Table II, Figures 5-6, the seven crashes of
+# Table III, the findings with computed verdicts) to $(OUT)/report.md, then a
+# movie and an interactive viewer of the example impact.
 run: $(STAMP)
-	$(BIN)/quadimpact run $(EXAMPLE) --model paper-replica --out results/paper-example-replica --viz
-	$(BIN)/quadimpact run $(EXAMPLE) --model default --out results/paper-example-default --viz
+	$(BIN)/quadimpact reproduce --out $(OUT)
+	$(BIN)/quadimpact animate $(OUT)/example-paper-replica
+	$(BIN)/quadimpact view $(OUT)/example-paper-replica
 
 # Headless Chromium for the viewer's browser tests (tests/test_viz.py), from
 # Debian's packages, only when it is missing and we are root (as in CI);
