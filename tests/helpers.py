@@ -28,3 +28,22 @@ def run_packed(setup: RunSetup, **changes: np.ndarray) -> tuple[np.ndarray, np.n
 def states(out: np.ndarray) -> np.ndarray:
     """The NX state columns of an output array."""
     return out[:, L.OUT_X : L.OUT_X + L.NX]
+
+
+def run_cli(*args: str, cwd, timeout: float = 120):
+    """Run ``python -m quadimpact.cli ARGS`` in a subprocess (the installed or the src package)."""
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    import quadimpact
+
+    src = Path(quadimpact.__file__).resolve().parents[1]
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(src), env.get("PYTHONPATH")]))
+    env.pop("QUADIMPACT_DEBUG", None)
+    return subprocess.run(
+        [sys.executable, "-m", "quadimpact.cli", *args],
+        cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout,
+    )  # fmt: skip

@@ -3,14 +3,14 @@
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 import quadimpact.errors
+
+from helpers import run_cli
 
 SRC = Path(quadimpact.errors.__file__).resolve().parents[1]
 SPIRI_TOML = SRC / "quadimpact/vehicles/spiri.toml"
@@ -20,20 +20,6 @@ SUMMARY_KEYS = (
     "inclination_deg heading_deg leading_bumpers n_episodes crash_time_s t_start_s t_final_s"
 ).split()
 OUTPUT_FILES = ("summary.json", "timeseries.parquet", "episodes.csv", "fig5.png", "fig6.png")
-
-
-def run_cli(*args: str, cwd: Path, timeout: float = 60) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
-    env.pop("QUADIMPACT_DEBUG", None)
-    return subprocess.run(
-        [sys.executable, "-m", "quadimpact.cli", *args],
-        cwd=cwd,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
 
 
 def assert_input_error(proc: subprocess.CompletedProcess, *fragments: str) -> None:

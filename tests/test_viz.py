@@ -12,7 +12,6 @@ import os
 import re
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +25,8 @@ from quadimpact.frames import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial
+
+from helpers import run_cli
 
 SRC = Path(quadimpact.errors.__file__).resolve().parents[1]
 SPIRI = load_vehicle()
@@ -325,20 +326,6 @@ def test_viewer_renders_in_headless_chromium(run_dir: Path, tmp_path: Path) -> N
 
 
 # ------------------------------------------------------------------ commands
-def run_cli(*args: str, cwd: Path, timeout: float = 120) -> subprocess.CompletedProcess:
-    env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
-    env.pop("QUADIMPACT_DEBUG", None)
-    return subprocess.run(
-        [sys.executable, "-m", "quadimpact.cli", *args],
-        cwd=cwd,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
-
-
 def test_commands_write_their_files(run_dir: Path, tmp_path: Path) -> None:
     pytest.importorskip("imageio_ffmpeg", reason="pip install 'quadimpact[viz]'")
     d = copy_run(run_dir, tmp_path)
