@@ -6,6 +6,8 @@ from pathlib import Path
 
 import click
 
+from quadimpact.cli_options import parallel_options
+
 
 @click.command("experiments")
 @click.option(
@@ -28,9 +30,7 @@ import click
     show_default=True,
     help="Runs per crash over the stated uncertainty (0: none).",
 )
-@click.option("--workers", type=click.IntRange(min=1), help="Local processes [default: all cores].")
-@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the sweeps on a Dask cluster.")
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
+@parallel_options
 def experiments(
     out: Path,
     data: Path | None,

@@ -6,6 +6,8 @@ from pathlib import Path
 
 import click
 
+from quadimpact.cli_options import parallel_options
+
 
 @click.command("reproduce")
 @click.option(
@@ -15,8 +17,6 @@ import click
     show_default=True,
     help="Report folder (report.md, figures, tables; the sweeps it ran, resumable).",
 )
-@click.option("--workers", type=click.IntRange(min=1), help="Local processes [default: all cores].")
-@click.option("--scheduler", metavar="tcp://HOST:PORT", help="Run the sweeps on a Dask cluster.")
 @click.option(
     "--no-ablation",
     is_flag=True,
@@ -29,7 +29,7 @@ import click
     help="Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
     "../shared/data beside the project]; without it the comparisons are left out.",
 )
-@click.option("--no-progress", is_flag=True, help="No progress bar.")
+@parallel_options
 def reproduce(
     out: Path,
     workers: int | None,

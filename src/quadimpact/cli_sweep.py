@@ -11,6 +11,7 @@ from pathlib import Path
 
 import click
 
+from quadimpact.cli_options import parallel_options
 from quadimpact.errors import InputError
 
 __all__ = ["sweep"]
@@ -59,19 +60,7 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
     help="Output folder: runs.parquet (one row per run), sweep.json, plots/. Run the same "
     "command again to resume an interrupted sweep.",
 )
-@click.option(
-    "--workers",
-    type=click.IntRange(min=1),
-    metavar="N",
-    help="Local worker processes (1: in this process). [default: all cores]",
-)
-@click.option(
-    "--scheduler",
-    metavar="tcp://HOST:PORT",
-    help="Run on an existing Dask cluster instead of local processes "
-    "(needs pip install 'quadimpact[distributed]').",
-)
-@click.option("--no-progress", is_flag=True, help="Do not show the progress bar.")
+@parallel_options
 @click.option("--no-plots", is_flag=True, help="Do not write plots/.")
 def sweep(
     sweep_file: Path | None,

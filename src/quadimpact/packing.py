@@ -82,9 +82,8 @@ def pack_vehicle(v: Vehicle) -> np.ndarray:
     veh[L.V_JR] = v.rotor_inertia_kg_m2
     veh[L.V_GRAVITY] = v.gravity_m_s2
     veh[L.V_RB] = v.bumper_radius_m
-    centres, u, n = v.bumper_frames()
+    centres, _, n = v.bumper_frames()
     veh[L.V_BUMP_C : L.V_BUMP_C + 12] = centres.ravel()
-    veh[L.V_BUMP_U : L.V_BUMP_U + 12] = u.ravel()
     veh[L.V_BUMP_N : L.V_BUMP_N + 12] = n.ravel()
     veh[L.V_K] = v.contact_stiffness
     veh[L.V_N] = v.contact_exponent

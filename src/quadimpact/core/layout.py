@@ -34,13 +34,12 @@ V_JR = 37  # rotor inertia about its axis, kg m^2
 V_GRAVITY = 38  # m/s^2
 V_RB = 39  # bumper circle radius, m
 V_BUMP_C = 40  # 12, bumper centre j (body, m)
-V_BUMP_U = 52  # 12, in-plane outward unit vector u_j (body)
-V_BUMP_N = 64  # 12, circle plane unit normal n_j (body)
-V_K = 76  # contact stiffness, N/m^n
-V_N = 77  # contact exponent
-V_E = 78  # coefficient of restitution
-V_TAU_M = 79  # motor time constant, s (first-order rotor mode)
-NVEH = 80
+V_BUMP_N = 52  # 12, circle plane unit normal n_j (body)
+V_K = 64  # contact stiffness, N/m^n
+V_N = 65  # contact exponent
+V_E = 66  # coefficient of restitution
+V_TAU_M = 67  # motor time constant, s (first-order rotor mode)
+NVEH = 68
 
 # --------------------------------------------------------------------------
 # Surfaces: array surf of shape (n_surfaces, NSURF). A plane through p0 with
