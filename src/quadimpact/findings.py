@@ -197,9 +197,7 @@ def a_dominates_at_low_speed(table: pd.DataFrame) -> Finding:
         "below 10 deg, type A dominates at low speed",
         "share of A below 10 deg by speed: "
         + ", ".join(f"{v:g} m/s {s:.0%}" for v, s in share_a.items()),
-        "agrees"
-        if ok
-        else ("partly" if 0.0 < share_a[slow] >= share_a.max() else "disagrees"),
+        "agrees" if ok else ("partly" if 0.0 < share_a[slow] >= share_a.max() else "disagrees"),
         float(share_a[slow]),
     )
 

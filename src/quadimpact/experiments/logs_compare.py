@@ -7,7 +7,7 @@ from pathlib import Path
 
 from quadimpact.experiments.compare import compare
 from quadimpact.experiments.crashes import Crash
-from quadimpact.experiments.logs import SpiriMatLog, data_dir
+from quadimpact.experiments.logs import FlightLog
 from quadimpact.result import SimulationResult
 
 COMPARE_PNG = "compare.png"
@@ -15,7 +15,7 @@ COMPARE_CSV = "compare.csv"
 
 
 def attitude_rms_for_crash(
-    crash: Crash, result: SimulationResult, data: str | Path | None, folder: Path
+    crash: Crash, result: SimulationResult, log: FlightLog | None, folder: Path
 ) -> float:
     """RMS attitude error (deg) over the first 0.3 s after impact, NaN without the log.
 
@@ -24,11 +24,9 @@ def attitude_rms_for_crash(
     comparison table and plot are written into ``folder``. The scenarios fly
     rear first as the real vehicle did, so the log is read in its own frame.
     """
-    root = Path(data) if data is not None else data_dir()
-    if root is None or not (root / crash.log_file).is_file():
+    if log is None:
         return math.nan
-    path = root / crash.log_file
-    comparison = compare(result, SpiriMatLog(path))
+    comparison = compare(result, log)
     folder.mkdir(parents=True, exist_ok=True)
     comparison.table().to_csv(folder / COMPARE_CSV, index=False)
     comparison.plot(folder / COMPARE_PNG, title=f"Crash {crash.number}: simulation vs log")
