@@ -59,6 +59,7 @@ def test_help_and_version(tmp_path: Path) -> None:
         (["run", "missing.toml"], ["missing.toml: file not found"]),
         (["run", "--vehicle", "spirit"], ["vehicle 'spirit': unknown vehicle name"]),
         (["launch"], ["No such command 'launch'"]),
+        (["experiments", "--log-samples", "-1"], ["'--log-samples'", "-1 is not in the range"]),
     ],
 )
 def test_bad_flags_exit_2_with_one_line(tmp_path: Path, args: list[str], fragments) -> None:
@@ -160,3 +161,22 @@ def test_format_summary_for_people() -> None:
     assert text.splitlines()[-1].startswith("output         results/run (summary.json")
     quiet = format_summary({"status": "completed", "crash_time_s": None}, Path("o"))
     assert "crash time     no crash" in quiet and "delta_init     n/a" in quiet
+
+
+def test_experiments_writes_table3(tmp_path: Path) -> None:
+    """The stable interface: ``quadimpact experiments --out DIR [--data PATH]``."""
+    import pandas as pd
+
+    from quadimpact.experiments.table3 import LOG_COLUMNS, TABLE3_COLUMNS
+
+    missing = tmp_path / "no-data"
+    missing.mkdir()
+    args = ["experiments", "--out", "exp", "--samples", "0", "--log-samples", "0", "--workers", "1"]
+    proc = run_cli(*args, "--data", str(missing), cwd=tmp_path, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    table = pd.read_csv(tmp_path / "exp" / "table3.csv")
+    assert list(table.columns) == [*TABLE3_COLUMNS, *LOG_COLUMNS] and len(table) == 7
+    # no logs in that folder: the log columns are empty, the simulations are not
+    assert table["attitude_rms_deg_0_3s"].isna().all() and table["type_log"].isna().all()
+    assert table["type_ours"].notna().all()
+    assert "ours_at_log" in proc.stdout and "table3.csv" in proc.stdout
