@@ -304,10 +304,19 @@ def render_report(
     return "\n".join(lines) + "\n"
 
 
+def _percent(x: float) -> str:
+    """A share as a whole percentage; never 0 % or 100 % unless exact."""
+    if 0 < x < 0.005:
+        return "<1%"
+    if 0.995 <= x < 1:
+        return ">99%"
+    return f"{x:.0%}"
+
+
 def _share_text(r: pd.Series, prefix: str) -> str:
     cols = [c for c in r.index if c.startswith(prefix)]
     return ", ".join(
-        f"{c.removeprefix(prefix)} {r[c]:.0%}" for c in cols if r[c] == r[c] and r[c] > 0
+        f"{c.removeprefix(prefix)} {_percent(r[c])}" for c in cols if r[c] == r[c] and r[c] > 0
     )
 
 
@@ -350,10 +359,15 @@ def table3_markdown(table: pd.DataFrame) -> str:
         if r["type_ours"] != r["type_paper_experiment"]:
             key = f"share_{r['type_paper_experiment']}"
             seen = r[key] if key in r and r[key] == r[key] else float("nan")
+            deep = (
+                f"; the bumpers deflect {r['max_penetration_mm']:.0f} mm, beyond their radius"
+                if has_log and r["max_penetration_mm"] > rb_mm
+                else ""
+            )
             note = (
                 f"- Crash {r['crash']}: the experiment was type {r['type_paper_experiment']}, ours "
                 f"at the nominal conditions is {r['type_ours']} (the replica: "
-                f"{r['type_replica']}). Over the stated uncertainty type "
+                f"{r['type_replica']}{deep}). Over the stated uncertainty type "
                 f"{r['type_paper_experiment']} occurs in {seen:.0%} of the runs ({dist})."
             )
             if has_log and isinstance(r["type_log_conditions"], str):
