@@ -167,7 +167,7 @@ def test_experiments_writes_table3(tmp_path: Path) -> None:
     """The stable interface: ``quadimpact experiments --out DIR [--data PATH]``."""
     import pandas as pd
 
-    from quadimpact.experiments.table3 import LOG_COLUMNS, TABLE3_COLUMNS
+    from quadimpact.experiments.table3 import EXTRA_COLUMNS, TABLE3_COLUMNS
 
     missing = tmp_path / "no-data"
     missing.mkdir()
@@ -175,7 +175,7 @@ def test_experiments_writes_table3(tmp_path: Path) -> None:
     proc = run_cli(*args, "--data", str(missing), cwd=tmp_path, timeout=300)
     assert proc.returncode == 0, proc.stderr
     table = pd.read_csv(tmp_path / "exp" / "table3.csv")
-    assert list(table.columns) == [*TABLE3_COLUMNS, *LOG_COLUMNS] and len(table) == 7
+    assert list(table.columns) == [*TABLE3_COLUMNS, *EXTRA_COLUMNS] and len(table) == 7
     # no logs in that folder: the log columns are empty, the simulations are not
     assert table["attitude_rms_deg_0_3s"].isna().all() and table["type_log"].isna().all()
     assert table["type_ours"].notna().all()

@@ -8,7 +8,7 @@ import pytest
 from quadimpact.analysis import RESPONSE_TYPES
 from quadimpact.experiments.crashes import TABLE3, scenario_file
 from quadimpact.experiments.logs import data_dir
-from quadimpact.experiments.table3 import LOG_COLUMNS, TABLE3_COLUMNS, run_experiments
+from quadimpact.experiments.table3 import EXTRA_COLUMNS, TABLE3_COLUMNS, run_experiments
 from quadimpact.study import reproduce
 
 
@@ -48,7 +48,7 @@ def test_crash_scenarios_match_table3():
 def test_experiments_table3(tmp_path):
     table = run_experiments(tmp_path, samples=0, log_samples=0, workers=1)
     csv = pd.read_csv(tmp_path / "table3.csv")
-    assert list(csv.columns) == [*TABLE3_COLUMNS, *LOG_COLUMNS] and len(csv) == 7
+    assert list(csv.columns) == [*TABLE3_COLUMNS, *EXTRA_COLUMNS] and len(csv) == 7
     assert set(csv["type_ours"]) <= set(RESPONSE_TYPES)
     # the motors are powered off at the first contact in every crash
     for c in TABLE3:
@@ -89,10 +89,10 @@ def test_sensitivity_shares_sum_to_one(tmp_path):
 
 
 def test_table3_report_flags_depths_beyond_the_bumper_radius():
-    from quadimpact.experiments.table3 import LOG_COLUMNS, TABLE3_COLUMNS
+    from quadimpact.experiments.table3 import EXTRA_COLUMNS, TABLE3_COLUMNS
     from quadimpact.study import table3_markdown
 
-    row = {c: math.nan for c in (*TABLE3_COLUMNS, *LOG_COLUMNS)}
+    row = {c: math.nan for c in (*TABLE3_COLUMNS, *EXTRA_COLUMNS)}
     row.update(crash=5, heading_deg=11.0, speed_m_s=2.0, inclination_deg=15.0,
                type_paper_experiment="Other", type_paper_simulation="Other", type_ours="D",
                type_replica="D", share_B=0.13, share_D=0.73, share_Other=0.14,

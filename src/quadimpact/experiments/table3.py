@@ -16,7 +16,7 @@ changes. The log's own response type (classified from its motion) is given
 too.
 
 It writes ``table3.csv`` (the stable interface: ``TABLE3_COLUMNS``, then
-``LOG_COLUMNS``), ``table3.parquet``, one folder per crash (the nominal runs'
+``EXTRA_COLUMNS``), ``table3.parquet``, one folder per crash (the nominal runs'
 files and the comparison plots) and the sensitivity sweeps (resumable).
 """
 
@@ -59,14 +59,11 @@ TABLE3_COLUMNS = (
     *(f"share_{t}" for t in RESPONSE_TYPES),
     "attitude_rms_deg_0_3s",
 )
-#: Columns after ``TABLE3_COLUMNS``: the deepest bumper deflection of our nominal
-#: run (default model; beyond the bumper radius, 110 mm, the model no longer
-#: holds), the log's own estimates (empty where the log does not show the
-#: contact), the log's own type, ours at the log's estimates (default model),
-#: the shares over their uncertainty, that run's attitude error against the log
-#: and its deepest deflection.
+#: The log's own estimates (empty where the log does not show the contact), the
+#: log's own type, ours at the log's estimates (default model), the shares over
+#: their uncertainty, that run's attitude error against the log and its deepest
+#: bumper deflection, mm.
 LOG_COLUMNS = (
-    "max_penetration_mm",
     "log_heading_deg",
     "log_speed_m_s",
     "log_inclination_deg",
@@ -78,6 +75,10 @@ LOG_COLUMNS = (
     "attitude_rms_log_conditions_deg_0_3s",
     "log_max_penetration_mm",
 )
+#: Columns of ``table3.csv`` after ``TABLE3_COLUMNS``: the deepest bumper
+#: deflection of our nominal run (default model, mm; beyond the bumper radius,
+#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``.
+EXTRA_COLUMNS = ("max_penetration_mm", *LOG_COLUMNS)
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
@@ -98,6 +99,12 @@ def sensitivity_spec(crash: Crash, n: int = SENSITIVITY_RUNS) -> SweepSpec:
             },
         },
     )  # fmt: skip
+
+
+def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
+    """Share of each response type among a sweep's runs, as ``{prefix + type: share}``."""
+    counts = sweep["response_type"].value_counts()
+    return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
 
 
 def read_log(crash: Crash, data: str | Path | None = None) -> SpiriMatLog | None:
@@ -183,9 +190,7 @@ def _log_row(
     spec = log_sensitivity_spec(crash, pre, samples) if samples > 0 else None
     if spec is not None:
         sweep = run_sweep(spec, out / "sensitivity-log" / f"crash_{crash.number}", **sweep_options)
-        counts = sweep["response_type"].value_counts()
-        for t in RESPONSE_TYPES:
-            row[f"log_share_{t}"] = float(counts.get(t, 0)) / len(sweep)
+        row.update(_shares(sweep, "log_share_"))
     return row
 
 
@@ -242,9 +247,7 @@ def run_experiments(
                 out / "sensitivity" / f"crash_{crash.number}",
                 **sweep_options,
             )
-            counts = sweep["response_type"].value_counts()
-            for t in RESPONSE_TYPES:
-                shares[f"share_{t}"] = float(counts.get(t, 0)) / len(sweep)
+            shares = _shares(sweep, "share_")
         log = read_log(crash, data_dir)
         rms = attitude_rms_for_crash(crash, results["default"], log, folder)
         rows.append(
@@ -258,11 +261,11 @@ def run_experiments(
                 **types,
                 **shares,
                 "attitude_rms_deg_0_3s": rms,
-                **_log_row(crash, log, folder, out, log_samples, sweep_options),
                 "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
+                **_log_row(crash, log, folder, out, log_samples, sweep_options),
             }
         )
-    table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *LOG_COLUMNS])
+    table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *EXTRA_COLUMNS])
     table.to_csv(out / "table3.csv", index=False)
     table.to_parquet(out / "table3.parquet")
     return table
