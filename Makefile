@@ -32,7 +32,7 @@ run: $(STAMP)
 	$(BIN)/quadimpact animate $(OUT)/example-paper-replica
 	$(BIN)/quadimpact view $(OUT)/example-paper-replica
 
-# Headless Chromium for the viewer's browser tests (tests/test_viz.py), from
+# Headless Chromium for the viewer's browser tests (tests/viz/test_viz.py), from
 # Debian's packages, only when it is missing and we are root (as in CI);
 # otherwise those tests skip and say why. Idempotent.
 browser:

@@ -2,11 +2,17 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
+import quadimpact
 from quadimpact.core import layout as L
 from quadimpact.core.run import execute
 from quadimpact.scenario import RunSetup
+
+#: The bundled Spiri's parameter file.
+SPIRI_TOML = Path(quadimpact.__file__).resolve().parent / "vehicles" / "spiri.toml"
 
 
 def run_packed(setup: RunSetup, **changes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

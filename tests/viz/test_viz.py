@@ -291,6 +291,7 @@ needs_chromium = pytest.mark.skipif(
 )
 
 
+@pytest.mark.browser
 @needs_chromium
 def test_viewer_renders_in_headless_chromium(run_dir: Path, tmp_path: Path) -> None:
     from PIL import Image

@@ -35,11 +35,7 @@ from quadimpact.experiments.logs import (
 )
 
 DATA = data_dir()
-pytestmark = pytest.mark.skipif(
-    DATA is None,
-    reason="shared crash data absent (set QUADIMPACT_DATA to the folder holding "
-    "spiri-crash-set-1/ and spiri_crash_set_1.toml)",
-)
+pytestmark = pytest.mark.data
 
 # Table III: crash -> (heading deg, V_c m/s, inclination deg, inclination +-)
 TABLE3 = {

@@ -12,6 +12,7 @@ from quadimpact.experiments.table3 import EXTRA_COLUMNS, TABLE3_COLUMNS, run_exp
 from quadimpact.study import reproduce
 
 
+@pytest.mark.slow
 def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path):
     r = reproduce(tmp_path, ablation=False, experiments=False, workers=2)
     text = r.report.read_text()
@@ -45,6 +46,7 @@ def test_crash_scenarios_match_table3():
         assert s.power_off is not None and s.power_off.trigger == "first-contact"
 
 
+@pytest.mark.slow
 def test_experiments_table3(tmp_path):
     table = run_experiments(tmp_path, samples=0, log_samples=0, workers=1)
     csv = pd.read_csv(tmp_path / "table3.csv")

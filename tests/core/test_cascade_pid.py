@@ -13,6 +13,7 @@ inclination at 1.76 m/s).
 import itertools
 
 import numpy as np
+import pytest
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
@@ -46,6 +47,7 @@ def impact_energy(result, episode, vehicle) -> float:
     return 0.5 * m_eff * max(rate, episode["v_i_m_s"]) ** 2
 
 
+@pytest.mark.slow
 def test_cascade_pid_never_pushes_beyond_a_bumper_radius():
     from quadimpact import load_vehicle
 

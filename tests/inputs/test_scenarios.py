@@ -19,6 +19,8 @@ from quadimpact.config import (
 )
 from quadimpact.errors import InputError, input_error_from_validation
 
+from helpers import SPIRI_TOML
+
 DEFAULT_SWITCHES = {
     "yaw_reaction": "physical",
     "bumper1_yaw_twice": False,
@@ -268,7 +270,7 @@ normal = [0.0, 0.0, 1.0]
 
 
 def test_vehicle_path_relative_to_scenario_file(tmp_path: Path) -> None:
-    spiri = Path(__file__).resolve().parents[1] / "src/quadimpact/vehicles/spiri.toml"
+    spiri = SPIRI_TOML
     sub = tmp_path / "cases"
     sub.mkdir()
     (sub / "heavy.toml").write_text(spiri.read_text().replace("0.933", "1.2"))

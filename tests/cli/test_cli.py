@@ -8,12 +8,7 @@ from pathlib import Path
 
 import pytest
 
-import quadimpact.errors
-
-from helpers import run_cli
-
-SRC = Path(quadimpact.errors.__file__).resolve().parents[1]
-SPIRI_TOML = SRC / "quadimpact/vehicles/spiri.toml"
+from helpers import SPIRI_TOML, run_cli
 
 SUMMARY_KEYS = (
     "status reason warnings model controller delta_init_m peak_force_n impact_speed_m_s "
@@ -163,6 +158,7 @@ def test_format_summary_for_people() -> None:
     assert "crash time     no crash" in quiet and "delta_init     n/a" in quiet
 
 
+@pytest.mark.slow
 def test_experiments_writes_table3(tmp_path: Path) -> None:
     """The stable interface: ``quadimpact experiments --out DIR [--data PATH]``."""
     import pandas as pd

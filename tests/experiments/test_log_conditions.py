@@ -7,7 +7,6 @@ import pytest
 
 from quadimpact.config import WallApproach
 from quadimpact.experiments.crashes import TABLE3, scenario_file
-from quadimpact.experiments.logs import data_dir
 from quadimpact.experiments.table3 import (
     LOG_RANGE_SIGMAS,
     log_conditions,
@@ -16,11 +15,7 @@ from quadimpact.experiments.table3 import (
 )
 from quadimpact.simulation import simulate
 
-pytestmark = pytest.mark.skipif(
-    data_dir() is None,
-    reason="shared crash data absent (set QUADIMPACT_DATA to the folder holding "
-    "spiri-crash-set-1/ and spiri_crash_set_1.toml)",
-)
+pytestmark = pytest.mark.data
 
 
 @pytest.fixture(scope="module")

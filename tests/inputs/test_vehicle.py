@@ -13,7 +13,7 @@ import pytest
 from quadimpact.errors import InputError
 from quadimpact.vehicle import Vehicle, bundled_vehicles, load_vehicle
 
-SPIRI_TOML = Path(__file__).resolve().parents[1] / "src/quadimpact/vehicles/spiri.toml"
+from helpers import SPIRI_TOML
 
 
 @pytest.fixture(scope="module")

@@ -111,7 +111,7 @@ def test_plot_is_written(run, tmp_path):
     assert out.exists() and out.stat().st_size > 10_000
 
 
-@pytest.mark.skipif(data_dir() is None, reason="shared crash data absent (set QUADIMPACT_DATA)")
+@pytest.mark.data
 def test_real_log_comparison_runs(tmp_path):
     log = SpiriMatLog(data_dir() / "spiri-crash-set-1" / "crash_5.mat", front_first=True)
     pre = log.pre_impact()

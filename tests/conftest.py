@@ -1,0 +1,27 @@
+"""Test markers (registered in pyproject.toml; the default run runs them all).
+
+``slow``: more than about 5 s; ``data``: needs the shared flight data (skipped,
+saying so, when it is absent); ``browser``: needs headless Chromium (skipped,
+saying so, when it is absent; see ``tests/viz/test_viz.py``). Deselect with
+e.g. ``pytest -m "not slow and not data"``.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+from quadimpact.experiments.logs import DATA_ENV_VAR, data_dir
+
+DATA_MISSING = (
+    f"shared crash data absent (set {DATA_ENV_VAR} to the folder holding "
+    "spiri-crash-set-1/ and spiri_crash_set_1.toml, or put it in ../shared/data)"
+)
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if data_dir() is not None:
+        return
+    skip = pytest.mark.skip(reason=DATA_MISSING)
+    for item in items:
+        if item.get_closest_marker("data") is not None:
+            item.add_marker(skip)
