@@ -19,7 +19,7 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
-from quadimpact.frames import (
+from quadimpact.rotations import (
     body_to_inertial,
     euler_zyx_to_quat,
     quat_to_euler_zyx,

@@ -29,7 +29,6 @@ from .config import FlightScenario, ModelOptions, WallApproach, resolve_model_op
 from .core import layout as L
 from .core.contact import bumper_plane_contact
 from .core.run import execute
-from .frames import euler_zyx_to_quat, quat_to_matrix
 from .packing import (
     RPM,
     Surface,
@@ -39,6 +38,7 @@ from .packing import (
     pack_vehicle,
     trim_rotor_speeds,
 )
+from .rotations import euler_zyx_to_quat, inclination_deg, quat_to_matrix
 from .vehicle import Vehicle, load_vehicle
 
 PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (MODEL.md 8.4)
@@ -118,8 +118,7 @@ def wall_attitude(
 
 def inclination_deg_of(q: np.ndarray) -> float:
     """Inclination (deg) of attitude ``q``: angle of body z projected on X-Z from Z, + toward +X."""
-    z = quat_to_matrix(np.asarray(q, dtype=float))[..., :, 2]
-    return float(np.degrees(np.arctan2(-z[..., 0], z[..., 2])))
+    return float(inclination_deg(quat_to_matrix(np.asarray(q, dtype=float))))
 
 
 # ---------------------------------------------------------------- settings

@@ -26,8 +26,8 @@ from .analysis import (
 from .config import FlightScenario, WallApproach
 from .core import layout as L
 from .core.run import execute
-from .frames import quat_to_euler_zyx, quat_to_matrix
 from .result import SimulationResult
+from .rotations import quat_to_euler_zyx, quat_to_matrix
 from .scenario import RunSetup, inclination_deg_of, prepare
 
 STATUS_NAMES = {

@@ -18,8 +18,8 @@ import pytest
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
-from quadimpact.frames import quat_to_matrix
 from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.rotations import quat_to_matrix
 
 STATE_COLS = [
     "x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3",

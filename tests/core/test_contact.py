@@ -9,8 +9,8 @@ from scipy.integrate import solve_ivp
 from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
-from quadimpact.frames import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.scenario import prepare
 
 from helpers import run_packed

@@ -9,7 +9,7 @@ from numba import njit
 from quadimpact import FlightScenario, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.run import execute, make_kernel
-from quadimpact.frames import quat_to_matrix
+from quadimpact.rotations import quat_to_matrix
 from quadimpact.scenario import prepare
 
 from helpers import run_packed, states

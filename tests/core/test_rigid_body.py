@@ -4,7 +4,7 @@ import numpy as np
 
 from quadimpact.config import FlightScenario
 from quadimpact.core import layout as L
-from quadimpact.frames import quat_to_matrix
+from quadimpact.rotations import quat_to_matrix
 from quadimpact.scenario import prepare
 
 from helpers import run_packed, states

@@ -197,7 +197,7 @@ def test_frames_at_rest_before_take_off():
     assert abs(rest["altitude_m"].median()) < 0.03
     assert abs(rest["roll_deg"].median()) < 5.0 and abs(rest["pitch_deg"].median()) < 5.0
     # quaternion and Euler angles agree (ZYX, body FRD -> NED)
-    from quadimpact.frames import quat_to_euler_zyx
+    from quadimpact.rotations import quat_to_euler_zyx
 
     r, p, y = quat_to_euler_zyx(pose[["q0", "q1", "q2", "q3"]].to_numpy())
     np.testing.assert_allclose(np.degrees(p), pose["pitch_deg"], atol=1e-6)

@@ -16,7 +16,7 @@ from quadimpact.analysis import (
     timeseries_frame,
 )
 from quadimpact.core import layout as L
-from quadimpact.frames import euler_zyx_to_quat
+from quadimpact.rotations import euler_zyx_to_quat
 
 SURFACES = ("wall", "ground")
 D = math.pi / 180.0

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from quadimpact import WallApproach, simulate
-from quadimpact.frames import euler_zyx_to_quat, quat_to_matrix
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.scenario import inclination_deg_of, wall_attitude
 
 

@@ -21,8 +21,8 @@ import quadimpact.errors
 from quadimpact import WallApproach, load_vehicle, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
-from quadimpact.frames import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial
 

@@ -46,6 +46,7 @@ from quadimpact.experiments.logs import (
     bumper_rim_extent,
     rpm_to_rad_s,
 )
+from quadimpact.rotations import quat_to_matrix, wrap_angle_deg
 
 __all__ = [
     "CONTACT_TOL_M",
@@ -173,8 +174,6 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
     idx, tp = idx[:end], tp[:end]
     tracked_until = float(tp[-1])
     q = pose[["q0", "q1", "q2", "q3"]].to_numpy()[idx]
-    from quadimpact.frames import quat_to_matrix
-
     C = quat_to_matrix(q)
     reach = bumper_rim_extent(C, np.array([1.0, 0.0, 0.0]))
     rim = pose["x_m"].to_numpy()[idx][:, None] + reach  # (n, 4)
@@ -309,8 +308,6 @@ class SyntheticLog(FlightLog):
         def at(col: str) -> float:
             return float(np.interp(t0, ts["t_s"], ts[col]))
 
-        from quadimpact.frames import quat_to_matrix
-
         q = np.array([at(c) for c in ("q0", "q1", "q2", "q3")])
         C = quat_to_matrix(q)
         incl = math.degrees(math.atan2(-C[0, 2], C[2, 2]))
@@ -382,10 +379,6 @@ def synthetic_log(
 
 
 # ------------------------------------------------------------------ comparison
-def _wrap_deg(a: np.ndarray) -> np.ndarray:
-    return np.mod(np.asarray(a, dtype=float) + 180.0, 360.0) - 180.0
-
-
 def _interp_segments(t_new: np.ndarray, t: np.ndarray, y: np.ndarray, gap: float) -> np.ndarray:
     """Linear interpolation that gives nan inside gaps longer than ``gap`` and outside."""
     out = np.interp(t_new, t, y, left=np.nan, right=np.nan)
@@ -465,10 +458,10 @@ class Comparison:
             if col in sim:
                 x, y = sim.tau_s.to_numpy(), sim[col].to_numpy()
                 if wrapped:
-                    x, y = break_wraps(x, _wrap_deg(y))
+                    x, y = break_wraps(x, wrap_angle_deg(y))
                 ax.plot(x, y, "-", color="tab:blue", lw=1.2, label="simulation")
             if col in lp:
-                y = _wrap_deg(lp[col].to_numpy()) if wrapped else lp[col]
+                y = wrap_angle_deg(lp[col].to_numpy()) if wrapped else lp[col]
                 ax.plot(lp.tau_s, y, "o", color="tab:red", ms=3, label="log")
             ax.set_ylabel(label)
         colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
@@ -578,7 +571,7 @@ def compare(
     if "yaw_deg" in sim and "yaw_deg" in pose and len(pose):
         y_sim0 = float(np.interp(0.0, sim["tau_s"], sim["yaw_deg"]))
         k0 = int(np.argmin(np.abs(pose["tau_s"].to_numpy())))
-        dyaw = float(_wrap_deg(np.array(y_sim0 - pose["yaw_deg"].iloc[k0])))
+        dyaw = float(wrap_angle_deg(np.array(y_sim0 - pose["yaw_deg"].iloc[k0])))
         if abs(dyaw) > 90.0:
             notes.append(
                 f"headings at the impact differ by {dyaw:.0f} deg: the log approaches "
@@ -616,7 +609,7 @@ def compare(
                                   left=np.nan, right=np.nan)  # fmt: skip
                 err = y_sim - y_log
                 if wrapped:
-                    err = _wrap_deg(err)
+                    err = wrap_angle_deg(err)
                 err = err[np.isfinite(err)]
                 all_err.append(err)
                 rows.append(_row(group, qname, unit, w, err))

@@ -36,6 +36,15 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from quadimpact.rotations import (
+    inclination_deg,
+    matrix_to_euler_zyx_deg,
+    matrix_to_quat,
+    matrix_to_rotvec,
+    quat_xyzw_to_matrix,
+    wrap_angle_deg,
+)
+
 __all__ = [
     "ATTITUDE_SYSTEMATIC_DEG",
     "ATTITUDE_WINDOW_S",
@@ -356,83 +365,6 @@ class FlightLog(ABC):
 
 
 # ------------------------------------------------------------------ helpers
-def _wrap_deg(a: Any) -> Any:
-    w = np.mod(np.asarray(a, dtype=float) + 180.0, 360.0) - 180.0
-    return np.where(w <= -180.0, w + 360.0, w)
-
-
-def _quat_xyzw_to_matrix(q: np.ndarray) -> np.ndarray:
-    """Rotation matrices of (x, y, z, w) quaternions (ROS order), shape (n, 3, 3)."""
-    q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    x, y, z, w = q.T
-    C = np.empty((len(q), 3, 3))
-    C[:, 0, 0] = 1 - 2 * (y * y + z * z)
-    C[:, 0, 1] = 2 * (x * y - z * w)
-    C[:, 0, 2] = 2 * (x * z + y * w)
-    C[:, 1, 0] = 2 * (x * y + z * w)
-    C[:, 1, 1] = 1 - 2 * (x * x + z * z)
-    C[:, 1, 2] = 2 * (y * z - x * w)
-    C[:, 2, 0] = 2 * (x * z - y * w)
-    C[:, 2, 1] = 2 * (y * z + x * w)
-    C[:, 2, 2] = 1 - 2 * (x * x + y * y)
-    return C
-
-
-def _matrix_to_quat(C: np.ndarray) -> np.ndarray:
-    """Scalar-first unit quaternions of rotation matrices (n, 3, 3), sign-continuous."""
-    n = len(C)
-    q = np.empty((n, 4))
-    tr = np.trace(C, axis1=1, axis2=2)
-    for i in range(n):
-        m = C[i]
-        if tr[i] > 0:
-            s = 2.0 * math.sqrt(1.0 + tr[i])
-            q[i] = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s,
-                    (m[1, 0] - m[0, 1]) / s]  # fmt: skip
-        elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
-            s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
-            q[i] = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s,
-                    (m[0, 2] + m[2, 0]) / s]  # fmt: skip
-        elif m[1, 1] > m[2, 2]:
-            s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
-            q[i] = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s,
-                    (m[1, 2] + m[2, 1]) / s]  # fmt: skip
-        else:
-            s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
-            q[i] = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s,
-                    0.25 * s]  # fmt: skip
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
-    if n:
-        if q[0, 0] < 0:
-            q[0] = -q[0]
-        for i in range(1, n):  # continuity: q and -q are the same attitude
-            if np.dot(q[i], q[i - 1]) < 0:
-                q[i] = -q[i]
-    return q
-
-
-def _euler_zyx_deg(C: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    roll = np.degrees(np.arctan2(C[:, 2, 1], C[:, 2, 2]))
-    pitch = np.degrees(np.arctan2(-C[:, 2, 0], np.hypot(C[:, 0, 0], C[:, 1, 0])))
-    yaw = np.degrees(np.arctan2(C[:, 1, 0], C[:, 0, 0]))
-    return roll, pitch, yaw
-
-
-def _inclination_deg(C: np.ndarray) -> np.ndarray:
-    """STUDIES.md 1: body z projected on X-Z, angle from Z, + leaning toward +X."""
-    return np.degrees(np.arctan2(-C[:, 0, 2], C[:, 2, 2]))
-
-
-def _rotvec(R: np.ndarray) -> np.ndarray:
-    """Rotation vectors of rotation matrices (n, 3, 3)."""
-    cos = np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    ang = np.arccos(cos)
-    v = np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
-    s = np.sin(ang)
-    k = np.where(s > 1e-9, ang / (2.0 * np.where(s > 1e-9, s, 1.0)), 0.5)
-    return v * k[:, None]
-
-
 def _segments(t: np.ndarray, gap: float) -> np.ndarray:
     """Segment id per sample: a new segment after every gap longer than ``gap``."""
     if len(t) == 0:
@@ -679,7 +611,7 @@ class SpiriMatLog(FlightLog):
         v = self._raw["vicon"]
         t = v["t_raw_s"].to_numpy()
         p = v[["x_m", "y_m", "z_m"]].to_numpy() @ MOCAP_TO_NED.T
-        C = MOCAP_TO_NED @ _quat_xyzw_to_matrix(v[["qx", "qy", "qz", "qw"]].to_numpy())
+        C = MOCAP_TO_NED @ quat_xyzw_to_matrix(v[["qx", "qy", "qz", "qw"]].to_numpy())
         if self.front_first:
             C = C @ np.diag([-1.0, -1.0, 1.0])
         return {"t": t, "p": p, "C": C}
@@ -712,9 +644,9 @@ class SpiriMatLog(FlightLog):
         safe = np.where(ok, dt, 1.0)
         vel = np.where(ok[:, None], (p[nxt] - p[prev]) / safe[:, None], np.nan)
         rel = np.einsum("nji,njk->nik", C[prev], C[nxt])  # C_prev^T C_next
-        w = np.where(ok[:, None], _rotvec(rel) / safe[:, None], np.nan)
-        q = _matrix_to_quat(C)
-        roll, pitch, yaw = _euler_zyx_deg(C)
+        w = np.where(ok[:, None], matrix_to_rotvec(rel) / safe[:, None], np.nan)
+        q = matrix_to_quat(C)
+        roll, pitch, yaw = matrix_to_euler_zyx_deg(C)
         df = pd.DataFrame(
             {
                 "t_s": t - self.mocap_clock_offset_s,
@@ -921,9 +853,9 @@ class SpiriMatLog(FlightLog):
         if sa.sum() < 3:
             sa = pre & (t >= t[last] - ATTITUDE_WINDOW_S)
         Ca = C[sa]
-        roll, pitch, yaw = _euler_zyx_deg(Ca)
+        roll, pitch, yaw = matrix_to_euler_zyx_deg(Ca)
         yaw_u = np.degrees(np.unwrap(np.radians(yaw)))
-        incl = _inclination_deg(Ca)
+        incl = inclination_deg(Ca)
         tau_a = t[sa] - tc
         ang: dict[str, float] = {}
         unc: dict[str, float] = {}
@@ -938,9 +870,9 @@ class SpiriMatLog(FlightLog):
                 val, resid, slope = float(np.mean(series)), float(np.std(series)), 0.0
             ang[key] = val
             unc[key] = math.sqrt(resid**2 + (slope * dtc) ** 2 + ATTITUDE_SYSTEMATIC_DEG**2)
-        heading = float(_wrap_deg(ang["yaw_deg"]))
+        heading = float(wrap_angle_deg(ang["yaw_deg"]))
         rear = abs(heading) > 90.0
-        equiv = float(_wrap_deg(heading - 180.0)) if rear else heading
+        equiv = float(wrap_angle_deg(heading - 180.0)) if rear else heading
         # leading bumper and wall plane at the contact (the last sample before it,
         # moved to t_c with the fitted velocity)
         reach = bumper_rim_extent(C[last][None], np.array([1.0, 0.0, 0.0]))[0]

@@ -34,8 +34,8 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
-from quadimpact.frames import quat_to_matrix
 from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.rotations import quat_to_matrix
 from quadimpact.vehicle import Vehicle, load_vehicle
 
 __all__ = [

@@ -1,4 +1,4 @@
-"""Attitude and frame conversions (vectorised NumPy).
+"""Attitude and frame conversions (vectorised NumPy), for every layer above the core.
 
 Conventions (MODEL.md section 1):
 
@@ -10,11 +10,17 @@ Conventions (MODEL.md section 1):
 - Euler angles: aerospace ZYX, ``C = Rz(yaw) Ry(pitch) Rx(roll)``; angles in
   radians here (the time-series table carries degrees).
 
-Every function accepts a single quaternion of shape ``(4,)`` or a stack of
-shape ``(..., 4)`` and broadcasts over the leading dimensions.
+Every function accepts a single quaternion of shape ``(4,)`` (or matrix of
+shape ``(3, 3)``) or a stack of shape ``(..., 4)`` (``(..., 3, 3)``) and
+broadcasts over the leading dimensions. The flight logs' helpers
+(:func:`quat_xyzw_to_matrix`, :func:`matrix_to_quat`,
+:func:`matrix_to_euler_zyx_deg`, :func:`matrix_to_rotvec`) work on rotation
+matrices in the same convention.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -23,8 +29,14 @@ __all__ = [
     "GIMBAL_LOCK_COS",
     "body_to_inertial",
     "euler_zyx_to_quat",
+    "inclination_deg",
+    "matrix_to_euler_zyx_deg",
+    "matrix_to_quat",
+    "matrix_to_rotvec",
     "quat_to_euler_zyx",
     "quat_to_matrix",
+    "quat_xyzw_to_matrix",
+    "wrap_angle_deg",
     "wrap_angle_rad",
 ]
 
@@ -64,8 +76,32 @@ def quat_to_matrix(q: ArrayLike) -> NDArray[np.float64]:
         axis ``k`` expressed in the inertial frame.
     """
     a = _as_quat(q)
-    q0, q1, q2, q3 = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    c = np.empty(a.shape[:-1] + (3, 3), dtype=np.float64)
+    return _unit_quat_matrix(a[..., 0], a[..., 1], a[..., 2], a[..., 3])
+
+
+def quat_xyzw_to_matrix(q: ArrayLike) -> NDArray[np.float64]:
+    """Rotation matrices of ``(x, y, z, w)`` quaternions (ROS order, scalar last).
+
+    Parameters
+    ----------
+    q : array_like, shape (..., 4)
+        Quaternion(s) ``[x, y, z, w]``; normalised before use.
+
+    Returns
+    -------
+    numpy.ndarray, shape (..., 3, 3)
+        The same matrices as :func:`quat_to_matrix` of ``[w, x, y, z]``.
+    """
+    a = np.asarray(q, dtype=np.float64)
+    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    return _unit_quat_matrix(a[..., 3], a[..., 0], a[..., 1], a[..., 2])
+
+
+def _unit_quat_matrix(
+    q0: ArrayLike, q1: ArrayLike, q2: ArrayLike, q3: ArrayLike
+) -> NDArray[np.float64]:
+    """``C`` of the unit quaternion with components ``q0`` (scalar) .. ``q3``."""
+    c = np.empty(np.shape(q0) + (3, 3), dtype=np.float64)
     c[..., 0, 0] = 1.0 - 2.0 * (q2 * q2 + q3 * q3)
     c[..., 0, 1] = 2.0 * (q1 * q2 - q0 * q3)
     c[..., 0, 2] = 2.0 * (q1 * q3 + q0 * q2)
@@ -78,11 +114,20 @@ def quat_to_matrix(q: ArrayLike) -> NDArray[np.float64]:
     return c
 
 
+def _wrap(angle: ArrayLike, half_turn: float) -> NDArray[np.float64]:
+    a = np.asarray(angle, dtype=np.float64)
+    w = np.mod(a + half_turn, 2.0 * half_turn) - half_turn  # [-half, half)
+    return np.where(w <= -half_turn, w + 2.0 * half_turn, w)
+
+
 def wrap_angle_rad(angle: ArrayLike) -> NDArray[np.float64]:
     """Wrap angle(s) to the interval (-pi, pi] (radians)."""
-    a = np.asarray(angle, dtype=np.float64)
-    w = np.mod(a + np.pi, 2.0 * np.pi) - np.pi  # [-pi, pi)
-    return np.where(w <= -np.pi, w + 2.0 * np.pi, w)
+    return _wrap(angle, np.pi)
+
+
+def wrap_angle_deg(angle: ArrayLike) -> NDArray[np.float64]:
+    """Wrap angle(s) to the interval (-180, 180] (degrees)."""
+    return _wrap(angle, 180.0)
 
 
 def quat_to_euler_zyx(
@@ -173,3 +218,90 @@ def body_to_inertial(q: ArrayLike, v_body: ArrayLike) -> NDArray[np.float64]:
         raise ValueError(f"vector array must have a last axis of length 3 (got {v.shape})")
     c = quat_to_matrix(q)
     return np.einsum("...ij,...j->...i", c, v)
+
+
+# ----------------------------------------------------------- rotation matrices
+def matrix_to_quat(C: ArrayLike) -> NDArray[np.float64]:
+    """Scalar-first unit quaternions of rotation matrices, sign-continuous along the stack.
+
+    Parameters
+    ----------
+    C : array_like, shape (n, 3, 3)
+        Rotation matrices, body -> inertial.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, 4)
+        ``q`` with ``quat_to_matrix(q) == C``; the first has ``q0 >= 0`` and each
+        next one the sign closer to its predecessor (``q`` and ``-q`` are the
+        same attitude).
+    """
+    C = np.asarray(C, dtype=np.float64)
+    n = len(C)
+    q = np.empty((n, 4))
+    tr = np.trace(C, axis1=1, axis2=2)
+    for i in range(n):
+        m = C[i]
+        if tr[i] > 0:
+            s = 2.0 * math.sqrt(1.0 + tr[i])
+            q[i] = [0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s,
+                    (m[1, 0] - m[0, 1]) / s]  # fmt: skip
+        elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+            s = 2.0 * math.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2])
+            q[i] = [(m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s,
+                    (m[0, 2] + m[2, 0]) / s]  # fmt: skip
+        elif m[1, 1] > m[2, 2]:
+            s = 2.0 * math.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2])
+            q[i] = [(m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s,
+                    (m[1, 2] + m[2, 1]) / s]  # fmt: skip
+        else:
+            s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
+            q[i] = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s,
+                    0.25 * s]  # fmt: skip
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    if n:
+        if q[0, 0] < 0:
+            q[0] = -q[0]
+        for i in range(1, n):  # continuity: q and -q are the same attitude
+            if np.dot(q[i], q[i - 1]) < 0:
+                q[i] = -q[i]
+    return q
+
+
+def matrix_to_euler_zyx_deg(
+    C: ArrayLike,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Roll, pitch, yaw (deg, ZYX) of rotation matrices, straight from ``atan2``.
+
+    Unlike :func:`quat_to_euler_zyx`: degrees, no gimbal-lock rule, roll and
+    yaw in [-180, 180] as ``atan2`` gives them.
+    """
+    C = np.asarray(C, dtype=np.float64)
+    roll = np.degrees(np.arctan2(C[..., 2, 1], C[..., 2, 2]))
+    pitch = np.degrees(np.arctan2(-C[..., 2, 0], np.hypot(C[..., 0, 0], C[..., 1, 0])))
+    yaw = np.degrees(np.arctan2(C[..., 1, 0], C[..., 0, 0]))
+    return roll, pitch, yaw
+
+
+def inclination_deg(C: ArrayLike) -> NDArray[np.float64]:
+    """Inclination (deg) of attitude matrices (STUDIES.md section 1).
+
+    The angle of the body z axis, projected on the inertial X-Z plane, from
+    the inertial Z axis; positive when the vehicle leans toward +X (the wall).
+    """
+    C = np.asarray(C, dtype=np.float64)
+    return np.degrees(np.arctan2(-C[..., 0, 2], C[..., 2, 2]))
+
+
+def matrix_to_rotvec(R: ArrayLike) -> NDArray[np.float64]:
+    """Rotation vectors (axis times angle, rad) of rotation matrices, shape (..., 3)."""
+    R = np.asarray(R, dtype=np.float64)
+    cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+    ang = np.arccos(cos)
+    v = np.stack(
+        [R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]],
+        -1,
+    )
+    s = np.sin(ang)
+    k = np.where(s > 1e-9, ang / (2.0 * np.where(s > 1e-9, s, 1.0)), 0.5)
+    return v * k[..., None]

@@ -3,11 +3,17 @@
 import numpy as np
 import pytest
 
-from quadimpact.frames import (
+from quadimpact.rotations import (
     body_to_inertial,
     euler_zyx_to_quat,
+    inclination_deg,
+    matrix_to_euler_zyx_deg,
+    matrix_to_quat,
+    matrix_to_rotvec,
     quat_to_euler_zyx,
     quat_to_matrix,
+    quat_xyzw_to_matrix,
+    wrap_angle_deg,
     wrap_angle_rad,
 )
 
@@ -135,3 +141,47 @@ def test_body_to_inertial_batched() -> None:
     np.testing.assert_allclose(
         body_to_inertial(q, v), [[1, 0, 0], [0, 1, 0], [-1, 0, 0]], atol=1e-15
     )
+
+
+# ------------------------------------------------------- matrix helpers (flight logs)
+def _random_quats(n: int = 50) -> np.ndarray:
+    q = np.random.default_rng(3).normal(size=(n, 4))
+    return q / np.linalg.norm(q, axis=1, keepdims=True)
+
+
+def test_ros_order_quaternion_is_the_same_rotation() -> None:
+    q = _random_quats()
+    ros = q[:, [1, 2, 3, 0]]  # (x, y, z, w)
+    np.testing.assert_allclose(quat_xyzw_to_matrix(ros), quat_to_matrix(q), atol=1e-15)
+
+
+def test_matrix_to_quat_round_trip_and_sign_continuity() -> None:
+    q = _random_quats()
+    back = matrix_to_quat(quat_to_matrix(q))
+    np.testing.assert_allclose(quat_to_matrix(back), quat_to_matrix(q), atol=1e-12)
+    assert back[0, 0] >= 0 and np.all(np.sum(back[1:] * back[:-1], axis=1) >= 0)
+
+
+def test_matrix_euler_and_inclination_agree_with_the_quaternion_forms() -> None:
+    q = _random_quats()
+    C = quat_to_matrix(q)
+    roll, pitch, yaw = matrix_to_euler_zyx_deg(C)
+    r, p, y = quat_to_euler_zyx(q)
+    np.testing.assert_allclose(pitch, np.degrees(p), atol=1e-9)
+    np.testing.assert_allclose(wrap_angle_deg(roll - np.degrees(r)), 0.0, atol=1e-9)
+    np.testing.assert_allclose(wrap_angle_deg(yaw - np.degrees(y)), 0.0, atol=1e-9)
+    # leaning 10 deg toward +X (pitch -10 deg at yaw 0) is an inclination of +10 deg
+    assert inclination_deg(quat_to_matrix(euler_zyx_to_quat(0.0, -10 * D, 0.0))) == pytest.approx(
+        10.0
+    )
+
+
+def test_wrap_angle_deg_is_half_open() -> None:
+    np.testing.assert_array_equal(wrap_angle_deg([-180.0, 180.0, 190.0, -190.0, 540.0]),
+                                  [180.0, 180.0, -170.0, 170.0, 180.0])  # fmt: skip
+
+
+def test_rotation_vector_of_a_known_rotation() -> None:
+    C = rz(0.3) @ rx(0.0)
+    np.testing.assert_allclose(matrix_to_rotvec(C[None]), [[0.0, 0.0, 0.3]], atol=1e-12)
+    np.testing.assert_allclose(matrix_to_rotvec(np.eye(3)[None]), [[0.0, 0.0, 0.0]])
