@@ -12,7 +12,7 @@ from quadimpact.core.run import execute
 from quadimpact.scenario import RunSetup
 
 #: The bundled Spiri's parameter file.
-SPIRI_TOML = Path(quadimpact.__file__).resolve().parent / "vehicles" / "spiri.toml"
+SPIRI_TOML = Path(quadimpact.__file__).resolve().parent / "inputs" / "vehicles" / "spiri.toml"
 
 
 def run_packed(setup: RunSetup, **changes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

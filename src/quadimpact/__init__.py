@@ -17,13 +17,13 @@ from typing import Any
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "WallApproach": "quadimpact.config",
-    "FlightScenario": "quadimpact.config",
-    "Plane": "quadimpact.config",
-    "ModelOptions": "quadimpact.config",
-    "load_scenario_file": "quadimpact.config",
-    "Vehicle": "quadimpact.vehicle",
-    "load_vehicle": "quadimpact.vehicle",
+    "WallApproach": "quadimpact.inputs.scenarios",
+    "FlightScenario": "quadimpact.inputs.scenarios",
+    "Plane": "quadimpact.inputs.world",
+    "ModelOptions": "quadimpact.inputs.model",
+    "load_scenario_file": "quadimpact.inputs.scenarios",
+    "Vehicle": "quadimpact.inputs.vehicle",
+    "load_vehicle": "quadimpact.inputs.vehicle",
     "InputError": "quadimpact.errors",
     "simulate": "quadimpact.simulation",
 }

@@ -292,12 +292,9 @@ def build_scenario(
     """
     from pydantic import ValidationError
 
-    from quadimpact.config import (
-        FlightScenario,
-        ModelOptions,
-        WallApproach,
-        load_scenario_file,
-    )
+    from quadimpact.inputs.files import apply_overrides
+    from quadimpact.inputs.model import ModelOptions
+    from quadimpact.inputs.scenarios import FlightScenario, WallApproach, load_scenario_file
 
     data: dict[str, Any] = {}
     if scenario_path is not None:
@@ -319,7 +316,7 @@ def build_scenario(
         except ValidationError as exc:
             raise input_error_from_validation(exc, "--option", model=ModelOptions) from None
         data["model_options"] = {**(data.get("model_options") or {}), **parsed}
-    data.update(given)
+    data = apply_overrides(data, given)
 
     cls = FlightScenario if kind == "flight" else WallApproach
     try:

@@ -6,12 +6,12 @@ Slots are named in ``quadimpact.core.layout``. Nothing here integrates.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
 
 import numpy as np
 
 from .core import layout as L
-from .vehicle import Vehicle
+from .inputs.vehicle import Vehicle
+from .inputs.world import Plane
 
 # Paper gains (MODEL.md 6.1): (P, I, D) for altitude, climb rate, heading,
 # roll/pitch and yaw rate, in the order of the G_* blocks.
@@ -57,17 +57,6 @@ FRICTION_V_REG_M_S = 1e-2  # friction regularisation velocity
 MAX_STEPS_PER_S = 2_000_000
 
 
-@dataclass(frozen=True)
-class Surface:
-    """A contact plane: through ``point_m`` (inertial NED, m), unit ``normal``
-    pointing out of the obstacle into free space."""
-
-    name: str
-    point_m: tuple[float, float, float]
-    normal: tuple[float, float, float]
-    is_ground: bool = False
-
-
 def pack_vehicle(v: Vehicle) -> np.ndarray:
     """Vehicle parameters as the ``V_*`` vector (SI, body frame)."""
     veh = np.zeros(L.NVEH)
@@ -92,7 +81,7 @@ def pack_vehicle(v: Vehicle) -> np.ndarray:
     return veh
 
 
-def pack_surfaces(surfaces: Sequence[Surface]) -> np.ndarray:
+def pack_surfaces(surfaces: Sequence[Plane]) -> np.ndarray:
     """Surfaces as an (n, NSURF) array; normals normalised."""
     surf = np.zeros((len(surfaces), L.NSURF))
     for i, s in enumerate(surfaces):

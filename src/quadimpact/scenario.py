@@ -1,7 +1,7 @@
 """Scenarios to packed runs: attitude, trim, surfaces, and the wall-approach shooting.
 
-``prepare(scenario)`` turns a validated :class:`~quadimpact.config.WallApproach`
-or :class:`~quadimpact.config.FlightScenario` into a :class:`RunSetup`: the
+``prepare(scenario)`` turns a validated :class:`~quadimpact.inputs.scenarios.WallApproach`
+or :class:`~quadimpact.inputs.scenarios.FlightScenario` into a :class:`RunSetup`: the
 flat arrays of the compiled core plus what the analysis needs to read the
 result (surface names, references, the approach solution, warnings).
 
@@ -25,13 +25,15 @@ from typing import Any
 import numpy as np
 from scipy.optimize import brentq
 
-from .config import FlightScenario, ModelOptions, WallApproach, resolve_model_options
 from .core import layout as L
 from .core.contact import bumper_plane_contact
 from .core.run import execute
+from .inputs.model import ModelOptions, resolve_model_options
+from .inputs.scenarios import FlightScenario, WallApproach
+from .inputs.vehicle import Vehicle, load_vehicle
+from .inputs.world import GROUND, Plane
 from .packing import (
     RPM,
-    Surface,
     pack_controller,
     pack_options,
     pack_surfaces,
@@ -39,7 +41,6 @@ from .packing import (
     trim_rotor_speeds,
 )
 from .rotations import euler_zyx_to_quat, inclination_deg, quat_to_matrix
-from .vehicle import Vehicle, load_vehicle
 
 PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (MODEL.md 8.4)
 PAPER_FIT_SCALE = 1.3836686
@@ -66,7 +67,7 @@ class RunSetup:
     vehicle: Vehicle
     options: ModelOptions
     output_rate_hz: float
-    wall: Surface | None = None
+    wall: Plane | None = None
     approach: dict[str, Any] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
     sched_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -187,9 +188,9 @@ def _schedule(s: WallApproach | FlightScenario) -> dict[str, np.ndarray]:
     }
 
 
-def _ground(s: WallApproach | FlightScenario) -> list[Surface]:
+def _ground(s: WallApproach | FlightScenario) -> list[Plane]:
     if s.ground == "contact":
-        return [Surface("ground", (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), is_ground=True)]
+        return [GROUND]
     return []
 
 
@@ -236,8 +237,7 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
         "pitch_rad": math.radians(ref_att[1]),
         "yaw_rad": math.radians(ref_att[2]),
     }
-    surfaces = [Surface(p.name, tuple(p.point_m), tuple(p.normal)) for p in s.surfaces]
-    surfaces += _ground(s)
+    surfaces = [*s.surfaces, *_ground(s)]
     duration = s.final_time_s - s.start_time_s
     return RunSetup(
         x0=x0,
@@ -304,7 +304,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
     q = euler_zyx_to_quat(roll, pitch, yaw)
     rotors = _initial_speeds(v, roll, pitch, o.initial_rotor_speeds, yaw_paper)
     refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    wall = Surface("wall", (float(s.wall_distance_m), 0.0, 0.0), (-1.0, 0.0, 0.0))
+    wall = Plane.wall(s.wall_distance_m)
     surfaces = [wall, *_ground(s)]
     tc = float(s.impact_time_s)
     vc = float(s.speed_m_s)

@@ -23,9 +23,9 @@ from .analysis import (
     impact_metrics,
     timeseries_frame,
 )
-from .config import FlightScenario, WallApproach
 from .core import layout as L
 from .core.run import execute
+from .inputs.scenarios import FlightScenario, WallApproach
 from .result import SimulationResult
 from .rotations import quat_to_euler_zyx, quat_to_matrix
 from .scenario import RunSetup, inclination_deg_of, prepare
@@ -50,7 +50,7 @@ def simulate(
     Parameters
     ----------
     scenario : WallApproach or FlightScenario
-        Validated input (``quadimpact.config``).
+        Validated input (``quadimpact.inputs.scenarios``).
     max_episodes : int
         Size of the episode buffer; episodes beyond it are counted and reported.
     kernel : callable, optional

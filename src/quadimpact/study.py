@@ -28,8 +28,9 @@ from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
 from . import __version__
-from .config import MODEL_VARIANTS, WallApproach
 from .findings import Finding, evaluate, fig4_curves, findings_frame
+from .inputs.model import MODEL_VARIANTS
+from .inputs.scenarios import WallApproach
 from .simulation import simulate
 from .sweep import SweepSpec, run_sweep
 from .viz.scene import Scene
@@ -330,7 +331,7 @@ def _depth(x: float, rb_mm: float) -> str:
 
 def table3_markdown(table: pd.DataFrame) -> str:
     """Table III, ours beside the paper's, and each differing row explained by the data."""
-    from quadimpact.vehicle import load_vehicle
+    from quadimpact.inputs.vehicle import load_vehicle
 
     rb_mm = 1e3 * load_vehicle("spiri").bumper_radius_m
     has_log = "type_log_conditions" in table.columns

@@ -72,6 +72,7 @@ from pathlib import Path
 from typing import Any
 
 from quadimpact.errors import InputError, format_value, one_line
+from quadimpact.inputs.files import apply_overrides, locate_vehicle, read_toml_file
 
 __all__ = [
     "SweepSpec",
@@ -352,8 +353,8 @@ class SweepSpec:
         *,
         where: str = "sweep",
     ) -> None:
-        from quadimpact.config import _KINDS
-        from quadimpact.vehicle import Vehicle
+        from quadimpact.inputs.scenarios import _KINDS
+        from quadimpact.inputs.vehicle import Vehicle
 
         self.where = where
         self.base = self._read_base(base)
@@ -424,19 +425,11 @@ class SweepSpec:
 
     # ------------------------------------------------------------ reading
     def _read_base(self, base: Any) -> dict[str, Any]:
-        from quadimpact.config import read_toml_file
-
         if base is None:
             return {}
         if isinstance(base, (str, os.PathLike)):
             path = Path(base)
-            data = read_toml_file(path)
-            vehicle = data.get("vehicle")
-            if isinstance(vehicle, str) and not Path(vehicle).is_absolute():
-                beside = path.parent / vehicle
-                if beside.is_file():
-                    data["vehicle"] = str(beside.resolve())
-            return _plain(data)
+            return _plain(locate_vehicle(read_toml_file(path), path.parent))
         if not isinstance(base, Mapping):
             raise InputError(f"{self.where}: base: must be a table of scenario fields or a path")
         return _plain(dict(base))
@@ -581,20 +574,7 @@ class SweepSpec:
         """The scenario mapping of run ``run_id`` (base + swept values)."""
         if inputs is None:
             inputs = self.inputs(run_id)
-        data = dict(self.base)
-        overrides = dict(self.base.get("vehicle_overrides") or {})
-        if "vehicle_overrides" in inputs:
-            overrides = dict(inputs["vehicle_overrides"] or {})
-        for name, value in inputs.items():
-            if name == "vehicle_overrides":
-                continue
-            if name in self._vehicle_fields:
-                overrides[name] = value
-            else:
-                data[name] = value
-        if overrides:
-            data["vehicle_overrides"] = overrides
-        return data
+        return apply_overrides(self.base, inputs, self._vehicle_fields)
 
     def input_columns(self, inputs: Mapping[str, Any]) -> dict[str, Any]:
         """Row values of the input columns for one run's inputs."""
@@ -613,8 +593,8 @@ class SweepSpec:
         InputError
             ``<where>: run <i> (<swept values>): <field>: <rule> (got <value>)``.
         """
-        from quadimpact.config import scenario_from_dict
-        from quadimpact.vehicle import load_vehicle
+        from quadimpact.inputs.scenarios import scenario_from_dict
+        from quadimpact.inputs.vehicle import load_vehicle
 
         base = scenario_from_dict(self.base, where=f"{self.where}: base")
         base.build_vehicle(where=f"{self.where}: base")
@@ -715,8 +695,6 @@ def load_sweep_file(path: str | os.PathLike[str]) -> SweepSpec:
     InputError
         Missing file, TOML syntax error, unknown key, bad field or value.
     """
-    from quadimpact.config import read_toml_file
-
     path = Path(path)
     data = read_toml_file(path)
     base = data.get("base")
@@ -726,11 +704,7 @@ def load_sweep_file(path: str | os.PathLike[str]) -> SweepSpec:
             candidate = path.parent / candidate
         data["base"] = candidate
     elif isinstance(base, Mapping):
-        vehicle = base.get("vehicle")
-        if isinstance(vehicle, str) and not Path(vehicle).is_absolute():
-            beside = path.parent / vehicle
-            if beside.is_file():
-                data["base"] = {**base, "vehicle": str(beside.resolve())}
+        data["base"] = locate_vehicle(base, path.parent)
     return SweepSpec.from_dict(data, where=str(path))
 
 
@@ -819,7 +793,7 @@ def run_chunk(items: Sequence[Item]) -> list[dict[str, Any]]:
         integrator has the kernel's status and reason.
     """
     from quadimpact import simulate
-    from quadimpact.config import scenario_from_dict
+    from quadimpact.inputs.scenarios import scenario_from_dict
 
     rows = []
     for run_id, scenario_data, inputs in items:
@@ -843,7 +817,7 @@ def warm_up() -> None:
     if _WARM:
         return
     from quadimpact import simulate  # noqa: F401  (the simulator: pandas, analysis...)
-    from quadimpact.config import WallApproach
+    from quadimpact.inputs.scenarios import WallApproach
     from quadimpact.scenario import prepare
 
     prepare(WallApproach(final_time_s=0.6, impact_time_s=0.1))  # runs the kernel

@@ -18,7 +18,8 @@ import pytest
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
-from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.inputs.world import Plane
+from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import quat_to_matrix
 
 STATE_COLS = [
@@ -37,7 +38,7 @@ def impact_energy(result, episode, vehicle) -> float:
     x[6:10] /= np.linalg.norm(x[6:10])
     C = np.ascontiguousarray(quat_to_matrix(x[6:10]))
     d = result.summary["wall_distance_m"]
-    surf = pack_surfaces([Surface("wall", (d, 0.0, 0.0), (-1.0, 0.0, 0.0))])
+    surf = pack_surfaces([Plane.wall(d)])
     _, rate, rx, ry, rz, *_ = bumper_plane_contact(
         x, C, pack_vehicle(vehicle), int(episode["bumper"]) - 1, surf, 0
     )

@@ -9,7 +9,8 @@ from scipy.integrate import solve_ivp
 from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
-from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.inputs.world import GROUND, Plane
+from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.scenario import prepare
 
@@ -19,7 +20,7 @@ SPIRI = load_vehicle()
 RB = SPIRI.bumper_radius_m
 ALPHA = math.radians(SPIRI.bumper_tilt_deg)
 WALL_D = 1.0
-WALL = pack_surfaces([Surface("wall", (WALL_D, 0.0, 0.0), (-1.0, 0.0, 0.0))])
+WALL = pack_surfaces([Plane.wall(WALL_D)])
 
 
 def state(pos, euler_deg, v_body=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)):
@@ -91,7 +92,7 @@ def test_level_heading_45_bumper_4_leads_with_hand_computed_point():
 def test_closed_form_matches_brute_force(euler_deg, plane):
     p0 = np.array(plane[0])
     m = np.array(plane[1]) / np.linalg.norm(plane[1])
-    surf = pack_surfaces([Surface("s", tuple(p0), tuple(m))])
+    surf = pack_surfaces([Plane(name="s", point_m=tuple(p0), normal=tuple(m))])
     x = state((0.7, 0.1, -1.9), euler_deg)
     for j in range(4):
         d, _, rx, ry, rz, *_ = contact(x, j, surf)
@@ -103,7 +104,7 @@ def test_closed_form_matches_brute_force(euler_deg, plane):
 
 def test_circle_parallel_to_plane_touches_at_its_centre():
     flat = SPIRI.with_overrides(bumper_tilt_deg=0.0)
-    ground = pack_surfaces([Surface("ground", (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True)])
+    ground = pack_surfaces([GROUND])
     x = state((0.0, 0.0, 0.05), (0, 0, 0), v_body=(0.0, 0.0, 0.7))
     for j in range(4):
         d, dd, rx, ry, rz, *_ = contact(x, j, ground, flat)

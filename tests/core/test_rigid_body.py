@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from quadimpact.config import FlightScenario
 from quadimpact.core import layout as L
+from quadimpact.inputs.scenarios import FlightScenario
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.scenario import prepare
 

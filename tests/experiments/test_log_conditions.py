@@ -5,7 +5,6 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.config import WallApproach
 from quadimpact.experiments.crashes import TABLE3, scenario_file
 from quadimpact.experiments.table3 import (
     LOG_RANGE_SIGMAS,
@@ -13,6 +12,7 @@ from quadimpact.experiments.table3 import (
     log_sensitivity_spec,
     read_log,
 )
+from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.simulation import simulate
 
 pytestmark = pytest.mark.data

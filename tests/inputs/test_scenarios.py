@@ -8,16 +8,10 @@ from pathlib import Path
 import pytest
 from pydantic import ValidationError
 
-from quadimpact.config import (
-    MODEL_VARIANTS,
-    FlightScenario,
-    ModelOptions,
-    Plane,
-    WallApproach,
-    load_scenario_file,
-    resolve_model_options,
-)
 from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.inputs.model import MODEL_VARIANTS, ModelOptions, resolve_model_options
+from quadimpact.inputs.scenarios import FlightScenario, WallApproach, load_scenario_file
+from quadimpact.inputs.world import Plane
 
 from helpers import SPIRI_TOML
 

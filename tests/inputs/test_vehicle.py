@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from quadimpact.errors import InputError
-from quadimpact.vehicle import Vehicle, bundled_vehicles, load_vehicle
+from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 
 from helpers import SPIRI_TOML
 

@@ -21,7 +21,8 @@ import quadimpact.errors
 from quadimpact import WallApproach, load_vehicle, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
-from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.inputs.world import Plane
+from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial
@@ -83,7 +84,7 @@ def test_drawn_circles_are_the_contact_laws_circles(fine_scene: Scene) -> None:
 
 def test_drawn_deepest_point_is_the_computed_contact_point(fine_scene: Scene) -> None:
     sc = fine_scene
-    wall = pack_surfaces([Surface("wall", (WALL_D, 0.0, 0.0), (-1.0, 0.0, 0.0))])
+    wall = pack_surfaces([Plane.wall(WALL_D)])
     veh = pack_vehicle(SPIRI)
     t = float(sc.t[np.searchsorted(sc.t, sc.first_contact_s + 0.08)])  # a sample, in contact
     fr = sc.frame(t)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
 
-from quadimpact.config import WallApproach, load_scenario_file
+from quadimpact.inputs.scenarios import WallApproach, load_scenario_file
 
 HEADING_UNCERTAINTY_DEG = 6.4  # Table III: psi +- 6.4 deg
 SPEED_UNCERTAINTY_M_S = 0.01  # Table III: V_c +- 0.01 m/s

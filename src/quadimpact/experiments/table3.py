@@ -29,7 +29,6 @@ from typing import Any
 import pandas as pd
 
 from quadimpact.analysis import RESPONSE_TYPES
-from quadimpact.config import read_toml_file
 from quadimpact.experiments.crashes import (
     HEADING_UNCERTAINTY_DEG,
     SPEED_UNCERTAINTY_M_S,
@@ -39,6 +38,7 @@ from quadimpact.experiments.crashes import (
     scenario_path,
 )
 from quadimpact.experiments.logs import PreImpact, SpiriMatLog, data_dir
+from quadimpact.inputs.files import read_toml_file
 from quadimpact.simulation import simulate
 from quadimpact.sweep import SweepSpec, run_sweep
 
@@ -160,9 +160,9 @@ def _log_row(
     sweep_options: dict[str, Any],
 ) -> dict[str, Any]:
     """The ``LOG_COLUMNS`` of one crash (nan / None where not observable)."""
-    from quadimpact.config import WallApproach
     from quadimpact.experiments.compare import log_response
     from quadimpact.experiments.logs_compare import attitude_rms_for_crash
+    from quadimpact.inputs.scenarios import WallApproach
 
     row: dict[str, Any] = {c: math.nan for c in LOG_COLUMNS}
     row["type_log"] = row["type_log_conditions"] = None

@@ -96,7 +96,7 @@ def _scene(result_dir: Path, vehicle: str | None) -> Any:
             raise InputError(f"{result_dir}: no {name} (not a folder written by 'quadimpact run')")
     veh = None
     if vehicle is not None:
-        from quadimpact.vehicle import load_vehicle
+        from quadimpact.inputs.vehicle import load_vehicle
 
         veh = load_vehicle(vehicle)
     try:

@@ -34,9 +34,10 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
-from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
+from quadimpact.inputs.vehicle import Vehicle, load_vehicle
+from quadimpact.inputs.world import GROUND, Plane
+from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.vehicle import Vehicle, load_vehicle
 
 __all__ = [
     "AXIS_LENGTH_M",
@@ -171,7 +172,7 @@ class VehicleDrawing:
 
 def scene_surfaces(
     summary: Mapping[str, Any], episodes: pd.DataFrame | None = None
-) -> list[Surface]:
+) -> list[Plane]:
     """The contact surfaces of a run, from its summary (and episodes).
 
     A ``surfaces`` list in the summary (``name``, ``point_m``, ``normal``) is
@@ -179,27 +180,26 @@ def scene_surfaces(
     of a wall approach. The ground (altitude 0, normal up) is added when an
     episode touched it (it was then a contact surface).
     """
-    out: list[Surface] = []
+    out: list[Plane] = []
     listed = summary.get("surfaces")
     if isinstance(listed, Sequence) and listed:
         for s in listed:
             out.append(
-                Surface(
-                    str(s["name"]),
-                    tuple(float(c) for c in s["point_m"]),
-                    tuple(float(c) for c in s["normal"]),
-                    bool(s.get("is_ground", s["name"] == "ground")),
+                Plane(
+                    name=str(s["name"]),
+                    point_m=tuple(float(c) for c in s["point_m"]),
+                    normal=tuple(float(c) for c in s["normal"]),
+                    is_ground=bool(s.get("is_ground", s["name"] == "ground")),
                 )
             )
     elif summary.get("wall_distance_m") is not None:
-        d = float(summary["wall_distance_m"])
-        out.append(Surface("wall", (d, 0.0, 0.0), (-1.0, 0.0, 0.0)))
+        out.append(Plane.wall(summary["wall_distance_m"]))
     names = {s.name for s in out}
     touched = set()
     if episodes is not None and len(episodes) and "surface" in episodes:
         touched = {str(x) for x in episodes["surface"]}
     if "ground" in touched and "ground" not in names:
-        out.append(Surface("ground", (0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True))
+        out.append(GROUND)
     return out
 
 
@@ -410,7 +410,7 @@ class Scene:
         The run's episodes (to know whether the ground was a contact surface).
     vehicle : Vehicle, optional
         Default: ``load_vehicle(summary["vehicle"])``.
-    surfaces : list of Surface, optional
+    surfaces : list of Plane, optional
         Default: :func:`scene_surfaces`.
     n_points : int
         Segments per drawn circle.
@@ -422,7 +422,7 @@ class Scene:
         summary: Mapping[str, Any],
         episodes: pd.DataFrame | None = None,
         vehicle: Vehicle | None = None,
-        surfaces: list[Surface] | None = None,
+        surfaces: list[Plane] | None = None,
         n_points: int = 72,
     ) -> None:
         if len(timeseries) == 0:

@@ -11,9 +11,12 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from pydantic import BeforeValidator
+from pydantic import BeforeValidator, ConfigDict
 
-__all__ = ["Real", "Sign", "SignVec4", "Vec2", "Vec3", "Vec4", "Mat3", "Mat4x3"]
+__all__ = ["MODEL_CONFIG", "Real", "Sign", "SignVec4", "Vec2", "Vec3", "Vec4", "Mat3", "Mat4x3"]
+
+MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+"""The settings of every input model: unknown keys refused, immutable, finite numbers only."""
 
 
 def _real(value: Any) -> Any:

@@ -1,4 +1,4 @@
-"""Validated, immutable run inputs: model options, scenarios and scenario files.
+"""Validated, immutable scenarios and scenario files.
 
 Frames and units follow MODEL.md section 1: inertial frame NED (X toward the
 default wall, Y right, Z down; altitude ``h = -Z``), body frame FRD, SI units,
@@ -36,209 +36,28 @@ read with :func:`load_scenario_file`::
 
 from __future__ import annotations
 
-import math
-import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import (
-    BaseModel,
-    ConfigDict,
-    Field,
-    ValidationError,
-    field_validator,
-    model_validator,
-)
+from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
-from quadimpact._types import Real, Vec2, Vec3, Vec4
 from quadimpact.errors import InputError, input_error_from_validation
-from quadimpact.vehicle import Vehicle, bundled_vehicles, load_vehicle
+from quadimpact.inputs.files import locate_vehicle, read_toml_file
+from quadimpact.inputs.model import ModelName, ModelOptions, resolve_model_options
+from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec2, Vec3, Vec4
+from quadimpact.inputs.vehicle import Vehicle, load_vehicle
+from quadimpact.inputs.world import Plane
 
 __all__ = [
-    "ModelOptions",
-    "MODEL_VARIANTS",
-    "resolve_model_options",
-    "Plane",
     "PowerOff",
     "RunSettings",
     "WallApproach",
     "FlightScenario",
     "Scenario",
     "load_scenario_file",
+    "scenario_from_dict",
 ]
-
-ModelName = Literal["default", "paper-replica"]
-
-_CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-# ----------------------------------------------------------------- options
-class ModelOptions(BaseModel):
-    """Switches between the physically consistent model and the authors' simulator.
-
-    Each field left ``None`` takes the value of the chosen model variant
-    (:data:`MODEL_VARIANTS`); set it to change that single behaviour. The
-    ``default`` variant is the physically consistent model of MODEL.md
-    sections 2-7; the ``paper-replica`` variant reproduces the code behind the
-    paper's figures, errors included (MODEL.md section 8), so that published
-    numbers can be checked and each correction's effect seen on its own.
-
-    Attributes
-    ----------
-    yaw_reaction : {"physical", "paper"} or None
-        Rotor yaw reaction on the body. ``"physical"`` (default): drag torque
-        ``-s_j dt Omega_j^2`` and spin-up term ``-s_j Jr dOmega_j/dt``, the motor
-        torque reacting on the body, consistent with the gyroscopic term.
-        ``"paper"`` (replica): drag torque ``+s_j dt Omega_j^2`` and spin-up
-        ``-Jr sum_j dOmega_j/dt`` (no ``s_j``); the controller's allocation yaw row
-        follows the model in use.
-    bumper1_yaw_twice : bool or None
-        ``True`` (replica) counts bumper 1's contact yaw moment (body z
-        component) twice, as the authors' code did; ``False`` (default) once.
-    initial_rotor_speeds : {"trimmed", "level-hover"} or None
-        ``"trimmed"`` (default): initial rotor speeds from the allocation of
-        thrust ``m g / (cos(roll) cos(pitch))`` with zero torques.
-        ``"level-hover"`` (replica): all four at ``sqrt(m g / (4 kt))`` whatever
-        the tilt.
-    attitude_mapping : {"exact", "paper-fit"} or None
-        How a wall approach's heading and inclination become roll and pitch.
-        ``"exact"`` (default): ZYX Euler angles with yaw = heading and the body
-        z axis in the inertial X-Z plane at the inclination from Z.
-        ``"paper-fit"`` (replica): the authors' fitted mapping, for heading 0
-        roll 0 and pitch ``-inclination``; for heading +-45 deg
-        ``roll = pitch = -(incl - 0.0042477) / 1.3836686`` (rad); other
-        headings as ``"exact"``.
-    crash_rule : {"cm-ground", "paper-ticks"} or None
-        ``"cm-ground"`` (default): crash when the CM reaches altitude 0,
-        located exactly as an integrator event. ``"paper-ticks"`` (replica):
-        crash when the altitude is at or below -0.3 m, tested at the control
-        ticks only.
-    approach_start : {"late-start", "paper"} or None
-        ``"late-start"`` (default): when the vehicle would have to start
-        moving away from the wall (needed initial speed < 0), it starts at rest
-        later, at the time that brings it to the wall at the requested time
-        and speed. ``"paper"`` (replica): it starts at t = 0 even moving away
-        from the wall, and later at rest only when the start point would lie
-        beyond the wall. Control ticks run at ``t0 + k dt`` from the start.
-    """
-
-    model_config = _CONFIG
-
-    yaw_reaction: Literal["physical", "paper"] | None = Field(
-        None, description="Rotor yaw reaction torque: 'physical' or the authors' 'paper' signs."
-    )
-    bumper1_yaw_twice: bool | None = Field(
-        None, description="Count bumper 1's contact yaw moment twice (authors' code)."
-    )
-    initial_rotor_speeds: Literal["trimmed", "level-hover"] | None = Field(
-        None, description="Initial rotor speeds: trimmed for the tilt, or all at level hover."
-    )
-    attitude_mapping: Literal["exact", "paper-fit"] | None = Field(
-        None, description="Heading/inclination -> roll/pitch: exact, or the authors' fit."
-    )
-    crash_rule: Literal["cm-ground", "paper-ticks"] | None = Field(
-        None, description="Crash: CM at h = 0 (event), or h <= -0.3 m at control ticks."
-    )
-    approach_start: Literal["late-start", "paper"] | None = Field(
-        None,
-        description="Wall-approach start rule when v0 would be < 0: start later at rest, "
-        "or the authors' rule.",
-    )
-
-
-MODEL_VARIANTS: dict[str, dict[str, Any]] = {
-    "default": {
-        "yaw_reaction": "physical",
-        "bumper1_yaw_twice": False,
-        "initial_rotor_speeds": "trimmed",
-        "attitude_mapping": "exact",
-        "crash_rule": "cm-ground",
-        "approach_start": "late-start",
-    },
-    "paper-replica": {
-        "yaw_reaction": "paper",
-        "bumper1_yaw_twice": True,
-        "initial_rotor_speeds": "level-hover",
-        "attitude_mapping": "paper-fit",
-        "crash_rule": "paper-ticks",
-        "approach_start": "paper",
-    },
-}
-"""Every switch of :class:`ModelOptions` for each named model variant."""
-
-
-def resolve_model_options(
-    model: str, overrides: ModelOptions | Mapping[str, Any] | None = None
-) -> ModelOptions:
-    """All model switches for a variant, with some of them overridden.
-
-    Parameters
-    ----------
-    model : {"default", "paper-replica"}
-        The model variant.
-    overrides : ModelOptions or mapping or None, optional
-        Switches to change; ``None`` values (or missing keys) keep the variant's.
-
-    Returns
-    -------
-    ModelOptions
-        Every field set (none is ``None``).
-
-    Raises
-    ------
-    InputError
-        Unknown variant, unknown switch or invalid value.
-    """
-    if model not in MODEL_VARIANTS:
-        known = ", ".join(repr(name) for name in MODEL_VARIANTS)
-        raise InputError(f"model: must be one of {known} (got {model!r})")
-    values = dict(MODEL_VARIANTS[model])
-    if overrides is not None:
-        if not isinstance(overrides, ModelOptions):
-            try:
-                overrides = ModelOptions.model_validate(dict(overrides))
-            except ValidationError as exc:
-                raise input_error_from_validation(
-                    exc, prefix=("model_options",), model=ModelOptions
-                ) from None
-        values.update(overrides.model_dump(exclude_none=True))
-    return ModelOptions(**values)
-
-
-# ---------------------------------------------------------------- surfaces
-class Plane(BaseModel):
-    """A flat contact surface (wall, floor, ceiling...) in the inertial NED frame.
-
-    Attributes
-    ----------
-    name : str
-        Label used in results (episodes' ``surface`` column); unique per scenario.
-    point_m : tuple of 3 floats
-        Any point of the plane, inertial NED, m.
-    normal : tuple of 3 floats
-        Normal pointing out of the obstacle into free space, inertial NED;
-        any non-zero length, normalised on validation. The paper's wall at
-        ``X = d`` is ``point_m = (d, 0, 0)``, ``normal = (-1, 0, 0)``; the ground
-        is ``point_m = (0, 0, 0)``, ``normal = (0, 0, -1)``.
-    """
-
-    model_config = _CONFIG
-
-    name: str = Field(min_length=1, description="Label of the surface in results.")
-    point_m: Vec3 = Field(description="A point of the plane, inertial NED, m.")
-    normal: Vec3 = Field(
-        description="Unit normal out of the obstacle into free space, inertial NED "
-        "(normalised on validation)."
-    )
-
-    @field_validator("normal")
-    @classmethod
-    def _normalise(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
-        norm = math.sqrt(sum(c * c for c in value))
-        if norm < 1e-12:
-            raise ValueError("must be a non-zero vector")
-        return (value[0] / norm, value[1] / norm, value[2] / norm)
 
 
 # --------------------------------------------------------------- power-off
@@ -264,7 +83,7 @@ class PowerOff(BaseModel):
         once (the logs show them stopped with no measurable ramp).
     """
 
-    model_config = _CONFIG
+    model_config = MODEL_CONFIG
 
     trigger: Literal["first-contact"] | Real = Field(
         "first-contact", description="'first-contact' or a start time in s."
@@ -345,7 +164,7 @@ class RunSettings(BaseModel):
         Motor power-off schedule (the paper's experiments); ``None``: none.
     """
 
-    model_config = _CONFIG
+    model_config = MODEL_CONFIG
 
     model: ModelName = Field(
         "default", description="Model variant: 'default' (physical) or 'paper-replica'."
@@ -633,33 +452,6 @@ _KINDS: dict[str, type[WallApproach] | type[FlightScenario]] = {
 
 
 # -------------------------------------------------------------------- files
-def read_toml_file(path: str | Path) -> dict[str, Any]:
-    """Read a TOML file, turning every failure into a one-line :class:`InputError`.
-
-    Parameters
-    ----------
-    path : str or pathlib.Path
-        The file.
-
-    Returns
-    -------
-    dict
-        The parsed table.
-    """
-    path = Path(path)
-    if not path.is_file():
-        reason = "is a directory, not a file" if path.is_dir() else "file not found"
-        raise InputError(f"{path}: {reason}")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{path}: cannot read file ({exc})") from None
-    try:
-        return tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{path}: invalid TOML: {exc}") from None
-
-
 def scenario_from_dict(data: Mapping[str, Any], where: str = "scenario") -> Scenario:
     """Validate a scenario given as a mapping (the content of a scenario file).
 
@@ -688,7 +480,8 @@ def scenario_from_dict(data: Mapping[str, Any], where: str = "scenario") -> Scen
 def load_scenario_file(path: str | Path) -> Scenario:
     """Read and validate a scenario TOML file (format in this module's docstring).
 
-    A relative ``vehicle`` path is looked up next to the scenario file first.
+    A relative ``vehicle`` path is looked up next to the scenario file first
+    (:func:`~quadimpact.inputs.files.locate_vehicle`).
     The vehicle and its overrides are validated too, so that a bad vehicle
     is reported now, naming the file and field.
 
@@ -709,12 +502,7 @@ def load_scenario_file(path: str | Path) -> Scenario:
         or a value that breaks a rule: ``<file>: <field>: <rule> (got <value>)``.
     """
     path = Path(path)
-    data = read_toml_file(path)
-    vehicle = data.get("vehicle")
-    if isinstance(vehicle, str) and vehicle not in bundled_vehicles():
-        beside = path.parent / vehicle
-        if not Path(vehicle).is_absolute() and beside.is_file():
-            data["vehicle"] = str(beside)
+    data = locate_vehicle(read_toml_file(path), path.parent)
     scenario = scenario_from_dict(data, where=str(path))
     scenario.build_vehicle(where=str(path))
     return scenario

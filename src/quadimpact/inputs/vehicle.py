@@ -1,6 +1,6 @@
 """Vehicle parameters: a validated, immutable description of a quadrotor with bumpers.
 
-Vehicles are data: the Spiri of the paper ships as ``vehicles/spiri.toml``
+Vehicles are data: the Spiri of the paper ships as ``inputs/vehicles/spiri.toml``
 and a user can write another file with the same keys (see that file for
 units and sources). Frames and conventions are those of MODEL.md section 1:
 body frame FRD (x forward, y right, z down) with its origin at the centre of
@@ -8,7 +8,7 @@ mass; SI units, rotor speeds in rad/s.
 
 Examples
 --------
->>> from quadimpact.vehicle import load_vehicle
+>>> from quadimpact.inputs.vehicle import load_vehicle
 >>> spiri = load_vehicle()                      # the bundled Spiri
 >>> round(spiri.hover_speed_rad_s, 1)
 598.1
@@ -18,16 +18,16 @@ Examples
 from __future__ import annotations
 
 import math
-import tomllib
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator
+from pydantic import BaseModel, Field, ValidationError, field_validator
 
-from quadimpact._types import Mat3, Mat4x3, Real, SignVec4, Vec2, Vec4
 from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.inputs.files import read_toml_file
+from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec4
 
 __all__ = ["Vehicle", "load_vehicle", "bundled_vehicles"]
 
@@ -81,7 +81,7 @@ class Vehicle(BaseModel):
         tau_m, motor time constant, s (first-order rotor mode only).
     """
 
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
+    model_config = MODEL_CONFIG
 
     name: str = Field(min_length=1, description="Label of the vehicle.")
     mass_kg: Real = Field(gt=0, description="Total mass m, kg.")
@@ -259,7 +259,7 @@ class Vehicle(BaseModel):
 
 # -------------------------------------------------------------------- loading
 def bundled_vehicles() -> list[str]:
-    """Names of the vehicles shipped with quadimpact (files ``vehicles/*.toml``).
+    """Names of the vehicles shipped with quadimpact (files ``inputs/vehicles/*.toml``).
 
     Returns
     -------
@@ -272,14 +272,11 @@ def bundled_vehicles() -> list[str]:
 
 def _vehicle_folder() -> Any:
     """The package folder of bundled vehicle files (an importlib.resources Traversable)."""
-    return resources.files("quadimpact").joinpath("vehicles")
+    return resources.files("quadimpact.inputs").joinpath("vehicles")
 
 
-def _parse_vehicle(text: str, where: str, default_name: str) -> Vehicle:
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{where}: invalid TOML: {exc}") from None
+def _read_vehicle(path: Any, where: str, default_name: str) -> Vehicle:
+    data = read_toml_file(path, where)
     data.setdefault("name", default_name)
     try:
         return Vehicle.model_validate(data)
@@ -313,8 +310,7 @@ def load_vehicle(name_or_path: str | Path | None = None) -> Vehicle:
         name_or_path = "spiri"
     if isinstance(name_or_path, str) and name_or_path in bundled_vehicles():
         resource = _vehicle_folder().joinpath(f"{name_or_path}.toml")
-        where = f"vehicle {name_or_path}.toml"
-        return _parse_vehicle(resource.read_text(encoding="utf-8"), where, name_or_path)
+        return _read_vehicle(resource, f"vehicle {name_or_path}.toml", name_or_path)
     path = Path(name_or_path)
     where = f"vehicle {path}"
     if not path.is_file():
@@ -324,10 +320,4 @@ def load_vehicle(name_or_path: str | Path | None = None) -> Vehicle:
                 f"vehicle {str(name_or_path)!r}: unknown vehicle name "
                 f"(bundled: {known}; or give the path of a .toml file)"
             )
-        reason = "is a directory, not a file" if path.is_dir() else "file not found"
-        raise InputError(f"{where}: {reason}")
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{where}: cannot read file ({exc})") from None
-    return _parse_vehicle(text, where, path.stem)
+    return _read_vehicle(path, where, path.stem)
