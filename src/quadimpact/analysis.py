@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
+from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, TIMESERIES_COLUMNS
 from quadimpact.rotations import (
     body_to_inertial,
     euler_zyx_to_quat,
@@ -37,52 +38,6 @@ __all__ = [
     "impact_metrics",
     "timeseries_frame",
 ]
-
-#: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
-BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
-
-#: Columns of the episodes table, in order (docs/RESULTS.md).
-EPISODE_COLUMNS: tuple[str, ...] = (
-    "bumper",
-    "surface",
-    "t_start_s",
-    "t_end_s",
-    "v_i_m_s",
-    "peak_delta_m",
-    "t_peak_s",
-    "peak_force_n",
-    "t_peak_force_s",
-    "open",
-)
-
-#: Columns of the time-series table, in order (docs/RESULTS.md).
-TIMESERIES_COLUMNS: tuple[str, ...] = (
-    "t_s",
-    "x_m",
-    "y_m",
-    "z_m",
-    "u_m_s",
-    "v_m_s",
-    "w_m_s",
-    "vx_m_s",
-    "vy_m_s",
-    "vz_m_s",
-    "q0",
-    "q1",
-    "q2",
-    "q3",
-    "p_rad_s",
-    "q_rad_s",
-    "r_rad_s",
-    *(f"omega{j}_rad_s" for j in BUMPERS),
-    *(f"omega_cmd{j}_rad_s" for j in BUMPERS),
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
-    "altitude_m",
-    *(f"delta{j}_m" for j in BUMPERS),
-    *(f"force{j}_n" for j in BUMPERS),
-)
 
 # Raw episode columns -> table columns (float-valued ones).
 _EPISODE_FLOAT_SOURCES: tuple[tuple[str, int], ...] = (

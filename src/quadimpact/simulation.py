@@ -1,4 +1,4 @@
-"""Front end: one scenario in, one :class:`~quadimpact.result.SimulationResult` out.
+"""Front end: one scenario in, one :class:`~quadimpact.results.result.SimulationResult` out.
 
 ``simulate`` prepares the packed inputs (``scenario.prepare``), runs the
 compiled loop once, and reads its raw record with the pure functions of
@@ -26,7 +26,7 @@ from .analysis import (
 from .core import layout as L
 from .core.run import execute
 from .inputs.scenarios import FlightScenario, WallApproach
-from .result import SimulationResult
+from .results.result import SimulationResult
 from .rotations import quat_to_euler_zyx, quat_to_matrix
 from .scenario import RunSetup, inclination_deg_of, prepare
 

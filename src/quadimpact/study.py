@@ -22,15 +22,15 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pandas as pd
-from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
 
 from . import __version__
+from .analysis import RESPONSE_TYPES
 from .findings import Finding, evaluate, fig4_curves, findings_frame
 from .inputs.model import MODEL_VARIANTS
 from .inputs.scenarios import WallApproach
+from .results import figures
 from .simulation import simulate
 from .sweep import SweepSpec, run_sweep
 from .viz.scene import Scene
@@ -44,7 +44,6 @@ FIG4_GRID: dict[str, list[float]] = {
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
 VARIANTS = ("paper-replica", "default")
 SWITCHES = tuple(MODEL_VARIANTS["default"])  # the replica's six differences
-TYPE_COLOURS = {"A": "#4daf4a", "B": "#377eb8", "C": "#ff7f00", "D": "#e41a1c", "Other": "#999999"}
 
 
 @dataclass
@@ -180,7 +179,7 @@ def fig4_figure(table: pd.DataFrame, variant: str) -> Figure:
     """Figure 4: delta_init against inclination, one panel per heading, one curve per speed."""
     curves = fig4_curves(table)
     headings = sorted({h for h, _ in curves.columns})
-    fig = Figure(figsize=(10, 4), layout="constrained")
+    fig = figures.new_figure(10, 4)
     axes = fig.subplots(1, len(headings), sharey=True, squeeze=False)[0]
     for ax, h in zip(axes, headings, strict=True):
         for v in sorted(curves[h].columns):
@@ -196,32 +195,11 @@ def fig4_figure(table: pd.DataFrame, variant: str) -> Figure:
 
 
 def type_map_figure(table: pd.DataFrame, variant: str) -> Figure:
-    """Table II as a picture: response type over inclination and (heading, speed)."""
-    t = table.assign(label=table.apply(type_label, axis=1))
-    grid = t.pivot_table(
-        index=["heading_deg", "speed_m_s"], columns="inclination_deg", values="label",
-        aggfunc="first",
+    """Table II as a picture: response type over inclination and speed, one panel per heading."""
+    return figures.type_map_figure(
+        table, "inclination_deg", "speed_m_s", facet="heading_deg", label=type_label,
+        title=f"Table II, {variant}: response type (C/D with the number of subsequent impacts)",
     )  # fmt: skip
-    kinds = list(TYPE_COLOURS)
-    labels = grid.to_numpy().astype(str)
-
-    def code(label: str) -> int:
-        base = label.rstrip("0123456789")
-        return kinds.index(base) if base in kinds else kinds.index("Other")
-
-    codes = np.array([[code(s) for s in row] for row in labels])
-
-    fig = Figure(figsize=(12, 3), layout="constrained")
-    ax = fig.subplots()
-    ax.imshow(codes, cmap=ListedColormap(list(TYPE_COLOURS.values())), vmin=0, vmax=len(kinds) - 1,
-              aspect="auto")  # fmt: skip
-    for (i, j), lab in np.ndenumerate(labels):
-        ax.text(j, i, lab, ha="center", va="center", fontsize=6)
-    ax.set_xticks(range(len(grid.columns)), [f"{c:+g}" for c in grid.columns], fontsize=6)
-    ax.set_yticks(range(len(grid.index)), [f"ψ {h:g}°, {v:g} m/s" for h, v in grid.index])
-    ax.set_xlabel("inclination (deg)")
-    ax.set_title(f"Table II, {variant}: response type (C/D with the number of subsequent impacts)")
-    return fig
 
 
 # ------------------------------------------------------------------ report
@@ -290,7 +268,7 @@ def render_report(
         lines.append(f"![Figure 4, {v}](fig4_{v}.png)")
     lines += ["", "## Table II", ""]
     for v in VARIANTS:
-        counts = tables[v]["response_type"].value_counts().reindex(list(TYPE_COLOURS), fill_value=0)
+        counts = tables[v]["response_type"].value_counts().reindex(RESPONSE_TYPES, fill_value=0)
         lines += [f"### {v}", "", f"![Table II, {v}](table2_{v}.png)", "",
                   "Counts: " + ", ".join(f"{k} {n}" for k, n in counts.items()), "",
                   table2_markdown(tables[v]), ""]  # fmt: skip

@@ -73,6 +73,7 @@ from typing import Any
 
 from quadimpact.errors import InputError, format_value, one_line
 from quadimpact.inputs.files import apply_overrides, locate_vehicle, read_toml_file
+from quadimpact.results.files import atomic_write, to_jsonable
 
 __all__ = [
     "SweepSpec",
@@ -259,18 +260,8 @@ def parse_values(text: str, field: str = "") -> list[Any]:
 
 # --------------------------------------------------------------- the spec
 def _plain(value: Any) -> Any:
-    """NumPy scalars/arrays and tuples to plain Python values (JSON-able)."""
-    if hasattr(value, "tolist") and not isinstance(value, (str, bytes)):
-        value = value.tolist()
-    if isinstance(value, tuple):
-        value = list(value)
-    if isinstance(value, list):
-        return [_plain(v) for v in value]
-    if isinstance(value, Mapping):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, Path):
-        return str(value)
-    return value
+    """NumPy values, tuples, paths... as plain Python values (JSON-able); NaN kept."""
+    return to_jsonable(value, finite=False, strict=False)
 
 
 def _canonical(value: Any) -> str:
@@ -887,34 +878,6 @@ def read_runs(out_dir: str | os.PathLike[str]) -> Any:
     return _to_pandas(pq.read_table(path))
 
 
-def _fsync_dir(path: Path) -> None:
-    with contextlib.suppress(OSError):
-        fd = os.open(path, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-
-
-def _write_parquet_atomic(table: Any, path: Path, row_group_size: int | None = None) -> None:
-    """Temporary file, fsync, rename, fsync the folder: the file is complete or absent."""
-    import pyarrow.parquet as pq
-
-    tmp = path.parent / f".{path.name}.{os.getpid()}.tmp"
-    try:
-        pq.write_table(table, tmp, row_group_size=row_group_size)
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    _fsync_dir(path.parent)
-
-
 class _PartWriter:
     """Buffers finished rows and writes them as atomic part files."""
 
@@ -941,10 +904,12 @@ class _PartWriter:
         if not self.buffer:
             return
         import pyarrow as pa
+        import pyarrow.parquet as pq
 
         table = pa.Table.from_pylist(self.buffer, schema=self.schema).sort_by("run_id")
         self.seq += 1
-        _write_parquet_atomic(table, self.parts / f"part-{self.seq:06d}.parquet")
+        path = self.parts / f"part-{self.seq:06d}.parquet"
+        atomic_write(path, lambda tmp: pq.write_table(table, tmp), durable=True)
         self.rows_written += len(self.buffer)
         self.buffer = []
 
@@ -1005,9 +970,8 @@ def _consolidate(out: Path, schema: Any, n_runs: int) -> None:
         ids = pq.read_table(src, columns=["run_id"]).column("run_id").to_numpy()
         if len(ids):
             spans.append((src, int(ids.min()), int(ids.max())))
-    tmp = out / f".runs.parquet.{os.getpid()}.tmp"
-    total = 0
-    try:
+    def merge(tmp: Path) -> None:
+        total = 0
         with pq.ParquetWriter(tmp, schema) as writer:
             for lo in range(0, n_runs, CONSOLIDATE_WINDOW):
                 hi = lo + CONSOLIDATE_WINDOW
@@ -1027,18 +991,10 @@ def _consolidate(out: Path, schema: Any, n_runs: int) -> None:
                     t = t.filter(pa.array(keep))
                 total += t.num_rows
                 writer.write_table(t, row_group_size=CONSOLIDATE_WINDOW)
-        fd = os.open(tmp, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
         if total != n_runs:
             raise RuntimeError(f"{out}: merged {total} runs, expected {n_runs}")
-        os.replace(tmp, target)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-    _fsync_dir(out)
+
+    atomic_write(target, merge, durable=True)
     for p in parts:
         p.unlink(missing_ok=True)
 
@@ -1085,10 +1041,7 @@ def _check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
     if (out / "runs.parquet").exists() or any((out / "parts").glob("part-*.parquet")):
         raise InputError(f"{out}: has sweep results but no sweep.json; use another output folder")
     text = json.dumps(record, indent=1, sort_keys=True, allow_nan=False) + "\n"
-    tmp = out / ".sweep.json.tmp"
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
-    _fsync_dir(out)
+    atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), durable=True)
 
 
 @contextlib.contextmanager

@@ -14,76 +14,39 @@ pyplot state); with ``path`` they are also written as PNG (atomically).
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import numpy as np
 import pandas as pd
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
-from matplotlib.patches import Patch
 
 from quadimpact.errors import InputError
-from quadimpact.plots import save_figure
+from quadimpact.results.figures import (
+    TYPE_COLOURS,
+    check_columns,
+    facet_panels,
+    format_level,
+    new_figure,
+    save_figure,
+    sorted_levels,
+    type_map_figure,
+)
 
 __all__ = ["TYPE_COLORS", "plot_metric", "plot_type_map", "auto_plots"]
 
-#: Fill colour of each response type in type maps (failed runs: black).
-TYPE_COLORS: dict[str, str] = {
-    "A": "#4daf4a",
-    "B": "#377eb8",
-    "C": "#ff7f00",
-    "D": "#e41a1c",
-    "Other": "#999999",
-    "failed": "#000000",
-}
-_TYPES = list(TYPE_COLORS)
+TYPE_COLORS = TYPE_COLOURS
+"""The type map's colours (:data:`quadimpact.results.figures.TYPE_COLOURS`)."""
+
 # metric -> (axis label, scale)
 _LABELS = {
     "delta_init_m": ("δ_init (mm)", 1e3),
     "max_penetration_m": ("max penetration (mm)", 1e3),
     "peak_force_n": ("peak force (N)", 1.0),
 }
-MAX_TEXT_CELLS = 400
-"""Type maps write n_subsequent_impacts in the cells up to this many cells per panel."""
 MAX_AUTO_RUNS = 50_000
 """``auto_plots`` does nothing for larger sweeps (keep ``quadimpact sweep`` cheap)."""
-
-
-def _new_figure(width_in: float, height_in: float) -> Figure:
-    fig = Figure(figsize=(width_in, height_in), layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _fmt(value: Any) -> str:
-    if isinstance(value, (float, np.floating)):
-        return f"{float(value):g}"
-    return str(value)
-
-
-def _check_columns(table: pd.DataFrame, *names: str | None) -> None:
-    for name in names:
-        if name is not None and name not in table.columns:
-            raise InputError(f"plot: {name}: no such column in the sweep table")
-
-
-def _levels(series: pd.Series) -> list[Any]:
-    values = series.dropna().unique().tolist()
-    try:
-        return sorted(values)
-    except TypeError:
-        return sorted(values, key=str)
-
-
-def _panels(table: pd.DataFrame, facet: str | None) -> list[tuple[Any, pd.DataFrame]]:
-    if facet is None:
-        return [(None, table)]
-    return [(v, table[table[facet] == v]) for v in _levels(table[facet])]
 
 
 def plot_metric(
@@ -121,15 +84,19 @@ def plot_metric(
     -------
     matplotlib.figure.Figure
     """
-    _check_columns(table, x, metric, by, facet)
+    check_columns(table, x, metric, by, facet)
     label, scale = _LABELS.get(metric, (metric, 1.0))
-    panels = _panels(table, facet)
+    panels = facet_panels(table, facet)
     if not panels:
         raise InputError(f"plot: {facet}: no values")
-    fig = _new_figure(1.0 + 4.2 * len(panels), 3.6)
+    fig = new_figure(1.0 + 4.2 * len(panels), 3.6)
     axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
     for ax, (fv, sub) in zip(axes, panels, strict=True):
-        groups = [(None, sub)] if by is None else [(v, sub[sub[by] == v]) for v in _levels(sub[by])]
+        groups = (
+            [(None, sub)]
+            if by is None
+            else [(v, sub[sub[by] == v]) for v in sorted_levels(sub[by])]
+        )
         for bv, g in groups:
             g = g.sort_values(x)
             y = pd.to_numeric(g[metric], errors="coerce").to_numpy(dtype=float) * scale
@@ -139,11 +106,11 @@ def plot_metric(
                 marker="o",
                 markersize=3,
                 linewidth=1.2,
-                label=None if bv is None else f"{by} = {_fmt(bv)}",
+                label=None if bv is None else f"{by} = {format_level(bv)}",
             )
         ax.set_xlabel(x)
         if fv is not None:
-            ax.set_title(f"{facet} = {_fmt(fv)}", fontsize=10)
+            ax.set_title(f"{facet} = {format_level(fv)}", fontsize=10)
         ax.grid(True, alpha=0.3)
         if by is not None:
             ax.legend(fontsize=8)
@@ -155,11 +122,6 @@ def plot_metric(
     return fig
 
 
-def _mode(values: pd.Series) -> Any:
-    counts = values.value_counts(dropna=False)
-    return counts.index[0] if len(counts) else None
-
-
 def plot_type_map(
     table: pd.DataFrame,
     x: str,
@@ -169,105 +131,10 @@ def plot_type_map(
     *,
     title: str | None = None,
 ) -> Figure:
-    """Response type over two fields (categorical colours), one panel per ``facet`` value.
-
-    Parameters
-    ----------
-    table : pandas.DataFrame
-        A sweep table with ``response_type``, ``status`` and ``n_subsequent_impacts``.
-    x, y : str
-        Fields along the horizontal and vertical axes (each value one cell,
-        evenly spaced, in sorted order).
-    path : path-like, optional
-        Also write the figure there as PNG.
-    facet : str, optional
-        One panel (stacked vertically) per value of this field.
-    title : str, optional
-        Figure title.
-
-    Returns
-    -------
-    matplotlib.figure.Figure
-
-    Notes
-    -----
-    A cell holding several runs (other fields varying) shows the most
-    frequent type. Cells show ``n_subsequent_impacts`` (the paper's Table II
-    count) when a panel has at most :data:`MAX_TEXT_CELLS` cells.
-    """
-    _check_columns(table, x, y, facet, "response_type", "status")
-    xs, ys = _levels(table[x]), _levels(table[y])
-    if not xs or not ys:
-        raise InputError("plot: type map of an empty table")
-    panels = _panels(table, facet)
-    width = min(18.0, 1.8 + 0.32 * len(xs))
-    height = 0.9 + len(panels) * (0.6 + 0.32 * len(ys))
-    fig = _new_figure(width, height + 0.4)
-    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
-    cmap = ListedColormap([TYPE_COLORS[t] for t in _TYPES])
-    col = {v: i for i, v in enumerate(xs)}
-    row = {v: i for i, v in enumerate(ys)}
-    present: set[str] = set()
-    show_text = len(xs) * len(ys) <= MAX_TEXT_CELLS
-    fontsize = max(5.0, min(8.0, 9.0 - 0.05 * len(xs)))
-    for ax, (fv, sub) in zip(axes, panels, strict=True):
-        label = sub["response_type"].astype(object).where(sub["status"] != "failed", "failed")
-        cells = pd.DataFrame(
-            {
-                "x": sub[x].to_numpy(),
-                "y": sub[y].to_numpy(),
-                "t": label.to_numpy(),
-                "n": sub["n_subsequent_impacts"].to_numpy()
-                if "n_subsequent_impacts" in sub
-                else None,
-            }
-        ).dropna(subset=["x", "y"])
-        grid = np.full((len(ys), len(xs)), np.nan)
-        for (xv, yv), g in cells.groupby(["x", "y"], sort=False):
-            t = _mode(g["t"])
-            if t is None or (isinstance(t, float) and math.isnan(t)) or t not in _TYPES:
-                continue
-            present.add(t)
-            grid[row[yv], col[xv]] = _TYPES.index(t)
-            if show_text and t != "failed":
-                n = g.loc[g["t"] == t, "n"].iloc[0]
-                if n is not None and not pd.isna(n):
-                    ax.text(
-                        col[xv],
-                        row[yv],
-                        str(int(n)),
-                        ha="center",
-                        va="center",
-                        fontsize=fontsize,
-                        color="white" if t in ("B", "D") else "black",
-                    )
-        ax.pcolormesh(
-            np.arange(len(xs) + 1) - 0.5,
-            np.arange(len(ys) + 1) - 0.5,
-            np.ma.masked_invalid(grid),
-            cmap=cmap,
-            vmin=-0.5,
-            vmax=len(_TYPES) - 0.5,
-            edgecolors="white",
-            linewidth=0.5,
-        )
-        step = max(1, math.ceil(len(xs) / 21))
-        ax.set_xticks(range(0, len(xs), step), [_fmt(v) for v in xs[::step]], fontsize=8)
-        ax.set_yticks(range(len(ys)), [_fmt(v) for v in ys], fontsize=8)
-        ax.set_xlim(-0.5, len(xs) - 0.5)
-        ax.set_ylim(-0.5, len(ys) - 0.5)
-        ax.set_xlabel(x)
-        ax.set_ylabel(y)
-        if fv is not None:
-            ax.set_title(f"{facet} = {_fmt(fv)}", fontsize=10)
-    handles = [Patch(color=TYPE_COLORS[t], label=t) for t in _TYPES if t in present]
-    if handles:
-        fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8)
-    if title:
-        fig.suptitle(title)
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+    """Response type over two fields, one panel per ``facet`` value: the type map
+    (:func:`quadimpact.results.figures.type_map_figure`) of a sweep table, with
+    ``n_subsequent_impacts`` in the cells."""
+    return type_map_figure(table, x, y, facet, title=title, path=path)
 
 
 def choose_plot_fields(

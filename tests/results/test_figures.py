@@ -7,7 +7,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
-from quadimpact.plots import break_wraps, make_fig5, make_fig6, plot_fig5, plot_fig6
+from quadimpact.results.figures import break_wraps, make_fig5, make_fig6, plot_fig5, plot_fig6
 
 
 def make_ts(n: int = 400) -> pd.DataFrame:

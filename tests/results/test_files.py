@@ -9,20 +9,20 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from quadimpact.analysis import TIMESERIES_COLUMNS, episodes_frame
+from quadimpact.analysis import episodes_frame
 from quadimpact.core import layout as L
-from quadimpact.io import (
+from quadimpact.results.files import (
     EPISODES_LEADING_COLUMNS,
+    TIMESERIES_COLUMNS,
     UNITS_METADATA_KEY,
     column_unit,
-    read_result,
     read_timeseries_units,
     to_jsonable,
     write_episodes_csv,
     write_summary_json,
     write_timeseries_parquet,
 )
-from quadimpact.result import SimulationResult
+from quadimpact.results.result import SimulationResult, read_result
 
 
 def make_timeseries(n: int = 50) -> pd.DataFrame:
@@ -179,3 +179,25 @@ def test_plot_failure_keeps_data_and_is_reported(
 def test_read_result_missing_folder(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
         read_result(tmp_path / "nope")
+
+
+def test_to_jsonable_keeps_nan_and_unknown_values_when_asked() -> None:
+    marker = object()
+    out = to_jsonable({"a": np.float64("nan"), "b": (np.int64(2), marker)}, finite=False, strict=False)
+    assert math.isnan(out["a"]) and out["b"] == [2, marker]
+
+
+def test_atomic_write_leaves_the_old_file_on_failure(tmp_path: Path) -> None:
+    from quadimpact.results.files import atomic_write
+
+    target = tmp_path / "table.bin"
+    atomic_write(target, lambda tmp: tmp.write_bytes(b"old"), durable=True)
+
+    def fail(tmp: Path) -> None:
+        assert tmp.name.endswith(".mp4") and tmp.parent == tmp_path
+        tmp.write_bytes(b"half")
+        raise RuntimeError("disk full")
+
+    with pytest.raises(RuntimeError, match="disk full"):
+        atomic_write(target, fail, suffix=".mp4")
+    assert target.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["table.bin"]

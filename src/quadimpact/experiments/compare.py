@@ -434,11 +434,9 @@ class Comparison:
 
     def plot(self, path: str | os.PathLike[str], title: str | None = None) -> Path:
         """Side-by-side panels (sim lines, log markers) written as a PNG; returns the path."""
-        from matplotlib.backends.backend_agg import FigureCanvasAgg
-        from matplotlib.figure import Figure
+        from quadimpact.results.figures import break_wraps, new_figure, save_figure
 
-        fig = Figure(figsize=(15, 13), layout="constrained")
-        FigureCanvasAgg(fig)
+        fig = new_figure(15, 13)
         axes = fig.subplots(4, 3)
         tmax = max(self.windows) + 0.2
         tmin = -0.2
@@ -451,8 +449,6 @@ class Comparison:
         sim = self.sim[(self.sim.tau_s >= tmin) & (self.sim.tau_s <= tmax)]
         lp = self.log_pose[(self.log_pose.tau_s >= tmin) & (self.log_pose.tau_s <= tmax)]
         lm = self.log_motors[(self.log_motors.tau_s >= tmin) & (self.log_motors.tau_s <= tmax)]
-        from quadimpact.plots import break_wraps
-
         for ax, (col, label) in zip(axes.flat[:9], panels, strict=True):
             wrapped = col in ("roll_deg", "yaw_deg")
             if col in sim:
@@ -498,8 +494,6 @@ class Comparison:
             lines.append(textwrap.fill(note, 60))
         text.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=8)
         fig.suptitle(title or f"{self.name}: simulation vs log, aligned at impact")
-        from quadimpact.plots import save_figure
-
         return save_figure(fig, path)
 
 

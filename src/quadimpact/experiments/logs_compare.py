@@ -8,7 +8,7 @@ from pathlib import Path
 from quadimpact.experiments.compare import compare
 from quadimpact.experiments.crashes import Crash
 from quadimpact.experiments.logs import FlightLog
-from quadimpact.result import SimulationResult
+from quadimpact.results.result import SimulationResult
 
 COMPARE_PNG = "compare.png"
 COMPARE_CSV = "compare.csv"

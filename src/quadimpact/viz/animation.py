@@ -26,7 +26,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.plots import break_wraps
+from quadimpact.results.figures import break_wraps
+from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene
 
@@ -269,47 +270,47 @@ def write_animation(
     out.mkdir(parents=True, exist_ok=True)
     fig = AnimationFigure(scene, camera or DEFAULT_ANIMATION_CAMERA, w, h, t0, t1, slow)
 
-    writer = None
-    mp4_path = out / ANIMATION_MP4
-    tmp_mp4 = out / f".{ANIMATION_MP4}.tmp.mp4"
-    if mp4:
-        import imageio_ffmpeg
-
-        writer = imageio_ffmpeg.write_frames(
-            str(tmp_mp4),
-            (w, h),
-            fps=fps,
-            codec="libx264",
-            pix_fmt_in="rgb24",
-            pix_fmt_out="yuv420p",
-            quality=7,
-            macro_block_size=2,
-            ffmpeg_log_level="error",
-        )
-        writer.send(None)
     gif_frames = []
     gif_step = max(1, int(round(fps / gif_fps))) if gif else 0
-    try:
-        for k, t in enumerate(times):
-            pixels = fig.render(float(t))
+
+    def render(movie: Path | None) -> None:
+        """Draw every frame: into the movie (when given) and the GIF's frames."""
+        writer = None
+        if movie is not None:
+            import imageio_ffmpeg
+
+            writer = imageio_ffmpeg.write_frames(
+                str(movie),
+                (w, h),
+                fps=fps,
+                codec="libx264",
+                pix_fmt_in="rgb24",
+                pix_fmt_out="yuv420p",
+                quality=7,
+                macro_block_size=2,
+                ffmpeg_log_level="error",
+            )
+            writer.send(None)
+        try:
+            for k, t in enumerate(times):
+                pixels = fig.render(float(t))
+                if writer is not None:
+                    writer.send(pixels.tobytes())
+                if gif and k % gif_step == 0:
+                    gif_frames.append(_gif_frame(pixels, gif_width))
+                if progress is not None:
+                    progress(k + 1, len(times))
+        finally:
             if writer is not None:
-                writer.send(pixels.tobytes())
-            if gif and k % gif_step == 0:
-                gif_frames.append(_gif_frame(pixels, gif_width))
-            if progress is not None:
-                progress(k + 1, len(times))
-    except BaseException:
-        if writer is not None:
-            writer.close()
-        tmp_mp4.unlink(missing_ok=True)
-        raise
-    if writer is not None:
-        writer.close()
-        os.replace(tmp_mp4, mp4_path)
+                writer.close()
+
+    mp4_path = out / ANIMATION_MP4
+    if mp4:
+        atomic_write(mp4_path, render, suffix=".mp4")  # ffmpeg reads the format from the name
+    else:
+        render(None)
     gif_path = None
     if gif:
-        from quadimpact.io import atomic_write
-
         duration = int(round(1000.0 * gif_step / fps))
         gif_path = out / ANIMATION_GIF
         atomic_write(

@@ -86,7 +86,7 @@ def _camera(
 
 def _scene(result_dir: Path, vehicle: str | None) -> Any:
     """The scene of a result folder, with input errors as one line."""
-    from quadimpact.io import SUMMARY_JSON, TIMESERIES_PARQUET
+    from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET
     from quadimpact.viz.scene import Scene
 
     if not result_dir.is_dir():

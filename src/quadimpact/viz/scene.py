@@ -457,13 +457,13 @@ class Scene:
 
     @classmethod
     def from_result(cls, result: Any, vehicle: Vehicle | None = None, **kw: Any) -> Scene:
-        """Scene of a :class:`~quadimpact.result.SimulationResult`."""
+        """Scene of a :class:`~quadimpact.results.result.SimulationResult`."""
         return cls(result.timeseries, result.summary, result.episodes, vehicle=vehicle, **kw)
 
     @classmethod
     def from_dir(cls, directory: Any, vehicle: Vehicle | None = None, **kw: Any) -> Scene:
-        """Scene of a result folder (``quadimpact.io.read_result``)."""
-        from quadimpact.io import read_result
+        """Scene of a result folder (``quadimpact.results.result.read_result``)."""
+        from quadimpact.results.result import read_result
 
         return cls.from_result(read_result(directory), vehicle=vehicle, **kw)
 

@@ -15,7 +15,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.io import atomic_write
+from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene
 

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.io import atomic_write
+from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import WALL_WIDTH_M
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, BUMPER_NAMES, Camera, Scene
 

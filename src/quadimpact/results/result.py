@@ -1,4 +1,9 @@
-"""The result of one simulation run and how it is written to a folder."""
+"""The result of one simulation run, how it is written to a folder and read back.
+
+The simulation builds a :class:`SimulationResult` (``quadimpact.simulation``);
+this module only holds and writes it, so that results never depend on the
+simulator.
+"""
 
 from __future__ import annotations
 
@@ -13,9 +18,9 @@ from typing import Any
 
 import pandas as pd
 
-from quadimpact import io as qio
+from quadimpact.results import files
 
-__all__ = ["FIG5_PNG", "FIG6_PNG", "SimulationResult"]
+__all__ = ["FIG5_PNG", "FIG6_PNG", "SimulationResult", "read_result"]
 
 FIG5_PNG = "fig5.png"
 FIG6_PNG = "fig6.png"
@@ -98,11 +103,11 @@ class SimulationResult:
         summary.pop("plot_errors", None)
         summary.setdefault("references", dict(self.references))
         summary.setdefault("stats", dict(self.stats))
-        qio.write_summary_json(summary, d / qio.SUMMARY_JSON)
-        qio.write_episodes_csv(self.episodes, d / qio.EPISODES_CSV)
-        qio.write_timeseries_parquet(self.timeseries, d / qio.TIMESERIES_PARQUET)
+        files.write_summary_json(summary, d / files.SUMMARY_JSON)
+        files.write_episodes_csv(self.episodes, d / files.EPISODES_CSV)
+        files.write_timeseries_parquet(self.timeseries, d / files.TIMESERIES_PARQUET)
 
-        from quadimpact import plots  # matplotlib only when figures are wanted
+        from quadimpact.results import figures as plots  # matplotlib only when drawing
 
         title = self.plot_title()
         jobs: tuple[tuple[str, Callable[[Path], Path]], ...] = (
@@ -126,7 +131,33 @@ class SimulationResult:
         if errors:
             summary["plot_errors"] = errors
             self.summary["plot_errors"] = list(errors)
-            qio.write_summary_json(summary, d / qio.SUMMARY_JSON)
+            files.write_summary_json(summary, d / files.SUMMARY_JSON)
         else:
             self.summary.pop("plot_errors", None)
         return d
+
+
+def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
+    """Load a result folder written by :meth:`SimulationResult.write`.
+
+    Returns a :class:`SimulationResult` with ``summary``,
+    ``episodes``, ``timeseries``, and ``references``/``stats`` taken from the
+    summary (empty dicts if absent); ``scenario`` is ``None``. Enough to
+    re-plot the folder.
+    """
+    d = Path(directory)
+    if not d.is_dir():
+        raise FileNotFoundError(f"result folder not found: {d}")
+    summary = files.read_summary_json(d / files.SUMMARY_JSON)
+    episodes = files.read_episodes_csv(d / files.EPISODES_CSV)
+    timeseries = files.read_timeseries_parquet(d / files.TIMESERIES_PARQUET)
+    references = dict(summary.get("references") or {})
+    stats = dict(summary.get("stats") or {})
+    return SimulationResult(
+        summary=summary,
+        episodes=episodes,
+        timeseries=timeseries,
+        references=references,
+        scenario=None,
+        stats=stats,
+    )

@@ -10,41 +10,44 @@ A result folder holds:
   as JSON in the schema metadata key ``quadimpact.units``;
 - ``fig5.png``, ``fig6.png``: the plots.
 
-Every writer writes a temporary file next to the target and renames it into
-place (``os.replace``), so a reader never sees a half-written file.
+Every file quadimpact writes (these, the figures, the pictures, a sweep's
+parts and table) is written by :func:`atomic_write`: a temporary file next to
+the target, renamed into place (``os.replace``), so a reader never sees a
+half-written file. :func:`to_jsonable` is the one conversion of values to
+plain JSON types (the summary here; a sweep's inputs and table rows).
+
+pandas and pyarrow are imported by the functions that need them, so that
+importing this module stays light (sweep workers, the command line).
 """
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import math
 import os
-import tempfile
+import secrets
+import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-import pandas as pd
-import pyarrow as pa
-import pyarrow.parquet as pq
-
-from quadimpact.analysis import EPISODE_COLUMNS
-
 if TYPE_CHECKING:
-    from quadimpact.result import SimulationResult
+    import pandas as pd
 
 __all__ = [
+    "BUMPERS",
+    "EPISODE_COLUMNS",
     "EPISODES_CSV",
     "EPISODES_LEADING_COLUMNS",
     "SUMMARY_JSON",
+    "TIMESERIES_COLUMNS",
     "TIMESERIES_PARQUET",
     "UNITS_METADATA_KEY",
     "atomic_write",
     "column_unit",
     "read_episodes_csv",
-    "read_result",
     "read_summary_json",
     "read_timeseries_parquet",
     "read_timeseries_units",
@@ -57,6 +60,52 @@ __all__ = [
 SUMMARY_JSON = "summary.json"
 EPISODES_CSV = "episodes.csv"
 TIMESERIES_PARQUET = "timeseries.parquet"
+
+#: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
+BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
+
+#: Columns of the episodes table, in order (docs/RESULTS.md).
+EPISODE_COLUMNS: tuple[str, ...] = (
+    "bumper",
+    "surface",
+    "t_start_s",
+    "t_end_s",
+    "v_i_m_s",
+    "peak_delta_m",
+    "t_peak_s",
+    "peak_force_n",
+    "t_peak_force_s",
+    "open",
+)
+
+#: Columns of the time-series table, in order (docs/RESULTS.md).
+TIMESERIES_COLUMNS: tuple[str, ...] = (
+    "t_s",
+    "x_m",
+    "y_m",
+    "z_m",
+    "u_m_s",
+    "v_m_s",
+    "w_m_s",
+    "vx_m_s",
+    "vy_m_s",
+    "vz_m_s",
+    "q0",
+    "q1",
+    "q2",
+    "q3",
+    "p_rad_s",
+    "q_rad_s",
+    "r_rad_s",
+    *(f"omega{j}_rad_s" for j in BUMPERS),
+    *(f"omega_cmd{j}_rad_s" for j in BUMPERS),
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "altitude_m",
+    *(f"delta{j}_m" for j in BUMPERS),
+    *(f"force{j}_n" for j in BUMPERS),
+)
 
 #: Schema metadata key holding ``{column: unit}`` as a JSON string.
 UNITS_METADATA_KEY = "quadimpact.units"
@@ -93,54 +142,112 @@ def column_unit(name: str) -> str:
     return "1"
 
 
-def to_jsonable(obj: Any) -> Any:
-    """Convert ``obj`` into plain JSON types.
+def to_jsonable(obj: Any, *, finite: bool = True, strict: bool = True) -> Any:
+    """Convert ``obj`` into plain JSON types (the one converter).
 
-    NaN and infinities become ``None``; NumPy scalars and arrays, tuples,
-    sets, paths, dataclasses and pydantic models become their plain
-    equivalents. Anything else raises ``TypeError`` (nothing is silently
-    turned into a string).
+    NumPy scalars and arrays (anything with ``tolist``), tuples, sets (sorted),
+    paths, dataclasses and pydantic models become their plain equivalents;
+    mapping keys become strings.
+
+    Parameters
+    ----------
+    obj : object
+        The value.
+    finite : bool, keyword
+        NaN and infinities become ``None`` (JSON has neither; the summary).
+        ``False`` keeps them (a sweep's inputs, which are checked afterwards).
+    strict : bool, keyword
+        Anything else raises ``TypeError`` (nothing is silently turned into a
+        string); ``False`` returns it unchanged.
     """
+
+    def convert(value: Any) -> Any:
+        return to_jsonable(value, finite=finite, strict=strict)
+
     if obj is None or isinstance(obj, bool | str):
         return obj
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, int | np.integer):
+    if isinstance(obj, int):
         return int(obj)
-    if isinstance(obj, float | np.floating):
+    if isinstance(obj, float):  # NumPy float64 too
         f = float(obj)
-        return f if math.isfinite(f) else None
-    if isinstance(obj, np.ndarray):
-        return [to_jsonable(v) for v in obj.tolist()]
+        return None if finite and not math.isfinite(f) else f
     if isinstance(obj, Mapping):
-        return {str(k): to_jsonable(v) for k, v in obj.items()}
+        return {str(k): convert(v) for k, v in obj.items()}
     if isinstance(obj, list | tuple | set | frozenset):
         items = sorted(obj) if isinstance(obj, set | frozenset) else obj
-        return [to_jsonable(v) for v in items]
+        return [convert(v) for v in items]
     if isinstance(obj, os.PathLike):
         return os.fspath(obj)
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        return to_jsonable(dataclasses.asdict(obj))
+        return convert(dataclasses.asdict(obj))
     model_dump = getattr(obj, "model_dump", None)
     if callable(model_dump):
-        return to_jsonable(model_dump(mode="json"))
-    if obj is pd.NA or obj is pd.NaT:
+        return convert(model_dump(mode="json"))
+    tolist = getattr(obj, "tolist", None)
+    if callable(tolist) and not isinstance(obj, bytes):  # NumPy scalars and arrays
+        return convert(tolist())
+    pd = sys.modules.get("pandas")  # pd.NA and pd.NaT only exist once pandas is loaded
+    if pd is not None and (obj is pd.NA or obj is pd.NaT):
         return None
+    if not strict:
+        return obj
     raise TypeError(f"summary: cannot write a value of type {type(obj).__name__} to JSON")
 
 
-def atomic_write(path: str | os.PathLike[str], write: Callable[[Path], None]) -> Path:
-    """Call ``write(tmp)`` on a temporary file beside ``path``, then rename it to ``path``."""
+def _fsync(path: Path) -> None:
+    with contextlib.suppress(OSError):  # folders cannot be opened everywhere
+        fd = os.open(path, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def atomic_write(
+    path: str | os.PathLike[str],
+    write: Callable[[Path], None],
+    *,
+    durable: bool = False,
+    suffix: str = ".tmp",
+) -> Path:
+    """Write a file so that it is either complete or absent (the one atomic writer).
+
+    ``write(tmp)`` writes a temporary file beside ``path`` (in the same
+    folder: ``.<name>.<pid>.<random><suffix>``), which is then renamed to
+    ``path``; if ``write`` fails the temporary file is removed and the error
+    raised, and ``path`` keeps its old content (or stays absent).
+
+    Parameters
+    ----------
+    path : path-like
+        The target file.
+    write : callable
+        Writes the content to the path it is given (which does not exist yet).
+    durable : bool, keyword
+        Also flush the file and the folder to disk (``fsync``) around the
+        rename, so that the file survives a power cut once this returns
+        (a sweep's parts and table).
+    suffix : str, keyword
+        End of the temporary name (a writer that picks its format from the
+        name, like ffmpeg, needs the real extension).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
     target = Path(path)
-    fd, tmp_name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    tmp = Path(tmp_name)
+    tmp = target.parent / f".{target.name}.{os.getpid()}.{secrets.token_hex(4)}{suffix}"
     try:
         write(tmp)
+        if durable:
+            _fsync(tmp)
         os.replace(tmp, target)
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise
+    if durable:
+        _fsync(target.parent)
     return target
 
 
@@ -183,6 +290,8 @@ def write_episodes_csv(df: pd.DataFrame, path: str | os.PathLike[str]) -> Path:
 
 def read_episodes_csv(path: str | os.PathLike[str]) -> pd.DataFrame:
     """Read an episodes CSV back with the table's dtypes (``bumper`` int, ``open`` bool)."""
+    import pandas as pd
+
     # Only empty fields are missing values, so a surface named e.g. "None" survives.
     df = pd.read_csv(path, keep_default_na=False, na_values=[""])
     if "bumper" in df.columns:
@@ -205,6 +314,9 @@ def write_timeseries_parquet(df: pd.DataFrame, path: str | os.PathLike[str]) -> 
     The schema metadata key :data:`UNITS_METADATA_KEY` holds a JSON object
     ``{column: unit}`` (units from :func:`column_unit`).
     """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
     table = pa.Table.from_pandas(df, preserve_index=False)
     units = {str(c): column_unit(str(c)) for c in df.columns}
     meta = dict(table.schema.metadata or {})
@@ -215,39 +327,15 @@ def write_timeseries_parquet(df: pd.DataFrame, path: str | os.PathLike[str]) -> 
 
 def read_timeseries_parquet(path: str | os.PathLike[str]) -> pd.DataFrame:
     """Read a time series written by :func:`write_timeseries_parquet`."""
+    import pyarrow.parquet as pq
+
     return pq.read_table(path).to_pandas()
 
 
 def read_timeseries_units(path: str | os.PathLike[str]) -> dict[str, str]:
     """Column units stored in a time-series Parquet file (empty if absent)."""
+    import pyarrow.parquet as pq
+
     meta = pq.read_schema(path).metadata or {}
     raw = meta.get(UNITS_METADATA_KEY.encode())
     return json.loads(raw) if raw else {}
-
-
-def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
-    """Load a result folder written by :meth:`SimulationResult.write`.
-
-    Returns a :class:`~quadimpact.result.SimulationResult` with ``summary``,
-    ``episodes``, ``timeseries``, and ``references``/``stats`` taken from the
-    summary (empty dicts if absent); ``scenario`` is ``None``. Enough to
-    re-plot the folder.
-    """
-    from quadimpact.result import SimulationResult
-
-    d = Path(directory)
-    if not d.is_dir():
-        raise FileNotFoundError(f"result folder not found: {d}")
-    summary = read_summary_json(d / SUMMARY_JSON)
-    episodes = read_episodes_csv(d / EPISODES_CSV)
-    timeseries = read_timeseries_parquet(d / TIMESERIES_PARQUET)
-    references = dict(summary.get("references") or {})
-    stats = dict(summary.get("stats") or {})
-    return SimulationResult(
-        summary=summary,
-        episodes=episodes,
-        timeseries=timeseries,
-        references=references,
-        scenario=None,
-        stats=stats,
-    )

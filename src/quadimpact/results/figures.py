@@ -1,0 +1,388 @@
+"""Figures: of one run (the paper's Figures 5 and 6), and the shared figure helpers.
+
+Figures are built as :class:`matplotlib.figure.Figure` objects on an Agg
+canvas, never through ``pyplot``, so nothing leaks into global state and the
+functions work in worker processes without a display. ``make_*`` return the
+figure (for inspection and tests); ``plot_*`` build it and write a PNG.
+
+Input of Figures 5 and 6 is the time-series table (``timeseries.parquet``:
+inertial NED positions, ``altitude_m = -z``, ZYX Euler angles in degrees).
+:func:`new_figure` and :func:`save_figure` serve every figure of the package;
+:func:`type_map_figure` (with :data:`TYPE_COLOURS`) draws the response types
+of a sweep table, for ``quadimpact sweep`` and the paper's Table II.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.colors import ListedColormap
+from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+
+from quadimpact.errors import InputError
+from quadimpact.results.files import atomic_write
+
+__all__ = [
+    "BUMPER_COLORS",
+    "FIG_DPI",
+    "MAX_TEXT_CELLS",
+    "TYPE_COLOURS",
+    "break_wraps",
+    "check_columns",
+    "facet_panels",
+    "format_level",
+    "make_fig5",
+    "make_fig6",
+    "new_figure",
+    "plot_fig5",
+    "plot_fig6",
+    "save_figure",
+    "sorted_levels",
+    "type_map_figure",
+]
+
+#: Resolution of the written PNG files (dots per inch).
+FIG_DPI = 150
+
+#: Line colour of bumpers 1-4 (shared by every plot of bumper quantities).
+BUMPER_COLORS: dict[int, str] = {1: "tab:blue", 2: "tab:orange", 3: "tab:green", 4: "tab:red"}
+
+_REF_STYLE = {"color": "k", "linestyle": "--", "linewidth": 1.0}
+
+#: Fill colour of each response type in type maps (failed runs: black).
+TYPE_COLOURS: dict[str, str] = {
+    "A": "#4daf4a",
+    "B": "#377eb8",
+    "C": "#ff7f00",
+    "D": "#e41a1c",
+    "Other": "#999999",
+    "failed": "#000000",
+}
+_TYPES = list(TYPE_COLOURS)
+MAX_TEXT_CELLS = 400
+"""Type maps write each cell's text up to this many cells per panel."""
+
+
+
+def new_figure(width_in: float, height_in: float) -> Figure:
+    """An empty figure (constrained layout) on its own Agg canvas: no pyplot state."""
+    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    FigureCanvasAgg(fig)
+    return fig
+
+
+def save_figure(fig: Figure, path: str | os.PathLike[str]) -> Path:
+    """Write ``fig`` as PNG to ``path`` (atomically: temporary file, then rename)."""
+    return atomic_write(path, lambda tmp: fig.savefig(tmp, format="png", dpi=FIG_DPI))
+
+
+def break_wraps(
+    t: np.ndarray, angle_deg: np.ndarray, jump_deg: float = 180.0
+) -> tuple[np.ndarray, np.ndarray]:
+    """Insert a NaN sample wherever a wrapped angle jumps by more than ``jump_deg``.
+
+    Keeps a wrapped angle (e.g. yaw in (-180, 180]) from being drawn as a
+    vertical line across the panel when it passes +-180 deg. Returns the
+    inputs unchanged (as float arrays) when there is no such jump.
+    """
+    t = np.asarray(t, dtype=np.float64)
+    y = np.asarray(angle_deg, dtype=np.float64)
+    jumps = np.flatnonzero(np.abs(np.diff(y)) > jump_deg)
+    if jumps.size == 0:
+        return t, y
+    idx = jumps + 1
+    return np.insert(t, idx, np.nan), np.insert(y, idx, np.nan)
+
+
+def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
+    """Bumper deflections against time (paper Figure 5).
+
+    Parameters
+    ----------
+    ts : pandas.DataFrame
+        Time series with ``t_s`` (s) and ``delta1_m``..``delta4_m`` (m).
+    title : str, optional
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One axes; line ``j-1`` is bumper ``j`` in millimetres.
+    """
+    fig = new_figure(7.0, 3.8)
+    ax = fig.add_subplot()
+    t = ts["t_s"].to_numpy(dtype=np.float64)
+    for j in (1, 2, 3, 4):
+        delta_mm = 1e3 * ts[f"delta{j}_m"].to_numpy(dtype=np.float64)
+        ax.plot(t, delta_mm, color=BUMPER_COLORS[j], linewidth=1.2, label=f"Bumper {j}")
+    ax.set_xlabel("Time (s)")
+    ax.set_ylabel("Bumper deflection (mm)")
+    ax.grid(True, alpha=0.4)
+    ax.legend(loc="best")
+    if len(t):
+        ax.set_xlim(float(t[0]), float(t[-1]))
+    if title:
+        ax.set_title(title)
+    return fig
+
+
+def make_fig6(
+    ts: pd.DataFrame,
+    refs: Mapping[str, float],
+    wall_x_m: float | None = None,
+    title: str | None = None,
+) -> Figure:
+    """Vehicle states against time (paper Figure 6).
+
+    Six panels sharing the time axis: left column X (with the wall plane
+    ``X = wall_x_m`` dashed), Y, altitude (with its reference dashed), all in
+    metres (inertial NED position; altitude = -Z); right column roll, pitch,
+    yaw (ZYX Euler, degrees) each with its reference dashed.
+
+    Parameters
+    ----------
+    ts : pandas.DataFrame
+        Time series with ``t_s``, ``x_m``, ``y_m``, ``altitude_m``,
+        ``roll_deg``, ``pitch_deg``, ``yaw_deg``.
+    refs : mapping
+        ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (rad) and ``altitude_m`` (m);
+        a missing or ``None`` entry draws no reference line.
+    wall_x_m : float, optional
+        Inertial X of the wall plane (m).
+    title : str, optional
+        Figure title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Axes in order X, roll, Y, pitch, altitude, yaw (row-major). In each
+        axes the first line is the simulated quantity.
+    """
+    fig = new_figure(10.0, 7.5)
+    axes = fig.subplots(3, 2, sharex=True)
+    t = ts["t_s"].to_numpy(dtype=np.float64)
+
+    def ref_value(key: str, scale: float = 1.0) -> float | None:
+        v = refs.get(key)
+        if v is None or not math.isfinite(float(v)):
+            return None
+        return float(v) * scale
+
+    left = (
+        ("x_m", "X (m)", wall_x_m, "wall"),
+        ("y_m", "Y (m)", None, None),
+        ("altitude_m", "Altitude (m)", ref_value("altitude_m"), "reference"),
+    )
+    for ax, (col, label, ref, ref_label) in zip(axes[:, 0], left, strict=True):
+        ax.plot(t, ts[col].to_numpy(dtype=np.float64), color="tab:blue", label="simulated")
+        if ref is not None and math.isfinite(ref):
+            ax.axhline(ref, label=ref_label, **_REF_STYLE)
+        ax.set_ylabel(label)
+
+    deg = 180.0 / math.pi
+    right = (
+        ("roll_deg", "Roll φ (deg)", ref_value("roll_rad", deg)),
+        ("pitch_deg", "Pitch θ (deg)", ref_value("pitch_rad", deg)),
+        ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg)),
+    )
+    for ax, (col, label, ref) in zip(axes[:, 1], right, strict=True):
+        tt, yy = break_wraps(t, ts[col].to_numpy(dtype=np.float64))
+        ax.plot(tt, yy, color="tab:blue", label="simulated")
+        if ref is not None:
+            ax.axhline(ref, label="reference", **_REF_STYLE)
+        ax.set_ylabel(label)
+
+    for ax in axes.flat:
+        ax.grid(True, alpha=0.4)
+        if len(ax.get_legend_handles_labels()[0]) > 1:
+            ax.legend(loc="best", fontsize="small")
+    for ax in axes[-1, :]:
+        ax.set_xlabel("Time (s)")
+    if len(t):
+        axes[0, 0].set_xlim(float(t[0]), float(t[-1]))
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def plot_fig5(ts: pd.DataFrame, path: str | os.PathLike[str], title: str | None = None) -> Path:
+    """Write the bumper-deflection figure (:func:`make_fig5`) to ``path`` as PNG."""
+    return save_figure(make_fig5(ts, title=title), path)
+
+
+def plot_fig6(
+    ts: pd.DataFrame,
+    refs: Mapping[str, float],
+    path: str | os.PathLike[str],
+    wall_x_m: float | None = None,
+    title: str | None = None,
+) -> Path:
+    """Write the states figure (:func:`make_fig6`) to ``path`` as PNG."""
+    return save_figure(make_fig6(ts, refs, wall_x_m=wall_x_m, title=title), path)
+
+
+# ------------------------------------------------------ sweep tables: helpers
+def format_level(value: Any) -> str:
+    """A field's value as an axis or panel label (floats without trailing zeros)."""
+    if isinstance(value, (float, np.floating)):
+        return f"{float(value):g}"
+    return str(value)
+
+
+def check_columns(table: pd.DataFrame, *names: str | None) -> None:
+    """Raise a one-line InputError for a name (not None) that is not a column of ``table``."""
+    for name in names:
+        if name is not None and name not in table.columns:
+            raise InputError(f"plot: {name}: no such column in the sweep table")
+
+
+def sorted_levels(series: pd.Series) -> list[Any]:
+    """The distinct values of a column, sorted (as text when they do not compare)."""
+    values = series.dropna().unique().tolist()
+    try:
+        return sorted(values)
+    except TypeError:
+        return sorted(values, key=str)
+
+
+def facet_panels(table: pd.DataFrame, facet: str | None) -> list[tuple[Any, pd.DataFrame]]:
+    """(value, rows) per value of ``facet``; one panel of every row without it."""
+    if facet is None:
+        return [(None, table)]
+    return [(v, table[table[facet] == v]) for v in sorted_levels(table[facet])]
+
+
+# ------------------------------------------------------ sweep tables: type map
+def _mode(values: pd.Series) -> Any:
+    counts = values.value_counts(dropna=False)
+    return counts.index[0] if len(counts) else None
+
+
+def _cell_texts(sub: pd.DataFrame, label: Callable[[pd.Series], str] | None) -> list[str | None]:
+    """Each run's cell text: ``label(row)``, or its ``n_subsequent_impacts`` (None if absent)."""
+    if label is not None:
+        return [label(r) for _, r in sub.iterrows()]
+    if "n_subsequent_impacts" not in sub:
+        return [None] * len(sub)
+    return [None if pd.isna(n) else str(int(n)) for n in sub["n_subsequent_impacts"]]
+
+
+def type_map_figure(
+    table: pd.DataFrame,
+    x: str,
+    y: str,
+    facet: str | None = None,
+    *,
+    title: str | None = None,
+    label: Callable[[pd.Series], str] | None = None,
+    path: str | os.PathLike[str] | None = None,
+) -> Figure:
+    """Response type over two fields (categorical colours), one panel per ``facet`` value.
+
+    Parameters
+    ----------
+    table : pandas.DataFrame
+        A sweep table with ``response_type``, ``status`` and ``n_subsequent_impacts``.
+    x, y : str
+        Fields along the horizontal and vertical axes (each value one cell,
+        evenly spaced, in sorted order).
+    facet : str, optional
+        One panel (stacked vertically) per value of this field.
+    title : str, optional
+        Figure title.
+    label : callable, optional
+        The text of a cell from its run's row (the paper's Table II writes
+        ``C3``: the type and the count); default ``n_subsequent_impacts``.
+    path : path-like, optional
+        Also write the figure there as PNG.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Notes
+    -----
+    A cell holding several runs (other fields varying) shows the most
+    frequent type. Cells show their text (``n_subsequent_impacts``, the paper's
+    Table II count, or ``label``) when a panel has at most
+    :data:`MAX_TEXT_CELLS` cells; failed runs (black) have none.
+    """
+    check_columns(table, x, y, facet, "response_type", "status")
+    xs, ys = sorted_levels(table[x]), sorted_levels(table[y])
+    if not xs or not ys:
+        raise InputError("plot: type map of an empty table")
+    panels = facet_panels(table, facet)
+    width = min(18.0, 1.8 + 0.32 * len(xs))
+    height = 0.9 + len(panels) * (0.6 + 0.32 * len(ys))
+    fig = new_figure(width, height + 0.4)
+    axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
+    cmap = ListedColormap([TYPE_COLOURS[t] for t in _TYPES])
+    col = {v: i for i, v in enumerate(xs)}
+    row = {v: i for i, v in enumerate(ys)}
+    present: set[str] = set()
+    show_text = len(xs) * len(ys) <= MAX_TEXT_CELLS
+    fontsize = max(5.0, min(8.0, 9.0 - 0.05 * len(xs)))
+    for ax, (fv, sub) in zip(axes, panels, strict=True):
+        kind = sub["response_type"].astype(object).where(sub["status"] != "failed", "failed")
+        cells = pd.DataFrame(
+            {
+                "x": sub[x].to_numpy(),
+                "y": sub[y].to_numpy(),
+                "t": kind.to_numpy(),
+                "n": _cell_texts(sub, label),
+            }
+        ).dropna(subset=["x", "y"])
+        grid = np.full((len(ys), len(xs)), np.nan)
+        for (xv, yv), g in cells.groupby(["x", "y"], sort=False):
+            t = _mode(g["t"])
+            if t is None or (isinstance(t, float) and math.isnan(t)) or t not in _TYPES:
+                continue
+            present.add(t)
+            grid[row[yv], col[xv]] = _TYPES.index(t)
+            if show_text and t != "failed":
+                text = g.loc[g["t"] == t, "n"].iloc[0]
+                if text is not None:
+                    ax.text(
+                        col[xv],
+                        row[yv],
+                        text,
+                        ha="center",
+                        va="center",
+                        fontsize=fontsize,
+                        color="white" if t in ("B", "D") else "black",
+                    )
+        ax.pcolormesh(
+            np.arange(len(xs) + 1) - 0.5,
+            np.arange(len(ys) + 1) - 0.5,
+            np.ma.masked_invalid(grid),
+            cmap=cmap,
+            vmin=-0.5,
+            vmax=len(_TYPES) - 0.5,
+            edgecolors="white",
+            linewidth=0.5,
+        )
+        step = max(1, math.ceil(len(xs) / 21))
+        ax.set_xticks(range(0, len(xs), step), [format_level(v) for v in xs[::step]], fontsize=8)
+        ax.set_yticks(range(len(ys)), [format_level(v) for v in ys], fontsize=8)
+        ax.set_xlim(-0.5, len(xs) - 0.5)
+        ax.set_ylim(-0.5, len(ys) - 0.5)
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        if fv is not None:
+            ax.set_title(f"{facet} = {format_level(fv)}", fontsize=10)
+    handles = [Patch(color=TYPE_COLOURS[t], label=t) for t in _TYPES if t in present]
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8)
+    if title:
+        fig.suptitle(title)
+    if path is not None:
+        save_figure(fig, path)
+    return fig
