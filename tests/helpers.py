@@ -9,7 +9,7 @@ import numpy as np
 import quadimpact
 from quadimpact.core import layout as L
 from quadimpact.core.run import execute
-from quadimpact.scenario import RunSetup
+from quadimpact.simulation.setup import RunSetup
 
 #: The bundled Spiri's parameter file.
 SPIRI_TOML = Path(quadimpact.__file__).resolve().parent / "inputs" / "vehicles" / "spiri.toml"

@@ -26,12 +26,12 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from . import __version__
-from .analysis import RESPONSE_TYPES
 from .findings import Finding, evaluate, fig4_curves, findings_frame
 from .inputs.model import MODEL_VARIANTS
 from .inputs.scenarios import WallApproach
 from .results import figures
 from .simulation import simulate
+from .simulation.metrics import RESPONSE_TYPES
 from .sweep import SweepSpec, run_sweep
 from .viz.scene import Scene
 from .viz.snapshots import write_snapshots

@@ -809,7 +809,7 @@ def warm_up() -> None:
         return
     from quadimpact import simulate  # noqa: F401  (the simulator: pandas, analysis...)
     from quadimpact.inputs.scenarios import WallApproach
-    from quadimpact.scenario import prepare
+    from quadimpact.simulation.setup import prepare
 
     prepare(WallApproach(final_time_s=0.6, impact_time_s=0.1))  # runs the kernel
     _WARM = True

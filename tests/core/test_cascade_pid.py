@@ -19,8 +19,8 @@ from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
 from quadimpact.inputs.world import Plane
-from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import quat_to_matrix
+from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
 
 STATE_COLS = [
     "x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3",

@@ -10,9 +10,9 @@ from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
 from quadimpact.inputs.world import GROUND, Plane
-from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
-from quadimpact.scenario import prepare
+from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
+from quadimpact.simulation.setup import prepare
 
 from helpers import run_packed
 

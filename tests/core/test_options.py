@@ -10,7 +10,7 @@ from quadimpact import FlightScenario, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.run import execute, make_kernel
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.scenario import prepare
+from quadimpact.simulation.setup import prepare
 
 from helpers import run_packed, states
 

@@ -5,7 +5,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.inputs.scenarios import FlightScenario
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.scenario import prepare
+from quadimpact.simulation.setup import prepare
 
 from helpers import run_packed, states
 

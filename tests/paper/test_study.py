@@ -5,10 +5,10 @@ import math
 import pandas as pd
 import pytest
 
-from quadimpact.analysis import RESPONSE_TYPES
 from quadimpact.experiments.crashes import TABLE3, scenario_file
 from quadimpact.experiments.logs import data_dir
 from quadimpact.experiments.table3 import EXTRA_COLUMNS, TABLE3_COLUMNS, run_experiments
+from quadimpact.simulation.metrics import RESPONSE_TYPES
 from quadimpact.study import reproduce
 
 

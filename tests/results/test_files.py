@@ -9,7 +9,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from quadimpact.analysis import episodes_frame
+from quadimpact.simulation.record import episodes_frame
 from quadimpact.core import layout as L
 from quadimpact.results.files import (
     EPISODES_LEADING_COLUMNS,

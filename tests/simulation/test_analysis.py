@@ -6,17 +6,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from quadimpact.analysis import (
-    EPISODE_COLUMNS,
-    TIMESERIES_COLUMNS,
-    attitude_excursion_deg,
-    episodes_frame,
-    group_impacts,
-    impact_metrics,
-    timeseries_frame,
-)
 from quadimpact.core import layout as L
+from quadimpact.results.files import EPISODE_COLUMNS, TIMESERIES_COLUMNS
 from quadimpact.rotations import euler_zyx_to_quat
+from quadimpact.simulation.metrics import attitude_excursion_deg, group_impacts, impact_metrics
+from quadimpact.simulation.record import episodes_frame, timeseries_frame
 
 SURFACES = ("wall", "ground")
 D = math.pi / 180.0

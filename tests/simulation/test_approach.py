@@ -7,7 +7,7 @@ import pytest
 
 from quadimpact import WallApproach, simulate
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
-from quadimpact.scenario import inclination_deg_of, wall_attitude
+from quadimpact.simulation.approach import inclination_deg_of, wall_attitude
 
 
 @pytest.mark.parametrize("heading", [0.0, 30.0, 45.0, -45.0, 90.0])

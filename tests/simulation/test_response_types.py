@@ -4,7 +4,7 @@ import pandas as pd
 import pytest
 
 from quadimpact import WallApproach, simulate
-from quadimpact.analysis import GRAZE_DELTA_M, classify_response, impact_metrics
+from quadimpact.simulation.metrics import GRAZE_DELTA_M, classify_response, impact_metrics
 
 
 def episodes(*rows):

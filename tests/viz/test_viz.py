@@ -22,8 +22,8 @@ from quadimpact import WallApproach, load_vehicle, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import bumper_plane_contact
 from quadimpact.inputs.world import Plane
-from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
+from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial
 

@@ -37,7 +37,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from quadimpact.analysis import classify_response
 from quadimpact.experiments.logs import (
     MOCAP_GAP_S,
     POWER_OFF_RPM,
@@ -47,6 +46,7 @@ from quadimpact.experiments.logs import (
     rpm_to_rad_s,
 )
 from quadimpact.rotations import quat_to_matrix, wrap_angle_deg
+from quadimpact.simulation.metrics import classify_response
 
 __all__ = [
     "CONTACT_TOL_M",

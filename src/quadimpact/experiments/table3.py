@@ -28,7 +28,6 @@ from typing import Any
 
 import pandas as pd
 
-from quadimpact.analysis import RESPONSE_TYPES
 from quadimpact.experiments.crashes import (
     HEADING_UNCERTAINTY_DEG,
     SPEED_UNCERTAINTY_M_S,
@@ -40,6 +39,7 @@ from quadimpact.experiments.crashes import (
 from quadimpact.experiments.logs import PreImpact, SpiriMatLog, data_dir
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.simulation import simulate
+from quadimpact.simulation.metrics import RESPONSE_TYPES
 from quadimpact.sweep import SweepSpec, run_sweep
 
 SENSITIVITY_RUNS = 300  # per crash

@@ -36,8 +36,8 @@ import pandas as pd
 from quadimpact.core import layout as L
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import GROUND, Plane
-from quadimpact.packing import pack_surfaces, pack_vehicle
 from quadimpact.rotations import quat_to_matrix
+from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
 
 __all__ = [
     "AXIS_LENGTH_M",
@@ -215,7 +215,7 @@ def contact_points(
     drawing : VehicleDrawing
         The vehicle.
     surf : numpy.ndarray
-        Packed surfaces (:func:`quadimpact.packing.pack_surfaces`).
+        Packed surfaces (:func:`quadimpact.simulation.packing.pack_surfaces`).
 
     Returns
     -------

@@ -9,9 +9,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .core import layout as L
-from .inputs.vehicle import Vehicle
-from .inputs.world import Plane
+from quadimpact.core import layout as L
+from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.inputs.world import Plane
 
 # Paper gains (MODEL.md 6.1): (P, I, D) for altitude, climb rate, heading,
 # roll/pitch and yaw rate, in the order of the G_* blocks.

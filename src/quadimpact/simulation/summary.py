@@ -1,34 +1,31 @@
-"""Front end: one scenario in, one :class:`~quadimpact.results.result.SimulationResult` out.
+"""The summary of a run (``summary.json``, STUDIES.md section 2) and its one-line outcome.
 
-``simulate`` prepares the packed inputs (``scenario.prepare``), runs the
-compiled loop once, and reads its raw record with the pure functions of
-``analysis`` into tables and the summary of STUDIES.md section 2.
+Built from the run's setup, its tables and the kernel's raw stats: the status,
+warnings, the impact conditions reached at the first onset, the approach
+solution and the metrics of :mod:`quadimpact.simulation.metrics`.
 """
 
 from __future__ import annotations
 
 import math
-import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from . import __version__
-from .analysis import (
+from quadimpact import __version__
+from quadimpact.core import layout as L
+from quadimpact.inputs.scenarios import WallApproach
+from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
+from quadimpact.simulation.approach import inclination_deg_of
+from quadimpact.simulation.metrics import (
     GRAZE_DELTA_M,
     attitude_excursion_deg,
     classify_response,
-    episodes_frame,
     impact_metrics,
-    timeseries_frame,
 )
-from .core import layout as L
-from .core.run import execute
-from .inputs.scenarios import FlightScenario, WallApproach
-from .results.result import SimulationResult
-from .rotations import quat_to_euler_zyx, quat_to_matrix
-from .scenario import RunSetup, inclination_deg_of, prepare
+from quadimpact.simulation.setup import RunSetup
+
+__all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]
 
 STATUS_NAMES = {
     L.STATUS_COMPLETED: "completed",
@@ -37,80 +34,6 @@ STATUS_NAMES = {
 }
 SPEED_CHECK_TOL_M_S = 1e-6  # reached impact speed vs request, warn beyond
 ONSET_TIME_TOL_S = 1e-6  # first contact time vs T_c, warn beyond
-
-
-def simulate(
-    scenario: WallApproach | FlightScenario,
-    *,
-    max_episodes: int = 1024,
-    kernel: Callable | None = None,
-) -> SimulationResult:
-    """Run one scenario.
-
-    Parameters
-    ----------
-    scenario : WallApproach or FlightScenario
-        Validated input (``quadimpact.inputs.scenarios``).
-    max_episodes : int
-        Size of the episode buffer; episodes beyond it are counted and reported.
-    kernel : callable, optional
-        A run loop from ``quadimpact.core.run.make_kernel`` (plug-in controller);
-        default: the cached kernel with the built-in controllers.
-
-    Returns
-    -------
-    SimulationResult
-        ``.summary`` (dict of summary.json), ``.episodes`` and ``.timeseries``
-        (pandas DataFrames, SI units, inertial NED / body FRD).
-    """
-    setup = prepare(scenario)
-    return run_setup(setup, scenario, max_episodes=max_episodes, kernel=kernel)
-
-
-def run_setup(
-    setup: RunSetup,
-    scenario: Any = None,
-    *,
-    max_episodes: int = 1024,
-    kernel: Callable | None = None,
-) -> SimulationResult:
-    """Run a prepared setup through the compiled loop and analyse the record."""
-    t_out = setup.output_times()
-    wall_start = time.perf_counter()
-    out, ep, st = execute(
-        setup.x0,
-        setup.t0,
-        setup.tf,
-        setup.veh,
-        setup.surf,
-        setup.opts,
-        setup.ctrl,
-        t_out,
-        max_episodes=max_episodes,
-        kernel=kernel,
-        **setup.schedule(),
-    )
-    wall_s = time.perf_counter() - wall_start
-    ts = timeseries_frame(out, out.shape[0])
-    episodes = episodes_frame(ep, ep.shape[0], setup.surface_names)
-    summary = build_summary(setup, scenario, ts, episodes, st)
-    stats = {
-        "steps": int(st[L.ST_N_STEPS]),
-        "rejected_steps": int(st[L.ST_N_REJECTED]),
-        "rhs_evaluations": int(st[L.ST_N_RHS]),
-        "control_ticks": int(st[L.ST_N_TICKS]),
-        "output_rows": int(st[L.ST_N_OUT]),
-        "wall_time_s": wall_s,
-    }
-    summary["integrator"] = stats
-    return SimulationResult(
-        summary=summary,
-        episodes=episodes,
-        timeseries=ts,
-        references=dict(setup.references),
-        scenario=scenario,
-        stats=stats,
-    )
 
 
 def _nan_to_none(v: float) -> float | None:

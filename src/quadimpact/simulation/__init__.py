@@ -1,0 +1,15 @@
+"""One run, Python side: inputs to packed arrays, the compiled loop, tables and summary.
+
+* :mod:`~quadimpact.simulation.packing`: validated inputs -> the kernel's flat arrays;
+* :mod:`~quadimpact.simulation.approach`: the wall approach's attitude and shooting;
+* :mod:`~quadimpact.simulation.setup`: :class:`RunSetup`, ``prepare(scenario)``;
+* :mod:`~quadimpact.simulation.record`: raw kernel arrays -> episodes and time series;
+* :mod:`~quadimpact.simulation.metrics`: impacts, metrics, response types;
+* :mod:`~quadimpact.simulation.summary`: the summary of a run;
+* :mod:`~quadimpact.simulation.simulate`: :func:`simulate` and :func:`run_setup`.
+"""
+
+from quadimpact.simulation.simulate import run_setup, simulate
+from quadimpact.simulation.summary import build_summary
+
+__all__ = ["build_summary", "run_setup", "simulate"]

@@ -1,0 +1,174 @@
+"""Raw kernel arrays -> tables: the episodes and time-series tables of a run.
+
+Pure functions of plain arrays, testable on hand-made inputs. Raw arrays come
+from the compiled kernel with the layout of :mod:`quadimpact.core.layout`
+(``OUT_*`` time-series columns, ``E_*`` episode columns); the tables' columns
+are :data:`~quadimpact.results.files.EPISODE_COLUMNS` and
+:data:`~quadimpact.results.files.TIMESERIES_COLUMNS` (docs/RESULTS.md). Frames
+and units follow MODEL.md section 1 (inertial NED, body FRD, SI).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from quadimpact.core import layout as L
+from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS
+from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
+
+__all__ = ["episodes_frame", "timeseries_frame"]
+
+# Raw episode columns -> table columns (float-valued ones).
+_EPISODE_FLOAT_SOURCES: tuple[tuple[str, int], ...] = (
+    ("t_start_s", L.E_T_START),
+    ("t_end_s", L.E_T_END),
+    ("v_i_m_s", L.E_V_I),
+    ("peak_delta_m", L.E_PEAK_DELTA),
+    ("t_peak_s", L.E_T_PEAK),
+    ("peak_force_n", L.E_PEAK_FORCE),
+    ("t_peak_force_s", L.E_T_PEAK_FORCE),
+)
+
+
+def _rows(raw: np.ndarray, n: int, width: int, what: str) -> np.ndarray:
+    """First ``n`` rows of a 2-D raw kernel array, checked against its layout width."""
+    a = np.asarray(raw, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] < width:
+        raise ValueError(f"{what}: expected a 2-D array with {width} columns (got {a.shape})")
+    n = int(n)
+    if not 0 <= n <= a.shape[0]:
+        raise ValueError(f"{what}: row count must be in [0, {a.shape[0]}] (got {n})")
+    return a[:n]
+
+
+def _empty_episodes() -> pd.DataFrame:
+    data: dict[str, Any] = {
+        "bumper": pd.Series([], dtype="int64"),
+        "surface": pd.Series([], dtype=object).astype(str),
+    }
+    for name, _ in _EPISODE_FLOAT_SOURCES:
+        data[name] = pd.Series([], dtype="float64")
+    data["open"] = pd.Series([], dtype=bool)
+    return pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
+
+
+def episodes_frame(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> pd.DataFrame:
+    """Contact-episode table from the kernel's episode array.
+
+    Parameters
+    ----------
+    raw : numpy.ndarray, shape (max_episodes, NEP)
+        Episode records with the ``E_*`` columns of :mod:`quadimpact.core.layout`
+        (bumper 0-based, surface as an index into the run's surfaces).
+    n : int
+        Number of valid rows (``stats[ST_N_EPISODES]``, capped by the buffer).
+    surface_names : sequence of str
+        Name of each surface, in the order of the kernel's surface array.
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`EPISODE_COLUMNS`: ``bumper`` (1-4), ``surface`` (name),
+        times in s, ``v_i_m_s`` (penetration rate at onset, m/s),
+        ``peak_delta_m`` (m), ``peak_force_n`` (N), ``open`` (bool: still in
+        contact when the run stopped; ``t_end_s`` is then the run end).
+        Sorted by ``t_start_s`` then ``bumper``, with a fresh 0..n-1 index.
+    """
+    rows = _rows(raw, n, L.NEP, "episodes")
+    if rows.shape[0] == 0:
+        return _empty_episodes()
+    bumper_idx = np.rint(rows[:, L.E_BUMPER]).astype(np.int64)
+    if np.any((bumper_idx < 0) | (bumper_idx > 3)):
+        raise ValueError(f"episodes: bumper index outside 0..3 (got {sorted(set(bumper_idx))})")
+    surf_idx = np.rint(rows[:, L.E_SURFACE]).astype(np.int64)
+    names = list(surface_names)
+    if np.any((surf_idx < 0) | (surf_idx >= len(names))):
+        raise ValueError(
+            f"episodes: surface index outside 0..{len(names) - 1} (got {sorted(set(surf_idx))})"
+        )
+    data: dict[str, Any] = {
+        "bumper": bumper_idx + 1,
+        "surface": [str(names[i]) for i in surf_idx],
+    }
+    for name, col in _EPISODE_FLOAT_SOURCES:
+        data[name] = rows[:, col].copy()
+    data["open"] = rows[:, L.E_OPEN] > 0.5
+    df = pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
+    df = df.sort_values(["t_start_s", "bumper"], kind="mergesort").reset_index(drop=True)
+    return df
+
+
+def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
+    """Time-series table from the kernel's output samples.
+
+    Parameters
+    ----------
+    raw : numpy.ndarray, shape (max_out, NOUT)
+        Output samples with the ``OUT_*`` columns of :mod:`quadimpact.core.layout`.
+    n : int
+        Number of valid rows (``stats[ST_N_OUT]``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`TIMESERIES_COLUMNS`: time (s); CM position ``x/y/z_m``
+        (inertial NED, m); CM velocity in body axes ``u/v/w_m_s`` and in
+        inertial axes ``vx/vy/vz_m_s`` (m/s, ``C(q) [u, v, w]``); quaternion
+        ``q0..q3`` (scalar first, body -> inertial, as integrated); body rates
+        ``p/q/r_rad_s``; rotor speeds and commands (rad/s); ZYX Euler angles
+        ``roll/pitch/yaw_deg`` (degrees; roll and yaw wrapped to (-180, 180],
+        pitch in [-90, 90]; not unwrapped); ``altitude_m = -z_m``; per-bumper
+        deflection ``delta1..4_m`` (m, max over surfaces) and normal force
+        ``force1..4_n`` (N, sum over surfaces).
+    """
+    rows = _rows(raw, n, L.NOUT, "timeseries")
+    x0 = L.OUT_X
+    pos = rows[:, x0 + L.X_POS : x0 + L.X_POS + 3]
+    vel_b = rows[:, x0 + L.X_VEL : x0 + L.X_VEL + 3]
+    quat = rows[:, x0 + L.X_QUAT : x0 + L.X_QUAT + 4]
+    omega = rows[:, x0 + L.X_OMEGA : x0 + L.X_OMEGA + 3]
+    rotor = rows[:, x0 + L.X_ROTOR : x0 + L.X_ROTOR + 4]
+    if rows.shape[0] > 0:
+        vel_i = body_to_inertial(quat, vel_b)
+        roll, pitch, yaw = quat_to_euler_zyx(quat)
+    else:
+        vel_i = np.empty((0, 3))
+        roll = pitch = yaw = np.empty(0)
+    data: dict[str, np.ndarray] = {
+        "t_s": rows[:, L.OUT_T],
+        "x_m": pos[:, 0],
+        "y_m": pos[:, 1],
+        "z_m": pos[:, 2],
+        "u_m_s": vel_b[:, 0],
+        "v_m_s": vel_b[:, 1],
+        "w_m_s": vel_b[:, 2],
+        "vx_m_s": vel_i[:, 0],
+        "vy_m_s": vel_i[:, 1],
+        "vz_m_s": vel_i[:, 2],
+        "q0": quat[:, 0],
+        "q1": quat[:, 1],
+        "q2": quat[:, 2],
+        "q3": quat[:, 3],
+        "p_rad_s": omega[:, 0],
+        "q_rad_s": omega[:, 1],
+        "r_rad_s": omega[:, 2],
+    }
+    for j in BUMPERS:
+        data[f"omega{j}_rad_s"] = rotor[:, j - 1]
+    for j in BUMPERS:
+        data[f"omega_cmd{j}_rad_s"] = rows[:, L.OUT_CMD + j - 1]
+    data["roll_deg"] = np.degrees(roll)
+    data["pitch_deg"] = np.degrees(pitch)
+    data["yaw_deg"] = np.degrees(yaw)
+    data["altitude_m"] = -pos[:, 2]
+    for j in BUMPERS:
+        data[f"delta{j}_m"] = rows[:, L.OUT_DELTA + j - 1]
+    for j in BUMPERS:
+        data[f"force{j}_n"] = rows[:, L.OUT_FORCE + j - 1]
+    return pd.DataFrame({k: np.array(v, dtype=np.float64) for k, v in data.items()})
+
+

@@ -1,0 +1,243 @@
+"""Scenarios to packed runs: the vehicle, trim, surfaces and references of one run.
+
+``prepare(scenario)`` turns a validated :class:`~quadimpact.inputs.scenarios.WallApproach`
+or :class:`~quadimpact.inputs.scenarios.FlightScenario` into a :class:`RunSetup`: the
+flat arrays of the compiled core plus what the analysis needs to read the
+result (surface names, references, the approach solution, warnings). The
+wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approach`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from quadimpact.core import layout as L
+from quadimpact.inputs.model import ModelOptions
+from quadimpact.inputs.scenarios import FlightScenario, WallApproach
+from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.inputs.world import GROUND, Plane
+from quadimpact.rotations import euler_zyx_to_quat
+from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
+from quadimpact.simulation.packing import (
+    RPM,
+    pack_controller,
+    pack_options,
+    pack_surfaces,
+    pack_vehicle,
+    trim_rotor_speeds,
+)
+
+__all__ = ["CONTROLLER_KINDS", "RunSetup", "prepare", "prepare_flight", "prepare_wall_approach"]
+
+PAPER_CRASH_ALTITUDE_M = -0.3  # MODEL.md 8.5
+
+CONTROLLER_KINDS = {"paper": L.CTRL_PAPER, "cascade-pid": L.CTRL_CASCADE_PID}
+
+
+@dataclass
+class RunSetup:
+    """Everything the compiled loop takes, and what is needed to read its record."""
+
+    x0: np.ndarray
+    t0: float
+    tf: float
+    veh: np.ndarray
+    surf: np.ndarray
+    opts: np.ndarray
+    ctrl: np.ndarray
+    surface_names: tuple[str, ...]
+    references: dict[str, float]
+    vehicle: Vehicle
+    options: ModelOptions
+    output_rate_hz: float
+    wall: Plane | None = None
+    approach: dict[str, Any] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
+    sched_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    sched_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
+    sched_stop: np.ndarray = field(default_factory=lambda: np.zeros(4))
+
+    def schedule(self) -> dict[str, np.ndarray]:
+        """The power-off schedule as keyword arguments of ``core.run.execute``."""
+        return {
+            "sched_t": self.sched_t,
+            "sched_rate": self.sched_rate,
+            "sched_stop": self.sched_stop,
+        }
+
+    def output_times(self) -> np.ndarray:
+        """Output grid: ``t0``, the multiples of 1/rate inside (t0, tf), and ``tf`` (s)."""
+        dt = 1.0 / self.output_rate_hz
+        k0 = math.floor(self.t0 / dt) + 1
+        k1 = math.ceil(self.tf / dt)
+        inner = np.arange(k0, k1) * dt
+        inner = inner[(inner > self.t0 + 1e-12) & (inner < self.tf - 1e-12)]
+        return np.concatenate([[self.t0], inner, [self.tf]])
+
+
+# ---------------------------------------------------------------- settings
+def _initial_speeds(
+    v: Vehicle, roll: float, pitch: float, rule: str, yaw_paper: bool
+) -> np.ndarray:
+    weight = v.mass_kg * v.gravity_m_s2
+    if rule == "level-hover":
+        return np.full(4, math.sqrt(weight / (4.0 * v.thrust_coefficient)))
+    return trim_rotor_speeds(v, weight / (math.cos(roll) * math.cos(pitch)), yaw_paper)
+
+
+def _packed_options(
+    s: WallApproach | FlightScenario, o: ModelOptions, duration_s: float, *, free: bool = False
+) -> np.ndarray:
+    if free:
+        crash_rule, level, stop = L.CRASH_NONE, 0.0, False
+    elif s.ground == "contact":
+        crash_rule, level, stop = L.CRASH_NONE, 0.0, False
+    elif o.crash_rule == "paper-ticks":
+        crash_rule, level, stop = L.CRASH_PAPER_TICKS, PAPER_CRASH_ALTITUDE_M, True
+    else:
+        crash_rule, level, stop = L.CRASH_CM_GROUND, 0.0, True
+    limits = None
+    if s.rotor_speed_limits_rpm is not None:
+        lo, hi = s.rotor_speed_limits_rpm
+        limits = (lo * RPM, hi * RPM)
+    opts = pack_options(
+        yaw_paper=o.yaw_reaction == "paper",
+        bumper1_yaw_twice=bool(o.bumper1_yaw_twice),
+        crash_rule=crash_rule,
+        crash_altitude_m=level,
+        stop_on_crash=stop,
+        first_order_rotors=s.rotor_mode == "first-order",
+        omega_limits_rad_s=limits,
+        slew_limit_rad_s2=s.rotor_slew_limit_rad_s2,
+        friction_coefficient=s.friction_coefficient,
+        rtol=s.rtol,
+        atol=s.atol,
+        duration_s=duration_s,
+    )
+    if s.power_off is not None:
+        trigger = s.power_off.trigger
+        opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
+    return opts
+
+
+def _schedule(s: WallApproach | FlightScenario) -> dict[str, np.ndarray]:
+    """The power-off schedule as the kernel's arrays (s; rad/s^2; stall flags)."""
+    if s.power_off is None:
+        return {}
+    stop = np.zeros(4)
+    for m in s.power_off.stopped_motors:
+        stop[m - 1] = 1.0
+    return {
+        "sched_t": np.asarray(s.power_off.segment_start_s, dtype=float),
+        "sched_rate": np.asarray(s.power_off.rates_rpm_per_s, dtype=float) * RPM,
+        "sched_stop": stop,
+    }
+
+
+def _ground(s: WallApproach | FlightScenario) -> list[Plane]:
+    if s.ground == "contact":
+        return [GROUND]
+    return []
+
+
+def _setup(
+    s: WallApproach | FlightScenario,
+    v: Vehicle,
+    o: ModelOptions,
+    refs: dict[str, float],
+    surfaces: list[Plane],
+    duration_s: float,
+    **fields: Any,
+) -> RunSetup:
+    """The packed run, common to both scenario kinds (``fields``: ``x0``, ``t0``, ``wall``)."""
+    yaw_paper = o.yaw_reaction == "paper"
+    return RunSetup(
+        tf=float(s.final_time_s),
+        veh=pack_vehicle(v),
+        surf=pack_surfaces(surfaces),
+        opts=_packed_options(s, o, duration_s),
+        ctrl=pack_controller(CONTROLLER_KINDS[s.controller], v, refs, yaw_paper),
+        surface_names=tuple(x.name for x in surfaces),
+        references=refs,
+        vehicle=v,
+        options=o,
+        output_rate_hz=float(s.output_rate_hz),
+        **fields,
+        **_schedule(s),
+    )
+
+
+# ------------------------------------------------------------- flight scenario
+def prepare_flight(s: FlightScenario) -> RunSetup:
+    """A general initial state set by the user (no shooting)."""
+    v = s.build_vehicle()
+    o = s.resolved_model_options()
+    roll, pitch, yaw = (math.radians(a) for a in s.euler_deg)
+    q = euler_zyx_to_quat(roll, pitch, yaw)
+    rotors = (
+        np.asarray(s.rotor_speeds_rad_s, dtype=float)
+        if s.rotor_speeds_rad_s is not None
+        else _initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper")
+    )
+    x0 = initial_state(
+        np.asarray(s.position_m, float),
+        np.asarray(s.velocity_m_s, float),
+        q,
+        np.asarray(s.angular_velocity_rad_s, float),
+        rotors,
+    )
+    ref_att = s.attitude_ref_deg if s.attitude_ref_deg is not None else s.euler_deg
+    refs = {
+        "altitude_m": float(s.altitude_ref_m if s.altitude_ref_m is not None else -s.position_m[2]),
+        "roll_rad": math.radians(ref_att[0]),
+        "pitch_rad": math.radians(ref_att[1]),
+        "yaw_rad": math.radians(ref_att[2]),
+    }
+    surfaces = [*s.surfaces, *_ground(s)]
+    duration = s.final_time_s - s.start_time_s
+    return _setup(s, v, o, refs, surfaces, duration, x0=x0, t0=float(s.start_time_s))
+
+
+# --------------------------------------------------------------- wall approach
+def prepare_wall_approach(s: WallApproach) -> RunSetup:
+    """The paper's scenario, with the approach solved so that first contact is at T_c."""
+    v = s.build_vehicle()
+    o = s.resolved_model_options()
+    if s.roll_deg is not None and s.pitch_deg is not None:
+        roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.heading_deg))
+    else:
+        roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
+    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
+    wall = Plane.wall(s.wall_distance_m)
+    surfaces = [wall, *_ground(s)]
+    duration = float(s.final_time_s)
+    setup = _setup(s, v, o, refs, surfaces, duration, x0=np.zeros(L.NX), t0=0.0, wall=wall)
+    h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
+    setup.x0, setup.t0, setup.approach = solve_approach(
+        veh=setup.veh,
+        ctrl=setup.ctrl,
+        schedule=setup.schedule(),
+        free_opts=_packed_options(s, o, float(s.impact_time_s), free=True),
+        wall=pack_surfaces([wall]),
+        q=euler_zyx_to_quat(roll, pitch, yaw),
+        rotors=_initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper"),
+        start=np.array([0.0, 0.0, -float(h0)]),
+        impact_time_s=s.impact_time_s,
+        speed_m_s=s.speed_m_s,
+        late_start=o.approach_start == "late-start",
+    )
+    if setup.approach["late_start"]:
+        setup.warnings.append(
+            f"the approach needs v0 < 0: the vehicle starts at rest at t0 = {setup.t0:.6f} s"
+        )
+    return setup
+
+def prepare(scenario: WallApproach | FlightScenario) -> RunSetup:
+    """Validated scenario -> packed run."""
+    if isinstance(scenario, WallApproach):
+        return prepare_wall_approach(scenario)
+    return prepare_flight(scenario)
