@@ -16,7 +16,7 @@ import numpy as np
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.contact import bumper_plane_contact
+from quadimpact.core.geometry import bumper_contact
 from quadimpact.frames import quat_to_matrix
 from quadimpact.packing import Surface, pack_surfaces, pack_vehicle
 
@@ -37,7 +37,7 @@ def impact_energy(result, episode, vehicle) -> float:
     C = np.ascontiguousarray(quat_to_matrix(x[6:10]))
     d = result.summary["wall_distance_m"]
     surf = pack_surfaces([Surface("wall", (d, 0.0, 0.0), (-1.0, 0.0, 0.0))])
-    _, rate, rx, ry, rz, *_ = bumper_plane_contact(
+    _, rate, rx, ry, rz, *_ = bumper_contact(
         x, C, pack_vehicle(vehicle), int(episode["bumper"]) - 1, surf, 0
     )
     n_body = C.T @ np.array([1.0, 0.0, 0.0])  # direction of the push on the wall

@@ -27,7 +27,7 @@ from scipy.optimize import brentq
 
 from .config import FlightScenario, ModelOptions, WallApproach, resolve_model_options
 from .core import layout as L
-from .core.contact import bumper_plane_contact
+from .core.geometry import bumper_contact
 from .core.run import execute
 from .frames import euler_zyx_to_quat, quat_to_matrix
 from .packing import (
@@ -290,7 +290,7 @@ def bumper_depths(x: np.ndarray, veh: np.ndarray, surf: np.ndarray, s: int = 0) 
     (the compiled contact geometry, called from Python)."""
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
-    return np.array([bumper_plane_contact(xq, C, veh, j, surf, s)[0] for j in range(4)])
+    return np.array([bumper_contact(xq, C, veh, j, surf, s)[0] for j in range(4)])
 
 
 def prepare_wall_approach(s: WallApproach) -> RunSetup:
