@@ -17,7 +17,7 @@ import pytest
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.contact import bumper_plane_contact
+from quadimpact.core.geometry import bumper_contact
 from quadimpact.inputs.world import Plane
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
@@ -39,7 +39,7 @@ def impact_energy(result, episode, vehicle) -> float:
     C = np.ascontiguousarray(quat_to_matrix(x[6:10]))
     d = result.summary["wall_distance_m"]
     surf = pack_surfaces([Plane.wall(d)])
-    _, rate, rx, ry, rz, *_ = bumper_plane_contact(
+    _, rate, rx, ry, rz, *_ = bumper_contact(
         x, C, pack_vehicle(vehicle), int(episode["bumper"]) - 1, surf, 0
     )
     n_body = C.T @ np.array([1.0, 0.0, 0.0])  # direction of the push on the wall

@@ -8,7 +8,7 @@ from scipy.integrate import solve_ivp
 
 from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import layout as L
-from quadimpact.core.contact import bumper_plane_contact
+from quadimpact.core.geometry import bumper_contact
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
@@ -34,7 +34,7 @@ def state(pos, euler_deg, v_body=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)):
 
 def contact(x, j, surf=WALL, vehicle=SPIRI):
     C = np.ascontiguousarray(quat_to_matrix(x[6:10]))
-    return bumper_plane_contact(x, C, pack_vehicle(vehicle), j, surf, 0)
+    return bumper_contact(x, C, pack_vehicle(vehicle), j, surf, 0)
 
 
 def brute_force_depth(x, j, p0, m, vehicle=SPIRI, n=200001):

@@ -20,7 +20,7 @@ import pytest
 import quadimpact.errors
 from quadimpact import WallApproach, load_vehicle, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.contact import bumper_plane_contact
+from quadimpact.core.geometry import bumper_contact
 from quadimpact.inputs.world import Plane
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
@@ -92,7 +92,7 @@ def test_drawn_deepest_point_is_the_computed_contact_point(fine_scene: Scene) ->
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
     computed = {}
     for j in range(4):
-        d, _dd, rx, ry, rz, *_ = bumper_plane_contact(x, C, veh, j, wall, 0)
+        d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, veh, j, wall, 0)
         p_c = x[0:3] + C @ np.array([rx, ry, rz])
         computed[j + 1] = (d, p_c)
         # the deepest point of the drawn rim (brute force over its points)

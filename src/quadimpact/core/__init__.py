@@ -1,12 +1,22 @@
 """Compiled core of quadimpact (Numba ``njit``).
 
-One module per pipeline stage: ``rigid_body`` (Newton-Euler and quaternion
-kinematics), ``rotors`` (thrust, reaction and gyroscopic moments),
-``contact`` (bumper geometry and the Hunt-Crossley law), ``dynamics`` (the
-right-hand side that sums them), ``control`` (the controllers and the
-allocation), ``integrator`` (Dormand-Prince 5(4) with dense output),
-``events`` (root location on the dense output) and ``run`` (the loop that
-ties them). Array slots are named in ``layout``.
+Arrays only: nothing here takes a Python object; every input and output is
+a ``float64`` array whose slots are named in ``layout`` (the contract with
+the Python side). One module per pipeline stage:
+
+* ``rigid_body``: Newton-Euler in body axes, quaternion kinematics;
+* ``rotors``: thrust, rotor reaction torques, gyroscopic moment;
+* ``actuators``: rotor command limits and slew, rotor modes, power-off schedules;
+* ``geometry``: a bumper against a surface of a given kind (depth, rate,
+  point, normal), dispatched on the surface's kind;
+* ``contact``: the force laws (Hunt-Crossley, friction) and the contact wrench;
+* ``dynamics``: the right-hand side that sums gravity, rotors and contact;
+* ``sensors/``: the measurement record, the IMU, impact detection;
+* ``controllers/``: one module per built-in controller, their dispatch;
+* ``integrator``: Dormand-Prince 5(4) with dense output;
+* ``events``: event functions and their location on the dense output;
+* ``step``: one control interval at a time, all loop state in arrays;
+* ``run``: a whole run as a loop over ``step.advance``; Python entries.
 
 Numba's on-disk cache checks only the file of each cached function, not the
 files of the functions it calls and inlines: an edited ``control.py`` would
@@ -26,19 +36,20 @@ _STAMP = "quadimpact-core-sources.sha256"
 
 
 def _cache_dirs() -> list[Path]:
-    dirs = [_HERE / "__pycache__"]
+    packages = [_HERE] + sorted(p.parent for p in _HERE.rglob("__init__.py") if p.parent != _HERE)
+    dirs = [p / "__pycache__" for p in packages]
     custom = os.environ.get("NUMBA_CACHE_DIR")
     if custom:
         # Numba mirrors the source folder's absolute path below NUMBA_CACHE_DIR
-        dirs.append(Path(custom) / _HERE.relative_to(_HERE.anchor))
+        dirs += [Path(custom) / p.relative_to(p.anchor) for p in packages]
     return dirs
 
 
 def ensure_fresh_cache() -> None:
     """Clear the core's Numba cache files if any core source changed since they were made."""
     digest = hashlib.sha256()
-    for src in sorted(_HERE.glob("*.py")):
-        digest.update(src.name.encode())
+    for src in sorted(_HERE.rglob("*.py")):
+        digest.update(str(src.relative_to(_HERE)).encode())
         digest.update(src.read_bytes())
     current = digest.hexdigest()
     for folder in _cache_dirs():

@@ -1,22 +1,20 @@
-"""Bumper contact: circle-plane geometry and the Hunt-Crossley force law.
+"""The contact law: Hunt-Crossley normal force, friction, and the contact wrench.
 
-This is the contact law of the paper (section III) as restated in MODEL.md
-section 4:
+This is the paper's contact law (its section III). The geometry of a bumper
+against a surface (depth, rate, point, normal) comes from ``geometry.py``;
+this module turns those records into forces:
 
-* bumper ``j`` is a circle of radius ``Rb`` centred on rotor ``j`` (body
-  frame), tilted so that its outer rim is raised by ``alpha``; its plane
-  normal is ``n_j``;
-* against a plane through ``p0`` with unit normal ``m`` (pointing out of the
-  obstacle into free space) the deepest rim point is found in closed form:
-  ``w = m - (m.n) n``, ``p_C = c - Rb w/|w|``; the penetration is
-  ``delta = -(p_C - p0).m`` and its rate ``delta_dot`` is the velocity of the
-  material rim point at ``p_C`` projected on ``-m``;
-* the normal force is Hunt-Crossley with Herbert-McWhannell damping,
-  ``F_n = max(0, k delta^n + lambda delta^n delta_dot)``,
+* normal force, Hunt-Crossley with Herbert-McWhannell damping,
+  ``F_n = max(0, k delta^n + lambda delta^n delta_dot)`` while ``delta > 0``,
   ``lambda = 6 (1 - e) k / (((2e - 1)^2 + 3) v_i)``, where ``v_i`` is
   ``delta_dot`` at the located onset of this contact (floored at ``v_min``);
 * optional regularised Coulomb friction ``-mu F_n v_t / sqrt(|v_t|^2 + v_reg^2)``
-  opposes the contact point's sliding velocity ``v_t``.
+  opposing the contact point's sliding velocity ``v_t``;
+* the wrench of all active bumper-surface pairs about the CM (body axes), with
+  the paper replica's error of counting bumper 1's yaw moment twice as a switch;
+* the contact *gap* that the event locator watches: ``delta`` itself, or, with
+  the recovery replica's broad-phase gate, ``min(delta, gate - d_CM)`` so that
+  the force switches on only once the CM is within ``gate`` of the surface.
 
 All functions are Numba ``njit`` and allocation free.
 """
@@ -26,98 +24,19 @@ import math
 import numpy as np
 from numba import njit
 
+from .geometry import bumper_contact, surface_distance
 from .layout import (
-    S_NORMAL,
-    S_P0,
-    V_BUMP_C,
-    V_BUMP_N,
+    CS_ACTIVE,
+    CS_LAMBDA,
+    O_CONTACT_GATE,
+    O_DOUBLE_BUMPER1_YAW,
+    O_MU,
+    O_V_REG,
     V_E,
     V_K,
     V_N,
-    V_RB,
-    X_OMEGA,
     X_POS,
-    X_VEL,
 )
-
-PARALLEL_EPS = 1e-12  # |w| below this: the circle is parallel to the plane
-
-
-@njit(cache=True)
-def bumper_plane_contact(
-    x: np.ndarray, C: np.ndarray, veh: np.ndarray, j: int, surf: np.ndarray, s: int
-) -> tuple[float, float, float, float, float, float, float, float]:
-    """Deepest point of bumper ``j`` against surface ``s``.
-
-    Parameters
-    ----------
-    x : state vector (layout ``X_*``): position (inertial, m), velocity (body,
-        m/s), quaternion, angular velocity (body, rad/s).
-    C : body-to-inertial rotation matrix of ``x``'s quaternion.
-    veh : packed vehicle (layout ``V_*``).
-    j : bumper index, 0..3.
-    surf : packed surfaces, shape (n_surfaces, NSURF); ``s`` selects one.
-
-    Returns
-    -------
-    delta : penetration (m), positive in contact.
-    delta_dot : penetration rate (m/s).
-    rcx, rcy, rcz : contact point from the CM, body frame (m).
-    vcx, vcy, vcz : contact point velocity, inertial frame (m/s).
-    """
-    mx = surf[s, S_NORMAL]
-    my = surf[s, S_NORMAL + 1]
-    mz = surf[s, S_NORMAL + 2]
-    cb0 = veh[V_BUMP_C + 3 * j]
-    cb1 = veh[V_BUMP_C + 3 * j + 1]
-    cb2 = veh[V_BUMP_C + 3 * j + 2]
-    nb0 = veh[V_BUMP_N + 3 * j]
-    nb1 = veh[V_BUMP_N + 3 * j + 1]
-    nb2 = veh[V_BUMP_N + 3 * j + 2]
-    # centre offset and normal in inertial components
-    ox = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    oy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    oz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
-    nx = C[0, 0] * nb0 + C[0, 1] * nb1 + C[0, 2] * nb2
-    ny = C[1, 0] * nb0 + C[1, 1] * nb1 + C[1, 2] * nb2
-    nz = C[2, 0] * nb0 + C[2, 1] * nb1 + C[2, 2] * nb2
-    mn = mx * nx + my * ny + mz * nz
-    wx = mx - mn * nx
-    wy = my - mn * ny
-    wz = mz - mn * nz
-    wn = math.sqrt(wx * wx + wy * wy + wz * wz)
-    rb = veh[V_RB]
-    # contact point relative to the CM, inertial components
-    if wn > PARALLEL_EPS:
-        dx = ox - rb * wx / wn
-        dy = oy - rb * wy / wn
-        dz = oz - rb * wz / wn
-    else:
-        dx = ox
-        dy = oy
-        dz = oz
-    px = x[X_POS] + dx
-    py = x[X_POS + 1] + dy
-    pz = x[X_POS + 2] + dz
-    delta = -(
-        (px - surf[s, S_P0]) * mx + (py - surf[s, S_P0 + 1]) * my + (pz - surf[s, S_P0 + 2]) * mz
-    )
-    # contact point in body components: r_C = C^T d
-    rcx = C[0, 0] * dx + C[1, 0] * dy + C[2, 0] * dz
-    rcy = C[0, 1] * dx + C[1, 1] * dy + C[2, 1] * dz
-    rcz = C[0, 2] * dx + C[1, 2] * dy + C[2, 2] * dz
-    # material velocity of that point: v + omega x r_C (body), then inertial
-    p = x[X_OMEGA]
-    q = x[X_OMEGA + 1]
-    r = x[X_OMEGA + 2]
-    ub = x[X_VEL] + q * rcz - r * rcy
-    vb = x[X_VEL + 1] + r * rcx - p * rcz
-    wb = x[X_VEL + 2] + p * rcy - q * rcx
-    vcx = C[0, 0] * ub + C[0, 1] * vb + C[0, 2] * wb
-    vcy = C[1, 0] * ub + C[1, 1] * vb + C[1, 2] * wb
-    vcz = C[2, 0] * ub + C[2, 1] * vb + C[2, 2] * wb
-    delta_dot = -(vcx * mx + vcy * my + vcz * mz)
-    return delta, delta_dot, rcx, rcy, rcz, vcx, vcy, vcz
 
 
 @njit(cache=True)
@@ -153,7 +72,7 @@ def friction_force(
     """Regularised Coulomb friction (N, inertial) opposing the sliding velocity.
 
     ``F_t = -mu F_n v_t / sqrt(|v_t|^2 + v_reg^2)`` with ``v_t`` the component of
-    the contact-point velocity along the plane.
+    the contact-point velocity ``v_c`` along the surface of normal ``m``.
     """
     vn = vcx * mx + vcy * my + vcz * mz
     tx = vcx - vn * mx
@@ -161,3 +80,75 @@ def friction_force(
     tz = vcz - vn * mz
     scale = -mu * fn / math.sqrt(tx * tx + ty * ty + tz * tz + v_reg * v_reg)
     return scale * tx, scale * ty, scale * tz
+
+
+@njit(cache=True, inline="always")
+def contact_gap(x: np.ndarray, delta: float, surf: np.ndarray, s: int, opts: np.ndarray) -> float:
+    """The function whose rise through 0 starts a contact episode (and whose fall ends it).
+
+    ``delta`` without a gate; with the gate ``g = opts[O_CONTACT_GATE] > 0`` (the
+    recovery replica), ``min(delta, g - d)`` with ``d`` the CM's distance from
+    the surface, so a bumper already ``delta`` deep gets its force at once when
+    the CM crosses into the gate.
+    """
+    gate = opts[O_CONTACT_GATE]
+    if gate <= 0.0:
+        return delta
+    d = surface_distance(x[X_POS], x[X_POS + 1], x[X_POS + 2], surf, s)
+    return min(delta, gate - d)
+
+
+@njit(cache=True)
+def contact_wrench(
+    x: np.ndarray,
+    C: np.ndarray,
+    veh: np.ndarray,
+    surf: np.ndarray,
+    opts: np.ndarray,
+    cs: np.ndarray,
+) -> tuple[float, float, float, float, float, float]:
+    """Sum of the contact forces and moments of all active bumper-surface pairs.
+
+    ``cs[4 s + j, CS_ACTIVE]`` says whether bumper ``j`` is in an episode with
+    surface ``s`` (set at the located onset); ``cs[., CS_LAMBDA]`` holds its
+    damping coefficient, fixed at that onset. Returns force and moment about
+    the CM, body frame (N, N m).
+    """
+    fx = 0.0
+    fy = 0.0
+    fz = 0.0
+    mx = 0.0
+    my = 0.0
+    mz = 0.0
+    mu = opts[O_MU]
+    double_b1 = opts[O_DOUBLE_BUMPER1_YAW] > 0.5
+    for c in range(cs.shape[0]):
+        if cs[c, CS_ACTIVE] < 0.5:
+            continue
+        j = c % 4
+        d, dd, rx, ry, rz, vcx, vcy, vcz, nx, ny, nz = bumper_contact(x, C, veh, j, surf, c // 4)
+        fn = normal_force(veh, d, dd, cs[c, CS_LAMBDA])
+        if fn <= 0.0:
+            continue
+        gx = fn * nx
+        gy = fn * ny
+        gz = fn * nz
+        if mu > 0.0:
+            tx, ty, tz = friction_force(fn, mu, opts[O_V_REG], vcx, vcy, vcz, nx, ny, nz)
+            gx += tx
+            gy += ty
+            gz += tz
+        # inertial -> body: C^T g
+        bx = C[0, 0] * gx + C[1, 0] * gy + C[2, 0] * gz
+        by = C[0, 1] * gx + C[1, 1] * gy + C[2, 1] * gz
+        bz = C[0, 2] * gx + C[1, 2] * gy + C[2, 2] * gz
+        fx += bx
+        fy += by
+        fz += bz
+        mx += ry * bz - rz * by
+        my += rz * bx - rx * bz
+        mzj = rx * by - ry * bx
+        mz += mzj
+        if double_b1 and j == 0:
+            mz += mzj  # paper replica: bumper 1's yaw moment counted twice
+    return fx, fy, fz, mx, my, mz

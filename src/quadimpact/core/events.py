@@ -1,9 +1,10 @@
 """Event functions and their location on the integrator's dense output.
 
-Events of a run (MODEL.md section 7):
+Events of a run (docs/NUMERICS.md):
 
-* ``EV_GAP``: penetration ``delta`` of one bumper-surface pair crosses 0
-  (contact onset upward, contact end downward);
+* ``EV_GAP``: the contact gap of one bumper-surface pair crosses 0 (contact
+  onset upward, contact end downward): the penetration ``delta``, or with the
+  recovery replica's gate ``min(delta, gate - d_CM)`` (``contact.contact_gap``);
 * ``EV_RATE``: ``delta_dot`` of an active contact crosses 0 downward (the
   peak deflection of the episode: located, not sampled);
 * ``EV_ALTITUDE``: the CM altitude ``h = -Z`` crosses the crash level.
@@ -15,7 +16,8 @@ variant of regula falsi, bracketing all along, to ``EVENT_TOL`` in time.
 import numpy as np
 from numba import njit
 
-from .contact import bumper_plane_contact
+from .contact import contact_gap
+from .geometry import bumper_depth
 from .integrator import dense_eval
 from .layout import X_POS, X_QUAT
 from .quaternion import rotation_matrix
@@ -35,15 +37,16 @@ def event_value(
     C: np.ndarray,
     veh: np.ndarray,
     surf: np.ndarray,
+    opts: np.ndarray,
     level: float,
 ) -> float:
     """Value of event function ``kind`` for contact ``c = 4 s + j`` at state ``xs``."""
     if kind == EV_ALTITUDE:
         return -xs[X_POS + 2] - level
     rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
-    d, dd, _, _, _, _, _, _ = bumper_plane_contact(xs, C, veh, c % 4, surf, c // 4)
+    d, dd = bumper_depth(xs, C, veh, c % 4, surf, c // 4)
     if kind == EV_GAP:
-        return d
+        return contact_gap(xs, d, surf, c // 4, opts)
     return dd
 
 
@@ -62,6 +65,7 @@ def locate(
     C: np.ndarray,
     veh: np.ndarray,
     surf: np.ndarray,
+    opts: np.ndarray,
     level: float,
 ) -> float:
     """Root of an event function on ``[0, sb]`` (fractions of the step ``h``).
@@ -84,7 +88,7 @@ def locate(
         if not (sa < s < sb):
             s = 0.5 * (sa + sb)
         dense_eval(x_old, Q, h, s, xs)
-        fs = event_value(kind, c, xs, C, veh, surf, level)
+        fs = event_value(kind, c, xs, C, veh, surf, opts, level)
         if (fs > 0.0) == side_b:
             sb = s
             fb = fs
@@ -116,11 +120,12 @@ def contact_event(
     C: np.ndarray,
     veh: np.ndarray,
     surf: np.ndarray,
+    opts: np.ndarray,
 ) -> float:
     """Fraction of the step at which contact ``c`` begins or ends (``NO_EVENT``: neither).
 
-    ``ga``/``gb`` are its penetration at the step's start and end, ``gda``/``gdb``
-    the rates there. An inactive contact begins where ``delta`` rises through 0;
+    ``ga``/``gb`` are its gap at the step's start and end, ``gda``/``gdb``
+    the penetration rates there. An inactive contact begins where ``delta`` rises through 0;
     if both ends are negative but within the distance the contact point can
     travel in the step, the dense output is also sampled inside the step so that
     a graze is not stepped over. An active contact ends where ``delta`` falls
@@ -128,18 +133,20 @@ def contact_event(
     """
     if not active:
         if gb > 0.0:
-            return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, 0.0)
+            return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, opts, 0.0)
         band = h * (abs(gda) + abs(gdb))
         if -ga < band or -gb < band:
             for m in range(1, NEAR_GRAZE_SAMPLES + 1):
                 sm = m / (NEAR_GRAZE_SAMPLES + 1.0)
                 dense_eval(x_old, Q, h, sm, xs)
-                gm = event_value(EV_GAP, c, xs, C, veh, surf, 0.0)
+                gm = event_value(EV_GAP, c, xs, C, veh, surf, opts, 0.0)
                 if gm > 0.0:
-                    return locate(EV_GAP, c, x_old, Q, h, ga, gm, sm, tol, xs, C, veh, surf, 0.0)
+                    return locate(
+                        EV_GAP, c, x_old, Q, h, ga, gm, sm, tol, xs, C, veh, surf, opts, 0.0
+                    )
         return NO_EVENT
     if gb > 0.0:
         return NO_EVENT
     if ga > 0.0:
-        return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, 0.0)
+        return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, opts, 0.0)
     return 0.0  # touched and left at once (a graze)

@@ -6,8 +6,11 @@ Physically consistent form (the default):
 * moments ``sum_j r_Tj x F_Tj - s_j (dt Omega_j^2 + Jr Omega_dot_j) e_z``;
 * gyroscopic moment ``-Jr (sum_j s_j Omega_j) (omega x e_z)``.
 
-The paper replica (``O_YAW_REACTION_PAPER``) uses the authors' yaw reaction
-instead: ``+s_j dt Omega_j^2`` and ``-Jr sum_j Omega_dot_j`` (MODEL.md 8.1).
+The authors' codes got the yaw reaction wrong in two separable ways, each a
+switch: the drag torque with the rotor's own sense, ``+s_j dt Omega_j^2``
+(``drag_paper``; both the paper's code and the later recovery code), and the
+spin-up term without the spin sign, ``-Jr sum_j Omega_dot_j``
+(``spinup_paper``; the paper's code only).
 """
 
 import numpy as np
@@ -18,7 +21,7 @@ from .layout import V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
 
 @njit(cache=True)
 def rotor_wrench(
-    x: np.ndarray, omega_dot: np.ndarray, veh: np.ndarray, yaw_paper: bool
+    x: np.ndarray, omega_dot: np.ndarray, veh: np.ndarray, drag_paper: bool, spinup_paper: bool
 ) -> tuple[float, float, float, float]:
     """Total rotor thrust and moments, body frame.
 
@@ -27,7 +30,8 @@ def rotor_wrench(
     x : state; rotor speeds ``Omega_j`` (rad/s) at ``X_ROTOR``.
     omega_dot : rotor accelerations ``Omega_dot_j`` (rad/s^2), shape (4,).
     veh : packed vehicle.
-    yaw_paper : use the paper replica's yaw reaction.
+    drag_paper : drag torque ``+s_j dt Omega_j^2`` (authors' sense) instead of ``-s_j ...``.
+    spinup_paper : spin-up reaction ``-Jr Omega_dot_j`` without the spin sign.
 
     Returns
     -------
@@ -50,8 +54,12 @@ def rotor_wrench(
         # r_Tj x (0, 0, -t)
         mx -= veh[V_ROTOR_POS + 3 * j + 1] * t
         my += veh[V_ROTOR_POS + 3 * j] * t
-        if yaw_paper:
+        if drag_paper and spinup_paper:
             mz += s * dt * w * w - jr * omega_dot[j]
+        elif drag_paper:
+            mz += s * (dt * w * w - jr * omega_dot[j])
+        elif spinup_paper:
+            mz -= s * dt * w * w + jr * omega_dot[j]
         else:
             mz -= s * (dt * w * w + jr * omega_dot[j])
         spin_sum += s * w

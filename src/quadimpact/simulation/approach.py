@@ -20,7 +20,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from quadimpact.core import layout as L
-from quadimpact.core.contact import bumper_plane_contact
+from quadimpact.core.geometry import bumper_contact
 from quadimpact.core.run import execute
 from quadimpact.rotations import inclination_deg, quat_to_matrix
 
@@ -128,7 +128,7 @@ def bumper_depths(x: np.ndarray, veh: np.ndarray, surf: np.ndarray, s: int = 0) 
     (the compiled contact geometry, called from Python)."""
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
-    return np.array([bumper_plane_contact(xq, C, veh, j, surf, s)[0] for j in range(4)])
+    return np.array([bumper_contact(xq, C, veh, j, surf, s)[0] for j in range(4)])
 
 
 def solve_approach(

@@ -10,6 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.controllers.common import P_GAINS, P_THRUST_COS_FLOOR
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
 
@@ -89,6 +90,7 @@ def pack_surfaces(surfaces: Sequence[Plane]) -> np.ndarray:
         surf[i, L.S_P0 : L.S_P0 + 3] = s.point_m
         surf[i, L.S_NORMAL : L.S_NORMAL + 3] = n / np.linalg.norm(n)
         surf[i, L.S_IS_GROUND] = 1.0 if s.is_ground else 0.0
+        surf[i, L.S_KIND] = L.SURF_PLANE
     return surf
 
 
@@ -129,8 +131,8 @@ def pack_controller(
     ctrl[L.C_PSI_REF] = refs["yaw_rad"]
     if gains is None:
         gains = DEFAULT_GAINS.get(kind, PAPER_GAINS)
-    ctrl[L.C_GAINS : L.C_GAINS + 15] = gains
-    ctrl[L.C_THRUST_COS_FLOOR] = CASCADE_THRUST_COS_FLOOR
+    ctrl[L.C_PARAMS + P_GAINS : L.C_PARAMS + P_GAINS + 15] = gains
+    ctrl[L.C_PARAMS + P_THRUST_COS_FLOOR] = CASCADE_THRUST_COS_FLOOR
     ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = np.linalg.inv(
         allocation_matrix(v, yaw_paper)
     ).ravel()
@@ -158,6 +160,7 @@ def pack_options(
     """Model switches and integrator settings as the ``O_*`` vector."""
     opts = np.zeros(L.NOPT)
     opts[L.O_YAW_REACTION_PAPER] = float(yaw_paper)
+    opts[L.O_SPINUP_PAPER] = float(yaw_paper)
     opts[L.O_DOUBLE_BUMPER1_YAW] = float(bumper1_yaw_twice)
     opts[L.O_CRASH_RULE] = crash_rule
     opts[L.O_CRASH_ALTITUDE] = crash_altitude_m

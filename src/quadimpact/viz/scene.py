@@ -10,7 +10,7 @@ Z down) from the vehicle's parameter file and the sampled states of a run:
 * the contact surfaces (the wall at ``X = wall_distance_m``; the ground when it
   was a contact surface) and the ground plane ``altitude = 0`` for reference;
 * during contact, per bumper and surface, the deepest rim point given by the
-  compiled contact function :func:`quadimpact.core.contact.bumper_plane_contact`
+  compiled contact function :func:`quadimpact.core.geometry.bumper_contact`
   (so the drawing shows the point the simulation pushed on), the deflection
   (the segment from that point to the surface, of length delta) and the normal
   force as an arrow along the surface normal;
@@ -224,7 +224,7 @@ def contact_points(
     depths : numpy.ndarray, shape (4, n_surfaces)
         Penetrations delta, m (positive in contact).
     """
-    from quadimpact.core.contact import bumper_plane_contact
+    from quadimpact.core.geometry import bumper_contact
 
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
@@ -233,7 +233,7 @@ def contact_points(
     depths = np.zeros((4, ns))
     for j in range(4):
         for s in range(ns):
-            d, _dd, rx, ry, rz, *_ = bumper_plane_contact(xq, C, drawing.packed, j, surf, s)
+            d, _dd, rx, ry, rz, *_ = bumper_contact(xq, C, drawing.packed, j, surf, s)
             points[j, s] = xq[L.X_POS : L.X_POS + 3] + C @ np.array([rx, ry, rz])
             depths[j, s] = d
     return points, depths

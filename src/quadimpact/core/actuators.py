@@ -1,0 +1,135 @@
+"""Actuators: rotor command limits and slew, rotor modes, and motor power-off schedules.
+
+Per control tick, :func:`apply_command` turns the controller's four speed
+commands into the rotor inputs of the interval (``rin``, layout ``RIN_*``):
+the generic slew limit, speed range and zero floor (options ``O_SLEW_MAX``,
+``O_OMEGA_MIN``, ``O_OMEGA_MAX``), then
+
+* ideal rotors (the paper): the rotor states jump to the command and are
+  held (zero-order hold); the reaction torque uses the finite difference
+  ``(cmd_k - cmd_{k-1}) / dt`` as ``Omega_dot``;
+* first-order rotors: ``Omega_dot = (cmd - Omega) / tau_m`` (:func:`rotor_rates`).
+
+Motor power-off (the experiments of the paper's section V): from a trigger
+time ``t_p`` (the first contact, or a given time) each motor's speed follows
+a prescribed piecewise-linear schedule, whatever the controller commands:
+over segment ``k``, ``[t_p + start_k, t_p + start_{k+1})``, motor ``j``
+changes at ``rate[k, j]`` (rad/s^2), and never goes below zero (a motor that
+reaches zero stays there until a later segment's rate is positive).
+Motors marked as stalling stop at the trigger (their speed jumps to zero; the
+spin-down torque of that jump is not modelled).
+
+The rotor speeds are states whose derivative is the current rate, so the
+integrator reproduces the schedule exactly (a linear function); the run loop
+cuts its steps at every segment start and at every instant a motor reaches
+zero, which ``next_boundary`` gives in closed form.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .layout import (
+    O_OMEGA_MAX,
+    O_OMEGA_MIN,
+    O_SLEW_MAX,
+    RIN_CMD,
+    RIN_FF,
+    RIN_FIRST_ORDER,
+    RIN_PREV_CMD,
+    RIN_RATE,
+    V_TAU_M,
+    X_ROTOR,
+)
+
+ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
+
+
+@njit(cache=True)
+def apply_segment(x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray) -> None:
+    """Rotor inputs for segment ``seg``: prescribed rates, floored at zero speed."""
+    rin[RIN_FIRST_ORDER] = 0.0
+    for j in range(4):
+        if x[X_ROTOR + j] <= ZERO_SPEED:
+            x[X_ROTOR + j] = 0.0
+        r = sched_rate[seg, j]
+        if x[X_ROTOR + j] <= 0.0 and r < 0.0:
+            r = 0.0
+        rin[RIN_RATE + j] = r
+        rin[RIN_FF + j] = r
+
+
+@njit(cache=True)
+def next_boundary(
+    t: float, x: np.ndarray, t_p: float, sched_t: np.ndarray, seg: int, rin: np.ndarray
+) -> float:
+    """Next instant (s) where the rotor inputs change: a segment start or a motor stopping."""
+    t_b = t_p + sched_t[seg + 1] if seg + 1 < sched_t.shape[0] else math.inf
+    for j in range(4):
+        r = rin[RIN_RATE + j]
+        if r < 0.0 and x[X_ROTOR + j] > 0.0:
+            t_b = min(t_b, t + x[X_ROTOR + j] / -r)
+    return t_b
+
+
+@njit(cache=True)
+def segment_at(t: float, t_p: float, sched_t: np.ndarray) -> int:
+    """Index of the segment in force at time ``t`` (0 before the second start)."""
+    seg = 0
+    while seg + 1 < sched_t.shape[0] and t_p + sched_t[seg + 1] <= t:
+        seg += 1
+    return seg
+
+
+@njit(cache=True)
+def apply_command(
+    cmd: np.ndarray,
+    x: np.ndarray,
+    rin: np.ndarray,
+    opts: np.ndarray,
+    dt: float,
+    scheduled: bool,
+) -> None:
+    """Limit the tick's speed commands (rad/s) and set the interval's rotor inputs.
+
+    ``scheduled``: a power-off schedule is in force, so only the recorded command
+    changes (the schedule keeps driving the rotor states).
+    """
+    w_lo = opts[O_OMEGA_MIN]
+    w_hi = opts[O_OMEGA_MAX]
+    slew = opts[O_SLEW_MAX]
+    first_order = rin[RIN_FIRST_ORDER] > 0.5
+    for j in range(4):
+        prev = rin[RIN_PREV_CMD + j]
+        w = cmd[j]
+        if slew > 0.0:
+            w = min(max(w, prev - slew * dt), prev + slew * dt)
+        if w_lo > 0.0 and w < w_lo:
+            w = w_lo
+        if w_hi > 0.0 and w > w_hi:
+            w = w_hi
+        if w < 0.0:
+            w = 0.0
+        rin[RIN_CMD + j] = w
+        if scheduled:  # the schedule overrides the controller
+            pass
+        elif first_order:
+            rin[RIN_RATE + j] = 0.0
+            rin[RIN_FF + j] = 0.0
+        else:
+            rin[RIN_RATE + j] = 0.0
+            rin[RIN_FF + j] = (w - prev) / dt
+            x[X_ROTOR + j] = w
+        rin[RIN_PREV_CMD + j] = w
+
+
+@njit(cache=True)
+def rotor_rates(x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray) -> None:
+    """Rotor accelerations (rad/s^2) of the current rotor mode, into ``omega_dot``."""
+    if rin[RIN_FIRST_ORDER] > 0.5:
+        for j in range(4):
+            omega_dot[j] = (rin[RIN_CMD + j] - x[X_ROTOR + j]) / veh[V_TAU_M]
+    else:
+        for j in range(4):
+            omega_dot[j] = rin[RIN_RATE + j]

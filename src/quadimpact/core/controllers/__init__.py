@@ -1,0 +1,71 @@
+"""Built-in controllers, compiled, and the dispatch the cached run loop calls.
+
+Interface of a controller step (built-in or plugged in, all Numba ``njit``)::
+
+    step(t, meas, ctrl, mem, veh, dt, cmd) -> None
+
+* ``t``: time of the control tick, s;
+* ``meas``: the measurement record (layout ``MS_*``): the state estimate
+  ``meas[MS_X:MS_X+NX]`` (today the true state), the latest IMU sample and the
+  impact detector's verdict and wall-normal estimate;
+* ``ctrl``: packed settings (layout ``C_*``): kind, references, the inverse
+  allocation, the vehicle's rotor range, and the controller's own parameter
+  block at ``C_PARAMS``;
+* ``mem``: ``NMEM`` float64 slots the controller owns across ticks (zeroed at
+  the start of a run); ``mem[MEM_STAGE]`` is reported as its stage;
+* ``veh``: the packed vehicle; ``dt``: the control period, s;
+* ``cmd``: the four rotor-speed commands it writes, rad/s.
+
+The run loop then applies the generic speed and slew limits
+(``actuators.apply_command``) and holds the command for the period.
+
+One module per controller: ``paper.py``, ``cascade_pid.py``, ``recovery.py``.
+A new built-in is its module, a branch below, and an entry in the Python-side
+registry (``quadimpact.simulation.controllers``); a controller that is not
+built in is plugged in with ``core.run.make_kernel`` instead.
+"""
+
+import numpy as np
+from numba import njit
+
+from ..layout import C_KIND, CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, MS_X, X_ROTOR
+from .cascade_pid import cascade_pid_step
+from .paper import paper_step
+from .recovery import recovery_step
+
+
+@njit(cache=True)
+def hold_step(
+    t: float,
+    meas: np.ndarray,
+    ctrl: np.ndarray,
+    mem: np.ndarray,
+    veh: np.ndarray,
+    dt: float,
+    cmd: np.ndarray,
+) -> None:
+    """No controller: the rotors keep their current speeds."""
+    for j in range(4):
+        cmd[j] = meas[MS_X + X_ROTOR + j]
+
+
+@njit(cache=True)
+def builtin_step(
+    t: float,
+    meas: np.ndarray,
+    ctrl: np.ndarray,
+    mem: np.ndarray,
+    veh: np.ndarray,
+    dt: float,
+    cmd: np.ndarray,
+) -> None:
+    """Dispatch to the built-in controller named by ``ctrl[C_KIND]`` (``CTRL_*``)."""
+    kind = int(ctrl[C_KIND])
+    if kind == CTRL_PAPER:
+        paper_step(t, meas, ctrl, mem, veh, dt, cmd)
+    elif kind == CTRL_CASCADE_PID:
+        cascade_pid_step(t, meas, ctrl, mem, veh, dt, cmd)
+    elif kind == CTRL_RECOVERY:
+        recovery_step(t, meas, ctrl, mem, veh, dt, cmd)
+    else:
+        hold_step(t, meas, ctrl, mem, veh, dt, cmd)

@@ -1,0 +1,243 @@
+"""The ``recovery`` controller: a pre-impact behaviour, then a staged recovery law.
+
+Before an impact is detected (stage 0) it runs a pre-impact behaviour:
+
+* ``PRE_NOMINAL``: the nominal controller (``paper`` or ``cascade-pid``, with
+  the scenario's references, as in the wall approach);
+* ``PRE_HOLD``: the rotor speeds stay where they are (the initial trimmed speeds);
+* ``PRE_SPIN_DOWN``: the rotor commands are zero, so the speeds fall at the
+  loop's slew limit to zero (the authors' Monte Carlo). The rotor range
+  applies only to the staged law's commands.
+
+From the tick at which the detector has fired (``meas[MS_DETECTED]``) it runs
+the staged law until the end of the run. With ``u = -C e_z`` the body's up
+axis (inertial components), ``V_Z`` the inertial vertical velocity (down
+positive) and ``n`` the wall-normal estimate (``meas[MS_NORMAL]``)::
+
+    f_des = -g e_Z + a_ref - k_z V_Z e_Z          desired thrust per unit mass (inertial)
+    T     = m (f_des . u)  if positive, else 0    collective thrust
+    theta = angle(u, f_des),  e = (u x f_des) / |u x f_des|
+    q_e   = (cos theta/2, sin theta/2 C^T e)      tilt error quaternion, body axes
+    p_des = K_att q_e,x,  q_des = K_att q_e,y,  r_des = 0
+    nu    = K_rate * (omega_des - omega)          angular acceleration command
+    tau   = I nu - (omega x I omega)_diag terms   feedback linearisation (common.py)
+
+then the allocation (negative squares to zero) and the vehicle's rotor range.
+
+Stages (checked at each tick, at most one stage per tick; the test uses the
+error quaternion of the previous tick's law and the current rates, then the
+law is computed for the stage now in force):
+
+====  ==================  ==========  ====  =====================================
+stage meaning             a_ref       k_z   leaves when
+====  ==================  ==========  ====  =====================================
+1     impact detected     a_mag n     0     |q_e,x|, |q_e,y| < q_tol and |p|, |q| < rate_tol
+2     tilted away         0           0     the same test (now toward level)
+3     level               0           10    body z velocity w < w_tol
+4     recovered           0           10    stays
+====  ==================  ==========  ====  =====================================
+
+At the detection tick the stage becomes 1 and the law runs at once (no test).
+Rates come from the gyro (``meas[MS_IMU_W]``), attitude and velocity from the
+state estimate. Every gain, threshold, ``a_mag`` and ``k_z`` is a parameter
+(layout ``R_*`` below, at ``ctrl[C_PARAMS + ...]``); the recovery replica's
+"level target at the detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    C_OMEGA_MAX,
+    C_OMEGA_MIN,
+    C_PARAMS,
+    CTRL_CASCADE_PID,
+    MEM_STAGE,
+    MS_DETECTED,
+    MS_IMU_W,
+    MS_NORMAL,
+    MS_X,
+    NX,
+    V_GRAVITY,
+    V_MASS,
+    X_QUAT,
+    X_ROTOR,
+    X_VEL,
+)
+from ..quaternion import rotation_matrix
+from .cascade_pid import cascade_pid_step
+from .common import N_PID_MEM, N_PID_PARAMS, allocate, linearised_torques
+from .paper import paper_step
+
+# ---- parameters, at ctrl[C_PARAMS + ...] (the PID block of common.py comes first)
+R_NOMINAL_KIND = N_PID_PARAMS  # CTRL_PAPER or CTRL_CASCADE_PID (pre-impact nominal)
+R_PRE_IMPACT = N_PID_PARAMS + 1  # PRE_* below
+R_K_ATT = N_PID_PARAMS + 2  # 1/s, tilt error -> rate reference
+R_K_RATE = N_PID_PARAMS + 3  # 3: 1/s, rate error -> angular acceleration (p, q, r)
+R_A_MAG = N_PID_PARAMS + 6  # m/s^2, stage 1 push away from the wall
+R_K_Z = N_PID_PARAMS + 7  # 4: 1/s, vertical-velocity gain of stages 1-4
+R_Q_TOL = N_PID_PARAMS + 11  # tilt-error tolerance of the stage 1 and 2 tests
+R_RATE_TOL = N_PID_PARAMS + 12  # rad/s, |p|, |q| tolerance of the stage 1 and 2 tests
+R_W_TOL = N_PID_PARAMS + 13  # m/s, body z velocity below which stage 3 ends
+R_FIRST_TICK_LEVEL = N_PID_PARAMS + 14  # 1: a_ref = 0 at the detection tick (replica)
+N_RECOVERY_PARAMS = N_PID_PARAMS + 15
+
+PRE_NOMINAL = 0
+PRE_HOLD = 1
+PRE_SPIN_DOWN = 2
+
+# ---- memory (after the PID slots of the nominal controller)
+RM_QE_X = N_PID_MEM  # previous tick's tilt error quaternion, x and y
+RM_QE_Y = N_PID_MEM + 1
+
+STAGE_PRE_IMPACT = 0
+STAGE_DETECTED = 1
+STAGE_TILTED = 2
+STAGE_LEVEL = 3
+STAGE_RECOVERED = 4
+
+
+@njit(cache=True)
+def next_stage(
+    stage: int, qe_x: float, qe_y: float, p: float, q: float, w: float,
+    q_tol: float, rate_tol: float, w_tol: float,
+) -> int:  # fmt: skip
+    """The stage machine: the stage after this tick's test (at most one step up).
+
+    ``qe_x``, ``qe_y``: the previous tick's tilt error quaternion (body x, y);
+    ``p``, ``q``: body rates now (rad/s); ``w``: body z velocity now (m/s, down
+    positive).
+    """
+    if stage == STAGE_DETECTED or stage == STAGE_TILTED:
+        if abs(qe_x) < q_tol and abs(qe_y) < q_tol and abs(p) < rate_tol and abs(q) < rate_tol:
+            return stage + 1
+        return stage
+    if stage == STAGE_LEVEL:
+        if w < w_tol:
+            return STAGE_RECOVERED
+        return stage
+    return stage
+
+
+@njit(cache=True)
+def staged_law(
+    stage: int,
+    a_ref_on: bool,
+    x: np.ndarray,
+    omega: np.ndarray,
+    normal: np.ndarray,
+    ctrl: np.ndarray,
+    veh: np.ndarray,
+    cmd: np.ndarray,
+) -> tuple[float, float]:
+    """Rotor commands (rad/s) of the staged law in ``stage`` (1-4); returns ``(q_e,x, q_e,y)``.
+
+    ``x``: state estimate; ``omega``: measured body rates (rad/s); ``normal``:
+    wall-normal estimate (inertial, unit, away from the wall); ``a_ref_on``:
+    whether stage 1's push away from the wall applies.
+    """
+    p0 = C_PARAMS
+    C = np.empty((3, 3))
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
+    g = veh[V_GRAVITY]
+    # up axis u = -C e_z and the inertial vertical velocity V_Z = (C v)_Z
+    ux = -C[0, 2]
+    uy = -C[1, 2]
+    uz = -C[2, 2]
+    vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
+    k_z = ctrl[p0 + R_K_Z + stage - 1]
+    ax = 0.0
+    ay = 0.0
+    az = 0.0
+    if stage == STAGE_DETECTED and a_ref_on:
+        a_mag = ctrl[p0 + R_A_MAG]
+        ax = a_mag * normal[0]
+        ay = a_mag * normal[1]
+        az = a_mag * normal[2]
+    fx = ax
+    fy = ay
+    fz = -g + az - k_z * vz
+    thrust = veh[V_MASS] * (fx * ux + fy * uy + fz * uz)
+    if thrust < 0.0:
+        thrust = 0.0
+    # tilt error: rotation taking u onto f_des, as a quaternion in body axes
+    fn = math.sqrt(fx * fx + fy * fy + fz * fz)
+    cx = uy * fz - uz * fy
+    cy = uz * fx - ux * fz
+    cz = ux * fy - uy * fx
+    cn = math.sqrt(cx * cx + cy * cy + cz * cz)
+    qex = 0.0
+    qey = 0.0
+    if fn > 0.0 and cn > 0.0:
+        cos_t = (ux * fx + uy * fy + uz * fz) / fn
+        theta = math.atan2(cn / fn, cos_t)
+        s = math.sin(0.5 * theta) / cn
+        # C^T e (body components of the axis)
+        qex = s * (C[0, 0] * cx + C[1, 0] * cy + C[2, 0] * cz)
+        qey = s * (C[0, 1] * cx + C[1, 1] * cy + C[2, 1] * cz)
+    k_att = ctrl[p0 + R_K_ATT]
+    p_des = k_att * qex
+    q_des = k_att * qey
+    nu_p = ctrl[p0 + R_K_RATE] * (p_des - omega[0])
+    nu_q = ctrl[p0 + R_K_RATE + 1] * (q_des - omega[1])
+    nu_r = ctrl[p0 + R_K_RATE + 2] * (0.0 - omega[2])
+    tx, ty, tz = linearised_torques(omega, veh, nu_p, nu_q, nu_r)
+    allocate(ctrl, thrust, tx, ty, tz, cmd)
+    lo = ctrl[C_OMEGA_MIN]
+    hi = ctrl[C_OMEGA_MAX]
+    for j in range(4):
+        if cmd[j] < lo:
+            cmd[j] = lo
+        elif cmd[j] > hi:
+            cmd[j] = hi
+    return qex, qey
+
+
+@njit(cache=True)
+def recovery_step(
+    t: float,
+    meas: np.ndarray,
+    ctrl: np.ndarray,
+    mem: np.ndarray,
+    veh: np.ndarray,
+    dt: float,
+    cmd: np.ndarray,
+) -> None:
+    """One tick of the recovery controller; writes four rotor speeds (rad/s) into ``cmd``."""
+    p0 = C_PARAMS
+    x = meas[MS_X : MS_X + NX]
+    stage = int(mem[MEM_STAGE])
+    if stage == STAGE_PRE_IMPACT:
+        if meas[MS_DETECTED] < 0.5:
+            pre = int(ctrl[p0 + R_PRE_IMPACT])
+            if pre == PRE_NOMINAL:
+                if int(ctrl[p0 + R_NOMINAL_KIND]) == CTRL_CASCADE_PID:
+                    cascade_pid_step(t, meas, ctrl, mem, veh, dt, cmd)
+                else:
+                    paper_step(t, meas, ctrl, mem, veh, dt, cmd)
+            elif pre == PRE_HOLD:
+                for j in range(4):
+                    cmd[j] = x[X_ROTOR + j]
+            else:
+                for j in range(4):
+                    cmd[j] = 0.0
+            return
+        stage = STAGE_DETECTED
+        first_tick = True
+    else:
+        first_tick = False
+        w_body = x[X_VEL + 2]
+        stage = next_stage(
+            stage, mem[RM_QE_X], mem[RM_QE_Y], meas[MS_IMU_W], meas[MS_IMU_W + 1], w_body,
+            ctrl[p0 + R_Q_TOL], ctrl[p0 + R_RATE_TOL], ctrl[p0 + R_W_TOL],
+        )  # fmt: skip
+    a_ref_on = not (first_tick and ctrl[p0 + R_FIRST_TICK_LEVEL] > 0.5)
+    qex, qey = staged_law(
+        stage, a_ref_on, x, meas[MS_IMU_W : MS_IMU_W + 3], meas[MS_NORMAL : MS_NORMAL + 3],
+        ctrl, veh, cmd,
+    )  # fmt: skip
+    mem[RM_QE_X] = qex
+    mem[RM_QE_Y] = qey
+    mem[MEM_STAGE] = stage

@@ -1,0 +1,104 @@
+"""Impact detection from the IMU samples alone, and the wall-normal estimate.
+
+Never reads the simulator's contact state: it sees what the measurement
+record holds after each IMU sample (``imu.imu_sample``).
+
+Rule (the authors'): an impact is detected at the first sample whose
+horizontal specific force reaches a threshold (default 0.5 g), measured in
+body axes ``|(f_x, f_y)|`` or, as an option, in world axes ``|(C f)_XY|``;
+optionally only after N consecutive samples at or above it. In free flight
+without drag the body-horizontal specific force at the CM is exactly zero, so
+the rule responds to contact (and to lever-arm terms when the IMU is off the
+CM, and to noise).
+
+Wall-normal estimate at detection: the horizontal part of the measured
+inertial acceleration ``C f + g e_Z`` (attitude from the state estimate),
+normalised. It points roughly away from the obstacle; the thrust's horizontal
+part is in it too.
+
+Recorded: the first detection's time, the state there and the normal
+(``ST_T_DETECT``, ``ST_DETECT_X``, ``ST_DETECT_NORMAL``), and the number of
+times the condition rose (``ST_N_DETECTIONS``: rising edges of "N consecutive
+samples at or above the threshold"), from which a false-detection rate on
+contact-free flight is measured.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    I_HORIZONTAL,
+    MS_DETECTED,
+    MS_IMU_F,
+    MS_NORMAL,
+    MS_T_DETECT,
+    NX,
+    SC_DET_PERSIST,
+    SC_DET_THRESHOLD,
+    SC_DET_WORLD,
+    SS_COUNT,
+    SS_N,
+    ST_DETECT_NORMAL,
+    ST_DETECT_X,
+    ST_N_DETECTIONS,
+    ST_T_DETECT,
+)
+
+
+@njit(cache=True)
+def detect(
+    t: float,
+    x: np.ndarray,
+    C: np.ndarray,
+    veh: np.ndarray,
+    scfg: np.ndarray,
+    sst: np.ndarray,
+    meas: np.ndarray,
+    imu_out: np.ndarray,
+    stats: np.ndarray,
+) -> None:
+    """Apply the detection rule to the sample just taken at time ``t`` (state ``x``)."""
+    fx = meas[MS_IMU_F]
+    fy = meas[MS_IMU_F + 1]
+    fz = meas[MS_IMU_F + 2]
+    # inertial components of the measured specific force
+    ix = C[0, 0] * fx + C[0, 1] * fy + C[0, 2] * fz
+    iy = C[1, 0] * fx + C[1, 1] * fy + C[1, 2] * fz
+    if scfg[SC_DET_WORLD] > 0.5:
+        hm = math.sqrt(ix * ix + iy * iy)
+    else:
+        hm = math.sqrt(fx * fx + fy * fy)
+    i = int(sst[SS_N]) - 1
+    if 0 <= i < imu_out.shape[0]:
+        imu_out[i, I_HORIZONTAL] = hm
+    threshold = scfg[SC_DET_THRESHOLD]
+    if threshold <= 0.0:
+        return
+    if hm >= threshold:
+        sst[SS_COUNT] += 1.0
+    else:
+        sst[SS_COUNT] = 0.0
+    if sst[SS_COUNT] != max(1.0, scfg[SC_DET_PERSIST]):
+        return
+    stats[ST_N_DETECTIONS] += 1.0
+    if meas[MS_DETECTED] > 0.5:
+        return
+    # the first detection: time, state and the wall-normal estimate
+    meas[MS_DETECTED] = 1.0
+    meas[MS_T_DETECT] = t
+    stats[ST_T_DETECT] = t
+    for k in range(NX):
+        stats[ST_DETECT_X + k] = x[k]
+    # horizontal part of the inertial acceleration C f + g e_Z: gravity is vertical, so
+    # it is the horizontal part of C f
+    n = math.sqrt(ix * ix + iy * iy)
+    nx = ix / n if n > 0.0 else 0.0
+    ny = iy / n if n > 0.0 else 0.0
+    meas[MS_NORMAL] = nx
+    meas[MS_NORMAL + 1] = ny
+    meas[MS_NORMAL + 2] = 0.0
+    stats[ST_DETECT_NORMAL] = nx
+    stats[ST_DETECT_NORMAL + 1] = ny
+    stats[ST_DETECT_NORMAL + 2] = 0.0
