@@ -27,7 +27,7 @@ from pydantic import BaseModel, Field, ValidationError, field_validator
 
 from quadimpact.errors import InputError, input_error_from_validation
 from quadimpact.inputs.files import read_toml_file
-from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec4
+from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec3, Vec4
 
 __all__ = ["Vehicle", "load_vehicle", "bundled_vehicles"]
 
@@ -39,8 +39,9 @@ class Vehicle(BaseModel):
 
     All vectors are in the body frame (FRD: x forward, y right, z down, origin
     at the centre of mass). Rotor ``j`` (1-4) is row ``j-1`` of
-    ``rotor_positions_m`` and bumper ``j`` is centred on rotor ``j``. The model
-    is frozen; derive variants with :meth:`with_overrides`.
+    ``rotor_positions_m``; bumper ``j`` is centred on rotor ``j`` unless
+    ``bumper_centres_m`` says otherwise. The model is frozen; derive variants
+    with :meth:`with_overrides`.
 
     Attributes
     ----------
@@ -76,9 +77,19 @@ class Vehicle(BaseModel):
     restitution : float
         e, coefficient of restitution in (0, 1].
     rotor_speed_range_rpm : tuple of 2 floats
-        Hardware rotor speed range [min, max], rpm (documentation and optional limits).
+        Hardware rotor speed range [min, max], rpm: the limits of the
+        ``cascade-pid`` and ``recovery`` controllers' commands (and optional
+        loop limits).
     motor_time_constant_s : float
         tau_m, motor time constant, s (first-order rotor mode only).
+    bumper_centres_m : tuple of 4 tuples of 3 floats or None
+        Bumper circle centres from the CM, body FRD, m, row j-1 for bumper j;
+        ``None`` (the Spiri): on the rotor hubs.
+    imu_position_m : tuple of 3 floats
+        IMU position from the CM, body FRD, m (default the CM).
+    rotor_slew_limit_rpm_per_s : float or None
+        Largest rate of change of a rotor speed command, rpm/s; ``None``: not
+        known (no limit). In force in impact trials.
     """
 
     model_config = MODEL_CONFIG
@@ -118,6 +129,16 @@ class Vehicle(BaseModel):
     )
     motor_time_constant_s: Real = Field(
         0.02, gt=0, description="tau_m: motor time constant, s (first-order rotor mode)."
+    )
+    bumper_centres_m: Mat4x3 | None = Field(
+        None,
+        description="Bumper circle centres from the CM, body FRD, m; None: on the rotor hubs.",
+    )
+    imu_position_m: Vec3 = Field(
+        (0.0, 0.0, 0.0), description="IMU position from the CM, body FRD, m."
+    )
+    rotor_slew_limit_rpm_per_s: Real | None = Field(
+        None, gt=0, description="Rotor speed command slew limit, rpm/s; None: not known."
     )
 
     # ------------------------------------------------------------------ checks
@@ -188,7 +209,7 @@ class Vehicle(BaseModel):
         Returns
         -------
         centres : numpy.ndarray, shape (4, 3)
-            Circle centres, body FRD, m (the rotor positions).
+            Circle centres, body FRD, m (``bumper_centres_m``, else the rotor positions).
         u : numpy.ndarray, shape (4, 3)
             In-plane outward unit vectors, body FRD.
         n : numpy.ndarray, shape (4, 3)
@@ -200,7 +221,12 @@ class Vehicle(BaseModel):
         e_z = np.array([0.0, 0.0, 1.0])
         u = math.cos(a) * d - math.sin(a) * e_z
         n = -math.sin(a) * d - math.cos(a) * e_z
-        return self.rotor_positions, u, n
+        centres = (
+            np.array(self.bumper_centres_m, dtype=float)
+            if self.bumper_centres_m is not None
+            else self.rotor_positions
+        )
+        return centres, u, n
 
     # ---------------------------------------------------------------- variants
     def with_overrides(self, **fields: Any) -> Vehicle:
