@@ -196,6 +196,6 @@ def input_error_from_validation(
         rule += _suggest(model, error.get("loc", ()))
     parts = [p for p in (where, field) if p]
     text = ": ".join(parts + [rule])
-    if show_value and "input" in error:
+    if show_value and "input" in error and error.get("loc"):  # not the whole table
         text += f" (got {format_value(error['input'])})"
     return InputError(text)

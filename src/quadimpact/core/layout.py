@@ -273,7 +273,10 @@ ST_N_DETECTIONS = ST_DETECT_NORMAL + 3  # rising edges of the detection conditio
 ST_N_IMU = ST_N_DETECTIONS + 1  # IMU samples taken (also beyond the buffer)
 ST_STAGE_T = ST_N_IMU + 1  # N_STAGES: tick at which each stage was first entered (NaN)
 ST_STAGE_X = ST_STAGE_T + N_STAGES  # 3 N_STAGES: CM position there, inertial
-NSTAT = ST_STAGE_X + 3 * N_STAGES
+ST_MIN_ALT = ST_STAGE_X + 3 * N_STAGES  # m, lowest CM altitude (step ends and events)
+ST_MIN_TILT_COS = ST_MIN_ALT + 1  # after detection: lowest cos(tilt from vertical) (1: none)
+ST_MAX_RATE = ST_MIN_TILT_COS + 1  # after detection: largest |omega|, rad/s (0: none)
+NSTAT = ST_MAX_RATE + 1
 
 STATUS_COMPLETED = 0
 STATUS_CRASHED = 1

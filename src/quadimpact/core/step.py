@@ -77,6 +77,7 @@ from .layout import (
     LS_T_SCHED,
     LS_TF,
     MEM_STAGE,
+    MS_DETECTED,
     MS_IMU_T,
     MS_T_DETECT,
     N_STAGES,
@@ -114,6 +115,9 @@ from .layout import (
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
     ST_MAX_DELTA,
+    ST_MAX_RATE,
+    ST_MIN_ALT,
+    ST_MIN_TILT_COS,
     ST_MISSED_ONSETS,
     ST_N_EPISODES,
     ST_N_OUT,
@@ -133,6 +137,7 @@ from .layout import (
     STATUS_COMPLETED,
     STATUS_CRASHED,
     STATUS_FAILED,
+    X_OMEGA,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -300,6 +305,8 @@ def start(
     for s in range(N_STAGES):
         stats[ST_STAGE_T + s] = np.nan
     stats[ST_T_END] = t0
+    stats[ST_MIN_ALT] = -x[X_POS + 2]
+    stats[ST_MIN_TILT_COS] = 1.0
     dt_c = opts[O_DT_CONTROL]
     h_max = opts[O_H_MAX] if opts[O_H_MAX] > 0.0 else dt_c
     for i in range(ls.shape[0]):
@@ -371,6 +378,24 @@ def _open_episode(
     else:
         cs[c, CS_EPISODE] = -1.0
         stats[ST_EPISODES_DROPPED] += 1.0
+
+
+@njit(cache=True)
+def _track_extremes(x: np.ndarray, detected: bool, stats: np.ndarray) -> None:
+    """Lowest altitude; after detection the largest tilt and rate (exact at step ends)."""
+    alt = -x[X_POS + 2]
+    if alt < stats[ST_MIN_ALT]:
+        stats[ST_MIN_ALT] = alt
+    if detected:
+        q1 = x[X_QUAT + 1]
+        q2 = x[X_QUAT + 2]
+        n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
+        c22 = 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2  # cos of the body z axis from vertical
+        if c22 < stats[ST_MIN_TILT_COS]:
+            stats[ST_MIN_TILT_COS] = c22
+        w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
+        if w > stats[ST_MAX_RATE]:
+            stats[ST_MAX_RATE] = w
 
 
 @njit(cache=True)
@@ -625,6 +650,7 @@ def tick(
             stats[ST_REASON] = REASON_NOT_FINITE
             failed = True
             break
+        _track_extremes(x, meas[MS_DETECTED] > 0.5, stats)
         h = h_new
         _contact_values(x, C, veh, surf, opts, g_a, gd_a)
         for c in range(nc):

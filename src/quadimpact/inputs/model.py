@@ -1,5 +1,5 @@
 """Model options: the switches between the physically consistent model and the
-authors' simulator (MODEL.md section 8), and the two named model variants."""
+authors' simulators, and the three named model variants (docs/VARIANTS.md)."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, ValidationError
 
 from quadimpact.errors import InputError, input_error_from_validation
-from quadimpact.inputs.types import MODEL_CONFIG
+from quadimpact.inputs.types import MODEL_CONFIG, Real
 
 __all__ = ["MODEL_VARIANTS", "ModelName", "ModelOptions", "resolve_model_options"]
 
-ModelName = Literal["default", "paper-replica"]
+ModelName = Literal["default", "paper-replica", "recovery-replica"]
 
 
 class ModelOptions(BaseModel):
@@ -21,20 +21,23 @@ class ModelOptions(BaseModel):
 
     Each field left ``None`` takes the value of the chosen model variant
     (:data:`MODEL_VARIANTS`); set it to change that single behaviour. The
-    ``default`` variant is the physically consistent model of MODEL.md
-    sections 2-7; the ``paper-replica`` variant reproduces the code behind the
-    paper's figures, errors included (MODEL.md section 8), so that published
-    numbers can be checked and each correction's effect seen on its own.
+    ``default`` variant is the physically consistent model (docs/MODEL.md);
+    ``paper-replica`` reproduces the code behind the paper's figures and
+    ``recovery-replica`` the authors' later recovery simulator, errors
+    included (docs/VARIANTS.md), so that published numbers can be checked and
+    each correction's effect seen on its own.
 
     Attributes
     ----------
     yaw_reaction : {"physical", "paper"} or None
-        Rotor yaw reaction on the body. ``"physical"`` (default): drag torque
-        ``-s_j dt Omega_j^2`` and spin-up term ``-s_j Jr dOmega_j/dt``, the motor
-        torque reacting on the body, consistent with the gyroscopic term.
-        ``"paper"`` (replica): drag torque ``+s_j dt Omega_j^2`` and spin-up
-        ``-Jr sum_j dOmega_j/dt`` (no ``s_j``); the controller's allocation yaw row
-        follows the model in use.
+        Sense of the rotor drag torque on the body. ``"physical"`` (default):
+        ``-s_j dt Omega_j^2``, the motor torque reacting on the body, consistent
+        with the gyroscopic term. ``"paper"`` (both replicas): ``+s_j dt Omega_j^2``.
+        The controller's allocation yaw row follows the model in use.
+    spinup_reaction : {"physical", "paper"} or None
+        Rotor spin-up reaction on the body. ``"physical"`` (default and the
+        recovery replica): ``-s_j Jr dOmega_j/dt``. ``"paper"`` (paper replica):
+        ``-Jr sum_j dOmega_j/dt``, without the spin sign.
     bumper1_yaw_twice : bool or None
         ``True`` (replica) counts bumper 1's contact yaw moment (body z
         component) twice, as the authors' code did; ``False`` (default) once.
@@ -63,6 +66,21 @@ class ModelOptions(BaseModel):
         and speed. ``"paper"`` (replica): it starts at t = 0 even moving away
         from the wall, and later at rest only when the start point would lie
         beyond the wall. Control ticks run at ``t0 + k dt`` from the start.
+    detection_tick_reference : {"tilt-away", "level"} or None
+        The ``recovery`` controller's target at the tick of detection.
+        ``"tilt-away"`` (default): stage 1's push away from the wall from that
+        tick on. ``"level"`` (recovery replica): a level target at that tick,
+        the tilt away from the next tick on.
+    contact_gate_m : float or None
+        ``0`` (default): contact forces wherever a bumper penetrates. ``> 0``
+        (recovery replica: 0.30 m): contact forces act only while the CM is
+        within this distance of the surface (the authors' broad-phase test),
+        so a bumper may already be ~16 mm deep when its force switches on; the
+        gate crossing is a located event.
+    pre_impact : {"scenario", "spin-down"} or None
+        ``"scenario"`` (default): the ``recovery`` controller's pre-impact
+        behaviour is the scenario's ``pre_impact``. ``"spin-down"`` (recovery
+        replica): always spin-down, as in the authors' Monte Carlo code.
     """
 
     model_config = MODEL_CONFIG
@@ -87,6 +105,18 @@ class ModelOptions(BaseModel):
         description="Wall-approach start rule when v0 would be < 0: start later at rest, "
         "or the authors' rule.",
     )
+    spinup_reaction: Literal["physical", "paper"] | None = Field(
+        None, description="Rotor spin-up reaction: with the spin sign, or the paper's without."
+    )
+    detection_tick_reference: Literal["tilt-away", "level"] | None = Field(
+        None, description="Recovery target at the detection tick: tilt away, or level."
+    )
+    contact_gate_m: Real | None = Field(
+        None, ge=0, le=10, description="Contact forces only with the CM this close, m; 0: off."
+    )
+    pre_impact: Literal["scenario", "spin-down"] | None = Field(
+        None, description="Recovery pre-impact behaviour: the scenario's, or spin-down."
+    )
 
 
 MODEL_VARIANTS: dict[str, dict[str, Any]] = {
@@ -97,6 +127,10 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "attitude_mapping": "exact",
         "crash_rule": "cm-ground",
         "approach_start": "late-start",
+        "spinup_reaction": "physical",
+        "detection_tick_reference": "tilt-away",
+        "contact_gate_m": 0.0,
+        "pre_impact": "scenario",
     },
     "paper-replica": {
         "yaw_reaction": "paper",
@@ -105,6 +139,22 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "attitude_mapping": "paper-fit",
         "crash_rule": "paper-ticks",
         "approach_start": "paper",
+        "spinup_reaction": "paper",
+        "detection_tick_reference": "tilt-away",
+        "contact_gate_m": 0.0,
+        "pre_impact": "scenario",
+    },
+    "recovery-replica": {
+        "yaw_reaction": "paper",
+        "bumper1_yaw_twice": False,
+        "initial_rotor_speeds": "trimmed",
+        "attitude_mapping": "exact",
+        "crash_rule": "cm-ground",
+        "approach_start": "late-start",
+        "spinup_reaction": "physical",
+        "detection_tick_reference": "level",
+        "contact_gate_m": 0.30,
+        "pre_impact": "spin-down",
     },
 }
 """Every switch of :class:`ModelOptions` for each named model variant."""
@@ -117,7 +167,7 @@ def resolve_model_options(
 
     Parameters
     ----------
-    model : {"default", "paper-replica"}
+    model : {"default", "paper-replica", "recovery-replica"}
         The model variant.
     overrides : ModelOptions or mapping or None, optional
         Switches to change; ``None`` values (or missing keys) keep the variant's.

@@ -4,19 +4,22 @@ Frames and units follow MODEL.md section 1: inertial frame NED (X toward the
 default wall, Y right, Z down; altitude ``h = -Z``), body frame FRD, SI units,
 angles in degrees where a field name says ``_deg``.
 
-Two scenario kinds exist:
+Three scenario kinds exist:
 
-- :class:`WallApproach`: the paper's experiment (STUDIES.md section 1): the
-  vehicle holds an attitude and altitude and reaches a vertical wall at
+- :class:`WallApproach`: the paper's experiment (docs/STUDIES.md section 1):
+  the vehicle holds an attitude and altitude and reaches a vertical wall at
   ``X = wall_distance_m`` at ``impact_time_s`` with speed ``speed_m_s``.
 - :class:`FlightScenario`: a general initial state set by the user, with any
   number of contact planes (:class:`Plane`).
+- :class:`ImpactTrial`: the recovery benchmark (docs/RECOVERY.md section 5):
+  the vehicle starts 0.32 m from the wall ``X = 0`` at a given attitude and
+  speed, its rotors spinning down, and must detect the impact and recover.
 
-Both share :class:`RunSettings` (model variant, controller, vehicle, rotor
-mode, integrator settings). A scenario can be written as a TOML file and
-read with :func:`load_scenario_file`::
+All share :class:`RunSettings` (model variant, controller, vehicle, rotor
+mode, sensors, integrator settings). A scenario can be written as a TOML file
+and read with :func:`load_scenario_file`::
 
-    kind = "wall-approach"        # or "flight"; default "wall-approach"
+    kind = "wall-approach"        # or "flight", "impact-trial"; default "wall-approach"
     heading_deg = 45
     inclination_deg = 15
     speed_m_s = 0.75
@@ -28,6 +31,12 @@ read with :func:`load_scenario_file`::
     [vehicle_overrides]           # change vehicle fields for this run
     restitution = 0.5
 
+    [controller_params]           # the controller's own parameters
+    attitude_pid = [7.2, 4.0, 4.2]
+
+    [imu]                         # on-board IMU and impact detector (docs/RECOVERY.md)
+    preset = "noisy"
+
     [[surfaces]]                  # flight scenarios only
     name = "wall"
     point_m = [1.5, 0.0, 0.0]
@@ -38,13 +47,19 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
 from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.inputs.controllers import (
+    controller_entry,
+    controller_names,
+    validate_params,
+)
 from quadimpact.inputs.files import locate_vehicle, read_toml_file
 from quadimpact.inputs.model import ModelName, ModelOptions, resolve_model_options
+from quadimpact.inputs.sensors import DetectionSettings, ImuSettings
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec2, Vec3, Vec4
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import Plane
@@ -54,6 +69,7 @@ __all__ = [
     "RunSettings",
     "WallApproach",
     "FlightScenario",
+    "ImpactTrial",
     "Scenario",
     "load_scenario_file",
     "scenario_from_dict",
@@ -129,14 +145,24 @@ class RunSettings(BaseModel):
 
     Attributes
     ----------
-    model : {"default", "paper-replica"}
-        Model variant (see :class:`ModelOptions`).
+    model : {"default", "paper-replica", "recovery-replica"}
+        Model variant (see :class:`ModelOptions`, docs/VARIANTS.md).
     model_options : ModelOptions
         Single switches overriding the variant; ``None`` fields keep it.
-    controller : {"paper", "cascade-pid"}
-        ``"paper"``: the authors' discrete PID as they ran it (MODEL.md 6.1);
-        ``"cascade-pid"``: the same structure with proper integrals, anti-windup
-        and speed limits (MODEL.md 6.2).
+    controller : str
+        A registered controller (``quadimpact.inputs.controllers``):
+        ``"paper"``, the authors' discrete PID as they ran it (docs/MODEL.md
+        6.1); ``"cascade-pid"``, the same structure with proper integrals,
+        anti-windup and speed limits (6.2); ``"recovery"``, a pre-impact
+        behaviour then the staged recovery law after detection
+        (docs/RECOVERY.md 3); or one registered by the user.
+    controller_params : dict
+        The controller's own parameters (validated by its registry entry).
+    pre_impact : {"nominal", "hold", "spin-down", "immediate"} or None
+        The ``recovery`` controller's behaviour before detection; ``None``: the
+        kind's default (``"nominal"``; ``"spin-down"`` for impact trials).
+    nominal_controller : {"paper", "cascade-pid"}
+        The nominal controller of ``pre_impact = "nominal"``.
     vehicle : str
         Bundled vehicle name (``"spiri"``) or the path of a vehicle TOML file.
     vehicle_overrides : dict
@@ -146,14 +172,17 @@ class RunSettings(BaseModel):
         ``"first-order"``: ``dOmega/dt = (Omega_cmd - Omega) / tau_m``.
     rotor_speed_limits_rpm : tuple of 2 floats or None
         Command limits [min, max], rpm; ``None``: none (the paper).
-    rotor_slew_limit_rad_s2 : float or None
-        Largest rate of change of the command, rad/s^2; ``None``: none.
+    rotor_slew_limit_rad_s2 : float or "vehicle" or None
+        Largest rate of change of the command, rad/s^2; ``"vehicle"``: the
+        vehicle file's ``rotor_slew_limit_rpm_per_s`` (none if it has none);
+        ``None``: none.
     friction_coefficient : float
         Coulomb friction coefficient mu at the bumpers (regularised), >= 0;
         0 is the paper (frictionless).
-    ground : {"crash", "contact"}
+    ground : {"crash", "contact", "none"}
         ``"crash"``: the run ends when the vehicle reaches the ground (per the
-        crash rule); ``"contact"``: the ground is a contact surface instead.
+        crash rule); ``"contact"``: the ground is a contact surface instead;
+        ``"none"``: no ground at all (the vehicle may fall through altitude 0).
     output_rate_hz : float
         Sampling rate of the output time series, Hz.
     rtol, atol : float or None
@@ -162,18 +191,34 @@ class RunSettings(BaseModel):
         End of the simulation, s.
     power_off : PowerOff or None
         Motor power-off schedule (the paper's experiments); ``None``: none.
+    imu : ImuSettings
+        The on-board IMU (``"ideal"``, ``"noisy"`` or a table).
+    detection : DetectionSettings
+        The impact detector working on the IMU samples.
+    seed : int
+        Seed of the run's random draws (IMU noise and bias), >= 0.
     """
 
     model_config = MODEL_CONFIG
 
     model: ModelName = Field(
-        "default", description="Model variant: 'default' (physical) or 'paper-replica'."
+        "default",
+        description="Model variant: 'default' (physical), 'paper-replica' or 'recovery-replica'.",
     )
     model_options: ModelOptions = Field(
         default_factory=ModelOptions, description="Switches overriding the model variant."
     )
-    controller: Literal["paper", "cascade-pid"] = Field(
-        "paper", description="Controller: the authors' 'paper' PID or 'cascade-pid'."
+    controller: str = Field(
+        "paper", description="Controller: 'paper', 'cascade-pid', 'recovery' or a registered one."
+    )
+    controller_params: dict[str, Any] = Field(
+        default_factory=dict, description="The controller's own parameters."
+    )
+    pre_impact: Literal["nominal", "hold", "spin-down", "immediate"] | None = Field(
+        None, description="Recovery controller before detection; None: the kind's default."
+    )
+    nominal_controller: Literal["paper", "cascade-pid"] = Field(
+        "paper", description="Nominal controller of pre_impact = 'nominal'."
     )
     vehicle: str = Field(
         "spiri", min_length=1, description="Bundled vehicle name or path to a vehicle TOML file."
@@ -187,14 +232,16 @@ class RunSettings(BaseModel):
     rotor_speed_limits_rpm: Vec2 | None = Field(
         None, description="Rotor speed command limits [min, max], rpm; None: unlimited."
     )
-    rotor_slew_limit_rad_s2: Real | None = Field(
-        None, gt=0, description="Rotor speed command slew limit, rad/s^2; None: unlimited."
+    rotor_slew_limit_rad_s2: Real | Literal["vehicle"] | None = Field(
+        None,
+        description="Rotor speed command slew limit, rad/s^2; 'vehicle': the vehicle's; "
+        "None: unlimited.",
     )
     friction_coefficient: Real = Field(
         0.0, ge=0, description="Coulomb friction coefficient at the bumpers (0: the paper)."
     )
-    ground: Literal["crash", "contact"] = Field(
-        "crash", description="Ground: ends the run ('crash') or is a contact surface."
+    ground: Literal["crash", "contact", "none"] = Field(
+        "crash", description="Ground: ends the run ('crash'), a contact surface, or 'none'."
     )
     output_rate_hz: Real = Field(
         1000.0, gt=0, le=100000, description="Output time-series sampling rate, Hz."
@@ -209,6 +256,57 @@ class RunSettings(BaseModel):
     power_off: PowerOff | None = Field(
         None, description="Motor power-off schedule after a trigger (the experiments)."
     )
+    imu: ImuSettings = Field(default_factory=ImuSettings, description="The on-board IMU.")
+    detection: DetectionSettings = Field(
+        default_factory=DetectionSettings, description="The impact detector."
+    )
+    seed: int = Field(0, ge=0, lt=2**63, description="Seed of the run's random draws.")
+
+    @field_validator("seed", mode="before")
+    @classmethod
+    def _integer_seed(cls, value: Any) -> Any:
+        if isinstance(value, bool) or (isinstance(value, float) and not value.is_integer()):
+            raise ValueError("must be an integer")
+        if isinstance(value, float):
+            return int(value)
+        return value
+
+    @field_validator("controller")
+    @classmethod
+    def _registered_controller(cls, value: str) -> str:
+        if value not in controller_names():
+            try:
+                controller_entry(value)
+            except InputError as exc:  # the rule without the field name (pydantic adds it)
+                raise ValueError(str(exc).removeprefix("controller: ")) from None
+        return value
+
+    @model_validator(mode="after")
+    def _controller_params(self) -> RunSettings:
+        # unknown keys and bad values of the controller's parameters, reported now
+        validate_params(self.controller, self.controller_params)
+        return self
+
+    def resolved_controller_params(self) -> BaseModel:
+        """The controller's parameters, validated, with its defaults filled in."""
+        return validate_params(self.controller, self.controller_params)
+
+    def resolved_pre_impact(self) -> str:
+        """The recovery controller's pre-impact behaviour in force (model switch included)."""
+        if self.resolved_model_options().pre_impact == "spin-down":
+            return "spin-down"
+        if self.pre_impact is not None:
+            return self.pre_impact
+        return self._default_pre_impact
+
+    _default_pre_impact: ClassVar[str] = "nominal"
+
+    @field_validator("rotor_slew_limit_rad_s2")
+    @classmethod
+    def _positive_slew(cls, value: Any) -> Any:
+        if isinstance(value, float) and not value > 0:
+            raise ValueError(f"must be > 0 (got {value:g})")
+        return value
 
     @field_validator("vehicle_overrides")
     @classmethod
@@ -442,12 +540,67 @@ class FlightScenario(RunSettings):
         return self
 
 
-Scenario = WallApproach | FlightScenario
+class ImpactTrial(RunSettings):
+    """The impact trial of the recovery benchmark (docs/RECOVERY.md section 5).
+
+    The wall is the plane ``X = 0`` (normal ``-X``); the CM starts at
+    ``X = -start_distance_m`` at ``altitude_m``, with attitude ``roll_deg``,
+    ``pitch_deg``, ``yaw_deg`` (ZYX; positive pitch tilts the thrust away from
+    the wall, so the inclination toward the wall is about ``-pitch``),
+    inertial velocity ``(speed_m_s, 0, 0)``, no rotation, and rotor speeds
+    from the allocation of the collective thrust ``m g cos(roll) cos(pitch)``
+    with zero torques. The vehicle's rotor range and slew limit are in force.
+    By default: the Navi, the ``recovery`` controller spinning its rotors down
+    until it detects the impact, friction 0.3, no ground, 3 s.
+
+    Attributes
+    ----------
+    kind : "impact-trial"
+        Scenario kind tag (as in scenario files).
+    roll_deg, pitch_deg, yaw_deg : float
+        Initial attitude, ZYX Euler angles, deg (the authors drew roll in
+        +-15, pitch in +-45, yaw in +-45).
+    speed_m_s : float
+        Initial speed toward the wall (inertial X), m/s (the authors: 0.5-2.5).
+    start_distance_m : float
+        Distance of the CM from the wall at the start, m.
+    altitude_m : float
+        Initial altitude ``h = -Z``, m (also the nominal controller's set-point).
+    """
+
+    kind: Literal["impact-trial"] = Field("impact-trial", description="Scenario kind tag.")
+    vehicle: str = Field(
+        "navi", min_length=1, description="Bundled vehicle name or path to a vehicle TOML file."
+    )
+    controller: str = Field("recovery", description="Controller (default 'recovery').")
+    friction_coefficient: Real = Field(
+        0.3, ge=0, description="Coulomb friction coefficient at the bumpers."
+    )
+    ground: Literal["crash", "contact", "none"] = Field(
+        "none", description="No ground by default (the trial starts 5 m up)."
+    )
+    rotor_slew_limit_rad_s2: Real | Literal["vehicle"] | None = Field(
+        "vehicle", description="Rotor command slew limit, rad/s^2; default the vehicle's."
+    )
+    roll_deg: Real = Field(0.0, ge=-90, le=90, description="Initial roll, deg (ZYX).")
+    pitch_deg: Real = Field(0.0, gt=-90, lt=90, description="Initial pitch, deg (ZYX).")
+    yaw_deg: Real = Field(0.0, ge=-180, le=180, description="Initial yaw, deg (ZYX).")
+    speed_m_s: Real = Field(1.5, gt=0, le=20, description="Initial speed toward the wall, m/s.")
+    start_distance_m: Real = Field(
+        0.32, gt=0, le=100, description="CM distance from the wall at the start, m."
+    )
+    altitude_m: Real = Field(5.0, gt=0, description="Initial altitude, m.")
+
+    _default_pre_impact: ClassVar[str] = "spin-down"
+
+
+Scenario = WallApproach | FlightScenario | ImpactTrial
 """Any scenario accepted by ``simulate``."""
 
-_KINDS: dict[str, type[WallApproach] | type[FlightScenario]] = {
+_KINDS: dict[str, type[WallApproach] | type[FlightScenario] | type[ImpactTrial]] = {
     "wall-approach": WallApproach,
     "flight": FlightScenario,
+    "impact-trial": ImpactTrial,
 }
 
 
@@ -464,12 +617,13 @@ def scenario_from_dict(data: Mapping[str, Any], where: str = "scenario") -> Scen
 
     Returns
     -------
-    WallApproach or FlightScenario
+    WallApproach or FlightScenario or ImpactTrial
         The validated scenario.
     """
     kind = data.get("kind", "wall-approach")
     if kind not in _KINDS:
-        raise InputError(f"{where}: kind: must be 'wall-approach' or 'flight' (got {kind!r})")
+        known = ", ".join(repr(k) for k in _KINDS)
+        raise InputError(f"{where}: kind: must be one of {known} (got {kind!r})")
     cls = _KINDS[kind]
     try:
         return cls.model_validate(dict(data))

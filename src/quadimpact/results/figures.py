@@ -15,6 +15,7 @@ of a sweep table, for ``quadimpact sweep`` and the paper's Table II.
 from __future__ import annotations
 
 import math
+import numbers
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -227,6 +228,95 @@ def plot_fig6(
 ) -> Path:
     """Write the states figure (:func:`make_fig6`) to ``path`` as PNG."""
     return save_figure(make_fig6(ts, refs, wall_x_m=wall_x_m, title=title), path)
+
+
+STAGE_COLORS = {1: "tab:red", 2: "tab:orange", 3: "tab:olive", 4: "tab:green"}
+STAGE_NAMES = {1: "1 detected", 2: "2 tilted away", 3: "3 level", 4: "4 recovered"}
+
+
+def mark_stages(ax: Any, summary: Mapping[str, Any] | None, *, label: bool = False) -> None:
+    """Vertical lines at the detection and at each recovery stage's entry (from the summary)."""
+    if not summary:
+        return
+    t_detect = summary.get("t_detect_s")
+    if isinstance(t_detect, numbers.Real):
+        ax.axvline(t_detect, color="black", linestyle=":", linewidth=1.0,
+                   label="detection" if label else None)  # fmt: skip
+    for k in (2, 3, 4):
+        t = summary.get(f"t_stage{k}_s")
+        if isinstance(t, numbers.Real):
+            ax.axvline(t, color=STAGE_COLORS[k], linestyle="--", linewidth=1.0,
+                       label=f"stage {STAGE_NAMES[k]}" if label else None)  # fmt: skip
+
+
+def make_imu(
+    imu: pd.DataFrame,
+    ts: pd.DataFrame | None = None,
+    summary: Mapping[str, Any] | None = None,
+    title: str | None = None,
+) -> Figure:
+    """The IMU samples beside the bumper deflections: the impact spike and its detection.
+
+    Panels sharing the time axis: bumper deflections (mm, from the time
+    series), the measured specific force (body FRD, m/s^2) with the detector's
+    horizontal measure and its threshold, and the measured body rates (rad/s).
+    The detection and each recovery stage's entry are marked (from the
+    summary, when given).
+    """
+    n_panels = 3 if ts is not None and len(ts) else 2
+    fig = new_figure(8.0, 2.4 * n_panels + 0.4)
+    axes = list(np.atleast_1d(fig.subplots(n_panels, 1, sharex=True)))
+    t = imu["t_s"].to_numpy(dtype=np.float64)
+    if n_panels == 3:
+        ax = axes.pop(0)
+        tt = ts["t_s"].to_numpy(dtype=np.float64)
+        for j in (1, 2, 3, 4):
+            ax.plot(tt, 1e3 * ts[f"delta{j}_m"].to_numpy(dtype=np.float64),
+                    color=BUMPER_COLORS[j], linewidth=1.0, label=f"Bumper {j}")  # fmt: skip
+        ax.set_ylabel("Deflection (mm)")
+        mark_stages(ax, summary)
+        ax.legend(loc="upper right", fontsize="small", ncols=2)
+        ax.grid(True, alpha=0.4)
+        first = ax
+    else:
+        first = axes[0]
+    ax_f, ax_w = axes
+    for col, color in (("fx_m_s2", "tab:blue"), ("fy_m_s2", "tab:orange"), ("fz_m_s2", "tab:green")):
+        ax_f.plot(t, imu[col].to_numpy(dtype=np.float64), color=color, linewidth=1.0,
+                  label=col.split("_")[0])  # fmt: skip
+    ax_f.plot(t, imu["f_horizontal_m_s2"].to_numpy(dtype=np.float64), color="black",
+              linewidth=1.2, label="|f_xy| (detector)")  # fmt: skip
+    threshold = (summary or {}).get("detection_threshold_m_s2")
+    if isinstance(threshold, numbers.Real):
+        ax_f.axhline(threshold, color="gray", linestyle="-.", linewidth=1.0, label="threshold")
+    ax_f.set_ylabel("Specific force (m/s²)")
+    mark_stages(ax_f, summary, label=True)
+    ax_f.legend(loc="upper right", fontsize="small", ncols=3)
+    for col, color in (("p_rad_s", "tab:blue"), ("q_rad_s", "tab:orange"), ("r_rad_s", "tab:green")):
+        ax_w.plot(t, imu[col].to_numpy(dtype=np.float64), color=color, linewidth=1.0,
+                  label=col.split("_")[0])  # fmt: skip
+    ax_w.set_ylabel("Body rate (rad/s)")
+    ax_w.set_xlabel("Time (s)")
+    mark_stages(ax_w, summary)
+    ax_w.legend(loc="upper right", fontsize="small", ncols=3)
+    for ax in (ax_f, ax_w):
+        ax.grid(True, alpha=0.4)
+    if len(t):
+        first.set_xlim(float(t[0]), float(t[-1]))
+    if title:
+        fig.suptitle(title)
+    return fig
+
+
+def plot_imu(
+    imu: pd.DataFrame,
+    ts: pd.DataFrame | None,
+    path: str | os.PathLike[str],
+    summary: Mapping[str, Any] | None = None,
+    title: str | None = None,
+) -> Path:
+    """Write the IMU figure (:func:`make_imu`) to ``path`` as PNG."""
+    return save_figure(make_imu(imu, ts, summary=summary, title=title), path)
 
 
 # ------------------------------------------------------ sweep tables: helpers

@@ -53,13 +53,17 @@ __all__ = [
     "read_timeseries_units",
     "to_jsonable",
     "write_episodes_csv",
+    "write_imu_parquet",
     "write_summary_json",
     "write_timeseries_parquet",
+    "IMU_COLUMNS",
+    "IMU_PARQUET",
 ]
 
 SUMMARY_JSON = "summary.json"
 EPISODES_CSV = "episodes.csv"
 TIMESERIES_PARQUET = "timeseries.parquet"
+IMU_PARQUET = "imu.parquet"
 
 #: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
 BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
@@ -105,6 +109,27 @@ TIMESERIES_COLUMNS: tuple[str, ...] = (
     "altitude_m",
     *(f"delta{j}_m" for j in BUMPERS),
     *(f"force{j}_n" for j in BUMPERS),
+    "stage",
+)
+
+#: Columns of the IMU table (imu.parquet), in order (docs/RESULTS.md): the
+#: measured specific force (body FRD) and angular rate, the true ones, and the
+#: detector's horizontal measure.
+IMU_COLUMNS: tuple[str, ...] = (
+    "t_s",
+    "fx_m_s2",
+    "fy_m_s2",
+    "fz_m_s2",
+    "p_rad_s",
+    "q_rad_s",
+    "r_rad_s",
+    "fx_true_m_s2",
+    "fy_true_m_s2",
+    "fz_true_m_s2",
+    "p_true_rad_s",
+    "q_true_rad_s",
+    "r_true_rad_s",
+    "f_horizontal_m_s2",
 )
 
 #: Schema metadata key holding ``{column: unit}`` as a JSON string.
@@ -323,6 +348,11 @@ def write_timeseries_parquet(df: pd.DataFrame, path: str | os.PathLike[str]) -> 
     meta[UNITS_METADATA_KEY.encode()] = json.dumps(units).encode()
     table = table.replace_schema_metadata(meta)
     return atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+
+
+def write_imu_parquet(df: pd.DataFrame, path: str | os.PathLike[str]) -> Path:
+    """Write the IMU samples to Parquet, with column units (as the time series)."""
+    return write_timeseries_parquet(df, path)
 
 
 def read_timeseries_parquet(path: str | os.PathLike[str]) -> pd.DataFrame:

@@ -20,10 +20,11 @@ import pandas as pd
 
 from quadimpact.results import files
 
-__all__ = ["FIG5_PNG", "FIG6_PNG", "SimulationResult", "read_result"]
+__all__ = ["FIG5_PNG", "FIG6_PNG", "IMU_PNG", "SimulationResult", "read_result"]
 
 FIG5_PNG = "fig5.png"
 FIG6_PNG = "fig6.png"
+IMU_PNG = "imu.png"
 
 
 @dataclass
@@ -46,6 +47,9 @@ class SimulationResult:
         The input scenario (``None`` when read back from a folder).
     stats : dict
         Integrator counters (steps, rejected steps, right-hand-side calls, ...).
+    imu : pandas.DataFrame or None
+        The IMU samples (columns in docs/RESULTS.md; body FRD, SI); ``None``
+        when the run had no IMU record.
     """
 
     summary: dict[str, Any]
@@ -54,6 +58,7 @@ class SimulationResult:
     references: dict[str, Any] = field(default_factory=dict)
     scenario: object = None
     stats: dict[str, Any] = field(default_factory=dict)
+    imu: pd.DataFrame | None = None
 
     # ------------------------------------------------------------------
     def _scenario_value(self, key: str) -> Any:
@@ -92,7 +97,8 @@ class SimulationResult:
         Files, in this order so that a plotting failure loses no data:
         ``summary.json`` (the summary plus ``references`` and ``stats`` unless
         it already has those keys), ``episodes.csv``, ``timeseries.parquet``,
-        ``fig5.png``, ``fig6.png``. A figure that fails is not written (a stale
+        ``imu.parquet`` (when there are IMU samples), ``fig5.png``,
+        ``fig6.png``, ``imu.png``. A figure that fails is not written (a stale
         one from an earlier write is removed); the failure is printed as a
         one-line warning on stderr and listed under ``plot_errors`` in
         ``summary.json`` (and in ``self.summary``).
@@ -106,6 +112,11 @@ class SimulationResult:
         files.write_summary_json(summary, d / files.SUMMARY_JSON)
         files.write_episodes_csv(self.episodes, d / files.EPISODES_CSV)
         files.write_timeseries_parquet(self.timeseries, d / files.TIMESERIES_PARQUET)
+        has_imu = self.imu is not None and len(self.imu) > 0
+        if has_imu:
+            files.write_imu_parquet(self.imu, d / files.IMU_PARQUET)
+        else:
+            (d / files.IMU_PARQUET).unlink(missing_ok=True)
 
         from quadimpact.results import figures as plots  # matplotlib only when drawing
 
@@ -119,6 +130,17 @@ class SimulationResult:
                 ),
             ),
         )
+        if has_imu:
+            jobs += (
+                (
+                    IMU_PNG,
+                    lambda p: plots.plot_imu(
+                        self.imu, self.timeseries, p, summary=self.summary, title=title
+                    ),
+                ),
+            )
+        else:
+            (d / IMU_PNG).unlink(missing_ok=True)
         errors: list[str] = []
         for name, job in jobs:
             try:
@@ -151,6 +173,8 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     summary = files.read_summary_json(d / files.SUMMARY_JSON)
     episodes = files.read_episodes_csv(d / files.EPISODES_CSV)
     timeseries = files.read_timeseries_parquet(d / files.TIMESERIES_PARQUET)
+    imu_path = d / files.IMU_PARQUET
+    imu = files.read_timeseries_parquet(imu_path) if imu_path.is_file() else None
     references = dict(summary.get("references") or {})
     stats = dict(summary.get("stats") or {})
     return SimulationResult(
@@ -160,4 +184,5 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
         references=references,
         scenario=None,
         stats=stats,
+        imu=imu,
     )

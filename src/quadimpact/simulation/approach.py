@@ -13,7 +13,7 @@ Brent's method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial).
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -98,6 +98,7 @@ def _free_flight_end(
     t0: float,
     t_end: float,
     free_opts: np.ndarray,
+    kernel: Callable | None = None,
 ) -> np.ndarray:
     """State at ``t_end`` of a run from ``(t0, x0)`` with no surfaces and no crash."""
     out, _, stats = execute(
@@ -110,6 +111,7 @@ def _free_flight_end(
         ctrl,
         np.array([t_end]),
         max_episodes=1,
+        kernel=kernel,
         **schedule,
     )
     if stats[L.ST_STATUS] == L.STATUS_FAILED or out.shape[0] != 1:
@@ -144,6 +146,7 @@ def solve_approach(
     impact_time_s: float,
     speed_m_s: float,
     late_start: bool,
+    kernel: Callable | None = None,
 ) -> tuple[np.ndarray, float, dict[str, Any]]:
     """Initial state and time that bring the first contact at ``T_c`` with ``V_X = V_c``.
 
@@ -163,6 +166,8 @@ def solve_approach(
         The ``late-start`` rule: start later at rest whenever ``v0 < 0`` would be
         needed; otherwise (the authors' rule) only when the start would lie
         beyond the wall.
+    kernel : callable, optional
+        The run loop of a plug-in controller (default: the built-in kernel).
 
     Returns
     -------
@@ -180,7 +185,7 @@ def solve_approach(
     def shoot(t0: float, v0: float, x_start: float) -> tuple[np.ndarray, np.ndarray]:
         pos = start + np.array([x_start, 0.0, 0.0])
         x0 = initial_state(pos, np.array([v0, 0.0, 0.0]), q, np.zeros(3), rotors)
-        return x0, _free_flight_end(veh, ctrl, schedule, x0, t0, tc, free_opts)
+        return x0, _free_flight_end(veh, ctrl, schedule, x0, t0, tc, free_opts, kernel)
 
     def solve_from(t0: float, v0: float) -> tuple[float, float, float, np.ndarray]:
         """Correct v0 (unless at rest) and X0 until the residuals vanish."""

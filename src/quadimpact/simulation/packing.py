@@ -10,41 +10,12 @@ from collections.abc import Sequence
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.controllers.common import P_GAINS, P_THRUST_COS_FLOOR
+from quadimpact.inputs.controllers import ControllerEntry, PackContext
+from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
 
-# Paper gains (MODEL.md 6.1): (P, I, D) for altitude, climb rate, heading,
-# roll/pitch and yaw rate, in the order of the G_* blocks.
-PAPER_GAINS = np.array(
-    [
-        2.0, 0.0, 0.4,  # altitude h -> climb-rate reference
-        1.6, 60.0, 0.0,  # climb rate -> vertical acceleration
-        1.2, 1.0, 0.2,  # heading -> yaw-rate reference
-        7.2, 4.0, 4.2,  # roll and pitch -> angular acceleration
-        1.8, 2.0, 0.0,  # yaw rate -> yaw acceleration
-    ]
-)  # fmt: skip
-
-# cascade-pid gains: the paper's, retuned where a running integral changes the
-# loop (linearised analysis in docs/CONTROLLERS.md): climb rate P 4, I 4 (the
-# paper's 1.6 and 60 give damping 0.05 with a true integral); heading I 0 (the
-# yaw-rate integral already removes steady yaw errors; paper 1) and yaw rate
-# P 3, I 1 (paper 1.8, 2: damping 0.26 with running integrals). Every loop then
-# has damping >= 0.7.
-CASCADE_GAINS = np.array(
-    [
-        2.0, 0.0, 0.4,  # altitude h -> climb-rate reference
-        4.0, 4.0, 0.0,  # climb rate -> vertical acceleration
-        1.2, 0.0, 0.2,  # heading -> yaw-rate reference
-        7.2, 4.0, 4.2,  # roll and pitch -> angular acceleration
-        3.0, 1.0, 0.0,  # yaw rate -> yaw acceleration
-    ]
-)  # fmt: skip
-DEFAULT_GAINS = {L.CTRL_PAPER: PAPER_GAINS, L.CTRL_CASCADE_PID: CASCADE_GAINS}
-
 CONTROL_RATE_HZ = 200.0
-CASCADE_THRUST_COS_FLOOR = 0.5
 RPM = 2.0 * np.pi / 60.0  # rad/s per rpm
 
 # Integrator defaults, chosen by measurement (docs/NUMERICS.md,
@@ -113,38 +84,43 @@ def trim_rotor_speeds(v: Vehicle, thrust_n: float, yaw_paper: bool) -> np.ndarra
 
 
 def pack_controller(
-    kind: int,
-    v: Vehicle,
+    entry: ControllerEntry,
+    params: object,
+    context: PackContext,
     refs: dict[str, float],
     yaw_paper: bool,
-    gains: np.ndarray | None = None,
 ) -> np.ndarray:
     """Controller settings as the ``C_*`` vector.
 
+    The common head (kind, references, inverse allocation, the vehicle's rotor
+    range) and the controller's parameter block (its registry entry's packer).
     ``refs`` holds ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``.
     """
+    v: Vehicle = context.vehicle
     ctrl = np.zeros(L.NCTRL)
-    ctrl[L.C_KIND] = kind
+    ctrl[L.C_KIND] = entry.kind
     ctrl[L.C_H_REF] = refs["altitude_m"]
     ctrl[L.C_PHI_REF] = refs["roll_rad"]
     ctrl[L.C_THETA_REF] = refs["pitch_rad"]
     ctrl[L.C_PSI_REF] = refs["yaw_rad"]
-    if gains is None:
-        gains = DEFAULT_GAINS.get(kind, PAPER_GAINS)
-    ctrl[L.C_PARAMS + P_GAINS : L.C_PARAMS + P_GAINS + 15] = gains
-    ctrl[L.C_PARAMS + P_THRUST_COS_FLOOR] = CASCADE_THRUST_COS_FLOOR
     ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = np.linalg.inv(
         allocation_matrix(v, yaw_paper)
     ).ravel()
     lo, hi = v.rotor_speed_range_rpm
     ctrl[L.C_OMEGA_MIN] = lo * RPM
     ctrl[L.C_OMEGA_MAX] = hi * RPM
+    block = np.asarray(entry.pack(params, context), dtype=float)
+    if block.shape != (L.NPARAM,):
+        raise ValueError(f"controller {entry.name!r}: its packer must return {L.NPARAM} numbers")
+    ctrl[L.C_PARAMS : L.C_PARAMS + L.NPARAM] = block
     return ctrl
 
 
 def pack_options(
     *,
     yaw_paper: bool,
+    spinup_paper: bool,
+    contact_gate_m: float,
     bumper1_yaw_twice: bool,
     crash_rule: int,
     crash_altitude_m: float,
@@ -160,7 +136,8 @@ def pack_options(
     """Model switches and integrator settings as the ``O_*`` vector."""
     opts = np.zeros(L.NOPT)
     opts[L.O_YAW_REACTION_PAPER] = float(yaw_paper)
-    opts[L.O_SPINUP_PAPER] = float(yaw_paper)
+    opts[L.O_SPINUP_PAPER] = float(spinup_paper)
+    opts[L.O_CONTACT_GATE] = float(contact_gate_m)
     opts[L.O_DOUBLE_BUMPER1_YAW] = float(bumper1_yaw_twice)
     opts[L.O_CRASH_RULE] = crash_rule
     opts[L.O_CRASH_ALTITUDE] = crash_altitude_m
@@ -180,3 +157,55 @@ def pack_options(
     opts[L.O_EVENT_TOL] = EVENT_TOL_S
     opts[L.O_POWER_OFF_T] = np.inf
     return opts
+
+
+def pack_sensors(
+    imu: ResolvedImu,
+    detection: DetectionSettings,
+    v: Vehicle,
+    seed: int,
+    duration_s: float,
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """The IMU and detector as the ``SC_*`` vector, the run's noise draws and the sample count.
+
+    Random draws (NumPy's PCG64 seeded with ``seed``): first the six biases
+    (standard normal times the configured bias standard deviation), then the
+    white noise, one row of six standard normal numbers per sample, only when
+    the IMU has noise or bias (an ideal IMU draws nothing).
+
+    Returns
+    -------
+    scfg : ndarray (NSCFG,)
+    noise : ndarray (n_imu, 6) or (0, 6)
+    n_imu : int
+        Samples the run takes at most: ``t0`` and every ``1/rate`` to the end.
+    """
+    scfg = np.zeros(L.NSCFG)
+    rate = float(imu.rate_hz)
+    n_imu = int(np.floor(duration_s * rate + 1e-9)) + 2
+    scfg[L.SC_RATE] = rate
+    scfg[L.SC_POS : L.SC_POS + 3] = imu.position_m
+    scfg[L.SC_NOISE_F] = imu.accel_noise_m_s2
+    scfg[L.SC_NOISE_W] = imu.gyro_noise_rad_s
+    scfg[L.SC_RANGE_F] = imu.accel_range_m_s2 or 0.0
+    scfg[L.SC_RANGE_W] = imu.gyro_range_rad_s or 0.0
+    scfg[L.SC_FILTER] = {
+        "none": L.FILTER_NONE,
+        "first-order": L.FILTER_FIRST_ORDER,
+        "moving-average": L.FILTER_MOVING_AVERAGE,
+    }[imu.filter]
+    if imu.filter == "first-order":
+        scfg[L.SC_FILTER_PARAM] = float(imu.filter_time_constant_s)
+    elif imu.filter == "moving-average":
+        scfg[L.SC_FILTER_PARAM] = float(imu.filter_window)
+    if detection.enabled:
+        scfg[L.SC_DET_THRESHOLD] = detection.threshold_g * v.gravity_m_s2
+    scfg[L.SC_DET_WORLD] = 1.0 if detection.frame == "world" else 0.0
+    scfg[L.SC_DET_PERSIST] = float(detection.persistence)
+    noise = np.zeros((0, 6))
+    if imu.has_noise:
+        rng = np.random.default_rng(seed)
+        sigma_bias = np.array([imu.accel_bias_m_s2] * 3 + [imu.gyro_bias_rad_s] * 3)
+        scfg[L.SC_BIAS : L.SC_BIAS + 6] = rng.standard_normal(6) * sigma_bias
+        noise = rng.standard_normal((n_imu, 6))
+    return scfg, noise, n_imu

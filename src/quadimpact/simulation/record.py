@@ -17,10 +17,10 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
-from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS
+from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
 from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
 
-__all__ = ["episodes_frame", "timeseries_frame"]
+__all__ = ["episodes_frame", "imu_frame", "timeseries_frame"]
 
 # Raw episode columns -> table columns (float-valued ones).
 _EPISODE_FLOAT_SOURCES: tuple[tuple[str, int], ...] = (
@@ -123,7 +123,8 @@ def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
         ``roll/pitch/yaw_deg`` (degrees; roll and yaw wrapped to (-180, 180],
         pitch in [-90, 90]; not unwrapped); ``altitude_m = -z_m``; per-bumper
         deflection ``delta1..4_m`` (m, max over surfaces) and normal force
-        ``force1..4_n`` (N, sum over surfaces).
+        ``force1..4_n`` (N, sum over surfaces); ``stage``, the controller's
+        stage in force (0 for controllers without stages).
     """
     rows = _rows(raw, n, L.NOUT, "timeseries")
     x0 = L.OUT_X
@@ -169,6 +170,28 @@ def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
         data[f"delta{j}_m"] = rows[:, L.OUT_DELTA + j - 1]
     for j in BUMPERS:
         data[f"force{j}_n"] = rows[:, L.OUT_FORCE + j - 1]
+    data["stage"] = rows[:, L.OUT_STAGE]
     return pd.DataFrame({k: np.array(v, dtype=np.float64) for k, v in data.items()})
+
+
+def imu_frame(raw: np.ndarray) -> pd.DataFrame:
+    """IMU table from the kernel's IMU samples (layout ``I_*``).
+
+    Returns
+    -------
+    pandas.DataFrame
+        Columns :data:`~quadimpact.results.files.IMU_COLUMNS`: time (s); measured
+        specific force ``fx/fy/fz_m_s2`` (body FRD, m/s^2) and angular rate
+        ``p/q/r_rad_s``; the true values (``*_true_*``); the detector's horizontal
+        measure ``f_horizontal_m_s2``.
+    """
+    rows = np.asarray(raw, dtype=np.float64).reshape(-1, L.NIMU)
+    sources = (
+        L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
+        L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
+        L.I_HORIZONTAL,
+    )  # fmt: skip
+    return pd.DataFrame({name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources,
+                                                                           strict=True)})
 
 

@@ -10,32 +10,35 @@ wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approac
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.run import make_kernel
+from quadimpact.inputs.controllers import PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions
-from quadimpact.inputs.scenarios import FlightScenario, WallApproach
+from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.packing import (
+    CONTROL_RATE_HZ,
     RPM,
     pack_controller,
     pack_options,
+    pack_sensors,
     pack_surfaces,
     pack_vehicle,
     trim_rotor_speeds,
 )
 
-__all__ = ["CONTROLLER_KINDS", "RunSetup", "prepare", "prepare_flight", "prepare_wall_approach"]
+__all__ = ["RunSetup", "prepare", "prepare_flight", "prepare_impact_trial", "prepare_wall_approach"]
 
-PAPER_CRASH_ALTITUDE_M = -0.3  # MODEL.md 8.5
-
-CONTROLLER_KINDS = {"paper": L.CTRL_PAPER, "cascade-pid": L.CTRL_CASCADE_PID}
+PAPER_CRASH_ALTITUDE_M = -0.3  # docs/VARIANTS.md 4.5
 
 
 @dataclass
@@ -60,6 +63,15 @@ class RunSetup:
     sched_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
     sched_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
     sched_stop: np.ndarray = field(default_factory=lambda: np.zeros(4))
+    scfg: np.ndarray = field(default_factory=lambda: np.zeros(L.NSCFG))
+    noise: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    n_imu: int = 0
+    controller: str = "paper"
+    kernel: Callable | None = None
+
+    def sensors(self) -> dict[str, Any]:
+        """The IMU and detector as keyword arguments of ``core.run.execute_record``."""
+        return {"scfg": self.scfg, "noise": self.noise, "n_imu": self.n_imu}
 
     def schedule(self) -> dict[str, np.ndarray]:
         """The power-off schedule as keyword arguments of ``core.run.execute``."""
@@ -89,12 +101,20 @@ def _initial_speeds(
     return trim_rotor_speeds(v, weight / (math.cos(roll) * math.cos(pitch)), yaw_paper)
 
 
+def _slew_limit_rad_s2(s: RunSettings, v: Vehicle) -> float | None:
+    if s.rotor_slew_limit_rad_s2 == "vehicle":
+        if v.rotor_slew_limit_rpm_per_s is None:
+            return None
+        return v.rotor_slew_limit_rpm_per_s * RPM
+    return s.rotor_slew_limit_rad_s2
+
+
 def _packed_options(
-    s: WallApproach | FlightScenario, o: ModelOptions, duration_s: float, *, free: bool = False
+    s: RunSettings, o: ModelOptions, v: Vehicle, duration_s: float, *, free: bool = False
 ) -> np.ndarray:
     if free:
         crash_rule, level, stop = L.CRASH_NONE, 0.0, False
-    elif s.ground == "contact":
+    elif s.ground in ("contact", "none"):
         crash_rule, level, stop = L.CRASH_NONE, 0.0, False
     elif o.crash_rule == "paper-ticks":
         crash_rule, level, stop = L.CRASH_PAPER_TICKS, PAPER_CRASH_ALTITUDE_M, True
@@ -106,13 +126,15 @@ def _packed_options(
         limits = (lo * RPM, hi * RPM)
     opts = pack_options(
         yaw_paper=o.yaw_reaction == "paper",
+        spinup_paper=o.spinup_reaction == "paper",
+        contact_gate_m=float(o.contact_gate_m),
         bumper1_yaw_twice=bool(o.bumper1_yaw_twice),
         crash_rule=crash_rule,
         crash_altitude_m=level,
         stop_on_crash=stop,
         first_order_rotors=s.rotor_mode == "first-order",
         omega_limits_rad_s=limits,
-        slew_limit_rad_s2=s.rotor_slew_limit_rad_s2,
+        slew_limit_rad_s2=_slew_limit_rad_s2(s, v),
         friction_coefficient=s.friction_coefficient,
         rtol=s.rtol,
         atol=s.atol,
@@ -124,7 +146,7 @@ def _packed_options(
     return opts
 
 
-def _schedule(s: WallApproach | FlightScenario) -> dict[str, np.ndarray]:
+def _schedule(s: RunSettings) -> dict[str, np.ndarray]:
     """The power-off schedule as the kernel's arrays (s; rad/s^2; stall flags)."""
     if s.power_off is None:
         return {}
@@ -138,14 +160,23 @@ def _schedule(s: WallApproach | FlightScenario) -> dict[str, np.ndarray]:
     }
 
 
-def _ground(s: WallApproach | FlightScenario) -> list[Plane]:
+def _ground(s: RunSettings) -> list[Plane]:
     if s.ground == "contact":
         return [GROUND]
     return []
 
 
+def _kernel(entry) -> Callable | None:
+    """The compiled loop of a plug-in controller (once per process); None for built-ins."""
+    if entry.step is None:
+        return None
+    if "kernel" not in entry.kernel_cache:
+        entry.kernel_cache["kernel"] = make_kernel(entry.step)
+    return entry.kernel_cache["kernel"]
+
+
 def _setup(
-    s: WallApproach | FlightScenario,
+    s: RunSettings,
     v: Vehicle,
     o: ModelOptions,
     refs: dict[str, float],
@@ -153,22 +184,43 @@ def _setup(
     duration_s: float,
     **fields: Any,
 ) -> RunSetup:
-    """The packed run, common to both scenario kinds (``fields``: ``x0``, ``t0``, ``wall``)."""
+    """The packed run, common to every scenario kind (``fields``: ``x0``, ``t0``, ``wall``)."""
     yaw_paper = o.yaw_reaction == "paper"
-    return RunSetup(
+    entry = controller_entry(s.controller)
+    context = PackContext(
+        vehicle=v,
+        options=o,
+        pre_impact=s.resolved_pre_impact(),
+        nominal_controller=s.nominal_controller,
+    )
+    imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
+    scfg, noise, n_imu = pack_sensors(imu, s.detection, v, s.seed, duration_s)
+    setup = RunSetup(
         tf=float(s.final_time_s),
         veh=pack_vehicle(v),
         surf=pack_surfaces(surfaces),
-        opts=_packed_options(s, o, duration_s),
-        ctrl=pack_controller(CONTROLLER_KINDS[s.controller], v, refs, yaw_paper),
+        opts=_packed_options(s, o, v, duration_s),
+        ctrl=pack_controller(entry, s.resolved_controller_params(), context, refs, yaw_paper),
         surface_names=tuple(x.name for x in surfaces),
         references=refs,
         vehicle=v,
         options=o,
         output_rate_hz=float(s.output_rate_hz),
+        scfg=scfg,
+        noise=noise,
+        n_imu=n_imu,
+        controller=s.controller,
+        kernel=_kernel(entry),
         **fields,
         **_schedule(s),
     )
+    if s.controller == "recovery" and context.pre_impact == "spin-down":
+        if setup.opts[L.O_SLEW_MAX] <= 0.0:
+            setup.warnings.append(
+                f"no rotor slew limit (vehicle {v.name} has none): the pre-impact spin-down "
+                "stops the rotors at the first tick"
+            )
+    return setup
 
 
 # ------------------------------------------------------------- flight scenario
@@ -221,7 +273,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         veh=setup.veh,
         ctrl=setup.ctrl,
         schedule=setup.schedule(),
-        free_opts=_packed_options(s, o, float(s.impact_time_s), free=True),
+        free_opts=_packed_options(s, o, v, float(s.impact_time_s), free=True),
         wall=pack_surfaces([wall]),
         q=euler_zyx_to_quat(roll, pitch, yaw),
         rotors=_initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper"),
@@ -229,6 +281,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         impact_time_s=s.impact_time_s,
         speed_m_s=s.speed_m_s,
         late_start=o.approach_start == "late-start",
+        kernel=setup.kernel,
     )
     if setup.approach["late_start"]:
         setup.warnings.append(
@@ -236,8 +289,40 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         )
     return setup
 
-def prepare(scenario: WallApproach | FlightScenario) -> RunSetup:
+# ---------------------------------------------------------------- impact trial
+def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
+    """The recovery benchmark's trial (docs/RECOVERY.md 5): the wall ``X = 0``, no shooting.
+
+    The CM starts at ``X = -start_distance_m``, altitude ``altitude_m``, the
+    attitude and the inertial velocity ``(speed_m_s, 0, 0)`` given, at rest in
+    rotation, with the rotor speeds of the collective thrust
+    ``m g cos(roll) cos(pitch)`` and zero torques (multiplied by the cosines:
+    the vehicle was flying level before it tilted, as in the authors' set-up).
+    """
+    v = s.build_vehicle()
+    o = s.resolved_model_options()
+    roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.yaw_deg))
+    weight = v.mass_kg * v.gravity_m_s2
+    rotors = trim_rotor_speeds(
+        v, weight * math.cos(roll) * math.cos(pitch), o.yaw_reaction == "paper"
+    )
+    x0 = initial_state(
+        np.array([-float(s.start_distance_m), 0.0, -float(s.altitude_m)]),
+        np.array([float(s.speed_m_s), 0.0, 0.0]),
+        euler_zyx_to_quat(roll, pitch, yaw),
+        np.zeros(3),
+        rotors,
+    )
+    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
+    wall = Plane.wall(0.0)
+    surfaces = [wall, *_ground(s)]
+    return _setup(s, v, o, refs, surfaces, float(s.final_time_s), x0=x0, t0=0.0, wall=wall)
+
+
+def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
     """Validated scenario -> packed run."""
     if isinstance(scenario, WallApproach):
         return prepare_wall_approach(scenario)
+    if isinstance(scenario, ImpactTrial):
+        return prepare_impact_trial(scenario)
     return prepare_flight(scenario)

@@ -13,18 +13,18 @@ from collections.abc import Callable
 from typing import Any
 
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
-from quadimpact.inputs.scenarios import FlightScenario, WallApproach
+from quadimpact.core.run import execute_record
+from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.result import SimulationResult
-from quadimpact.simulation.record import episodes_frame, timeseries_frame
+from quadimpact.simulation.record import episodes_frame, imu_frame, timeseries_frame
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.summary import build_summary
 
-__all__ = ["run_setup", "simulate"]
+__all__ = ["analyse", "run_setup", "simulate"]
 
 
 def simulate(
-    scenario: WallApproach | FlightScenario,
+    scenario: WallApproach | FlightScenario | ImpactTrial,
     *,
     max_episodes: int = 1024,
     kernel: Callable | None = None,
@@ -33,19 +33,19 @@ def simulate(
 
     Parameters
     ----------
-    scenario : WallApproach or FlightScenario
+    scenario : WallApproach or FlightScenario or ImpactTrial
         Validated input (``quadimpact.inputs.scenarios``).
     max_episodes : int
         Size of the episode buffer; episodes beyond it are counted and reported.
     kernel : callable, optional
         A run loop from ``quadimpact.core.run.make_kernel`` (plug-in controller);
-        default: the cached kernel with the built-in controllers.
+        default: the registered controller's (the cached kernel for built-ins).
 
     Returns
     -------
     SimulationResult
-        ``.summary`` (dict of summary.json), ``.episodes`` and ``.timeseries``
-        (pandas DataFrames, SI units, inertial NED / body FRD).
+        ``.summary`` (dict of summary.json), ``.episodes``, ``.timeseries`` and
+        ``.imu`` (pandas DataFrames, SI units, inertial NED / body FRD).
     """
     setup = prepare(scenario)
     return run_setup(setup, scenario, max_episodes=max_episodes, kernel=kernel)
@@ -61,7 +61,7 @@ def run_setup(
     """Run a prepared setup through the compiled loop and analyse the record."""
     t_out = setup.output_times()
     wall_start = time.perf_counter()
-    out, ep, st = execute(
+    rec = execute_record(
         setup.x0,
         setup.t0,
         setup.tf,
@@ -71,13 +71,21 @@ def run_setup(
         setup.ctrl,
         t_out,
         max_episodes=max_episodes,
-        kernel=kernel,
+        kernel=kernel or setup.kernel,
         **setup.schedule(),
+        **setup.sensors(),
     )
     wall_s = time.perf_counter() - wall_start
+    return analyse(setup, scenario, rec, wall_s)
+
+
+def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan")):
+    """Tables and summary of a raw record (``core.run.RawRecord``) of ``setup``."""
+    out, ep, st = rec.out, rec.episodes, rec.stats
     ts = timeseries_frame(out, out.shape[0])
     episodes = episodes_frame(ep, ep.shape[0], setup.surface_names)
-    summary = build_summary(setup, scenario, ts, episodes, st)
+    final_state = out[-1, L.OUT_X : L.OUT_X + L.NX] if out.shape[0] else setup.x0
+    summary = build_summary(setup, scenario, ts, episodes, st, final_state=final_state)
     stats = {
         "steps": int(st[L.ST_N_STEPS]),
         "rejected_steps": int(st[L.ST_N_REJECTED]),
@@ -94,4 +102,5 @@ def run_setup(
         references=dict(setup.references),
         scenario=scenario,
         stats=stats,
+        imu=imu_frame(rec.imu),
     )

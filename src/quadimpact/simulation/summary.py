@@ -23,6 +23,7 @@ from quadimpact.simulation.metrics import (
     classify_response,
     impact_metrics,
 )
+from quadimpact.simulation.recovery_metrics import contact_normal, recovery_metrics
 from quadimpact.simulation.setup import RunSetup
 
 __all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]
@@ -40,8 +41,19 @@ def _nan_to_none(v: float) -> float | None:
     return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
 
 
-def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) -> dict[str, Any]:
-    """The summary of STUDIES.md section 2 from the raw stats and the tables."""
+def build_summary(
+    setup: RunSetup,
+    scenario: Any,
+    ts,
+    episodes,
+    st: np.ndarray,
+    final_state: np.ndarray | None = None,
+) -> dict[str, Any]:
+    """The summary (docs/STUDIES.md section 2, docs/RECOVERY.md section 6) of a run.
+
+    From the raw stats, the tables and the state at the end of the run
+    (default: the last row of the time series).
+    """
     status_code = int(st[L.ST_STATUS])
     status = STATUS_NAMES[status_code]
     warnings = list(setup.warnings)
@@ -55,10 +67,11 @@ def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) 
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
         q = xo[L.X_QUAT : L.X_QUAT + 4]
         vel = quat_to_matrix(q) @ xo[L.X_VEL : L.X_VEL + 3]
-        normal = (
-            setup.surf[0, L.S_NORMAL : L.S_NORMAL + 3] if setup.surf.shape[0] else -np.eye(3)[0]
-        )
-        speed = float(-vel @ normal)
+        first = _first_obstacle_episode(setup, episodes)
+        if first is not None:  # the contact normal there, from the contact geometry
+            bumper, surface = first
+            normal = contact_normal(xo, setup.veh, setup.surf, bumper, surface)
+            speed = float(-vel @ normal)
         heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
         incl = inclination_deg_of(q)
 
@@ -147,8 +160,47 @@ def build_summary(setup: RunSetup, scenario: Any, ts, episodes, st: np.ndarray) 
                 )
     if len(ts):
         summary["attitude_excursion"] = attitude_excursion_deg(ts, setup.references)
+    if final_state is None:
+        final_state = (
+            ts[["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s"]].to_numpy()[-1]
+            if len(ts)
+            else np.zeros(6)
+        )
+    summary["pre_impact"] = (
+        scenario.resolved_pre_impact() if getattr(scenario, "controller", None) == "recovery"
+        else None
+    )  # fmt: skip
+    summary["detection_threshold_m_s2"] = float(setup.scfg[L.SC_DET_THRESHOLD]) or None
+    summary.update(
+        recovery_metrics(
+            st,
+            episodes,
+            veh=setup.veh,
+            surf=setup.surf,
+            surface_names=setup.surface_names,
+            obstacle_names=_obstacle_names(setup),
+            final_state=np.asarray(final_state, dtype=float),
+        )
+    )
     summary["outcome"] = describe_outcome(summary)
     return summary
+
+
+def _obstacle_names(setup: RunSetup) -> list[str]:
+    """Names of the packed surfaces that are obstacles (not the ground)."""
+    return [n for k, n in enumerate(setup.surface_names) if setup.surf[k, L.S_IS_GROUND] < 0.5]
+
+
+def _first_obstacle_episode(setup: RunSetup, episodes) -> tuple[int, int] | None:
+    """(bumper index 0-3, surface index) of the first contact with an obstacle."""
+    if len(episodes) == 0:
+        return None
+    names = _obstacle_names(setup)
+    eps = episodes[episodes["surface"].astype(str).isin(names)]
+    if len(eps) == 0:
+        return None
+    row = eps.sort_values(["t_start_s", "bumper"], kind="mergesort").iloc[0]
+    return int(row["bumper"]) - 1, list(setup.surface_names).index(str(row["surface"]))
 
 
 def describe_outcome(s: dict[str, Any]) -> str:
@@ -164,6 +216,13 @@ def describe_outcome(s: dict[str, Any]) -> str:
             f"then {s['n_subsequent_impacts']} subsequent impact(s) "
             f"({s['n_subsequent_episodes']} episode(s))"
         )
+    if s.get("recovered"):
+        first += (
+            f"; detected at t = {s['t_detect_s']:.3f} s, recovered (stage 4) at "
+            f"t = {s['t_stage4_s']:.3f} s"
+        )
+    elif s.get("t_stage1_s") is not None:
+        first += f"; detected at t = {s['t_detect_s']:.3f} s, not recovered"
     if s["crash_time_s"] is not None:
         where = ""
         if s.get("crash_distance_from_wall_m") is not None:

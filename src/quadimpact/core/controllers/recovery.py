@@ -7,7 +7,10 @@ Before an impact is detected (stage 0) it runs a pre-impact behaviour:
 * ``PRE_HOLD``: the rotor speeds stay where they are (the initial trimmed speeds);
 * ``PRE_SPIN_DOWN``: the rotor commands are zero, so the speeds fall at the
   loop's slew limit to zero (the authors' Monte Carlo). The rotor range
-  applies only to the staged law's commands.
+  applies only to the staged law's commands;
+* ``PRE_IMMEDIATE``: none: the staged law runs from the first tick, as if an
+  impact had been detected there (with no wall-normal estimate, stage 1's
+  target is level). For exercising the law from any initial state.
 
 From the tick at which the detector has fired (``meas[MS_DETECTED]``) it runs
 the staged law until the end of the run. With ``u = -C e_z`` the body's up
@@ -87,6 +90,7 @@ N_RECOVERY_PARAMS = N_PID_PARAMS + 15
 PRE_NOMINAL = 0
 PRE_HOLD = 1
 PRE_SPIN_DOWN = 2
+PRE_IMMEDIATE = 3
 
 # ---- memory (after the PID slots of the nominal controller)
 RM_QE_X = N_PID_MEM  # previous tick's tilt error quaternion, x and y
@@ -210,8 +214,8 @@ def recovery_step(
     x = meas[MS_X : MS_X + NX]
     stage = int(mem[MEM_STAGE])
     if stage == STAGE_PRE_IMPACT:
-        if meas[MS_DETECTED] < 0.5:
-            pre = int(ctrl[p0 + R_PRE_IMPACT])
+        pre = int(ctrl[p0 + R_PRE_IMPACT])
+        if meas[MS_DETECTED] < 0.5 and pre != PRE_IMMEDIATE:
             if pre == PRE_NOMINAL:
                 if int(ctrl[p0 + R_NOMINAL_KIND]) == CTRL_CASCADE_PID:
                     cascade_pid_step(t, meas, ctrl, mem, veh, dt, cmd)

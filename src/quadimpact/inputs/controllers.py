@@ -1,0 +1,340 @@
+"""The controller registry: every controller a scenario can name, with its parameters.
+
+A controller is a compiled step (``quadimpact.core.controllers``), a model of
+its parameters (validated, with defaults; units in the names) and a packer
+that writes them into the kernel's parameter block (``ctrl[C_PARAMS:]``). One
+:func:`register_controller` call makes a controller selectable by name in
+scenario files (``controller = "..."``, ``[controller_params]``), in sweeps
+and in ``quadimpact run --controller``.
+
+Built-in controllers (``paper``, ``cascade-pid``, ``recovery``) have a kind id
+that the cached kernel dispatches on. A controller registered with a ``step``
+(a Numba ``njit`` function ``step(t, meas, ctrl, mem, veh, dt, cmd)``, see
+``quadimpact.core.controllers``) runs in a kernel compiled for it
+(``core.run.make_kernel``, once per process).
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, Field, ValidationError
+
+from quadimpact.core import layout as L
+from quadimpact.core.controllers import common as PID
+from quadimpact.core.controllers import recovery as REC
+from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
+
+__all__ = [
+    "CASCADE_GAINS",
+    "CascadePidParams",
+    "ControllerEntry",
+    "PAPER_GAINS",
+    "PackContext",
+    "PaperParams",
+    "RecoveryParams",
+    "controller_entry",
+    "controller_names",
+    "register_controller",
+    "unregister_controller",
+]
+
+# Paper gains (docs/MODEL.md section 6.1): (P, I, D) for altitude, climb rate,
+# heading, roll/pitch and yaw rate.
+PAPER_GAINS = {
+    "altitude_pid": (2.0, 0.0, 0.4),  # altitude h -> climb-rate reference
+    "climb_pid": (1.6, 60.0, 0.0),  # climb rate -> vertical acceleration
+    "heading_pid": (1.2, 1.0, 0.2),  # heading -> yaw-rate reference
+    "attitude_pid": (7.2, 4.0, 4.2),  # roll and pitch -> angular acceleration
+    "yaw_rate_pid": (1.8, 2.0, 0.0),  # yaw rate -> yaw acceleration
+}
+# cascade-pid gains: the paper's, retuned where a running integral changes the
+# loop (linearised analysis in docs/CONTROLLERS.md): climb rate P 4, I 4 (the
+# paper's 1.6 and 60 give damping 0.05 with a true integral); heading I 0 (the
+# yaw-rate integral already removes steady yaw errors; paper 1) and yaw rate
+# P 3, I 1 (paper 1.8, 2: damping 0.26 with running integrals). Every loop then
+# has damping >= 0.7.
+CASCADE_GAINS = {
+    "altitude_pid": (2.0, 0.0, 0.4),
+    "climb_pid": (4.0, 4.0, 0.0),
+    "heading_pid": (1.2, 0.0, 0.2),
+    "attitude_pid": (7.2, 4.0, 4.2),
+    "yaw_rate_pid": (3.0, 1.0, 0.0),
+}
+_PID_FIELDS = ("altitude_pid", "climb_pid", "heading_pid", "attitude_pid", "yaw_rate_pid")
+
+
+# ------------------------------------------------------------------ params
+class PaperParams(BaseModel):
+    """Gains of the ``paper`` controller: (P, I, D) of each loop (docs/MODEL.md 6.1)."""
+
+    model_config = MODEL_CONFIG
+
+    altitude_pid: Vec3 = Field(PAPER_GAINS["altitude_pid"], description="h -> climb rate.")
+    climb_pid: Vec3 = Field(PAPER_GAINS["climb_pid"], description="climb rate -> accel.")
+    heading_pid: Vec3 = Field(PAPER_GAINS["heading_pid"], description="heading -> yaw rate.")
+    attitude_pid: Vec3 = Field(PAPER_GAINS["attitude_pid"], description="roll, pitch -> accel.")
+    yaw_rate_pid: Vec3 = Field(PAPER_GAINS["yaw_rate_pid"], description="yaw rate -> accel.")
+
+    def gains(self) -> np.ndarray:
+        """The 15 gains in the kernel's order (``common.G_*`` blocks)."""
+        return np.array([g for name in _PID_FIELDS for g in getattr(self, name)], dtype=float)
+
+
+class CascadePidParams(PaperParams):
+    """Gains of ``cascade-pid`` (retuned, docs/CONTROLLERS.md) and its tilt floor."""
+
+    altitude_pid: Vec3 = Field(CASCADE_GAINS["altitude_pid"], description="h -> climb rate.")
+    climb_pid: Vec3 = Field(CASCADE_GAINS["climb_pid"], description="climb rate -> accel.")
+    heading_pid: Vec3 = Field(CASCADE_GAINS["heading_pid"], description="heading -> yaw rate.")
+    attitude_pid: Vec3 = Field(CASCADE_GAINS["attitude_pid"], description="roll, pitch -> accel.")
+    yaw_rate_pid: Vec3 = Field(CASCADE_GAINS["yaw_rate_pid"], description="yaw rate -> accel.")
+    thrust_cos_floor: Real = Field(
+        0.5, gt=0, le=1, description="Floor of cos(roll) cos(pitch) in the thrust compensation."
+    )
+
+
+class RecoveryParams(BaseModel):
+    """Gains and thresholds of the ``recovery`` controller's staged law (docs/RECOVERY.md 3).
+
+    The pre-impact behaviour and the nominal controller are scenario fields
+    (``pre_impact``, ``nominal_controller``).
+    """
+
+    model_config = MODEL_CONFIG
+
+    k_att_1_s: Real = Field(20.0, ge=0, description="Tilt error -> rate reference, 1/s.")
+    k_rate_1_s: Vec3 = Field(
+        (20.0, 20.0, 2.0), description="Rate error -> angular acceleration (p, q, r), 1/s."
+    )
+    a_mag_m_s2: Real | None = Field(
+        None, ge=0, description="Stage 1 push away from the wall, m/s^2; None: the vehicle's g."
+    )
+    k_z_1_s: Vec4 = Field(
+        (0.0, 0.0, 10.0, 10.0), description="Vertical-velocity gain of stages 1-4, 1/s."
+    )
+    tilt_error_tol: Real = Field(
+        0.3, gt=0, le=1, description="|q_e,x|, |q_e,y| below this end stages 1 and 2."
+    )
+    rate_tol_rad_s: Real = Field(0.5, gt=0, description="|p|, |q| below this end stages 1-2.")
+    w_tol_m_s: Real = Field(0.3, description="Body z velocity below this ends stage 3, m/s.")
+
+
+# ------------------------------------------------------------------ registry
+@dataclass(frozen=True)
+class PackContext:
+    """What a packer may need besides its parameters.
+
+    Attributes
+    ----------
+    vehicle : quadimpact.inputs.vehicle.Vehicle
+    options : quadimpact.inputs.model.ModelOptions
+        Every model switch of the run.
+    pre_impact : str
+        The recovery controller's pre-impact behaviour in force.
+    nominal_controller : str
+        The nominal controller's name (the wall approach's, or recovery's pre-impact).
+    """
+
+    vehicle: Any
+    options: Any
+    pre_impact: str = "nominal"
+    nominal_controller: str = "paper"
+
+
+@dataclass(frozen=True)
+class ControllerEntry:
+    """One registered controller.
+
+    Attributes
+    ----------
+    name : str
+        As written in scenario files and on the command line.
+    kind : int
+        ``ctrl[C_KIND]``: a built-in ``CTRL_*`` id, or ``CTRL_USER`` for a plug-in.
+    params : type of pydantic.BaseModel
+        Its parameters (``[controller_params]``), with defaults.
+    pack : callable
+        ``pack(params, context) -> ndarray (NPARAM,)``: the parameter block.
+    step : callable or None
+        The compiled step of a plug-in (``None`` for built-ins).
+    description : str
+        One line for help texts.
+    """
+
+    name: str
+    kind: int
+    params: type[BaseModel]
+    pack: Callable[[BaseModel, PackContext], np.ndarray]
+    step: Callable | None = None
+    description: str = ""
+    kernel_cache: dict = field(default_factory=dict, compare=False, repr=False)
+
+
+class _NoParams(BaseModel):
+    model_config = MODEL_CONFIG
+
+
+def _empty_block(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    return np.zeros(L.NPARAM)
+
+
+def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    block = np.zeros(L.NPARAM)
+    block[PID.P_GAINS : PID.P_GAINS + 15] = params.gains()
+    block[PID.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
+    return block
+
+
+_PRE_IMPACT = {
+    "nominal": REC.PRE_NOMINAL,
+    "hold": REC.PRE_HOLD,
+    "spin-down": REC.PRE_SPIN_DOWN,
+    "immediate": REC.PRE_IMMEDIATE,
+}
+PRE_IMPACT_CHOICES: tuple[str, ...] = tuple(_PRE_IMPACT)
+"""The recovery controller's pre-impact behaviours."""
+
+
+def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    nominal = controller_entry(ctx.nominal_controller)
+    block = _pack_pid(nominal.params(), ctx)
+    p: RecoveryParams = params  # type: ignore[assignment]
+    block[REC.R_NOMINAL_KIND] = nominal.kind
+    block[REC.R_PRE_IMPACT] = _PRE_IMPACT[ctx.pre_impact]
+    block[REC.R_K_ATT] = p.k_att_1_s
+    block[REC.R_K_RATE : REC.R_K_RATE + 3] = p.k_rate_1_s
+    block[REC.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
+    block[REC.R_K_Z : REC.R_K_Z + 4] = p.k_z_1_s
+    block[REC.R_Q_TOL] = p.tilt_error_tol
+    block[REC.R_RATE_TOL] = p.rate_tol_rad_s
+    block[REC.R_W_TOL] = p.w_tol_m_s
+    level = ctx.options.detection_tick_reference == "level"
+    block[REC.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
+    return block
+
+
+_REGISTRY: dict[str, ControllerEntry] = {}
+
+
+def register_controller(
+    name: str,
+    step: Callable | None = None,
+    *,
+    params: type[BaseModel] | None = None,
+    pack: Callable[[BaseModel, PackContext], np.ndarray] | None = None,
+    kind: int | None = None,
+    description: str = "",
+    replace: bool = False,
+) -> ControllerEntry:
+    """Make a controller selectable by ``name`` in scenarios, sweeps and the CLI.
+
+    Parameters
+    ----------
+    name : str
+        Its name (letters, digits, ``-`` and ``_``).
+    step : callable, optional
+        A Numba ``njit`` step ``step(t, meas, ctrl, mem, veh, dt, cmd)`` (a plug-in);
+        omit for a built-in (then give ``kind``).
+    params : pydantic model class, optional
+        Its parameters with defaults (default: none).
+    pack : callable, optional
+        ``pack(params, context) -> ndarray (NPARAM,)``, the parameter block at
+        ``ctrl[C_PARAMS:]`` (default: zeros).
+    kind : int, optional
+        A built-in ``CTRL_*`` id of the cached kernel.
+    description : str, optional
+        One line for help texts.
+    replace : bool, optional
+        Replace an entry of the same name instead of refusing.
+
+    Returns
+    -------
+    ControllerEntry
+    """
+    if not name or not all(c.isalnum() or c in "-_" for c in name):
+        raise ValueError(f"controller name {name!r}: letters, digits, '-' and '_' only")
+    if name in _REGISTRY and not replace:
+        raise ValueError(f"controller {name!r} is already registered (replace=True to replace)")
+    if step is None and kind is None:
+        raise ValueError(f"controller {name!r}: give its compiled step (or a built-in kind)")
+    entry = ControllerEntry(
+        name=name,
+        kind=L.CTRL_USER if kind is None else int(kind),
+        params=params or _NoParams,
+        pack=pack or _empty_block,
+        step=step,
+        description=description,
+    )
+    _REGISTRY[name] = entry
+    return entry
+
+
+def unregister_controller(name: str) -> None:
+    """Remove a registered controller (built-ins cannot be removed)."""
+    if name in ("paper", "cascade-pid", "recovery"):
+        raise ValueError(f"controller {name!r} is built in")
+    _REGISTRY.pop(name, None)
+
+
+def controller_names() -> tuple[str, ...]:
+    """Names of every registered controller, built-ins first."""
+    return tuple(_REGISTRY)
+
+
+def controller_entry(name: str) -> ControllerEntry:
+    """The registry entry of ``name``.
+
+    Raises
+    ------
+    InputError
+        Unknown name (with the registered names and a near miss).
+    """
+    try:
+        return _REGISTRY[name]
+    except (KeyError, TypeError):
+        known = ", ".join(repr(n) for n in _REGISTRY)
+        close = difflib.get_close_matches(str(name), list(_REGISTRY), n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise InputError(f"controller: must be one of {known} (got {name!r}){hint}") from None
+
+
+def validate_params(name: str, values: Mapping[str, Any] | BaseModel | None) -> BaseModel:
+    """The validated parameters of controller ``name`` (defaults for what is not given)."""
+    entry = controller_entry(name)
+    if isinstance(values, entry.params):
+        return values
+    try:
+        return entry.params.model_validate(dict(values or {}))
+    except ValidationError as exc:
+        raise input_error_from_validation(
+            exc, prefix=("controller_params",), model=entry.params
+        ) from None
+
+
+register_controller(
+    "paper",
+    kind=L.CTRL_PAPER,
+    params=PaperParams,
+    pack=_pack_pid,
+    description="the authors' discrete PID as they ran it (quirks included)",
+)
+register_controller(
+    "cascade-pid",
+    kind=L.CTRL_CASCADE_PID,
+    params=CascadePidParams,
+    pack=_pack_pid,
+    description="the same loops with running integrals, anti-windup and rotor limits",
+)
+register_controller(
+    "recovery",
+    kind=L.CTRL_RECOVERY,
+    params=RecoveryParams,
+    pack=_pack_recovery,
+    description="pre-impact behaviour, then the staged recovery law after detection",
+)

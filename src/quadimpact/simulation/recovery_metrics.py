@@ -1,0 +1,172 @@
+"""Detection and recovery metrics of a run (docs/RECOVERY.md section 6).
+
+Pure functions of the kernel's stats (detection, stage entries, extremes)
+and the episodes table, so they can be tested on hand-made inputs. Times are
+in seconds of simulated time (an impact trial starts at 0); a stage's time is
+the control tick at which the run entered it (the authors' tables give the
+end of that 5-ms interval, tick + 5 ms). Distances in m, inertial NED
+(altitude ``h = -Z``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from quadimpact.core import layout as L
+from quadimpact.core.geometry import bumper_contact
+from quadimpact.rotations import quat_to_matrix
+from quadimpact.simulation.metrics import GRAZE_DELTA_M, group_impacts
+
+__all__ = ["RECOVERY_KEYS", "contact_normal", "recovery_metrics"]
+
+RECOVERED_STAGE = 4
+
+RECOVERY_KEYS: tuple[str, ...] = (
+    "detected",
+    "not_detected",
+    "false_detection",
+    "n_detections",
+    "t_detect_s",
+    "detection_latency_s",
+    "normal_error_deg",
+    "t_stage1_s",
+    "t_stage2_s",
+    "t_stage3_s",
+    "t_stage4_s",
+    "recovered",
+    "time_to_recover_s",
+    "height_loss_stage2_m",
+    "height_loss_stage3_m",
+    "height_loss_m",
+    "horizontal_drift_stage2_m",
+    "horizontal_drift_stage3_m",
+    "horizontal_drift_m",
+    "min_altitude_m",
+    "impacts_after_detection",
+    "max_tilt_deg",
+    "max_rate_rad_s",
+    "final_speed_m_s",
+)
+"""The metric keys, in summary order."""
+
+
+def _finite(v: float) -> float | None:
+    return None if v is None or not math.isfinite(v) else float(v)
+
+
+def contact_normal(
+    x: np.ndarray, veh: np.ndarray, surf: np.ndarray, bumper: int, surface: int
+) -> np.ndarray:
+    """The contact normal (inertial, unit, out of the obstacle) of a bumper-surface pair at ``x``.
+
+    From the compiled contact geometry, whatever the surface's kind.
+    """
+    xq = np.ascontiguousarray(x, dtype=float)
+    C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
+    rec = bumper_contact(xq, C, veh, int(bumper), surf, int(surface))
+    return np.array(rec[8:11])
+
+
+def _first_obstacle_episode(episodes: pd.DataFrame, obstacle_names: Sequence[str]):
+    if len(episodes) == 0:
+        return None
+    eps = episodes[episodes["surface"].astype(str).isin(list(obstacle_names))]
+    if len(eps) == 0:
+        return None
+    return eps.sort_values(["t_start_s", "bumper"], kind="mergesort").iloc[0]
+
+
+def recovery_metrics(
+    st: np.ndarray,
+    episodes: pd.DataFrame,
+    *,
+    veh: np.ndarray,
+    surf: np.ndarray,
+    surface_names: Sequence[str],
+    obstacle_names: Sequence[str],
+    final_state: np.ndarray,
+) -> dict[str, Any]:
+    """The metrics of docs/RECOVERY.md section 6 from a run's record.
+
+    Parameters
+    ----------
+    st : numpy.ndarray (NSTAT,)
+        The kernel's stats (layout ``ST_*``).
+    episodes : pandas.DataFrame
+        The episodes table (``simulation.record.episodes_frame``).
+    veh, surf : numpy.ndarray
+        The packed vehicle and surfaces (for the true contact normal).
+    surface_names : sequence of str
+        Names of the packed surfaces, in order.
+    obstacle_names : sequence of str
+        The surfaces that count as obstacles (the ground does not).
+    final_state : numpy.ndarray (NX,)
+        The state at the end of the run.
+
+    Returns
+    -------
+    dict
+        :data:`RECOVERY_KEYS`; floats are ``None`` where undefined (no
+        detection, stage not reached...), booleans and counts always set.
+    """
+    t_detect = float(st[L.ST_T_DETECT])
+    detected = math.isfinite(t_detect)
+    first_contact = float(st[L.ST_ONSET_T])
+    contact = math.isfinite(first_contact)
+    false_detection = detected and (not contact or t_detect < first_contact)
+    out: dict[str, Any] = dict.fromkeys(RECOVERY_KEYS)
+    out["detected"] = bool(detected)
+    out["not_detected"] = bool(contact and not detected)
+    out["false_detection"] = bool(false_detection)
+    out["n_detections"] = int(st[L.ST_N_DETECTIONS])
+    out["t_detect_s"] = _finite(t_detect)
+    out["min_altitude_m"] = _finite(float(st[L.ST_MIN_ALT]))
+    v = final_state[L.X_VEL : L.X_VEL + 3]
+    out["final_speed_m_s"] = _finite(float(np.sqrt(v @ v)))
+    stage_t = [float(st[L.ST_STAGE_T + k]) for k in range(L.N_STAGES)]
+    for k in (1, 2, 3, 4):
+        out[f"t_stage{k}_s"] = _finite(stage_t[k])
+    out["recovered"] = bool(math.isfinite(stage_t[RECOVERED_STAGE]))
+    out["impacts_after_detection"] = 0
+    if not detected:
+        return out
+
+    if contact and not false_detection:
+        out["detection_latency_s"] = t_detect - first_contact
+        first = _first_obstacle_episode(episodes, obstacle_names)
+        if first is not None:
+            s_index = list(surface_names).index(str(first["surface"]))
+            x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
+            n_true = contact_normal(x_onset, veh, surf, int(first["bumper"]) - 1, s_index)
+            n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
+            if np.linalg.norm(n_est) > 0:
+                c = float(np.clip(n_est @ n_true / np.linalg.norm(n_true), -1.0, 1.0))
+                out["normal_error_deg"] = math.degrees(math.acos(c))
+    p_detect = st[L.ST_DETECT_X + L.X_POS : L.ST_DETECT_X + L.X_POS + 3]
+    for k, name in ((2, "stage2"), (3, "stage3"), (4, None)):
+        if not math.isfinite(stage_t[k]):
+            continue
+        p = st[L.ST_STAGE_X + 3 * k : L.ST_STAGE_X + 3 * k + 3]
+        loss = -p_detect[2] - (-p[2])  # altitude at detection minus altitude at entry
+        drift = math.hypot(p[0] - p_detect[0], p[1] - p_detect[1])
+        suffix = f"_{name}" if name else ""
+        out[f"height_loss{suffix}_m"] = float(loss)
+        out[f"horizontal_drift{suffix}_m"] = float(drift)
+    if out["recovered"]:
+        out["time_to_recover_s"] = stage_t[RECOVERED_STAGE] - t_detect
+    out["max_tilt_deg"] = math.degrees(math.acos(float(np.clip(st[L.ST_MIN_TILT_COS], -1, 1))))
+    out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
+    # impacts (grazes excluded, obstacles only) that start after the detection
+    if len(episodes):
+        eps = episodes[episodes["surface"].astype(str).isin(list(obstacle_names))]
+        eps = eps[eps["peak_delta_m"] >= GRAZE_DELTA_M].reset_index(drop=True)
+        starts = eps["t_start_s"].to_numpy()
+        out["impacts_after_detection"] = int(
+            sum(1 for g in group_impacts(eps) if starts[g].min() > t_detect)
+        )
+    return out
