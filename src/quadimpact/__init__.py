@@ -19,6 +19,10 @@ __version__ = "0.1.0"
 _EXPORTS = {
     "WallApproach": "quadimpact.inputs.scenarios",
     "FlightScenario": "quadimpact.inputs.scenarios",
+    "ImpactTrial": "quadimpact.inputs.scenarios",
+    "ImuSettings": "quadimpact.inputs.sensors",
+    "DetectionSettings": "quadimpact.inputs.sensors",
+    "register_controller": "quadimpact.inputs.controllers",
     "Plane": "quadimpact.inputs.world",
     "ModelOptions": "quadimpact.inputs.model",
     "load_scenario_file": "quadimpact.inputs.scenarios",
@@ -26,6 +30,8 @@ _EXPORTS = {
     "load_vehicle": "quadimpact.inputs.vehicle",
     "InputError": "quadimpact.errors",
     "simulate": "quadimpact.simulation",
+    "Simulation": "quadimpact.simulation",
+    "read_result": "quadimpact.results.result",
 }
 
 __all__ = ["__version__", *_EXPORTS]

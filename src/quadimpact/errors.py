@@ -137,6 +137,26 @@ def _rule(error: Mapping[str, Any]) -> tuple[str, bool]:
     return message[:1].lower() + message[1:], True
 
 
+def near_miss(key: str, candidates: Sequence[str]) -> str | None:
+    """The candidate a mistyped ``key`` most likely meant, or ``None``.
+
+    In order: the same name in another case; a name that is ``key`` plus a
+    unit or qualifier suffix (``speed`` -> ``speed_m_s``, ``friction`` ->
+    ``friction_coefficient``; the shortest); then the closest spelling
+    (``restitusion`` -> ``restitution``).
+    """
+    key = str(key)
+    names = [str(c) for c in candidates]
+    lower = {n.lower(): n for n in names}
+    if key.lower() in lower:
+        return lower[key.lower()]
+    longer = sorted((n for n in names if n.lower().startswith(key.lower() + "_")), key=len)
+    if longer:
+        return longer[0]
+    close = difflib.get_close_matches(key, names, n=1, cutoff=0.7)
+    return close[0] if close else None
+
+
 def _suggest(model: Any, loc: Sequence[Any]) -> str:
     """A ``did you mean`` hint for an unknown key, if a close field name exists."""
     current = model
@@ -148,8 +168,8 @@ def _suggest(model: Any, loc: Sequence[Any]) -> str:
     fields = getattr(current, "model_fields", None)
     if not fields or not loc:
         return ""
-    close = difflib.get_close_matches(str(loc[-1]), list(fields), n=1)
-    return f"; did you mean {close[0]!r}?" if close else ""
+    close = near_miss(str(loc[-1]), list(fields))
+    return f"; did you mean {close!r}?" if close else ""
 
 
 def input_error_from_validation(

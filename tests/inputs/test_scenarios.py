@@ -22,6 +22,10 @@ DEFAULT_SWITCHES = {
     "attitude_mapping": "exact",
     "crash_rule": "cm-ground",
     "approach_start": "late-start",
+    "spinup_reaction": "physical",
+    "detection_tick_reference": "tilt-away",
+    "contact_gate_m": 0.0,
+    "pre_impact": "scenario",
 }
 REPLICA_SWITCHES = {
     "yaw_reaction": "paper",
@@ -30,6 +34,18 @@ REPLICA_SWITCHES = {
     "attitude_mapping": "paper-fit",
     "crash_rule": "paper-ticks",
     "approach_start": "paper",
+    "spinup_reaction": "paper",
+    "detection_tick_reference": "tilt-away",
+    "contact_gate_m": 0.0,
+    "pre_impact": "scenario",
+}
+# the recovery replica: the paper replica's drag sense, the rest its own (docs/VARIANTS.md 5)
+RECOVERY_REPLICA_SWITCHES = {
+    **DEFAULT_SWITCHES,
+    "yaw_reaction": "paper",
+    "detection_tick_reference": "level",
+    "contact_gate_m": 0.30,
+    "pre_impact": "spin-down",
 }
 
 
@@ -106,10 +122,13 @@ def test_models_are_frozen_and_forbid_extras() -> None:
         ({"rotor_speed_limits_rpm": [8000, 3000]}, "must be [min, max] with min < max"),
         ({"rotor_speed_limits_rpm": [3000]}, "must have exactly 2 numbers (got 1)"),
         ({"rotor_slew_limit_rad_s2": 0}, "rotor_slew_limit_rad_s2: must be > 0 (got 0)"),
-        ({"model": "replica"}, "model: must be one of 'default' or 'paper-replica'"),
-        ({"controller": "pid"}, "controller: must be one of 'paper' or 'cascade-pid'"),
+        (
+            {"model": "replica"},
+            "model: must be one of 'default', 'paper-replica' or 'recovery-replica'",
+        ),
+        ({"controller": "pid"}, "controller: must be one of 'paper', 'cascade-pid', 'recovery'"),
         ({"rotor_mode": "lag"}, "rotor_mode: must be one of 'ideal' or 'first-order'"),
-        ({"ground": "bounce"}, "ground: must be one of 'crash' or 'contact'"),
+        ({"ground": "bounce"}, "ground: must be one of 'crash', 'contact' or 'none'"),
         ({"heading_deg": math.inf}, "heading_deg: must be a finite number (got inf)"),
         ({"heading_deg": True}, "heading_deg: must be a number (got True)"),
         ({"vehicle_overrides": {"colour": 1}}, "vehicle_overrides: unknown vehicle field"),
@@ -167,6 +186,7 @@ def test_plane_normal_is_normalised() -> None:
 def test_variants_resolve_every_switch() -> None:
     assert MODEL_VARIANTS["default"] == DEFAULT_SWITCHES
     assert MODEL_VARIANTS["paper-replica"] == REPLICA_SWITCHES
+    assert MODEL_VARIANTS["recovery-replica"] == RECOVERY_REPLICA_SWITCHES
     assert resolve_model_options("default", None).model_dump() == DEFAULT_SWITCHES
     assert resolve_model_options("paper-replica", ModelOptions()).model_dump() == REPLICA_SWITCHES
     assert WallApproach(model="paper-replica").resolved_model_options().model_dump() == (
@@ -282,7 +302,10 @@ def test_vehicle_path_relative_to_scenario_file(tmp_path: Path) -> None:
             "hedding_deg = 5\n",
             "scenario.toml: hedding_deg: unknown key; did you mean 'heading_deg'",
         ),
-        ('kind = "orbit"\n', "scenario.toml: kind: must be 'wall-approach' or 'flight'"),
+        (
+            'kind = "orbit"\n',
+            "scenario.toml: kind: must be one of 'wall-approach', 'flight', 'impact-trial'",
+        ),
         ("[model_options]\ncrash_rule = 1\n", "scenario.toml: model_options.crash_rule: must be"),
         (
             "[vehicle_overrides]\nrestitution = 1.5\n",

@@ -22,7 +22,7 @@ def spiri() -> Vehicle:
 
 
 def test_bundled_spiri_has_model_values(spiri: Vehicle) -> None:
-    assert bundled_vehicles() == ["spiri"]
+    assert bundled_vehicles() == ["navi", "spiri"]
     assert load_vehicle("spiri") == spiri
     assert spiri.name == "spiri"
     assert spiri.mass_kg == 0.933
@@ -210,7 +210,7 @@ def test_bad_toml_syntax_names_file_and_line(tmp_path: Path) -> None:
 
 def test_unknown_name_and_missing_file(tmp_path: Path) -> None:
     with pytest.raises(
-        InputError, match=r"vehicle 'spirit': unknown vehicle name \(bundled: spiri"
+        InputError, match=r"vehicle 'spirit': unknown vehicle name \(bundled: navi, spiri"
     ):
         load_vehicle("spirit")
     missing = tmp_path / "nope.toml"

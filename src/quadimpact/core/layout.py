@@ -91,10 +91,11 @@ ROTOR_FIRST_ORDER = 1
 #
 # A common head (kind, references, allocation, rotor range) followed by a
 # block of NPARAM slots that each controller lays out for itself (see its
-# module in core/controllers/). Memory slot MEM_STAGE is reserved: a
-# controller with discrete stages writes its current stage there, and the
+# module in core/controllers/). Memory slot MEM_STAGE (the last) is reserved:
+# a controller with discrete stages writes its current stage there, and the
 # loop records it per output sample and the tick at which each stage was
-# first entered (ST_STAGE_T).
+# first entered (ST_STAGE_T). Controllers written for the earlier 24-slot
+# memory never touch it.
 # --------------------------------------------------------------------------
 C_KIND = 0  # CTRL_* below
 C_H_REF = 1  # m, altitude reference
@@ -115,7 +116,7 @@ CTRL_RECOVERY = 3
 CTRL_USER = 99  # a plug-in controller compiled with run.make_kernel
 
 NMEM = 64  # controller memory (previous errors, integrals, flags), zeroed at the start
-MEM_STAGE = 0  # reserved: the controller's current stage (0 when it has none)
+MEM_STAGE = NMEM - 1  # reserved: the controller's current stage (0 when it has none)
 N_STAGES = 8  # stages 0..7 have recorded entry ticks
 
 # --------------------------------------------------------------------------

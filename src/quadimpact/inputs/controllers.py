@@ -16,7 +16,6 @@ that the cached kernel dispatches on. A controller registered with a ``step``
 
 from __future__ import annotations
 
-import difflib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
@@ -27,7 +26,7 @@ from pydantic import BaseModel, Field, ValidationError
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import common as PID
 from quadimpact.core.controllers import recovery as REC
-from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.errors import InputError, input_error_from_validation, near_miss
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
 
 __all__ = [
@@ -299,8 +298,8 @@ def controller_entry(name: str) -> ControllerEntry:
         return _REGISTRY[name]
     except (KeyError, TypeError):
         known = ", ".join(repr(n) for n in _REGISTRY)
-        close = difflib.get_close_matches(str(name), list(_REGISTRY), n=1)
-        hint = f"; did you mean {close[0]!r}?" if close else ""
+        close = near_miss(str(name), list(_REGISTRY))
+        hint = f"; did you mean {close!r}?" if close else ""
         raise InputError(f"controller: must be one of {known} (got {name!r}){hint}") from None
 
 

@@ -6,10 +6,14 @@
 * :mod:`~quadimpact.simulation.record`: raw kernel arrays -> episodes and time series;
 * :mod:`~quadimpact.simulation.metrics`: impacts, metrics, response types;
 * :mod:`~quadimpact.simulation.summary`: the summary of a run;
-* :mod:`~quadimpact.simulation.simulate`: :func:`simulate` and :func:`run_setup`.
+* :mod:`~quadimpact.simulation.recovery_metrics`: detection and recovery metrics;
+* :mod:`~quadimpact.simulation.simulate`: :func:`simulate` and :func:`run_setup`;
+* :mod:`~quadimpact.simulation.stepping`: :class:`Simulation`, a run advanced
+  one control interval at a time from Python.
 """
 
 from quadimpact.simulation.simulate import run_setup, simulate
+from quadimpact.simulation.stepping import Simulation
 from quadimpact.simulation.summary import build_summary
 
-__all__ = ["build_summary", "run_setup", "simulate"]
+__all__ = ["Simulation", "build_summary", "run_setup", "simulate"]

@@ -216,13 +216,12 @@ def describe_outcome(s: dict[str, Any]) -> str:
             f"then {s['n_subsequent_impacts']} subsequent impact(s) "
             f"({s['n_subsequent_episodes']} episode(s))"
         )
+    if s.get("t_detect_s") is not None:
+        first += f"; impact detected at t = {s['t_detect_s']:.3f} s"
     if s.get("recovered"):
-        first += (
-            f"; detected at t = {s['t_detect_s']:.3f} s, recovered (stage 4) at "
-            f"t = {s['t_stage4_s']:.3f} s"
-        )
+        first += f"; recovered (stage 4) at t = {s['t_stage4_s']:.3f} s"
     elif s.get("t_stage1_s") is not None:
-        first += f"; detected at t = {s['t_detect_s']:.3f} s, not recovered"
+        first += "; not recovered"
     if s["crash_time_s"] is not None:
         where = ""
         if s.get("crash_distance_from_wall_m") is not None:

@@ -91,7 +91,7 @@ G_HEADING = 6
 G_ATT = 9
 G_YAWRATE = 12
 
-# Memory slots (mem[0] is layout.MEM_STAGE):
+# Memory slots (the last, layout.MEM_STAGE, is reserved):
 M_STARTED = 1  # 1 after the first tick
 M_E_H = 2  # previous errors
 M_E_V = 3
