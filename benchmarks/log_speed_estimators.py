@@ -48,7 +48,9 @@ import numpy as np
 from scipy import signal
 
 from quadimpact.experiments.crashes import TABLE3
-from quadimpact.experiments.logs import LOOKBACK_S, SpiriMatLog, crash_set_1, data_dir
+from quadimpact.experiments.estimation import LOOKBACK_S
+from quadimpact.experiments.logs import data_dir
+from quadimpact.experiments.spiri_mat import SpiriMatLog, crash_set_1
 
 RATES_HZ = (60.0, 100.0, 120.0)
 CUTOFFS_HZ = (10.0, 20.0, 30.0)

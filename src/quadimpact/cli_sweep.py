@@ -114,7 +114,7 @@ def sweep(
     )
     plots: list[Path] = []
     if not no_plots:
-        from quadimpact.sweep_plots import auto_plots
+        from quadimpact.sweep.plots import auto_plots
 
         try:
             plots = auto_plots(out, spec)

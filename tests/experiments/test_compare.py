@@ -8,14 +8,11 @@ import numpy as np
 import pytest
 
 from quadimpact import WallApproach, simulate
-from quadimpact.experiments.compare import (
-    GROUPS,
-    Comparison,
-    compare,
-    log_response,
-    synthetic_log,
-)
-from quadimpact.experiments.logs import FlightLog, SpiriMatLog, data_dir
+from quadimpact.experiments.compare import GROUPS, Comparison, compare, log_response
+from quadimpact.experiments.logs import FlightLog, data_dir
+from quadimpact.experiments.spiri_mat import SpiriMatLog
+
+from synthetic_log import synthetic_log
 
 WINDOWS = (0.3, 0.5)
 

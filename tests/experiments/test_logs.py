@@ -24,15 +24,13 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.experiments.logs import (
+from quadimpact.experiments.estimation import (
     IMPACT_RATE_THRESHOLD,
     IMPACT_SEARCH_AFTER_S,
     IMPACT_SEARCH_BEFORE_S,
-    SpiriMatLog,
-    crash_set_1,
-    data_dir,
-    rpm_to_rad_s,
 )
+from quadimpact.experiments.logs import data_dir, rpm_to_rad_s
+from quadimpact.experiments.spiri_mat import SpiriMatLog, crash_set_1
 
 DATA = data_dir()
 pytestmark = pytest.mark.data

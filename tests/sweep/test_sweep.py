@@ -544,7 +544,7 @@ def test_cli_sweep_errors(tmp_path, args, fragment):
 
 # ------------------------------------------------------------------ plots
 def test_plots(serial_table, tmp_path):
-    from quadimpact.sweep_plots import choose_plot_fields, plot_metric, plot_type_map
+    from quadimpact.sweep.plots import choose_plot_fields, plot_metric, plot_type_map
 
     fig = plot_metric(serial_table, "inclination_deg", by="heading_deg", path=tmp_path / "m.png")
     assert len(fig.axes) == 1 and len(fig.axes[0].lines) == 2

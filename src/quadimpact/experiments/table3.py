@@ -36,7 +36,8 @@ from quadimpact.experiments.crashes import (
     scenario_file,
     scenario_path,
 )
-from quadimpact.experiments.logs import PreImpact, SpiriMatLog, data_dir
+from quadimpact.experiments.logs import PreImpact, data_dir
+from quadimpact.experiments.spiri_mat import SpiriMatLog
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.simulation import simulate
 from quadimpact.simulation.metrics import RESPONSE_TYPES

@@ -33,6 +33,7 @@ from quadimpact.results.figures import (
     sorted_levels,
     type_map_figure,
 )
+from quadimpact.sweep.store import read_runs
 
 __all__ = ["TYPE_COLORS", "plot_metric", "plot_type_map", "auto_plots"]
 
@@ -177,8 +178,6 @@ def auto_plots(out_dir: str | os.PathLike[str], spec: Any) -> list[Path]:
         The files written (none for other sweeps, or above
         :data:`MAX_AUTO_RUNS` runs).
     """
-    from quadimpact.sweep import read_runs
-
     if spec.runs or spec.sample is not None or spec.n_runs > MAX_AUTO_RUNS:
         return []
     choice = choose_plot_fields(spec.columns, spec.grid)

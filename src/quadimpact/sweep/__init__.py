@@ -1,0 +1,70 @@
+"""Sweeps: many runs of one base scenario, streamed to one Parquet table.
+
+A sweep names a **base** scenario (the keys of a scenario file) and the runs
+to make from it: a **grid** (every combination of the listed values, the
+last field varying fastest), an explicit list of **runs**, or a random
+**sample** (``n`` points, a ``seed``, uniform ``ranges`` and/or ``choices``).
+A grid can be combined with ``runs`` or ``sample``: every grid point is then
+run with every entry. Fields are scenario fields (``heading_deg``,
+``inclination_deg``, ``speed_m_s``, ``final_time_s``, ``model``...) or vehicle
+fields (``restitution``, ``contact_stiffness``, ``mass_kg``...), named as in
+scenario and vehicle files; vehicle fields go to the run's
+``vehicle_overrides``. A sweep file::
+
+    [base]                        # or: base = "scenario.toml" (beside this file)
+    model = "paper-replica"
+
+    [grid]
+    heading_deg = [0, 45]
+    inclination_deg = "-20:20:1"  # inclusive range start:stop:step, or "0,45" lists
+    speed_m_s = [0.5, 0.75, 1.0]
+
+    # [[runs]]                    # explicit runs ...
+    # inclination_deg = 5
+    # [sample]                    # ... or a random sample
+    # n = 1000
+    # seed = 1
+    # ranges = { inclination_deg = [-20, 20] }   # uniform in [low, high]
+    # choices = { heading_deg = [0, 45] }        # one of the values
+
+The whole sweep (every run's scenario and vehicle) is validated before any
+run starts; problems are one-line :class:`~quadimpact.errors.InputError`.
+
+Output folder ``DIR``:
+
+* ``runs.parquet``: one row per run, sorted by ``run_id`` (the run's index in
+  the enumeration above): the swept inputs under their names, then the run's
+  summary (``docs/RESULTS.md``) flattened: nested tables joined with ``__``
+  (``approach__start_time_s``), lists as JSON strings (``leading_bumpers``,
+  ``warnings``, ``subsequent_impacts``, ``crash_position_m``); the kernel's
+  wall-clock time is left out so that the table is the same, bit for bit,
+  however and wherever the sweep ran. The column set and types are fixed
+  (:data:`SUMMARY_COLUMNS`); a run that failed (numerically, or by raising
+  while being prepared) is a row with ``status = "failed"`` and its
+  ``reason``.
+* ``sweep.json``: the sweep, so that running it again resumes it (and a
+  different sweep in the same folder is refused).
+* ``parts/``: completed runs while the sweep runs, in small Parquet files
+  written atomically (a part is complete or absent); merged into
+  ``runs.parquet`` at the end. A run again does only the missing runs.
+
+Runs execute in parallel on local cores (``workers``), in-process
+(``workers=1``), or on a Dask cluster (``scheduler="tcp://host:port"``); all
+three call the same pure function :func:`run_chunk`.
+"""
+
+from quadimpact.sweep.run import run_sweep
+from quadimpact.sweep.spec import SweepSpec, load_sweep_file, parse_values
+from quadimpact.sweep.store import SUMMARY_COLUMNS, flatten_summary, read_runs
+from quadimpact.sweep.worker import run_chunk
+
+__all__ = [
+    "SweepSpec",
+    "SUMMARY_COLUMNS",
+    "load_sweep_file",
+    "parse_values",
+    "read_runs",
+    "run_chunk",
+    "run_sweep",
+    "flatten_summary",
+]

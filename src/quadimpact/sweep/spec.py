@@ -1,0 +1,544 @@
+"""A sweep's definition: parsing swept values, :class:`SweepSpec` and sweep files."""
+
+from __future__ import annotations
+
+import difflib
+import hashlib
+import json
+import math
+import os
+import re
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from decimal import ROUND_FLOOR, Decimal
+from pathlib import Path
+from typing import Any
+
+from quadimpact.errors import InputError, format_value
+from quadimpact.inputs.files import apply_overrides, locate_vehicle, read_toml_file
+from quadimpact.results.files import to_jsonable
+
+MAX_RUNS = 10_000_000
+"""Largest number of runs in one sweep."""
+
+# ------------------------------------------------------------------ values
+_INT_RE = re.compile(r"^[+-]?\d+$")
+_NUM_RE = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
+
+
+def _scalar(text: str) -> Any:
+    """One comma-list item: int, float, true/false, or a string (quotes optional)."""
+    if _INT_RE.match(text):
+        return int(text)
+    if _NUM_RE.match(text):
+        return float(text)
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    if len(text) >= 2 and text[0] == text[-1] and text[0] in "'\"":
+        return text[1:-1]
+    return text
+
+
+def _range(text: str, where: str) -> list[Any]:
+    """Inclusive ``start:stop:step`` in exact decimal arithmetic (no float drift)."""
+    parts = [p.strip() for p in text.split(":")]
+    if len(parts) != 3:
+        raise InputError(f"{where}a range is start:stop:step (got {text!r})")
+    if not all(_NUM_RE.match(p) for p in parts):
+        raise InputError(f"{where}range start, stop and step must be numbers (got {text!r})")
+    start, stop, step = (Decimal(p) for p in parts)
+    if step == 0:
+        raise InputError(f"{where}range step must not be 0 (got {text!r})")
+    count = int(((stop - start) / step).to_integral_value(rounding=ROUND_FLOOR)) + 1
+    if count < 1:
+        raise InputError(
+            f"{where}empty range: the step must lead from start to stop (got {text!r})"
+        )
+    if count > MAX_RUNS:
+        raise InputError(f"{where}range has {count} values, more than {MAX_RUNS} (got {text!r})")
+    integral = all(_INT_RE.match(p) for p in parts)
+    values = (start + k * step for k in range(count))
+    return [int(v) if integral else float(v) for v in values]
+
+
+def parse_values(text: str, field: str = "") -> list[Any]:
+    """Values of one swept field written as text (``--grid FIELD=VALUES``, TOML strings).
+
+    Parameters
+    ----------
+    text : str
+        A comma list (``"0,45"``, ``"paper-replica,default"``) whose items are
+        numbers, ``true``/``false``, strings, or inclusive ranges
+        ``start:stop:step`` (``"-20:20:1"``: -20, -19, ..., 20). Range values
+        are ``start + k step`` computed in decimal arithmetic, so
+        ``"0.5:1:0.25"`` gives exactly 0.5, 0.75, 1.0 and ``"0:0.3:0.1"`` ends at
+        0.3, not 0.30000000000000004. Ranges of integers give ints.
+    field : str, optional
+        Field name for error messages.
+
+    Returns
+    -------
+    list
+        The values, in order.
+
+    Raises
+    ------
+    InputError
+        Empty text or item, malformed range, zero step, empty range.
+    """
+    where = f"{field}: " if field else ""
+    if not isinstance(text, str):
+        raise InputError(f"{where}values must be text (got {format_value(text)})")
+    items = [p.strip() for p in text.split(",")]
+    if not text.strip() or not all(items):
+        raise InputError(f"{where}empty value in the list (got {text!r})")
+    values: list[Any] = []
+    for item in items:
+        if ":" in item and not (item[0] in "'\"" and item[-1] == item[0]):
+            values.extend(_range(item, where))
+        else:
+            values.append(_scalar(item))
+    return values
+
+
+
+# --------------------------------------------------------------- the spec
+def plain(value: Any) -> Any:
+    """NumPy values, tuples, paths... as plain Python values (JSON-able); NaN kept."""
+    return to_jsonable(value, finite=False, strict=False)
+
+
+def canonical(value: Any) -> str:
+    return json.dumps(value, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def _is_number(v: Any) -> bool:
+    return isinstance(v, (int, float)) and not isinstance(v, bool)
+
+
+def _column_kind(values: Iterable[Any]) -> str:
+    values = list(values)
+    if all(isinstance(v, bool) for v in values):
+        return "b"
+    if all(_is_number(v) for v in values):
+        return "f"
+    if all(isinstance(v, str) for v in values):
+        return "s"
+    return "j"
+
+
+def _column_value(value: Any, kind: str) -> Any:
+    """A swept value as stored in its ``runs.parquet`` column."""
+    if value is None:
+        return None
+    if kind == "f":
+        return float(value)
+    if kind == "j":
+        return canonical(value)
+    return value
+
+
+def _short(inputs: Mapping[str, Any]) -> str:
+    return ", ".join(f"{k}={format_value(v)}" for k, v in inputs.items())
+
+
+class SweepSpec:
+    """A sweep: a base scenario and the runs made from it (see :mod:`quadimpact.sweep`).
+
+    Parameters
+    ----------
+    base : mapping or path, optional
+        Scenario fields, as in a scenario file (``kind``, ``model``,
+        ``vehicle_overrides``...), or the path of a scenario TOML file. Default:
+        the paper's wall approach with its defaults.
+    grid : mapping, optional
+        Field -> values: a list, a single value, or text for
+        :func:`parse_values` (``"-20:20:1"``, ``"0,45"``). Every combination is
+        run; the last field varies fastest.
+    runs : sequence of mappings, optional
+        Explicit runs, each a mapping field -> value (fields left out keep the
+        base's value).
+    sample : mapping, optional
+        ``{"n": int, "seed": int (default 0), "ranges": {field: [low, high]},
+        "choices": {field: [values]}}``: ``n`` random points, each field uniform
+        in ``[low, high]`` or drawn uniformly from ``choices`` (NumPy's PCG64
+        generator seeded with ``seed``).
+    where : str, optional
+        Start of error messages (the sweep file's name).
+
+    Raises
+    ------
+    InputError
+        Unknown field, bad values, empty sweep, bad base scenario. Each run's
+        scenario is checked by :meth:`validate` (``run_sweep`` calls it).
+
+    Notes
+    -----
+    Run ``i`` is grid point ``i // m`` combined with entry ``i % m`` of the
+    runs or sample (``m`` entries; ``m = 1`` without them). Numeric swept
+    values are stored (and passed to the scenario) as floats.
+    """
+
+    def __init__(
+        self,
+        base: Mapping[str, Any] | str | os.PathLike[str] | None = None,
+        grid: Mapping[str, Any] | None = None,
+        runs: Sequence[Mapping[str, Any]] | None = None,
+        sample: Mapping[str, Any] | None = None,
+        *,
+        where: str = "sweep",
+    ) -> None:
+        from quadimpact.inputs.scenarios import _KINDS
+        from quadimpact.inputs.vehicle import Vehicle
+
+        self.where = where
+        self.base = self._read_base(base)
+        kind = self.base.get("kind", "wall-approach")
+        if kind not in _KINDS:
+            raise InputError(
+                f"{where}: base: kind: must be 'wall-approach' or 'flight' (got {kind!r})"
+            )
+        self._scenario_fields = [f for f in _KINDS[kind].model_fields if f != "kind"]
+        self._vehicle_fields = [f for f in Vehicle.model_fields if f not in self._scenario_fields]
+        self._kind_name = kind
+
+        self.grid: dict[str, list[Any]] = {}
+        if grid is not None:
+            if not isinstance(grid, Mapping):
+                raise InputError(f"{where}: grid: must be a table of field = values")
+            for name, values in grid.items():
+                self._check_field(str(name), "grid")
+                self.grid[str(name)] = self._grid_values(str(name), values)
+
+        if runs is not None and sample is not None:
+            raise InputError(f"{where}: give either runs or sample, not both")
+        self.runs: list[dict[str, Any]] | None = None
+        if runs is not None:
+            self.runs = self._read_runs(runs)
+        self.sample: dict[str, Any] | None = None
+        if sample is not None:
+            self.sample = self._read_sample(sample)
+        if not self.grid and not self.runs and self.sample is None:
+            raise InputError(f"{where}: empty sweep: give a grid, runs or a sample")
+
+        # input columns, in order, and their kinds
+        fields: dict[str, list[Any]] = {k: list(v) for k, v in self.grid.items()}
+        for entry in self.runs or []:
+            for k, v in entry.items():
+                fields.setdefault(k, []).append(v)
+        if self.sample is not None:
+            for k in self.sample["ranges"]:
+                fields[k] = [0.0]
+            for k, v in self.sample["choices"].items():
+                fields[k] = list(v)
+        inner = {k for e in self.runs or [] for k in e}
+        if self.sample is not None:
+            inner |= set(self.sample["ranges"]) | set(self.sample["choices"])
+        for k in self.grid:
+            if k in inner:
+                raise InputError(f"{where}: {k}: swept both in the grid and in runs/sample")
+        self.columns: dict[str, str] = {k: _column_kind(v) for k, v in fields.items()}
+        # numbers as floats (one type per column, so equal sweeps compare equal)
+        for k, values in self.grid.items():
+            self.grid[k] = [_column_value(v, "f") if self.columns[k] == "f" else v for v in values]
+        for entry in self.runs or []:
+            for k, v in entry.items():
+                if self.columns[k] == "f":
+                    entry[k] = float(v)
+        if self.sample is not None:
+            for k, values in self.sample["choices"].items():
+                if self.columns[k] == "f":
+                    self.sample["choices"][k] = [float(v) for v in values]
+
+        self._sizes = [len(v) for v in self.grid.values()]
+        self._inner = len(self.runs) if self.runs else (self.sample["n"] if self.sample else 1)
+        n = math.prod(self._sizes) * self._inner
+        if n > MAX_RUNS:
+            raise InputError(f"{where}: {n} runs, more than {MAX_RUNS}")
+        self.n_runs = n
+        self._drawn: dict[str, list[Any]] | None = None
+
+    # ------------------------------------------------------------ reading
+    def _read_base(self, base: Any) -> dict[str, Any]:
+        if base is None:
+            return {}
+        if isinstance(base, (str, os.PathLike)):
+            path = Path(base)
+            return plain(locate_vehicle(read_toml_file(path), path.parent))
+        if not isinstance(base, Mapping):
+            raise InputError(f"{self.where}: base: must be a table of scenario fields or a path")
+        return plain(dict(base))
+
+    def _check_field(self, name: str, section: str) -> None:
+        if name in self._scenario_fields or name in self._vehicle_fields:
+            return
+        if name == "kind":
+            raise InputError(f"{self.where}: {section}: kind: cannot be swept (set it in base)")
+        known = self._scenario_fields + self._vehicle_fields
+        close = difflib.get_close_matches(name, known, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise InputError(
+            f"{self.where}: {section}: {name}: unknown field (not a {self._kind_name} scenario "
+            f"field nor a vehicle field){hint}"
+        )
+
+    def _grid_values(self, name: str, values: Any) -> list[Any]:
+        where = f"{self.where}: grid: {name}"
+        if isinstance(values, str):
+            out = parse_values(values, f"{self.where}: grid: {name}")
+        elif isinstance(values, Mapping):
+            raise InputError(f"{where}: must be a list of values or a 'start:stop:step' text")
+        elif hasattr(values, "__iter__") and not isinstance(values, bytes):
+            out = plain(list(values))
+        else:
+            out = [plain(values)]
+        if not out:
+            raise InputError(f"{where}: no values")
+        self._check_values(where, out)
+        seen: list[Any] = []
+        for v in out:
+            key = canonical(float(v) if _is_number(v) else v)
+            if key in seen:
+                raise InputError(f"{where}: value {format_value(v)} is listed twice")
+            seen.append(key)
+        return out
+
+    @staticmethod
+    def _check_values(where: str, values: Iterable[Any]) -> None:
+        for v in values:
+            if v is None:
+                raise InputError(f"{where}: values must not be empty (got None)")
+            if isinstance(v, float) and not math.isfinite(v):
+                raise InputError(f"{where}: values must be finite numbers (got {v})")
+
+    def _read_runs(self, runs: Any) -> list[dict[str, Any]]:
+        if isinstance(runs, (str, Mapping)) or not hasattr(runs, "__iter__"):
+            raise InputError(f"{self.where}: runs: must be a list of tables ([[runs]])")
+        out = []
+        for i, entry in enumerate(runs):
+            if not isinstance(entry, Mapping):
+                raise InputError(f"{self.where}: runs[{i}]: must be a table of field = value")
+            entry = plain(dict(entry))
+            for name, v in entry.items():
+                self._check_field(name, f"runs[{i}]")
+                self._check_values(f"{self.where}: runs[{i}]: {name}", [v])
+            out.append(entry)
+        if not out:
+            raise InputError(f"{self.where}: runs: empty list")
+        return out
+
+    def _read_sample(self, sample: Any) -> dict[str, Any]:
+        w = f"{self.where}: sample"
+        if not isinstance(sample, Mapping):
+            raise InputError(f"{w}: must be a table with n, seed, ranges and/or choices")
+        unknown = set(sample) - {"n", "seed", "ranges", "choices"}
+        if unknown:
+            raise InputError(f"{w}: {sorted(unknown)[0]}: unknown key (n, seed, ranges, choices)")
+        n, seed = sample.get("n"), sample.get("seed", 0)
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= MAX_RUNS:
+            raise InputError(
+                f"{w}: n: must be an integer in [1, {MAX_RUNS}] (got {format_value(n)})"
+            )
+        if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
+            raise InputError(f"{w}: seed: must be an integer >= 0 (got {format_value(seed)})")
+        ranges: dict[str, list[float]] = {}
+        for name, bounds in dict(sample.get("ranges") or {}).items():
+            self._check_field(name, "sample.ranges")
+            b = plain(bounds)
+            if (
+                not isinstance(b, list)
+                or len(b) != 2
+                or not all(_is_number(x) and math.isfinite(x) for x in b)
+                or not b[0] < b[1]
+            ):
+                raise InputError(
+                    f"{w}.ranges: {name}: must be [low, high] numbers with low < high "
+                    f"(got {format_value(bounds)})"
+                )
+            ranges[name] = [float(b[0]), float(b[1])]
+        choices: dict[str, list[Any]] = {}
+        for name, values in dict(sample.get("choices") or {}).items():
+            self._check_field(name, "sample.choices")
+            v = plain(values)
+            if not isinstance(v, list) or not v:
+                raise InputError(f"{w}.choices: {name}: must be a non-empty list of values")
+            self._check_values(f"{w}.choices: {name}", v)
+            if name in ranges:
+                raise InputError(f"{w}: {name}: both in ranges and choices")
+            choices[name] = v
+        if not ranges and not choices:
+            raise InputError(f"{w}: give ranges and/or choices to draw from")
+        return {"n": n, "seed": seed, "ranges": ranges, "choices": choices}
+
+    # --------------------------------------------------------- enumeration
+    def _draws(self) -> dict[str, list[Any]]:
+        if self._drawn is None:
+            import numpy as np
+
+            assert self.sample is not None
+            rng = np.random.Generator(np.random.PCG64(self.sample["seed"]))
+            n = self.sample["n"]
+            drawn: dict[str, list[Any]] = {}
+            for name, (lo, hi) in self.sample["ranges"].items():
+                drawn[name] = rng.uniform(lo, hi, size=n).tolist()
+            for name, values in self.sample["choices"].items():
+                drawn[name] = [values[j] for j in rng.integers(0, len(values), size=n).tolist()]
+            self._drawn = drawn
+        return self._drawn
+
+    def inputs(self, run_id: int) -> dict[str, Any]:
+        """The swept values of run ``run_id`` (field -> value)."""
+        if not 0 <= run_id < self.n_runs:
+            raise IndexError(run_id)
+        g, j = divmod(run_id, self._inner)
+        values: dict[str, Any] = {}
+        idx = []
+        for size in reversed(self._sizes):
+            g, r = divmod(g, size)
+            idx.append(r)
+        for (name, vals), r in zip(self.grid.items(), reversed(idx), strict=True):
+            values[name] = vals[r]
+        if self.runs:
+            values.update(self.runs[j])
+        elif self.sample is not None:
+            for name, drawn in self._draws().items():
+                values[name] = drawn[j]
+        return values
+
+    def scenario_dict(self, run_id: int, inputs: Mapping[str, Any] | None = None) -> dict[str, Any]:
+        """The scenario mapping of run ``run_id`` (base + swept values)."""
+        if inputs is None:
+            inputs = self.inputs(run_id)
+        return apply_overrides(self.base, inputs, self._vehicle_fields)
+
+    def input_columns(self, inputs: Mapping[str, Any]) -> dict[str, Any]:
+        """Row values of the input columns for one run's inputs."""
+        return {k: _column_value(inputs.get(k), kind) for k, kind in self.columns.items()}
+
+    def validate(self, check: Callable[[int], None] | None = None) -> None:
+        """Build and validate every run's scenario and vehicle (raises the first problem).
+
+        Parameters
+        ----------
+        check : callable, optional
+            Called with each run_id after it validated (progress hooks).
+
+        Raises
+        ------
+        InputError
+            ``<where>: run <i> (<swept values>): <field>: <rule> (got <value>)``.
+        """
+        from quadimpact.inputs.scenarios import scenario_from_dict
+        from quadimpact.inputs.vehicle import load_vehicle
+
+        base = scenario_from_dict(self.base, where=f"{self.where}: base")
+        base.build_vehicle(where=f"{self.where}: base")
+        vehicles: dict[str, Any] = {}
+        checked: set[str] = set()
+        for run_id in range(self.n_runs):
+            inputs = self.inputs(run_id)
+            try:
+                scenario = scenario_from_dict(self.scenario_dict(run_id, inputs), where="")
+                key = canonical([scenario.vehicle, plain(scenario.vehicle_overrides)])
+                if key not in checked:
+                    if scenario.vehicle not in vehicles:
+                        vehicles[scenario.vehicle] = load_vehicle(scenario.vehicle)
+                    vehicles[scenario.vehicle].apply_overrides(
+                        dict(scenario.vehicle_overrides), where="", prefix=("vehicle_overrides",)
+                    )
+                    if len(checked) < 100_000:
+                        checked.add(key)
+            except InputError as exc:
+                message = str(exc).removeprefix(": ")
+                raise InputError(
+                    f"{self.where}: run {run_id} ({_short(inputs)}): {message}"
+                ) from None
+            if check is not None:
+                check(run_id)
+
+    # ---------------------------------------------------------- (de)serial
+    def to_dict(self) -> dict[str, Any]:
+        """The normalised sweep as plain data (what ``sweep.json`` stores)."""
+        return {
+            "base": self.base,
+            "grid": self.grid,
+            "runs": self.runs,
+            "sample": self.sample,
+        }
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any], where: str = "sweep") -> SweepSpec:
+        """Build a spec from :meth:`to_dict`'s output (or a sweep file's table)."""
+        if not isinstance(data, Mapping):
+            raise InputError(f"{where}: must be a table")
+        unknown = set(data) - {"base", "grid", "runs", "sample"}
+        if unknown:
+            key = sorted(unknown)[0]
+            close = difflib.get_close_matches(key, ["base", "grid", "runs", "sample"], n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else " (base, grid, runs, sample)"
+            raise InputError(f"{where}: {key}: unknown key{hint}")
+        return cls(
+            base=data.get("base"),
+            grid=data.get("grid"),
+            runs=data.get("runs"),
+            sample=data.get("sample"),
+            where=where,
+        )
+
+    @classmethod
+    def from_file(cls, path: str | os.PathLike[str]) -> SweepSpec:
+        """Read a sweep TOML file (see :func:`load_sweep_file`)."""
+        return load_sweep_file(path)
+
+    def with_grid(self, grid: Mapping[str, Any]) -> SweepSpec:
+        """A copy whose grid has these fields replaced or added (``--grid`` on a file)."""
+        merged = dict(self.grid)
+        merged.update(grid)
+        return SweepSpec(self.base, merged, self.runs, self.sample, where=self.where)
+
+    def varying_fields(self) -> list[str]:
+        """Grid fields with more than one value."""
+        return [k for k, v in self.grid.items() if len(v) > 1]
+
+    def fingerprint(self) -> str:
+        """SHA-256 of the normalised sweep (and of the sampled values, if any)."""
+        h = hashlib.sha256(canonical(self.to_dict()).encode())
+        if self.sample is not None:
+            h.update(canonical(self._draws()).encode())
+        return h.hexdigest()
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, SweepSpec) and canonical(self.to_dict()) == canonical(
+            other.to_dict()
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    def __repr__(self) -> str:
+        mode = "runs" if self.runs else "sample" if self.sample else "grid"
+        return f"SweepSpec({self.n_runs} runs, {mode}, grid={list(self.grid)})"
+
+
+def load_sweep_file(path: str | os.PathLike[str]) -> SweepSpec:
+    """Read a sweep TOML file: ``base`` (table or scenario path), ``grid``, ``runs``, ``sample``.
+
+    A relative ``base`` path (and a relative ``vehicle`` path in the base) is
+    looked up beside the sweep file.
+
+    Raises
+    ------
+    InputError
+        Missing file, TOML syntax error, unknown key, bad field or value.
+    """
+    path = Path(path)
+    data = read_toml_file(path)
+    base = data.get("base")
+    if isinstance(base, str):
+        candidate = Path(base)
+        if not candidate.is_absolute():
+            candidate = path.parent / candidate
+        data["base"] = candidate
+    elif isinstance(base, Mapping):
+        data["base"] = locate_vehicle(base, path.parent)
+    return SweepSpec.from_dict(data, where=str(path))
+
+

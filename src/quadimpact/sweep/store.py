@@ -1,0 +1,415 @@
+"""The sweep's Parquet store: the table's schema, its rows, part files, resume and merge.
+
+The run rows (:func:`flatten_summary`, :data:`SUMMARY_COLUMNS`) are written in
+small atomic part files as the runs finish (:class:`PartWriter`); a sweep run
+again finds what is done (:func:`scan_done`) and finally everything is merged,
+sorted by ``run_id``, into ``runs.parquet`` (:func:`consolidate`).
+``sweep.json`` records the sweep (:func:`check_folder`), and a lock keeps two
+sweeps from writing one folder (:func:`folder_lock`)."""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import math
+import os
+import re
+import time
+from collections.abc import Callable, Iterable, Iterator, Mapping
+from pathlib import Path
+from typing import Any
+
+from quadimpact.errors import InputError, one_line
+from quadimpact.results.files import atomic_write
+from quadimpact.sweep.spec import SweepSpec, canonical, plain
+
+FLUSH_ROWS = 1024
+"""A part file is written when this many completed runs are waiting..."""
+FLUSH_SECONDS = 1.0
+"""... or when the oldest waiting run completed this long ago (so a kill loses
+the runs in flight plus at most about this much finished work)."""
+CONSOLIDATE_WINDOW = 20_000
+"""Rows per row group of ``runs.parquet`` (the merge reads one window at a time)."""
+FORMAT_VERSION = 1
+
+# Column kinds: f float64, i int64, b bool, s string, j JSON text.
+
+_ARROW_KINDS = ("f", "i", "b", "s", "j")
+
+SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("status", "s"),
+    ("reason", "s"),
+    ("warnings", "j"),
+    ("model", "s"),
+    ("model_options__yaw_reaction", "s"),
+    ("model_options__bumper1_yaw_twice", "b"),
+    ("model_options__initial_rotor_speeds", "s"),
+    ("model_options__attitude_mapping", "s"),
+    ("model_options__crash_rule", "s"),
+    ("model_options__approach_start", "s"),
+    ("controller", "s"),
+    ("vehicle", "s"),
+    ("delta_init_m", "f"),
+    ("peak_force_n", "f"),
+    ("initial_impact_duration_s", "f"),
+    ("first_contact_s", "f"),
+    ("impact_speed_m_s", "f"),
+    ("heading_deg", "f"),
+    ("inclination_deg", "f"),
+    ("impact_heading_deg", "f"),
+    ("impact_inclination_deg", "f"),
+    ("leading_bumpers", "j"),
+    ("aft_bumpers", "j"),
+    ("response_type", "s"),
+    ("n_episodes", "i"),
+    ("n_grazes", "i"),
+    ("n_subsequent_impacts", "i"),
+    ("n_subsequent_episodes", "i"),
+    ("subsequent_impacts", "j"),
+    ("crash_time_s", "f"),
+    ("power_off_time_s", "f"),
+    ("crash_position_m", "j"),
+    ("max_penetration_m", "f"),
+    ("bumper_model_valid", "b"),
+    ("t_start_s", "f"),
+    ("t_final_s", "f"),
+    ("references__altitude_m", "f"),
+    ("references__roll_rad", "f"),
+    ("references__pitch_rad", "f"),
+    ("references__yaw_rad", "f"),
+    ("quadimpact_version", "s"),
+    ("wall_distance_m", "f"),
+    ("crash_distance_from_wall_m", "f"),
+    ("approach__start_time_s", "f"),
+    ("approach__start_x_m", "f"),
+    ("approach__start_speed_m_s", "f"),
+    ("approach__late_start", "b"),
+    ("approach__speed_residual_m_s", "f"),
+    ("requested__heading_deg", "f"),
+    ("requested__inclination_deg", "f"),
+    ("requested__speed_m_s", "f"),
+    ("requested__impact_time_s", "f"),
+    ("attitude_excursion__roll_excursion_deg", "f"),
+    ("attitude_excursion__pitch_excursion_deg", "f"),
+    ("attitude_excursion__yaw_excursion_deg", "f"),
+    ("attitude_excursion__tilt_max_deg", "f"),
+    ("outcome", "s"),
+    ("integrator__steps", "i"),
+    ("integrator__rejected_steps", "i"),
+    ("integrator__rhs_evaluations", "i"),
+    ("integrator__control_ticks", "i"),
+    ("integrator__output_rows", "i"),
+    ("summary_extra", "j"),
+)
+"""Summary columns of ``runs.parquet`` and their kinds (``f`` float64, ``i``
+nullable int64, ``b`` nullable bool, ``s`` string, ``j`` JSON text). Summary
+keys not listed land, as JSON, in ``summary_extra`` (null when none), so the
+schema never depends on what a run returned."""
+
+_SUMMARY_KIND = dict(SUMMARY_COLUMNS)
+
+
+def _is_time_measurement(key: str) -> bool:
+    """Flattened summary keys that measure wall-clock time (not deterministic)."""
+    return key.startswith("integrator__") and "time" in key
+
+
+
+# ------------------------------------------------------------ the worker
+def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dict[str, Any]:
+    """One ``runs.parquet`` row (without run_id and inputs) from a run's summary.
+
+    Nested tables are joined with ``__``; lists become JSON text; wall-clock
+    timings are dropped; keys outside :data:`SUMMARY_COLUMNS` go, as JSON, to
+    ``summary_extra``; missing keys are null. Values take their column's type.
+    """
+    flat: dict[str, Any] = {}
+
+    def walk(prefix: str, value: Any) -> None:
+        if isinstance(value, Mapping):
+            for k, v in value.items():
+                walk(f"{prefix}__{k}" if prefix else str(k), v)
+        else:
+            flat[prefix] = value
+
+    walk("", summary)
+    skip = set(skip)
+    row: dict[str, Any] = {}
+    extra: dict[str, Any] = {}
+    for key, value in flat.items():
+        if _is_time_measurement(key) or key in skip:
+            continue
+        kind = _SUMMARY_KIND.get(key)
+        if kind is None or key == "summary_extra":
+            extra[key] = plain(value)
+            continue
+        row[key] = _typed(value, kind)
+    for key, _kind in SUMMARY_COLUMNS:
+        if key not in skip:
+            row.setdefault(key, None)
+    row["summary_extra"] = canonical(extra) if extra else None
+    return row
+
+
+def _typed(value: Any, kind: str) -> Any:
+    if value is None:
+        return None
+    value = plain(value)
+    if kind == "f":
+        return None if isinstance(value, float) and math.isnan(value) else float(value)
+    if kind == "i":
+        return int(value)
+    if kind == "b":
+        return bool(value)
+    if kind == "s":
+        return str(value)
+    return json.dumps(value, separators=(",", ":"))
+
+
+def failed_row(reason: str, skip: Iterable[str]) -> dict[str, Any]:
+    from quadimpact import __version__
+
+    row = flatten_summary({}, skip)
+    if "status" in row:
+        row["status"] = "failed"
+    if "reason" in row:
+        row["reason"] = one_line(reason)
+    if "quadimpact_version" in row:
+        row["quadimpact_version"] = __version__
+    return row
+
+
+
+# ---------------------------------------------------------------- storage
+def schema_of(spec: SweepSpec) -> Any:
+    import pyarrow as pa
+
+    types = {
+        "f": pa.float64(),
+        "i": pa.int64(),
+        "b": pa.bool_(),
+        "s": pa.string(),
+        "j": pa.string(),
+    }
+    fields = [pa.field("run_id", pa.int64(), nullable=False)]
+    fields += [pa.field(k, types[kind]) for k, kind in spec.columns.items()]
+    fields += [pa.field(k, types[kind]) for k, kind in SUMMARY_COLUMNS if k not in spec.columns]
+    meta = {
+        "quadimpact.sweep": canonical(
+            {"inputs": list(spec.columns), "n_runs": spec.n_runs, "format": FORMAT_VERSION}
+        )
+    }
+    return pa.schema(fields, metadata=meta)
+
+
+def _to_pandas(table: Any) -> Any:
+    import pandas as pd
+    import pyarrow as pa
+
+    mapping = {pa.int64(): pd.Int64Dtype(), pa.bool_(): pd.BooleanDtype()}
+    df = table.to_pandas(types_mapper=mapping.get)
+    # run_id is never null: a plain int64 column
+    if "run_id" in df:
+        df["run_id"] = df["run_id"].astype("int64")
+    return df
+
+
+def read_runs(out_dir: str | os.PathLike[str]) -> Any:
+    """Read ``DIR/runs.parquet`` as a pandas DataFrame (nullable ints and bools).
+
+    Integer columns are ``Int64`` and booleans ``boolean`` (so a failed run's
+    nulls never change a column's type); floats are float64 (null as NaN);
+    text is object (null as None).
+    """
+    import pyarrow.parquet as pq
+
+    path = Path(out_dir) / "runs.parquet"
+    if not path.is_file():
+        raise InputError(f"{path}: file not found")
+    return _to_pandas(pq.read_table(path))
+
+
+class PartWriter:
+    """Buffers finished rows and writes them as atomic part files."""
+
+    def __init__(self, parts: Path, schema: Any, start_seq: int) -> None:
+        self.parts = parts
+        self.schema = schema
+        self.seq = start_seq
+        self.buffer: list[dict[str, Any]] = []
+        self.oldest = 0.0
+        self.rows_written = 0
+
+    def add(self, rows: list[dict[str, Any]]) -> None:
+        """Buffer ``rows`` (may be empty: a clock tick) and write a part when due."""
+        if rows:
+            if not self.buffer:
+                self.oldest = time.monotonic()
+            self.buffer.extend(rows)
+        if self.buffer and (
+            len(self.buffer) >= FLUSH_ROWS or time.monotonic() - self.oldest >= FLUSH_SECONDS
+        ):
+            self.flush()
+
+    def flush(self) -> None:
+        if not self.buffer:
+            return
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        table = pa.Table.from_pylist(self.buffer, schema=self.schema).sort_by("run_id")
+        self.seq += 1
+        path = self.parts / f"part-{self.seq:06d}.parquet"
+        atomic_write(path, lambda tmp: pq.write_table(table, tmp), durable=True)
+        self.rows_written += len(self.buffer)
+        self.buffer = []
+
+
+_PART_RE = re.compile(r"^part-(\d+)\.parquet$")
+
+
+def scan_done(out: Path, n_runs: int, warn: Callable[[str], None]) -> tuple[Any, int]:
+    """Mask of run_ids already written (runs.parquet and parts), and the last part number."""
+    import numpy as np
+    import pyarrow.parquet as pq
+
+    done = np.zeros(n_runs, dtype=bool)
+    parts = out / "parts"
+    last = 0
+    sources = []
+    if (out / "runs.parquet").is_file():
+        sources.append(out / "runs.parquet")
+    if parts.is_dir():
+        for p in sorted(parts.iterdir()):
+            if p.name.startswith(".") and p.name.endswith(".tmp"):
+                p.unlink(missing_ok=True)  # left by a kill mid-write
+            elif m := _PART_RE.match(p.name):
+                last = max(last, int(m.group(1)))
+                sources.append(p)
+    for src in sources:
+        try:
+            ids = pq.read_table(src, columns=["run_id"]).column("run_id").to_numpy()
+        except Exception as exc:  # unreadable: redo its runs
+            warn(f"{src}: unreadable ({one_line(str(exc))}); its runs will be redone")
+            src.unlink(missing_ok=True)
+            continue
+        ids = ids[(ids >= 0) & (ids < n_runs)]
+        done[ids] = True
+    return done, last
+
+
+def consolidate(out: Path, schema: Any, n_runs: int) -> None:
+    """Merge runs.parquet and the parts into runs.parquet, sorted, one window at a time."""
+    import numpy as np
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    parts_dir = out / "parts"
+    parts = (
+        sorted(p for p in parts_dir.iterdir() if _PART_RE.match(p.name))
+        if parts_dir.is_dir()
+        else []
+    )
+    target = out / "runs.parquet"
+    if not parts and target.is_file():
+        meta = pq.read_metadata(target)
+        if meta.num_rows == n_runs and pq.read_schema(target).equals(schema, check_metadata=False):
+            return
+    sources = ([target] if target.is_file() else []) + parts
+    spans = []
+    for src in sources:
+        ids = pq.read_table(src, columns=["run_id"]).column("run_id").to_numpy()
+        if len(ids):
+            spans.append((src, int(ids.min()), int(ids.max())))
+    def merge(tmp: Path) -> None:
+        total = 0
+        with pq.ParquetWriter(tmp, schema) as writer:
+            for lo in range(0, n_runs, CONSOLIDATE_WINDOW):
+                hi = lo + CONSOLIDATE_WINDOW
+                pieces = []
+                for src, a, b in spans:
+                    if b < lo or a >= hi:
+                        continue
+                    t = pq.read_table(src, filters=[("run_id", ">=", lo), ("run_id", "<", hi)])
+                    pieces.append(t.select(schema.names).cast(schema))
+                if not pieces:
+                    continue
+                t = pa.concat_tables(pieces).sort_by("run_id")
+                ids = t.column("run_id").to_numpy()
+                keep = np.ones(len(ids), dtype=bool)
+                keep[1:] = ids[1:] != ids[:-1]
+                if not keep.all():
+                    t = t.filter(pa.array(keep))
+                total += t.num_rows
+                writer.write_table(t, row_group_size=CONSOLIDATE_WINDOW)
+        if total != n_runs:
+            raise RuntimeError(f"{out}: merged {total} runs, expected {n_runs}")
+
+    atomic_write(target, merge, durable=True)
+    for p in parts:
+        p.unlink(missing_ok=True)
+
+
+def check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
+    """Write sweep.json, or check that the folder holds this very sweep."""
+    from quadimpact import __version__
+
+    record = {
+        "format": FORMAT_VERSION,
+        "quadimpact_version": __version__,
+        "n_runs": spec.n_runs,
+        "fingerprint": spec.fingerprint(),
+        "columns": [[f.name, str(f.type)] for f in schema],
+        "spec": spec.to_dict(),
+    }
+    path = out / "sweep.json"
+    if path.is_file():
+        try:
+            old = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError) as exc:
+            raise InputError(
+                f"{path}: unreadable ({exc}); delete the folder to start over"
+            ) from None
+        if old != json.loads(canonical(record)):
+            differs = [
+                k
+                for k in ("spec", "quadimpact_version", "n_runs", "columns", "fingerprint")
+                if old.get(k) != json.loads(canonical(record)).get(k)
+            ]
+            detail = differs[0] if differs else "format"
+            if detail == "spec":
+                keys = [
+                    k
+                    for k in ("base", "grid", "runs", "sample")
+                    if (old.get("spec") or {}).get(k) != json.loads(canonical(spec.to_dict()))[k]
+                ]
+                detail = "its " + ", ".join(keys or ["spec"])
+            raise InputError(
+                f"{out}: holds a different sweep ({detail} differs, see sweep.json); "
+                "use another output folder, or delete this one to start over"
+            )
+        return
+    if (out / "runs.parquet").exists() or any((out / "parts").glob("part-*.parquet")):
+        raise InputError(f"{out}: has sweep results but no sweep.json; use another output folder")
+    text = json.dumps(record, indent=1, sort_keys=True, allow_nan=False) + "\n"
+    atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), durable=True)
+
+
+@contextlib.contextmanager
+def folder_lock(out: Path) -> Iterator[None]:
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock
+        yield
+        return
+    fd = os.open(out / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise InputError(f"{out}: another sweep is writing to this folder") from None
+        yield
+    finally:
+        os.close(fd)
+
+
