@@ -36,6 +36,8 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import pandas as pd
 
+from quadimpact.results.schema import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS, TIMESERIES_COLUMNS
+
 __all__ = [
     "BUMPERS",
     "EPISODE_COLUMNS",
@@ -64,73 +66,6 @@ SUMMARY_JSON = "summary.json"
 EPISODES_CSV = "episodes.csv"
 TIMESERIES_PARQUET = "timeseries.parquet"
 IMU_PARQUET = "imu.parquet"
-
-#: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
-BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
-
-#: Columns of the episodes table, in order (docs/RESULTS.md).
-EPISODE_COLUMNS: tuple[str, ...] = (
-    "bumper",
-    "surface",
-    "t_start_s",
-    "t_end_s",
-    "v_i_m_s",
-    "peak_delta_m",
-    "t_peak_s",
-    "peak_force_n",
-    "t_peak_force_s",
-    "open",
-)
-
-#: Columns of the time-series table, in order (docs/RESULTS.md).
-TIMESERIES_COLUMNS: tuple[str, ...] = (
-    "t_s",
-    "x_m",
-    "y_m",
-    "z_m",
-    "u_m_s",
-    "v_m_s",
-    "w_m_s",
-    "vx_m_s",
-    "vy_m_s",
-    "vz_m_s",
-    "q0",
-    "q1",
-    "q2",
-    "q3",
-    "p_rad_s",
-    "q_rad_s",
-    "r_rad_s",
-    *(f"omega{j}_rad_s" for j in BUMPERS),
-    *(f"omega_cmd{j}_rad_s" for j in BUMPERS),
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
-    "altitude_m",
-    *(f"delta{j}_m" for j in BUMPERS),
-    *(f"force{j}_n" for j in BUMPERS),
-    "stage",
-)
-
-#: Columns of the IMU table (imu.parquet), in order (docs/RESULTS.md): the
-#: measured specific force (body FRD) and angular rate, the true ones, and the
-#: detector's horizontal measure.
-IMU_COLUMNS: tuple[str, ...] = (
-    "t_s",
-    "fx_m_s2",
-    "fy_m_s2",
-    "fz_m_s2",
-    "p_rad_s",
-    "q_rad_s",
-    "r_rad_s",
-    "fx_true_m_s2",
-    "fy_true_m_s2",
-    "fz_true_m_s2",
-    "p_true_rad_s",
-    "q_true_rad_s",
-    "r_true_rad_s",
-    "f_horizontal_m_s2",
-)
 
 #: Schema metadata key holding ``{column: unit}`` as a JSON string.
 UNITS_METADATA_KEY = "quadimpact.units"

@@ -21,6 +21,7 @@ from typing import Any
 
 from quadimpact.errors import InputError, one_line
 from quadimpact.results.files import atomic_write
+from quadimpact.results.schema import SUMMARY_KEYS
 from quadimpact.sweep.spec import SweepSpec, canonical, plain
 
 FLUSH_ROWS = 1024
@@ -36,82 +37,23 @@ FORMAT_VERSION = 1
 
 _ARROW_KINDS = ("f", "i", "b", "s", "j")
 
-SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
-    ("status", "s"),
-    ("reason", "s"),
-    ("warnings", "j"),
-    ("model", "s"),
-    ("model_options__yaw_reaction", "s"),
-    ("model_options__bumper1_yaw_twice", "b"),
-    ("model_options__initial_rotor_speeds", "s"),
-    ("model_options__attitude_mapping", "s"),
-    ("model_options__crash_rule", "s"),
-    ("model_options__approach_start", "s"),
-    ("controller", "s"),
-    ("vehicle", "s"),
-    ("delta_init_m", "f"),
-    ("peak_force_n", "f"),
-    ("initial_impact_duration_s", "f"),
-    ("first_contact_s", "f"),
-    ("impact_speed_m_s", "f"),
-    ("heading_deg", "f"),
-    ("inclination_deg", "f"),
-    ("impact_heading_deg", "f"),
-    ("impact_inclination_deg", "f"),
-    ("leading_bumpers", "j"),
-    ("aft_bumpers", "j"),
-    ("response_type", "s"),
-    ("n_episodes", "i"),
-    ("n_grazes", "i"),
-    ("n_subsequent_impacts", "i"),
-    ("n_subsequent_episodes", "i"),
-    ("subsequent_impacts", "j"),
-    ("crash_time_s", "f"),
-    ("power_off_time_s", "f"),
-    ("crash_position_m", "j"),
-    ("max_penetration_m", "f"),
-    ("bumper_model_valid", "b"),
-    ("t_start_s", "f"),
-    ("t_final_s", "f"),
-    ("references__altitude_m", "f"),
-    ("references__roll_rad", "f"),
-    ("references__pitch_rad", "f"),
-    ("references__yaw_rad", "f"),
-    ("quadimpact_version", "s"),
-    ("wall_distance_m", "f"),
-    ("crash_distance_from_wall_m", "f"),
-    ("approach__start_time_s", "f"),
-    ("approach__start_x_m", "f"),
-    ("approach__start_speed_m_s", "f"),
-    ("approach__late_start", "b"),
-    ("approach__speed_residual_m_s", "f"),
-    ("requested__heading_deg", "f"),
-    ("requested__inclination_deg", "f"),
-    ("requested__speed_m_s", "f"),
-    ("requested__impact_time_s", "f"),
-    ("attitude_excursion__roll_excursion_deg", "f"),
-    ("attitude_excursion__pitch_excursion_deg", "f"),
-    ("attitude_excursion__yaw_excursion_deg", "f"),
-    ("attitude_excursion__tilt_max_deg", "f"),
-    ("outcome", "s"),
-    ("integrator__steps", "i"),
-    ("integrator__rejected_steps", "i"),
-    ("integrator__rhs_evaluations", "i"),
-    ("integrator__control_ticks", "i"),
-    ("integrator__output_rows", "i"),
-    ("summary_extra", "j"),
-)
-"""Summary columns of ``runs.parquet`` and their kinds (``f`` float64, ``i``
-nullable int64, ``b`` nullable bool, ``s`` string, ``j`` JSON text). Summary
-keys not listed land, as JSON, in ``summary_extra`` (null when none), so the
-schema never depends on what a run returned."""
-
-_SUMMARY_KIND = dict(SUMMARY_COLUMNS)
-
-
 def _is_time_measurement(key: str) -> bool:
     """Flattened summary keys that measure wall-clock time (not deterministic)."""
     return key.startswith("integrator__") and "time" in key
+
+
+SUMMARY_COLUMNS: tuple[tuple[str, str], ...] = (
+    *((k.name, k.kind) for k in SUMMARY_KEYS if not _is_time_measurement(k.name)),
+    ("summary_extra", "j"),
+)
+"""Summary columns of ``runs.parquet`` and their kinds (``f`` float64, ``i``
+nullable int64, ``b`` nullable bool, ``s`` string, ``j`` JSON text): the
+summary schema (``quadimpact.results.schema.SUMMARY_KEYS``) without the
+wall-clock timings, so that a table is the same whatever ran it. Summary keys
+outside the schema land, as JSON, in ``summary_extra`` (null when none)."""
+
+_SUMMARY_KIND = dict(SUMMARY_COLUMNS)
+
 
 
 
