@@ -28,11 +28,12 @@ def test_wall_approaches_without_the_wall_never_detect():
     for model, heading, incl, speed in itertools.product(
         ("paper-replica", "default"), (0.0, 45.0), (-20.0, -10.0, 0.0, 10.0, 20.0), (0.5, 1.0)
     ):
+        off_cm = {"imu_position_m": (0.02, 0.01, -0.05)}
         setup = prepare(WallApproach(heading_deg=heading, inclination_deg=incl, speed_m_s=speed,
-                                     model=model, vehicle_overrides={"imu_position_m":
-                                                                     (0.02, 0.01, -0.05)}))  # fmt: skip
-        rec = execute_record(setup.x0, setup.t0, setup.tf, setup.veh, np.zeros((0, L.NSURF)),
-                             setup.opts, setup.ctrl, setup.output_times(), **setup.sensors())  # fmt: skip
+                                     model=model, vehicle_overrides=off_cm))  # fmt: skip
+        no_wall = np.zeros((0, L.NSURF))
+        rec = execute_record(setup.x0, setup.t0, setup.tf, setup.veh, no_wall, setup.opts,
+                             setup.ctrl, setup.output_times(), **setup.sensors())  # fmt: skip
         assert rec.stats[L.ST_N_DETECTIONS] == 0 and math.isnan(rec.stats[L.ST_T_DETECT])
         assert rec.imu[:, L.I_HORIZONTAL].max() < 0.1 * 0.5 * G
         count += 1

@@ -26,8 +26,8 @@ def test_initial_state(roll, pitch, yaw, model):
     # rotor speeds: the allocation of m g cos(phi) cos(theta) with zero torques
     A = allocation_matrix(v, setup.options.yaw_reaction == "paper")
     w2 = x[L.X_ROTOR : L.X_ROTOR + 4] ** 2
-    np.testing.assert_allclose(A @ w2, [v.mass_kg * 9.81 * math.cos(phi) * math.cos(theta), 0, 0, 0],
-                               atol=1e-12)  # fmt: skip
+    thrust = v.mass_kg * 9.81 * math.cos(phi) * math.cos(theta)
+    np.testing.assert_allclose(A @ w2, [thrust, 0, 0, 0], atol=1e-12)
     np.testing.assert_allclose(x[L.X_POS : L.X_POS + 3], (-0.32, 0.0, -5.0))
     vel = quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]) @ x[L.X_VEL : L.X_VEL + 3]
     np.testing.assert_allclose(vel, (1.2, 0.0, 0.0), atol=1e-15)
