@@ -5,7 +5,7 @@ import itertools
 import numpy as np
 import pandas as pd
 
-from quadimpact import findings as F
+from quadimpact.paper import findings as F
 
 
 def table(

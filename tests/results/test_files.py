@@ -9,7 +9,6 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from quadimpact.simulation.record import episodes_frame
 from quadimpact.core import layout as L
 from quadimpact.results.files import (
     EPISODES_LEADING_COLUMNS,
@@ -23,6 +22,7 @@ from quadimpact.results.files import (
     write_timeseries_parquet,
 )
 from quadimpact.results.result import SimulationResult, read_result
+from quadimpact.simulation.record import episodes_frame
 
 
 def make_timeseries(n: int = 50) -> pd.DataFrame:
@@ -183,7 +183,8 @@ def test_read_result_missing_folder(tmp_path: Path) -> None:
 
 def test_to_jsonable_keeps_nan_and_unknown_values_when_asked() -> None:
     marker = object()
-    out = to_jsonable({"a": np.float64("nan"), "b": (np.int64(2), marker)}, finite=False, strict=False)
+    value = {"a": np.float64("nan"), "b": (np.int64(2), marker)}
+    out = to_jsonable(value, finite=False, strict=False)
     assert math.isnan(out["a"]) and out["b"] == [2, marker]
 
 

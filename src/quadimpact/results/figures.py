@@ -281,7 +281,8 @@ def make_imu(
     else:
         first = axes[0]
     ax_f, ax_w = axes
-    for col, color in (("fx_m_s2", "tab:blue"), ("fy_m_s2", "tab:orange"), ("fz_m_s2", "tab:green")):
+    axis_colors = ("tab:blue", "tab:orange", "tab:green")
+    for col, color in zip(("fx_m_s2", "fy_m_s2", "fz_m_s2"), axis_colors, strict=True):
         ax_f.plot(t, imu[col].to_numpy(dtype=np.float64), color=color, linewidth=1.0,
                   label=col.split("_")[0])  # fmt: skip
     ax_f.plot(t, imu["f_horizontal_m_s2"].to_numpy(dtype=np.float64), color="black",
@@ -292,7 +293,7 @@ def make_imu(
     ax_f.set_ylabel("Specific force (m/s²)")
     mark_stages(ax_f, summary, label=True)
     ax_f.legend(loc="upper right", fontsize="small", ncols=3)
-    for col, color in (("p_rad_s", "tab:blue"), ("q_rad_s", "tab:orange"), ("r_rad_s", "tab:green")):
+    for col, color in zip(("p_rad_s", "q_rad_s", "r_rad_s"), axis_colors, strict=True):
         ax_w.plot(t, imu[col].to_numpy(dtype=np.float64), color=color, linewidth=1.0,
                   label=col.split("_")[0])  # fmt: skip
     ax_w.set_ylabel("Body rate (rad/s)")

@@ -6,16 +6,12 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli_options import parallel_options
+from quadimpact.cli.options import out_option, parallel_options
 
 
 @click.command("reproduce")
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=Path("results/paper"),
-    show_default=True,
-    help="Report folder (report.md, figures, tables; the sweeps it ran, resumable).",
+@out_option(
+    "results/paper", "Report folder (report.md, figures, tables; the sweeps it ran, resumable)."
 )
 @click.option(
     "--no-ablation",
@@ -48,7 +44,7 @@ def reproduce(
     verdict computed from the data, and shows which of the replica's
     differences causes each disagreement.
     """
-    from quadimpact.study import reproduce as run_study
+    from quadimpact.paper.study import reproduce as run_study
 
     result = run_study(
         out, workers=workers, scheduler=scheduler, progress=not no_progress,

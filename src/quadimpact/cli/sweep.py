@@ -1,17 +1,16 @@
 """``quadimpact sweep``: many runs to one table (``quadimpact.sweep``).
 
-Registered in ``quadimpact.cli._register_subcommands``. Heavy modules are
+Registered on the group in :mod:`quadimpact.cli`. Heavy modules are
 imported inside the command, so that ``quadimpact --help`` stays fast.
 """
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import click
 
-from quadimpact.cli_options import parallel_options
+from quadimpact.cli.options import parallel_options
 from quadimpact.errors import InputError
 
 __all__ = ["sweep"]
@@ -150,6 +149,3 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
         lines.append(f"plots   {out / 'plots'} ({', '.join(p.name for p in plots)})")
     return "\n".join(lines)
 
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(sweep())

@@ -1,6 +1,6 @@
 """Command-line commands ``quadimpact animate``, ``snapshots`` and ``view``.
 
-Registered on the main group in :mod:`quadimpact.cli`. Each reads a result
+Registered on the group in :mod:`quadimpact.cli`. Each reads a result
 folder written by ``quadimpact run`` and writes into it:
 
 * ``animate DIR``: ``DIR/animation.mp4`` (and ``DIR/animation.gif`` with ``--gif``);
@@ -11,7 +11,6 @@ folder written by ``quadimpact run`` and writes into it:
 from __future__ import annotations
 
 import functools
-import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -330,6 +329,3 @@ def make_all(out: Path, result: Any) -> list[Path]:
     files.append(write_viewer(out, scene=scene))
     return files
 
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit("use: quadimpact animate|snapshots|view RESULT_DIR")

@@ -1,26 +1,18 @@
-"""Command-line interface: ``quadimpact run ...``.
-
-Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
-commands, so that ``quadimpact --help`` answers at once. Every input problem
-ends the program with one line on stderr, ``quadimpact: error: ...``, and
-exit status 2; set ``QUADIMPACT_DEBUG=1`` to see tracebacks.
-"""
+"""``quadimpact run``: one scenario (a file, flags, or both) to a result folder."""
 
 from __future__ import annotations
 
 import math
-import os
-import sys
-import traceback
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 import click
 
+from quadimpact.cli.options import CONTROLLER, MODEL, out_option
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
-__all__ = ["cli", "main", "build_scenario"]
+__all__ = ["build_scenario", "format_summary", "run"]
 
 # click parameter name -> (scenario field, flag as typed)
 _FLAGS: dict[str, tuple[str, str]] = {
@@ -49,49 +41,12 @@ _WALL_ONLY = {
     "wall_distance_m",
     "altitude_m",
 }
-_OUTPUT_FILES = "summary.json, timeseries.parquet, episodes.csv, fig5.png, fig6.png"
-
-
-def _version() -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version("quadimpact")
-    except PackageNotFoundError:
-        return str(getattr(sys.modules.get("quadimpact"), "__version__", "unknown"))
-
-
-def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
-    if value and not ctx.resilient_parsing:
-        click.echo(f"quadimpact {_version()}")
-        ctx.exit(0)
-
-
-@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
-@click.option(
-    "--version",
-    is_flag=True,
-    expose_value=False,
-    is_eager=True,
-    callback=_print_version,
-    help="Print the version and exit.",
+_OUTPUT_FILES = (
+    "summary.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, fig6.png, imu.png"
 )
-def cli() -> None:
-    """Simulate a bumper-protected quadrotor colliding with a wall.
-
-    quadimpact implements the model of "Dynamics of a quadrotor undergoing
-    impact with a wall" (the Spiri quadrotor, Hunt-Crossley bumper contact,
-    the authors' PID controller) with a physically consistent default model
-    and a "paper-replica" variant that reproduces the authors' simulator.
-
-    Frames: inertial NED (X toward the wall, Y right, Z down; altitude = -Z),
-    body FRD (x forward, y right, z down). Units: SI, angles in degrees.
-
-    Start with:  quadimpact run --help
-    """
 
 
-@cli.command("run")
+@click.command("run")
 @click.argument(
     "scenario",
     required=False,
@@ -145,10 +100,10 @@ def cli() -> None:
 )
 @click.option(
     "--model",
-    type=click.Choice(["default", "paper-replica"]),
+    type=MODEL,
     help="Model variant: 'default' is physically consistent; 'paper-replica' reproduces "
-    "the authors' simulator, errors included, to match the published figures. "
-    "[default: default]",
+    "the authors' simulator, errors included, to match the published figures; "
+    "'recovery-replica' their later recovery simulator. [default: default]",
 )
 @click.option(
     "--option",
@@ -156,14 +111,17 @@ def cli() -> None:
     multiple=True,
     metavar="NAME=VALUE",
     help="Change one switch of the model variant (repeatable), e.g. crash_rule=cm-ground. "
-    "Switches: yaw_reaction, bumper1_yaw_twice, initial_rotor_speeds, attitude_mapping, "
-    "crash_rule, approach_start.",
+    "Switches: yaw_reaction, spinup_reaction, bumper1_yaw_twice, initial_rotor_speeds, "
+    "attitude_mapping, crash_rule, approach_start, detection_tick_reference, "
+    "contact_gate_m, pre_impact (docs/VARIANTS.md).",
 )
 @click.option(
     "--controller",
-    type=click.Choice(["paper", "cascade-pid"]),
+    type=CONTROLLER,
     help="'paper': the authors' discrete PID as they ran it; 'cascade-pid': the same "
-    "structure with running integrals, anti-windup and rotor limits. [default: paper]",
+    "structure with running integrals, anti-windup and rotor limits; 'recovery': a "
+    "pre-impact behaviour, then the staged recovery law after the impact is detected; "
+    "or any registered controller. [default: paper]",
 )
 @click.option(
     "--vehicle",
@@ -184,9 +142,9 @@ def cli() -> None:
 )
 @click.option(
     "--ground",
-    type=click.Choice(["crash", "contact"]),
+    type=click.Choice(["crash", "contact", "none"]),
     help="'crash': reaching the ground ends the run; 'contact': the ground is a contact "
-    "surface. [default: crash]",
+    "surface; 'none': no ground. [default: crash]",
 )
 @click.option(
     "--output-rate",
@@ -204,13 +162,7 @@ def cli() -> None:
     type=float,
     help="Integrator absolute tolerance, > 0. [default: kernel default]",
 )
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=Path("results/run"),
-    show_default=True,
-    help="Output folder (created if needed).",
-)
+@out_option("results/run", "Output folder (created if needed).")
 @click.option(
     "--viz",
     is_flag=True,
@@ -248,7 +200,7 @@ def run(
     result.write(out)
     click.echo(format_summary(result.summary, out))
     if viz:
-        from quadimpact.viz.cli import make_all
+        from quadimpact.cli.viz import make_all
 
         for path in make_all(out, result):
             click.echo(f"picture        {path}")
@@ -391,83 +343,3 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         lines.append(f"warning        {one_line(str(warning))}")
     lines.append(f"output         {out} ({_OUTPUT_FILES})")
     return "\n".join(lines)
-
-
-# ---- subcommands defined in their own modules: one registration line each ----
-# (import inside a function keeps `quadimpact --help` fast and avoids cycles)
-def _register_subcommands() -> None:
-    from quadimpact.viz.cli import animate, snapshots, view
-
-    cli.add_command(animate)
-    cli.add_command(snapshots)
-    cli.add_command(view)
-
-    from quadimpact.cli_sweep import sweep
-
-    cli.add_command(sweep)
-
-    from quadimpact.cli_study import reproduce
-
-    cli.add_command(reproduce)
-
-    from quadimpact.cli_experiments import experiments
-
-    cli.add_command(experiments)
-
-
-_register_subcommands()
-
-
-def _fail(message: str, code: int) -> None:
-    click.echo(f"quadimpact: error: {one_line(message)}", err=True)
-    sys.exit(code)
-
-
-def main(argv: list[str] | None = None) -> None:
-    """Entry point of the ``quadimpact`` command.
-
-    Input errors (bad flag, value, file) print one line and exit with status 2;
-    unexpected failures print one line and exit with status 1 (set
-    ``QUADIMPACT_DEBUG=1`` for the traceback).
-
-    Parameters
-    ----------
-    argv : list of str, optional
-        Arguments; default ``sys.argv[1:]``.
-    """
-    debug = os.environ.get("QUADIMPACT_DEBUG", "") not in ("", "0")
-    try:
-        code = cli.main(args=argv, prog_name="quadimpact", standalone_mode=False)
-    except click.exceptions.NoArgsIsHelpError as exc:
-        click.echo(exc.ctx.get_help() if exc.ctx else "quadimpact --help")
-        code = 0
-    except click.exceptions.UsageError as exc:
-        if debug:
-            traceback.print_exc()
-        where = exc.ctx.command_path if exc.ctx else "quadimpact"
-        _fail(f"{exc.format_message()} (see '{where} --help')", 2)
-    except click.exceptions.Abort:
-        _fail("aborted", 130)
-    except click.ClickException as exc:
-        _fail(exc.format_message(), exc.exit_code)
-    except InputError as exc:
-        if debug:
-            traceback.print_exc()
-        _fail(str(exc), 2)
-    except KeyboardInterrupt:
-        _fail("interrupted", 130)
-    except Exception as exc:  # the last line of defence: one line, no traceback
-        if debug:
-            traceback.print_exc()
-        pydantic = sys.modules.get("pydantic")
-        if pydantic is not None and isinstance(exc, pydantic.ValidationError):
-            _fail(str(input_error_from_validation(exc)), 2)
-        _fail(
-            f"unexpected {type(exc).__name__}: {exc} (set QUADIMPACT_DEBUG=1 to see the traceback)",
-            1,
-        )
-    sys.exit(code if isinstance(code, int) else 0)
-
-
-if __name__ == "__main__":
-    main()

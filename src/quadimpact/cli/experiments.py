@@ -6,16 +6,13 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli_options import parallel_options
+from quadimpact.cli.options import out_option, parallel_options
 
 
 @click.command("experiments")
-@click.option(
-    "--out",
-    type=click.Path(file_okay=False, path_type=Path),
-    default=Path("results/experiments"),
-    show_default=True,
-    help="Output folder: table3.csv, one folder per crash, the sensitivity sweeps.",
+@out_option(
+    "results/experiments",
+    "Output folder: table3.csv, one folder per crash, the sensitivity sweeps.",
 )
 @click.option(
     "--data",

@@ -1,0 +1,128 @@
+"""Command-line interface: the ``quadimpact`` group, one module per command.
+
+* :mod:`~quadimpact.cli.run`: ``quadimpact run``;
+* :mod:`~quadimpact.cli.sweep`: ``quadimpact sweep``;
+* :mod:`~quadimpact.cli.reproduce`: ``quadimpact reproduce``;
+* :mod:`~quadimpact.cli.experiments`: ``quadimpact experiments``;
+* :mod:`~quadimpact.cli.viz`: ``quadimpact animate``, ``snapshots``, ``view``;
+* :mod:`~quadimpact.cli.options`: options shared by several commands.
+
+Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
+commands, so that ``quadimpact --help`` answers at once. Every input problem
+ends the program with one line on stderr, ``quadimpact: error: ...``, and
+exit status 2; set ``QUADIMPACT_DEBUG=1`` to see tracebacks.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import traceback
+
+import click
+
+from quadimpact.cli import experiments, reproduce, run, sweep, viz
+from quadimpact.cli.run import build_scenario, format_summary
+from quadimpact.errors import InputError, input_error_from_validation, one_line
+
+__all__ = ["build_scenario", "cli", "format_summary", "main"]
+
+
+def _version() -> str:
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("quadimpact")
+    except PackageNotFoundError:
+        return str(getattr(sys.modules.get("quadimpact"), "__version__", "unknown"))
+
+
+def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> None:
+    if value and not ctx.resilient_parsing:
+        click.echo(f"quadimpact {_version()}")
+        ctx.exit(0)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"], "max_content_width": 100})
+@click.option(
+    "--version",
+    is_flag=True,
+    expose_value=False,
+    is_eager=True,
+    callback=_print_version,
+    help="Print the version and exit.",
+)
+def cli() -> None:
+    """Simulate a bumper-protected quadrotor colliding with a wall.
+
+    quadimpact implements the model of "Dynamics of a quadrotor undergoing
+    impact with a wall" (the Spiri quadrotor, Hunt-Crossley bumper contact,
+    the authors' PID controller) with a physically consistent default model
+    and a "paper-replica" variant that reproduces the authors' simulator.
+
+    Frames: inertial NED (X toward the wall, Y right, Z down; altitude = -Z),
+    body FRD (x forward, y right, z down). Units: SI, angles in degrees.
+
+    Start with:  quadimpact run --help
+    """
+
+
+# ---- the commands, each in its own module: one registration line each ----
+cli.add_command(run.run)
+cli.add_command(viz.animate)
+cli.add_command(viz.snapshots)
+cli.add_command(viz.view)
+cli.add_command(sweep.sweep)
+cli.add_command(reproduce.reproduce)
+cli.add_command(experiments.experiments)
+
+
+def _fail(message: str, code: int) -> None:
+    click.echo(f"quadimpact: error: {one_line(message)}", err=True)
+    sys.exit(code)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Entry point of the ``quadimpact`` command.
+
+    Input errors (bad flag, value, file) print one line and exit with status 2;
+    unexpected failures print one line and exit with status 1 (set
+    ``QUADIMPACT_DEBUG=1`` for the traceback).
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        Arguments; default ``sys.argv[1:]``.
+    """
+    debug = os.environ.get("QUADIMPACT_DEBUG", "") not in ("", "0")
+    try:
+        code = cli.main(args=argv, prog_name="quadimpact", standalone_mode=False)
+    except click.exceptions.NoArgsIsHelpError as exc:
+        click.echo(exc.ctx.get_help() if exc.ctx else "quadimpact --help")
+        code = 0
+    except click.exceptions.UsageError as exc:
+        if debug:
+            traceback.print_exc()
+        where = exc.ctx.command_path if exc.ctx else "quadimpact"
+        _fail(f"{exc.format_message()} (see '{where} --help')", 2)
+    except click.exceptions.Abort:
+        _fail("aborted", 130)
+    except click.ClickException as exc:
+        _fail(exc.format_message(), exc.exit_code)
+    except InputError as exc:
+        if debug:
+            traceback.print_exc()
+        _fail(str(exc), 2)
+    except KeyboardInterrupt:
+        _fail("interrupted", 130)
+    except Exception as exc:  # the last line of defence: one line, no traceback
+        if debug:
+            traceback.print_exc()
+        pydantic = sys.modules.get("pydantic")
+        if pydantic is not None and isinstance(exc, pydantic.ValidationError):
+            _fail(str(input_error_from_validation(exc)), 2)
+        _fail(
+            f"unexpected {type(exc).__name__}: {exc} (set QUADIMPACT_DEBUG=1 to see the traceback)",
+            1,
+        )
+    sys.exit(code if isinstance(code, int) else 0)

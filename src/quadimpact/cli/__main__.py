@@ -1,0 +1,5 @@
+"""``python -m quadimpact.cli``: the ``quadimpact`` command."""
+
+from quadimpact.cli import main
+
+main()

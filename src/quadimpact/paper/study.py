@@ -1,0 +1,181 @@
+"""The paper's study in one call: Figure 4, Table II, Figures 5-6 and a report.
+
+``reproduce(out_dir)`` runs, for both model variants (MODEL.md section 8),
+the Figure 4 sweep (heading 0 and 45 deg, inclination -20..20 deg in 1-deg
+steps, impact speed 0.5, 0.75, 1 m/s: 246 runs each) and the example run
+(45 deg, 15 deg, 0.75 m/s), evaluates the paper's findings on each
+(:mod:`~quadimpact.paper.findings`), and, to explain where the variants disagree, repeats the
+replica with each of its six differences switched off in turn. It writes:
+
+* ``report.md`` (:mod:`~quadimpact.paper.report`): the findings with the
+  paper's claim, what each variant measured and the computed verdict; the
+  ablation; the figures and Table II;
+* ``fig4_<variant>.png``, ``table2_<variant>.png``, ``example-<variant>/``
+  (the run's files, Figures 5 and 6);
+* ``fig4.parquet`` (every run of every sweep), ``table2.parquet``,
+  ``findings.parquet``, ``ablation.parquet``;
+* ``sweeps/<name>/``: the resumable sweep folders.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+from matplotlib.figure import Figure
+
+from quadimpact.inputs.model import MODEL_VARIANTS
+from quadimpact.inputs.scenarios import WallApproach
+from quadimpact.paper.findings import Finding, evaluate, fig4_curves, findings_frame
+from quadimpact.paper.report import render_report, type_label
+from quadimpact.results import figures
+from quadimpact.simulation import simulate
+from quadimpact.sweep import SweepSpec, run_sweep
+from quadimpact.viz.scene import Scene
+from quadimpact.viz.snapshots import write_snapshots
+
+FIG4_GRID: dict[str, list[float]] = {
+    "heading_deg": [0.0, 45.0],
+    "inclination_deg": [float(i) for i in range(-20, 21)],
+    "speed_m_s": [0.5, 0.75, 1.0],
+}
+EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
+VARIANTS = ("paper-replica", "default")
+SWITCHES = tuple(MODEL_VARIANTS["default"])  # the replica's six differences
+
+
+@dataclass
+class StudyResult:
+    """What ``reproduce`` produced (paths and tables)."""
+
+    out_dir: Path
+    report: Path
+    tables: dict[str, pd.DataFrame]
+    findings: pd.DataFrame
+    ablation: pd.DataFrame
+    elapsed_s: float
+
+
+def _ablation_name(switch: str) -> str:
+    return f"replica-without-{switch}"
+
+
+def _run_variant(
+    name: str, base: dict, out: Path, workers: int | None, scheduler: str | None, progress: bool
+) -> tuple[pd.DataFrame, tuple[dict, pd.DataFrame, pd.DataFrame]]:
+    table = run_sweep(
+        SweepSpec(base=base, grid=FIG4_GRID),
+        out / "sweeps" / name,
+        workers=workers,
+        scheduler=scheduler,
+        progress=progress,
+    )
+    example = simulate(WallApproach(**EXAMPLE, **base))
+    return table, example
+
+
+def reproduce(
+    out_dir: str | Path,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    progress: bool = False,
+    ablation: bool = True,
+    experiments: bool = True,
+    data_dir: str | Path | None = None,
+) -> StudyResult:
+    """Run the paper's study and write the report folder (see the module docstring).
+
+    With ``experiments`` the seven crashes of Table III are simulated too
+    (``experiments/table3.py``, into ``out_dir/experiments``), compared with
+    their logs when ``data_dir`` (or the default data folder) holds them.
+    """
+    start = time.perf_counter()
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    tables: dict[str, pd.DataFrame] = {}
+    found: dict[str, list[Finding]] = {}
+    for variant in VARIANTS:
+        table, ex = _run_variant(variant, {"model": variant}, out, workers, scheduler, progress)
+        ex.write(out / f"example-{variant}")
+        write_snapshots(out / f"example-{variant}", scene=Scene.from_result(ex))
+        tables[variant] = table
+        found[variant] = evaluate(table, (ex.summary, ex.episodes, ex.timeseries))
+    ablation_rows = []
+    if ablation:
+        for switch in SWITCHES:
+            name = _ablation_name(switch)
+            base = {
+                "model": "paper-replica",
+                "model_options": {switch: MODEL_VARIANTS["default"][switch]},
+            }
+            table, ex = _run_variant(name, base, out, workers, scheduler, progress)
+            tables[name] = table
+            fs = evaluate(table, (ex.summary, ex.episodes, ex.timeseries))
+            ablation_rows += [{"switch": switch, **f.__dict__} for f in fs]
+    ablation_df = pd.DataFrame(ablation_rows)
+    findings = findings_frame(found)
+    table3 = None
+    if experiments:
+        from quadimpact.experiments.table3 import run_experiments
+
+        table3 = run_experiments(
+            out / "experiments", data_dir=data_dir, workers=workers, scheduler=scheduler,
+            progress=progress,
+        )  # fmt: skip
+
+    # tables behind the report
+    pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
+    table2(tables).to_parquet(out / "table2.parquet")
+    findings.to_parquet(out / "findings.parquet")
+    ablation_df.to_parquet(out / "ablation.parquet")
+    for variant in VARIANTS:
+        fig4_figure(tables[variant], variant).savefig(out / f"fig4_{variant}.png", dpi=120)
+        type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
+    elapsed = time.perf_counter() - start
+    report = out / "report.md"
+    report.write_text(render_report(tables, findings, ablation_df, elapsed, table3))
+    return StudyResult(out, report, tables, findings, ablation_df, elapsed)
+
+
+# ------------------------------------------------------------------ tables
+def table2(tables: dict[str, pd.DataFrame]) -> pd.DataFrame:
+    """Response type and subsequent-impact count of every Figure 4 run, all sweeps."""
+    cols = ["heading_deg", "speed_m_s", "inclination_deg", "response_type", "n_subsequent_impacts"]
+    parts = []
+    for v, t in tables.items():
+        p = t[cols].copy()
+        p["label"] = t.apply(type_label, axis=1)
+        p["variant"] = v
+        parts.append(p)
+    return pd.concat(parts, ignore_index=True)
+
+
+# ------------------------------------------------------------------ figures
+def fig4_figure(table: pd.DataFrame, variant: str) -> Figure:
+    """Figure 4: delta_init against inclination, one panel per heading, one curve per speed."""
+    curves = fig4_curves(table)
+    headings = sorted({h for h, _ in curves.columns})
+    fig = figures.new_figure(10, 4)
+    axes = fig.subplots(1, len(headings), sharey=True, squeeze=False)[0]
+    for ax, h in zip(axes, headings, strict=True):
+        for v in sorted(curves[h].columns):
+            ax.plot(curves.index, curves[h][v] * 1e3, marker=".", label=f"{v:g} m/s")
+        ax.axvline(10.0, color="0.6", lw=0.8, ls="--")
+        ax.set_title(f"ψ = {h:g}°")
+        ax.set_xlabel("inclination (deg)")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("δ_init (mm)")
+    axes[-1].legend(title="V_c")
+    fig.suptitle(f"Figure 4, {variant}: maximum deflection at the initial impact")
+    return fig
+
+
+def type_map_figure(table: pd.DataFrame, variant: str) -> Figure:
+    """Table II as a picture: response type over inclination and speed, one panel per heading."""
+    return figures.type_map_figure(
+        table, "inclination_deg", "speed_m_s", facet="heading_deg", label=type_label,
+        title=f"Table II, {variant}: response type (C/D with the number of subsequent impacts)",
+    )  # fmt: skip
