@@ -17,7 +17,9 @@ Examples
 
 from __future__ import annotations
 
+import json
 import math
+import os
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -275,12 +277,24 @@ class Vehicle(BaseModel):
                 field = ".".join((*prefix, str(key)))
                 known = ", ".join(type(self).model_fields)
                 raise InputError(f"{where}: {field}: unknown vehicle field (known: {known})")
+        try:
+            key = (id(self), json.dumps(fields, sort_keys=True, default=repr))
+        except (TypeError, ValueError):
+            key = None
+        cached = _OVERRIDDEN.get(key) if key is not None else None
+        if cached is not None and cached[0] is self:
+            return cached[1]
         data = self.model_dump()
         data.update(fields)
         try:
-            return type(self).model_validate(data)
+            vehicle = type(self).model_validate(data)
         except ValidationError as exc:
             raise input_error_from_validation(exc, where, prefix=prefix) from None
+        if key is not None:
+            if len(_OVERRIDDEN) >= _CACHE_LIMIT:
+                _OVERRIDDEN.pop(next(iter(_OVERRIDDEN)))
+            _OVERRIDDEN[key] = (self, vehicle)  # holds self, so its id stays its own
+        return vehicle
 
 
 # -------------------------------------------------------------------- loading
@@ -296,12 +310,49 @@ def bundled_vehicles() -> list[str]:
     return sorted(p.name[:-5] for p in folder.iterdir() if p.name.endswith(".toml"))
 
 
+_BUNDLED: list[str] = []
+
+
+def _bundled_names() -> list[str]:
+    """:func:`bundled_vehicles`, listed once per process (the package's own files)."""
+    if not _BUNDLED:
+        _BUNDLED.extend(bundled_vehicles())
+    return _BUNDLED
+
+
 def _vehicle_folder() -> Any:
     """The package folder of bundled vehicle files (an importlib.resources Traversable)."""
     return resources.files("quadimpact.inputs").joinpath("vehicles")
 
 
+_CACHE: dict[tuple[str, int, int], Vehicle] = {}
+_OVERRIDDEN: dict[tuple[int, str], tuple[Vehicle, Vehicle]] = {}
+_CACHE_LIMIT = 64
+
+
+def _file_key(path: Any) -> tuple[str, int, int] | None:
+    """(absolute path, modification time ns, size) of a real file, else ``None``."""
+    try:
+        st = os.stat(path)
+    except (OSError, TypeError, ValueError):
+        return None
+    return (os.path.abspath(str(path)), st.st_mtime_ns, st.st_size)
+
+
 def _read_vehicle(path: Any, where: str, default_name: str) -> Vehicle:
+    """Parse and validate a vehicle file, once per process while the file is unchanged."""
+    key = _file_key(path)
+    if key is not None and key in _CACHE:
+        return _CACHE[key]
+    vehicle = _parse_vehicle(path, where, default_name)
+    if key is not None:
+        if len(_CACHE) >= _CACHE_LIMIT:
+            _CACHE.pop(next(iter(_CACHE)))
+        _CACHE[key] = vehicle  # a frozen model: safe to share
+    return vehicle
+
+
+def _parse_vehicle(path: Any, where: str, default_name: str) -> Vehicle:
     data = read_toml_file(path, where)
     data.setdefault("name", default_name)
     try:
@@ -312,6 +363,10 @@ def _read_vehicle(path: Any, where: str, default_name: str) -> Vehicle:
 
 def load_vehicle(name_or_path: str | Path | None = None) -> Vehicle:
     """Load a vehicle by bundled name or from a TOML file.
+
+    A file is read and validated once per process while it is unchanged
+    (keyed by its path, modification time and size); the same frozen
+    :class:`Vehicle` is returned again.
 
     Parameters
     ----------
@@ -334,7 +389,7 @@ def load_vehicle(name_or_path: str | Path | None = None) -> Vehicle:
     """
     if name_or_path is None:
         name_or_path = "spiri"
-    if isinstance(name_or_path, str) and name_or_path in bundled_vehicles():
+    if isinstance(name_or_path, str) and name_or_path in _bundled_names():
         resource = _vehicle_folder().joinpath(f"{name_or_path}.toml")
         return _read_vehicle(resource, f"vehicle {name_or_path}.toml", name_or_path)
     path = Path(name_or_path)

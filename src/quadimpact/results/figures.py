@@ -19,10 +19,9 @@ import numbers
 import os
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
@@ -30,6 +29,9 @@ from matplotlib.patches import Patch
 
 from quadimpact.errors import InputError
 from quadimpact.results.files import atomic_write
+
+if TYPE_CHECKING:  # pandas only where a table is drawn
+    import pandas as pd
 
 __all__ = [
     "BUMPER_COLORS",
@@ -73,9 +75,22 @@ MAX_TEXT_CELLS = 400
 
 
 
-def new_figure(width_in: float, height_in: float) -> Figure:
-    """An empty figure (constrained layout) on its own Agg canvas: no pyplot state."""
-    fig = Figure(figsize=(width_in, height_in), layout="constrained")
+def new_figure(
+    width_in: float, height_in: float, margins: Mapping[str, float] | None = None
+) -> Figure:
+    """An empty figure on its own Agg canvas: no pyplot state.
+
+    By default the layout is Matplotlib's constrained layout. With ``margins``
+    (``left``, ``right``, ``bottom``, ``top``, ``hspace``, ``wspace`` in figure
+    fractions, as ``Figure.subplots_adjust``) the subplots get fixed margins
+    instead: the per-run figures use that, since the layout engine costs as much
+    as drawing them.
+    """
+    if margins is None:
+        fig = Figure(figsize=(width_in, height_in), layout="constrained")
+    else:
+        fig = Figure(figsize=(width_in, height_in))
+        fig.subplots_adjust(**margins)
     FigureCanvasAgg(fig)
     return fig
 
@@ -83,6 +98,21 @@ def new_figure(width_in: float, height_in: float) -> Figure:
 def save_figure(fig: Figure, path: str | os.PathLike[str]) -> Path:
     """Write ``fig`` as PNG to ``path`` (atomically: temporary file, then rename)."""
     return atomic_write(path, lambda tmp: fig.savefig(tmp, format="png", dpi=FIG_DPI))
+
+
+def _fig_margins(
+    width_in: float, height_in: float, title: str | None, hspace: float = 0.2, wspace: float = 0.2
+) -> dict[str, float]:
+    """Fixed margins of a per-run figure, in inches turned into figure fractions."""
+    top_in = 0.55 if title else 0.25
+    return {
+        "left": 0.8 / width_in,
+        "right": 1.0 - 0.2 / width_in,
+        "bottom": 0.55 / height_in,
+        "top": 1.0 - top_in / height_in,
+        "hspace": hspace,
+        "wspace": wspace,
+    }
 
 
 def break_wraps(
@@ -118,11 +148,11 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     matplotlib.figure.Figure
         One axes; line ``j-1`` is bumper ``j`` in millimetres.
     """
-    fig = new_figure(7.0, 3.8)
+    fig = new_figure(7.0, 3.8, margins=_fig_margins(7.0, 3.8, title))
     ax = fig.add_subplot()
-    t = ts["t_s"].to_numpy(dtype=np.float64)
+    t = np.asarray(ts["t_s"], dtype=np.float64)
     for j in (1, 2, 3, 4):
-        delta_mm = 1e3 * ts[f"delta{j}_m"].to_numpy(dtype=np.float64)
+        delta_mm = 1e3 * np.asarray(ts[f"delta{j}_m"], dtype=np.float64)
         ax.plot(t, delta_mm, color=BUMPER_COLORS[j], linewidth=1.2, label=f"Bumper {j}")
     ax.set_xlabel("Time (s)")
     ax.set_ylabel("Bumper deflection (mm)")
@@ -167,9 +197,9 @@ def make_fig6(
         Axes in order X, roll, Y, pitch, altitude, yaw (row-major). In each
         axes the first line is the simulated quantity.
     """
-    fig = new_figure(10.0, 7.5)
+    fig = new_figure(10.0, 7.5, margins=_fig_margins(10.0, 7.5, title, hspace=0.12, wspace=0.25))
     axes = fig.subplots(3, 2, sharex=True)
-    t = ts["t_s"].to_numpy(dtype=np.float64)
+    t = np.asarray(ts["t_s"], dtype=np.float64)
 
     def ref_value(key: str, scale: float = 1.0) -> float | None:
         v = refs.get(key)
@@ -183,7 +213,7 @@ def make_fig6(
         ("altitude_m", "Altitude (m)", ref_value("altitude_m"), "reference"),
     )
     for ax, (col, label, ref, ref_label) in zip(axes[:, 0], left, strict=True):
-        ax.plot(t, ts[col].to_numpy(dtype=np.float64), color="tab:blue", label="simulated")
+        ax.plot(t, np.asarray(ts[col], dtype=np.float64), color="tab:blue", label="simulated")
         if ref is not None and math.isfinite(ref):
             ax.axhline(ref, label=ref_label, **_REF_STYLE)
         ax.set_ylabel(label)
@@ -195,7 +225,7 @@ def make_fig6(
         ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg)),
     )
     for ax, (col, label, ref) in zip(axes[:, 1], right, strict=True):
-        tt, yy = break_wraps(t, ts[col].to_numpy(dtype=np.float64))
+        tt, yy = break_wraps(t, np.asarray(ts[col], dtype=np.float64))
         ax.plot(tt, yy, color="tab:blue", label="simulated")
         if ref is not None:
             ax.axhline(ref, label="reference", **_REF_STYLE)
@@ -263,15 +293,16 @@ def make_imu(
     The detection and each recovery stage's entry are marked (from the
     summary, when given).
     """
-    n_panels = 3 if ts is not None and len(ts) else 2
-    fig = new_figure(8.0, 2.4 * n_panels + 0.4)
+    n_panels = 3 if ts is not None and len(ts["t_s"]) else 2
+    height = 2.4 * n_panels + 0.4
+    fig = new_figure(8.0, height, margins=_fig_margins(8.0, height, title, hspace=0.12))
     axes = list(np.atleast_1d(fig.subplots(n_panels, 1, sharex=True)))
-    t = imu["t_s"].to_numpy(dtype=np.float64)
+    t = np.asarray(imu["t_s"], dtype=np.float64)
     if n_panels == 3:
         ax = axes.pop(0)
-        tt = ts["t_s"].to_numpy(dtype=np.float64)
+        tt = np.asarray(ts["t_s"], dtype=np.float64)
         for j in (1, 2, 3, 4):
-            ax.plot(tt, 1e3 * ts[f"delta{j}_m"].to_numpy(dtype=np.float64),
+            ax.plot(tt, 1e3 * np.asarray(ts[f"delta{j}_m"], dtype=np.float64),
                     color=BUMPER_COLORS[j], linewidth=1.0, label=f"Bumper {j}")  # fmt: skip
         ax.set_ylabel("Deflection (mm)")
         mark_stages(ax, summary)
@@ -283,9 +314,9 @@ def make_imu(
     ax_f, ax_w = axes
     axis_colors = ("tab:blue", "tab:orange", "tab:green")
     for col, color in zip(("fx_m_s2", "fy_m_s2", "fz_m_s2"), axis_colors, strict=True):
-        ax_f.plot(t, imu[col].to_numpy(dtype=np.float64), color=color, linewidth=1.0,
+        ax_f.plot(t, np.asarray(imu[col], dtype=np.float64), color=color, linewidth=1.0,
                   label=col.split("_")[0])  # fmt: skip
-    ax_f.plot(t, imu["f_horizontal_m_s2"].to_numpy(dtype=np.float64), color="black",
+    ax_f.plot(t, np.asarray(imu["f_horizontal_m_s2"], dtype=np.float64), color="black",
               linewidth=1.2, label="|f_xy| (detector)")  # fmt: skip
     threshold = (summary or {}).get("detection_threshold_m_s2")
     if isinstance(threshold, numbers.Real):
@@ -294,7 +325,7 @@ def make_imu(
     mark_stages(ax_f, summary, label=True)
     ax_f.legend(loc="upper right", fontsize="small", ncols=3)
     for col, color in zip(("p_rad_s", "q_rad_s", "r_rad_s"), axis_colors, strict=True):
-        ax_w.plot(t, imu[col].to_numpy(dtype=np.float64), color=color, linewidth=1.0,
+        ax_w.plot(t, np.asarray(imu[col], dtype=np.float64), color=color, linewidth=1.0,
                   label=col.split("_")[0])  # fmt: skip
     ax_w.set_ylabel("Body rate (rad/s)")
     ax_w.set_xlabel("Time (s)")
@@ -363,6 +394,8 @@ def _cell_texts(sub: pd.DataFrame, label: Callable[[pd.Series], str] | None) -> 
         return [label(r) for _, r in sub.iterrows()]
     if "n_subsequent_impacts" not in sub:
         return [None] * len(sub)
+    import pandas as pd
+
     return [None if pd.isna(n) else str(int(n)) for n in sub["n_subsequent_impacts"]]
 
 
@@ -423,6 +456,8 @@ def type_map_figure(
     fontsize = max(5.0, min(8.0, 9.0 - 0.05 * len(xs)))
     for ax, (fv, sub) in zip(axes, panels, strict=True):
         kind = sub["response_type"].astype(object).where(sub["status"] != "failed", "failed")
+        import pandas as pd
+
         cells = pd.DataFrame(
             {
                 "x": sub[x].to_numpy(),

@@ -33,6 +33,8 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -236,16 +238,46 @@ def read_summary_json(path: str | os.PathLike[str]) -> dict[str, Any]:
         return json.load(fh)
 
 
-def write_episodes_csv(df: pd.DataFrame, path: str | os.PathLike[str]) -> Path:
+def write_episodes_csv(
+    df: pd.DataFrame | Mapping[str, Any], path: str | os.PathLike[str]
+) -> Path:
     """Write the episodes table to CSV, atomically.
 
     Columns :data:`EPISODES_LEADING_COLUMNS` come first (those present), then
-    the others in their table order. Floats are written with full precision.
+    the others in their table order. Floats are written with full precision
+    (``%.17g``). ``df`` is a DataFrame or a mapping of equal-length columns
+    (written without pandas, to the same text).
     """
+    if not hasattr(df, "columns"):
+        return atomic_write(path, lambda tmp: _write_columns_csv(df, tmp))
     lead = [c for c in EPISODES_LEADING_COLUMNS if c in df.columns]
     cols = lead + [c for c in df.columns if c not in lead]
     out = df.loc[:, cols]
     return atomic_write(path, lambda tmp: out.to_csv(tmp, index=False, float_format="%.17g"))
+
+
+def _csv_text(value: Any) -> str:
+    if isinstance(value, (bool, np.bool_)):
+        return "True" if value else "False"
+    if isinstance(value, (float, np.floating)):
+        return "" if math.isnan(value) else f"{value:.17g}"
+    return str(value)
+
+
+def _write_columns_csv(columns: Mapping[str, Any], path: Path) -> None:
+    """A table of columns as CSV, the way ``DataFrame.to_csv(index=False, float_format="%.17g")``
+    writes it (empty fields for NaN, ``True``/``False``, minimal quoting, ``\\n`` lines)."""
+    import csv
+
+    names = list(columns)
+    lead = [c for c in EPISODES_LEADING_COLUMNS if c in names]
+    names = lead + [c for c in names if c not in lead]
+    n = len(columns[names[0]]) if names else 0
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f, lineterminator="\n")
+        writer.writerow(names)
+        for i in range(n):
+            writer.writerow([_csv_text(columns[c][i]) for c in names])
 
 
 def read_episodes_csv(path: str | os.PathLike[str]) -> pd.DataFrame:
@@ -268,21 +300,35 @@ def read_episodes_csv(path: str | os.PathLike[str]) -> pd.DataFrame:
     return df
 
 
-def write_timeseries_parquet(df: pd.DataFrame, path: str | os.PathLike[str]) -> Path:
+def write_timeseries_parquet(
+    df: pd.DataFrame | Mapping[str, Any], path: str | os.PathLike[str]
+) -> Path:
     """Write the time series to Parquet (pyarrow), with column units in the schema.
 
     The schema metadata key :data:`UNITS_METADATA_KEY` holds a JSON object
-    ``{column: unit}`` (units from :func:`column_unit`).
+    ``{column: unit}`` (units from :func:`column_unit`). ``df`` is a DataFrame
+    or a mapping of equal-length NumPy columns (written without pandas).
     """
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    table = pa.Table.from_pandas(df, preserve_index=False)
-    units = {str(c): column_unit(str(c)) for c in df.columns}
+    if hasattr(df, "columns"):
+        table = pa.Table.from_pandas(df, preserve_index=False)
+    else:
+        table = pa.Table.from_arrays(
+            [_float_array(pa, v) for v in df.values()], names=[str(k) for k in df]
+        )
+    units = {str(c): column_unit(str(c)) for c in (df.columns if hasattr(df, "columns") else df)}
     meta = dict(table.schema.metadata or {})
     meta[UNITS_METADATA_KEY.encode()] = json.dumps(units).encode()
     table = table.replace_schema_metadata(meta)
     return atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+
+
+def _float_array(pa: Any, values: Any) -> Any:
+    """A float64 Arrow array over a NumPy column, without type inference (which imports pandas)."""
+    x = np.ascontiguousarray(values, dtype=np.float64)
+    return pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)])
 
 
 def write_imu_parquet(df: pd.DataFrame, path: str | os.PathLike[str]) -> Path:

@@ -12,11 +12,11 @@ import numbers
 import os
 import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import pandas as pd
+if TYPE_CHECKING:
+    import pandas as pd
 
 from quadimpact.results import files
 
@@ -27,9 +27,12 @@ FIG6_PNG = "fig6.png"
 IMU_PNG = "imu.png"
 
 
-@dataclass
 class SimulationResult:
     """Everything one run produced.
+
+    The tables are built when first read (or when the folder is written), so
+    that a run whose summary is all that is wanted (a sweep) never builds a
+    DataFrame.
 
     Attributes
     ----------
@@ -52,13 +55,73 @@ class SimulationResult:
         when the run had no IMU record.
     """
 
-    summary: dict[str, Any]
-    episodes: pd.DataFrame
-    timeseries: pd.DataFrame
-    references: dict[str, Any] = field(default_factory=dict)
-    scenario: object = None
-    stats: dict[str, Any] = field(default_factory=dict)
-    imu: pd.DataFrame | None = None
+    def __init__(
+        self,
+        summary: dict[str, Any],
+        episodes: pd.DataFrame | None = None,
+        timeseries: pd.DataFrame | None = None,
+        references: dict[str, Any] | None = None,
+        scenario: object = None,
+        stats: dict[str, Any] | None = None,
+        imu: pd.DataFrame | None = None,
+        *,
+        tables: Callable[[str], Any] | None = None,
+    ) -> None:
+        self.summary = summary
+        self.references = dict(references or {})
+        self.scenario = scenario
+        self.stats = dict(stats or {})
+        self._tables: dict[str, Any] = {"episodes": episodes, "timeseries": timeseries, "imu": imu}
+        self._build = tables
+
+    def _table(self, name: str) -> Any:
+        if self._tables[name] is None and self._build is not None:
+            self._tables[name] = self._build(name)
+        return self._tables[name]
+
+    def _columns(self, name: str) -> Any:
+        """The table ``name`` as built, or its raw columns (no DataFrame) if not built yet."""
+        if self._tables[name] is None and self._build is not None:
+            return self._build(name + "_columns")
+        return self._tables[name]
+
+    @property
+    def episodes(self) -> pd.DataFrame:
+        """Contact episodes (built on first use)."""
+        return self._table("episodes")
+
+    @episodes.setter
+    def episodes(self, value: pd.DataFrame) -> None:
+        self._tables["episodes"] = value
+
+    @property
+    def timeseries(self) -> pd.DataFrame:
+        """Sampled states (built on first use)."""
+        return self._table("timeseries")
+
+    @timeseries.setter
+    def timeseries(self, value: pd.DataFrame) -> None:
+        self._tables["timeseries"] = value
+
+    @property
+    def imu(self) -> pd.DataFrame | None:
+        """IMU samples (built on first use)."""
+        return self._table("imu")
+
+    @imu.setter
+    def imu(self, value: pd.DataFrame | None) -> None:
+        self._tables["imu"] = value
+
+    def __repr__(self) -> str:
+        s = self.summary
+        parts = [f"status={s.get('status')!r}"]
+        if s.get("response_type") is not None:
+            parts.append(f"type={s.get('response_type')!r}")
+        if s.get("delta_init_m") is not None:
+            parts.append(f"delta_init={s['delta_init_m'] * 1e3:.2f} mm")
+        if s.get("recovered"):
+            parts.append("recovered")
+        return f"SimulationResult({', '.join(parts)})"
 
     # ------------------------------------------------------------------
     def _scenario_value(self, key: str) -> Any:
@@ -110,11 +173,13 @@ class SimulationResult:
         summary.setdefault("references", dict(self.references))
         summary.setdefault("stats", dict(self.stats))
         files.write_summary_json(summary, d / files.SUMMARY_JSON)
-        files.write_episodes_csv(self.episodes, d / files.EPISODES_CSV)
-        files.write_timeseries_parquet(self.timeseries, d / files.TIMESERIES_PARQUET)
-        has_imu = self.imu is not None and len(self.imu) > 0
+        timeseries = self._columns("timeseries")
+        imu = self._columns("imu")
+        files.write_episodes_csv(self._columns("episodes"), d / files.EPISODES_CSV)
+        files.write_timeseries_parquet(timeseries, d / files.TIMESERIES_PARQUET)
+        has_imu = imu is not None and len(imu["t_s"]) > 0
         if has_imu:
-            files.write_imu_parquet(self.imu, d / files.IMU_PARQUET)
+            files.write_imu_parquet(imu, d / files.IMU_PARQUET)
         else:
             (d / files.IMU_PARQUET).unlink(missing_ok=True)
 
@@ -122,11 +187,11 @@ class SimulationResult:
 
         title = self.plot_title()
         jobs: tuple[tuple[str, Callable[[Path], Path]], ...] = (
-            (FIG5_PNG, lambda p: plots.plot_fig5(self.timeseries, p, title=title)),
+            (FIG5_PNG, lambda p: plots.plot_fig5(timeseries, p, title=title)),
             (
                 FIG6_PNG,
                 lambda p: plots.plot_fig6(
-                    self.timeseries, self.references, p, wall_x_m=self.wall_x_m(), title=title
+                    timeseries, self.references, p, wall_x_m=self.wall_x_m(), title=title
                 ),
             ),
         )
@@ -134,9 +199,7 @@ class SimulationResult:
             jobs += (
                 (
                     IMU_PNG,
-                    lambda p: plots.plot_imu(
-                        self.imu, self.timeseries, p, summary=self.summary, title=title
-                    ),
+                    lambda p: plots.plot_imu(imu, timeseries, p, summary=self.summary, title=title),
                 ),
             )
         else:

@@ -1,10 +1,13 @@
 """Metrics of a run from its tables: impact grouping, initial-impact metrics,
 attitude excursion and the response type.
 
-Everything here is a pure function of pandas tables (the episodes and time
-series of :mod:`quadimpact.simulation.record`) or plain lists, so it can be
-tested on hand-made inputs. Definitions follow STUDIES.md sections 2 and 3;
-frames and units follow MODEL.md section 1 (inertial NED, body FRD, SI).
+Everything here is a pure function of tables or plain lists, so it can be
+tested on hand-made inputs. A "table" is anything whose columns are read
+with ``table[name]``: a pandas DataFrame (the episodes and time series of
+:mod:`quadimpact.simulation.record`) or a plain mapping of NumPy arrays (what
+``simulate`` uses, so that a summary needs no DataFrame). Definitions follow
+docs/STUDIES.md sections 2 and 3; frames and units docs/MODEL.md section 1
+(inertial NED, body FRD, SI).
 """
 
 from __future__ import annotations
@@ -14,7 +17,6 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from quadimpact.results.files import BUMPERS
 from quadimpact.rotations import (
@@ -33,8 +35,46 @@ __all__ = [
 ]
 
 
-def group_impacts(episodes: pd.DataFrame) -> list[list[int]]:
-    """Group contact episodes into impacts (STUDIES.md section 2).
+Table = Any
+"""A DataFrame or a mapping of equal-length NumPy arrays (columns by name)."""
+
+
+def column(table: Table, name: str, dtype: Any = np.float64) -> np.ndarray:
+    """Column ``name`` of a table as a NumPy array."""
+    values = table[name]
+    if hasattr(values, "to_numpy"):
+        return values.to_numpy(dtype=dtype)
+    return np.asarray(values, dtype=dtype)
+
+
+def has_column(table: Table, name: str) -> bool:
+    """Whether the table has column ``name``."""
+    columns = getattr(table, "columns", None)
+    return name in (columns if columns is not None else table)
+
+
+def n_rows(table: Table) -> int:
+    """Number of rows of a table."""
+    if hasattr(table, "shape"):
+        return int(table.shape[0])
+    return len(next(iter(table.values()))) if len(table) else 0
+
+
+def select(table: Table, rows: np.ndarray, names: Sequence[str]) -> dict[str, np.ndarray]:
+    """The columns ``names`` of a table at ``rows`` (a mask or positions), as arrays."""
+    out = {}
+    for name in names:
+        values = table[name]
+        values = values.to_numpy() if hasattr(values, "to_numpy") else np.asarray(values)
+        out[name] = values[rows]
+    return out
+
+
+_EPISODE_NEEDED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_delta_m", "peak_force_n")
+
+
+def group_impacts(episodes: Table) -> list[list[int]]:
+    """Group contact episodes into impacts (docs/STUDIES.md section 2).
 
     Episodes are taken in order of ``t_start_s`` (ties by ``bumper``). An
     impact starts with the earliest episode not yet grouped; every following
@@ -50,8 +90,8 @@ def group_impacts(episodes: pd.DataFrame) -> list[list[int]]:
 
     Parameters
     ----------
-    episodes : pandas.DataFrame
-        Table with at least ``t_start_s``, ``t_end_s`` (s) and ``bumper``.
+    episodes : table
+        With at least ``t_start_s``, ``t_end_s`` (s) and ``bumper``.
 
     Returns
     -------
@@ -59,14 +99,14 @@ def group_impacts(episodes: pd.DataFrame) -> list[list[int]]:
         Row positions (``iloc``) in ``episodes``, one list per impact, impacts
         in time order and members in start order.
     """
-    if len(episodes) == 0:
+    if n_rows(episodes) == 0:
         return []
-    start = episodes["t_start_s"].to_numpy(dtype=np.float64)
-    end = episodes["t_end_s"].to_numpy(dtype=np.float64)
+    start = column(episodes, "t_start_s")
+    end = column(episodes, "t_end_s")
     if np.any(~np.isfinite(start)) or np.any(np.isnan(end)):
         raise ValueError("episodes: t_start_s must be finite and t_end_s not NaN")
-    if "bumper" in episodes.columns:
-        bumper = episodes["bumper"].to_numpy(dtype=np.float64)
+    if has_column(episodes, "bumper"):
+        bumper = column(episodes, "bumper")
         order = np.lexsort((bumper, start))
     else:
         order = np.argsort(start, kind="stable")
@@ -88,16 +128,17 @@ def group_impacts(episodes: pd.DataFrame) -> list[list[int]]:
 
 
 def impact_metrics(
-    episodes: pd.DataFrame,
+    episodes: Table,
     exclude_surfaces: Sequence[str] = ("ground",),
     min_peak_delta_m: float = 0.0,
 ) -> dict[str, Any]:
-    """Initial-impact metrics and counts of subsequent impacts (STUDIES.md section 2).
+    """Initial-impact metrics and counts of subsequent impacts (docs/STUDIES.md section 2).
 
     Parameters
     ----------
-    episodes : pandas.DataFrame
-        Episodes table (:func:`~quadimpact.simulation.record.episodes_frame`).
+    episodes : table
+        Episodes (:func:`~quadimpact.simulation.record.episodes_frame`, or its
+        columns as arrays: :func:`~quadimpact.simulation.record.episode_columns`).
     exclude_surfaces : sequence of str
         Surfaces whose episodes are ignored (by default the ground, when it is
         a contact surface: touching down is not an impact with the obstacle).
@@ -123,14 +164,15 @@ def impact_metrics(
         has two episodes in that impact).
         Floats are NaN and lists empty when there is no episode.
     """
-    if len(episodes) and len(exclude_surfaces):
-        keep = ~episodes["surface"].astype(str).isin([str(s) for s in exclude_surfaces])
-        eps = episodes.loc[keep.to_numpy()].reset_index(drop=True)
-    else:
-        eps = episodes.reset_index(drop=True)
-    n_all = len(eps)
+    n = n_rows(episodes)
+    keep = np.ones(n, dtype=bool)
+    if n and len(exclude_surfaces):
+        surface = column(episodes, "surface", dtype=object).astype(str)
+        keep = ~np.isin(surface, [str(s) for s in exclude_surfaces])
+    n_all = int(keep.sum())
     if n_all and min_peak_delta_m > 0.0:
-        eps = eps.loc[(eps["peak_delta_m"] >= min_peak_delta_m).to_numpy()].reset_index(drop=True)
+        keep &= column(episodes, "peak_delta_m") >= min_peak_delta_m
+    eps = select(episodes, keep, _EPISODE_NEEDED) if n else dict.fromkeys(_EPISODE_NEEDED, [])
     groups = group_impacts(eps)
     out: dict[str, Any] = {
         "delta_init_m": math.nan,
@@ -141,22 +183,22 @@ def impact_metrics(
         "leading_bumpers": [],
         "aft_bumpers": [],
         "n_episodes": n_all,
-        "n_grazes": n_all - len(eps),
+        "n_grazes": n_all - n_rows(eps),
         "n_subsequent_impacts": 0,
         "n_subsequent_episodes": 0,
         "subsequent_impacts": [],
     }
     if not groups:
         return out
-    first = eps.iloc[groups[0]]
-    start = float(first["t_start_s"].min())
-    end = float(max(first["t_end_s"].max(), start))
-    leading = sorted({int(b) for b in first["bumper"]})
-    bumper_col = eps["bumper"].to_numpy()
+    first = np.asarray(groups[0], dtype=np.int64)
+    start = float(eps["t_start_s"][first].min())
+    end = float(max(eps["t_end_s"][first].max(), start))
+    bumper_col = np.asarray(eps["bumper"])
+    leading = sorted({int(b) for b in bumper_col[first]})
     out.update(
         {
-            "delta_init_m": float(first["peak_delta_m"].max()),
-            "peak_force_n": float(first["peak_force_n"].max()),
+            "delta_init_m": float(eps["peak_delta_m"][first].max()),
+            "peak_force_n": float(eps["peak_force_n"][first].max()),
             "initial_impact_start_s": start,
             "initial_impact_end_s": end,
             "initial_impact_duration_s": end - start,
@@ -170,13 +212,14 @@ def impact_metrics(
     return out
 
 
-def attitude_excursion_deg(ts: pd.DataFrame, refs: Mapping[str, float]) -> dict[str, float]:
+def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, float]:
     """Largest attitude departure from the reference over a run (degrees).
 
     Parameters
     ----------
-    ts : pandas.DataFrame
-        Time-series table (:func:`~quadimpact.simulation.record.timeseries_frame`):
+    ts : table
+        Time series (:func:`~quadimpact.simulation.record.timeseries_frame` or
+        its columns :func:`~quadimpact.simulation.record.timeseries_columns`):
         uses ``roll_deg``, ``pitch_deg``, ``yaw_deg`` and, for the tilt,
         ``q0..q3`` (falling back to the Euler angles when the quaternion
         columns are absent).
@@ -196,21 +239,29 @@ def attitude_excursion_deg(ts: pd.DataFrame, refs: Mapping[str, float]) -> dict[
         are reported wrapped. All NaN for an empty table.
     """
     keys = ("roll_excursion_deg", "pitch_excursion_deg", "yaw_excursion_deg", "tilt_max_deg")
-    if len(ts) == 0:
+    if n_rows(ts) == 0:
         return dict.fromkeys(keys, math.nan)
     roll_ref = float(refs["roll_rad"])
     pitch_ref = float(refs["pitch_rad"])
     yaw_ref = float(refs["yaw_rad"])
-    roll = np.radians(ts["roll_deg"].to_numpy(dtype=np.float64))
-    pitch = np.radians(ts["pitch_deg"].to_numpy(dtype=np.float64))
-    yaw = np.radians(ts["yaw_deg"].to_numpy(dtype=np.float64))
+    if all(has_column(ts, c) for c in ("q0", "q1", "q2", "q3")):
+        from quadimpact.simulation.attitude import excursion_from_quaternions
+
+        quat = np.ascontiguousarray(
+            np.stack([column(ts, c) for c in ("q0", "q1", "q2", "q3")], axis=1)
+        )
+        z_ref = quat_to_matrix(euler_zyx_to_quat(roll_ref, pitch_ref, yaw_ref))[:, 2]
+        values = excursion_from_quaternions(
+            quat, roll_ref, pitch_ref, yaw_ref, np.ascontiguousarray(z_ref)
+        )
+        return {k: float(v) for k, v in zip(keys, values, strict=True)}
+    roll = np.radians(column(ts, "roll_deg"))
+    pitch = np.radians(column(ts, "pitch_deg"))
+    yaw = np.radians(column(ts, "yaw_deg"))
     d_roll = np.abs(wrap_angle_rad(roll - roll_ref))
     d_pitch = np.abs(pitch - pitch_ref)
     d_yaw = np.abs(wrap_angle_rad(yaw - yaw_ref))
-    if all(c in ts.columns for c in ("q0", "q1", "q2", "q3")):
-        quat = ts[["q0", "q1", "q2", "q3"]].to_numpy(dtype=np.float64)
-    else:
-        quat = euler_zyx_to_quat(roll, pitch, yaw)
+    quat = euler_zyx_to_quat(roll, pitch, yaw)
     z_body = quat_to_matrix(quat)[:, :, 2]
     z_ref = quat_to_matrix(euler_zyx_to_quat(roll_ref, pitch_ref, yaw_ref))[:, 2]
     tilt = np.arccos(np.clip(z_body @ z_ref, -1.0, 1.0))

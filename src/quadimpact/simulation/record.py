@@ -11,16 +11,25 @@ and units follow MODEL.md section 1 (inertial NED, body FRD, SI).
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from quadimpact.core import layout as L
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
 from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
 
-__all__ = ["episodes_frame", "imu_frame", "timeseries_frame"]
+if TYPE_CHECKING:  # pandas is imported where a DataFrame is built
+    import pandas as pd
+
+__all__ = [
+    "episode_columns",
+    "episodes_frame",
+    "imu_columns",
+    "imu_frame",
+    "timeseries_columns",
+    "timeseries_frame",
+]
 
 # Raw episode columns -> table columns (float-valued ones).
 _EPISODE_FLOAT_SOURCES: tuple[tuple[str, int], ...] = (
@@ -46,6 +55,8 @@ def _rows(raw: np.ndarray, n: int, width: int, what: str) -> np.ndarray:
 
 
 def _empty_episodes() -> pd.DataFrame:
+    import pandas as pd
+
     data: dict[str, Any] = {
         "bumper": pd.Series([], dtype="int64"),
         "surface": pd.Series([], dtype=object).astype(str),
@@ -54,6 +65,30 @@ def _empty_episodes() -> pd.DataFrame:
         data[name] = pd.Series([], dtype="float64")
     data["open"] = pd.Series([], dtype=bool)
     return pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
+
+
+def episode_columns(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> dict[str, np.ndarray]:
+    """The columns of :func:`episodes_frame` as NumPy arrays (no DataFrame), same order."""
+    rows = _rows(raw, n, L.NEP, "episodes")
+    bumper_idx = np.rint(rows[:, L.E_BUMPER]).astype(np.int64)
+    if np.any((bumper_idx < 0) | (bumper_idx > 3)):
+        raise ValueError(f"episodes: bumper index outside 0..3 (got {sorted(set(bumper_idx))})")
+    surf_idx = np.rint(rows[:, L.E_SURFACE]).astype(np.int64)
+    names = list(surface_names)
+    if np.any((surf_idx < 0) | (surf_idx >= len(names))):
+        raise ValueError(
+            f"episodes: surface index outside 0..{len(names) - 1} (got {sorted(set(surf_idx))})"
+        )
+    # sorted by start, then bumper; ties keep the kernel's order (a stable sort)
+    order = np.lexsort((bumper_idx, rows[:, L.E_T_START]))
+    data: dict[str, np.ndarray] = {
+        "bumper": bumper_idx[order] + 1,
+        "surface": np.array([str(names[i]) for i in surf_idx[order]], dtype=object),
+    }
+    for name, col in _EPISODE_FLOAT_SOURCES:
+        data[name] = rows[order, col].copy()
+    data["open"] = rows[order, L.E_OPEN] > 0.5
+    return {name: data[name] for name in EPISODE_COLUMNS}
 
 
 def episodes_frame(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> pd.DataFrame:
@@ -78,28 +113,13 @@ def episodes_frame(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> pd.
         contact when the run stopped; ``t_end_s`` is then the run end).
         Sorted by ``t_start_s`` then ``bumper``, with a fresh 0..n-1 index.
     """
-    rows = _rows(raw, n, L.NEP, "episodes")
-    if rows.shape[0] == 0:
+    import pandas as pd
+
+    data = episode_columns(raw, n, surface_names)
+    if len(data["bumper"]) == 0:
         return _empty_episodes()
-    bumper_idx = np.rint(rows[:, L.E_BUMPER]).astype(np.int64)
-    if np.any((bumper_idx < 0) | (bumper_idx > 3)):
-        raise ValueError(f"episodes: bumper index outside 0..3 (got {sorted(set(bumper_idx))})")
-    surf_idx = np.rint(rows[:, L.E_SURFACE]).astype(np.int64)
-    names = list(surface_names)
-    if np.any((surf_idx < 0) | (surf_idx >= len(names))):
-        raise ValueError(
-            f"episodes: surface index outside 0..{len(names) - 1} (got {sorted(set(surf_idx))})"
-        )
-    data: dict[str, Any] = {
-        "bumper": bumper_idx + 1,
-        "surface": [str(names[i]) for i in surf_idx],
-    }
-    for name, col in _EPISODE_FLOAT_SOURCES:
-        data[name] = rows[:, col].copy()
-    data["open"] = rows[:, L.E_OPEN] > 0.5
-    df = pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
-    df = df.sort_values(["t_start_s", "bumper"], kind="mergesort").reset_index(drop=True)
-    return df
+    data["surface"] = list(data["surface"])
+    return pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
 
 
 def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
@@ -126,6 +146,13 @@ def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
         ``force1..4_n`` (N, sum over surfaces); ``stage``, the controller's
         stage in force (0 for controllers without stages).
     """
+    import pandas as pd
+
+    return pd.DataFrame(timeseries_columns(raw, n))
+
+
+def timeseries_columns(raw: np.ndarray, n: int) -> dict[str, np.ndarray]:
+    """The columns of :func:`timeseries_frame` as NumPy arrays (no DataFrame)."""
     rows = _rows(raw, n, L.NOUT, "timeseries")
     x0 = L.OUT_X
     pos = rows[:, x0 + L.X_POS : x0 + L.X_POS + 3]
@@ -171,7 +198,18 @@ def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
     for j in BUMPERS:
         data[f"force{j}_n"] = rows[:, L.OUT_FORCE + j - 1]
     data["stage"] = rows[:, L.OUT_STAGE]
-    return pd.DataFrame({k: np.array(v, dtype=np.float64) for k, v in data.items()})
+    return {k: np.array(v, dtype=np.float64) for k, v in data.items()}
+
+
+def imu_columns(raw: np.ndarray) -> dict[str, np.ndarray]:
+    """The columns of :func:`imu_frame` as NumPy arrays (no DataFrame)."""
+    rows = np.asarray(raw, dtype=np.float64).reshape(-1, L.NIMU)
+    sources = (
+        L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
+        L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
+        L.I_HORIZONTAL,
+    )  # fmt: skip
+    return {name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources, strict=True)}
 
 
 def imu_frame(raw: np.ndarray) -> pd.DataFrame:
@@ -185,13 +223,6 @@ def imu_frame(raw: np.ndarray) -> pd.DataFrame:
         ``p/q/r_rad_s``; the true values (``*_true_*``); the detector's horizontal
         measure ``f_horizontal_m_s2``.
     """
-    rows = np.asarray(raw, dtype=np.float64).reshape(-1, L.NIMU)
-    sources = (
-        L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
-        L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
-        L.I_HORIZONTAL,
-    )  # fmt: skip
-    return pd.DataFrame({name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources,
-                                                                           strict=True)})
+    import pandas as pd
 
-
+    return pd.DataFrame(imu_columns(raw))

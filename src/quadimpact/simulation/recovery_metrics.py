@@ -15,12 +15,18 @@ from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import bumper_contact
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.simulation.metrics import GRAZE_DELTA_M, group_impacts
+from quadimpact.simulation.metrics import (
+    GRAZE_DELTA_M,
+    Table,
+    column,
+    group_impacts,
+    n_rows,
+    select,
+)
 
 __all__ = ["RECOVERY_KEYS", "contact_normal", "recovery_metrics"]
 
@@ -72,18 +78,25 @@ def contact_normal(
     return np.array(rec[8:11])
 
 
-def _first_obstacle_episode(episodes: pd.DataFrame, obstacle_names: Sequence[str]):
-    if len(episodes) == 0:
+def first_obstacle_episode(
+    episodes: Table, obstacle_names: Sequence[str]
+) -> tuple[int, str] | None:
+    """(bumper 1-4, surface name) of the first contact with an obstacle (not the ground)."""
+    if n_rows(episodes) == 0:
         return None
-    eps = episodes[episodes["surface"].astype(str).isin(list(obstacle_names))]
-    if len(eps) == 0:
+    surface = column(episodes, "surface", dtype=object).astype(str)
+    rows = np.flatnonzero(np.isin(surface, list(obstacle_names)))
+    if rows.size == 0:
         return None
-    return eps.sort_values(["t_start_s", "bumper"], kind="mergesort").iloc[0]
+    start = column(episodes, "t_start_s")[rows]
+    bumper = column(episodes, "bumper")[rows]
+    first = rows[np.lexsort((bumper, start))[0]]
+    return int(column(episodes, "bumper")[first]), str(surface[first])
 
 
 def recovery_metrics(
     st: np.ndarray,
-    episodes: pd.DataFrame,
+    episodes: Table,
     *,
     veh: np.ndarray,
     surf: np.ndarray,
@@ -97,8 +110,8 @@ def recovery_metrics(
     ----------
     st : numpy.ndarray (NSTAT,)
         The kernel's stats (layout ``ST_*``).
-    episodes : pandas.DataFrame
-        The episodes table (``simulation.record.episodes_frame``).
+    episodes : table
+        The episodes (``simulation.record.episodes_frame`` or ``episode_columns``).
     veh, surf : numpy.ndarray
         The packed vehicle and surfaces (for the true contact normal).
     surface_names : sequence of str
@@ -138,11 +151,12 @@ def recovery_metrics(
 
     if contact and not false_detection:
         out["detection_latency_s"] = t_detect - first_contact
-        first = _first_obstacle_episode(episodes, obstacle_names)
+        first = first_obstacle_episode(episodes, obstacle_names)
         if first is not None:
-            s_index = list(surface_names).index(str(first["surface"]))
+            bumper, surface = first
+            s_index = list(surface_names).index(surface)
             x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
-            n_true = contact_normal(x_onset, veh, surf, int(first["bumper"]) - 1, s_index)
+            n_true = contact_normal(x_onset, veh, surf, bumper - 1, s_index)
             n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
             if np.linalg.norm(n_est) > 0:
                 c = float(np.clip(n_est @ n_true / np.linalg.norm(n_true), -1.0, 1.0))
@@ -162,10 +176,12 @@ def recovery_metrics(
     out["max_tilt_deg"] = math.degrees(math.acos(float(np.clip(st[L.ST_MIN_TILT_COS], -1, 1))))
     out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
     # impacts (grazes excluded, obstacles only) that start after the detection
-    if len(episodes):
-        eps = episodes[episodes["surface"].astype(str).isin(list(obstacle_names))]
-        eps = eps[eps["peak_delta_m"] >= GRAZE_DELTA_M].reset_index(drop=True)
-        starts = eps["t_start_s"].to_numpy()
+    if n_rows(episodes):
+        surface = column(episodes, "surface", dtype=object).astype(str)
+        keep = np.isin(surface, list(obstacle_names))
+        keep &= column(episodes, "peak_delta_m") >= GRAZE_DELTA_M
+        eps = select(episodes, keep, ("bumper", "t_start_s", "t_end_s"))
+        starts = eps["t_start_s"]
         out["impacts_after_detection"] = int(
             sum(1 for g in group_impacts(eps) if starts[g].min() > t_detect)
         )

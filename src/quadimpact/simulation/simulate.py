@@ -16,7 +16,14 @@ from quadimpact.core import layout as L
 from quadimpact.core.run import execute_record
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.result import SimulationResult
-from quadimpact.simulation.record import episodes_frame, imu_frame, timeseries_frame
+from quadimpact.simulation.record import (
+    episode_columns,
+    episodes_frame,
+    imu_columns,
+    imu_frame,
+    timeseries_columns,
+    timeseries_frame,
+)
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.summary import build_summary
 
@@ -80,12 +87,17 @@ def run_setup(
 
 
 def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan")):
-    """Tables and summary of a raw record (``core.run.RawRecord``) of ``setup``."""
+    """The summary of a raw record (``core.run.RawRecord``) of ``setup``, tables on demand.
+
+    The summary is computed from the raw arrays (no DataFrame); the result's
+    ``timeseries``, ``episodes`` and ``imu`` tables are built when first read.
+    """
     out, ep, st = rec.out, rec.episodes, rec.stats
-    ts = timeseries_frame(out, out.shape[0])
-    episodes = episodes_frame(ep, ep.shape[0], setup.surface_names)
+    x0 = L.OUT_X + L.X_QUAT
+    quat = {f"q{k}": out[:, x0 + k] for k in range(4)}  # what the summary reads of the samples
+    episodes = episode_columns(ep, ep.shape[0], setup.surface_names)
     final_state = out[-1, L.OUT_X : L.OUT_X + L.NX] if out.shape[0] else setup.x0
-    summary = build_summary(setup, scenario, ts, episodes, st, final_state=final_state)
+    summary = build_summary(setup, scenario, quat, episodes, st, final_state=final_state)
     stats = {
         "steps": int(st[L.ST_N_STEPS]),
         "rejected_steps": int(st[L.ST_N_REJECTED]),
@@ -95,12 +107,27 @@ def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan
         "wall_time_s": wall_s,
     }
     summary["integrator"] = stats
+    names = setup.surface_names
+    imu = rec.imu
+
+    def tables(name: str) -> Any:
+        if name == "timeseries":
+            return timeseries_frame(out, out.shape[0])
+        if name == "timeseries_columns":
+            return timeseries_columns(out, out.shape[0])
+        if name == "episodes":
+            return episodes_frame(ep, ep.shape[0], names)
+        if name == "episodes_columns":
+            cols = dict(episodes)
+            return cols
+        if name == "imu_columns":
+            return imu_columns(imu)
+        return imu_frame(imu)
+
     return SimulationResult(
         summary=summary,
-        episodes=episodes,
-        timeseries=ts,
         references=dict(setup.references),
         scenario=scenario,
         stats=stats,
-        imu=imu_frame(rec.imu),
+        tables=tables,
     )

@@ -21,9 +21,15 @@ from quadimpact.simulation.metrics import (
     GRAZE_DELTA_M,
     attitude_excursion_deg,
     classify_response,
+    column,
     impact_metrics,
+    n_rows,
 )
-from quadimpact.simulation.recovery_metrics import contact_normal, recovery_metrics
+from quadimpact.simulation.recovery_metrics import (
+    contact_normal,
+    first_obstacle_episode,
+    recovery_metrics,
+)
 from quadimpact.simulation.setup import RunSetup
 
 __all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]
@@ -67,10 +73,11 @@ def build_summary(
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
         q = xo[L.X_QUAT : L.X_QUAT + 4]
         vel = quat_to_matrix(q) @ xo[L.X_VEL : L.X_VEL + 3]
-        first = _first_obstacle_episode(setup, episodes)
+        first = first_obstacle_episode(episodes, _obstacle_names(setup))
         if first is not None:  # the contact normal there, from the contact geometry
             bumper, surface = first
-            normal = contact_normal(xo, setup.veh, setup.surf, bumper, surface)
+            s_index = list(setup.surface_names).index(surface)
+            normal = contact_normal(xo, setup.veh, setup.surf, bumper - 1, s_index)
             speed = float(-vel @ normal)
         heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
         incl = inclination_deg_of(q)
@@ -158,14 +165,13 @@ def build_summary(
                 warnings.append(
                     f"impact speed {speed:.6f} m/s differs from the requested {scenario.speed_m_s}"
                 )
-    if len(ts):
+    if n_rows(ts):
         summary["attitude_excursion"] = attitude_excursion_deg(ts, setup.references)
     if final_state is None:
-        final_state = (
-            ts[["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s"]].to_numpy()[-1]
-            if len(ts)
-            else np.zeros(6)
-        )
+        final_state = np.zeros(L.NX)
+        if n_rows(ts):
+            for k, name in enumerate(("x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s")):
+                final_state[k] = column(ts, name)[-1]
     summary["pre_impact"] = (
         scenario.resolved_pre_impact() if getattr(scenario, "controller", None) == "recovery"
         else None
@@ -191,16 +197,6 @@ def _obstacle_names(setup: RunSetup) -> list[str]:
     return [n for k, n in enumerate(setup.surface_names) if setup.surf[k, L.S_IS_GROUND] < 0.5]
 
 
-def _first_obstacle_episode(setup: RunSetup, episodes) -> tuple[int, int] | None:
-    """(bumper index 0-3, surface index) of the first contact with an obstacle."""
-    if len(episodes) == 0:
-        return None
-    names = _obstacle_names(setup)
-    eps = episodes[episodes["surface"].astype(str).isin(names)]
-    if len(eps) == 0:
-        return None
-    row = eps.sort_values(["t_start_s", "bumper"], kind="mergesort").iloc[0]
-    return int(row["bumper"]) - 1, list(setup.surface_names).index(str(row["surface"]))
 
 
 def describe_outcome(s: dict[str, Any]) -> str:
