@@ -54,7 +54,8 @@ def _as_quat(q: ArrayLike) -> NDArray[np.float64]:
     a = np.asarray(q, dtype=np.float64)
     if a.shape[-1:] != (4,):
         raise ValueError(f"quaternion array must have a last axis of length 4 (got {a.shape})")
-    norm = np.linalg.norm(a, axis=-1, keepdims=True)
+    # = np.linalg.norm(a, axis=-1, keepdims=True), without its argument handling
+    norm = np.sqrt(np.add.reduce(a * a, axis=-1, keepdims=True))
     if np.any(norm == 0.0):
         raise ValueError("quaternion of zero norm cannot represent a rotation")
     return a / norm

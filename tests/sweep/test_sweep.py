@@ -360,14 +360,16 @@ def test_impossible_run_is_a_failed_row(serial_table, tmp_path):
 
 
 def test_exception_in_a_run_is_a_failed_row(monkeypatch, serial_table, tmp_path):
-    real = quadimpact.simulate
+    import quadimpact.simulation.batch as batch
+
+    real = batch.prepare
 
     def fake(scenario, **kwargs):
         if scenario.inclination_deg == 10:
             raise RuntimeError("approach shooting run failed: test")
         return real(scenario, **kwargs)
 
-    monkeypatch.setattr(quadimpact, "simulate", fake)
+    monkeypatch.setattr(batch, "prepare", fake)
     table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "x", workers=1)
     bad = table[table["inclination_deg"] == 10.0]
     assert list(bad["status"]) == ["failed", "failed"]
@@ -380,9 +382,9 @@ def test_exception_in_a_run_is_a_failed_row(monkeypatch, serial_table, tmp_path)
 
 CRASH_SCRIPT = """
 import os
-import quadimpact
+import quadimpact.simulation.batch as batch
 
-real = quadimpact.simulate
+real = batch.prepare
 
 
 def crashing(scenario, **kwargs):  # imported again in each worker (forkserver/spawn)
@@ -391,7 +393,7 @@ def crashing(scenario, **kwargs):  # imported again in each worker (forkserver/s
     return real(scenario, **kwargs)
 
 
-quadimpact.simulate = crashing
+batch.prepare = crashing
 
 if __name__ == "__main__":
     from quadimpact.sweep import SweepSpec, run_sweep

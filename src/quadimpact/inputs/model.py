@@ -185,6 +185,21 @@ def resolve_model_options(
     if model not in MODEL_VARIANTS:
         known = ", ".join(repr(name) for name in MODEL_VARIANTS)
         raise InputError(f"model: must be one of {known} (got {model!r})")
+    if isinstance(overrides, ModelOptions) or overrides is None:
+        key = (model, overrides)  # frozen models hash by their values
+        hit = _RESOLVED.get(key)
+        if hit is None:
+            hit = _resolve(model, overrides)
+            if len(_RESOLVED) < 256:
+                _RESOLVED[key] = hit
+        return hit
+    return _resolve(model, overrides)
+
+
+_RESOLVED: dict[Any, ModelOptions] = {}
+
+
+def _resolve(model: str, overrides: ModelOptions | Mapping[str, Any] | None) -> ModelOptions:
     values = dict(MODEL_VARIANTS[model])
     if overrides is not None:
         if not isinstance(overrides, ModelOptions):

@@ -6,6 +6,7 @@ Slots are named in ``quadimpact.core.layout``. Nothing here integrates.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -29,8 +30,28 @@ FRICTION_V_REG_M_S = 1e-2  # friction regularisation velocity
 MAX_STEPS_PER_S = 2_000_000
 
 
+_PACKED: dict[tuple[int, str], tuple[Vehicle, np.ndarray]] = {}
+_PACKED_LIMIT = 128
+
+
+def _memo(kind: str, v: Vehicle, make: Any) -> np.ndarray:
+    """A copy of ``make()`` computed once per (frozen) vehicle object and kind."""
+    key = (id(v), kind)
+    hit = _PACKED.get(key)
+    if hit is None or hit[0] is not v:
+        if len(_PACKED) >= _PACKED_LIMIT:
+            _PACKED.pop(next(iter(_PACKED)))
+        hit = (v, make())  # holds v, so its id stays its own
+        _PACKED[key] = hit
+    return hit[1].copy()
+
+
 def pack_vehicle(v: Vehicle) -> np.ndarray:
-    """Vehicle parameters as the ``V_*`` vector (SI, body frame)."""
+    """Vehicle parameters as the ``V_*`` vector (SI, body frame); computed once per vehicle."""
+    return _memo("veh", v, lambda: _pack_vehicle(v))
+
+
+def _pack_vehicle(v: Vehicle) -> np.ndarray:
     veh = np.zeros(L.NVEH)
     inertia = v.inertia
     veh[L.V_MASS] = v.mass_kg
@@ -103,9 +124,9 @@ def pack_controller(
     ctrl[L.C_PHI_REF] = refs["roll_rad"]
     ctrl[L.C_THETA_REF] = refs["pitch_rad"]
     ctrl[L.C_PSI_REF] = refs["yaw_rad"]
-    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = np.linalg.inv(
-        allocation_matrix(v, yaw_paper)
-    ).ravel()
+    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = _memo(
+        f"alloc-inv-{yaw_paper}", v, lambda: np.linalg.inv(allocation_matrix(v, yaw_paper)).ravel()
+    )
     lo, hi = v.rotor_speed_range_rpm
     ctrl[L.C_OMEGA_MIN] = lo * RPM
     ctrl[L.C_OMEGA_MAX] = hi * RPM

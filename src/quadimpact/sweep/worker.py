@@ -33,20 +33,33 @@ def run_chunk(items: Sequence[Item]) -> list[dict[str, Any]]:
         and ``reason = "<ExceptionType>: <message>"``; a run that fails in the
         integrator has the kernel's status and reason.
     """
-    from quadimpact import simulate
     from quadimpact.inputs.scenarios import scenario_from_dict
+    from quadimpact.simulation.batch import simulate_batch
 
-    rows = []
-    for run_id, scenario_data, inputs in items:
-        head = {"run_id": int(run_id), **inputs}
+    rows: list[dict[str, Any] | None] = [None] * len(items)
+    valid: list[tuple[int, Any]] = []
+    for k, (run_id, scenario_data, inputs) in enumerate(items):
         try:
-            scenario = scenario_from_dict(scenario_data, where=f"run {run_id}")
-            summary = simulate(scenario).summary
-            row = flatten_summary(summary, skip=inputs)
+            valid.append((k, scenario_from_dict(scenario_data, where=f"run {run_id}")))
         except Exception as exc:  # a failed run is a row; the sweep goes on
-            row = failed_row(f"{type(exc).__name__}: {exc}", inputs)
-        rows.append({**head, **row})
-    return rows
+            rows[k] = failed_row(f"{type(exc).__name__}: {exc}", inputs)
+    errors: dict[int, str] = {}
+
+    def failed(i: int, exc: BaseException) -> dict[str, Any]:
+        errors[i] = f"{type(exc).__name__}: {exc}"
+        return {}
+
+    summaries = simulate_batch([s for _, s in valid], on_error=failed)
+    for i, ((k, _), summary) in enumerate(zip(valid, summaries, strict=True)):
+        inputs = items[k][2]
+        if i in errors:
+            rows[k] = failed_row(errors[i], inputs)
+        else:
+            rows[k] = flatten_summary(summary, skip=inputs)
+    return [
+        {"run_id": int(run_id), **inputs, **row}
+        for (run_id, _, inputs), row in zip(items, rows, strict=True)
+    ]
 
 
 SINGLE_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
