@@ -93,10 +93,18 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
     return row
 
 
+_PLAIN_TYPES = (float, int, str, bool)
+
+
+def _plain_list(value: Any) -> bool:
+    return type(value) is list and all(type(v) in _PLAIN_TYPES for v in value)
+
+
 def _typed(value: Any, kind: str) -> Any:
     if value is None:
         return None
-    value = plain(value)
+    if type(value) not in _PLAIN_TYPES and not _plain_list(value):
+        value = plain(value)
     if kind == "f":
         return None if isinstance(value, float) and math.isnan(value) else float(value)
     if kind == "i":
