@@ -172,6 +172,22 @@ def _suggest(model: Any, loc: Sequence[Any]) -> str:
     return f"; did you mean {close!r}?" if close else ""
 
 
+def _typo_of_missing(missing: Mapping[str, Any], errors: Sequence[Mapping[str, Any]]) -> str:
+    """For a required key reported missing: the unknown key beside it that is its near miss."""
+    loc = tuple(missing.get("loc", ()))
+    if not loc:
+        return ""
+    extras = [
+        str(e["loc"][-1])
+        for e in errors
+        if e.get("type") == "extra_forbidden" and tuple(e.get("loc", ()))[:-1] == loc[:-1]
+    ]
+    for extra in extras:
+        if near_miss(extra, [str(loc[-1])]) is not None:
+            return f" ({extra!r} is there: a misspelling of {str(loc[-1])!r}?)"
+    return ""
+
+
 def input_error_from_validation(
     exc: Any,
     where: str = "",
@@ -214,6 +230,8 @@ def input_error_from_validation(
     rule, show_value = _rule(error)
     if error.get("type") == "extra_forbidden" and model is not None:
         rule += _suggest(model, error.get("loc", ()))
+    if error.get("type") == "missing":
+        rule += _typo_of_missing(error, errors)
     parts = [p for p in (where, field) if p]
     text = ": ".join(parts + [rule])
     if show_value and "input" in error and error.get("loc"):  # not the whole table

@@ -108,7 +108,7 @@ def test_models_are_frozen_and_forbid_extras() -> None:
         ({"inclination_deg": -60.5}, "inclination_deg: must be >= -60 (got -60.5)"),
         ({"speed_m_s": 0}, "speed_m_s: must be > 0 (got 0)"),
         ({"speed_m_s": 25}, "speed_m_s: must be <= 20 (got 25)"),
-        ({"impact_time_s": 0}, "impact_time_s: must be > 0 (got 0)"),
+        ({"impact_time_s": 0}, "impact_time_s: must be >= 0.005 (got 0)"),
         ({"impact_time_s": 3.0}, "impact_time_s: must be < final_time_s (3) (got 3)"),
         ({"final_time_s": 0.4}, "impact_time_s: must be < final_time_s (0.4) (got 0.5)"),
         ({"final_time_s": 601}, "final_time_s: must be <= 600 (got 601)"),

@@ -163,7 +163,7 @@ BAD_VEHICLES = [
         "spin_directions = [-1, 1, 1, 1]",
         ["spin_directions: must sum to 0"],
     ),
-    ("mass_kg = 0.933", "mass_kg = -0.933", ["mass_kg: must be > 0 (got -0.933)"]),
+    ("mass_kg = 0.933", "mass_kg = -0.933", ["mass_kg: must be >= 0.001 (got -0.933)"]),
     ("mass_kg = 0.933", 'mass_kg = "heavy"', ["mass_kg: must be a number (got 'heavy')"]),
     ("mass_kg = 0.933", "mass_kg = nan", ["mass_kg: must be a finite number"]),
     ("bumper_tilt_deg = 11.0", "bumper_tilt_deg = 90.0", ["bumper_tilt_deg: must be < 90"]),

@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import BaseModel, Field, StrictBool, ValidationError
 
 from quadimpact.errors import InputError, input_error_from_validation
 from quadimpact.inputs.types import MODEL_CONFIG, Real
@@ -88,7 +88,7 @@ class ModelOptions(BaseModel):
     yaw_reaction: Literal["physical", "paper"] | None = Field(
         None, description="Rotor yaw reaction torque: 'physical' or the authors' 'paper' signs."
     )
-    bumper1_yaw_twice: bool | None = Field(
+    bumper1_yaw_twice: StrictBool | None = Field(
         None, description="Count bumper 1's contact yaw moment twice (authors' code)."
     )
     initial_rotor_speeds: Literal["trimmed", "level-hover"] | None = Field(

@@ -51,7 +51,7 @@ from typing import Any, ClassVar, Literal
 
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
-from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.errors import InputError, input_error_from_validation, near_miss
 from quadimpact.inputs.controllers import (
     controller_entry,
     controller_names,
@@ -252,7 +252,9 @@ class RunSettings(BaseModel):
     atol: Real | None = Field(
         None, gt=0, description="Integrator absolute tolerance; None: kernel default."
     )
-    final_time_s: Real = Field(3.0, gt=0, le=600, description="End of the simulation, s.")
+    final_time_s: Real = Field(
+        3.0, ge=0.005, le=600, description="End of the simulation, s (at least one control period)."
+    )
     power_off: PowerOff | None = Field(
         None, description="Motor power-off schedule after a trigger (the experiments)."
     )
@@ -313,7 +315,9 @@ class RunSettings(BaseModel):
     def _known_vehicle_fields(cls, value: dict[str, Any]) -> dict[str, Any]:
         for key in value:
             if key not in Vehicle.model_fields:
-                raise ValueError(f"unknown vehicle field {key!r}")
+                close = near_miss(str(key), list(Vehicle.model_fields))
+                hint = f"; did you mean {close!r}?" if close else ""
+                raise ValueError(f"unknown vehicle field {key!r}{hint}")
         return value
 
     @field_validator("rotor_speed_limits_rpm")
@@ -433,7 +437,9 @@ class WallApproach(RunSettings):
     speed_m_s: Real = Field(
         0.75, gt=0, le=20, description="CM speed toward the wall at first contact, m/s."
     )
-    impact_time_s: Real = Field(0.5, gt=0, description="Time of the first contact, s.")
+    impact_time_s: Real = Field(
+        0.5, ge=0.005, description="Time of the first contact, s (at least one control period)."
+    )
     wall_distance_m: Real = Field(1.5, description="Wall position along inertial X (NED), m.")
     altitude_m: Real = Field(2.0, gt=0, description="Altitude set-point and initial altitude, m.")
     roll_deg: Real | None = Field(

@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, field_validator, model_validator
+from pydantic import BaseModel, Field, StrictBool, field_validator, model_validator
 
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3
 
@@ -201,7 +201,7 @@ class DetectionSettings(BaseModel):
 
     model_config = MODEL_CONFIG
 
-    enabled: bool = Field(True, description="Run the impact detector.")
+    enabled: StrictBool = Field(True, description="Run the impact detector.")
     threshold_g: Real = Field(0.5, gt=0, le=100, description="Threshold, in g.")
     frame: Literal["body", "world"] = Field("body", description="Horizontal in body or world axes.")
     persistence: int = Field(1, ge=1, le=1000, description="Consecutive samples needed.")

@@ -25,9 +25,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError, field_validator
+from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
-from quadimpact.errors import InputError, input_error_from_validation
+from quadimpact.errors import InputError, input_error_from_validation, near_miss
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec3, Vec4
 
@@ -97,7 +97,7 @@ class Vehicle(BaseModel):
     model_config = MODEL_CONFIG
 
     name: str = Field(min_length=1, description="Label of the vehicle.")
-    mass_kg: Real = Field(gt=0, description="Total mass m, kg.")
+    mass_kg: Real = Field(ge=1e-3, le=1e3, description="Total mass m, kg (1 g to 1 t).")
     inertia_kg_m2: Mat3 = Field(
         description="Inertia tensor about the CM, body FRD axes, kg m^2 (symmetric, PD)."
     )
@@ -115,7 +115,7 @@ class Vehicle(BaseModel):
         gt=0, description="Jr: rotor + propeller inertia about the spin axis, kg m^2."
     )
     gravity_m_s2: Real = Field(gt=0, description="Gravitational acceleration g, m/s^2.")
-    bumper_radius_m: Real = Field(gt=0, description="Rb: bumper circle radius, m.")
+    bumper_radius_m: Real = Field(gt=0, description="Rb: bumper circle radius, m (at most 2 m).")
     bumper_tilt_deg: Real = Field(
         ge=0, lt=90, description="alpha: bumper tilt, deg; the outer rim is raised."
     )
@@ -149,6 +149,8 @@ class Vehicle(BaseModel):
     def _check_inertia(cls, value: tuple) -> tuple:
         mat = np.asarray(value, dtype=float)
         scale = float(np.max(np.abs(mat)))
+        if scale > 1e3:
+            raise ValueError(f"entries must be at most 1e3 kg m^2 in magnitude (got {scale:.4g})")
         if scale == 0.0 or np.max(np.abs(mat - mat.T)) > _SYMMETRY_RTOL * scale:
             raise ValueError("must be symmetric positive definite (not symmetric)")
         eig = np.linalg.eigvalsh(0.5 * (mat + mat.T))
@@ -156,6 +158,16 @@ class Vehicle(BaseModel):
             raise ValueError(
                 "must be symmetric positive definite "
                 f"(not positive definite: smallest eigenvalue {eig[0]:.4g})"
+            )
+        return value
+
+    @field_validator("bumper_radius_m")
+    @classmethod
+    def _check_bumper_radius(cls, value: float) -> float:
+        if value > 2.0:
+            raise ValueError(
+                f"must be at most 2 m, a bumper around one rotor (got {value:g}; "
+                "millimetres typed as metres?)"
             )
         return value
 
@@ -177,6 +189,71 @@ class Vehicle(BaseModel):
         if not lo < hi:
             raise ValueError("must be [min, max] with min < max")
         return value
+
+    @model_validator(mode="after")
+    def _physically_consistent(self) -> Vehicle:
+        """Rules no real vehicle breaks (errors); see :meth:`plausibility_warnings` for the
+        merely unusual."""
+        moments = np.linalg.eigvalsh(np.asarray(self.inertia_kg_m2, dtype=float))
+        a, b, c = (float(m) for m in moments)  # ascending
+        if c > (a + b) * (1.0 + 1e-9):
+            raise ValueError(
+                f"inertia_kg_m2: its principal moments ({a:.4g}, {b:.4g}, {c:.4g} kg m^2) break "
+                "the triangle inequality (the largest exceeds the sum of the other two): no "
+                "rigid body has this inertia"
+            )
+        if not 1e-9 <= a and c <= 1e3:
+            raise ValueError(
+                f"inertia_kg_m2: principal moments must lie in [1e-9, 1e3] kg m^2 "
+                f"(got {a:.4g} to {c:.4g})"
+            )
+        arms = np.linalg.norm(np.asarray(self.rotor_positions_m, dtype=float)[:, :2], axis=1)
+        if not (arms.min() >= 0.005 and arms.max() <= 5.0):
+            raise ValueError(
+                "rotor_positions_m: rotor arms (horizontal distance from the CM) must lie in "
+                f"[0.005, 5] m (got {arms.min():.4g} to {arms.max():.4g} m)"
+            )
+        hover_rpm = self.hover_speed_rad_s * 60.0 / (2.0 * math.pi)
+        lo, hi = self.rotor_speed_range_rpm
+        if not lo <= hover_rpm <= hi:
+            in_rad_s = lo <= self.hover_speed_rad_s <= hi  # the range reads as rad/s
+            hint = " (rad/s typed as rpm?)" if in_rad_s else ""
+            raise ValueError(
+                f"rotor_speed_range_rpm: hovering needs {hover_rpm:.4g} rpm per rotor, outside "
+                f"[{lo:g}, {hi:g}] rpm: the rotors cannot hold the vehicle up{hint}"
+            )
+        kt = self.thrust_coefficient
+        r = np.asarray(self.rotor_positions_m, dtype=float)
+        spins = np.asarray(self.spin_directions, dtype=float)
+        alloc = np.vstack([np.full(4, kt), -kt * r[:, 1], kt * r[:, 0],
+                           -self.drag_torque_coefficient * spins])  # fmt: skip
+        if np.linalg.cond(alloc) > 1e12:
+            raise ValueError(
+                "rotor_positions_m, spin_directions: the rotors cannot produce thrust and the "
+                "three torques independently (the allocation is singular: rotors on one "
+                "line or point, or neighbouring rather than diagonal rotors spinning alike)"
+            )
+        return self
+
+    def plausibility_warnings(self) -> list[str]:
+        """Values that are valid but unusual for a bumper-protected quadrotor (one sentence each)."""
+        out = []
+        arms = np.linalg.norm(self.rotor_positions[:, :2], axis=1)
+        if not 0.3 * arms.mean() <= self.bumper_radius_m <= 3.0 * arms.mean():
+            out.append(
+                f"bumper_radius_m {self.bumper_radius_m:g} m is unusual for rotor arms of "
+                f"{arms.mean():.3g} m (a bumper circle around each rotor)"
+            )
+        hi = self.rotor_speed_range_rpm[1] * 2.0 * math.pi / 60.0
+        ratio = (hi / self.hover_speed_rad_s) ** 2
+        if not 1.2 <= ratio <= 10.0:
+            out.append(
+                f"thrust-to-weight ratio at the top rotor speed is {ratio:.3g} "
+                "(quadrotors fly with about 1.5 to 5)"
+            )
+        if self.restitution < 0.3:
+            out.append(f"restitution {self.restitution:g} is unusually low for a bumper")
+        return out
 
     # ------------------------------------------------------------ derived data
     @property
@@ -276,7 +353,11 @@ class Vehicle(BaseModel):
             if key not in type(self).model_fields:
                 field = ".".join((*prefix, str(key)))
                 known = ", ".join(type(self).model_fields)
-                raise InputError(f"{where}: {field}: unknown vehicle field (known: {known})")
+                close = near_miss(str(key), list(type(self).model_fields))
+                hint = f"; did you mean {close!r}?" if close else ""
+                raise InputError(
+                    f"{where}: {field}: unknown vehicle field{hint} (known: {known})"
+                )
         try:
             key = (id(self), json.dumps(fields, sort_keys=True, default=repr))
         except (TypeError, ValueError):

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, StrictBool, field_validator
 
 from quadimpact.inputs.types import MODEL_CONFIG, Vec3
 
@@ -39,7 +39,7 @@ class Plane(BaseModel):
         description="Unit normal out of the obstacle into free space, inertial NED "
         "(normalised on validation)."
     )
-    is_ground: bool = Field(False, description="The ground: its first contact is the crash.")
+    is_ground: StrictBool = Field(False, description="The ground: its first contact is the crash.")
 
     @field_validator("normal")
     @classmethod
