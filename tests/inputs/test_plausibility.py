@@ -39,7 +39,8 @@ def test_vehicle_rules(override, fragment):
 
 
 def test_unusual_values_warn_not_fail():
-    assert SPIRI.plausibility_warnings() == [] and load_vehicle("navi").plausibility_warnings() == []
+    assert SPIRI.plausibility_warnings() == []
+    assert load_vehicle("navi").plausibility_warnings() == []
     odd = SPIRI.with_overrides(bumper_radius_m=0.02, restitution=0.1)
     text = " ".join(odd.plausibility_warnings())
     assert "bumper_radius_m" in text and "restitution" in text

@@ -236,7 +236,7 @@ class Vehicle(BaseModel):
         return self
 
     def plausibility_warnings(self) -> list[str]:
-        """Values that are valid but unusual for a bumper-protected quadrotor (one sentence each)."""
+        """Valid but unusual values for a bumper-protected quadrotor (one sentence each)."""
         out = []
         arms = np.linalg.norm(self.rotor_positions[:, :2], axis=1)
         if not 0.3 * arms.mean() <= self.bumper_radius_m <= 3.0 * arms.mean():
