@@ -214,6 +214,7 @@ def _setup(
         **fields,
         **_schedule(s),
     )
+    setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())
     if s.controller == "recovery" and context.pre_impact == "spin-down":
         if setup.opts[L.O_SLEW_MAX] <= 0.0:
             setup.warnings.append(
