@@ -149,8 +149,8 @@ class Vehicle(BaseModel):
     def _check_inertia(cls, value: tuple) -> tuple:
         mat = np.asarray(value, dtype=float)
         scale = float(np.max(np.abs(mat)))
-        if scale > 1e3:
-            raise ValueError(f"entries must be at most 1e3 kg m^2 in magnitude (got {scale:.4g})")
+        if scale > 1e9:
+            raise ValueError(f"entries must be at most 1e9 kg m^2 in magnitude (got {scale:.4g})")
         if scale == 0.0 or np.max(np.abs(mat - mat.T)) > _SYMMETRY_RTOL * scale:
             raise ValueError("must be symmetric positive definite (not symmetric)")
         eig = np.linalg.eigvalsh(0.5 * (mat + mat.T))
@@ -202,9 +202,9 @@ class Vehicle(BaseModel):
                 "the triangle inequality (the largest exceeds the sum of the other two): no "
                 "rigid body has this inertia"
             )
-        if not 1e-9 <= a and c <= 1e3:
+        if not (1e-12 <= a and c <= 1e9):
             raise ValueError(
-                f"inertia_kg_m2: principal moments must lie in [1e-9, 1e3] kg m^2 "
+                f"inertia_kg_m2: principal moments must lie in [1e-12, 1e9] kg m^2 "
                 f"(got {a:.4g} to {c:.4g})"
             )
         arms = np.linalg.norm(np.asarray(self.rotor_positions_m, dtype=float)[:, :2], axis=1)
