@@ -621,6 +621,13 @@ def tick(
                 i_out += 1
             while sst[SS_NEXT_T] <= t_b:
                 ts = sst[SS_NEXT_T]
+                if ts == t_b and fsal:
+                    # at the end of an uncut step: its solution and derivative (FSAL)
+                    rotation_matrix(x_b[X_QUAT : X_QUAT + 4], C)
+                    imu_sample(ts, x_b, K[6], C, veh, scfg, sst, noise, meas, imu_out, stats)
+                    detect(ts, x_b, C, veh, scfg, sst, meas, imu_out, stats)
+                    sst[SS_NEXT_T] = t0 + sst[SS_N] / scfg[SC_RATE]
+                    continue
                 dense_eval(x, Q, h_try, (ts - t) / h_try, xs)
                 _sample_imu(ts, xs, xd, C, wdot, veh, surf, opts, rin, cs, scfg, sst, noise,
                             meas, imu_out, stats, t0)  # fmt: skip
