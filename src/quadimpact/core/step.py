@@ -264,7 +264,7 @@ def _sample_imu(
 ) -> None:
     """IMU sample and detection at ``t`` from the state ``xs`` (inputs of the interval)."""
     state_derivative(xs, xd, veh, surf, opts, rin, cs, C, wdot)
-    stats[ST_N_RHS] += 1.0
+    # (not counted in ST_N_RHS: that is the integrator's own count)
     imu_sample(t, xs, xd, C, veh, scfg, sst, noise, meas, imu_out, stats)
     detect(t, xs, C, veh, scfg, sst, meas, imu_out, stats)
     sst[SS_NEXT_T] = t0 + sst[SS_N] / scfg[SC_RATE]
