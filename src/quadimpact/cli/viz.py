@@ -54,8 +54,9 @@ def _camera_options(func: Callable[..., Any]) -> Callable[..., Any]:
         click.option(
             "--vehicle",
             metavar="NAME_OR_PATH",
-            help="Vehicle file to draw, if the result's vehicle name is not a bundled "
-            "vehicle (e.g. the run used --vehicle path.toml).",
+            help="Vehicle to draw instead of the one the run recorded in scenario.json; "
+            "needed only for a folder without scenario.json (written by an older "
+            "version) whose vehicle is not a bundled one.",
         ),
     ]
     for opt in reversed(opts):
@@ -310,8 +311,7 @@ def make_all(out: Path, result: Any) -> list[Path]:
     from quadimpact.viz.snapshots import write_snapshots
     from quadimpact.viz.viewer import write_viewer
 
-    vehicle = getattr(getattr(result, "scenario", None), "build_vehicle", None)
-    scene = Scene.from_result(result, vehicle=vehicle() if callable(vehicle) else None)
+    scene = Scene.from_result(result)  # the world the run recorded (scenario.json)
     files: list[Path] = []
     try:
         png, pdf, warnings = write_snapshots(out, scene=scene)
