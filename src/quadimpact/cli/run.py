@@ -42,7 +42,8 @@ _WALL_ONLY = {
     "altitude_m",
 }
 _OUTPUT_FILES = (
-    "summary.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, fig6.png, imu.png"
+    "summary.json, scenario.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, "
+    "fig6.png, imu.png"
 )
 
 
@@ -178,7 +179,8 @@ def run(
     the given heading, inclination and altitude and is started so that its
     first bumper touches a vertical wall 1.5 m ahead at t = 0.5 s with the
     given speed; 3 s are simulated. A scenario file sets the same fields
-    (or a general "flight"); flags override the file's values.
+    (or is a general "flight", or an "impact-trial"); flags override the
+    file's values.
 
     The paper's example (its Figures 5 and 6):
 
@@ -186,8 +188,8 @@ def run(
       quadimpact run --heading 45 --inclination 15 --speed 0.75 \\
           --model paper-replica --out results/paper-example-replica
 
-    Writes summary.json, timeseries.parquet, episodes.csv, fig5.png and
-    fig6.png.
+    Writes summary.json, scenario.json (the world that ran), timeseries.parquet,
+    episodes.csv, imu.parquet and the figures.
     """
     built = build_scenario(scenario, flags, options)
     vehicle = built.build_vehicle()
@@ -234,8 +236,8 @@ def build_scenario(
 
     Returns
     -------
-    WallApproach or FlightScenario
-        The validated scenario.
+    WallApproach or FlightScenario or ImpactTrial
+        The validated scenario (of the file's ``kind``).
 
     Raises
     ------
@@ -246,17 +248,18 @@ def build_scenario(
 
     from quadimpact.inputs.files import apply_overrides
     from quadimpact.inputs.model import ModelOptions
-    from quadimpact.inputs.scenarios import FlightScenario, WallApproach, load_scenario_file
+    from quadimpact.inputs.scenarios import _KINDS, load_scenario_file
 
     data: dict[str, Any] = {}
     if scenario_path is not None:
         data = load_scenario_file(scenario_path).model_dump()
     kind = data.get("kind", "wall-approach")
+    cls = _KINDS[kind]
 
     given = {_FLAGS[key][0]: value for key, value in flags.items() if value is not None}
     rename = {field: flag for field, flag in _FLAGS.values()}
     for field in given:
-        if field in _WALL_ONLY and kind != "wall-approach":
+        if field in _WALL_ONLY and field not in cls.model_fields:
             raise InputError(
                 f"{rename[field]}: applies to wall-approach scenarios only "
                 f"({scenario_path} has kind = {kind!r})"
@@ -269,8 +272,6 @@ def build_scenario(
             raise input_error_from_validation(exc, "--option", model=ModelOptions) from None
         data["model_options"] = {**(data.get("model_options") or {}), **parsed}
     data = apply_overrides(data, given)
-
-    cls = FlightScenario if kind == "flight" else WallApproach
     try:
         return cls.model_validate(data)
     except ValidationError as exc:
@@ -288,10 +289,16 @@ def build_scenario(
 
 def _describe(scenario: Any, vehicle_name: str) -> str:
     """One line saying what is about to be simulated."""
-    if getattr(scenario, "kind", "") == "wall-approach":
+    kind = getattr(scenario, "kind", "")
+    if kind == "wall-approach":
         what = (
             f"wall approach, heading {scenario.heading_deg:g} deg, inclination "
             f"{scenario.inclination_deg:g} deg, speed {scenario.speed_m_s:g} m/s"
+        )
+    elif kind == "impact-trial":
+        what = (
+            f"impact trial, roll {scenario.roll_deg:g} deg, pitch {scenario.pitch_deg:g} deg, "
+            f"yaw {scenario.yaw_deg:g} deg, speed {scenario.speed_m_s:g} m/s"
         )
     else:
         what = f"flight with {len(scenario.surfaces)} surface(s)"
