@@ -620,3 +620,28 @@ def test_stage_label_follows_the_recovery_run(trial_dir: Path, run_dir: Path) ->
     assert not any(line.startswith("stage") for line in fig.clock.get_text().splitlines())
     data = viewer_data(plain)
     assert data["frames"]["stage"] is None and data["stage_labels"] is None
+
+
+@pytest.mark.browser
+@needs_chromium
+def test_viewer_shows_the_stage_in_chromium(trial_dir: Path, run_dir: Path, tmp_path: Path) -> None:
+    """The page's clock names the stage in force, and a run without stages names none."""
+    import json
+
+    from quadimpact.viz.viewer import write_viewer
+
+    summary = json.loads((trial_dir / "summary.json").read_text())
+    url = write_viewer(copy_run(trial_dir, tmp_path)).resolve().as_uri()
+    probes = [(summary["t_detect_s"] - 0.01, 0, "stage 0: before detection"),
+              (summary["t_stage2_s"] + 0.01, 2, "stage 2: tilted away"),
+              (summary["t_stage4_s"] + 0.01, 4, "stage 4: recovered")]  # fmt: skip
+    for t, stage, label in probes:
+        dom = browse(f"{url}#t={t:.4f}", tmp_path, "--dump-dom").stdout
+        body = dict(re.findall(r'data-([a-z-]+)="([^"]*)"', re.search(r"<body([^>]*)>", dom)[1]))
+        assert body["stage"] == str(stage), (t, body)
+        clock = re.search(r'<span id="clock">([^<]*)</span>', dom)[1]
+        assert clock.endswith(label), clock
+    plain = tmp_path / "plain"
+    shutil.copytree(run_dir, plain)
+    dom = browse(write_viewer(plain).resolve().as_uri() + "#t=0.6", tmp_path, "--dump-dom").stdout
+    assert 'data-stage=""' in dom and "stage" not in re.search(r'id="clock">([^<]*)<', dom)[1]
