@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from quadimpact.cli.options import CONTROLLER, MODEL, out_option
+from quadimpact.cli.options import CONTROLLER, MODEL, file_argument, number_option, out_option
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
 __all__ = ["build_scenario", "format_summary", "run"]
@@ -48,57 +48,33 @@ _OUTPUT_FILES = (
 
 
 @click.command("run")
-@click.argument(
-    "scenario",
-    required=False,
-    metavar="[SCENARIO.toml]",
-    type=click.Path(dir_okay=False, path_type=Path),
-)
-@click.option(
+@file_argument("scenario", "[SCENARIO.toml]")
+@number_option(
     "--heading",
-    type=float,
-    metavar="DEG",
-    help="Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
+    "DEG",
+    "Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
     "wall (bumpers 1 and 4 lead). [default: 0]",
 )
-@click.option(
+@number_option(
     "--inclination",
-    type=float,
-    metavar="DEG",
-    help="Tilt of the body z axis toward the wall, in the vertical plane through the wall "
+    "DEG",
+    "Tilt of the body z axis toward the wall, in the vertical plane through the wall "
     "normal, deg in [-60, 60]. [default: 0]",
 )
-@click.option(
+@number_option(
     "--speed",
-    type=float,
-    metavar="M/S",
-    help="Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
+    "M/S",
+    "Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
     "[default: 0.75]",
 )
-@click.option(
-    "--impact-time",
-    type=float,
-    metavar="S",
-    help="Time of the first contact, s (> 0, < final time). [default: 0.5]",
+@number_option(
+    "--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]"
 )
-@click.option(
-    "--wall-distance",
-    type=float,
-    metavar="M",
-    help="Wall position along inertial X (NED), m. [default: 1.5]",
+@number_option("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
+@number_option(
+    "--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]"
 )
-@click.option(
-    "--altitude",
-    type=float,
-    metavar="M",
-    help="Altitude set-point and initial altitude, m (> 0). [default: 2]",
-)
-@click.option(
-    "--final-time",
-    type=float,
-    metavar="S",
-    help="End of the simulation, s in (0, 600]. [default: 3]",
-)
+@number_option("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--model",
     type=MODEL,
@@ -135,11 +111,9 @@ _OUTPUT_FILES = (
     help="'ideal': commanded rotor speeds apply at once (the paper); 'first-order': "
     "motor lag with the vehicle's time constant. [default: ideal]",
 )
-@click.option(
-    "--friction",
-    type=float,
-    metavar="MU",
-    help="Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). [default: 0]",
+@number_option(
+    "--friction", "MU", "Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). "
+    "[default: 0]"
 )
 @click.option(
     "--ground",
@@ -147,22 +121,13 @@ _OUTPUT_FILES = (
     help="'crash': reaching the ground ends the run; 'contact': the ground is a contact "
     "surface; 'none': no ground. [default: crash]",
 )
-@click.option(
-    "--output-rate",
-    type=float,
-    metavar="HZ",
-    help="Sampling rate of the output time series, Hz. [default: 1000]",
+@number_option(
+    "--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]"
 )
-@click.option(
-    "--rtol",
-    type=float,
-    help="Integrator relative tolerance, in (0, 0.1). [default: kernel default]",
+@number_option(
+    "--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]"
 )
-@click.option(
-    "--atol",
-    type=float,
-    help="Integrator absolute tolerance, > 0. [default: kernel default]",
-)
+@number_option("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
 @out_option("results/run", "Output folder (created if needed).")
 @click.option(
     "--viz",
