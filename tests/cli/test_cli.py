@@ -79,6 +79,25 @@ def test_bad_scenario_file_exits_2(tmp_path: Path, text: str, fragments) -> None
     assert_input_error(proc, *fragments)
 
 
+def test_run_takes_an_impact_trial_file(tmp_path: Path) -> None:
+    """Each kind of scenario file runs; flags apply when the kind has the field."""
+    import json
+
+    (tmp_path / "trial.toml").write_text('kind = "impact-trial"\npitch_deg = -20\n')
+    proc = run_cli("run", "trial.toml", "--heading", "10", cwd=tmp_path)
+    assert_input_error(proc, "--heading: applies to wall-approach scenarios only")
+    out = tmp_path / "out"
+    proc = run_cli("run", "trial.toml", "--speed", "1.2", "--final-time", "0.3", "--out",
+                   str(out), cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "impact trial, roll 0 deg, pitch -20 deg" in proc.stderr
+    world = json.loads((out / "scenario.json").read_text())
+    assert world["scenario"]["kind"] == "impact-trial" and world["scenario"]["speed_m_s"] == 1.2
+    assert world["scenario"]["pitch_deg"] == -20 and world["vehicle"]["name"] == "navi"
+    summary = json.loads((out / "summary.json").read_text())
+    assert summary["controller"] == "recovery" and summary["detected"] is True
+
+
 def test_bad_vehicle_file_exits_2(tmp_path: Path) -> None:
     bad = SPIRI_TOML.read_text().replace("restitution = 0.9", "restitution = 0")
     (tmp_path / "bad.toml").write_text(bad)

@@ -391,3 +391,257 @@ def test_run_viz_flag(tmp_path: Path) -> None:
     assert proc.returncode == 0, proc.stderr
     for name in ("snapshots.png", "snapshots.pdf", "animation.mp4", "viewer.html"):
         assert (out / name).is_file(), name
+
+
+# ------------------------------------------------------------------ the world the run recorded
+SLOPE = Plane(name="slope", point_m=(0.3, 0.0, 0.0), normal=(-1.0, 0.0, -0.5))
+OVERRIDES = {
+    "bumper_radius_m": 0.15,
+    "bumper_tilt_deg": 4.0,
+    "bumper_centres_m": [
+        [0.16, 0.15, -0.03],
+        [-0.15, 0.15, -0.03],
+        [-0.15, -0.15, -0.03],
+        [0.16, -0.15, -0.03],
+    ],
+}
+SLOPE_TOML = """\
+kind = "flight"
+position_m = [0.0, 0.0, -1.0]
+velocity_m_s = [1.0, 0.0, 0.0]
+final_time_s = 0.9
+output_rate_hz = 200
+
+[[surfaces]]
+name = "slope"
+point_m = [0.3, 0.0, 0.0]
+normal = [-1.0, 0.0, -0.5]
+
+[vehicle_overrides]
+bumper_radius_m = 0.15
+bumper_tilt_deg = 4.0
+bumper_centres_m = [[0.16, 0.15, -0.03], [-0.15, 0.15, -0.03], [-0.15, -0.15, -0.03],
+                    [0.16, -0.15, -0.03]]
+"""
+
+
+def viewer_json(path: Path) -> dict:
+    import json
+
+    html = path.read_text(encoding="utf-8")
+    return json.loads(re.search(r'type="application/json">(.*?)</script>', html, re.S).group(1))
+
+
+@pytest.fixture(scope="module")
+def slope_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``quadimpact run FILE --viz``: a flight onto a slope with a bumper override."""
+    pytest.importorskip("imageio_ffmpeg", reason="pip install 'quadimpact[viz]'")
+    base = tmp_path_factory.mktemp("slope")
+    (base / "slope.toml").write_text(SLOPE_TOML, encoding="utf-8")
+    out = base / "run"
+    proc = run_cli("run", "slope.toml", "--viz", "--out", str(out), cwd=base)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+@pytest.mark.slow
+def test_run_viz_draws_the_recorded_slope_and_bumpers(slope_dir: Path) -> None:
+    """The viewer of ``run FILE --viz`` draws the file's plane and bumpers, and its contact
+    marks are the contact law's deepest points at the same states."""
+    import pandas as pd
+
+    for name in ("scenario.json", "snapshots.png", "animation.mp4", "viewer.html"):
+        assert (slope_dir / name).is_file(), name
+    data = viewer_json(slope_dir / "viewer.html")
+    # the slope where the file put it (and the reference ground, not a contact surface)
+    contact_surfaces = [s for s in data["surfaces"] if s["contact"]]
+    assert [s["name"] for s in contact_surfaces] == ["slope"]
+    np.testing.assert_allclose(contact_surfaces[0]["point"], SLOPE.point_m, atol=0)
+    unit = np.array(SLOPE.normal)
+    np.testing.assert_allclose(contact_surfaces[0]["normal"], unit, atol=1e-15)
+    np.testing.assert_allclose(unit, np.array([-1.0, 0.0, -0.5]) / math.sqrt(1.25), atol=1e-15)
+    # the bumpers of the override: its centres and radius
+    veh = data["vehicle"]
+    np.testing.assert_allclose(veh["centres"], OVERRIDES["bumper_centres_m"], atol=1e-6)
+    rims = np.asarray(veh["circles"]) - np.asarray(veh["centres"])[:, None, :]
+    np.testing.assert_allclose(np.linalg.norm(rims, axis=2), 0.15, atol=2e-5)
+    # every drawn contact point is bumper_contact's at the sample's state, computed
+    # here from the file's own numbers (not from what the run recorded)
+    vehicle = pack_vehicle(load_vehicle().with_overrides(**OVERRIDES))
+    surf = pack_surfaces([SLOPE])
+    ts = pd.read_parquet(slope_dir / "timeseries.parquet")
+    state_cols = ["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3",
+                  "p_rad_s", "q_rad_s", "r_rad_s",
+                  *(f"omega{j}_rad_s" for j in (1, 2, 3, 4))]  # fmt: skip
+    frames = data["frames"]
+    n_marks = 0
+    for k, marks in enumerate(frames["contacts"]):
+        if not marks:
+            continue
+        i = int(np.argmin(np.abs(ts["t_s"].to_numpy() - frames["t"][k])))
+        x = np.ascontiguousarray(ts[state_cols].to_numpy(dtype=float)[i])
+        C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
+        for mark in marks:
+            d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, vehicle, mark[0] - 1, surf, 0)
+            assert d > 0
+            np.testing.assert_allclose(mark[1:4], x[0:3] + C @ np.array([rx, ry, rz]), atol=1e-5)
+            assert mark[10] == pytest.approx(1e3 * d, abs=1e-3)  # deflection, mm
+            n_marks += 1
+    assert n_marks > 5  # the run does hit the slope
+
+
+def test_scene_of_a_flight_is_its_recorded_world(slope_dir: Path) -> None:
+    """Drawn rim, deepest point and deflection on the slope: the contact law's, exactly."""
+    sc = Scene.from_dir(slope_dir, n_points=7200)
+    assert [s.name for s in sc.surfaces] == ["slope"]
+    vehicle = load_vehicle().with_overrides(**OVERRIDES)
+    assert sc.drawing.vehicle == vehicle and sc.drawing.radius_m == 0.15
+    np.testing.assert_array_equal(sc.surf, pack_surfaces([SLOPE]))  # as the kernel had it
+    veh = pack_vehicle(vehicle)
+    m = np.array(SLOPE.normal)
+    touching = np.flatnonzero(sc.deltas.max(axis=1) > 1e-3)
+    assert len(touching) > 2
+    for i in touching[:: max(1, len(touching) // 4)]:
+        t = float(sc.t[i])
+        fr = sc.frame(t)
+        x = np.ascontiguousarray(sc.state_at(t))
+        C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
+        assert fr.contacts
+        for mark in fr.contacts:
+            j = mark.bumper - 1
+            d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, veh, j, sc.surf, 0)
+            p_c = x[0:3] + C @ np.array([rx, ry, rz])
+            np.testing.assert_allclose(mark.point, p_c, atol=1e-12)
+            assert mark.delta_m == pytest.approx(sc.deltas[i, j], rel=1e-6)
+            # the deepest point of the drawn rim, by brute force over its points
+            depth = -(fr.circles[j] - np.array(SLOPE.point_m)) @ m
+            k = int(np.argmax(depth))
+            assert depth[k] == pytest.approx(d, abs=1e-7)
+            np.testing.assert_allclose(fr.circles[j][k], p_c, atol=2e-4)
+            assert (mark.surface_point - np.array(SLOPE.point_m)) @ m == pytest.approx(0, abs=1e-12)
+
+
+@pytest.fixture(scope="module")
+def trial_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """An impact trial (the Navi, recovery controller): stages 0 to 4 within 1 s."""
+    from quadimpact import ImpactTrial
+
+    out = tmp_path_factory.mktemp("trial") / "run"
+    simulate(ImpactTrial(final_time_s=1.0, output_rate_hz=200)).write(out)
+    return out
+
+
+def test_navi_is_drawn_with_its_own_bumper_centres(trial_dir: Path) -> None:
+    navi = load_vehicle("navi")
+    sc = Scene.from_dir(trial_dir, n_points=720)
+    assert sc.drawing.vehicle == navi
+    centres = np.array(navi.bumper_centres_m)
+    assert np.abs(centres - navi.rotor_positions).max() > 5e-3  # apart from the hubs
+    np.testing.assert_array_equal(sc.drawing.centres, centres)
+    rim = sc.drawing.circles - centres[:, None, :]
+    np.testing.assert_allclose(np.linalg.norm(rim, axis=2), navi.bumper_radius_m, atol=1e-12)
+    assert [(s.name, s.point_m) for s in sc.surfaces] == [("wall", (0.0, 0.0, 0.0))]
+    t = sc.first_contact_s + 0.005
+    fr = sc.frame(t)
+    x = np.ascontiguousarray(sc.state_at(t))
+    C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
+    for mark in fr.contacts:
+        d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, pack_vehicle(navi), mark.bumper - 1,
+                                                pack_surfaces([Plane.wall(0.0)]), 0)  # fmt: skip
+        np.testing.assert_allclose(mark.point, x[0:3] + C @ np.array([rx, ry, rz]), atol=1e-12)
+    assert fr.contacts
+
+
+def test_folders_without_scenario_json_are_drawn_as_before(
+    run_dir: Path, slope_dir: Path, tmp_path: Path
+) -> None:
+    """Older folders: the wall from wall_distance_m, the bundled vehicle named in the summary."""
+    from quadimpact import read_result
+
+    d = copy_run(run_dir, tmp_path)
+    (d / "scenario.json").unlink()
+    result = read_result(d)
+    assert result.world == {} and result.vehicle() is None
+    sc = Scene.from_dir(d)
+    assert [(s.name, s.point_m, s.normal) for s in sc.surfaces] == [
+        ("wall", (WALL_D, 0.0, 0.0), (-1.0, 0.0, 0.0))
+    ]
+    assert sc.drawing.vehicle == SPIRI
+    assert [c.bumper for c in sc.frame(sc.first_contact_s + 1e-3).contacts] == [4]
+    result.write(d)  # written back: still no scenario.json, nothing made up
+    assert not (d / "scenario.json").exists()
+    # a flight folder without it: no plane to draw (its planes were only in scenario.json)
+    old = tmp_path / "old-slope"
+    shutil.copytree(slope_dir, old)
+    (old / "scenario.json").unlink()
+    sc = Scene.from_dir(old)
+    assert sc.surfaces == [] and sc.drawing.vehicle == SPIRI
+    with_world = Scene.from_dir(slope_dir)
+    assert [s.name for s in with_world.surfaces] == ["slope"]
+
+
+# ------------------------------------------------------------------ recovery stages
+def test_stage_label_follows_the_recovery_run(trial_dir: Path, run_dir: Path) -> None:
+    """Clock of the movie and the viewer: "stage k: name", changing at the stage entries."""
+    import json
+
+    from quadimpact.viz.animation import DEFAULT_ANIMATION_CAMERA, AnimationFigure
+    from quadimpact.viz.viewer import viewer_data
+
+    summary = json.loads((trial_dir / "summary.json").read_text())
+    entries = [summary["t_detect_s"]] + [summary[f"t_stage{k}_s"] for k in (2, 3, 4)]
+    assert all(a < b for a, b in zip(entries, entries[1:], strict=False))
+    names = ["stage 0: before detection", "stage 1: detected", "stage 2: tilted away",
+             "stage 3: level", "stage 4: recovered"]  # fmt: skip
+    sc = Scene.from_dir(trial_dir)
+    assert sc.has_stages
+    fig = AnimationFigure(sc, DEFAULT_ANIMATION_CAMERA, 640, 360)
+    probes = [entries[0] - 0.01] + [t + 0.01 for t in entries]
+    for t, expected in zip(probes, names, strict=True):
+        assert sc.stage_at(t) == names.index(expected)
+        fig.render(t)
+        lines = fig.clock.get_text().splitlines()
+        assert expected in lines, (t, lines)
+        assert sum(line.startswith("stage ") for line in lines) == 1
+    data = viewer_data(sc)
+    stage = np.array(data["frames"]["stage"])
+    frame_t = np.array(data["frames"]["t"])
+    assert len(stage) == len(frame_t)
+    assert data["stage_labels"] == {str(k): names[k] for k in range(5)}
+    # the frames' stage steps 0 -> 4 at the recorded entries (within a frame's spacing)
+    changes = frame_t[1:][np.diff(stage) != 0]
+    assert list(stage[np.r_[0, np.flatnonzero(np.diff(stage)) + 1]]) == [0, 1, 2, 3, 4]
+    np.testing.assert_allclose(changes, entries, atol=np.median(np.diff(frame_t)) + 1e-9)
+    # a run without stages (the paper's controller) shows none
+    plain = Scene.from_dir(run_dir)
+    assert not plain.has_stages and plain.stage_at(0.6) is None
+    fig = AnimationFigure(plain, DEFAULT_ANIMATION_CAMERA, 640, 360)
+    fig.render(0.6)
+    assert not any(line.startswith("stage") for line in fig.clock.get_text().splitlines())
+    data = viewer_data(plain)
+    assert data["frames"]["stage"] is None and data["stage_labels"] is None
+
+
+@pytest.mark.browser
+@needs_chromium
+def test_viewer_shows_the_stage_in_chromium(trial_dir: Path, run_dir: Path, tmp_path: Path) -> None:
+    """The page's clock names the stage in force, and a run without stages names none."""
+    import json
+
+    from quadimpact.viz.viewer import write_viewer
+
+    summary = json.loads((trial_dir / "summary.json").read_text())
+    url = write_viewer(copy_run(trial_dir, tmp_path)).resolve().as_uri()
+    probes = [(summary["t_detect_s"] - 0.01, 0, "stage 0: before detection"),
+              (summary["t_stage2_s"] + 0.01, 2, "stage 2: tilted away"),
+              (summary["t_stage4_s"] + 0.01, 4, "stage 4: recovered")]  # fmt: skip
+    for t, stage, label in probes:
+        dom = browse(f"{url}#t={t:.4f}", tmp_path, "--dump-dom").stdout
+        body = dict(re.findall(r'data-([a-z-]+)="([^"]*)"', re.search(r"<body([^>]*)>", dom)[1]))
+        assert body["stage"] == str(stage), (t, body)
+        clock = re.search(r'<span id="clock">([^<]*)</span>', dom)[1]
+        assert clock.endswith(label), clock
+    plain = tmp_path / "plain"
+    shutil.copytree(run_dir, plain)
+    dom = browse(write_viewer(plain).resolve().as_uri() + "#t=0.6", tmp_path, "--dump-dom").stdout
+    assert 'data-stage=""' in dom and "stage" not in re.search(r'id="clock">([^<]*)<', dom)[1]

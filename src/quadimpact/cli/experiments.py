@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import out_option, parallel_options
+from quadimpact.cli.options import data_option, defaulted_option, out_option, parallel_options
 
 
 @click.command("experiments")
@@ -14,25 +14,21 @@ from quadimpact.cli.options import out_option, parallel_options
     "results/experiments",
     "Output folder: table3.csv, one folder per crash, the sensitivity sweeps.",
 )
-@click.option(
-    "--data",
-    type=click.Path(file_okay=False, path_type=Path),
-    help="Folder of the crash set's data (spiri-crash-set-1/crash_N.mat) "
-    "[default: $QUADIMPACT_DATA, else ../shared/data beside the project].",
+@data_option(
+    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat) "
+    "[default: $QUADIMPACT_DATA, else ../shared/data beside the project]."
 )
-@click.option(
+@defaulted_option(
     "--samples",
-    type=click.IntRange(min=0),
-    default=300,
-    show_default=True,
-    help="Runs per crash over the stated uncertainty (0: none).",
+    click.IntRange(min=0),
+    300,
+    "Runs per crash over the stated uncertainty (0: none).",
 )
-@click.option(
+@defaulted_option(
     "--log-samples",
-    type=click.IntRange(min=0),
-    default=100,
-    show_default=True,
-    help="Runs per crash over the uncertainty of the log's own pre-impact estimates (0: none).",
+    click.IntRange(min=0),
+    100,
+    "Runs per crash over the uncertainty of the log's own pre-impact estimates (0: none).",
 )
 @parallel_options
 def experiments(

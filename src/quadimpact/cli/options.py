@@ -31,7 +31,41 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     return command
 
 
-def out_option(default: str, help: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
+
+
+def number_option(flag: str, metavar: str | None, help: str, type: Any = float) -> Decorator:
+    """``FLAG NUMBER`` without a default: ``None`` when not given (the help says the default)."""
+    return click.option(flag, type=type, metavar=metavar, help=help)
+
+
+def defaulted_option(flag: str, type: Any, default: Any, help: str) -> Decorator:
+    """``FLAG VALUE`` with a default shown in ``--help``."""
+    return click.option(flag, type=type, default=default, show_default=True, help=help)
+
+
+def file_argument(name: str, metavar: str) -> Decorator:
+    """An optional input file argument (``SCENARIO.toml``, ``SWEEP.toml``)."""
+    return click.argument(
+        name, required=False, metavar=metavar, type=click.Path(dir_okay=False, path_type=Path)
+    )
+
+
+def result_dir_argument(command: Callable[..., Any]) -> Callable[..., Any]:
+    """The ``RESULT_DIR`` argument: a folder written by ``quadimpact run``."""
+    return click.argument("result_dir", metavar="RESULT_DIR", type=click.Path(path_type=Path))(
+        command
+    )
+
+
+def data_option(help: str) -> Decorator:
+    """``--data FOLDER``: the crash set's flight data."""
+    return click.option(
+        "--data", type=click.Path(file_okay=False, path_type=Path), help=help
+    )
+
+
+def out_option(default: str, help: str) -> Decorator:
     """``--out FOLDER`` with a default folder (shown in ``--help``)."""
     return click.option(
         "--out",

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import out_option, parallel_options
+from quadimpact.cli.options import data_option, out_option, parallel_options
 
 
 @click.command("reproduce")
@@ -19,11 +19,9 @@ from quadimpact.cli.options import out_option, parallel_options
     help="Skip the replica reruns with one difference switched off at a time.",
 )
 @click.option("--no-experiments", is_flag=True, help="Skip the seven crashes of Table III.")
-@click.option(
-    "--data",
-    type=click.Path(file_okay=False, path_type=Path),
-    help="Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
-    "../shared/data beside the project]; without it the comparisons are left out.",
+@data_option(
+    "Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
+    "../shared/data beside the project]; without it the comparisons are left out."
 )
 @parallel_options
 def reproduce(

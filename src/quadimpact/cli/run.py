@@ -9,7 +9,7 @@ from typing import Any
 
 import click
 
-from quadimpact.cli.options import CONTROLLER, MODEL, out_option
+from quadimpact.cli.options import CONTROLLER, MODEL, file_argument, number_option, out_option
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
 __all__ = ["build_scenario", "format_summary", "run"]
@@ -42,62 +42,39 @@ _WALL_ONLY = {
     "altitude_m",
 }
 _OUTPUT_FILES = (
-    "summary.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, fig6.png, imu.png"
+    "summary.json, scenario.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, "
+    "fig6.png, imu.png"
 )
 
 
 @click.command("run")
-@click.argument(
-    "scenario",
-    required=False,
-    metavar="[SCENARIO.toml]",
-    type=click.Path(dir_okay=False, path_type=Path),
-)
-@click.option(
+@file_argument("scenario", "[SCENARIO.toml]")
+@number_option(
     "--heading",
-    type=float,
-    metavar="DEG",
-    help="Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
+    "DEG",
+    "Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
     "wall (bumpers 1 and 4 lead). [default: 0]",
 )
-@click.option(
+@number_option(
     "--inclination",
-    type=float,
-    metavar="DEG",
-    help="Tilt of the body z axis toward the wall, in the vertical plane through the wall "
+    "DEG",
+    "Tilt of the body z axis toward the wall, in the vertical plane through the wall "
     "normal, deg in [-60, 60]. [default: 0]",
 )
-@click.option(
+@number_option(
     "--speed",
-    type=float,
-    metavar="M/S",
-    help="Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
+    "M/S",
+    "Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
     "[default: 0.75]",
 )
-@click.option(
-    "--impact-time",
-    type=float,
-    metavar="S",
-    help="Time of the first contact, s (> 0, < final time). [default: 0.5]",
+@number_option(
+    "--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]"
 )
-@click.option(
-    "--wall-distance",
-    type=float,
-    metavar="M",
-    help="Wall position along inertial X (NED), m. [default: 1.5]",
+@number_option("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
+@number_option(
+    "--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]"
 )
-@click.option(
-    "--altitude",
-    type=float,
-    metavar="M",
-    help="Altitude set-point and initial altitude, m (> 0). [default: 2]",
-)
-@click.option(
-    "--final-time",
-    type=float,
-    metavar="S",
-    help="End of the simulation, s in (0, 600]. [default: 3]",
-)
+@number_option("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--model",
     type=MODEL,
@@ -134,11 +111,9 @@ _OUTPUT_FILES = (
     help="'ideal': commanded rotor speeds apply at once (the paper); 'first-order': "
     "motor lag with the vehicle's time constant. [default: ideal]",
 )
-@click.option(
-    "--friction",
-    type=float,
-    metavar="MU",
-    help="Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). [default: 0]",
+@number_option(
+    "--friction", "MU", "Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). "
+    "[default: 0]"
 )
 @click.option(
     "--ground",
@@ -146,22 +121,13 @@ _OUTPUT_FILES = (
     help="'crash': reaching the ground ends the run; 'contact': the ground is a contact "
     "surface; 'none': no ground. [default: crash]",
 )
-@click.option(
-    "--output-rate",
-    type=float,
-    metavar="HZ",
-    help="Sampling rate of the output time series, Hz. [default: 1000]",
+@number_option(
+    "--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]"
 )
-@click.option(
-    "--rtol",
-    type=float,
-    help="Integrator relative tolerance, in (0, 0.1). [default: kernel default]",
+@number_option(
+    "--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]"
 )
-@click.option(
-    "--atol",
-    type=float,
-    help="Integrator absolute tolerance, > 0. [default: kernel default]",
-)
+@number_option("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
 @out_option("results/run", "Output folder (created if needed).")
 @click.option(
     "--viz",
@@ -178,7 +144,8 @@ def run(
     the given heading, inclination and altitude and is started so that its
     first bumper touches a vertical wall 1.5 m ahead at t = 0.5 s with the
     given speed; 3 s are simulated. A scenario file sets the same fields
-    (or a general "flight"); flags override the file's values.
+    (or is a general "flight", or an "impact-trial"); flags override the
+    file's values.
 
     The paper's example (its Figures 5 and 6):
 
@@ -186,8 +153,8 @@ def run(
       quadimpact run --heading 45 --inclination 15 --speed 0.75 \\
           --model paper-replica --out results/paper-example-replica
 
-    Writes summary.json, timeseries.parquet, episodes.csv, fig5.png and
-    fig6.png.
+    Writes summary.json, scenario.json (the world that ran), timeseries.parquet,
+    episodes.csv, imu.parquet and the figures.
     """
     built = build_scenario(scenario, flags, options)
     vehicle = built.build_vehicle()
@@ -234,8 +201,8 @@ def build_scenario(
 
     Returns
     -------
-    WallApproach or FlightScenario
-        The validated scenario.
+    WallApproach or FlightScenario or ImpactTrial
+        The validated scenario (of the file's ``kind``).
 
     Raises
     ------
@@ -246,17 +213,18 @@ def build_scenario(
 
     from quadimpact.inputs.files import apply_overrides
     from quadimpact.inputs.model import ModelOptions
-    from quadimpact.inputs.scenarios import FlightScenario, WallApproach, load_scenario_file
+    from quadimpact.inputs.scenarios import _KINDS, load_scenario_file
 
     data: dict[str, Any] = {}
     if scenario_path is not None:
         data = load_scenario_file(scenario_path).model_dump()
     kind = data.get("kind", "wall-approach")
+    cls = _KINDS[kind]
 
     given = {_FLAGS[key][0]: value for key, value in flags.items() if value is not None}
     rename = {field: flag for field, flag in _FLAGS.values()}
     for field in given:
-        if field in _WALL_ONLY and kind != "wall-approach":
+        if field in _WALL_ONLY and field not in cls.model_fields:
             raise InputError(
                 f"{rename[field]}: applies to wall-approach scenarios only "
                 f"({scenario_path} has kind = {kind!r})"
@@ -269,8 +237,6 @@ def build_scenario(
             raise input_error_from_validation(exc, "--option", model=ModelOptions) from None
         data["model_options"] = {**(data.get("model_options") or {}), **parsed}
     data = apply_overrides(data, given)
-
-    cls = FlightScenario if kind == "flight" else WallApproach
     try:
         return cls.model_validate(data)
     except ValidationError as exc:
@@ -288,10 +254,16 @@ def build_scenario(
 
 def _describe(scenario: Any, vehicle_name: str) -> str:
     """One line saying what is about to be simulated."""
-    if getattr(scenario, "kind", "") == "wall-approach":
+    kind = getattr(scenario, "kind", "")
+    if kind == "wall-approach":
         what = (
             f"wall approach, heading {scenario.heading_deg:g} deg, inclination "
             f"{scenario.inclination_deg:g} deg, speed {scenario.speed_m_s:g} m/s"
+        )
+    elif kind == "impact-trial":
+        what = (
+            f"impact trial, roll {scenario.roll_deg:g} deg, pitch {scenario.pitch_deg:g} deg, "
+            f"yaw {scenario.yaw_deg:g} deg, speed {scenario.speed_m_s:g} m/s"
         )
     else:
         what = f"flight with {len(scenario.surfaces)} surface(s)"

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import parallel_options
+from quadimpact.cli.options import file_argument, parallel_options
 from quadimpact.errors import InputError
 
 __all__ = ["sweep"]
@@ -34,12 +34,7 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
 
 
 @click.command("sweep")
-@click.argument(
-    "sweep_file",
-    required=False,
-    metavar="[SWEEP.toml]",
-    type=click.Path(dir_okay=False, path_type=Path),
-)
+@file_argument("sweep_file", "[SWEEP.toml]")
 @click.option(
     "--grid",
     "grid",

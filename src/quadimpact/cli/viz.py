@@ -17,6 +17,11 @@ from typing import Any
 
 import click
 
+from quadimpact.cli.options import (
+    defaulted_option,
+    number_option,
+    result_dir_argument,
+)
 from quadimpact.errors import InputError
 
 __all__ = ["animate", "make_all", "snapshots", "view"]
@@ -25,19 +30,17 @@ __all__ = ["animate", "make_all", "snapshots", "view"]
 def _camera_options(func: Callable[..., Any]) -> Callable[..., Any]:
     """--azimuth, --elevation, --follow, --span (defaults depend on the command)."""
     opts = [
-        click.option(
+        number_option(
             "--azimuth",
-            type=float,
-            metavar="DEG",
-            help="Camera direction from the vehicle seen from above, deg from +X (toward "
+            "DEG",
+            "Camera direction from the vehicle seen from above, deg from +X (toward "
             "the wall) toward +Y (right): 90 = from starboard, wall on the right. "
             "[default: 120 snapshots, 110 otherwise]",
         ),
-        click.option(
+        number_option(
             "--elevation",
-            type=float,
-            metavar="DEG",
-            help="Camera height above the horizontal, deg in [-89, 89]. [default: 20]",
+            "DEG",
+            "Camera height above the horizontal, deg in [-89, 89]. [default: 20]",
         ),
         click.option(
             "--follow",
@@ -45,17 +48,15 @@ def _camera_options(func: Callable[..., Any]) -> Callable[..., Any]:
             help="'vehicle': centred on the vehicle; 'wall': fixed at the impact point. "
             "[default: wall for snapshots, vehicle otherwise]",
         ),
-        click.option(
-            "--span",
-            type=float,
-            metavar="M",
-            help="Height of the 3D view, m. [default: 1.0 snapshots, 0.9 otherwise]",
+        number_option(
+            "--span", "M", "Height of the 3D view, m. [default: 1.0 snapshots, 0.9 otherwise]"
         ),
         click.option(
             "--vehicle",
             metavar="NAME_OR_PATH",
-            help="Vehicle file to draw, if the result's vehicle name is not a bundled "
-            "vehicle (e.g. the run used --vehicle path.toml).",
+            help="Vehicle to draw instead of the one the run recorded in scenario.json; "
+            "needed only for a folder without scenario.json (written by an older "
+            "version) whose vehicle is not a bundled one.",
         ),
     ]
     for opt in reversed(opts):
@@ -143,30 +144,18 @@ def _parse_size(text: str) -> tuple[int, int]:
 
 # ------------------------------------------------------------------ animate
 @click.command("animate")
-@click.argument("result_dir", metavar="RESULT_DIR", type=click.Path(path_type=Path))
-@click.option(
-    "--fps",
-    type=click.FloatRange(min=1, max=240),
-    default=30.0,
-    show_default=True,
-    help="Frames per second of the movie.",
+@result_dir_argument
+@defaulted_option(
+    "--fps", click.FloatRange(min=1, max=240), 30.0, "Frames per second of the movie."
 )
-@click.option(
+@defaulted_option(
     "--slow",
-    type=click.FloatRange(min=0.01, max=1000),
-    default=1.0,
-    show_default=True,
-    help="Slow-down factor: 1 = real time, 4 = four times slower.",
+    click.FloatRange(min=0.01, max=1000),
+    1.0,
+    "Slow-down factor: 1 = real time, 4 = four times slower.",
 )
-@click.option(
-    "--start",
-    type=float,
-    metavar="S",
-    help="First simulated time shown, s. [default: start of the run]",
-)
-@click.option(
-    "--end", type=float, metavar="S", help="Last simulated time shown, s. [default: end of the run]"
-)
+@number_option("--start", "S", "First simulated time shown, s. [default: start of the run]")
+@number_option("--end", "S", "Last simulated time shown, s. [default: end of the run]")
 @click.option("--gif", is_flag=True, help="Also write animation.gif (smaller, 15 fps, for slides).")
 @click.option(
     "--size", default="1280x720", show_default=True, metavar="WxH", help="Movie size in pixels."
@@ -234,7 +223,7 @@ def _need_ffmpeg() -> None:
 
 # ------------------------------------------------------------------ snapshots
 @click.command("snapshots")
-@click.argument("result_dir", metavar="RESULT_DIR", type=click.Path(path_type=Path))
+@result_dir_argument
 @click.option(
     "--times",
     metavar="T1,T2,...",
@@ -274,13 +263,12 @@ def snapshots(
 
 # ------------------------------------------------------------------ view
 @click.command("view")
-@click.argument("result_dir", metavar="RESULT_DIR", type=click.Path(path_type=Path))
-@click.option(
+@result_dir_argument
+@defaulted_option(
     "--rate",
-    type=click.FloatRange(min=1, max=10000),
-    default=250.0,
-    show_default=True,
-    help="Frames per simulated second in the page.",
+    click.FloatRange(min=1, max=10000),
+    250.0,
+    "Frames per simulated second in the page.",
 )
 @_camera_options
 @_value_errors
@@ -310,8 +298,7 @@ def make_all(out: Path, result: Any) -> list[Path]:
     from quadimpact.viz.snapshots import write_snapshots
     from quadimpact.viz.viewer import write_viewer
 
-    vehicle = getattr(getattr(result, "scenario", None), "build_vehicle", None)
-    scene = Scene.from_result(result, vehicle=vehicle() if callable(vehicle) else None)
+    scene = Scene.from_result(result)  # the world the run recorded (scenario.json)
     files: list[Path] = []
     try:
         png, pdf, warnings = write_snapshots(out, scene=scene)

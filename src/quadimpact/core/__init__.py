@@ -19,8 +19,8 @@ the Python side). One module per pipeline stage:
 * ``run``: a whole run as a loop over ``step.advance``; Python entries.
 
 Numba's on-disk cache checks only the file of each cached function, not the
-files of the functions it calls and inlines: an edited ``control.py`` would
-leave ``run.py``'s cached loop stale. ``ensure_fresh_cache`` (run on import)
+files of the functions it calls and inlines: an edited ``controllers/paper.py``
+would leave ``run.py``'s cached loop stale. ``ensure_fresh_cache`` (run on import)
 keeps a hash of all the core sources next to the cache and clears the core's
 cache files when it changes.
 """

@@ -30,7 +30,7 @@ Everything that survives from one tick to the next is in the caller's arrays:
   in ``stats``, so a run stopped after any tick can be read).
 
 :func:`start` initialises them, :func:`advance` runs ``n`` ticks (or to the end)
-and :func:`finish` closes the open episodes; ``run.integrate`` is
+and :func:`finish` closes the open episodes; ``run.run_builtin`` is
 ``start`` + ``advance`` to the end. A run advanced tick by tick is the same
 computation as one advanced all at once, bit for bit.
 """

@@ -12,6 +12,11 @@ that the cached kernel dispatches on. A controller registered with a ``step``
 (a Numba ``njit`` function ``step(t, meas, ctrl, mem, veh, dt, cmd)``, see
 ``quadimpact.core.controllers``) runs in a kernel compiled for it
 (``core.run.make_kernel``, once per process).
+
+The registry lives in the process: a sweep's local worker processes see a
+plug-in only when the registration runs on import of the main script (or of
+a module it imports), not under ``if __name__ == "__main__":``
+(docs/CONTROLLERS.md, "Plugging in a controller").
 """
 
 from __future__ import annotations

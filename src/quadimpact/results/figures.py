@@ -37,6 +37,7 @@ __all__ = [
     "BUMPER_COLORS",
     "FIG_DPI",
     "MAX_TEXT_CELLS",
+    "STAGE_NAMES",
     "TYPE_COLOURS",
     "break_wraps",
     "check_columns",
@@ -49,6 +50,7 @@ __all__ = [
     "plot_fig6",
     "save_figure",
     "sorted_levels",
+    "stage_label",
     "type_map_figure",
 ]
 
@@ -261,7 +263,24 @@ def plot_fig6(
 
 
 STAGE_COLORS = {1: "tab:red", 2: "tab:orange", 3: "tab:olive", 4: "tab:green"}
-STAGE_NAMES = {1: "1 detected", 2: "2 tilted away", 3: "3 level", 4: "4 recovered"}
+#: The recovery controller's stages (docs/RECOVERY.md 3.4), as drawn in the
+#: figures, the movie's clock and the viewer.
+STAGE_NAMES = {
+    0: "before detection",
+    1: "detected",
+    2: "tilted away",
+    3: "level",
+    4: "recovered",
+}
+
+
+def stage_label(stage: int) -> str:
+    """``"stage 2: tilted away"``: a controller stage as the movie and the viewer show it.
+
+    A stage without a name (a plug-in controller's) is ``"stage N"``.
+    """
+    name = STAGE_NAMES.get(int(stage))
+    return f"stage {int(stage)}: {name}" if name else f"stage {int(stage)}"
 
 
 def mark_stages(ax: Any, summary: Mapping[str, Any] | None, *, label: bool = False) -> None:
@@ -276,7 +295,7 @@ def mark_stages(ax: Any, summary: Mapping[str, Any] | None, *, label: bool = Fal
         t = summary.get(f"t_stage{k}_s")
         if isinstance(t, numbers.Real):
             ax.axvline(t, color=STAGE_COLORS[k], linestyle="--", linewidth=1.0,
-                       label=f"stage {STAGE_NAMES[k]}" if label else None)  # fmt: skip
+                       label=f"stage {k} {STAGE_NAMES[k]}" if label else None)  # fmt: skip
 
 
 def make_imu(

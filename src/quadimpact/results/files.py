@@ -5,6 +5,9 @@ A result folder holds:
 - ``summary.json``: the run summary (NaN and infinities written as ``null``),
   plus the attitude/altitude ``references`` and integrator ``stats`` so the
   folder can be re-plotted;
+- ``scenario.json``: the world that ran (the validated scenario, what its
+  settings resolved to, the vehicle with its overrides applied, the contact
+  surfaces as packed), so the folder can be drawn as it ran;
 - ``episodes.csv``: one row per contact episode (see docs/RESULTS.md);
 - ``timeseries.parquet``: the sampled states, with the unit of every column
   as JSON in the schema metadata key ``quadimpact.units``;
@@ -45,6 +48,7 @@ __all__ = [
     "EPISODE_COLUMNS",
     "EPISODES_CSV",
     "EPISODES_LEADING_COLUMNS",
+    "SCENARIO_JSON",
     "SUMMARY_JSON",
     "TIMESERIES_COLUMNS",
     "TIMESERIES_PARQUET",
@@ -65,6 +69,7 @@ __all__ = [
 ]
 
 SUMMARY_JSON = "summary.json"
+SCENARIO_JSON = "scenario.json"
 EPISODES_CSV = "episodes.csv"
 TIMESERIES_PARQUET = "timeseries.parquet"
 IMU_PARQUET = "imu.parquet"
@@ -214,12 +219,13 @@ def atomic_write(
 
 
 def write_summary_json(summary: Mapping[str, Any], path: str | os.PathLike[str]) -> Path:
-    """Write ``summary`` as indented JSON (NaN -> null), atomically.
+    """Write ``summary`` (or any mapping: ``scenario.json``) as indented JSON, atomically.
 
     Parameters
     ----------
     summary : mapping
-        Run summary; values converted by :func:`to_jsonable`.
+        Run summary; values converted by :func:`to_jsonable` (NaN -> null).
+        Floats are written in full (``repr``), so they read back bit for bit.
     path : path-like
         Target file.
 
@@ -233,7 +239,7 @@ def write_summary_json(summary: Mapping[str, Any], path: str | os.PathLike[str])
 
 
 def read_summary_json(path: str | os.PathLike[str]) -> dict[str, Any]:
-    """Read a summary written by :func:`write_summary_json` (``null`` stays ``None``)."""
+    """Read a file written by :func:`write_summary_json` (``null`` stays ``None``)."""
     with open(path, encoding="utf-8") as fh:
         return json.load(fh)
 

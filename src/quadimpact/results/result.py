@@ -53,6 +53,12 @@ class SimulationResult:
     imu : pandas.DataFrame or None
         The IMU samples (columns in docs/RESULTS.md; body FRD, SI); ``None``
         when the run had no IMU record.
+    world : dict
+        The world that ran, the content of ``scenario.json`` (docs/RESULTS.md):
+        ``scenario`` (every field of the validated scenario), ``resolved`` (what
+        its settings resolved to), ``vehicle`` (every field, overrides applied)
+        and ``surfaces`` (the contact surfaces as packed). Empty when read
+        from a folder written before ``scenario.json`` existed.
     """
 
     def __init__(
@@ -64,6 +70,7 @@ class SimulationResult:
         scenario: object = None,
         stats: dict[str, Any] | None = None,
         imu: pd.DataFrame | None = None,
+        world: dict[str, Any] | None = None,
         *,
         tables: Callable[[str], Any] | None = None,
     ) -> None:
@@ -71,7 +78,12 @@ class SimulationResult:
         self.references = dict(references or {})
         self.scenario = scenario
         self.stats = dict(stats or {})
-        self._tables: dict[str, Any] = {"episodes": episodes, "timeseries": timeseries, "imu": imu}
+        self._tables: dict[str, Any] = {
+            "episodes": episodes,
+            "timeseries": timeseries,
+            "imu": imu,
+            "world": world,
+        }
         self._build = tables
 
     def _table(self, name: str) -> Any:
@@ -112,6 +124,15 @@ class SimulationResult:
     def imu(self, value: pd.DataFrame | None) -> None:
         self._tables["imu"] = value
 
+    @property
+    def world(self) -> dict[str, Any]:
+        """The world that ran (built on first use; empty when unknown)."""
+        return self._table("world") or {}
+
+    @world.setter
+    def world(self, value: dict[str, Any]) -> None:
+        self._tables["world"] = value
+
     def __repr__(self) -> str:
         s = self.summary
         parts = [f"status={s.get('status')!r}"]
@@ -125,13 +146,27 @@ class SimulationResult:
 
     # ------------------------------------------------------------------
     def _scenario_value(self, key: str) -> Any:
-        """``key`` from the scenario object, else from ``summary['scenario']``."""
+        """``key`` from the scenario object, else from the world record's scenario."""
         if self.scenario is not None and hasattr(self.scenario, key):
             return getattr(self.scenario, key)
-        sc = self.summary.get("scenario")
+        sc = self.world.get("scenario")
         if isinstance(sc, Mapping):
             return sc.get(key)
         return None
+
+    def vehicle(self) -> Any:
+        """The vehicle that ran (overrides applied), from the world record; ``None`` without one.
+
+        Returns
+        -------
+        quadimpact.inputs.vehicle.Vehicle or None
+        """
+        data = self.world.get("vehicle")
+        if not isinstance(data, Mapping):
+            return None
+        from quadimpact.inputs.vehicle import Vehicle
+
+        return Vehicle.model_validate(dict(data))
 
     def wall_x_m(self) -> float | None:
         """Inertial X of the wall plane (m), if known (wall-approach runs)."""
@@ -159,7 +194,8 @@ class SimulationResult:
 
         Files, in this order so that a plotting failure loses no data:
         ``summary.json`` (the summary plus ``references`` and ``stats`` unless
-        it already has those keys), ``episodes.csv``, ``timeseries.parquet``,
+        it already has those keys), ``scenario.json`` (the world record, when
+        there is one), ``episodes.csv``, ``timeseries.parquet``,
         ``imu.parquet`` (when there are IMU samples), ``fig5.png``,
         ``fig6.png``, ``imu.png``. A figure that fails is not written (a stale
         one from an earlier write is removed); the failure is printed as a
@@ -173,6 +209,11 @@ class SimulationResult:
         summary.setdefault("references", dict(self.references))
         summary.setdefault("stats", dict(self.stats))
         files.write_summary_json(summary, d / files.SUMMARY_JSON)
+        world = self.world
+        if world:
+            files.write_summary_json(world, d / files.SCENARIO_JSON)
+        else:
+            (d / files.SCENARIO_JSON).unlink(missing_ok=True)
         timeseries = self._columns("timeseries")
         imu = self._columns("imu")
         files.write_episodes_csv(self._columns("episodes"), d / files.EPISODES_CSV)
@@ -226,9 +267,10 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     """Load a result folder written by :meth:`SimulationResult.write`.
 
     Returns a :class:`SimulationResult` with ``summary``,
-    ``episodes``, ``timeseries``, and ``references``/``stats`` taken from the
-    summary (empty dicts if absent); ``scenario`` is ``None``. Enough to
-    re-plot the folder.
+    ``episodes``, ``timeseries``, ``imu``, ``references``/``stats`` taken from
+    the summary (empty dicts if absent) and ``world`` from ``scenario.json``
+    (empty for a folder written before that file existed); ``scenario`` is
+    ``None``. Enough to re-plot and redraw the folder.
     """
     d = Path(directory)
     if not d.is_dir():
@@ -238,6 +280,8 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     timeseries = files.read_timeseries_parquet(d / files.TIMESERIES_PARQUET)
     imu_path = d / files.IMU_PARQUET
     imu = files.read_timeseries_parquet(imu_path) if imu_path.is_file() else None
+    world_path = d / files.SCENARIO_JSON
+    world = files.read_summary_json(world_path) if world_path.is_file() else {}
     references = dict(summary.get("references") or {})
     stats = dict(summary.get("stats") or {})
     return SimulationResult(
@@ -248,4 +292,5 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
         scenario=None,
         stats=stats,
         imu=imu,
+        world=world,
     )

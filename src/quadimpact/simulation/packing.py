@@ -5,7 +5,7 @@ Slots are named in ``quadimpact.core.layout``. Nothing here integrates.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -83,6 +83,63 @@ def pack_surfaces(surfaces: Sequence[Plane]) -> np.ndarray:
         surf[i, L.S_NORMAL : L.S_NORMAL + 3] = n / np.linalg.norm(n)
         surf[i, L.S_IS_GROUND] = 1.0 if s.is_ground else 0.0
         surf[i, L.S_KIND] = L.SURF_PLANE
+    return surf
+
+
+#: Surface kinds by the names written in ``scenario.json`` (``core.layout.SURF_*``).
+SURFACE_KINDS: dict[str, int] = {"plane": L.SURF_PLANE}
+
+
+def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, Any]]:
+    """The packed surfaces as plain data, as the kernel received them (``scenario.json``).
+
+    Parameters
+    ----------
+    surf : numpy.ndarray, shape (n, NSURF)
+        Packed surfaces (:func:`pack_surfaces`).
+    names : sequence of str
+        Their names, in the same order.
+
+    Returns
+    -------
+    list of dict
+        Per surface: ``name``, ``point_m`` (inertial NED, m), ``normal`` (unit,
+        inertial NED, out of the obstacle), ``is_ground`` and ``kind`` (a key of
+        :data:`SURFACE_KINDS`). :func:`pack_surface_records` gives ``surf`` back
+        bit for bit.
+    """
+    kinds = {v: k for k, v in SURFACE_KINDS.items()}
+    return [
+        {
+            "name": str(name),
+            "point_m": [float(c) for c in row[L.S_P0 : L.S_P0 + 3]],
+            "normal": [float(c) for c in row[L.S_NORMAL : L.S_NORMAL + 3]],
+            "is_ground": bool(row[L.S_IS_GROUND] > 0.5),
+            "kind": kinds[int(row[L.S_KIND])],
+        }
+        for name, row in zip(names, surf, strict=True)
+    ]
+
+
+def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
+    """The packed surfaces of :func:`surface_records`' output (no normalisation: as recorded).
+
+    Raises
+    ------
+    ValueError
+        A record with a kind not in :data:`SURFACE_KINDS`.
+    """
+    surf = np.zeros((len(records), L.NSURF))
+    for i, r in enumerate(records):
+        kind = r.get("kind", "plane")
+        if kind not in SURFACE_KINDS:
+            known = ", ".join(SURFACE_KINDS)
+            name = r.get("name")
+            raise ValueError(f"surface {name!r}: kind must be one of {known} (got {kind!r})")
+        surf[i, L.S_P0 : L.S_P0 + 3] = [float(c) for c in r["point_m"]]
+        surf[i, L.S_NORMAL : L.S_NORMAL + 3] = [float(c) for c in r["normal"]]
+        surf[i, L.S_IS_GROUND] = 1.0 if r.get("is_ground") else 0.0
+        surf[i, L.S_KIND] = SURFACE_KINDS[kind]
     return surf
 
 

@@ -68,6 +68,10 @@ class RunSetup:
     n_imu: int = 0
     controller: str = "paper"
     kernel: Callable | None = None
+    resolved: dict[str, Any] = field(default_factory=dict)
+    """What the scenario's settings resolved to, as plain data (``scenario.json``'s
+    ``resolved``): the model variant and every switch, the controller and its
+    parameters with defaults, the pre-impact behaviour, the IMU and the slew limit."""
 
     def sensors(self) -> dict[str, Any]:
         """The IMU and detector as keyword arguments of ``core.run.execute_record``."""
@@ -195,12 +199,23 @@ def _setup(
     )
     imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
     scfg, noise, n_imu = pack_sensors(imu, s.detection, v, s.seed, duration_s)
+    params = s.resolved_controller_params()
+    resolved = {
+        "model": s.model,
+        "model_options": o.model_dump(mode="json"),
+        "controller": s.controller,
+        "controller_params": params.model_dump(mode="json"),
+        "pre_impact": context.pre_impact,
+        "nominal_controller": s.nominal_controller,
+        "imu": imu.model_dump(mode="json"),
+        "rotor_slew_limit_rad_s2": _slew_limit_rad_s2(s, v),
+    }
     setup = RunSetup(
         tf=float(s.final_time_s),
         veh=pack_vehicle(v),
         surf=pack_surfaces(surfaces),
         opts=_packed_options(s, o, v, duration_s),
-        ctrl=pack_controller(entry, s.resolved_controller_params(), context, refs, yaw_paper),
+        ctrl=pack_controller(entry, params, context, refs, yaw_paper),
         surface_names=tuple(x.name for x in surfaces),
         references=refs,
         vehicle=v,
@@ -211,6 +226,7 @@ def _setup(
         n_imu=n_imu,
         controller=s.controller,
         kernel=_kernel(entry),
+        resolved=resolved,
         **fields,
         **_schedule(s),
     )

@@ -12,10 +12,12 @@ import time
 from collections.abc import Callable
 from typing import Any
 
+from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.run import execute_record
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.result import SimulationResult
+from quadimpact.simulation.packing import surface_records
 from quadimpact.simulation.record import (
     episode_columns,
     episodes_frame,
@@ -27,7 +29,7 @@ from quadimpact.simulation.record import (
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.summary import build_summary
 
-__all__ = ["analyse", "run_setup", "simulate"]
+__all__ = ["analyse", "run_setup", "simulate", "world_record"]
 
 
 def simulate(
@@ -86,11 +88,41 @@ def run_setup(
     return analyse(setup, scenario, rec, wall_s)
 
 
+def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
+    """The world that ran, as plain data: the content of ``scenario.json`` (docs/RESULTS.md).
+
+    Parameters
+    ----------
+    setup : RunSetup
+        The prepared run.
+    scenario : WallApproach or FlightScenario or ImpactTrial, optional
+        The validated scenario it was prepared from.
+
+    Returns
+    -------
+    dict
+        ``scenario``: every field of the validated scenario (``None`` without
+        one); ``resolved``: what its settings resolved to
+        (:attr:`RunSetup.resolved`); ``vehicle``: every field of the vehicle
+        with its overrides applied (body FRD, SI); ``surfaces``: every contact
+        surface as packed for the kernel (the ground of ``ground = "contact"``
+        included; :func:`~quadimpact.simulation.packing.surface_records`).
+    """
+    return {
+        "scenario": scenario.model_dump(mode="json") if hasattr(scenario, "model_dump") else None,
+        "resolved": dict(setup.resolved),
+        "vehicle": setup.vehicle.model_dump(mode="json"),
+        "surfaces": surface_records(setup.surf, setup.surface_names),
+        "quadimpact_version": __version__,
+    }
+
+
 def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan")):
-    """The summary of a raw record (``core.run.RawRecord``) of ``setup``, tables on demand.
+    """Summary, tables and world record of a raw record (``core.run.RawRecord``) of ``setup``.
 
     The summary is computed from the raw arrays (no DataFrame); the result's
-    ``timeseries``, ``episodes`` and ``imu`` tables are built when first read.
+    ``timeseries``, ``episodes`` and ``imu`` tables and its ``world`` record
+    are built when first read.
     """
     out, ep, st = rec.out, rec.episodes, rec.stats
     x0 = L.OUT_X + L.X_QUAT
@@ -122,6 +154,8 @@ def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan
             return cols
         if name == "imu_columns":
             return imu_columns(imu)
+        if name == "world":
+            return world_record(setup, scenario)
         return imu_frame(imu)
 
     return SimulationResult(

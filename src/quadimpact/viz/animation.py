@@ -1,7 +1,10 @@
 """Movies of a run: MP4 (imageio-ffmpeg) and GIF (Pillow).
 
 The figure (3D view on the left; bumper deflections and attitude on the
-right, drawn as the clock runs) is built once. Its static part (axes, ticks,
+right, drawn as the clock runs) is built once. The clock in the 3D view
+shows the time, the time after impact and, for a run whose controller has
+stages (the ``recovery`` controller), the stage in force ("stage 2: tilted
+away"). Its static part (axes, ticks,
 legends, the faint whole-run curves) is rendered once and kept as a
 background; every frame restores it, moves the changing artists
 (:class:`~quadimpact.viz.render.SceneArtists`, the live lines, cursors and
@@ -26,7 +29,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import break_wraps
+from quadimpact.results.figures import break_wraps, stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene
@@ -184,6 +187,9 @@ class AnimationFigure:
         lines = [f"t = {t:6.3f} s", f"impact {tau:+6.3f} s"]
         if self.slow != 1:
             lines.append(f"{self.slow:g}x slower")
+        stage = sc.stage_at(t)
+        if stage is not None:
+            lines.append(stage_label(stage))
         if sc.crash_time_s is not None and t >= sc.crash_time_s - 1e-9:
             lines.append("CRASH")
         self.clock.set_text("\n".join(lines))

@@ -95,13 +95,13 @@ class SceneArtists:
 
         # planes: the contact surfaces, and the ground plane for reference
         self.planes: list[tuple[np.ndarray, np.ndarray, float | None, Polygon, LineCollection]] = []
-        planes = [(s.point_m, s.normal, s.name) for s in scene.surfaces]
+        planes = [(s.point_m, s.normal, s.is_ground) for s in scene.surfaces]
         if not any(s.is_ground for s in scene.surfaces):
-            planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), "ground"))
-        for point, normal, name in planes:
+            planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True))
+        for point, normal, is_ground in planes:
             p = np.asarray(point, float)
             m = np.asarray(normal, float) / np.linalg.norm(normal)
-            color = GROUND_COLOR if name == "ground" else WALL_COLOR
+            color = GROUND_COLOR if is_ground else WALL_COLOR
             # a camera on the free side of the plane sees it behind the vehicle
             in_front = float(-forward @ m) < 0.0
             z = 10 if in_front else 0.5

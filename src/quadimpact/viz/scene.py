@@ -1,14 +1,20 @@
 """Geometry of the 3D scene of an impact, in NumPy (no drawing here).
 
 Everything is computed in the inertial NED frame (X toward the wall, Y right,
-Z down) from the vehicle's parameter file and the sampled states of a run:
+Z down) from the world the run recorded (``scenario.json``: the vehicle with
+its overrides applied and the contact surfaces as the kernel received them)
+and the sampled states of a run:
 
 * the vehicle (:class:`VehicleDrawing`): the four bumper circles exactly as the
   contact law defines them (MODEL.md 4: circle ``j`` of radius ``Rb`` centred
-  on rotor ``j``, in-plane outward ``u_j``, normal ``n_j``), the rotor discs,
-  the hub, the arms and the body axes, as body-frame polylines;
-* the contact surfaces (the wall at ``X = wall_distance_m``; the ground when it
-  was a contact surface) and the ground plane ``altitude = 0`` for reference;
+  on ``c_j``, the rotor hub or the vehicle's ``bumper_centres_m``, in-plane
+  outward ``u_j``, normal ``n_j``), the rotor discs, the hub, the arms and the
+  body axes, as body-frame polylines;
+* the contact surfaces (every plane of the run: walls, slopes, the ground when
+  it was a contact surface) and the ground plane ``altitude = 0`` for
+  reference. A folder written before ``scenario.json`` existed is drawn as
+  before: the wall ``X = wall_distance_m`` of the summary, the ground if an
+  episode touched it, and the bundled vehicle named in the summary;
 * during contact, per bumper and surface, the deepest rim point given by the
   compiled contact function :func:`quadimpact.core.geometry.bumper_contact`
   (so the drawing shows the point the simulation pushed on), the deflection
@@ -32,12 +38,14 @@ from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
+from pydantic import ValidationError
 
 from quadimpact.core import layout as L
+from quadimpact.errors import input_error_from_validation
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
+from quadimpact.simulation.packing import pack_surface_records, pack_surfaces, pack_vehicle
 
 __all__ = [
     "AXIS_LENGTH_M",
@@ -55,6 +63,7 @@ __all__ = [
     "plane_grid",
     "rim_points",
     "scene_surfaces",
+    "scene_vehicle",
     "to_inertial",
 ]
 
@@ -170,35 +179,58 @@ class VehicleDrawing:
         )
 
 
-def scene_surfaces(
-    summary: Mapping[str, Any], episodes: pd.DataFrame | None = None
-) -> list[Plane]:
-    """The contact surfaces of a run, from its summary (and episodes).
+def _world_part(world: Mapping[str, Any] | None, key: str) -> Any:
+    return world.get(key) if isinstance(world, Mapping) else None
 
-    A ``surfaces`` list in the summary (``name``, ``point_m``, ``normal``) is
-    used when present; otherwise the wall ``X = wall_distance_m`` (normal -X)
-    of a wall approach. The ground (altitude 0, normal up) is added when an
-    episode touched it (it was then a contact surface).
+
+def scene_vehicle(summary: Mapping[str, Any], world: Mapping[str, Any] | None = None) -> Vehicle:
+    """The vehicle of a run: the world record's (overrides applied), else the named bundled one.
+
+    Raises
+    ------
+    InputError
+        A world record whose vehicle breaks a rule, or (without a record) a
+        vehicle name that is not bundled.
     """
-    out: list[Plane] = []
-    listed = summary.get("surfaces")
-    if isinstance(listed, Sequence) and listed:
-        for s in listed:
-            out.append(
-                Plane(
-                    name=str(s["name"]),
-                    point_m=tuple(float(c) for c in s["point_m"]),
-                    normal=tuple(float(c) for c in s["normal"]),
-                    is_ground=bool(s.get("is_ground", s["name"] == "ground")),
-                )
+    data = _world_part(world, "vehicle")
+    if isinstance(data, Mapping):
+        try:
+            return Vehicle.model_validate(dict(data))
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, "scenario.json: vehicle") from None
+    return load_vehicle(summary.get("vehicle") or None)
+
+
+def scene_surfaces(
+    summary: Mapping[str, Any],
+    episodes: pd.DataFrame | None = None,
+    world: Mapping[str, Any] | None = None,
+) -> list[Plane]:
+    """The contact surfaces of a run: the world record's, else from the summary and episodes.
+
+    With a world record (``scenario.json``), exactly its ``surfaces``, in the
+    kernel's order (possibly none). Without one (a folder written before that
+    file existed): the wall ``X = wall_distance_m`` (normal -X) of a wall
+    approach, and the ground (altitude 0, normal up) when an episode touched it.
+    """
+    records = _world_part(world, "surfaces")
+    if isinstance(records, Sequence):
+        return [
+            Plane(
+                name=str(r["name"]),
+                point_m=tuple(float(c) for c in r["point_m"]),
+                normal=tuple(float(c) for c in r["normal"]),
+                is_ground=bool(r.get("is_ground", False)),
             )
-    elif summary.get("wall_distance_m") is not None:
+            for r in records
+        ]
+    out: list[Plane] = []
+    if summary.get("wall_distance_m") is not None:
         out.append(Plane.wall(summary["wall_distance_m"]))
-    names = {s.name for s in out}
     touched = set()
     if episodes is not None and len(episodes) and "surface" in episodes:
         touched = {str(x) for x in episodes["surface"]}
-    if "ground" in touched and "ground" not in names:
+    if "ground" in touched and "ground" not in {s.name for s in out}:
         out.append(GROUND)
     return out
 
@@ -407,13 +439,18 @@ class Scene:
     summary : mapping
         The run's summary (``summary.json``).
     episodes : pandas.DataFrame, optional
-        The run's episodes (to know whether the ground was a contact surface).
+        The run's episodes (without a world record: to know whether the
+        ground was a contact surface).
     vehicle : Vehicle, optional
-        Default: ``load_vehicle(summary["vehicle"])``.
+        Default: :func:`scene_vehicle` (the world record's).
     surfaces : list of Plane, optional
-        Default: :func:`scene_surfaces`.
+        Default: :func:`scene_surfaces` (the world record's, packed exactly as
+        recorded).
     n_points : int
         Segments per drawn circle.
+    world : mapping, optional
+        The run's world record (``scenario.json``,
+        ``SimulationResult.world``); without it, the fallback of older folders.
     """
 
     def __init__(
@@ -424,15 +461,26 @@ class Scene:
         vehicle: Vehicle | None = None,
         surfaces: list[Plane] | None = None,
         n_points: int = 72,
+        world: Mapping[str, Any] | None = None,
     ) -> None:
         if len(timeseries) == 0:
             raise ValueError("the run has no samples to draw")
         self.summary = dict(summary)
+        self.world = dict(world or {})
         if vehicle is None:
-            vehicle = load_vehicle(summary.get("vehicle") or None)
+            vehicle = scene_vehicle(summary, self.world)
         self.drawing = VehicleDrawing.from_vehicle(vehicle, n_points)
-        self.surfaces = scene_surfaces(summary, episodes) if surfaces is None else list(surfaces)
-        self.surf = pack_surfaces(self.surfaces) if self.surfaces else np.zeros((0, L.NSURF))
+        records = _world_part(self.world, "surfaces")
+        if surfaces is not None:
+            self.surfaces = list(surfaces)
+        else:
+            self.surfaces = scene_surfaces(summary, episodes, self.world)
+        if surfaces is None and isinstance(records, Sequence):
+            self.surf = pack_surface_records(records)  # the kernel's numbers, bit for bit
+        elif self.surfaces:
+            self.surf = pack_surfaces(self.surfaces)
+        else:
+            self.surf = np.zeros((0, L.NSURF))
         ts = timeseries
         self.t = ts["t_s"].to_numpy(dtype=float)
         self.states = np.zeros((len(ts), L.NX))
@@ -451,13 +499,18 @@ class Scene:
         self.crash_time_s: float | None = None if crash is None else float(crash)
         wall = summary.get("wall_distance_m")
         self.wall_x_m: float | None = None if wall is None else float(wall)
+        stage = ts["stage"].to_numpy(dtype=float) if "stage" in ts else None
+        self.stages: np.ndarray | None = None
+        if stage is not None and (summary.get("controller") == "recovery" or np.any(stage != 0)):
+            self.stages = np.rint(stage).astype(int)
         self.anchor = self.state_at(
             self.t[0] if self.first_contact_s is None else self.first_contact_s
         )[0:3].copy()
 
     @classmethod
     def from_result(cls, result: Any, vehicle: Vehicle | None = None, **kw: Any) -> Scene:
-        """Scene of a :class:`~quadimpact.results.result.SimulationResult`."""
+        """Scene of a :class:`~quadimpact.results.result.SimulationResult` (its world record)."""
+        kw.setdefault("world", getattr(result, "world", None))
         return cls(result.timeseries, result.summary, result.episodes, vehicle=vehicle, **kw)
 
     @classmethod
@@ -497,6 +550,19 @@ class Scene:
         q = x[L.X_QUAT : L.X_QUAT + 4]
         x[L.X_QUAT : L.X_QUAT + 4] = q / np.linalg.norm(q)
         return x
+
+    @property
+    def has_stages(self) -> bool:
+        """Whether the run's controller reports stages (the ``recovery`` controller's 0-4)."""
+        return self.stages is not None
+
+    def stage_at(self, t: float) -> int | None:
+        """The controller's stage in force at time ``t`` (that of the last sample at or
+        before ``t``); ``None`` when the run has no stages."""
+        if self.stages is None:
+            return None
+        k = int(np.searchsorted(self.t, float(t) + 1e-12, side="right")) - 1
+        return int(self.stages[max(k, 0)])
 
     def values_at(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Deflections (m), forces (N) and Euler angles (deg) at time ``t`` (linear)."""
@@ -570,9 +636,12 @@ class Scene:
         return self.anchor
 
     def describe(self) -> str:
-        """One line naming the run (heading, inclination, speed, model, outcome type)."""
+        """One line naming the run (kind, heading, inclination, speed, model, outcome type)."""
         s = self.summary
         parts = []
+        kind = (_world_part(self.world, "scenario") or {}).get("kind")
+        if kind in ("flight", "impact-trial"):
+            parts.append(str(kind).replace("-", " "))
         if s.get("heading_deg") is not None:
             parts.append(f"heading {s['heading_deg']:g}°")
         if s.get("inclination_deg") is not None:

@@ -9,7 +9,9 @@ sheet or font, nothing fetched.
 
 The page has the 3D scene (drag to turn, wheel to zoom), a time slider,
 play/pause at a chosen slow-down, and the bumper deflection and attitude
-plots with a cursor linked to the slider (click a plot to jump there). URL
+plots with a cursor linked to the slider (click a plot to jump there). For a
+run whose controller has stages (the ``recovery`` controller), the clock
+shows the stage in force ("stage 2: tilted away"). URL
 parameters set the initial state: ``viewer.html#t=0.6&az=110&el=20&span=0.9&follow=wall``
 (``ti=`` is the time after impact, ``play=1`` starts playing).
 
@@ -28,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.results.figures import stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import WALL_WIDTH_M
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, BUMPER_NAMES, Camera, Scene
@@ -114,6 +117,7 @@ def viewer_data(
                 "contact": False,
             }
         )
+    stages = None if scene.stages is None else scene.stages[idx]
     s = scene.summary
     origin = "first contact" if scene.first_contact_s is not None else "start"
     subtitle = (
@@ -136,6 +140,10 @@ def viewer_data(
             "span": cam.span_m,
         },
         "surfaces": surfaces,
+        # the stage of each frame and the names of the stages met (null: no stages)
+        "stage_labels": None
+        if stages is None
+        else {str(k): stage_label(k) for k in sorted(set(stages.tolist()))},
         "vehicle": {
             "name": d.vehicle.name,
             "colors": [BUMPER_COLORS_HEX[j] for j in (1, 2, 3, 4)],
@@ -157,6 +165,7 @@ def viewer_data(
             "euler": _r(scene.euler_deg[idx], 2),
             "alt": _r(scene.altitude[idx], 4),
             "contacts": contacts,
+            "stage": None if stages is None else stages.tolist(),
         },
     }
 

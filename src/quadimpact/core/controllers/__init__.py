@@ -21,8 +21,9 @@ The run loop then applies the generic speed and slew limits
 
 One module per controller: ``paper.py``, ``cascade_pid.py``, ``recovery.py``.
 A new built-in is its module, a branch below, and an entry in the Python-side
-registry (``quadimpact.simulation.controllers``); a controller that is not
-built in is plugged in with ``core.run.make_kernel`` instead.
+registry (``quadimpact.inputs.controllers``); a controller that is not
+built in is registered there with its step (``register_controller(name,
+step=...)``), and runs in a loop compiled around it (``core.run.make_kernel``).
 """
 
 import numpy as np
