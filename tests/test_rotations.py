@@ -1,4 +1,4 @@
-"""Frame conversions: quaternion <-> rotation matrix <-> ZYX Euler (MODEL.md section 1)."""
+"""Frame conversions: quaternion <-> rotation matrix <-> ZYX Euler (docs/MODEL.md section 1)."""
 
 import numpy as np
 import pytest

@@ -1,6 +1,6 @@
 """Attitude and frame conversions (vectorised NumPy), for every layer above the core.
 
-Conventions (MODEL.md section 1):
+Conventions (docs/MODEL.md section 1):
 
 - Inertial frame I: NED (X toward the default wall, Y right, Z down).
 - Body frame B: FRD (x forward, y starboard, z down), origin at the CM.
@@ -285,7 +285,7 @@ def matrix_to_euler_zyx_deg(
 
 
 def inclination_deg(C: ArrayLike) -> NDArray[np.float64]:
-    """Inclination (deg) of attitude matrices (STUDIES.md section 1).
+    """Inclination (deg) of attitude matrices (docs/STUDIES.md section 1).
 
     The angle of the body z axis, projected on the inertial X-Z plane, from
     the inertial Z axis; positive when the vehicle leans toward +X (the wall).

@@ -1,6 +1,6 @@
 """Flight-log reader on the real Spiri crash set I (skipped without the shared data).
 
-Table III of the paper (STUDIES.md section 4) is the reference; the mapping of
+Table III of the paper (docs/STUDIES.md section 4) is the reference; the mapping of
 log files to its rows is the crash set's ``paper_crash``. Where our estimate
 and Table III disagree beyond the stated uncertainty the tests pin what the
 data show instead, and docs/EXPERIMENTS.md explains the discrepancy:

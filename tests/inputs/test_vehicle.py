@@ -1,5 +1,5 @@
-"""Vehicle parameters: the bundled Spiri (MODEL.md section 3), bumper geometry
-(MODEL.md section 4) and the one-line errors for bad vehicle files."""
+"""Vehicle parameters: the bundled Spiri (docs/MODEL.md section 3), bumper geometry
+(docs/MODEL.md section 4) and the one-line errors for bad vehicle files."""
 
 from __future__ import annotations
 

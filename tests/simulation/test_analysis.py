@@ -1,4 +1,4 @@
-"""Episodes table, impact grouping and metrics on hand-made inputs (STUDIES.md section 2)."""
+"""Episodes table, impact grouping and metrics on hand-made inputs (docs/STUDIES.md section 2)."""
 
 import math
 

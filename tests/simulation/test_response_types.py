@@ -1,4 +1,4 @@
-"""Response types (STUDIES.md 3) on hand-made episode lists, and on real runs."""
+"""Response types (docs/STUDIES.md 3) on hand-made episode lists, and on real runs."""
 
 import pandas as pd
 import pytest

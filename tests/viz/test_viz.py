@@ -68,7 +68,7 @@ def copy_run(run_dir: Path, tmp_path: Path) -> Path:
 
 # ------------------------------------------------------------------ scene geometry
 def test_drawn_circles_are_the_contact_laws_circles(fine_scene: Scene) -> None:
-    """Centre on rotor j, radius Rb, in the plane of normal n_j (MODEL.md 4)."""
+    """Centre on rotor j, radius Rb, in the plane of normal n_j (docs/MODEL.md 4)."""
     sc = fine_scene
     t = sc.first_contact_s + 0.05
     fr = sc.frame(t)

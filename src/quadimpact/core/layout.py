@@ -4,7 +4,7 @@ The compiled kernel takes no Python objects: vehicles, surfaces, options and
 controller settings are packed into ``float64`` arrays whose slots are named
 here. Numba treats these module-level integers as compile-time constants.
 
-Everything is SI; frames as in MODEL.md section 1 (inertial NED, body FRD).
+Everything is SI; frames as in docs/MODEL.md section 1 (inertial NED, body FRD).
 """
 
 # --------------------------------------------------------------------------

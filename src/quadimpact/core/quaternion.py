@@ -1,7 +1,7 @@
 """Quaternion and rotation helpers for the compiled core.
 
 Quaternions are scalar first, Hamilton product, and ``C(q)`` maps body
-components to inertial components (``a_I = C a_B``), as in MODEL.md section 1.
+components to inertial components (``a_I = C a_B``), as in docs/MODEL.md section 1.
 Euler angles are aerospace ZYX: ``C = Rz(psi) Ry(theta) Rx(phi)``.
 """
 

@@ -1,4 +1,4 @@
-"""Rotor forces and moments (MODEL.md section 2, paper eqs. 5-7).
+"""Rotor forces and moments (docs/MODEL.md section 2, paper eqs. 5-7).
 
 Physically consistent form (the default):
 

@@ -19,7 +19,7 @@ Positions are compared as displacements from each one's own position at the
 impact (``relative_position=True``): the log's motion-capture origin and the
 simulated wall distance and altitude differ by construction.
 
-:func:`log_response` classifies the log's response type (STUDIES.md section
+:func:`log_response` classifies the log's response type (docs/STUDIES.md section
 3) from the log's own motion, where the motion capture allows it, and says
 why not otherwise. (The tests turn a simulated run into a :class:`FlightLog`,
 ``tests/synthetic_log.py``: a run compared with itself has zero error.)
@@ -87,7 +87,7 @@ class LogResponse:
     Attributes
     ----------
     type : str
-        ``"A"``, ``"B"``, ``"C"``, ``"D"``, ``"Other"`` (STUDIES.md section 3)
+        ``"A"``, ``"B"``, ``"C"``, ``"D"``, ``"Other"`` (docs/STUDIES.md section 3)
         or ``"unknown"`` when the motion capture does not cover the impact to
         the landing.
     crashed : bool or None

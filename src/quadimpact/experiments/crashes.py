@@ -1,7 +1,7 @@
 """The seven real crashes of the paper's Table III, as scenarios.
 
 The conditions (heading, impact speed, inclination and their uncertainties)
-and the response types are the paper's Table III (STUDIES.md section 4); the
+and the response types are the paper's Table III (docs/STUDIES.md section 4); the
 motor power-off schedules and altitudes come from the crash set's data file
 and are written into the scenario files in ``crashes/crash_N.toml``, shipped
 with the package.

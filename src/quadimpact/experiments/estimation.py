@@ -112,7 +112,7 @@ def bumper_rim_extent(
     direction : numpy.ndarray, shape (3,)
         Unit vector (inertial), e.g. the wall normal into the wall (+X).
     vehicle : Vehicle, optional
-        Whose bumper circles (MODEL.md section 4); default the bundled Spiri,
+        Whose bumper circles (docs/MODEL.md section 4); default the bundled Spiri,
         the vehicle of the crash set.
 
     Returns

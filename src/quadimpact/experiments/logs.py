@@ -82,12 +82,12 @@ class PreImpact:
     ----------
     heading_deg : float
         Yaw of the body x axis from the wall normal, (-180, 180]
-        (STUDIES.md section 1; 0 = nose at the wall).
+        (docs/STUDIES.md section 1; 0 = nose at the wall).
     speed_m_s : float
         CM velocity toward the wall (along X) at the contact.
     inclination_deg : float
         Angle of the body z axis projected on the X-Z plane from Z, positive
-        when the vehicle leans toward the wall (STUDIES.md section 1).
+        when the vehicle leans toward the wall (docs/STUDIES.md section 1).
     roll_deg, pitch_deg, yaw_deg : float
         ZYX Euler angles at the contact (``yaw_deg`` = ``heading_deg``).
     altitude_m : float

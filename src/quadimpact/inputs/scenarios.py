@@ -1,6 +1,6 @@
 """Validated, immutable scenarios and scenario files.
 
-Frames and units follow MODEL.md section 1: inertial frame NED (X toward the
+Frames and units follow docs/MODEL.md section 1: inertial frame NED (X toward the
 default wall, Y right, Z down; altitude ``h = -Z``), body frame FRD, SI units,
 angles in degrees where a field name says ``_deg``.
 
@@ -390,7 +390,7 @@ def _check_euler(value: tuple[float, float, float] | None) -> tuple[float, float
 
 # --------------------------------------------------------------- scenarios
 class WallApproach(RunSettings):
-    """The paper's wall approach (STUDIES.md section 1).
+    """The paper's wall approach (docs/STUDIES.md section 1).
 
     The vehicle holds a fixed attitude (yaw = heading, tilted by the
     inclination toward the wall) and an altitude set-point, and is started so

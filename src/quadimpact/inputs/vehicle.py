@@ -2,7 +2,7 @@
 
 Vehicles are data: the Spiri of the paper ships as ``inputs/vehicles/spiri.toml``
 and a user can write another file with the same keys (see that file for
-units and sources). Frames and conventions are those of MODEL.md section 1:
+units and sources). Frames and conventions are those of docs/MODEL.md section 1:
 body frame FRD (x forward, y right, z down) with its origin at the centre of
 mass; SI units, rotor speeds in rad/s.
 
@@ -277,7 +277,7 @@ class Vehicle(BaseModel):
         return math.sqrt(self.mass_kg * self.gravity_m_s2 / (4.0 * self.thrust_coefficient))
 
     def bumper_frames(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Geometry of the four bumper circles in the body frame (MODEL.md section 4).
+        """Geometry of the four bumper circles in the body frame (docs/MODEL.md section 4).
 
         With ``d_j = (cos psi_j, sin psi_j, 0)``, ``a`` the tilt and ``e_z`` the
         body z axis (down)::

@@ -1,4 +1,4 @@
-"""The paper's findings (STUDIES.md section 4) as verdicts computed from data.
+"""The paper's findings (docs/STUDIES.md section 4) as verdicts computed from data.
 
 Each finding is a pure function of a Figure 4 sweep table (one row per run,
 with ``heading_deg``, ``inclination_deg``, ``speed_m_s``, ``delta_init_m``,

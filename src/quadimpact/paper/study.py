@@ -1,6 +1,6 @@
 """The paper's study in one call: Figure 4, Table II, Figures 5-6 and a report.
 
-``reproduce(out_dir)`` runs, for both model variants (MODEL.md section 8),
+``reproduce(out_dir)`` runs, for both model variants (docs/VARIANTS.md),
 the Figure 4 sweep (heading 0 and 45 deg, inclination -20..20 deg in 1-deg
 steps, impact speed 0.5, 0.75, 1 m/s: 246 runs each) and the example run
 (45 deg, 15 deg, 0.75 m/s), evaluates the paper's findings on each

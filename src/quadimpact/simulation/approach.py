@@ -1,4 +1,4 @@
-"""The paper's wall approach (STUDIES.md section 1): attitude and the approach shooting.
+"""The paper's wall approach (docs/STUDIES.md section 1): attitude and the approach shooting.
 
 The vehicle holds the attitude (heading psi, inclination iota) and the
 altitude from the start. Without aerodynamic drag nothing in the dynamics
@@ -35,7 +35,7 @@ __all__ = [
     "wall_attitude",
 ]
 
-PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (MODEL.md 8.4)
+PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (docs/VARIANTS.md 4.4)
 PAPER_FIT_SCALE = 1.3836686
 APPROACH_TOL_M_S = 1e-12  # shooting residuals (speed m/s, depth m)
 APPROACH_MAX_ITER = 4
@@ -48,9 +48,9 @@ def wall_attitude(
     """Roll, pitch, yaw (rad, ZYX) for a heading and an inclination toward the wall.
 
     ``exact``: yaw = psi and the body z axis in the inertial X-Z plane at
-    angle iota from Z, tilted so the thrust points toward +X (STUDIES.md 1):
+    angle iota from Z, tilted so the thrust points toward +X (docs/STUDIES.md 1):
     ``phi = -asin(sin psi sin iota)``, ``theta = asin(-cos psi sin iota / cos phi)``.
-    ``paper-fit``: the authors' mapping (MODEL.md 8.4) at psi = 0 and +-45 deg,
+    ``paper-fit``: the authors' mapping (docs/VARIANTS.md 4.4) at psi = 0 and +-45 deg,
     ``exact`` elsewhere.
     """
     psi = math.radians(heading_deg)

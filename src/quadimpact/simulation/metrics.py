@@ -286,7 +286,7 @@ def classify_response(
     subsequent_impacts: Sequence[Sequence[int]],
     crashed: bool,
 ) -> str:
-    """Post-impact response type (STUDIES.md section 3, the paper's Table II).
+    """Post-impact response type (docs/STUDIES.md section 3, the paper's Table II).
 
     A pure function of the impacts (:func:`impact_metrics`) and the crash.
 

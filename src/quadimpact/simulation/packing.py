@@ -25,7 +25,7 @@ RPM = 2.0 * np.pi / 60.0  # rad/s per rpm
 DEFAULT_RTOL = 1e-8
 DEFAULT_ATOL = 1e-10
 EVENT_TOL_S = 1e-12
-V_MIN_M_S = 1e-3  # floor of v_i in the damping coefficient (MODEL.md 4)
+V_MIN_M_S = 1e-3  # floor of v_i in the damping coefficient (docs/MODEL.md 4)
 FRICTION_V_REG_M_S = 1e-2  # friction regularisation velocity
 MAX_STEPS_PER_S = 2_000_000
 
@@ -144,7 +144,7 @@ def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
 
 
 def allocation_matrix(v: Vehicle, yaw_paper: bool) -> np.ndarray:
-    """``A`` with ``[T, tau_x, tau_y, tau_z] = A [Omega_1^2 .. Omega_4^2]`` (MODEL.md 6.1).
+    """``A`` with ``[T, tau_x, tau_y, tau_z] = A [Omega_1^2 .. Omega_4^2]`` (docs/MODEL.md 6.1).
 
     Rows: ``kt``, ``-kt y_j``, ``kt x_j`` and the yaw row of the rotor-torque
     model in use: ``-s_j dt`` (physical) or ``+s_j dt`` (paper replica).

@@ -5,7 +5,7 @@ from the compiled kernel with the layout of :mod:`quadimpact.core.layout`
 (``OUT_*`` time-series columns, ``E_*`` episode columns); the tables' columns
 are :data:`~quadimpact.results.files.EPISODE_COLUMNS` and
 :data:`~quadimpact.results.files.TIMESERIES_COLUMNS` (docs/RESULTS.md). Frames
-and units follow MODEL.md section 1 (inertial NED, body FRD, SI).
+and units follow docs/MODEL.md section 1 (inertial NED, body FRD, SI).
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The summary of a run (``summary.json``, STUDIES.md section 2) and its one-line outcome.
+"""The summary of a run (``summary.json``, docs/STUDIES.md section 2) and its one-line outcome.
 
 Built from the run's setup, its tables and the kernel's raw stats: the status,
 warnings, the impact conditions reached at the first onset, the approach

@@ -6,7 +6,7 @@ its overrides applied and the contact surfaces as the kernel received them)
 and the sampled states of a run:
 
 * the vehicle (:class:`VehicleDrawing`): the four bumper circles exactly as the
-  contact law defines them (MODEL.md 4: circle ``j`` of radius ``Rb`` centred
+  contact law defines them (docs/MODEL.md 4: circle ``j`` of radius ``Rb`` centred
   on ``c_j``, the rotor hub or the vehicle's ``bumper_centres_m``, in-plane
   outward ``u_j``, normal ``n_j``), the rotor discs, the hub, the arms and the
   body axes, as body-frame polylines;
@@ -95,7 +95,7 @@ def to_inertial(points_b: np.ndarray, position: np.ndarray, C: np.ndarray) -> np
 def rim_points(
     centre: np.ndarray, u: np.ndarray, n: np.ndarray, radius: float, beta: np.ndarray
 ) -> np.ndarray:
-    """Points ``c + R (cos b u + sin b (n x u))`` of a circle (MODEL.md 4), shape (len(beta), 3)."""
+    """Points ``c + R (cos b u + sin b (n x u))`` of a circle (docs/MODEL.md 4), (len(beta), 3)."""
     w = np.cross(n, u)
     b = np.asarray(beta, dtype=float)[:, None]
     return centre + radius * (np.cos(b) * u + np.sin(b) * w)
