@@ -92,8 +92,8 @@ def wilson_interval(k: int, n: int, z: float = Z_95) -> tuple[float, float]:
     (low, high) : tuple of float
         ``centre -+ halfwidth`` with ``p = k/n``,
         ``centre = (p + z²/(2n)) / (1 + z²/n)`` and
-        ``halfwidth = z sqrt(p(1-p)/n + z²/(4n²)) / (1 + z²/n)``, clipped to
-        [0, 1] against rounding.
+        ``halfwidth = z sqrt(p(1-p)/n + z²/(4n²)) / (1 + z²/n)``; exactly 0
+        (1) at ``k = 0`` (``k = n``), where the formula gives it but for rounding.
     """
     if n <= 0:
         return (math.nan, math.nan)
@@ -104,7 +104,9 @@ def wilson_interval(k: int, n: int, z: float = Z_95) -> tuple[float, float]:
     denominator = 1.0 + z2 / n
     centre = (p + z2 / (2 * n)) / denominator
     half = z * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denominator
-    return (max(0.0, centre - half), min(1.0, centre + half))
+    low = 0.0 if k == 0 else max(0.0, centre - half)
+    high = 1.0 if k == n else min(1.0, centre + half)
+    return (low, high)
 
 
 @dataclass(frozen=True)

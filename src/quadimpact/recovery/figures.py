@@ -34,6 +34,7 @@ from quadimpact.results.figures import (
 
 __all__ = [
     "FIGURES",
+    "compare_by_bin_figure",
     "distributions_figure",
     "example_figure",
     "success_by_bin_figure",
@@ -83,13 +84,18 @@ def success_map_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     return fig
 
 
-def _rate_panel(ax: Any, rates: pd.DataFrame, xlabel: str) -> None:
-    x = np.arange(len(rates))
+def _rate_points(ax: Any, x: np.ndarray, rates: pd.DataFrame, **style: Any) -> None:
+    """Each non-empty bin's rate at ``x`` with its Wilson interval as error bars."""
     shown = rates["n"].to_numpy() > 0
     y = rates["rate"].to_numpy(dtype=float)
     err = np.vstack([y - rates["low"].to_numpy(float), rates["high"].to_numpy(float) - y])
-    ax.errorbar(x[shown], y[shown], yerr=err[:, shown], fmt="o", color="tab:blue", capsize=3,
-                label="recovered / trials, 95 % Wilson interval")  # fmt: skip
+    err = np.clip(err, 0.0, None)  # rounding at k = 0 or k = n
+    ax.errorbar(x[shown], y[shown], yerr=err[:, shown], fmt="o", capsize=3, **style)
+
+
+def _rate_panel(ax: Any, rates: pd.DataFrame, xlabel: str) -> None:
+    x = np.arange(len(rates))
+    _rate_points(ax, x, rates, color="tab:blue", label="recovered / trials, 95 % Wilson interval")
     for xi, r in zip(x, rates.itertuples(), strict=True):
         if r.n:
             ax.annotate(f"n={r.n}", (xi, 1.08), ha="center", fontsize=7, color="0.35")
@@ -110,6 +116,36 @@ def success_by_bin_figure(numbers: dict[str, Any], title: str | None = None) -> 
     s = numbers["success"]
     fig.suptitle(title or f"Success rate {s.value:.1%} "
                  f"[{s.low:.1%}, {s.high:.1%}] over {s.n} trials")  # fmt: skip
+    return fig
+
+
+def compare_by_bin_figure(
+    numbers: dict[str, dict[str, Any]], key: str = "by_inclination", title: str | None = None
+) -> Figure:
+    """Success rate by bin of several studies side by side (label -> ``summarise`` numbers).
+
+    ``key``: ``"by_inclination"`` or ``"by_speed"``. The studies must share their bins.
+    """
+    fig = new_figure(8.0, 4.0)
+    ax = fig.add_subplot()
+    labels = list(numbers)
+    width = 0.7 / max(1, len(labels))
+    bins: list[str] = []
+    for k, label in enumerate(labels):
+        rates = numbers[label][key]
+        bins = list(rates["bin"])
+        x = np.arange(len(rates)) + (k - (len(labels) - 1) / 2) * width
+        s = numbers[label]["success"]
+        _rate_points(ax, x, rates, label=f"{label}: {s.value:.1%} over {s.n}")
+    ax.set_xticks(range(len(bins)), bins, rotation=30, fontsize=8)
+    ax.set_ylim(0.0, 1.05)
+    ax.set_xlabel("inclination toward the wall, -pitch (deg)" if key == "by_inclination"
+                  else "speed toward the wall (m/s)")  # fmt: skip
+    ax.set_ylabel("success rate (95 % Wilson interval)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="lower left")
+    if title:
+        ax.set_title(title)
     return fig
 
 

@@ -56,6 +56,7 @@ __all__ = [
     "RecoveryStudy",
     "describe",
     "run_study",
+    "run_trials",
     "sample_trials",
     "trial_inputs",
     "trial_table",
@@ -347,6 +348,39 @@ class RecoveryResult:
     warnings: list[str] = field(default_factory=list)
 
 
+def run_trials(
+    study: RecoveryStudy | SweepSpec,
+    out_dir: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool = False,
+) -> tuple[SweepSpec, pd.DataFrame, dict[str, Any]]:
+    """Run the trials into ``out_dir/sweep`` and write ``out_dir/trials.parquet``.
+
+    The part of :func:`run_study` without figures, report and example.
+
+    Returns
+    -------
+    (spec, table, info)
+        The sweep, the trials table (:func:`trial_table`) and
+        :func:`quadimpact.sweep.run_sweep`'s run information.
+    """
+    out = Path(out_dir)
+    if isinstance(study, SweepSpec):
+        spec = study
+        _check_trial_base(spec, spec.where)
+    else:
+        spec = study.sweep_spec()
+    info = run_sweep(
+        spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
+        load=False,
+    )  # fmt: skip
+    table = trial_table(read_runs(out / SWEEP_DIR), spec)
+    atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
+    return spec, table, info
+
+
 def run_study(
     study: RecoveryStudy | SweepSpec,
     out_dir: str | os.PathLike[str],
@@ -383,17 +417,10 @@ def run_study(
 
     start = time.perf_counter()
     out = Path(out_dir)
-    if isinstance(study, SweepSpec):
-        spec, options = study, None
-        _check_trial_base(spec, spec.where)
-    else:
-        spec, options = study.sweep_spec(), study
-    info = run_sweep(
-        spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
-        load=False,
-    )  # fmt: skip
-    table = trial_table(read_runs(out / SWEEP_DIR), spec)
-    atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
+    spec, table, info = run_trials(
+        study, out, workers=workers, scheduler=scheduler, progress=progress
+    )
+    options = study if isinstance(study, RecoveryStudy) else None
     description = describe(spec, options, table)
     description["run"] = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
     description["run"]["sweep_s"] = float(info["elapsed_s"])
