@@ -1,7 +1,8 @@
 """Recovery benchmark: the Monte Carlo's wall time and results, and the friction check.
 
 Run: ``python benchmarks/bench_recovery.py [--n 10000] [--n-variants 2000]
-[--n-friction 1000] [--workers 2] [--out DIR] [--skip-friction] [--json PATH]``.
+[--n-friction 1000] [--workers 2] [--out DIR] [--skip-studies] [--skip-variants]
+[--skip-friction] [--json PATH]``.
 
 1. **Navi Monte Carlo**, ``--n`` trials (default 10,000) of the authors'
    distribution (``quadimpact.recovery.study.RecoveryStudy``, seed 0), in the
@@ -184,7 +185,9 @@ def friction_check(n: int, workers: int) -> dict[str, Any]:
                 "dt4_median_s": float(np.median(d)) if d.size else math.nan,
                 "dt4_p90_s": float(np.quantile(d, 0.9)) if d.size else math.nan,
                 "dt4_max_s": float(d.max()) if d.size else math.nan,
-                "dt4_nonzero": int((d > 0).sum()),
+                "dt4_nonzero": int((d > 1e-9).sum()),
+                "dt4_over_one_tick": int((d > 0.005 + 1e-9).sum()),
+                "dt4_over_50ms": int((d > 0.05).sum()),
                 "steps_median": float(steps[v].median()),
                 "steps_mean": float(steps[v].mean()),
                 "failed": int((t[t["v_reg"] == v]["status"] == "failed").sum()),
@@ -196,6 +199,9 @@ def friction_check(n: int, workers: int) -> dict[str, Any]:
                   f"{entry['changed_vs_finest']:15d}  {entry['dt4_median_s']:.4f} / "
                   f"{entry['dt4_p90_s']:.4f} / {entry['dt4_max_s']:.4f}   "
                   f"{entry['steps_median']:.0f} / {entry['steps_mean']:.0f}")  # fmt: skip
+        print("  stage-4 time changed vs 1e-2 (of the trials recovered in both): " + ", ".join(
+            f"{e['v_reg']:g}: {e['dt4_nonzero']} by a tick or more, {e['dt4_over_one_tick']} by "
+            f"more than a tick, {e['dt4_over_50ms']} by more than 50 ms" for e in per[1:]))
         print("  stage-4 time over the recovered trials, median / p90 (s): " + ", ".join(
             f"{e['v_reg']:g}: {e['t4_median_s']:.3f} / {e['t4_p90_s']:.3f}" for e in per))
         out[model] = {"elapsed_s": elapsed, "rows": per}
@@ -211,6 +217,7 @@ def main() -> None:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--n-cpu", type=int, default=300, help="trials of the CPU-time measure")
     ap.add_argument("--out", type=Path, help="keep the study folders here (default: temporary)")
+    ap.add_argument("--skip-studies", action="store_true", help="only the friction check")
     ap.add_argument("--skip-variants", action="store_true")
     ap.add_argument("--skip-friction", action="store_true")
     ap.add_argument("--json", type=Path)
@@ -222,7 +229,7 @@ def main() -> None:
     print(f"machine: {info['cpu_count']} cores ({info['cpu_model']}), Python {info['python']}, "
           f"load average {', '.join(f'{x:.1f}' for x in info['load_average'])}")  # fmt: skip
     results: dict[str, Any] = {"machine": info, "studies": [], "cpu_per_trial_s": {}}
-    for m in MODELS:
+    for m in () if args.skip_studies else MODELS:
         cpu = cpu_per_trial(m, args.n_cpu)
         results["cpu_per_trial_s"][m] = cpu
         print(f"CPU per trial, {m}: {1e3 * cpu:.1f} ms (in-process, {args.n_cpu} trials): "
@@ -230,8 +237,10 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         out = args.out or Path(tmp)
         out.mkdir(parents=True, exist_ok=True)
-        runs = [(f"navi-{m}-{args.n}", RecoveryStudy(n=args.n, model=m)) for m in MODELS]
-        if not args.skip_variants:
+        runs = [] if args.skip_studies else [
+            (f"navi-{m}-{args.n}", RecoveryStudy(n=args.n, model=m)) for m in MODELS
+        ]
+        if not (args.skip_variants or args.skip_studies):
             nv = args.n_variants
             for m in MODELS:
                 runs += [

@@ -206,14 +206,18 @@ def recovery_part(
         trials[f"navi, {v}"] = run_trials(RecoveryStudy(n=RECOVERY_N, model=v),
                                           rec / f"navi-{v}", **par)[1]  # fmt: skip
     m = RECOVERY_COMPARE_N
-    first = trials["navi, default"]
-    trials[f"navi, default, first {m}"] = first[first["run_id"] < m]
     trials["navi, noisy IMU"] = run_trials(RecoveryStudy(n=m, imu="noisy"), rec / "navi-noisy",
                                            **par)[1]  # fmt: skip
     trials["spiri"] = run_trials(RecoveryStudy(vehicle="spiri", n=m), rec / "spiri", **par)[1]
-    numbers = {k: recovery_analysis.summarise(t) for k, t in trials.items()}
-    monte_carlo = {v: numbers[f"navi, {v}"] for v in RECOVERY_VARIANTS}
-    compare = {k: numbers[k] for k in list(trials)[len(RECOVERY_VARIANTS):]}
+    first = trials["navi, default"]
+    monte_carlo = {v: recovery_analysis.summarise(trials[f"navi, {v}"])
+                   for v in RECOVERY_VARIANTS}  # fmt: skip
+    compare = {
+        f"navi, ideal IMU (the first {m} above)": recovery_analysis.summarise(
+            first[first["run_id"] < m]
+        ),
+        **{k: recovery_analysis.summarise(trials[k]) for k in ("navi, noisy IMU", "spiri")},
+    }
 
     grid, runs = {}, []
     for variant in VARIANTS:
@@ -226,7 +230,7 @@ def recovery_part(
         runs.append(both.assign(variant=variant))
     crashes = crashes_without_power_off(VARIANTS)
 
-    pd.concat([t.assign(study=k) for k, t in trials.items() if "first" not in k]).to_parquet(
+    pd.concat([t.assign(study=k) for k, t in trials.items()]).to_parquet(
         out / "recovery_trials.parquet", index=False
     )
     pd.concat(runs, ignore_index=True).to_parquet(out / "recovery_fig4.parquet", index=False)

@@ -44,6 +44,7 @@ __all__ = [
     "add_derived",
     "bin_edges",
     "binned",
+    "class_conditions",
     "example_trial",
     "failure_analysis",
     "outcome_class",
@@ -311,6 +312,28 @@ def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
     return out
 
 
+def class_conditions(table: pd.DataFrame, classes: Iterable[str]) -> dict[str, dict[str, Any]]:
+    """Per class (those with trials): its count and the quantiles of its trials' conditions.
+
+    Conditions: ``inclination_deg``, ``speed_m_s``, ``|roll|``, ``|yaw|``, and
+    the initial impact's ``peak_force_n`` (NaN-free values only).
+    """
+    cls = table["outcome_class"].astype(str)
+    out = {}
+    for name in classes:
+        g = table[cls == name]
+        if len(g):
+            out[name] = {
+                "n": len(g),
+                "inclination_deg": quantiles(g["inclination_deg"]),
+                "speed_m_s": quantiles(g["speed_m_s"]),
+                "abs_roll_deg": quantiles(g["roll_deg"].abs()),
+                "abs_yaw_deg": quantiles(g["yaw_deg"].abs()),
+                "peak_force_n": quantiles(g["peak_force_n"]) if "peak_force_n" in g else None,
+            }
+    return out
+
+
 def summarise(table: pd.DataFrame) -> dict[str, Any]:
     """Every number of the report, from the trials table (with :func:`add_derived` columns).
 
@@ -322,9 +345,11 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
         ``recovered`` class over the detected impacts); ``false_recovered``
         (false detections that reached stage 4); ``by_inclination`` and
         ``by_speed`` (:func:`rate_by`); ``time_to_recover_s``,
-        ``height_loss_m``, ``horizontal_drift_m`` (:func:`quantiles` over the
-        recovered trials); ``detection_latency_s``, ``normal_error_deg`` (over
-        the detected impacts); ``failures`` (:func:`failure_analysis`).
+        ``height_loss_m``, ``horizontal_drift_m``, ``stage1_duration_s`` ..
+        ``stage3_duration_s`` (:func:`quantiles` over the recovered trials);
+        ``detection_latency_s``, ``normal_error_deg`` (over the detected
+        impacts); ``failures`` (:func:`failure_analysis`); ``conditions``
+        (:func:`class_conditions` of every class).
     """
     cls = table["outcome_class"].astype(str)
     counts = {c: int((cls == c).sum()) for c in OUTCOME_CLASSES}
@@ -343,9 +368,14 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
         "time_to_recover_s": quantiles(good["time_to_recover_s"]),
         "height_loss_m": quantiles(good["height_loss_m"]),
         "horizontal_drift_m": quantiles(good["horizontal_drift_m"]),
+        **{
+            f"stage{k}_duration_s": quantiles(good[f"t_stage{k + 1}_s"] - good[f"t_stage{k}_s"])
+            for k in (1, 2, 3)
+        },
         "detection_latency_s": quantiles(seen["detection_latency_s"]),
         "normal_error_deg": quantiles(seen["normal_error_deg"]),
         "failures": failure_analysis(table),
+        "conditions": class_conditions(table, OUTCOME_CLASSES),
     }
 
 

@@ -29,6 +29,9 @@ _MEASURES = (
     ("time_to_recover_s", "time to recover (detection to stage 4)", "s", 3),
     ("height_loss_m", "height loss (detection to stage 4; > 0: lost)", "m", 3),
     ("horizontal_drift_m", "horizontal drift (detection to stage 4)", "m", 3),
+    ("stage1_duration_s", "time in stage 1 (tilting away)", "s", 3),
+    ("stage2_duration_s", "time in stage 2 (levelling)", "s", 3),
+    ("stage3_duration_s", "time in stage 3 (arresting the descent)", "s", 3),
 )
 
 
@@ -178,6 +181,30 @@ def _outcomes(n: dict[str, Any]) -> list[str]:
         + f"; failed runs: {c['failed']}.",
         "",
     ]
+    why = {
+        "not detected": "the initial impact's horizontal specific force stayed below the "
+        "detection threshold",
+        "false detection": "the detector fired before the first contact",
+        "no contact": "the vehicle never touched the wall",
+    }
+    for name, text in why.items():
+        q = n["conditions"].get(name)
+        if q is None:
+            continue
+        force = q["peak_force_n"]
+        seen = n["conditions"].get("recovered")
+        lines.append(
+            f"- *{name}* ({q['n']}; {text}): inclination {q['inclination_deg']['min']:.1f}° to "
+            f"{q['inclination_deg']['max']:.1f}° (median {q['inclination_deg']['median']:.1f}°), "
+            f"speed {q['speed_m_s']['min']:.2f} to {q['speed_m_s']['max']:.2f} m/s (median "
+            f"{q['speed_m_s']['median']:.2f} m/s)"
+            + (f"; initial-impact peak force median {force['median']:.2f} N (recovered "
+               f"trials: {seen['peak_force_n']['median']:.2f} N)"
+               if force and force["n"] and seen and seen["peak_force_n"]["n"] else "")
+            + "."
+        )
+    if any(name in n["conditions"] for name in why):
+        lines.append("")
     return lines
 
 

@@ -47,7 +47,7 @@ from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, analysis
 from quadimpact.results.files import atomic_write
-from quadimpact.simulation.packing import RPM
+from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 
 __all__ = [
@@ -282,7 +282,7 @@ def describe(spec: SweepSpec, study: RecoveryStudy | None, table: pd.DataFrame) 
     """
     first = scenario_from_dict(spec.scenario_dict(0), where="recovery: run 0")
     vehicle = first.build_vehicle()
-    imu = first.imu.resolved(vehicle.imu_position_m, 200.0)
+    imu = first.imu.resolved(vehicle.imu_position_m, CONTROL_RATE_HZ)
 
     def values(column: str) -> list[Any]:
         if column not in table:
