@@ -85,6 +85,8 @@ def test_rerunning_resumes_and_gives_the_same_table(study_dir) -> None:
     before = pd.read_parquet(out / "trials.parquet")
     again = run_study(RecoveryStudy(n=N, seed=5), out, workers=1, example=False)
     assert again.run_info["n_ran"] == 0 and again.run_info["n_already_done"] == N
+    first_sweep = first.run_info["elapsed_s"]
+    assert f"the trials were run {N} in {first_sweep:.1f} s (serial)" in again.report.read_text()
     pd.testing.assert_frame_equal(pd.read_parquet(out / "trials.parquet"), before)
     # an interrupted sweep: keep its first 10 runs; the rerun does only the other 20
     runs = out / "sweep" / "runs.parquet"

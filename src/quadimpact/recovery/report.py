@@ -145,10 +145,15 @@ def _what_ran(d: dict[str, Any]) -> list[str]:
     ]
     run = d["run"]
     if run["n_ran"] == 0:
-        ran = f"nothing to run (all {run['n_runs']} trials done before)"
+        ran = f"nothing to run now (all {run['n_runs']} trials done before)"
     else:
         before = f", {run['n_already_done']} done before (resumed)" if run["n_already_done"] else ""
-        ran = f"{run['n_ran']} trials run in {run['sweep_s']:.1f} s ({run['backend']}){before}"
+        ran = f"{run['n_ran']} trials run now in {run['sweep_s']:.1f} s ({run['backend']}){before}"
+    history = d.get("sweeps") or []
+    if history and (run["n_ran"] == 0 or len(history) > 1):
+        ran += "; the trials were run " + ", ".join(
+            f"{h['n_ran']} in {h['sweep_s']:.1f} s ({h['backend']})" for h in history
+        )
     lines += [
         f"- **quadimpact** {d['quadimpact_version']}. **Wall time**: {ran}; the whole command "
         f"{d['elapsed_s']:.1f} s (tables, figures and the example included).",

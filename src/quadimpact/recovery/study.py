@@ -424,6 +424,7 @@ def run_study(
     description = describe(spec, options, table)
     description["run"] = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
     description["run"]["sweep_s"] = float(info["elapsed_s"])
+    description["sweeps"] = _sweep_history(out, description["run"])
     numbers = analysis.summarise(table)
     warnings: list[str] = []
 
@@ -447,6 +448,24 @@ def run_study(
     return RecoveryResult(
         out, table, description, numbers, report_path, paths, example_dir, info, elapsed, warnings
     )
+
+
+def _sweep_history(out: Path, run: dict[str, Any]) -> list[dict[str, Any]]:
+    """The invocations that ran trials of this study: the earlier ones (``study.json``), this one.
+
+    Each: ``n_ran``, ``sweep_s``, ``backend``. An earlier record is kept only
+    when its trials are still in the sweep (this invocation found some done).
+    """
+    history: list[dict[str, Any]] = []
+    path = out / STUDY_JSON
+    if run["n_already_done"] and path.is_file():
+        try:
+            history = list(json.loads(path.read_text(encoding="utf-8")).get("sweeps") or [])
+        except (OSError, ValueError):
+            history = []
+    if run["n_ran"]:
+        history.append({k: run[k] for k in ("n_ran", "sweep_s", "backend")})
+    return history
 
 
 def _jsonable(value: Any) -> Any:
