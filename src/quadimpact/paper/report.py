@@ -248,9 +248,9 @@ def recovery_markdown(part: Any, elapsed_s: float) -> str:
         "detected; a not-detected trial is a failure of the detector, counted on its own. "
         f"This part took {part.elapsed_s:.1f} s of the study's {elapsed_s:.1f} s.",
         "",
-        f"### Monte Carlo of the Navi ({n_mc} trials per variant)",
+        f"### Monte Carlo of the Navi ({n_mc:,} trials per variant)",
         "",
-        f"Impact trials from the authors' distribution (seed 0), {n_mc} per variant instead of "
+        f"Impact trials from the authors' distribution (seed 0), {n_mc:,} per variant instead of "
         "the 10,000 of `quadimpact recovery` (whose report has the maps, distributions and the "
         "failure analysis); ideal IMU, pre-impact spin-down.",
         "",
@@ -260,9 +260,9 @@ def recovery_markdown(part: Any, elapsed_s: float) -> str:
         "",
         *_bins_side_by_side(mc, "by_inclination", "inclination (-pitch, °)"),
         "",
-        f"### Sensing and vehicle ({n_cmp} trials, default model)",
+        f"### Sensing and vehicle ({n_cmp:,} trials, default model)",
         "",
-        f"The same first {n_cmp} trials (conditions and IMU seeds): the Navi with the ideal and "
+        f"The same first {n_cmp:,} trials (conditions and IMU seeds): the Navi with the ideal and "
         "the `noisy` IMU, and the Spiri (which has no rotor slew limit in its file: it is "
         "given the Navi's 70,000 RPM/s, without which the spin-down stops the rotors in one "
         "tick).",
