@@ -40,6 +40,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("simulation", ("quadimpact.simulation",)),
     ("sweep, viz", ("quadimpact.sweep", "quadimpact.viz")),
     ("experiments", ("quadimpact.experiments",)),
+    ("recovery", ("quadimpact.recovery",)),
     ("paper", ("quadimpact.paper",)),
     ("cli", ("quadimpact.cli",)),
 ]

@@ -3,12 +3,18 @@
 import pandas as pd
 import pytest
 
+from quadimpact.paper import study
 from quadimpact.paper.study import reproduce
+from quadimpact.recovery.report import rate_text
 from quadimpact.simulation.metrics import RESPONSE_TYPES
 
 
 @pytest.mark.slow
-def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path):
+def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch):
+    # the recovery part at 40 and 20 trials instead of 2,000 and 1,000 (its grid and crashes
+    # in full)
+    monkeypatch.setattr(study, "RECOVERY_N", 40)
+    monkeypatch.setattr(study, "RECOVERY_COMPARE_N", 20)
     r = reproduce(tmp_path, ablation=False, experiments=False, workers=2)
     text = r.report.read_text()
     f = r.findings
@@ -31,3 +37,24 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path):
         assert (tmp_path / name).is_file(), name
     t2 = pd.read_parquet(tmp_path / "table2.parquet")
     assert len(t2) == 2 * 246 and set(t2["response_type"].dropna()) <= set(RESPONSE_TYPES)
+    # beyond the paper: recovery, its numbers those of its tables
+    part = r.recovery
+    assert "## Beyond the paper: recovery" in text and "(40 trials per variant)" in text
+    for variant, numbers in part.monte_carlo.items():
+        assert f"| {variant} | 40 | {rate_text(numbers['success'])} |" in text
+    trials = pd.read_parquet(tmp_path / "recovery_trials.parquet")
+    navi = trials[trials["study"] == "navi, default"]
+    assert len(navi) == 40 and part.monte_carlo["default"]["success"].k == navi["recovered"].sum()
+    assert set(trials["study"]) == {"navi, default", "navi, recovery-replica", "navi, noisy IMU",
+                                    "spiri"}  # fmt: skip
+    fig4 = pd.read_parquet(tmp_path / "recovery_fig4.parquet")
+    assert len(fig4) == 2 * 246 and set(fig4["variant"]) == {"paper-replica", "default"}
+    for variant, grid in part.grid.items():
+        rows = grid.set_index("nominal_type")
+        assert rows.loc["all", "runs"] == 246
+        assert rows.loc["all", "saved"] == fig4[fig4["variant"] == variant]["saved"].sum()
+        n_a = rows.loc["A", "runs"] if "A" in rows.index else 0
+        assert n_a == (r.tables[variant]["response_type"] == "A").sum()
+    crashes = pd.read_parquet(tmp_path / "recovery_crashes.parquet")
+    assert len(crashes) == 14 and (tmp_path / "recovery_by_inclination.png").is_file()
+    assert f"This part took {part.elapsed_s:.1f} s" in text

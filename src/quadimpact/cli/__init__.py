@@ -4,6 +4,7 @@
 * :mod:`~quadimpact.cli.sweep`: ``quadimpact sweep``;
 * :mod:`~quadimpact.cli.reproduce`: ``quadimpact reproduce``;
 * :mod:`~quadimpact.cli.experiments`: ``quadimpact experiments``;
+* :mod:`~quadimpact.cli.recovery`: ``quadimpact recovery``;
 * :mod:`~quadimpact.cli.viz`: ``quadimpact animate``, ``snapshots``, ``view``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
 
@@ -21,7 +22,7 @@ import traceback
 
 import click
 
-from quadimpact.cli import experiments, reproduce, run, sweep, viz
+from quadimpact.cli import experiments, recovery, reproduce, run, sweep, viz
 from quadimpact.cli.run import build_scenario, format_summary
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
@@ -75,6 +76,7 @@ cli.add_command(viz.view)
 cli.add_command(sweep.sweep)
 cli.add_command(reproduce.reproduce)
 cli.add_command(experiments.experiments)
+cli.add_command(recovery.recovery)
 
 
 def _fail(message: str, code: int) -> None:

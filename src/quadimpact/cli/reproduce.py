@@ -19,6 +19,12 @@ from quadimpact.cli.options import data_option, out_option, parallel_options
     help="Skip the replica reruns with one difference switched off at a time.",
 )
 @click.option("--no-experiments", is_flag=True, help="Skip the seven crashes of Table III.")
+@click.option(
+    "--no-recovery",
+    is_flag=True,
+    help="Skip 'Beyond the paper: recovery' (the recovery Monte Carlo, the Figure 4 grid and "
+    "the crashes with the recovery controller).",
+)
 @data_option(
     "Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
     "../shared/data beside the project]; without it the comparisons are left out."
@@ -30,6 +36,7 @@ def reproduce(
     scheduler: str | None,
     no_ablation: bool,
     no_experiments: bool,
+    no_recovery: bool,
     data: Path | None,
     no_progress: bool,
 ) -> None:
@@ -40,13 +47,17 @@ def reproduce(
     20 deg, impact speed 0.5, 0.75, 1 m/s) and the example run; the report sets
     each of the paper's findings beside what each variant measured, with a
     verdict computed from the data, and shows which of the replica's
-    differences causes each disagreement.
+    differences causes each disagreement. Beyond the paper, it runs the
+    recovery controller: a Monte Carlo of impact trials of the Navi (2,000 per
+    variant), the Figure 4 grid and the seven crashes without power-off,
+    nominal against recovery (docs/RECOVERY.md).
     """
     from quadimpact.paper.study import reproduce as run_study
 
     result = run_study(
         out, workers=workers, scheduler=scheduler, progress=not no_progress,
-        ablation=not no_ablation, experiments=not no_experiments, data_dir=data,
+        ablation=not no_ablation, experiments=not no_experiments, recovery=not no_recovery,
+        data_dir=data,
     )  # fmt: skip
     f = result.findings
     click.echo(f"report         {result.report}")
@@ -56,4 +67,12 @@ def reproduce(
             f"{variant:<15}" + ", ".join(f"{counts.get(k, 0)} {k}" for k in ("agrees", "partly",
                                                                             "disagrees"))
         )  # fmt: skip
-    click.echo(f"time           {result.elapsed_s:.1f} s")
+    if result.recovery is not None:
+        from quadimpact.recovery.report import rate_text
+
+        for variant, numbers in result.recovery.monte_carlo.items():
+            click.echo(f"recovery       {variant}: {rate_text(numbers['success'])}")
+        click.echo(f"time           {result.elapsed_s:.1f} s "
+                   f"(recovery {result.recovery.elapsed_s:.1f} s)")  # fmt: skip
+    else:
+        click.echo(f"time           {result.elapsed_s:.1f} s")

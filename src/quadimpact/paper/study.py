@@ -15,6 +15,18 @@ replica with each of its six differences switched off in turn. It writes:
 * ``fig4.parquet`` (every run of every sweep), ``table2.parquet``,
   ``findings.parquet``, ``ablation.parquet``;
 * ``sweeps/<name>/``: the resumable sweep folders.
+
+With ``recovery`` (the default) it adds "Beyond the paper: recovery"
+(:func:`recovery_part`, docs/RECOVERY.md): the recovery Monte Carlo of the
+Navi at :data:`RECOVERY_N` trials in ``default`` and ``recovery-replica``;
+the noisy IMU and the Spiri at :data:`RECOVERY_COMPARE_N` trials against
+the Navi's first :data:`RECOVERY_COMPARE_N` trials (ideal IMU, default);
+the Figure 4 grid with the recovery controller (pre-impact nominal, the
+``paper`` controller) against the nominal runs, in both paper variants; and
+the seven Table III crashes without the motor power-off, nominal against
+recovery. It writes ``recovery/<study>/`` (the trials, resumable),
+``recovery_trials.parquet``, ``recovery_fig4.parquet``,
+``recovery_crashes.parquet`` and ``recovery_by_inclination.png``.
 """
 
 from __future__ import annotations
@@ -30,6 +42,15 @@ from quadimpact.inputs.model import MODEL_VARIANTS
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.paper.findings import Finding, evaluate, fig4_curves, findings_frame
 from quadimpact.paper.report import render_report, type_label
+from quadimpact.recovery import analysis as recovery_analysis
+from quadimpact.recovery.baselines import (
+    crashes_without_power_off,
+    grid_comparison,
+    recovery_base,
+    saved_by_type,
+)
+from quadimpact.recovery.figures import compare_by_bin_figure
+from quadimpact.recovery.study import RecoveryStudy, run_trials
 from quadimpact.results import figures
 from quadimpact.simulation import simulate
 from quadimpact.sweep import SweepSpec, run_sweep
@@ -44,6 +65,11 @@ FIG4_GRID: dict[str, list[float]] = {
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
 VARIANTS = ("paper-replica", "default")
 SWITCHES = tuple(MODEL_VARIANTS["default"])  # the replica's six differences
+#: Trials of the Navi's recovery Monte Carlo in each variant (reduced from the study's 10,000).
+RECOVERY_N = 2_000
+#: Trials of the noisy-IMU and Spiri comparisons (the first trials of the same seed).
+RECOVERY_COMPARE_N = 1_000
+RECOVERY_VARIANTS = ("default", "recovery-replica")
 
 
 @dataclass
@@ -55,6 +81,25 @@ class StudyResult:
     tables: dict[str, pd.DataFrame]
     findings: pd.DataFrame
     ablation: pd.DataFrame
+    elapsed_s: float
+    recovery: RecoveryPart | None = None
+
+
+@dataclass
+class RecoveryPart:
+    """The recovery part of the study: numbers (``recovery.analysis.summarise``) and tables.
+
+    ``monte_carlo``: variant -> numbers of the Navi's :data:`RECOVERY_N`
+    trials; ``compare``: label -> numbers of :data:`RECOVERY_COMPARE_N` trials
+    (the Navi's first, ideal IMU; the noisy IMU; the Spiri), default model;
+    ``grid``: paper variant -> ``saved_by_type`` of the Figure 4 grid;
+    ``crashes``: ``crashes_without_power_off``; ``elapsed_s``: its wall time.
+    """
+
+    monte_carlo: dict[str, dict]
+    compare: dict[str, dict]
+    grid: dict[str, pd.DataFrame]
+    crashes: pd.DataFrame
     elapsed_s: float
 
 
@@ -84,6 +129,7 @@ def reproduce(
     progress: bool = False,
     ablation: bool = True,
     experiments: bool = True,
+    recovery: bool = True,
     data_dir: str | Path | None = None,
 ) -> StudyResult:
     """Run the paper's study and write the report folder (see the module docstring).
@@ -91,6 +137,7 @@ def reproduce(
     With ``experiments`` the seven crashes of Table III are simulated too
     (``experiments/table3.py``, into ``out_dir/experiments``), compared with
     their logs when ``data_dir`` (or the default data folder) holds them.
+    With ``recovery``, "Beyond the paper: recovery" (:func:`recovery_part`).
     """
     start = time.perf_counter()
     out = Path(out_dir)
@@ -126,6 +173,8 @@ def reproduce(
             progress=progress,
         )  # fmt: skip
 
+    part = recovery_part(out, tables, workers, scheduler, progress) if recovery else None
+
     # tables behind the report
     pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
     table2(tables).to_parquet(out / "table2.parquet")
@@ -136,8 +185,62 @@ def reproduce(
         type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
     elapsed = time.perf_counter() - start
     report = out / "report.md"
-    report.write_text(render_report(tables, findings, ablation_df, elapsed, table3))
-    return StudyResult(out, report, tables, findings, ablation_df, elapsed)
+    report.write_text(render_report(tables, findings, ablation_df, elapsed, table3, part))
+    return StudyResult(out, report, tables, findings, ablation_df, elapsed, part)
+
+
+# ---------------------------------------------------------------- recovery
+def recovery_part(
+    out: Path,
+    tables: dict[str, pd.DataFrame],
+    workers: int | None,
+    scheduler: str | None,
+    progress: bool,
+) -> RecoveryPart:
+    """Beyond the paper: recovery (see the module docstring); ``tables``: the Figure 4 sweeps."""
+    start = time.perf_counter()
+    par = {"workers": workers, "scheduler": scheduler, "progress": progress}
+    rec = out / "recovery"
+    trials: dict[str, pd.DataFrame] = {}
+    for v in RECOVERY_VARIANTS:
+        trials[f"navi, {v}"] = run_trials(RecoveryStudy(n=RECOVERY_N, model=v),
+                                          rec / f"navi-{v}", **par)[1]  # fmt: skip
+    m = RECOVERY_COMPARE_N
+    trials["navi, noisy IMU"] = run_trials(RecoveryStudy(n=m, imu="noisy"), rec / "navi-noisy",
+                                           **par)[1]  # fmt: skip
+    trials["spiri"] = run_trials(RecoveryStudy(vehicle="spiri", n=m), rec / "spiri", **par)[1]
+    first = trials["navi, default"]
+    monte_carlo = {v: recovery_analysis.summarise(trials[f"navi, {v}"])
+                   for v in RECOVERY_VARIANTS}  # fmt: skip
+    compare = {
+        f"navi, ideal IMU (the first {m} above)": recovery_analysis.summarise(
+            first[first["run_id"] < m]
+        ),
+        **{k: recovery_analysis.summarise(trials[k]) for k in ("navi, noisy IMU", "spiri")},
+    }
+
+    grid, runs = {}, []
+    for variant in VARIANTS:
+        table = run_sweep(
+            SweepSpec(base=recovery_base({"model": variant}), grid=FIG4_GRID),
+            out / "sweeps" / f"recovery-{variant}", **par,
+        )  # fmt: skip
+        both = grid_comparison(tables[variant], table, list(FIG4_GRID))
+        grid[variant] = saved_by_type(both)
+        runs.append(both.assign(variant=variant))
+    crashes = crashes_without_power_off(VARIANTS)
+
+    pd.concat([t.assign(study=k) for k, t in trials.items()]).to_parquet(
+        out / "recovery_trials.parquet", index=False
+    )
+    pd.concat(runs, ignore_index=True).to_parquet(out / "recovery_fig4.parquet", index=False)
+    crashes.to_parquet(out / "recovery_crashes.parquet", index=False)
+    figures.save_figure(
+        compare_by_bin_figure(monte_carlo, "by_inclination",
+                              "Navi: success rate by inclination bin, both variants"),
+        out / "recovery_by_inclination.png",
+    )  # fmt: skip
+    return RecoveryPart(monte_carlo, compare, grid, crashes, time.perf_counter() - start)
 
 
 # ------------------------------------------------------------------ tables

@@ -1,0 +1,515 @@
+"""The recovery Monte Carlo: its spec, its run and the trials table (docs/RECOVERY.md 8).
+
+:class:`RecoveryStudy` is the authors' study: N impact trials (docs/RECOVERY.md
+5.1) with roll uniform in +-15 deg, pitch in +-45 deg, yaw in +-45 deg and the
+speed toward the wall in [0.5, 2.5] m/s. Trial ``i`` is a function of the
+study's seed ``S`` and ``i`` alone: its inputs and its IMU seed are drawn from
+its own PCG64 stream (``numpy.random.SeedSequence(S, spawn_key=(i,))``), so
+the noise is independent from trial to trial, the first ``M`` trials of a
+study of ``N > M`` trials are those of the study of ``M`` trials, and the
+table is the same on one core, two or a Dask cluster.
+
+:func:`run_study` runs a study (or a user's sweep whose base is an impact
+trial) through :func:`quadimpact.sweep.run_sweep` into ``DIR/sweep/``
+(resumable: the same command again resumes; a different one in the same
+folder is refused), then writes into ``DIR``:
+
+* ``trials.parquet``: one row per trial, the sweep's row (inputs, every
+  summary metric; ``docs/RESULTS.md``) with the trial's ``roll_deg``,
+  ``pitch_deg``, ``yaw_deg``, ``speed_m_s`` and ``seed`` whatever was swept,
+  and the derived columns of :func:`quadimpact.recovery.analysis.add_derived`
+  (``inclination_deg = -pitch_deg``, ``inclination_bin``, ``speed_bin``,
+  ``outcome_class``);
+* ``study.json``: what ran;
+* the figures (:mod:`quadimpact.recovery.figures`) and ``report.md``;
+* ``example/``: the example trial's result folder, with its viewer and
+  animation.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from quadimpact import __version__
+from quadimpact.errors import InputError, format_value
+from quadimpact.inputs.model import resolve_model_options
+from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
+from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
+from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, analysis
+from quadimpact.results.files import atomic_write
+from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
+from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+
+__all__ = [
+    "DISTRIBUTION",
+    "RecoveryResult",
+    "RecoveryStudy",
+    "describe",
+    "run_study",
+    "run_trials",
+    "sample_trials",
+    "trial_inputs",
+    "trial_table",
+]
+
+#: The authors' distribution: field -> (low, high), each uniform.
+DISTRIBUTION: dict[str, tuple[float, float]] = {
+    "roll_deg": (-15.0, 15.0),
+    "pitch_deg": (-45.0, 45.0),
+    "yaw_deg": (-45.0, 45.0),
+    "speed_m_s": (0.5, 2.5),
+}
+#: The vehicle whose rotor slew limit a vehicle without one borrows.
+SLEW_DONOR = "navi"
+#: IMU seeds are below 2**53, so that they are exact as the sweep's float inputs.
+SEED_LIMIT = 2**53
+#: The trial inputs every row of ``trials.parquet`` carries.
+TRIAL_FIELDS = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "seed")
+SWEEP_DIR = "sweep"
+TRIALS_PARQUET = "trials.parquet"
+STUDY_JSON = "study.json"
+EXAMPLE_DIR = "example"
+
+
+# ------------------------------------------------------------------ sampling
+def trial_rng(seed: int, index: int) -> np.random.Generator:
+    """Trial ``index``'s own random stream (PCG64) of a study seeded with ``seed``."""
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(index,))))
+
+
+def sample_trials(
+    n: int, seed: int, ranges: dict[str, tuple[float, float]] | None = None
+) -> list[dict[str, float | int]]:
+    """The inputs of ``n`` trials: each field uniform in its range, and an IMU seed.
+
+    Parameters
+    ----------
+    n : int
+        Number of trials, >= 1.
+    seed : int
+        The study's seed, >= 0.
+    ranges : dict, optional
+        Field -> (low, high) (default :data:`DISTRIBUTION`: degrees and m/s).
+
+    Returns
+    -------
+    list of dict
+        Per trial, in order: the fields of ``ranges`` and ``seed`` (the run's
+        IMU seed, an integer in [0, 2**53)). Trial ``i`` depends on ``seed``
+        and ``i`` only (:func:`trial_rng`).
+    """
+    ranges = DISTRIBUTION if ranges is None else ranges
+    trials = []
+    for i in range(n):
+        rng = trial_rng(seed, i)
+        u = rng.random(len(ranges))
+        trial: dict[str, float | int] = {
+            name: float(lo + (hi - lo) * x)
+            for (name, (lo, hi)), x in zip(ranges.items(), u, strict=True)
+        }
+        trial["seed"] = int(rng.integers(0, SEED_LIMIT))
+        trials.append(trial)
+    return trials
+
+
+# --------------------------------------------------------------------- spec
+def _check_choice(name: str, value: Any, choices: tuple[str, ...]) -> None:
+    if value not in choices:
+        known = ", ".join(repr(c) for c in choices)
+        raise InputError(f"{name}: must be one of {known} (got {format_value(value)})")
+
+
+def _check_int(name: str, value: Any, low: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int) or value < low:
+        raise InputError(f"{name}: must be an integer >= {low} (got {format_value(value)})")
+
+
+def _vehicle(ref: str, where: str = "vehicle") -> Vehicle:
+    try:
+        return load_vehicle(ref)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+@dataclass(frozen=True)
+class RecoveryStudy:
+    """The authors' Monte Carlo of impact trials, with quadimpact's variants.
+
+    Attributes
+    ----------
+    vehicle : str
+        Bundled vehicle name (``"navi"``, ``"spiri"``) or a vehicle TOML file.
+    n : int
+        Number of trials, >= 1.
+    seed : int
+        The study's seed, >= 0 (trial inputs and IMU seeds, :func:`sample_trials`).
+    model : {"default", "recovery-replica"}
+        Model variant (docs/VARIANTS.md).
+    imu : {"ideal", "noisy"}
+        IMU preset (docs/RECOVERY.md 1.4).
+    pre_impact : {"spin-down", "hold"}
+        The recovery controller's behaviour before the detection. The recovery
+        replica forces spin-down through its ``pre_impact`` switch; with
+        ``"hold"`` that switch is set to ``"scenario"``.
+
+    Notes
+    -----
+    A vehicle whose file has no rotor slew limit (the Spiri) is given the
+    Navi's (70,000 RPM/s, as the scenario field ``rotor_slew_limit_rad_s2``):
+    without a slew limit the spin-down would stop the rotors within one
+    control tick.
+    """
+
+    vehicle: str = "navi"
+    n: int = DEFAULT_N
+    seed: int = 0
+    model: str = "default"
+    imu: str = "ideal"
+    pre_impact: str = "spin-down"
+    _vehicle_ref: str = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        _check_int("n", self.n, 1)
+        _check_int("seed", self.seed, 0)
+        _check_choice("model", self.model, MODELS)
+        _check_choice("imu", self.imu, IMUS)
+        _check_choice("pre_impact", self.pre_impact, PRE_IMPACTS)
+        if not isinstance(self.vehicle, str) or not self.vehicle:
+            raise InputError(f"vehicle: must be a vehicle name or file (got {self.vehicle!r})")
+        _vehicle(self.vehicle)
+        # a file by its absolute path, so that a rerun from elsewhere resumes
+        ref = self.vehicle
+        if ref not in bundled_vehicles():
+            ref = str(Path(ref).resolve())
+        object.__setattr__(self, "_vehicle_ref", ref)
+
+    def lent_slew_limit_rad_s2(self) -> float | None:
+        """The slew limit lent to a vehicle without one (rad/s^2), None if it has its own."""
+        if _vehicle(self.vehicle).rotor_slew_limit_rpm_per_s is not None:
+            return None
+        donor = load_vehicle(SLEW_DONOR).rotor_slew_limit_rpm_per_s
+        assert donor is not None  # the shipped Navi file has one
+        return float(donor) * RPM
+
+    def base(self) -> dict[str, Any]:
+        """The impact-trial base scenario of every trial (a scenario-file mapping)."""
+        base: dict[str, Any] = {
+            "kind": "impact-trial",
+            "vehicle": self._vehicle_ref,
+            "model": self.model,
+            "controller": "recovery",
+            "imu": self.imu,
+            "pre_impact": self.pre_impact,
+        }
+        if resolve_model_options(self.model).pre_impact == "spin-down" and (
+            self.pre_impact != "spin-down"
+        ):
+            base["model_options"] = {"pre_impact": "scenario"}
+        slew = self.lent_slew_limit_rad_s2()
+        if slew is not None:
+            base["rotor_slew_limit_rad_s2"] = slew
+        return base
+
+    def sweep_spec(self) -> SweepSpec:
+        """The study as a sweep: the base and one ``[[runs]]`` entry per trial."""
+        return SweepSpec(
+            base=self.base(), runs=sample_trials(self.n, self.seed), where="recovery"
+        )
+
+    def options(self) -> dict[str, Any]:
+        """The study's options as plain data (``study.json``)."""
+        d = asdict(self)
+        d.pop("_vehicle_ref", None)
+        return d
+
+
+# ------------------------------------------------------------------- tables
+_TRIAL_DEFAULTS = {name: ImpactTrial.model_fields[name].default for name in TRIAL_FIELDS}
+
+
+def trial_inputs(spec: SweepSpec) -> pd.DataFrame:
+    """Roll, pitch, yaw (deg), speed (m/s) and IMU seed of every run of a sweep.
+
+    From each run's scenario (base and swept values), the impact trial's
+    defaults where neither sets a field. Indexed by ``run_id``.
+    """
+    rows = []
+    for run_id in range(spec.n_runs):
+        scenario = spec.scenario_dict(run_id)
+        rows.append({name: scenario.get(name, _TRIAL_DEFAULTS[name]) for name in TRIAL_FIELDS})
+    frame = pd.DataFrame(rows, index=pd.RangeIndex(spec.n_runs, name="run_id"))
+    for name in TRIAL_FIELDS[:-1]:
+        frame[name] = frame[name].astype("float64")
+    frame["seed"] = frame["seed"].astype("int64")
+    return frame
+
+
+def trial_table(runs: pd.DataFrame, spec: SweepSpec) -> pd.DataFrame:
+    """``trials.parquet``: the sweep's rows, the trial inputs and the derived columns."""
+    table = runs.sort_values("run_id").reset_index(drop=True)
+    inputs = trial_inputs(spec).reindex(table["run_id"].to_numpy())
+    for name in TRIAL_FIELDS:
+        table[name] = inputs[name].to_numpy()
+    return analysis.add_derived(table)
+
+
+def _check_trial_base(spec: SweepSpec, where: str) -> None:
+    kind = spec.base.get("kind", "wall-approach")
+    if kind != "impact-trial":
+        raise InputError(
+            f"{where}: base: kind: must be 'impact-trial' for the recovery study (got {kind!r})"
+        )
+
+
+# ----------------------------------------------------------------- describe
+def describe(spec: SweepSpec, study: RecoveryStudy | None, table: pd.DataFrame) -> dict[str, Any]:
+    """What ran, for ``study.json`` and the report: settings from the spec, facts from the table.
+
+    The first run's validated scenario gives the settings common to the runs
+    (friction, IMU, detection, slew limit, final time); the table's columns
+    give the values actually in force in every run (model, switches, vehicle,
+    controller, pre-impact behaviour, detection threshold).
+    """
+    first = scenario_from_dict(spec.scenario_dict(0), where="recovery: run 0")
+    vehicle = first.build_vehicle()
+    imu = first.imu.resolved(vehicle.imu_position_m, CONTROL_RATE_HZ)
+
+    def values(column: str) -> list[Any]:
+        if column not in table:
+            return []
+        return [v for v in pd.unique(table[column]) if v is not None and v == v]
+
+    switches = {
+        c.removeprefix("model_options__"): values(c)
+        for c in table.columns
+        if c.startswith("model_options__")
+    }
+    slew = first.rotor_slew_limit_rad_s2
+    if slew == "vehicle":
+        rpm_s = vehicle.rotor_slew_limit_rpm_per_s
+        slew_text = f"{rpm_s:,.0f} RPM/s (the vehicle's)" if rpm_s else "none"
+    elif slew is None:
+        slew_text = "none"
+    else:
+        slew_text = f"{slew / RPM:,.0f} RPM/s ({slew:.1f} rad/s², set by the study)"
+    swept = sorted(set(spec.columns))
+    return {
+        "quadimpact_version": __version__,
+        "source": "the authors' distribution" if study is not None else "a sweep file",
+        "study": study.options() if study is not None else None,
+        "sweep_file": spec.where if study is None else None,
+        "n_trials": int(spec.n_runs),
+        "swept": swept,
+        "distribution": {k: list(v) for k, v in DISTRIBUTION.items()} if study else None,
+        "vehicle": values("vehicle"),
+        "model": values("model"),
+        "model_options": switches,
+        "controller": values("controller"),
+        "pre_impact": values("pre_impact"),
+        "detection_threshold_m_s2": values("detection_threshold_m_s2"),
+        "detection": first.detection.model_dump(),
+        "imu": {"preset": first.imu.preset, **imu.model_dump()},
+        "friction_coefficient": float(first.friction_coefficient),
+        "slew_limit": slew_text,
+        "rotor_speed_range_rpm": list(vehicle.rotor_speed_range_rpm)
+        if vehicle.rotor_speed_range_rpm
+        else None,
+        "final_time_s": float(first.final_time_s),
+        "start_distance_m": float(first.start_distance_m),
+        "altitude_m": float(first.altitude_m),
+        "ground": first.ground,
+    }
+
+
+# ---------------------------------------------------------------------- run
+@dataclass
+class RecoveryResult:
+    """What :func:`run_study` produced."""
+
+    out_dir: Path
+    table: pd.DataFrame
+    description: dict[str, Any]
+    numbers: dict[str, Any]
+    report: Path
+    figures: list[Path]
+    example_dir: Path | None
+    run_info: dict[str, Any]
+    elapsed_s: float
+    warnings: list[str] = field(default_factory=list)
+
+
+def run_trials(
+    study: RecoveryStudy | SweepSpec,
+    out_dir: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool = False,
+) -> tuple[SweepSpec, pd.DataFrame, dict[str, Any]]:
+    """Run the trials into ``out_dir/sweep`` and write ``out_dir/trials.parquet``.
+
+    The part of :func:`run_study` without figures, report and example.
+
+    Returns
+    -------
+    (spec, table, info)
+        The sweep, the trials table (:func:`trial_table`) and
+        :func:`quadimpact.sweep.run_sweep`'s run information.
+    """
+    out = Path(out_dir)
+    if isinstance(study, SweepSpec):
+        spec = study
+        _check_trial_base(spec, spec.where)
+    else:
+        spec = study.sweep_spec()
+    info = run_sweep(
+        spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
+        load=False,
+    )  # fmt: skip
+    table = trial_table(read_runs(out / SWEEP_DIR), spec)
+    atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
+    return spec, table, info
+
+
+def run_study(
+    study: RecoveryStudy | SweepSpec,
+    out_dir: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool = False,
+    example: bool = True,
+    animation: bool = True,
+) -> RecoveryResult:
+    """Run the recovery study into ``out_dir`` (see the module docstring) and report it.
+
+    Parameters
+    ----------
+    study : RecoveryStudy or SweepSpec
+        The authors' Monte Carlo with its options, or a user's sweep whose
+        base is an impact trial.
+    out_dir : path-like
+        The study folder; its ``sweep/`` subfolder is the resumable sweep.
+    workers, scheduler, progress
+        As :func:`quadimpact.sweep.run_sweep`.
+    example : bool
+        Run the example trial again with its files, figure and viewer.
+    animation : bool
+        Also write the example's animation (needs the ``viz`` extra).
+
+    Raises
+    ------
+    InputError
+        A sweep whose base is not an impact trial, a folder holding a
+        different study, bad workers or scheduler.
+    """
+    from quadimpact.recovery import figures, report
+
+    start = time.perf_counter()
+    out = Path(out_dir)
+    spec, table, info = run_trials(
+        study, out, workers=workers, scheduler=scheduler, progress=progress
+    )
+    options = study if isinstance(study, RecoveryStudy) else None
+    description = describe(spec, options, table)
+    description["run"] = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
+    description["run"]["sweep_s"] = float(info["elapsed_s"])
+    description["sweeps"] = _sweep_history(out, description["run"])
+    numbers = analysis.summarise(table)
+    warnings: list[str] = []
+
+    paths = figures.write_figures(table, out, numbers)
+    example_dir = None
+    if example:
+        run_id = analysis.example_trial(table)
+        example_dir, more = _write_example(spec, run_id, table, out, animation)
+        paths += more[0]
+        warnings += more[1]
+        description["example"] = {"run_id": run_id, **_row_inputs(table, run_id)}
+    elapsed = time.perf_counter() - start
+    description["elapsed_s"] = elapsed
+    text = json.dumps(description, indent=1, sort_keys=True, default=_jsonable) + "\n"
+    atomic_write(out / STUDY_JSON, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    report_path = out / "report.md"
+    md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
+    atomic_write(report_path, lambda tmp: tmp.write_text(md, encoding="utf-8"))
+    for w in warnings:
+        print(f"quadimpact: warning: {w}", file=sys.stderr)
+    return RecoveryResult(
+        out, table, description, numbers, report_path, paths, example_dir, info, elapsed, warnings
+    )
+
+
+def _sweep_history(out: Path, run: dict[str, Any]) -> list[dict[str, Any]]:
+    """The invocations that ran trials of this study: the earlier ones (``study.json``), this one.
+
+    Each: ``n_ran``, ``sweep_s``, ``backend``. An earlier record is kept only
+    when its trials are still in the sweep (this invocation found some done).
+    """
+    history: list[dict[str, Any]] = []
+    path = out / STUDY_JSON
+    if run["n_already_done"] and path.is_file():
+        try:
+            history = list(json.loads(path.read_text(encoding="utf-8")).get("sweeps") or [])
+        except (OSError, ValueError):
+            history = []
+    if run["n_ran"]:
+        history.append({k: run[k] for k in ("n_ran", "sweep_s", "backend")})
+    return history
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    raise TypeError(f"not JSON: {type(value).__name__}")
+
+
+def _row_inputs(table: pd.DataFrame, run_id: int) -> dict[str, Any]:
+    row = table.loc[table["run_id"] == run_id].iloc[0]
+    return {name: row[name].item() for name in (*TRIAL_FIELDS, "inclination_deg")}
+
+
+def _write_example(
+    spec: SweepSpec, run_id: int, table: pd.DataFrame, out: Path, animation: bool
+) -> tuple[Path, tuple[list[Path], list[str]]]:
+    """Run trial ``run_id`` again into ``out/example`` with its figure, viewer and animation."""
+    from quadimpact.recovery import figures
+    from quadimpact.simulation import simulate
+    from quadimpact.viz.scene import Scene
+    from quadimpact.viz.viewer import write_viewer
+
+    scenario = scenario_from_dict(spec.scenario_dict(run_id), where=f"run {run_id}")
+    result = simulate(scenario)
+    row = table.loc[table["run_id"] == run_id].iloc[0]
+    if bool(result.summary["recovered"]) != bool(row["recovered"]):  # pragma: no cover
+        raise RuntimeError(f"trial {run_id}: the example run does not repeat its table row")
+    d = out / EXAMPLE_DIR
+    result.write(d)
+    paths = [figures.write_example(result, d / "recovery.png", run_id)]
+    warnings: list[str] = []
+    scene = Scene.from_result(result, vehicle=scenario.build_vehicle())
+    paths.append(write_viewer(d, scene=scene))
+    if animation:
+        try:
+            from quadimpact.viz.animation import write_animation
+
+            movie = write_animation(d, scene=scene).mp4
+            if movie is not None:
+                paths.append(Path(movie))
+        except Exception as exc:  # no ffmpeg (the viz extra): the study stands without it
+            warnings.append(f"example animation not written: {type(exc).__name__}: {exc}")
+    return d, (paths, warnings)

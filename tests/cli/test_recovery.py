@@ -1,0 +1,86 @@
+"""``quadimpact recovery`` and impact-trial sweeps on the command line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from test_cli import assert_input_error
+
+from helpers import run_cli
+
+TRIAL_SWEEP = """
+[base]
+kind = "impact-trial"
+vehicle = "navi"
+model = "recovery-replica"
+
+[[runs]]
+pitch_deg = -10.0
+speed_m_s = 1.0
+seed = 1
+
+[[runs]]
+pitch_deg = -44.0
+roll_deg = 3.0
+speed_m_s = 2.0
+seed = 2
+"""
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["--n", "0"], ["'--n'", "0 is not in the range x>=1"]),
+        (["--vehicle", "nope"], ["--vehicle: vehicle 'nope': unknown vehicle name"]),
+        (["--imu", "loud"], ["'--imu'", "'loud' is not one of 'ideal', 'noisy'"]),
+        (["--model", "paper-replica"], ["'--model'", "'paper-replica' is not one of"]),
+        (["--pre-impact", "nominal"], ["'--pre-impact'", "'nominal' is not one of"]),
+        (["--seed", "-3"], ["'--seed'", "-3 is not in the range x>=0"]),
+        (["--sweep", "missing.toml"], ["missing.toml: file not found"]),
+        (["--sweep", "trials.toml", "--n", "5"], ["--sweep: the sweep file sets the trials",
+                                                  "--n"]),
+        (["--sweep", "approach.toml"], ["approach.toml: base: kind: must be 'impact-trial'"]),
+    ],
+)
+def test_bad_arguments_exit_2_with_one_line(tmp_path: Path, args, fragments) -> None:
+    (tmp_path / "trials.toml").write_text(TRIAL_SWEEP)
+    (tmp_path / "approach.toml").write_text("[base]\nspeed_m_s = 1.0\n[grid]\nheading_deg = [0]\n")
+    proc = run_cli("recovery", *args, "--out", "out", "--workers", "1", cwd=tmp_path)
+    assert_input_error(proc, *fragments)
+    assert not (tmp_path / "out" / "trials.parquet").exists()
+
+
+def test_an_impact_trial_sweep_file_runs_with_quadimpact_sweep(tmp_path: Path) -> None:
+    (tmp_path / "trials.toml").write_text(TRIAL_SWEEP)
+    proc = run_cli("sweep", "trials.toml", "--out", "s", "--workers", "1", "--no-progress",
+                   cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    t = pd.read_parquet(tmp_path / "s" / "runs.parquet")
+    for column in ("recovered", "t_detect_s", "t_stage4_s", "time_to_recover_s",
+                   "height_loss_m", "horizontal_drift_m", "impacts_after_detection",
+                   "detection_latency_s", "not_detected", "false_detection"):  # fmt: skip
+        assert column in t.columns, column
+    assert list(t["pitch_deg"]) == [-10.0, -44.0] and (t["controller"] == "recovery").all()
+    assert (t["model_options__contact_gate_m"] == 0.3).all() and t["detected"].all()
+    # detected after the first contact, and stage 4 after the detection where reached
+    assert (t["t_detect_s"] >= t["first_contact_s"]).all()
+    ok = t["recovered"].astype(bool)
+    assert (t.loc[ok, "t_stage4_s"] > t.loc[ok, "t_detect_s"]).all()
+
+
+@pytest.mark.slow  # three processes, one with the example and its viewer
+def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
+    proc = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",
+                   "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert "success   " in proc.stdout and "report    r/report.md" in proc.stdout
+    t = pd.read_parquet(tmp_path / "r" / "trials.parquet")
+    k = int(t["recovered"].fillna(False).sum())
+    assert f"success   {k} / 6 = " in proc.stdout
+    again = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",
+                    "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
+    assert again.returncode == 0 and "all done before, nothing to run" in again.stdout
+    other = run_cli("recovery", "--n", "7", "--out", "r", "--workers", "1", cwd=tmp_path)
+    assert_input_error(other, "holds a different sweep")
