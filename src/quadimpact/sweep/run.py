@@ -110,7 +110,7 @@ def run_sweep(
         (out / "parts").mkdir(parents=True, exist_ok=True)
         stack.enter_context(folder_lock(out))
         check_folder(out, spec, schema)
-        done, last_part = scan_done(out, spec.n_runs, warn)
+        done, last_part = scan_done(out, spec.n_runs, schema, warn)
         n_before = int(done.sum())
         todo = (i for i in range(spec.n_runs) if not done[i])
         n_todo = spec.n_runs - n_before
