@@ -1,13 +1,14 @@
-"""Sweep worker count: ``quadimpact sweep --workers 1`` against ``--workers N``.
+"""Sweep worker count: ``quadimpact sweep --workers 1``, ``--workers N`` and the default.
 
 Run: ``python benchmarks/bench_sweep_workers.py [--runs 50,150,600] [--workers 2] [--repeat 3]
 [--json PATH]``.
 
 For each sweep size (a heading grid, 3-s paper-replica scenarios, about 10 ms a
-run) it runs the command line in a fresh process, alternately with one worker
-(in-process) and with ``--workers N`` (the local pool), ``--repeat`` times, and
-reports the wall time of the whole command (median and minimum) and the
-components the choice depends on:
+run) it runs the command line in a fresh process, in turn with one worker
+(in-process), with ``--workers N`` (the local pool) and without ``--workers``
+(the default: a measured start in-process, then the pool if worth it),
+``--repeat`` times, and reports the wall time of the whole command (median and
+minimum) and the components the choice depends on:
 
 * the pool's fork server: its start-up and warm-up (imports, the compiled
   kernel loaded from Numba's cache), which in-process runs pay as the kernel
@@ -48,7 +49,8 @@ def command_time(n_runs: int, workers: int, out: Path) -> dict:
     subprocess.run(
         [sys.executable, "-m", "quadimpact.cli", "sweep",
          f"--grid=heading_deg={heading_grid(n_runs)}", "--grid=model=paper-replica",
-         "--out", str(out), "--workers", str(workers), "--no-progress", "--no-plots"],
+         "--out", str(out), *(["--workers", str(workers)] if workers else []),
+         "--no-progress", "--no-plots"],
         check=True, capture_output=True,
     )  # fmt: skip
     wall = time.perf_counter() - start
@@ -104,7 +106,7 @@ def main() -> None:
     )
     with tempfile.TemporaryDirectory() as tmp:
         for n in (int(v) for v in args.runs.split(",")):
-            rows: dict[int, list[dict]] = {1: [], args.workers: []}
+            rows: dict[int, list[dict]] = {1: [], args.workers: [], 0: []}  # 0: the default
             for _ in range(args.repeat):
                 for w in rows:
                     rows[w].append(command_time(n, w, Path(tmp) / "out"))
@@ -113,7 +115,8 @@ def main() -> None:
             for w, times in rows.items():
                 walls = [t["wall_s"] for t in times]
                 parts.append(
-                    f"--workers {w}: median {statistics.median(walls):5.2f} s, "
+                    f"{f'--workers {w}' if w else 'default'}: "
+                    f"median {statistics.median(walls):5.2f} s, "
                     f"min {min(walls):5.2f} s (sweep process CPU "
                     f"{statistics.median(t['parent_cpu_s'] for t in times):.2f} s)"
                 )

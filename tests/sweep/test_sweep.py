@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -294,24 +295,49 @@ def test_default_small_sweep_runs_in_process(serial_table, tmp_path):
 
 
 def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
-    """By default, the first runs are done here until the pool's server is warm, the rest by
-    the pool (forced here: never "finish here"); one table, the same as in-process."""
+    """By default the first runs are done here, then (if other cores are idle) the pool does
+    the rest once its server is warm; one table, the same as in-process."""
     import quadimpact.sweep.run as run_module
     from quadimpact.sweep.pool import pool_context, server_ready, start_server
 
-    if run_module.default_workers() < 2:
-        pytest.skip("one core: the default runs in-process")
     spec = SweepSpec(base=BASE, grid={"heading_deg": [0, 45], "inclination_deg": "-4:10:2"})
     reference = run_sweep(spec, tmp_path / "ref", workers=1)
     start_server(pool_context())
     end = time.monotonic() + 60
     while not server_ready(pool_context()) and time.monotonic() < end:
         time.sleep(0.05)
-    monkeypatch.setattr(run_module, "FINISH_HERE_S", 0.0)
+    monkeypatch.setattr(run_module, "FINISH_HERE_S", 0.0)  # never "too little left"
+    monkeypatch.setattr(run_module, "MEASURE_S", 0.0)  # decide after the first run
     table = run_sweep(spec, tmp_path / "d")
-    n = run_module.default_workers()
-    assert table.attrs["sweep"]["backend"] == f"{n} processes, the first 3 runs in this one"
+    backend = table.attrs["sweep"]["backend"]
+    # the pool, unless the other cores were measured busy
+    handed_over = re.fullmatch(r"\d processes, the first [12] runs in this one", backend)
+    assert backend == "serial" or handed_over, backend
     pd.testing.assert_frame_equal(table, reference)
+
+
+@pytest.mark.parametrize(
+    ("idle", "cores", "workers"),
+    [(None, 4, 4), (0.0, 2, 1), (0.4, 2, 1), (0.5, 2, 2), (0.95, 2, 2), (6.7, 8, 8), (2.2, 8, 3)],
+)
+def test_default_pool_size(idle, cores, workers):
+    from quadimpact.sweep.run import pool_size
+
+    assert pool_size(idle, cores) == workers
+
+
+def test_idle_cores_measured():
+    """While this process burns CPU, at most the other cores are idle."""
+    from quadimpact.sweep.run import cpu_sample, default_workers, idle_cores
+
+    before = cpu_sample()
+    if before is None:
+        pytest.skip("no /proc/stat")
+    end = time.perf_counter() + 0.3
+    while time.perf_counter() < end:
+        pass
+    idle = idle_cores(before, cpu_sample())
+    assert idle is not None and 0.0 <= idle <= default_workers() - 0.5
 
 
 def _free_port() -> int:

@@ -45,6 +45,8 @@ LARGE_SWEEP_RUNS = 1_000_000
 """Sweeps with more runs than this need ``allow_large=True`` (``--allow-large``)."""
 FINISH_HERE_S = 1.0
 """A default sweep finishes in this process when its runs left would take less than this, s."""
+MEASURE_S = 0.25
+"""A default sweep measures the idle cores over its first runs for this long, s."""
 START_HERE_MAX_S = 3.0
 """Longest a default sweep runs in this process waiting for the pool's server to warm up, s."""
 VALIDATION_NOTE_RUNS = 100_000
@@ -198,7 +200,9 @@ def run_sweep(
                         backend = "serial"
                         run_serial(make_chunks(spec, todo, 16), sink)
                     else:
-                        n_here = _start_here(spec, todo, n_todo, sink) if workers is None else 0
+                        n_here = 0
+                        if workers is None:  # the default: a measured start here
+                            n_here, n_workers = _start_here(spec, todo, n_todo, sink, n_workers)
                         n_left = n_todo - n_here
                         if n_left:
                             n_workers = min(n_workers, n_left)
@@ -232,37 +236,96 @@ def run_sweep(
     return table
 
 
-def _start_here(spec: SweepSpec, todo: Iterator[int], n_todo: int, sink: Sink) -> int:
+def _start_here(
+    spec: SweepSpec, todo: Iterator[int], n_todo: int, sink: Sink, cores: int
+) -> tuple[int, int]:
     """The default start of a sweep on several cores: measured runs in this process.
 
-    The sweep process loads the kernel and does runs, timing them. If the
-    runs left would take less than :data:`FINISH_HERE_S` here, it finishes
-    them itself (a small sweep never pays for starting processes); otherwise
-    it starts the pool's fork server and goes on until the server has loaded
-    its own kernel (``pool.server_ready``; at most :data:`START_HERE_MAX_S`),
-    then hands the rest to the pool, having lost no time waiting for it
-    (``docs/SWEEPS.md`` has the measurements). Returns the runs done here.
+    The sweep process loads the kernel and does runs, timing them and
+    measuring how idle the cores it may use are (``/proc/stat``). It
+    finishes the sweep itself when the runs left would take less than
+    :data:`FINISH_HERE_S` here, or when after :data:`MEASURE_S` fewer than
+    one other core is idle (a pool would only compete with the other work
+    for the same cores). Otherwise it starts the pool's fork server with one
+    worker per idle core (and this one) and goes on here until the server has
+    loaded its own kernel (``pool.server_ready``; at most
+    :data:`START_HERE_MAX_S`), so that no time is lost waiting for it.
+    ``docs/SWEEPS.md`` has the measurements.
+
+    Returns
+    -------
+    (int, int)
+        Runs done here, and the pool's workers for the rest (1: none left).
     """
     warm_up()
     ctx = pool_context()
     started: float | None = None
+    workers = 1
     busy, n_here = 0.0, 0
+    t0, sample0 = time.perf_counter(), cpu_sample()
     for chunk in make_chunks(spec, todo, 1):  # one id at a time from the shared iterator
         t = time.perf_counter()
         run_serial(iter([chunk]), sink)
-        busy += time.perf_counter() - t
+        now = time.perf_counter()
+        busy += now - t
         n_here += 1
-        left = n_todo - n_here
-        if left * busy / n_here < FINISH_HERE_S:
-            run_serial(make_chunks(spec, todo, 16), sink)
-            return n_todo
+        if (n_todo - n_here) * busy / n_here < FINISH_HERE_S:
+            break  # less than that left: finish here
         if started is None:
+            if now - t0 < MEASURE_S:
+                continue
+            workers = pool_size(idle_cores(sample0, cpu_sample()), cores)
+            if workers < 2:
+                break  # the other cores are busy: finish here
             start_server(ctx)  # it loads the kernel while the runs go on here
-            started = time.perf_counter()
-        ready = server_ready(ctx) or time.perf_counter() - started > START_HERE_MAX_S
-        if ready and (n_here >= 3 or busy >= 0.2):  # measured enough
-            break
-    return n_here
+            started = now
+        elif server_ready(ctx) or now - started > START_HERE_MAX_S:
+            return n_here, workers
+    run_serial(make_chunks(spec, todo, 16), sink)
+    return n_todo, 1
+
+
+def pool_size(idle: float | None, cores: int) -> int:
+    """Workers for a default sweep: this core and every other idle one (half idle counts).
+
+    ``idle`` is the idle CPUs measured while this process was busy (None:
+    unknown, then every core).
+    """
+    if idle is None:
+        return cores
+    return max(1, min(cores, int(idle + 1.5)))
+
+
+def cpu_sample() -> dict[int, tuple[int, int]] | None:
+    """(idle, total) clock ticks of each CPU this process may use (``/proc/stat``; else None)."""
+    try:
+        cpus = os.sched_getaffinity(0)
+        sample = {}
+        with open("/proc/stat", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("cpu") and line[3].isdigit():
+                    name, *fields = line.split()
+                    ticks = [int(v) for v in fields[:8]]
+                    if int(name[3:]) in cpus:
+                        sample[int(name[3:])] = (ticks[3] + ticks[4], sum(ticks))
+        return sample or None
+    except (OSError, AttributeError, ValueError, IndexError):
+        return None
+
+
+def idle_cores(
+    before: dict[int, tuple[int, int]] | None, after: dict[int, tuple[int, int]] | None
+) -> float | None:
+    """How many of those CPUs were idle between two :func:`cpu_sample` (None: unknown)."""
+    if not before or not after:
+        return None
+    idle = 0.0
+    for cpu in before.keys() & after.keys():
+        ticks = after[cpu][1] - before[cpu][1]
+        if ticks <= 0:
+            return None
+        idle += (after[cpu][0] - before[cpu][0]) / ticks
+    return idle
 
 
 def _stopped(
