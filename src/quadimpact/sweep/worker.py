@@ -100,8 +100,9 @@ def warm_up() -> None:
     _WARM = True
 
 
-WATCH_SIGNAL = signal.SIGUSR2
-"""The signal the pool's fork server gets when the sweep process that started it ends."""
+WATCH_SIGNAL: int | None = getattr(signal, "SIGUSR2", None)
+"""The signal the pool's fork server gets when the sweep process that started it ends
+(None where there is no SIGUSR2: no fork server there either)."""
 WATCH_ENV = "QUADIMPACT_SWEEP_PARENT"
 """``<pid>:<multiprocessing temp dir>`` of the sweep process, for the fork server
 it starts (read and removed by :func:`preload`)."""
@@ -139,10 +140,12 @@ def pool_worker(conn: Any) -> None:
     that a stopped or busy worker goes too. Ctrl-C is ignored: the sweep
     decides, and stops its workers itself.
     """
-    set_parent_death_signal(signal.SIGKILL)
+    if sys.platform.startswith("linux"):
+        set_parent_death_signal(signal.SIGKILL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     for signum in (signal.SIGTERM, WATCH_SIGNAL):
-        signal.signal(signum, signal.SIG_DFL)  # the fork server's handler is inherited
+        if signum is not None:
+            signal.signal(signum, signal.SIG_DFL)  # the fork server's handler is inherited
     with contextlib.suppress(Exception):
         warm_up()
     try:
@@ -204,7 +207,7 @@ def _follow_sweep() -> str:
     """
     value = os.environ.pop(WATCH_ENV, "")
     pid_text, _, tempdir = value.partition(":")
-    if not pid_text.isdigit():
+    if not pid_text.isdigit() or WATCH_SIGNAL is None:
         return ""
     sweep_pid = int(pid_text)
 
