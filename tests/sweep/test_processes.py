@@ -227,6 +227,7 @@ def test_signals_end_the_sweep_cleanly(tmp_path, tmpdir_env, reference):
     _resume(out, tmpdir_env, reference, _parts_rows(out))
 
 
+@pytest.mark.slow
 def test_sigkill_and_resume(tmp_path, tmpdir_env, reference):
     """kill -9 of the whole group once a part is written; the rerun does only the rest.
 
@@ -261,6 +262,7 @@ def test_stopped_worker_times_out(tmp_path, tmpdir_env, reference):
     pd.testing.assert_frame_equal(read_runs(tmp_path / "out"), reference)
 
 
+@pytest.mark.slow
 def test_killed_fork_server(tmp_path, tmpdir_env, reference):
     """The workers die with their server; their runs are redone, the sweep completes."""
     sweep = Sweep(tmp_path / "out", tmpdir_env)
