@@ -1,11 +1,13 @@
 """Sweeps: value parsing, spec validation, identical tables on every backend
-(in-process, local processes, a real Dask cluster on loopback), resume after
-SIGKILL, failed runs as rows, the command line and the plots."""
+(in-process, local processes, a real Dask cluster on loopback), resume, failed
+runs as rows, the command line and the plots (signals, kills and lost workers:
+``test_processes.py``; damaged parts: ``test_store.py``)."""
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import signal
 import socket
 import subprocess
@@ -166,6 +168,34 @@ def test_spec_errors(kwargs, fragment):
     assert "\n" not in str(info.value)
 
 
+def test_long_grids_are_checked_in_linear_time():
+    """100,001 values: the duplicate check was quadratic (about 90 s), now well under 1 s."""
+    start = time.perf_counter()
+    spec = SweepSpec(grid={"heading_deg": "0:100000:1"})
+    assert time.perf_counter() - start < 10
+    assert spec.n_runs == 100_001 and spec.grid["heading_deg"][-1] == 100_000.0
+    with pytest.raises(InputError, match="value 7 is listed twice"):
+        SweepSpec(grid={"heading_deg": [*range(100_000), 7]})
+    with pytest.raises(InputError, match="value 'a' is listed twice"):
+        SweepSpec(grid={"model": ["a", "b", "a"]})
+    assert SweepSpec(grid={"heading_deg": [0.0, -0.0]}).n_runs == 2  # as canonical JSON
+
+
+def test_large_sweeps_need_confirmation(tmp_path):
+    grid = {"inclination_deg": [70.5, *range(999)], "heading_deg": "0:1:0.001"}  # 1,001,000 runs
+    with pytest.raises(InputError, match=r"1001000 runs, more than 1000000: confirm with "
+                       r"--allow-large \(allow_large=True\)"):  # fmt: skip
+        run_sweep(SweepSpec(grid=grid), tmp_path / "o", workers=1)
+    with pytest.raises(InputError, match="run 0 .*inclination_deg: must be <= 60"):
+        run_sweep(SweepSpec(grid=grid), tmp_path / "o", workers=1, allow_large=True)
+    assert not (tmp_path / "o").exists()
+    proc = _cli("sweep", "--grid=heading_deg=0:1000:1", "--grid=speed_m_s=0.5:1.5:0.001",
+                "--out", "o", cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 2 and len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert "1002001 runs, more than 1000000: confirm with --allow-large" in proc.stderr
+    assert not (tmp_path / "o").exists()
+
+
 def test_bad_values_rejected_before_anything_runs(tmp_path):
     spec = SweepSpec(grid={"inclination_deg": [0, 70]})
     with pytest.raises(
@@ -247,6 +277,67 @@ def test_parallel_table_is_identical(serial_table, tmp_path):
     table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "p", workers=2)
     assert table.attrs["sweep"]["backend"] == "2 processes"
     pd.testing.assert_frame_equal(table, serial_table)
+
+
+def _children() -> set[int]:
+    import psutil
+
+    return {p.pid for p in psutil.Process().children(recursive=True)}
+
+
+def test_default_small_sweep_runs_in_process(serial_table, tmp_path):
+    """By default, runs that would take under a second here start no process at all."""
+    before = _children()
+    table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "s")
+    assert table.attrs["sweep"]["backend"] == "serial"
+    assert not _children() - before
+    pd.testing.assert_frame_equal(table, serial_table)
+
+
+def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
+    """By default the first runs are done here, then (if other cores are idle) the pool does
+    the rest once its server is warm; one table, the same as in-process."""
+    import quadimpact.sweep.run as run_module
+    from quadimpact.sweep.pool import pool_context, server_ready, start_server
+
+    spec = SweepSpec(base=BASE, grid={"heading_deg": [0, 45], "inclination_deg": "-4:10:2"})
+    reference = run_sweep(spec, tmp_path / "ref", workers=1)
+    start_server(pool_context())
+    end = time.monotonic() + 60
+    while not server_ready(pool_context()) and time.monotonic() < end:
+        time.sleep(0.05)
+    monkeypatch.setattr(run_module, "FINISH_HERE_S", 0.0)  # never "too little left"
+    monkeypatch.setattr(run_module, "MEASURE_S", 0.0)  # decide after the first run
+    table = run_sweep(spec, tmp_path / "d")
+    backend = table.attrs["sweep"]["backend"]
+    # the pool, unless the other cores were measured busy
+    handed_over = re.fullmatch(r"\d processes, the first [12] runs in this one", backend)
+    assert backend == "serial" or handed_over, backend
+    pd.testing.assert_frame_equal(table, reference)
+
+
+@pytest.mark.parametrize(
+    ("idle", "cores", "workers"),
+    [(None, 4, 4), (0.0, 2, 1), (0.4, 2, 1), (0.5, 2, 2), (0.95, 2, 2), (6.7, 8, 8), (2.2, 8, 3)],
+)
+def test_default_pool_size(idle, cores, workers):
+    from quadimpact.sweep.run import pool_size
+
+    assert pool_size(idle, cores) == workers
+
+
+def test_idle_cores_measured():
+    """While this process burns CPU, at most the other cores are idle."""
+    from quadimpact.sweep.run import cpu_sample, default_workers, idle_cores
+
+    before = cpu_sample()
+    if before is None:
+        pytest.skip("no /proc/stat")
+    end = time.perf_counter() + 0.3
+    while time.perf_counter() < end:
+        pass
+    idle = idle_cores(before, cpu_sample())
+    assert idle is not None and 0.0 <= idle <= default_workers() - 0.5
 
 
 def _free_port() -> int:
@@ -436,75 +527,6 @@ def test_rerun_and_other_sweep_in_the_folder(serial_table, tmp_path):
     pd.testing.assert_frame_equal(resumed, full)
     with pytest.raises(InputError, match="holds a different sweep.*grid"):
         run_sweep(SweepSpec(base=BASE, grid={"heading_deg": [0]}), out, workers=1)
-
-
-def _wait_for_part(out: Path, proc: subprocess.Popen, timeout: float) -> None:
-    end = time.monotonic() + timeout
-    while time.monotonic() < end:
-        if list((out / "parts").glob("part-*.parquet")):
-            return
-        if proc.poll() is not None:
-            raise AssertionError(f"sweep ended before any part was written: {proc.returncode}")
-        time.sleep(0.01)
-    raise AssertionError("no part file appeared")
-
-
-def test_sigkill_and_resume(tmp_path):
-    grid = [
-        "--grid=heading_deg=0,45",
-        "--grid=inclination_deg=-20:20:1",
-        "--grid=speed_m_s=0.5,0.75,1.0,1.25",
-        "--grid=model=paper-replica",
-    ]
-    out = tmp_path / "killed"
-    proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "quadimpact.cli",
-            "sweep",
-            *grid,
-            "--out",
-            str(out),
-            "--workers",
-            "2",
-            "--no-progress",
-            "--no-plots",
-        ],  # fmt: skip
-        cwd=tmp_path,
-        env=_env(),
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.DEVNULL,
-        start_new_session=True,
-    )
-    try:
-        _wait_for_part(out, proc, timeout=60)
-    finally:
-        if proc.poll() is None:
-            os.killpg(proc.pid, signal.SIGKILL)  # the CLI, its forkserver and workers
-        proc.wait(timeout=10)
-    assert proc.returncode == -signal.SIGKILL
-    assert not (out / "runs.parquet").exists()
-    n_parts_rows = sum(len(pd.read_parquet(p)) for p in (out / "parts").glob("part-*.parquet"))
-    assert 0 < n_parts_rows < 328
-
-    done = _cli("sweep", *grid, "--out", str(out), "--workers", "2", "--no-progress",
-                "--no-plots", cwd=tmp_path)  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    assert f"{n_parts_rows} done before" in done.stdout
-
-    spec = SweepSpec(
-        grid={
-            "heading_deg": [0, 45],
-            "inclination_deg": "-20:20:1",
-            "speed_m_s": [0.5, 0.75, 1.0, 1.25],
-            "model": ["paper-replica"],
-        },
-    )
-    reference = run_sweep(spec, tmp_path / "reference", workers=2)
-    assert len(reference) == 328
-    pd.testing.assert_frame_equal(read_runs(out), reference)
-    assert not list((out / "parts").iterdir())
 
 
 # -------------------------------------------------------------------- CLI

@@ -16,7 +16,8 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
             "--workers",
             type=click.IntRange(min=1),
             metavar="N",
-            help="Local worker processes (1: in this process). [default: all cores]",
+            help="Local worker processes (1: in this process). [default: all cores, after "
+            "a start in this process; a sweep that takes under a second stays in it]",
         ),
         click.option(
             "--scheduler",

@@ -55,6 +55,20 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
     "command again to resume an interrupted sweep.",
 )
 @parallel_options
+@click.option(
+    "--timeout",
+    type=click.FloatRange(min=0, min_open=True),
+    metavar="SECONDS",
+    help="Longest time one run may take on a worker process or Dask; a run over it has "
+    "its worker stopped and is redone once on another worker, then recorded as failed. "
+    "[default: 60 s, more for long scenarios: 4 x the time the kernel's step budget "
+    "(2e6 steps per simulated second) takes at the measured cost of a step]",
+)
+@click.option(
+    "--allow-large",
+    is_flag=True,
+    help="Allow a sweep of more than 1,000,000 runs (refused otherwise).",
+)
 @click.option("--no-plots", is_flag=True, help="Do not write plots/.")
 def sweep(
     sweep_file: Path | None,
@@ -63,6 +77,8 @@ def sweep(
     workers: int | None,
     scheduler: str | None,
     no_progress: bool,
+    timeout: float | None,
+    allow_large: bool,
     no_plots: bool,
 ) -> None:
     """Run a sweep: one base scenario over a grid, a list or a random sample.
@@ -71,6 +87,12 @@ def sweep(
     or base = "scenario.toml") and the runs ([grid], [[runs]] or [sample]);
     without it the base is the paper's wall approach with its defaults and
     the runs are the --grid. Every run is validated before any starts.
+
+    Ctrl-C (any number of times) or SIGTERM stops the sweep at once and keeps
+    every finished run (exit status 130, 143 for SIGTERM); run the same
+    command again to resume: only the missing runs are done, and parts found
+    damaged are checked and redone. A worker process that dies or exceeds
+    --timeout costs only the run it was on, which is redone once elsewhere.
 
     Writes DIR/runs.parquet: one row per run with the swept inputs, the
     summary fields of `quadimpact run`, response_type (A, B, C, D, Other),
@@ -85,7 +107,14 @@ def sweep(
           --grid speed_m_s=0.5,0.75,1.0 --grid model=paper-replica --out fig4
       quadimpact sweep study.toml --grid restitution=0.2:0.8:0.1 --out restitution
     """
-    from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
+    from quadimpact.sweep import (
+        SweepInterrupted,
+        SweepSpec,
+        WorkerError,
+        load_sweep_file,
+        run_sweep,
+    )
+    from quadimpact.sweep.interrupt import stop_signals
 
     extra = _parse_grid(grid)
     if sweep_file is not None:
@@ -98,14 +127,21 @@ def sweep(
         spec = SweepSpec(grid=extra, where="sweep")
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
-    info = run_sweep(
-        spec,
-        out,
-        workers=workers,
-        scheduler=scheduler,
-        progress=not no_progress,
-        load=False,
-    )
+    # once stopped by a signal, every later one is ignored until the program has ended
+    with stop_signals(restore_after_stop=False):
+        try:
+            info = run_sweep(
+                spec,
+                out,
+                workers=workers,
+                scheduler=scheduler,
+                progress=not no_progress,
+                load=False,
+                timeout=timeout,
+                allow_large=allow_large,
+            )
+        except (SweepInterrupted, WorkerError) as exc:
+            raise click.exceptions.Exit(_stopped(exc)) from None
     plots: list[Path] = []
     if not no_plots:
         from quadimpact.sweep.plots import auto_plots
@@ -115,6 +151,21 @@ def sweep(
         except Exception as exc:  # plots never lose the table
             click.echo(f"quadimpact: warning: plots not written: {exc}", err=True)
     click.echo(_report(out, plots, info))
+
+
+def _stopped(exc: Exception) -> int:
+    """Say why the sweep stopped, what is saved, that a rerun resumes; the exit status."""
+    from quadimpact.sweep import SweepInterrupted
+    from quadimpact.sweep.interrupt import signal_name
+
+    resume = "run the same command again to resume"
+    if hasattr(exc, "saved"):
+        resume = f"{exc.saved} of {exc.n_runs} runs saved in {exc.out_dir}; {resume}"
+    if isinstance(exc, SweepInterrupted):
+        click.echo(f"quadimpact: interrupted by {signal_name(exc.signum)}: {resume}", err=True)
+        return exc.exit_code
+    click.echo(f"quadimpact: error: {getattr(exc, 'cause', exc)}; {resume}", err=True)
+    return 1
 
 
 def _report(out: Path, plots: list[Path], info: dict) -> str:

@@ -23,7 +23,7 @@ from quadimpact.core.run import RawRecord, default_sensors, run_builtin
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
 
-__all__ = ["simulate_batch"]
+__all__ = ["BatchRunner", "simulate_batch"]
 
 
 class _Buffers:
@@ -71,6 +71,24 @@ def _run(setup: RunSetup, buffers: _Buffers) -> tuple[RawRecord, float]:
     return rec, wall
 
 
+class BatchRunner:
+    """Runs scenarios one after another into output buffers it keeps (summaries only).
+
+    What :func:`simulate_batch` and a sweep worker use: ``runner.summary(scenario)``
+    is ``simulate(scenario).summary``, bit for bit, without building tables and
+    without allocating the output arrays again for each run.
+    """
+
+    def __init__(self, max_episodes: int = 1024) -> None:
+        self.buffers = _Buffers(max_episodes)
+
+    def summary(self, scenario: Any) -> dict[str, Any]:
+        """The summary of one validated scenario (raises as ``simulate`` does)."""
+        setup = prepare(scenario)
+        rec, wall = _run(setup, self.buffers)
+        return analyse(setup, scenario, rec, wall).summary
+
+
 def simulate_batch(
     scenarios: Sequence[Any],
     *,
@@ -95,13 +113,11 @@ def simulate_batch(
     list of dict
         One summary per scenario, in order.
     """
-    buffers = _Buffers(max_episodes)
+    runner = BatchRunner(max_episodes)
     summaries: list[dict[str, Any]] = []
     for i, scenario in enumerate(scenarios):
         try:
-            setup = prepare(scenario)
-            rec, wall = _run(setup, buffers)
-            summaries.append(analyse(setup, scenario, rec, wall).summary)
+            summaries.append(runner.summary(scenario))
         except Exception as exc:  # a run that cannot run is a failed summary; the batch goes on
             if on_error is not None:
                 summaries.append(dict(on_error(i, exc)))

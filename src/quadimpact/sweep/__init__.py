@@ -45,22 +45,38 @@ Output folder ``DIR``:
 * ``sweep.json``: the sweep, so that running it again resumes it (and a
   different sweep in the same folder is refused).
 * ``parts/``: completed runs while the sweep runs, in small Parquet files
-  written atomically (a part is complete or absent); merged into
-  ``runs.parquet`` at the end. A run again does only the missing runs.
+  written atomically (a part is complete or absent) and named after their
+  SHA-256; merged into ``runs.parquet`` at the end. A run again does only the
+  missing runs, after checking every part (checksum, schema, every value)
+  and ``runs.parquet``: what fails is redone, with a warning naming the file.
 
-Runs execute in parallel on local cores (``workers``), in-process
-(``workers=1``), or on a Dask cluster (``scheduler="tcp://host:port"``); all
-three call the same pure function :func:`run_chunk`.
+Runs execute in parallel on local worker processes (``workers``, default
+the cores this process may use), in-process (``workers=1``), or on a Dask
+cluster (``scheduler="tcp://host:port"``); all call the same pure function
+(:func:`run_chunk`, run by run). A run gets a time limit on workers
+(``timeout``, default derived from its final time and the measured cost of
+runs: :mod:`quadimpact.sweep.limits`); a run whose worker dies or exceeds it
+is redone once on another worker, then recorded as failed with the reason.
+Ctrl-C (any number of times) and SIGTERM stop the sweep promptly, keep what
+finished and raise :class:`SweepInterrupted`; run the sweep again to resume.
+Worker processes never outlive the sweep, even after ``kill -9``
+(:mod:`quadimpact.sweep.pool`). More than :data:`LARGE_SWEEP_RUNS` runs need
+``allow_large=True``. The details, with measurements: ``docs/SWEEPS.md``.
 """
 
-from quadimpact.sweep.run import run_sweep
+from quadimpact.sweep.interrupt import SweepInterrupted
+from quadimpact.sweep.pool import WorkerError
+from quadimpact.sweep.run import LARGE_SWEEP_RUNS, run_sweep
 from quadimpact.sweep.spec import SweepSpec, load_sweep_file, parse_values
 from quadimpact.sweep.store import SUMMARY_COLUMNS, flatten_summary, read_runs
 from quadimpact.sweep.worker import run_chunk
 
 __all__ = [
+    "LARGE_SWEEP_RUNS",
+    "SweepInterrupted",
     "SweepSpec",
     "SUMMARY_COLUMNS",
+    "WorkerError",
     "load_sweep_file",
     "parse_values",
     "read_runs",

@@ -1,22 +1,36 @@
 """Where a sweep's runs execute: in this process, a local process pool, or Dask.
 
-Each backend takes the chunks of missing runs (:func:`make_chunks`) and hands every
-chunk's rows to a ``sink`` as they complete; all call :func:`run_chunk`."""
+Each backend takes the chunks of missing runs (:func:`make_chunks`) and hands
+the rows of finished runs to a ``sink`` as they complete; all call
+:func:`~quadimpact.sweep.worker.run_item` (which :func:`run_chunk` repeats).
+The local pool is in :mod:`quadimpact.sweep.pool`."""
 
 from __future__ import annotations
 
 import contextlib
 import math
+import queue
 import re
+import time
 from collections import deque
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator
 from typing import Any
 
 from quadimpact.errors import InputError, format_value, one_line
+from quadimpact.sweep.interrupt import StopFlag
+from quadimpact.sweep.limits import QUEUED_CHUNKS, RunLimits, seconds
 from quadimpact.sweep.spec import SweepSpec
-from quadimpact.sweep.store import FLUSH_SECONDS, failed_row
-from quadimpact.sweep.worker import Item, init_pool_worker, run_chunk, worker_info
+from quadimpact.sweep.worker import (
+    Item,
+    failed_rows,
+    run_chunk_measured,
+    run_item,
+    warm_up,
+    worker_info,
+)
 
+Sink = Callable[[list[dict[str, Any]]], None]
+"""Takes the rows of finished runs (``[]``: a clock tick, so that waiting rows get written)."""
 
 # --------------------------------------------------------------- backends
 def make_chunks(spec: SweepSpec, todo: Any, size: int) -> Iterator[list[Item]]:
@@ -34,135 +48,18 @@ def make_chunks(spec: SweepSpec, todo: Any, size: int) -> Iterator[list[Item]]:
 
 
 def chunk_size(n_todo: int, slots: int) -> int:
-    # ~5-10 ms per run: chunks of up to 32 runs keep the per-task overhead
-    # (pickling, IPC) small, and about 8 chunks per worker keep them balanced.
+    """Runs per chunk: up to 32, and about 8 chunks per worker (balanced ends)."""
+    # ~5-30 ms per run: chunks of up to 32 runs keep the per-chunk overhead
+    # (pickling, a message each way) small; the pool's workers report every
+    # run, so the size only sets how work is shared out.
     return max(1, min(32, math.ceil(n_todo / (8 * max(1, slots)))))
 
 
-def run_serial(chunks: Iterator[list[Item]], sink: Callable[[list[dict]], None]) -> None:
+def run_serial(chunks: Iterator[list[Item]], sink: Sink) -> None:
+    """Run in this process, each finished run to ``sink`` at once (Ctrl-C keeps them)."""
     for chunk in chunks:
-        sink(run_chunk(chunk))
-
-
-def _pool_context() -> Any:
-    """Start method of the local worker pool.
-
-    ``forkserver``: workers are forked from a clean single-threaded server
-    process started once per parent (not from the parent, which may hold
-    pyarrow, Dask or matplotlib threads and locks that ``fork`` would copy in
-    a held state), and that server imports :mod:`quadimpact.sweep._preload`
-    first, which loads the simulator and the compiled kernel; so every pool
-    after the first starts in milliseconds with the kernel ready (``spawn``
-    would pay ~1 s of imports and cache loading per worker, per pool).
-    ``spawn`` where forkserver does not exist.
-    """
-    import multiprocessing as mp
-
-    if "forkserver" in mp.get_all_start_methods():
-        ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["quadimpact.sweep._preload"])
-        return ctx
-    return mp.get_context("spawn")
-
-
-def run_pool(
-    chunks: Iterator[list[Item]], workers: int, sink: Callable[[list[dict]], None]
-) -> None:
-    """Run the chunks on a local process pool, at most 3 chunks per worker in flight.
-
-    If a worker dies (a crash in native code, the OOM killer...), the pool is
-    broken: its unfinished chunks are redone one run at a time in a new pool,
-    and a run that kills a worker on its own is recorded as failed. If
-    workers die before finishing anything and a bare worker cannot start
-    either, the environment is at fault: RuntimeError.
-    """
-    ctx = _pool_context()
-    retry: deque[list[Item]] = deque()
-    source = iter(chunks)
-    while True:
-        lost, completed = _pool_pass(ctx, workers, source, retry, sink)
-        if lost is None:
-            return
-        if completed == 0 and not _pool_starts(ctx):
-            raise RuntimeError(
-                "sweep worker processes die at start-up (see the messages above); a script "
-                "that runs a sweep must guard its top level with `if __name__ == "
-                '"__main__":`, and code read from stdin cannot start workers (use workers=1)'
-            )
-        for chunk in lost:
-            if isinstance(chunk, _Isolated):
-                run_id, _data, inputs = chunk[0]
-                reason = "worker process died while running it (crash in native code?)"
-                sink([{"run_id": run_id, **inputs, **failed_row(reason, inputs)}])
-            else:
-                retry.extend(_Isolated([item]) for item in chunk)
-
-
-def _pool_pass(
-    ctx: Any,
-    workers: int,
-    source: Iterator[list[Item]],
-    retry: deque[list[Item]],
-    sink: Callable[[list[dict]], None],
-) -> tuple[list[list[Item]] | None, int]:
-    """One pool, until the work is done (None) or the pool breaks (its unfinished chunks)."""
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-    from concurrent.futures.process import BrokenProcessPool
-
-    executor = ProcessPoolExecutor(workers, mp_context=ctx, initializer=init_pool_worker)
-    pending: dict[Any, list[Item]] = {}
-    completed = 0
-    clean = False
-    try:
-        while True:
-            # runs redone after a crash go one at a time, so that a crash names its run
-            while len(pending) < (1 if retry or _has_isolated(pending) else 3 * workers):
-                chunk = retry.popleft() if retry else next(source, None)
-                if chunk is None:
-                    break
-                try:
-                    pending[executor.submit(run_chunk, chunk)] = chunk
-                except BrokenProcessPool:
-                    return [chunk, *pending.values()], completed
-            if not pending:
-                clean = True
-                return None, completed
-            done, _ = wait(list(pending), timeout=FLUSH_SECONDS / 2, return_when=FIRST_COMPLETED)
-            if not done:
-                sink([])  # no run finished for a while: write what is waiting
-            for fut in done:
-                try:
-                    rows = fut.result()
-                except BrokenProcessPool:
-                    return list(pending.values()), completed
-                del pending[fut]
-                sink(rows)
-                completed += 1
-    finally:
-        for fut in pending:
-            fut.cancel()
-        executor.shutdown(wait=clean, cancel_futures=True)
-
-
-def _pool_starts(ctx: Any) -> bool:
-    """Whether a one-worker pool can start and run a trivial task."""
-    from concurrent.futures import ProcessPoolExecutor
-    from concurrent.futures.process import BrokenProcessPool
-
-    with ProcessPoolExecutor(1, mp_context=ctx, initializer=init_pool_worker) as executor:
-        try:
-            executor.submit(worker_info).result(timeout=300)
-        except BrokenProcessPool:
-            return False
-    return True
-
-
-class _Isolated(list):
-    """A one-run chunk resubmitted after a worker died."""
-
-
-def _has_isolated(pending: Mapping[Any, list[Item]]) -> bool:
-    return any(isinstance(chunk, _Isolated) for chunk in pending.values())
+        for item in chunk:
+            sink([run_item(item)[0]])
 
 
 @contextlib.contextmanager
@@ -214,47 +111,193 @@ def dask_session(scheduler: Any) -> Iterator[tuple[Any, int]]:
                 f"Dask worker {worker} runs quadimpact {version}, this is {__version__}: "
                 "the table would not be reproducible"
             )
+        # load the kernel in every worker now: the chunks' clocks should not count it
+        with contextlib.suppress(Exception):
+            client.run(warm_up)
         yield client, sum(client.nthreads().values()) or 1
     finally:
         if own:
             client.close()
 
 
-def run_dask(
-    client: Any, threads: int, chunks: Iterator[list[Item]], sink: Callable[[list[dict]], None]
-) -> None:
-    """Submit the chunks (at most 3 per worker thread in flight), write them as they complete."""
-    from dask.distributed import as_completed
+DASK_FIRST_NOTE_S = 5.0
+"""Without any Dask worker for this long, say so (then every ``DASK_NOTE_EVERY_S``)."""
+DASK_NOTE_EVERY_S = 30.0
+DASK_POLL_S = 0.25
 
-    max_pending = 3 * threads
-    queue = as_completed(loop=client.loop)
-    pending: dict[Any, list[Item]] = {}
 
-    def submit_more() -> None:
-        while len(pending) < max_pending:
-            chunk = next(chunks, None)
-            if chunk is None:
+class _DaskTask:
+    """A chunk on Dask: its runs, its losses, and the time it waited with workers present."""
+
+    def __init__(self, items: list[Item], lost: int = 0, avoid: str | None = None) -> None:
+        self.items = items
+        self.lost = lost
+        self.avoid = avoid
+        self.active_s = 0.0
+
+
+class _Dask:
+    """The Dask loop of :func:`run_dask`."""
+
+    def __init__(self, client: Any, limits: RunLimits, sink: Sink, note: Callable[[str], None]):
+        self.client = client
+        self.limits = limits
+        self.sink = sink
+        self.note = note
+        self.done: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self.pending: dict[Any, _DaskTask] = {}
+        self.retry: deque[_DaskTask] = deque()
+        self.threads = 0
+        self.last_look = time.monotonic()
+        self.without_workers = 0.0  # s without any worker, so far
+        self.next_note = DASK_FIRST_NOTE_S
+        self.last_result = time.monotonic()
+
+    def submit(self, task: _DaskTask) -> None:
+        workers = None
+        if task.avoid is not None:
+            others = [w for w in self.client.nthreads() if w != task.avoid]
+            workers = others or None
+        fut = self.client.submit(
+            run_chunk_measured,
+            task.items,
+            pure=False,
+            workers=workers,
+            allow_other_workers=workers is not None,
+        )
+        self.pending[fut] = task
+        fut.add_done_callback(self.done.put)
+
+    def run(self, chunks: Iterator[list[Item]], stop: StopFlag) -> None:
+        source: Iterator[list[Item]] | None = chunks
+        self.look()
+        while True:
+            stop.check()
+            while len(self.pending) < QUEUED_CHUNKS * max(1, self.threads):
+                if self.retry:
+                    task = self.retry.popleft()
+                elif source is not None and (chunk := next(source, None)) is not None:
+                    task = _DaskTask(chunk)
+                else:
+                    source = None
+                    break
+                self.submit(task)
+            if not self.pending:
                 return
-            fut = client.submit(run_chunk, chunk, pure=False)
-            pending[fut] = chunk
-            queue.add(fut)
-
-    submit_more()
-    try:
-        for fut in queue:
-            chunk = pending.pop(fut)
             try:
-                rows = fut.result()
-            except Exception as exc:  # worker lost too often (KilledWorker...)
-                reason = f"Dask task failed: {type(exc).__name__}: {one_line(str(exc))}"
-                rows = [
-                    {"run_id": rid, **inp, **failed_row(reason, inp)} for rid, _d, inp in chunk
-                ]
+                fut = self.done.get(timeout=DASK_POLL_S)
+            except queue.Empty:
+                fut = None
+            stop.check()
+            if fut is None:
+                self.sink([])
+            while fut is not None:
+                if fut in self.pending:
+                    self.finished(fut, self.pending.pop(fut))
+                try:
+                    fut = self.done.get_nowait()
+                except queue.Empty:
+                    fut = None
+            if time.monotonic() - self.last_look >= 1.0:
+                self.look()
+
+    def finished(self, fut: Any, task: _DaskTask) -> None:
+        if fut.status == "finished":
+            rows, costs = fut.result()
             fut.release()
-            sink(rows)
-            submit_more()
+            for cost in costs:
+                self.limits.record(cost)
+            self.last_result = time.monotonic()
+            self.sink(rows)
+            return
+        try:
+            exc = fut.exception()
+            why = f"{type(exc).__name__}: {one_line(str(exc))}"
+        except Exception as error:  # cancelled...
+            why = f"{type(error).__name__}: {one_line(str(error))}"
+        fut.release()
+        self.lost(task, f"Dask task failed ({why})", None)
+
+    def lost(self, task: _DaskTask, why: str, avoid: str | None) -> None:
+        """Redo a lost chunk's runs once each (elsewhere), then record them as failed."""
+        if task.lost:
+            reason = f"{why}, twice"
+            self.note(f"warning: run {task.items[0][0]}: {reason}; recorded as failed")
+            self.sink(failed_rows(task.items, reason))
+            return
+        first, last = task.items[0][0], task.items[-1][0]
+        runs = f"run {first}" if first == last else f"runs {first}-{last}"
+        self.note(f"warning: {runs}: {why}; redoing {'it' if first == last else 'them one by one'}")
+        self.retry.extend(_DaskTask([item], lost=1, avoid=avoid) for item in task.items)
+
+    def look(self) -> None:
+        """Count the workers, advance the chunks' clocks, time out and say what is awaited."""
+        now = time.monotonic()
+        elapsed, self.last_look = now - self.last_look, now
+        try:
+            self.threads = sum(self.client.nthreads().values())
+        except Exception:  # the scheduler is unreachable: as if no worker
+            self.threads = 0
+        if self.threads == 0:
+            self.without_workers += elapsed
+            if self.without_workers >= self.next_note:
+                self.next_note = self.without_workers + DASK_NOTE_EVERY_S
+                self.note(
+                    f"waiting for Dask workers: none connected for {self.without_workers:.0f} s "
+                    f"({len(self.pending)} chunks waiting; Ctrl-C stops, a rerun resumes)"
+                )
+            return
+        self.without_workers, self.next_note = 0.0, DASK_FIRST_NOTE_S
+        late = []
+        for fut, task in self.pending.items():
+            task.active_s += elapsed
+            if task.active_s > self.limits.chunk_limit(task.items):
+                late.append((fut, task))
+        if late:
+            where = _processing_workers(self.client)
+            for fut, task in late:
+                del self.pending[fut]
+                self.client.cancel([fut])
+                limit = self.limits.chunk_limit(task.items)
+                self.lost(task, f"no result within {seconds(limit)} s", where.get(fut.key))
+        if now - self.last_result >= DASK_NOTE_EVERY_S:
+            self.last_result = now
+            oldest = max((t.active_s for t in self.pending.values()), default=0.0)
+            self.note(
+                f"waiting for {len(self.pending)} Dask chunks on {self.threads} worker threads "
+                f"(the oldest for {oldest:.0f} s)"
+            )
+
+
+def _processing_workers(client: Any) -> dict[Any, str]:
+    """Task key -> the worker processing it."""
+    try:
+        return {key: w for w, keys in client.processing().items() for key in keys}
+    except Exception:
+        return {}
+
+
+def run_dask(
+    client: Any,
+    chunks: Iterator[list[Item]],
+    sink: Sink,
+    *,
+    limits: RunLimits,
+    stop: StopFlag,
+    note: Callable[[str], None],
+) -> None:
+    """Run the chunks on Dask (up to 3 per worker thread in flight), rows to ``sink``.
+
+    A chunk that fails (its workers died: ``KilledWorker``) or exceeds its
+    time limit is redone once, one run per task and away from the worker it
+    was on; what is lost again is recorded as failed. Without workers it
+    waits, and says so every 30 s.
+    """
+    loop = _Dask(client, limits, sink, note)
+    try:
+        with stop.polled():
+            loop.run(chunks, stop)
     except BaseException:
-        client.cancel(list(pending))
+        with contextlib.suppress(Exception):
+            client.cancel(list(loop.pending))
         raise
-
-

@@ -66,6 +66,14 @@ class Progress:
                 if self.done < self.total:
                     self._print(self._line() + "\n")
 
+    def note(self, line: str) -> None:
+        """Print a message line on the stream (even when the bar is off), then the bar again."""
+        if self.enabled and self.tty:
+            self._print("\r\x1b[K" + line + "\n")
+            self._draw()
+        else:
+            self._print(line + "\n")
+
     def _draw(self) -> None:
         self.drawn = self.done
         self._print("\r" + self._line() + "\x1b[K")

@@ -6,18 +6,27 @@ import contextlib
 import os
 import sys
 import time
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
 from quadimpact.errors import InputError, format_value
 from quadimpact.sweep.backends import (
+    Sink,
     chunk_size,
     dask_session,
     make_chunks,
     run_dask,
-    run_pool,
     run_serial,
+)
+from quadimpact.sweep.interrupt import SweepInterrupted, signal_name, stop_signals
+from quadimpact.sweep.limits import RunLimits
+from quadimpact.sweep.pool import (
+    WorkerError,
+    pool_context,
+    run_pool,
+    server_ready,
+    start_server,
 )
 from quadimpact.sweep.progress import Progress
 from quadimpact.sweep.spec import SweepSpec
@@ -30,15 +39,43 @@ from quadimpact.sweep.store import (
     scan_done,
     schema_of,
 )
+from quadimpact.sweep.worker import warm_up
+
+LARGE_SWEEP_RUNS = 1_000_000
+"""Sweeps with more runs than this need ``allow_large=True`` (``--allow-large``)."""
+FINISH_HERE_S = 1.0
+"""A default sweep finishes in this process when its runs left would take less than this, s."""
+MEASURE_S = 0.25
+"""A default sweep measures the idle cores over its first runs for this long, s."""
+START_HERE_MAX_S = 3.0
+"""Longest a default sweep runs in this process waiting for the pool's server to warm up, s."""
+VALIDATION_NOTE_RUNS = 100_000
+"""From this many runs on, say that the runs are being checked (it takes a while)."""
 
 
 # --------------------------------------------------------------- run_sweep
+def default_workers() -> int:
+    """The default number of local worker processes: the cores this process may use."""
+    try:
+        return len(os.sched_getaffinity(0)) or 1
+    except (AttributeError, OSError):
+        return os.cpu_count() or 1
+
+
 def _resolve_workers(workers: int | None) -> int:
     if workers is None:
-        return os.cpu_count() or 1
+        return default_workers()
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InputError(f"--workers: must be an integer >= 1 (got {format_value(workers)})")
     return workers
+
+
+def _note(message: str, bar: Progress | None = None) -> None:
+    line = f"quadimpact: {message}"
+    if bar is not None:
+        bar.note(line)
+    else:
+        print(line, file=sys.stderr, flush=True)
 
 
 def run_sweep(
@@ -49,6 +86,8 @@ def run_sweep(
     progress: bool = False,
     *,
     load: bool = True,
+    timeout: float | None = None,
+    allow_large: bool = False,
 ) -> Any:
     """Run a sweep into ``out_dir`` (resuming whatever is already there) and return its table.
 
@@ -59,10 +98,14 @@ def run_sweep(
     out_dir : path-like
         Output folder (created): ``runs.parquet``, ``sweep.json``, ``parts/``.
         If it holds an unfinished run of the same sweep, only the missing runs
-        are done; a different sweep there is refused.
+        are done (parts that fail their checks are redone, with a warning
+        naming the file); a different sweep there is refused.
     workers : int, optional
-        Local processes; default all cores (``os.cpu_count()``); 1 runs in
-        this process.
+        Local worker processes; 1 runs in this process. Default: the cores
+        this process may use (:func:`default_workers`), after a measured
+        start in this process: the first runs are done here while the pool's
+        server loads the kernel, and a sweep whose runs left would take less
+        than :data:`FINISH_HERE_S` here is finished here (no process started).
     scheduler : str or dask.distributed.Client, optional
         Address of a running Dask scheduler (``"tcp://host:port"``), or a
         client: the runs go to its workers instead (``workers`` must then be
@@ -73,6 +116,14 @@ def run_sweep(
         Return the table (default); ``False`` returns only the run information
         dict below (for very large sweeps: read columns of ``runs.parquet`` as
         needed).
+    timeout : float, keyword, optional
+        Longest time a run may take on a worker, s (``--timeout``); default
+        derived from each run's final time and the measured cost of runs
+        (:mod:`quadimpact.sweep.limits`). A run over it has its worker killed
+        and is redone once on another worker, then recorded as failed. Not
+        applied to runs in this process (``workers=1``).
+    allow_large : bool, keyword
+        Allow more than :data:`LARGE_SWEEP_RUNS` runs.
 
     Returns
     -------
@@ -85,7 +136,12 @@ def run_sweep(
     ------
     InputError
         A bad sweep (before anything runs), a folder holding another sweep,
-        a bad ``workers``/``scheduler``.
+        a bad ``workers``/``scheduler``/``timeout``, too many runs.
+    SweepInterrupted
+        SIGINT (Ctrl-C) or SIGTERM came (any number of times): the workers
+        are stopped, the finished runs saved; running the sweep again resumes.
+    WorkerError
+        Worker processes could not be started (the finished runs are saved).
     """
     start = time.perf_counter()
     if not isinstance(spec, SweepSpec):
@@ -93,54 +149,77 @@ def run_sweep(
     if scheduler is not None and workers is not None:
         raise InputError("give workers or scheduler, not both")
     n_workers = 1 if scheduler is not None else _resolve_workers(workers)
-    spec.validate()
-    schema = schema_of(spec)
-
+    limits = RunLimits(timeout)
+    if spec.n_runs > LARGE_SWEEP_RUNS and not allow_large:
+        raise InputError(
+            f"{spec.where}: {spec.n_runs} runs, more than {LARGE_SWEEP_RUNS}: confirm with "
+            "--allow-large (allow_large=True) to run it"
+        )
     out = Path(out_dir)
     if out.exists() and not out.is_dir():
         raise InputError(f"{out}: not a folder")
 
-    def warn(message: str) -> None:
-        print(f"quadimpact: warning: {message}", file=sys.stderr)
+    saved = 0  # finished runs in the folder, as far as known
+    try:
+        with stop_signals() as stop, contextlib.ExitStack() as stack:
+            if workers is not None and n_workers > 1 and spec.n_runs > 1:
+                start_server(pool_context())  # it loads the kernel while the runs are checked
+            if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
+                _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
+            spec.validate()
+            schema = schema_of(spec)
+            client, threads = (
+                stack.enter_context(dask_session(scheduler)) if scheduler is not None else (None, 0)
+            )
+            (out / "parts").mkdir(parents=True, exist_ok=True)
+            stack.enter_context(folder_lock(out))
+            check_folder(out, spec, schema)
+            done, last_part = scan_done(out, spec.n_runs, schema, lambda m: _note(f"warning: {m}"))
+            n_before = saved = int(done.sum())
+            todo = (i for i in range(spec.n_runs) if not done[i])
+            n_todo = spec.n_runs - n_before
+            backend = "none"
+            if n_todo:
+                writer = PartWriter(out / "parts", schema, last_part)
+                bar = Progress(spec.n_runs, n_before, enabled=progress)
 
-    with contextlib.ExitStack() as stack:
-        client, threads = (
-            stack.enter_context(dask_session(scheduler)) if scheduler is not None else (None, 0)
-        )
-        (out / "parts").mkdir(parents=True, exist_ok=True)
-        stack.enter_context(folder_lock(out))
-        check_folder(out, spec, schema)
-        done, last_part = scan_done(out, spec.n_runs, warn)
-        n_before = int(done.sum())
-        todo = (i for i in range(spec.n_runs) if not done[i])
-        n_todo = spec.n_runs - n_before
-        backend = "none"
-        if n_todo:
-            writer = PartWriter(out / "parts", schema, last_part)
-            bar = Progress(spec.n_runs, n_before, enabled=progress)
+                def sink(rows: list[dict[str, Any]]) -> None:
+                    writer.add(rows)
+                    if rows:
+                        bar.update(len(rows))
 
-            def sink(rows: list[dict[str, Any]]) -> None:
-                writer.add(rows)
-                if rows:
-                    bar.update(len(rows))
+                def note(message: str) -> None:
+                    _note(message, bar)
 
-            try:
-                if client is not None:
-                    backend = f"dask, {threads} threads"
-                    chunks = make_chunks(spec, todo, chunk_size(n_todo, threads))
-                    run_dask(client, threads, chunks, sink)
-                elif n_workers == 1 or n_todo == 1:
-                    backend = "serial"
-                    run_serial(make_chunks(spec, todo, 16), sink)
-                else:
-                    n_workers = min(n_workers, n_todo)
-                    backend = f"{n_workers} processes"
-                    chunks = make_chunks(spec, todo, chunk_size(n_todo, n_workers))
-                    run_pool(chunks, n_workers, sink)
-            finally:
-                writer.flush()  # also on Ctrl-C: keep every finished run
-                bar.close()
-        consolidate(out, schema, spec.n_runs)
+                try:
+                    if client is not None:
+                        backend = f"dask, {threads} threads"
+                        chunks = make_chunks(spec, todo, chunk_size(n_todo, threads))
+                        run_dask(client, chunks, sink, limits=limits, stop=stop, note=note)
+                    elif n_workers == 1 or n_todo == 1:
+                        backend = "serial"
+                        run_serial(make_chunks(spec, todo, 16), sink)
+                    else:
+                        n_here = 0
+                        if workers is None:  # the default: a measured start here
+                            n_here, n_workers = _start_here(spec, todo, n_todo, sink, n_workers)
+                        n_left = n_todo - n_here
+                        if n_left:
+                            n_workers = min(n_workers, n_left)
+                            chunks = make_chunks(spec, todo, chunk_size(n_left, n_workers))
+                            run_pool(chunks, n_workers, sink, limits=limits, stop=stop, note=note)
+                        backend = (
+                            "serial" if not n_left
+                            else f"{n_workers} processes" if not n_here
+                            else f"{n_workers} processes, the first {n_here} runs in this one"
+                        )
+                finally:
+                    writer.flush()  # also on Ctrl-C or an error: keep every finished run
+                    bar.close()
+                    saved = n_before + writer.rows_written
+            consolidate(out, schema, spec.n_runs)
+    except (SweepInterrupted, WorkerError) as exc:
+        raise _stopped(exc, saved, spec.n_runs, out) from None
 
     info = {
         "n_runs": spec.n_runs,
@@ -156,3 +235,113 @@ def run_sweep(
     table.attrs["sweep"] = info
     return table
 
+
+def _start_here(
+    spec: SweepSpec, todo: Iterator[int], n_todo: int, sink: Sink, cores: int
+) -> tuple[int, int]:
+    """The default start of a sweep on several cores: measured runs in this process.
+
+    The sweep process loads the kernel and does runs, timing them and
+    measuring how idle the cores it may use are (``/proc/stat``). It
+    finishes the sweep itself when the runs left would take less than
+    :data:`FINISH_HERE_S` here, or when after :data:`MEASURE_S` fewer than
+    one other core is idle (a pool would only compete with the other work
+    for the same cores). Otherwise it starts the pool's fork server with one
+    worker per idle core (and this one) and goes on here until the server has
+    loaded its own kernel (``pool.server_ready``; at most
+    :data:`START_HERE_MAX_S`), so that no time is lost waiting for it.
+    ``docs/SWEEPS.md`` has the measurements.
+
+    Returns
+    -------
+    (int, int)
+        Runs done here, and the pool's workers for the rest (1: none left).
+    """
+    warm_up()
+    ctx = pool_context()
+    started: float | None = None
+    workers = 1
+    busy, n_here = 0.0, 0
+    t0, sample0 = time.perf_counter(), cpu_sample()
+    for chunk in make_chunks(spec, todo, 1):  # one id at a time from the shared iterator
+        t = time.perf_counter()
+        run_serial(iter([chunk]), sink)
+        now = time.perf_counter()
+        busy += now - t
+        n_here += 1
+        if (n_todo - n_here) * busy / n_here < FINISH_HERE_S:
+            break  # less than that left: finish here
+        if started is None:
+            if now - t0 < MEASURE_S:
+                continue
+            workers = pool_size(idle_cores(sample0, cpu_sample()), cores)
+            if workers < 2:
+                break  # the other cores are busy: finish here
+            start_server(ctx)  # it loads the kernel while the runs go on here
+            started = now
+        elif server_ready(ctx) or now - started > START_HERE_MAX_S:
+            return n_here, workers
+    run_serial(make_chunks(spec, todo, 16), sink)
+    return n_todo, 1
+
+
+def pool_size(idle: float | None, cores: int) -> int:
+    """Workers for a default sweep: this core and every other idle one (half idle counts).
+
+    ``idle`` is the idle CPUs measured while this process was busy (None:
+    unknown, then every core).
+    """
+    if idle is None:
+        return cores
+    return max(1, min(cores, int(idle + 1.5)))
+
+
+def cpu_sample() -> dict[int, tuple[int, int]] | None:
+    """(idle, total) clock ticks of each CPU this process may use (``/proc/stat``; else None)."""
+    try:
+        cpus = os.sched_getaffinity(0)
+        sample = {}
+        with open("/proc/stat", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("cpu") and line[3].isdigit():
+                    name, *fields = line.split()
+                    ticks = [int(v) for v in fields[:8]]
+                    if int(name[3:]) in cpus:
+                        sample[int(name[3:])] = (ticks[3] + ticks[4], sum(ticks))
+        return sample or None
+    except (OSError, AttributeError, ValueError, IndexError):
+        return None
+
+
+def idle_cores(
+    before: dict[int, tuple[int, int]] | None, after: dict[int, tuple[int, int]] | None
+) -> float | None:
+    """How many of those CPUs were idle between two :func:`cpu_sample` (None: unknown)."""
+    if not before or not after:
+        return None
+    idle = 0.0
+    for cpu in before.keys() & after.keys():
+        ticks = after[cpu][1] - before[cpu][1]
+        if ticks <= 0:
+            return None
+        idle += (after[cpu][0] - before[cpu][0]) / ticks
+    return idle
+
+
+def _stopped(
+    exc: SweepInterrupted | WorkerError, saved: int, n_runs: int, out: Path
+) -> SweepInterrupted | WorkerError:
+    """The same error, saying what is saved and that running the sweep again resumes it.
+
+    The new error also has the attributes ``cause`` (the original message),
+    ``saved`` (finished runs in the folder), ``n_runs`` and ``out_dir``.
+    """
+    resume = f"{saved} of {n_runs} runs saved in {out}; run the sweep again to resume"
+    if isinstance(exc, SweepInterrupted):
+        error: SweepInterrupted | WorkerError = SweepInterrupted(
+            exc.signum, f"sweep interrupted by {signal_name(exc.signum)}: {resume}"
+        )
+    else:
+        error = WorkerError(f"{exc}; {resume}")
+    error.cause, error.saved, error.n_runs, error.out_dir = str(exc), saved, n_runs, out  # type: ignore[union-attr]
+    return error

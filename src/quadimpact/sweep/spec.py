@@ -9,7 +9,7 @@ import math
 import os
 import re
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from decimal import ROUND_FLOOR, Decimal
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -39,25 +39,35 @@ def _scalar(text: str) -> Any:
 
 
 def _range(text: str, where: str) -> list[Any]:
-    """Inclusive ``start:stop:step`` in exact decimal arithmetic (no float drift)."""
+    """Inclusive ``start:stop:step`` in exact arithmetic (no float drift).
+
+    The three numbers are scaled to integers by a common power of ten, so that
+    value ``k`` is the exact ratio ``(start + k step) 10^d / 10^d``, rounded
+    once to the nearest float (Python's integer division is correctly
+    rounded): ``0:0.3:0.1`` ends at 0.3. Linear in the number of values.
+    """
     parts = [p.strip() for p in text.split(":")]
     if len(parts) != 3:
         raise InputError(f"{where}a range is start:stop:step (got {text!r})")
     if not all(_NUM_RE.match(p) for p in parts):
         raise InputError(f"{where}range start, stop and step must be numbers (got {text!r})")
-    start, stop, step = (Decimal(p) for p in parts)
+    numbers = [Decimal(p) for p in parts]
+    digits = max(0, *(-int(n.as_tuple().exponent) for n in numbers))
+    scale = 10**digits
+    start, stop, step = (int(n.scaleb(digits)) for n in numbers)
     if step == 0:
         raise InputError(f"{where}range step must not be 0 (got {text!r})")
-    count = int(((stop - start) / step).to_integral_value(rounding=ROUND_FLOOR)) + 1
+    count = (stop - start) // step + 1
     if count < 1:
         raise InputError(
             f"{where}empty range: the step must lead from start to stop (got {text!r})"
         )
     if count > MAX_RUNS:
         raise InputError(f"{where}range has {count} values, more than {MAX_RUNS} (got {text!r})")
-    integral = all(_INT_RE.match(p) for p in parts)
-    values = (start + k * step for k in range(count))
-    return [int(v) if integral else float(v) for v in values]
+    scaled = range(start, start + count * step, step)
+    if all(_INT_RE.match(p) for p in parts):
+        return list(scaled)
+    return [k / scale for k in scaled]
 
 
 def parse_values(text: str, field: str = "") -> list[Any]:
@@ -115,8 +125,14 @@ def _is_number(v: Any) -> bool:
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
+_PLAIN_TYPES = {bool: "b", int: "f", float: "f", str: "s"}
+
+
 def _column_kind(values: Iterable[Any]) -> str:
     values = list(values)
+    kinds = {_PLAIN_TYPES.get(t, "?") for t in set(map(type, values))}
+    if len(kinds) == 1 and "?" not in kinds:  # plain values of one kind (the fast path)
+        return kinds.pop()
     if all(isinstance(v, bool) for v in values):
         return "b"
     if all(_is_number(v) for v in values):
@@ -135,6 +151,35 @@ def _column_value(value: Any, kind: str) -> Any:
     if kind == "j":
         return canonical(value)
     return value
+
+
+def _value_key(value: Any) -> Any:
+    """A hashable key under which two swept values are the same value.
+
+    Numbers compare as floats (``0`` and ``0.0`` are one value; ``-0.0``
+    stays apart from ``0.0``, as in the canonical JSON), anything else by its
+    canonical JSON text.
+    """
+    if _is_number(value):
+        number = float(value)
+        return ("number", number, math.copysign(1.0, number))
+    return ("json", canonical(value))
+
+
+def _first_duplicate(values: Sequence[Any]) -> Any:
+    """The first value listed a second time (see :func:`_value_key`), or None; linear time."""
+    if set(map(type, values)) <= {int, float}:
+        # plain numbers: floats in a set (which also merges -0.0 and 0.0, so a
+        # smaller set only means "look closer")
+        if len(set(map(float, values))) == len(values):
+            return None
+    seen: set[Any] = set()
+    for v in values:
+        key = _value_key(v)
+        if key in seen:
+            return v
+        seen.add(key)
+    return None
 
 
 def _short(inputs: Mapping[str, Any]) -> str:
@@ -239,7 +284,8 @@ class SweepSpec:
         self.columns: dict[str, str] = {k: _column_kind(v) for k, v in fields.items()}
         # numbers as floats (one type per column, so equal sweeps compare equal)
         for k, values in self.grid.items():
-            self.grid[k] = [_column_value(v, "f") if self.columns[k] == "f" else v for v in values]
+            if self.columns[k] == "f":
+                self.grid[k] = list(map(float, values))
         for entry in self.runs or []:
             for k, v in entry.items():
                 if self.columns[k] == "f":
@@ -294,16 +340,15 @@ class SweepSpec:
         if not out:
             raise InputError(f"{where}: no values")
         self._check_values(where, out)
-        seen: list[Any] = []
-        for v in out:
-            key = canonical(float(v) if _is_number(v) else v)
-            if key in seen:
-                raise InputError(f"{where}: value {format_value(v)} is listed twice")
-            seen.append(key)
+        twice = _first_duplicate(out)
+        if twice is not None:
+            raise InputError(f"{where}: value {format_value(twice)} is listed twice")
         return out
 
     @staticmethod
-    def _check_values(where: str, values: Iterable[Any]) -> None:
+    def _check_values(where: str, values: Sequence[Any]) -> None:
+        if set(map(type, values)) <= {int, str, bool}:
+            return  # neither None nor a float (the fast path for long ranges)
         for v in values:
             if v is None:
                 raise InputError(f"{where}: values must not be empty (got None)")

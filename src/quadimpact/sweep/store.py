@@ -1,15 +1,20 @@
 """The sweep's Parquet store: the table's schema, its rows, part files, resume and merge.
 
 The run rows (:func:`flatten_summary`, :data:`SUMMARY_COLUMNS`) are written in
-small atomic part files as the runs finish (:class:`PartWriter`); a sweep run
-again finds what is done (:func:`scan_done`) and finally everything is merged,
-sorted by ``run_id``, into ``runs.parquet`` (:func:`consolidate`).
-``sweep.json`` records the sweep (:func:`check_folder`), and a lock keeps two
-sweeps from writing one folder (:func:`folder_lock`)."""
+small atomic part files as the runs finish (:class:`PartWriter`), each named
+after the SHA-256 of its bytes (``part-000012-<16 hex digits>.parquet``) and
+with Parquet's page checksums. A sweep run again checks every part fully
+(checksum, schema, every value decoded) and ``runs.parquet`` row group by row
+group; what fails is redone, with a warning naming the file
+(:func:`scan_done`). Finally everything is merged, sorted by ``run_id``, into
+``runs.parquet`` (:func:`consolidate`). ``sweep.json`` records the sweep
+(:func:`check_folder`), and a lock keeps two sweeps from writing one folder
+(:func:`folder_lock`)."""
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import math
 import os
@@ -202,49 +207,162 @@ class PartWriter:
             self.flush()
 
     def flush(self) -> None:
+        """Write the waiting rows as one part."""
         if not self.buffer:
             return
         import pyarrow as pa
-        import pyarrow.parquet as pq
 
-        table = pa.Table.from_pylist(self.buffer, schema=self.schema).sort_by("run_id")
-        self.seq += 1
-        path = self.parts / f"part-{self.seq:06d}.parquet"
-        atomic_write(path, lambda tmp: pq.write_table(table, tmp), durable=True)
-        self.rows_written += len(self.buffer)
+        self.write(pa.Table.from_pylist(self.buffer, schema=self.schema).sort_by("run_id"))
         self.buffer = []
 
+    def write(self, table: Any) -> Path:
+        """Write ``table`` as the next part: checksummed, atomic and durable."""
+        import pyarrow as pa
+        import pyarrow.parquet as pq
 
-_PART_RE = re.compile(r"^part-(\d+)\.parquet$")
+        stream = pa.BufferOutputStream()
+        pq.write_table(table, stream, write_page_checksum=True)
+        data = stream.getvalue().to_pybytes()
+        self.seq += 1
+        path = self.parts / f"part-{self.seq:06d}-{_digest(data)}.parquet"
+        atomic_write(path, lambda tmp: tmp.write_bytes(data), durable=True)
+        self.rows_written += table.num_rows
+        return path
 
 
-def scan_done(out: Path, n_runs: int, warn: Callable[[str], None]) -> tuple[Any, int]:
-    """Mask of run_ids already written (runs.parquet and parts), and the last part number."""
+def _digest(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()[:16]
+
+
+_PART_RE = re.compile(r"^part-(\d+)(?:-([0-9a-f]{16}))?\.parquet$")
+"""A part's name: its number and the start of its SHA-256 (absent in older parts)."""
+
+
+class BadFile(Exception):
+    """A part or table that fails its checks (the message says which check)."""
+
+
+def _check_schema(found: Any, schema: Any) -> None:
+    expected = {f.name: f.type for f in schema}
+    have = {f.name: f.type for f in found}
+    for name, kind in expected.items():
+        if name not in have:
+            raise BadFile(f"column {name!r} missing")
+        if have[name] != kind:
+            raise BadFile(f"column {name!r} is {have[name]}, expected {kind}")
+    extra = sorted(set(have) - set(expected))
+    if extra:
+        raise BadFile(f"unexpected column {extra[0]!r}")
+
+
+def _check_ids(table: Any, n_runs: int) -> Any:
+    ids = table.column("run_id")
+    if ids.null_count:
+        raise BadFile("null run_id")
+    ids = ids.to_numpy()
+    if len(ids) and (ids.min() < 0 or ids.max() >= n_runs):
+        raise BadFile(f"run_id outside 0..{n_runs - 1}")
+    return ids
+
+
+def check_part(path: Path, schema: Any, n_runs: int) -> Any:
+    """The run_ids of a part that passes every check; else :class:`BadFile`.
+
+    Checks: its bytes against the checksum in its name, its schema (every
+    column, with its type, and no other), every page decoded with its
+    Parquet checksum verified, run_ids in range.
+    """
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    match = _PART_RE.match(path.name)
+    data = path.read_bytes()
+    if match and match.group(2) and _digest(data) != match.group(2):
+        raise BadFile("its checksum does not match its content")
+    try:
+        file = pq.ParquetFile(pa.BufferReader(data), page_checksum_verification=True)
+        _check_schema(file.schema_arrow, schema)
+        table = file.read()
+    except BadFile:
+        raise
+    except Exception as exc:
+        raise BadFile(one_line(f"{type(exc).__name__}: {exc}")) from None
+    return _check_ids(table, n_runs)
+
+
+def _check_table(path: Path, schema: Any, n_runs: int, writer: PartWriter) -> tuple[Any, str]:
+    """run_ids of ``runs.parquet`` that pass the checks, and what failed ('' if nothing).
+
+    Checked row group by row group (flat memory); if one fails, the good ones
+    are written as new parts and ``runs.parquet`` is removed.
+    """
     import numpy as np
     import pyarrow.parquet as pq
+
+    try:
+        file = pq.ParquetFile(path, page_checksum_verification=True)
+        _check_schema(file.schema_arrow, schema)
+    except BadFile as exc:
+        return np.zeros(0, dtype=np.int64), str(exc)
+    except Exception as exc:
+        return np.zeros(0, dtype=np.int64), one_line(f"{type(exc).__name__}: {exc}")
+    good, problem = [], ""
+    with file:
+        for i in range(file.num_row_groups):
+            try:
+                group = file.read_row_group(i)
+                good.append((group, _check_ids(group, n_runs)))
+            except Exception as exc:
+                detail = str(exc) if isinstance(exc, BadFile) else f"{type(exc).__name__}: {exc}"
+                problem = problem or one_line(f"row group {i}: {detail}")
+    if not problem:
+        return np.concatenate([ids for _, ids in good] or [np.zeros(0, np.int64)]), ""
+    for group, _ids in good:
+        writer.write(group.cast(schema))
+    path.unlink()
+    return np.concatenate([ids for _, ids in good] or [np.zeros(0, np.int64)]), problem
+
+
+def scan_done(
+    out: Path, n_runs: int, schema: Any, warn: Callable[[str], None]
+) -> tuple[Any, int]:
+    """Mask of the run_ids already written (runs.parquet and parts), and the last part number.
+
+    Every part and ``runs.parquet`` is checked (:func:`check_part`); a part
+    that fails is removed, and so are the unreadable row groups of
+    ``runs.parquet`` (its good ones become parts): their runs will be redone,
+    and ``warn`` is told the file and what failed.
+    """
+    import numpy as np
 
     done = np.zeros(n_runs, dtype=bool)
     parts = out / "parts"
     last = 0
-    sources = []
-    if (out / "runs.parquet").is_file():
-        sources.append(out / "runs.parquet")
+    found = []
     if parts.is_dir():
         for p in sorted(parts.iterdir()):
             if p.name.startswith(".") and p.name.endswith(".tmp"):
                 p.unlink(missing_ok=True)  # left by a kill mid-write
             elif m := _PART_RE.match(p.name):
                 last = max(last, int(m.group(1)))
-                sources.append(p)
-    for src in sources:
+                found.append(p)
+    for p in found:
         try:
-            ids = pq.read_table(src, columns=["run_id"]).column("run_id").to_numpy()
-        except Exception as exc:  # unreadable: redo its runs
-            warn(f"{src}: unreadable ({one_line(str(exc))}); its runs will be redone")
-            src.unlink(missing_ok=True)
-            continue
-        ids = ids[(ids >= 0) & (ids < n_runs)]
+            done[check_part(p, schema, n_runs)] = True
+        except BadFile as exc:
+            warn(f"{p}: {exc}; its runs will be redone")
+            p.unlink(missing_ok=True)
+    table = out / "runs.parquet"
+    if table.is_file():
+        writer = PartWriter(parts, schema, last)
+        ids, problem = _check_table(table, schema, n_runs, writer)
         done[ids] = True
+        last = writer.seq
+        if problem:
+            warn(
+                f"{table}: {problem}; its {n_runs - int(done.sum())} missing runs will be redone"
+                + (f" (the {len(ids)} readable ones are kept)" if len(ids) else "")
+            )
     return done, last
 
 
@@ -266,21 +384,32 @@ def consolidate(out: Path, schema: Any, n_runs: int) -> None:
         if meta.num_rows == n_runs and pq.read_schema(target).equals(schema, check_metadata=False):
             return
     sources = ([target] if target.is_file() else []) + parts
+
+    def read(src: Path, **kwargs: Any) -> Any:
+        try:
+            return pq.read_table(src, **kwargs)
+        except Exception as exc:
+            raise RuntimeError(
+                f"{src}: unreadable ({type(exc).__name__}: {one_line(str(exc))}); run the "
+                "sweep again: the file will be checked and its runs redone"
+            ) from None
+
     spans = []
     for src in sources:
-        ids = pq.read_table(src, columns=["run_id"]).column("run_id").to_numpy()
+        ids = read(src, columns=["run_id"]).column("run_id").to_numpy()
         if len(ids):
             spans.append((src, int(ids.min()), int(ids.max())))
+
     def merge(tmp: Path) -> None:
         total = 0
-        with pq.ParquetWriter(tmp, schema) as writer:
+        with pq.ParquetWriter(tmp, schema, write_page_checksum=True) as writer:
             for lo in range(0, n_runs, CONSOLIDATE_WINDOW):
                 hi = lo + CONSOLIDATE_WINDOW
                 pieces = []
                 for src, a, b in spans:
                     if b < lo or a >= hi:
                         continue
-                    t = pq.read_table(src, filters=[("run_id", ">=", lo), ("run_id", "<", hi)])
+                    t = read(src, filters=[("run_id", ">=", lo), ("run_id", "<", hi)])
                     pieces.append(t.select(schema.names).cast(schema))
                 if not pieces:
                     continue

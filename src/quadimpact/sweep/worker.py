@@ -8,13 +8,57 @@ import contextlib
 import os
 import signal
 import sys
+import time
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, NamedTuple
 
 from quadimpact.sweep.store import failed_row, flatten_summary
 
 Item = tuple[int, dict[str, Any], dict[str, Any]]
 """A run to do: (run_id, scenario mapping, input column values)."""
+
+
+class RunCost(NamedTuple):
+    """What a run cost where it ran (never in the table): for the run time limits."""
+
+    wall_s: float
+    """The whole run: preparation, the kernel, the analysis."""
+    kernel_s: float
+    """The kernel's main run alone (the summary's ``integrator.wall_time_s``)."""
+    steps: int
+    """Its accepted and rejected steps."""
+
+
+_RUNNER: Any = None  # this process's BatchRunner (its output buffers serve every run)
+
+
+def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
+    """One run of a sweep: its ``runs.parquet`` row and what it cost (see :func:`run_chunk`).
+
+    The run goes through :class:`~quadimpact.simulation.batch.BatchRunner`
+    (the summary of ``simulate``, bit for bit, without its tables).
+    """
+    global _RUNNER
+    from quadimpact.inputs.scenarios import scenario_from_dict
+    from quadimpact.simulation.batch import BatchRunner
+
+    if _RUNNER is None:
+        _RUNNER = BatchRunner()
+
+    run_id, scenario_data, inputs = item
+    head = {"run_id": int(run_id), **inputs}
+    start = time.perf_counter()
+    kernel_s, steps = 0.0, 0
+    try:
+        scenario = scenario_from_dict(scenario_data, where=f"run {run_id}")
+        summary = _RUNNER.summary(scenario)
+        counters = summary.get("integrator") or {}
+        kernel_s = float(counters.get("wall_time_s") or 0.0)
+        steps = int(counters.get("steps") or 0) + int(counters.get("rejected_steps") or 0)
+        row = flatten_summary(summary, skip=inputs)
+    except Exception as exc:  # a failed run is a row; the sweep goes on
+        row = failed_row(f"{type(exc).__name__}: {exc}", inputs)
+    return {**head, **row}, RunCost(time.perf_counter() - start, kernel_s, steps)
 
 
 def run_chunk(items: Sequence[Item]) -> list[dict[str, Any]]:
@@ -33,33 +77,18 @@ def run_chunk(items: Sequence[Item]) -> list[dict[str, Any]]:
         and ``reason = "<ExceptionType>: <message>"``; a run that fails in the
         integrator has the kernel's status and reason.
     """
-    from quadimpact.inputs.scenarios import scenario_from_dict
-    from quadimpact.simulation.batch import simulate_batch
+    return [run_item(item)[0] for item in items]
 
-    rows: list[dict[str, Any] | None] = [None] * len(items)
-    valid: list[tuple[int, Any]] = []
-    for k, (run_id, scenario_data, inputs) in enumerate(items):
-        try:
-            valid.append((k, scenario_from_dict(scenario_data, where=f"run {run_id}")))
-        except Exception as exc:  # a failed run is a row; the sweep goes on
-            rows[k] = failed_row(f"{type(exc).__name__}: {exc}", inputs)
-    errors: dict[int, str] = {}
 
-    def failed(i: int, exc: BaseException) -> dict[str, Any]:
-        errors[i] = f"{type(exc).__name__}: {exc}"
-        return {}
+def failed_rows(items: Sequence[Item], reason: str) -> list[dict[str, Any]]:
+    """Rows of these runs with ``status = "failed"`` and the reason (lost runs)."""
+    return [{"run_id": rid, **inp, **failed_row(reason, inp)} for rid, _data, inp in items]
 
-    summaries = simulate_batch([s for _, s in valid], on_error=failed)
-    for i, ((k, _), summary) in enumerate(zip(valid, summaries, strict=True)):
-        inputs = items[k][2]
-        if i in errors:
-            rows[k] = failed_row(errors[i], inputs)
-        else:
-            rows[k] = flatten_summary(summary, skip=inputs)
-    return [
-        {"run_id": int(run_id), **inputs, **row}
-        for (run_id, _, inputs), row in zip(items, rows, strict=True)
-    ]
+
+def run_chunk_measured(items: Sequence[Item]) -> tuple[list[dict[str, Any]], list[RunCost]]:
+    """:func:`run_chunk` and what each run cost (what Dask workers run)."""
+    done = [run_item(item) for item in items]
+    return [row for row, _ in done], [cost for _, cost in done]
 
 
 SINGLE_THREAD_VARS = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -82,12 +111,66 @@ def warm_up() -> None:
     _WARM = True
 
 
-def init_pool_worker() -> None:
-    # Ctrl-C goes to the whole process group: the parent decides (it stops
-    # submitting, saves what finished); workers just finish their chunk.
+WATCH_SIGNAL: int | None = getattr(signal, "SIGUSR2", None)
+"""The signal the pool's fork server gets when the sweep process that started it ends
+(None where there is no SIGUSR2: no fork server there either)."""
+WATCH_ENV = "QUADIMPACT_SWEEP_PARENT"
+"""``<pid>:<multiprocessing temp dir>`` of the sweep process, for the fork server
+it starts (read and removed by :func:`preload`)."""
+SERVER_READY = "quadimpact-server-ready"
+"""File the fork server creates in that temp dir once it has loaded the kernel."""
+_PR_SET_PDEATHSIG = 1
+
+
+def set_parent_death_signal(signum: int) -> bool:
+    """Ask Linux to send ``signum`` to this process when its parent ends.
+
+    ``prctl(PR_SET_PDEATHSIG)`` through ctypes; the signal also comes when
+    the parent *thread* that started this process ends. Returns whether it
+    is set (False off Linux or without a C library).
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signum), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def pool_worker(conn: Any) -> None:
+    """The loop of a local pool worker (``pool.py``): chunks in, one message per run out.
+
+    Messages to the sweep: ``("ready", pid)`` once the kernel is loaded, then
+    per chunk ``("start",)`` and ``("row", row, cost)`` after each run. A
+    chunk is a list of items; None
+    (or the sweep's end of the pipe closing) ends the worker. The worker dies
+    with its parent (the fork server, which dies with the sweep): SIGKILL, so
+    that a stopped or busy worker goes too. Ctrl-C is ignored: the sweep
+    decides, and stops its workers itself.
+    """
+    if sys.platform.startswith("linux"):
+        set_parent_death_signal(signal.SIGKILL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    for signum in (signal.SIGTERM, WATCH_SIGNAL):
+        if signum is not None:
+            signal.signal(signum, signal.SIG_DFL)  # the fork server's handler is inherited
     with contextlib.suppress(Exception):
         warm_up()
+    try:
+        conn.send(("ready", os.getpid()))
+        while True:
+            chunk = conn.recv()
+            if chunk is None:
+                return
+            conn.send(("start",))
+            for item in chunk:
+                row, cost = run_item(item)
+                conn.send(("row", row, cost))
+    except (EOFError, OSError):  # the sweep is gone
+        return
 
 
 def worker_info() -> dict[str, Any]:
@@ -97,16 +180,58 @@ def worker_info() -> dict[str, Any]:
 
 
 def preload() -> None:
-    """Ready the forkserver of the local pools, so that every worker forked from it starts ready.
+    """Ready the fork server of the local pools, so that every worker forked from it starts ready.
 
-    Called by :mod:`quadimpact.sweep._preload`, which the forkserver imports
-    first (see ``backends._pool_context``): one thread per numerical library
-    (set before NumPy loads; nothing this package imports before it loads
-    NumPy), then :func:`warm_up`. Never raises: a worker that finds the kernel
-    not loaded loads it itself, and a failing preload must not break the
-    forkserver (Ctrl-C during start-up included).
+    Called by :mod:`quadimpact.sweep._preload`, which the fork server imports
+    first (see ``pool.start_server``): it ignores Ctrl-C (as will the workers
+    it forks), follows the sweep process (below), sets one thread per
+    numerical library (before NumPy loads; nothing this package imports
+    before it loads NumPy), then :func:`warm_up`. Never
+    raises: a worker that finds the kernel not loaded loads it itself, and a
+    failing preload must not break the fork server (Ctrl-C during start-up
+    included).
     """
+    # Ctrl-C reaches the whole process group; the sweep decides. Set before the
+    # server records its "old" handlers, so its workers start ignoring it too.
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    tempdir = ""
+    with contextlib.suppress(BaseException):
+        tempdir = _follow_sweep()
     for var in SINGLE_THREAD_VARS:
         os.environ.setdefault(var, "1")
     with contextlib.suppress(BaseException):
         warm_up()
+        if tempdir:  # tell the sweep that workers now start ready
+            open(os.path.join(tempdir, SERVER_READY), "w").close()
+
+
+def _follow_sweep() -> str:
+    """End this fork server when the sweep process that started it ends (Linux).
+
+    The sweep names itself in :data:`WATCH_ENV`; the server asks for
+    :data:`WATCH_SIGNAL` at its parent's death and, when it comes and the
+    parent is really gone (not just the thread that started the server),
+    removes the sweep's multiprocessing temporary folder (it holds the
+    server's socket, and nobody else is left to remove it) and exits, which
+    ends its workers (their own parent-death signal). Returns that folder
+    ('' without a sweep to follow).
+    """
+    value = os.environ.pop(WATCH_ENV, "")
+    pid_text, _, tempdir = value.partition(":")
+    if not pid_text.isdigit() or WATCH_SIGNAL is None:
+        return ""
+    sweep_pid = int(pid_text)
+
+    def parent_gone(_signum: int, _frame: Any) -> None:
+        if os.getppid() == sweep_pid:
+            return  # a thread of the sweep ended, the sweep goes on
+        if os.path.basename(tempdir).startswith("pymp-"):
+            import shutil
+
+            shutil.rmtree(tempdir, ignore_errors=True)
+        os._exit(0)
+
+    signal.signal(WATCH_SIGNAL, parent_gone)
+    if set_parent_death_signal(WATCH_SIGNAL) and os.getppid() != sweep_pid:
+        parent_gone(WATCH_SIGNAL, None)  # it ended before we asked
+    return tempdir
