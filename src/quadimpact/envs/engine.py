@@ -232,9 +232,16 @@ class Slots:
         n_ep = int(st[L.ST_N_EPISODES])
         episodes = episode_columns(self.EPISODES[k], n_ep, s.surface_names)
         obstacles = [n for i, n in enumerate(s.surface_names) if s.surf[i, L.S_IS_GROUND] < 0.5]
+        # the state at the end: the output row at the final time when the run got there
+        # (as analyse reads it), else the state reached
+        n_out = int(st[L.ST_N_OUT])
+        if n_out == self.T_OUT.shape[1]:
+            final = self.OUT[k, n_out - 1, L.OUT_X : L.OUT_X + L.NX].copy()
+        else:
+            final = self.X[k].copy()
         out = recovery_metrics(
             st, episodes, veh=s.veh, surf=s.surf, surface_names=s.surface_names,
-            obstacle_names=obstacles, final_state=self.X[k].copy(),
+            obstacle_names=obstacles, final_state=final,
         )  # fmt: skip
         out = {key: out[key] for key in RECOVERY_KEYS}
         out["outcome"] = OUTCOMES[int(self.ENV[k, B.B_OUTCOME])]
