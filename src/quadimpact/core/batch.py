@@ -162,9 +162,11 @@ def affine_map(a: float, lo: float, hi: float) -> float:
 
     Evaluated from the nearer end (``lo + (1 + a) h`` for ``a < -1/2``,
     ``hi - (1 - a) h`` for ``a > 1/2``) or from the middle (``m + a h``), so that
-    ``1 + a`` and ``1 - a`` are exact and the map hits nearly every float in
-    the range (not every one: near ``lo`` there are fewer floats ``a`` than
-    commands). ``a = -1`` gives ``lo`` and ``a = 1`` gives ``hi`` exactly.
+    ``1 + a`` and ``1 - a`` are exact: every float command from
+    ``lo + (hi - lo)/4`` to ``hi`` is the map of some float ``a``. Below, only a
+    part is (near ``a = -1`` floats are ``2^-53`` apart, which the map spreads
+    over more commands than there are floats ``a``). ``a = -1`` gives ``lo`` and
+    ``a = 1`` gives ``hi`` exactly.
     """
     h = 0.5 * (hi - lo)
     if a < -0.5:
