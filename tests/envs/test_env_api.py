@@ -77,7 +77,8 @@ def test_trials_follow_the_distribution_and_its_draw_order():
                           "speed_m_s": (0.5, 2.5)}.items():  # fmt: skip
         v = np.array([x[key] for x in draws])
         assert lo <= v.min() and v.max() <= hi and v.max() - v.min() > 0.9 * (hi - lo)
-    assert {x["vehicle"] for x in draws} == {"navi"} and {x["friction_coefficient"] for x in draws} == {0.3}
+    assert {x["vehicle"] for x in draws} == {"navi"}
+    assert {x["friction_coefficient"] for x in draws} == {0.3}
     assert len({x["seed"] for x in draws}) == 400
     # fixing a field does not shift the other draws
     fixed = E.TrialDistribution(pitch_deg=10.0, vehicle=("navi", "spiri"))
@@ -93,7 +94,8 @@ def test_observation_scales_and_contents():
     x = m[L.MS_X : L.MS_X + L.NX]
     np.testing.assert_allclose(obs[0:3], np.clip(m[L.MS_IMU_F : L.MS_IMU_F + 3] / 9.81, -10, 10),
                                rtol=1e-6)  # fmt: skip
-    np.testing.assert_allclose(obs[3:6], m[L.MS_IMU_W : L.MS_IMU_W + 3] / 10.0, rtol=1e-6, atol=1e-7)
+    gyro = m[L.MS_IMU_W : L.MS_IMU_W + 3] / 10.0
+    np.testing.assert_allclose(obs[3:6], gyro, rtol=1e-6, atol=1e-7)
     from quadimpact.rotations import quat_to_matrix
 
     C = quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4])

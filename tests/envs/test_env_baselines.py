@@ -18,8 +18,10 @@ from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS
 
 STAGE_KEYS = ("recovered", "t_detect_s", "t_stage1_s", "t_stage2_s", "t_stage3_s", "t_stage4_s",
               "time_to_recover_s")  # fmt: skip
-POSITION_KEYS = ("height_loss_m", "height_loss_stage2_m", "height_loss_stage3_m",
-                 "horizontal_drift_m", "horizontal_drift_stage2_m", "horizontal_drift_stage3_m")  # fmt: skip
+POSITION_KEYS = (
+    "height_loss_m", "height_loss_stage2_m", "height_loss_stage3_m",
+    "horizontal_drift_m", "horizontal_drift_stage2_m", "horizontal_drift_stage3_m",
+)  # fmt: skip
 
 
 def _run(env, policy, n, seed):
@@ -99,7 +101,8 @@ def test_the_action_map_gives_the_commands_exactly_where_floats_allow():
     found = [B.affine_inverse(w, lo, hi) for w in low]
     share = np.mean([e for _, e in found])
     assert 0.2 < share < 0.6
-    assert max(abs(B.affine_map(a, lo, hi) - w) for (a, _), w in zip(found, low, strict=True)) < 1e-13
+    worst = max(abs(B.affine_map(a, lo, hi) - w) for (a, _), w in zip(found, low, strict=True))
+    assert worst < 1e-13
     # the map is the documented affine map to rounding
     a = rng.uniform(-1, 1, 1000)
     np.testing.assert_allclose([B.affine_map(v, lo, hi) for v in a], lo + (a + 1) * (hi - lo) / 2,

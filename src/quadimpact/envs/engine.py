@@ -145,7 +145,8 @@ class Slots:
             fields = dict(trial)
             scenario = self.trials.trial(fields, ground=self.ground, record=self.record)
         s = prepare(scenario)
-        if s.surf.shape != self.SURF.shape[1:] or s.output_times().shape[0] != self.T_OUT.shape[1]:
+        same_grid = s.output_times().shape[0] == self.T_OUT.shape[1]
+        if s.surf.shape != self.SURF.shape[1:] or not same_grid or s.tf != self.trials.final_time_s:
             raise ValueError(
                 "trial: its surfaces and final time must be those of the environment's trials "
                 f"({self.SURF.shape[1]} surfaces, {self.trials.final_time_s:g} s)"
