@@ -68,7 +68,7 @@ def test_whole_trials_reproduce_every_recovery_metric(start):
     """No early end (hold_s None, no envelope): every key of docs/RECOVERY.md 6 is simulate's,
     bit for bit where every command was exact. From t = 0 the spin-down's zero commands need
     rotor_floor = "zero"."""
-    env = E.ImpactRecoveryEnv(start=start, hold_s=None, rotor_floor="zero",
+    env = E.ImpactRecoveryEnv(start=start, end_on_recovery=False, rotor_floor="zero",
                               envelope=E.Envelope(180.0, 1e9, 1e9, 1e9))  # fmt: skip
     trials, got = _run(env, E.RecoveryPolicy(env), 24, seed=9)
     want = simulate_batch(trials)

@@ -58,7 +58,7 @@ def test_recovered_termination_holds_the_condition_and_pays_the_bonus():
 
 
 def test_truncation_at_the_final_time_and_recovered_without_termination():
-    env = E.ImpactRecoveryEnv(hold_s=None, envelope=E.Envelope(180.0, 1e9, 1e9, 1e9))
+    env = E.ImpactRecoveryEnv(end_on_recovery=False, envelope=E.Envelope(180.0, 1e9, 1e9, 1e9))
     obs, _ = env.reset(seed=4)
     _, _, n, term, trunc, info = _until_end(env, E.RecoveryPolicy(env), obs)
     assert trunc and not term and info["outcome"] == "time limit"
@@ -95,7 +95,7 @@ def test_the_ground_ends_the_episode_when_enabled():
 
 def test_reward_is_the_documented_cost():
     w = E.RewardWeights(tilt=0.7, rate=0.3, vertical_speed=0.2, height_loss=0.4, effort=0.9)
-    env = E.ImpactRecoveryEnv(reward=w, hold_s=None)
+    env = E.ImpactRecoveryEnv(reward=w, end_on_recovery=False)
     obs, _ = env.reset(seed=8)
     h_ref = -env.unwrapped._slots.X[0, L.X_POS + 2]
     s = env._slots

@@ -114,7 +114,7 @@ def test_same_step_autoreset_and_the_sync_vector_env_agree():
 
 
 def test_disabled_autoreset_and_reset_mask():
-    venv = E.BatchedImpactRecoveryEnv(2, autoreset_mode="Disabled", hold_s=None)
+    venv = E.BatchedImpactRecoveryEnv(2, autoreset_mode="Disabled", end_on_recovery=False)
     venv.reset(seed=1)
     trial0 = dict(venv._slots.trial_fields[0])
     trial1 = dict(venv._slots.trial_fields[1])

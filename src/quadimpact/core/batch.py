@@ -28,11 +28,17 @@ Action maps (``a`` clipped to [-1, 1]):
   feedback-linearised torques, allocation, rotor range).
 
 Observer (the stage record for a policy that reports no stages): stage 1 at
-the first tick at which the detector has fired; from stage 1 on, at most one
-stage per tick, ``recovery.next_stage`` with the tilt error toward level
-(``recovery.staged_references`` in stage 2, the level target) of the tick's
-state and the tick's gyro reading. The recovered condition of a tick: that
-level test and body z velocity below ``w_tol`` at once.
+the first tick at which the detector has fired (the takeover); then, over the
+ticks after it, the *level test* (the tilt error toward level of
+``recovery.staged_references`` in stage 2, ``|q_e,x|, |q_e,y| < q_tol``, and the
+gyro's ``|p|, |q| < rate_tol``) and the *recovered condition* (the level test
+and body z velocity ``w < w_tol``) must each hold for a confirmation window of
+``P_HOLD_TICKS`` ticks: stages 2 and 3 are entered at the first tick of the
+first window of the level test, stage 4 at the first tick of the first window
+of the recovered condition (written into the run's stage record once the
+window is complete). A policy that reports its stages (``staged_policy``) has
+its own stage record; with either, the episode ends as recovered once stage 4
+is reached and the recovered condition has held for the window.
 """
 
 import math
@@ -49,7 +55,6 @@ from .controllers.recovery import (
     STAGE_PRE_IMPACT,
     STAGE_RECOVERED,
     STAGE_TILTED,
-    next_stage,
     rate_loop,
     recovery_step,
     staged_references,
@@ -79,6 +84,8 @@ from .layout import (
     O_SLEW_MAX,
     RIN_CMD,
     ST_CRASH_T,
+    ST_STAGE_T,
+    ST_STAGE_X,
     ST_STATUS,
     STATUS_FAILED,
     V_GRAVITY,
@@ -97,7 +104,7 @@ from .step import finish, start, tick
 B_ACTIVE = 0  # 1 while the episode runs
 B_STAGE = 1  # stage in force (the policy's or the observer's)
 B_POLICY = 2  # 1 once the policy has reported a stage this episode
-B_HOLD = 3  # consecutive ticks the recovered condition has held
+B_HOLD = 3  # consecutive ticks (after the takeover) the recovered condition has held
 B_H_REF = 4  # m, altitude at the takeover (height-loss reference)
 B_X_REF = 5  # m, CM X and Y at the takeover (distance reference)
 B_Y_REF = 6
@@ -105,7 +112,12 @@ B_STEPS = 7  # steps taken this episode
 B_OUTCOME = 8  # OC_* below
 B_RETURN = 9  # sum of the rewards of the episode
 B_INEXACT = 10  # policy commands the action map could not give exactly (in the slew window)
-NB = 12
+B_LEVEL_N = 11  # consecutive ticks (after the takeover) the level test has held
+B_LEVEL_T = 12  # s, first tick of that run
+B_LEVEL_P = 13  # 3: CM position there, inertial, m
+B_HOLD_T = 16  # s, first tick of the recovered condition's run
+B_HOLD_P = 17  # 3: CM position there, inertial, m
+NB = 20
 
 OC_RUNNING = 0
 OC_RECOVERED = 1
@@ -137,7 +149,8 @@ P_MAX_TILT_COS = 17  # envelope: cos of the largest tilt from vertical
 P_MAX_DROP = 18  # m, envelope: altitude below the takeover altitude
 P_MAX_DIST = 19  # m, envelope: horizontal distance from the takeover position
 P_MAX_RATE = 20  # rad/s, envelope: |omega|
-P_HOLD_TICKS = 21  # ticks the recovered condition must hold in stage 4 (inf: never ends)
+P_HOLD_TICKS = 21  # confirmation window of the level test and the recovered condition, ticks
+P_END_ON_RECOVERY = 29  # 1: the episode ends once recovered (stage 4 and the window held)
 P_GROUND = 22  # 1: the first ground contact ends the episode
 P_OBS_F = 23  # observation scales: specific force m/s^2, rates rad/s, speed m/s, time s,
 P_OBS_W = 24  # position m; observations are clipped to +-P_OBS_CLIP
@@ -257,25 +270,79 @@ def level_test(
 
 
 @njit(cache=True)
-def observer_stage(stage: int, tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> int:
-    """The observer's stage at a tick, from the stage in force before it."""
-    if stage == STAGE_PRE_IMPACT:
-        return STAGE_DETECTED if tmeas[MS_DETECTED] > 0.5 else STAGE_PRE_IMPACT
-    qex, qey, p, q, w = level_test(tmeas, ctrl, veh)
-    p0 = C_PARAMS
-    return next_stage(stage, qex, qey, p, q, w, ctrl[p0 + R_Q_TOL], ctrl[p0 + R_RATE_TOL],
-                      ctrl[p0 + R_W_TOL])  # fmt: skip
+def takeover_stage(stage: int, tmeas: np.ndarray) -> int:
+    """The observer's stage at a tick before its stage 2: 1 once the detector has fired."""
+    if stage == STAGE_PRE_IMPACT and tmeas[MS_DETECTED] > 0.5:
+        return STAGE_DETECTED
+    return stage
 
 
 @njit(cache=True)
-def recovered_condition(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> bool:
-    """Level, slow (|p|, |q|) and body z velocity below ``w_tol``, all at this tick."""
+def level_and_recovered(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> tuple[bool, bool]:
+    """The level test of the tick, and the recovered condition (level and ``w < w_tol``)."""
     qex, qey, p, q, w = level_test(tmeas, ctrl, veh)
     p0 = C_PARAMS
     qt = ctrl[p0 + R_Q_TOL]
     rt = ctrl[p0 + R_RATE_TOL]
     level = abs(qex) < qt and abs(qey) < qt and abs(p) < rt and abs(q) < rt
-    return level and w < ctrl[p0 + R_W_TOL]
+    return level, level and w < ctrl[p0 + R_W_TOL]
+
+
+@njit(cache=True)
+def recovered_condition(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> bool:
+    """Level, slow (|p|, |q|) and body z velocity below ``w_tol``, all at this tick."""
+    return level_and_recovered(tmeas, ctrl, veh)[1]
+
+
+@njit(cache=True)
+def _enter(stats: np.ndarray, stage: int, t: float, p: np.ndarray) -> None:
+    """Write a stage entry (tick, CM position) into a run's stage record."""
+    stats[ST_STAGE_T + stage] = t
+    for i in range(3):
+        stats[ST_STAGE_X + 3 * stage + i] = p[i]
+
+
+@njit(cache=True)
+def _track_windows(env: np.ndarray, tmeas: np.ndarray, x: np.ndarray, ctrl: np.ndarray,
+                   veh: np.ndarray) -> None:  # fmt: skip
+    """Runs of the level test and of the recovered condition at the tick ``tmeas[MS_T]``."""
+    if env[B_STAGE] < STAGE_DETECTED:
+        env[B_LEVEL_N] = 0.0
+        env[B_HOLD] = 0.0
+        return
+    level, rec = level_and_recovered(tmeas, ctrl, veh)
+    _count(env, level, B_LEVEL_N, B_LEVEL_T, B_LEVEL_P, tmeas[MS_T], x)
+    _count(env, rec, B_HOLD, B_HOLD_T, B_HOLD_P, tmeas[MS_T], x)
+
+
+@njit(cache=True)
+def _count(env: np.ndarray, ok: bool, n_slot: int, t_slot: int, p_slot: int, t: float,
+           x: np.ndarray) -> None:  # fmt: skip
+    """One tick of a run: its length, and its first tick and position."""
+    if not ok:
+        env[n_slot] = 0.0
+        return
+    if env[n_slot] == 0.0:
+        env[t_slot] = t
+        for i in range(3):
+            env[p_slot + i] = x[X_POS + i]
+    env[n_slot] += 1.0
+
+
+@njit(cache=True)
+def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np.ndarray) -> None:
+    """The observer's stages 2-4, entered at the start of their completed windows."""
+    window = par[P_HOLD_TICKS]
+    stage = int(env[B_STAGE])
+    if stage == STAGE_DETECTED and env[B_LEVEL_N] >= window:
+        _enter(stats, STAGE_TILTED, env[B_LEVEL_T], env[B_LEVEL_P : B_LEVEL_P + 3])
+        _enter(stats, STAGE_TILTED + 1, env[B_LEVEL_T], env[B_LEVEL_P : B_LEVEL_P + 3])
+        stage = STAGE_TILTED + 1
+    if stage == STAGE_TILTED + 1 and env[B_HOLD] >= window:
+        _enter(stats, STAGE_RECOVERED, env[B_HOLD_T], env[B_HOLD_P : B_HOLD_P + 3])
+        stage = STAGE_RECOVERED
+    env[B_STAGE] = stage
+    mem[MEM_STAGE] = stage
 
 
 @njit(cache=True)
@@ -497,8 +564,7 @@ def step_batch(
             env[B_STAGE] = reported[k]
             env[B_POLICY] = 1.0
         elif env[B_POLICY] < 0.5:
-            env[B_STAGE] = observer_stage(int(env[B_STAGE]), tmeas, ctrl, veh)
-        stage = int(env[B_STAGE])
+            env[B_STAGE] = takeover_stage(int(env[B_STAGE]), tmeas)
         MEM[k, MEM_STAGE] = env[B_STAGE]
         LS[k, LS_EXT] = 1.0
         for j in range(4):
@@ -514,14 +580,16 @@ def step_batch(
         r = -dt * cost_rate(x, RIN[k], veh, ctrl, par, env[B_H_REF])
         # termination: recovered and held, the ground, the envelope; truncation: the run's end
         finite = np.isfinite(x).all()
-        if finite and recovered_condition(tmeas, ctrl, veh):
-            env[B_HOLD] += 1.0
-        else:
-            env[B_HOLD] = 0.0
+        if finite:
+            _track_windows(env, tmeas, x, ctrl, veh)
+            if env[B_POLICY] < 0.5:
+                _observe_stages(env, STATS[k], MEM[k], par)
+        stage = int(env[B_STAGE])
         outcome = OC_RUNNING
         if not finite:
             outcome = OC_FAILED
-        elif stage >= STAGE_RECOVERED and env[B_HOLD] >= par[P_HOLD_TICKS]:
+        elif (par[P_END_ON_RECOVERY] > 0.5 and stage >= STAGE_RECOVERED
+              and env[B_HOLD] >= par[P_HOLD_TICKS]):  # fmt: skip
             outcome = OC_RECOVERED
         elif par[P_GROUND] > 0.5 and not np.isnan(STATS[k, ST_CRASH_T]):
             outcome = OC_GROUND

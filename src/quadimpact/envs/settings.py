@@ -209,7 +209,8 @@ def pack_parameters(
     rotor_floor: Literal["vehicle", "zero"],
     reward: RewardWeights,
     envelope: Envelope,
-    hold_s: float | None,
+    hold_s: float,
+    end_on_recovery: bool,
     ground: bool,
     dt_s: float = 0.005,
 ) -> np.ndarray:
@@ -220,8 +221,8 @@ def pack_parameters(
         raise ValueError(f"observe: one of {OBSERVATION_MODES} (got {observe!r})")
     if rotor_floor not in ("vehicle", "zero"):
         raise ValueError(f"rotor_floor: 'vehicle' or 'zero' (got {rotor_floor!r})")
-    if hold_s is not None and not hold_s >= 0.0:
-        raise ValueError(f"hold_s: >= 0 s or None (got {hold_s!r})")
+    if not hold_s > 0.0:
+        raise ValueError(f"hold_s: > 0 s (got {hold_s!r})")
     par = np.zeros(B.NPAR)
     par[B.P_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
     par[B.P_OBSERVE] = B.OBS_STATE if observe == "state" else B.OBS_IMU
@@ -242,7 +243,8 @@ def pack_parameters(
     par[B.P_MAX_DROP] = envelope.max_drop_m
     par[B.P_MAX_DIST] = envelope.max_distance_m
     par[B.P_MAX_RATE] = envelope.max_rate_rad_s
-    par[B.P_HOLD_TICKS] = math.inf if hold_s is None else max(1.0, round(hold_s / dt_s))
+    par[B.P_HOLD_TICKS] = max(1.0, round(hold_s / dt_s))
+    par[B.P_END_ON_RECOVERY] = 1.0 if end_on_recovery else 0.0
     par[B.P_GROUND] = 1.0 if ground else 0.0
     par[B.P_OBS_F] = 9.81
     par[B.P_OBS_W] = 10.0

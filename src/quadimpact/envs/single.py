@@ -66,9 +66,12 @@ class ImpactRecoveryEnv(gym.Env):
         full state.
     reward : RewardWeights, optional
     envelope : Envelope, optional
-    hold_s : float or None
-        How long (s) the recovered condition must hold in stage 4 to end the
-        episode as recovered; ``None``: never (run to the final time).
+    hold_s : float
+        The confirmation window (s): the recovered condition must hold this
+        long in stage 4 to end the episode as recovered; the observer's
+        stages 2-4 need their tests to hold this long too (docs/LEARNING.md 5).
+    end_on_recovery : bool
+        End the episode once recovered; False: run to the final time.
     ground : bool
         The ground (altitude 0) is a contact surface and its first contact
         ends the episode as a failure.
@@ -91,7 +94,8 @@ class ImpactRecoveryEnv(gym.Env):
         observe: Literal["imu", "state"] = "imu",
         reward: RewardWeights | None = None,
         envelope: Envelope | None = None,
-        hold_s: float | None = 0.2,
+        hold_s: float = 0.2,
+        end_on_recovery: bool = True,
         ground: bool = False,
         rotor_floor: Literal["vehicle", "zero"] = "vehicle",
         record: bool = False,
@@ -108,7 +112,7 @@ class ImpactRecoveryEnv(gym.Env):
         self.max_redraws = int(max_redraws)
         par = pack_parameters(
             action=action, observe=observe, rotor_floor=rotor_floor, reward=self.reward_weights,
-            envelope=self.envelope, hold_s=hold_s, ground=ground,
+            envelope=self.envelope, hold_s=hold_s, end_on_recovery=end_on_recovery, ground=ground,
         )  # fmt: skip
         self._slots = Slots(
             1, self.trials, par, until_detection=start == "detection", ground=ground, record=record

@@ -45,7 +45,7 @@ class BatchedImpactRecoveryEnv(VectorEnv):
     **kwargs
         As :class:`~quadimpact.envs.single.ImpactRecoveryEnv` (``trials``,
         ``start``, ``action``, ``observe``, ``reward``, ``envelope``,
-        ``hold_s``, ``ground``, ``rotor_floor``, ``record``, ``max_redraws``).
+        ``hold_s``, ``end_on_recovery``, ``ground``, ``rotor_floor``, ``record``, ``max_redraws``).
     """
 
     def __init__(
@@ -59,7 +59,8 @@ class BatchedImpactRecoveryEnv(VectorEnv):
         observe: Literal["imu", "state"] = "imu",
         reward: RewardWeights | None = None,
         envelope: Envelope | None = None,
-        hold_s: float | None = 0.2,
+        hold_s: float = 0.2,
+        end_on_recovery: bool = True,
         ground: bool = False,
         rotor_floor: Literal["vehicle", "zero"] = "vehicle",
         record: bool = False,
@@ -78,7 +79,7 @@ class BatchedImpactRecoveryEnv(VectorEnv):
         par = pack_parameters(
             action=action, observe=observe, rotor_floor=rotor_floor,
             reward=reward or RewardWeights(), envelope=envelope or Envelope(), hold_s=hold_s,
-            ground=ground,
+            end_on_recovery=end_on_recovery, ground=ground,
         )  # fmt: skip
         self._slots = Slots(
             self.num_envs, self.trials, par, until_detection=start == "detection",
@@ -108,7 +109,7 @@ class BatchedImpactRecoveryEnv(VectorEnv):
         gives one seed (or None) per sub-environment. ``options["trials"]``: a
         list of one trial (or None: a draw) per sub-environment.
         """
-        super().reset(seed=seed)
+        super().reset(seed=seed if isinstance(seed, (int, np.integer)) else None)
         n = self.num_envs
         if seed is None:
             seeds: list[int | None] = [None] * n
