@@ -139,7 +139,10 @@ class Slots:
     def load(self, k: int, trial: ImpactTrial | Mapping[str, Any]) -> None:
         """Put a trial's packed arrays into row ``k`` (not started)."""
         if isinstance(trial, ImpactTrial):
+            # the environment's output grid (it changes no computed value, only what is kept)
             scenario = trial
+            if not self.record:
+                scenario = trial.model_copy(update={"output_rate_hz": 1.0 / trial.final_time_s})
             fields = trial.model_dump(exclude_defaults=True)
         else:
             fields = dict(trial)
