@@ -24,7 +24,7 @@ from quadimpact.envs.settings import (
 from quadimpact.inputs.scenarios import ImpactTrial
 from quadimpact.results.result import SimulationResult
 
-__all__ = ["ImpactRecoveryEnv", "spaces_for"]
+__all__ = ["ImpactRecoveryEnv", "configure", "spaces_for"]
 
 StartMode = Literal["detection", "trial"]
 
@@ -40,6 +40,45 @@ def spaces_for(action: str, observe: str) -> tuple[gym.spaces.Box, gym.spaces.Bo
     act = gym.spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float64)
     obs = gym.spaces.Box(-10.0, 10.0, shape=(n_obs,), dtype=np.float32)
     return act, obs
+
+
+def configure(
+    env: Any,
+    n: int,
+    *,
+    trials: TrialDistribution | None = None,
+    start: StartMode = "detection",
+    action: Literal["rotors", "ctbr"] = "rotors",
+    observe: Literal["imu", "state"] = "imu",
+    reward: RewardWeights | None = None,
+    envelope: Envelope | None = None,
+    hold_s: float = 0.2,
+    end_on_recovery: bool = True,
+    ground: bool = False,
+    rotor_floor: Literal["vehicle", "zero"] = "vehicle",
+    record: bool = False,
+    max_redraws: int = 100,
+) -> None:
+    """Give an environment (single or batched) its settings and its ``n`` stacked runs.
+
+    The keywords are :class:`ImpactRecoveryEnv`'s.
+    """
+    if start not in ("detection", "trial"):
+        raise ValueError(f"start: 'detection' or 'trial' (got {start!r})")
+    env.trials = trials or TrialDistribution()
+    env.start_mode = start
+    env.action_mode = action
+    env.observe_mode = observe
+    env.reward_weights = reward or RewardWeights()
+    env.envelope = envelope or Envelope()
+    env.max_redraws = int(max_redraws)
+    par = pack_parameters(
+        action=action, observe=observe, rotor_floor=rotor_floor, reward=env.reward_weights,
+        envelope=env.envelope, hold_s=hold_s, end_on_recovery=end_on_recovery, ground=ground,
+    )  # fmt: skip
+    env._slots = Slots(
+        n, env.trials, par, until_detection=start == "detection", ground=ground, record=record
+    )
 
 
 class ImpactRecoveryEnv(gym.Env):
@@ -85,39 +124,9 @@ class ImpactRecoveryEnv(gym.Env):
 
     metadata: dict[str, Any] = {"render_modes": []}
 
-    def __init__(
-        self,
-        *,
-        trials: TrialDistribution | None = None,
-        start: StartMode = "detection",
-        action: Literal["rotors", "ctbr"] = "rotors",
-        observe: Literal["imu", "state"] = "imu",
-        reward: RewardWeights | None = None,
-        envelope: Envelope | None = None,
-        hold_s: float = 0.2,
-        end_on_recovery: bool = True,
-        ground: bool = False,
-        rotor_floor: Literal["vehicle", "zero"] = "vehicle",
-        record: bool = False,
-        max_redraws: int = 100,
-    ) -> None:
-        if start not in ("detection", "trial"):
-            raise ValueError(f"start: 'detection' or 'trial' (got {start!r})")
-        self.trials = trials or TrialDistribution()
-        self.start_mode = start
-        self.action_mode = action
-        self.observe_mode = observe
-        self.reward_weights = reward or RewardWeights()
-        self.envelope = envelope or Envelope()
-        self.max_redraws = int(max_redraws)
-        par = pack_parameters(
-            action=action, observe=observe, rotor_floor=rotor_floor, reward=self.reward_weights,
-            envelope=self.envelope, hold_s=hold_s, end_on_recovery=end_on_recovery, ground=ground,
-        )  # fmt: skip
-        self._slots = Slots(
-            1, self.trials, par, until_detection=start == "detection", ground=ground, record=record
-        )
-        self.action_space, self.observation_space = spaces_for(action, observe)
+    def __init__(self, **options: Any) -> None:
+        configure(self, 1, **options)
+        self.action_space, self.observation_space = spaces_for(self.action_mode, self.observe_mode)
         self._act = np.zeros((1, 4))
 
     # ------------------------------------------------------------ Gymnasium API

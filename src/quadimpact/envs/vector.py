@@ -12,7 +12,7 @@ same numbers.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from gymnasium.utils import seeding
@@ -21,9 +21,7 @@ from gymnasium.vector.utils import batch_space
 
 from quadimpact.core import batch as B
 from quadimpact.core import layout as L
-from quadimpact.envs.engine import Slots
-from quadimpact.envs.settings import Envelope, RewardWeights, TrialDistribution, pack_parameters
-from quadimpact.envs.single import spaces_for
+from quadimpact.envs.single import configure, spaces_for
 
 __all__ = ["BatchedImpactRecoveryEnv"]
 
@@ -42,7 +40,7 @@ class BatchedImpactRecoveryEnv(VectorEnv):
         episode's last observation and info in ``info["final_obs"]`` and
         ``info["final_info"]``) or ``DISABLED`` (reset through
         ``reset(options={"reset_mask": ...})``).
-    **kwargs
+    **options
         As :class:`~quadimpact.envs.single.ImpactRecoveryEnv` (``trials``,
         ``start``, ``action``, ``observe``, ``reward``, ``envelope``,
         ``hold_s``, ``end_on_recovery``, ``ground``, ``rotor_floor``, ``record``, ``max_redraws``).
@@ -53,45 +51,19 @@ class BatchedImpactRecoveryEnv(VectorEnv):
         num_envs: int = 8,
         *,
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
-        trials: TrialDistribution | None = None,
-        start: Literal["detection", "trial"] = "detection",
-        action: Literal["rotors", "ctbr"] = "rotors",
-        observe: Literal["imu", "state"] = "imu",
-        reward: RewardWeights | None = None,
-        envelope: Envelope | None = None,
-        hold_s: float = 0.2,
-        end_on_recovery: bool = True,
-        ground: bool = False,
-        rotor_floor: Literal["vehicle", "zero"] = "vehicle",
-        record: bool = False,
-        max_redraws: int = 100,
+        **options: Any,
     ) -> None:
-        if start not in ("detection", "trial"):
-            raise ValueError(f"start: 'detection' or 'trial' (got {start!r})")
         self.num_envs = int(num_envs)
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         self.metadata = {"autoreset_mode": self.autoreset_mode, "render_modes": []}
-        self.trials = trials or TrialDistribution()
-        self.start_mode = start
-        self.action_mode = action
-        self.observe_mode = observe
-        self.max_redraws = int(max_redraws)
-        par = pack_parameters(
-            action=action, observe=observe, rotor_floor=rotor_floor,
-            reward=reward or RewardWeights(), envelope=envelope or Envelope(), hold_s=hold_s,
-            end_on_recovery=end_on_recovery, ground=ground,
-        )  # fmt: skip
-        self._slots = Slots(
-            self.num_envs, self.trials, par, until_detection=start == "detection",
-            ground=ground, record=record,
-        )  # fmt: skip
+        configure(self, self.num_envs, **options)
+        action, observe = self.action_mode, self.observe_mode
         self.single_action_space, self.single_observation_space = spaces_for(action, observe)
         self.action_space = batch_space(self.single_action_space, self.num_envs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
         self._rngs: list[np.random.Generator] = [seeding.np_random()[0] for _ in range(num_envs)]
         self._autoreset = np.zeros(self.num_envs, dtype=np.bool_)
         self._actions = np.zeros((self.num_envs, 4))
-        self._zero = np.zeros(self.num_envs)
 
     # ------------------------------------------------------------ resets
     def _reset_row(self, k: int, trial: Any = None) -> None:
