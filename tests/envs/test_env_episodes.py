@@ -183,3 +183,9 @@ def test_given_trials_and_their_checks():
     spiri = E.ImpactRecoveryEnv(trials=replica)
     spiri.reset(seed=1)
     assert spiri.run_setup.vehicle.name.lower().startswith("spiri")
+    # an IMU table in the overrides replaces the preset choice
+    table = {"imu": {"preset": "noisy", "position": "cm"}}
+    cm = E.ImpactRecoveryEnv(trials=E.TrialDistribution(overrides=table))
+    cm.reset(seed=2)
+    scfg = cm.run_setup.scfg
+    assert scfg[L.SC_NOISE_F] == 1.0 and np.all(scfg[L.SC_POS : L.SC_POS + 3] == 0)

@@ -85,9 +85,9 @@ class Slots:
         n_surf = template.surf.shape[0]
         n_out = template.output_times().shape[0]
         n_imu = int(template.n_imu)
-        presets = [trials.imu] if isinstance(trials.imu, str) else list(trials.imu)
         self.n_noise = max(
-            self._prepare({**self._template_fields(), "imu": p}).noise.shape[0] for p in presets
+            self._prepare({**self._template_fields(), "imu": p}).noise.shape[0]
+            for p in trials.imu_choices()
         )
         nc = 4 * n_surf
         self.X = np.zeros((n, L.NX))
@@ -129,7 +129,7 @@ class Slots:
         first = {
             "vehicle": t.vehicle if isinstance(t.vehicle, str) else t.vehicle[0],
             "model": t.model if isinstance(t.model, str) else t.model[0],
-            "imu": t.imu if isinstance(t.imu, str) else t.imu[0],
+            "imu": t.imu_choices()[0],
         }
         return first
 

@@ -108,6 +108,12 @@ class TrialDistribution:
     controller_params: Mapping[str, Any] = field(default_factory=dict)
     overrides: Mapping[str, Any] = field(default_factory=dict)
 
+    def imu_choices(self) -> list[Any]:
+        """The IMU settings a trial can have (presets, or the override's table)."""
+        if "imu" in self.overrides:
+            return [self.overrides["imu"]]
+        return [self.imu] if isinstance(self.imu, str) else list(self.imu)
+
     def draw(self, rng: np.random.Generator) -> dict[str, Any]:
         """The drawn fields of one trial (the :class:`ImpactTrial` keywords that vary)."""
         fields: dict[str, Any] = {
@@ -120,6 +126,8 @@ class TrialDistribution:
             "model": _choice(rng, self.model),
             "imu": _choice(rng, self.imu),
         }
+        if "imu" in self.overrides:  # a full IMU table replaces the preset choice
+            fields["imu"] = self.overrides["imu"]
         fields["seed"] = int(rng.integers(0, 2**63 - 1))
         return fields
 
