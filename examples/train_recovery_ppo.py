@@ -73,6 +73,20 @@ def summarise(name: str, rows: list[dict]) -> dict:
     }
 
 
+def after_recovery(rows: list[dict]) -> dict:
+    """Of the trials recovered when run to the final time: how many stay inside the envelope
+    to the end, and their median speed there."""
+    rec = [r for r in rows if r["recovered"]]
+    kept = [r for r in rec if r["outcome"] == "time limit"]
+    return {
+        "recovered": len(rec),
+        "inside_envelope_to_the_end": len(kept),
+        "median_final_speed_m_s": float(np.median([r["final_speed_m_s"] for r in kept]))
+        if kept else math.nan,
+        "outcomes": {o: sum(r["outcome"] == o for r in rec) for o in {r["outcome"] for r in rec}},
+    }
+
+
 def evaluate_in_env(policy_fn, trials: list, n_envs: int = 50, **changes) -> list[dict]:
     """Episode metrics of a policy on the given trials (batched, no autoreset)."""
     kwargs = {**ENV_KWARGS, **changes}
@@ -157,6 +171,10 @@ def main() -> None:
     ap.add_argument("--envs", type=int, default=64, help="trials stepped together")
     ap.add_argument("--eval", type=int, default=500, help="held-out evaluation trials")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--run-to-end", action="store_true",
+                    help="train without ending episodes at the recovery (end_on_recovery=False)")
+    ap.add_argument("--load", default=None,
+                    help="evaluate a saved model (ppo_recovery.zip) instead of training")
     ap.add_argument("--threads", type=int, default=1,
                     help="PyTorch threads (more than 1 is much slower on a busy 2-core machine)")
     args = ap.parse_args()
@@ -169,26 +187,31 @@ def main() -> None:
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
 
-    env = SB3BatchedEnv(args.envs, **ENV_KWARGS)
-    env.seed(args.seed)
-    venv = VecNormalize(env, norm_obs=False, norm_reward=True, gamma=0.995)
-    model = PPO(
-        "MlpPolicy", venv, n_steps=128, batch_size=2048, n_epochs=5, learning_rate=3e-4,
-        gamma=0.995, gae_lambda=0.95, clip_range=0.2, ent_coef=0.0,
-        policy_kwargs={"net_arch": [128, 128], "log_std_init": -0.5}, seed=args.seed,
-        verbose=0, device="cpu",
-    )  # fmt: skip
-    curve = Curve()
-    t0 = time.perf_counter()
-    model.learn(total_timesteps=args.steps, callback=curve.callback)
-    train_s = time.perf_counter() - t0
-    model.save(out / "ppo_recovery.zip")
-    plot_curve(curve.rows, out / "learning_curve.png")
-    with open(out / "learning_curve.csv", "w") as f:
-        f.write("timesteps,wall_s,episodes,mean_return,success_rate\n")
-        for r in curve.rows:
-            f.write(f"{r['timesteps']},{r['wall_s']:.1f},{r['episodes']},"
-                    f"{r['mean_return']:.4f},{r['success_rate']:.4f}\n")  # fmt: skip
+    if args.load:
+        model = PPO.load(args.load, device="cpu")
+        train_s = math.nan
+        curve = Curve()
+    else:
+        env = SB3BatchedEnv(args.envs, **ENV_KWARGS, end_on_recovery=not args.run_to_end)
+        env.seed(args.seed)
+        venv = VecNormalize(env, norm_obs=False, norm_reward=True, gamma=0.995)
+        model = PPO(
+            "MlpPolicy", venv, n_steps=128, batch_size=2048, n_epochs=5, learning_rate=3e-4,
+            gamma=0.995, gae_lambda=0.95, clip_range=0.2, ent_coef=0.0,
+            policy_kwargs={"net_arch": [128, 128], "log_std_init": -0.5}, seed=args.seed,
+            verbose=0, device="cpu",
+        )  # fmt: skip
+        curve = Curve()
+        t0 = time.perf_counter()
+        model.learn(total_timesteps=args.steps, callback=curve.callback)
+        train_s = time.perf_counter() - t0
+        model.save(out / "ppo_recovery.zip")
+        plot_curve(curve.rows, out / "learning_curve.png")
+        with open(out / "learning_curve.csv", "w") as f:
+            f.write("timesteps,wall_s,episodes,mean_return,success_rate\n")
+            for r in curve.rows:
+                f.write(f"{r['timesteps']},{r['wall_s']:.1f},{r['episodes']},"
+                        f"{r['mean_return']:.4f},{r['success_rate']:.4f}\n")  # fmt: skip
 
     # ---- evaluation on held-out trials (a different seed from training's)
     dist = E.TrialDistribution()
@@ -199,9 +222,28 @@ def main() -> None:
     def learned(v):
         return lambda obs: model.predict(obs, deterministic=True)[0]
 
+    def staged_observed(v):
+        # the staged controller's actions, judged by the observer as any policy is
+        pol = E.RecoveryPolicy(v)
+
+        def act(obs):
+            a = pol(obs)
+            v.report_stages(np.full(v.num_envs, -1.0))
+            return a
+
+        return act
+
+    # after the recovery: the same trials run to the final time (no end on recovery)
+    after = {
+        "PPO (learned)": after_recovery(evaluate_in_env(learned, trials, end_on_recovery=False)),
+        "staged controller (rotors)": after_recovery(evaluate_in_env(
+            E.RecoveryPolicy, trials, action="rotors", end_on_recovery=False)),
+    }  # fmt: skip
     table = [
         summarise("PPO (learned)", evaluate_in_env(learned, trials)),
-        summarise("staged controller (simulate)", simulate_batch(trials)),
+        summarise("staged controller (simulate: its own stages)", simulate_batch(trials)),
+        summarise("staged controller through the env, judged by the observer (rotors)",
+                  evaluate_in_env(staged_observed, trials, action="rotors")),
         summarise("hover speeds, no correction (rotors)",
                   evaluate_in_env(E.HoverPolicy, trials, action="rotors")),
         summarise("hover thrust, zero rate references (ctbr)",
@@ -213,12 +255,15 @@ def main() -> None:
     result = {
         "train_steps": args.steps, "train_wall_s": train_s, "eval_wall_s": eval_s,
         "env": ENV_KWARGS, "n_envs": args.envs, "curve_last": curve.rows[-5:], "table": table,
+        "model": args.load, "after_recovery": after, "run_to_end": args.run_to_end,
     }  # fmt: skip
     (out / "evaluation.json").write_text(json.dumps(result, indent=2))
+    trained = (f"Training: {args.steps:,} steps in {train_s / 60:.1f} min "
+               f"({args.steps / train_s:,.0f} steps/s, {args.envs} trials batched). "
+               if not args.load else f"Model: {args.load}. ")  # fmt: skip
     lines = [
-        f"Training: {args.steps:,} steps in {train_s / 60:.1f} min "
-        f"({args.steps / train_s:,.0f} steps/s, {args.envs} trials batched). "
-        f"Evaluation: {args.eval} held-out trials of the authors' distribution.",
+        trained + f"Evaluation: {args.eval} held-out trials of the authors' distribution "
+        f"({eval_s:.0f} s).",
         "",
         "| policy | recovered | success rate (95 % Wilson) | median time to recover (s) "
         "| median height loss (m) |",
@@ -231,6 +276,12 @@ def main() -> None:
             f"({100 * lo:.1f}-{100 * hi:.1f}) | {r['median_time_to_recover_s']:.3f} "
             f"| {r['median_height_loss_m']:.3f} |"
         )
+    lines += ["", "Run to the final time instead of ending at the recovery (the same trials):", "",
+              "| policy | recovered | inside the envelope to 3 s | median speed at 3 s (m/s) |",
+              "|---|---|---|---|"]  # fmt: skip
+    for name, a in after.items():
+        lines.append(f"| {name} | {a['recovered']} | {a['inside_envelope_to_the_end']} "
+                     f"| {a['median_final_speed_m_s']:.2f} |")  # fmt: skip
     (out / "evaluation.md").write_text("\n".join(lines) + "\n")
     print("\n".join(lines))
 
