@@ -20,7 +20,7 @@ setup: $(STAMP)
 # network access for the build backend, fall back to the venv's own setuptools.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install -e ".[dev,viz,distributed]" \
+	$(BIN)/python -m pip install -e ".[dev,viz,distributed,rl]" \
 	  || $(BIN)/python -m pip install --no-build-isolation --no-deps -e .
 	touch $(STAMP)
 

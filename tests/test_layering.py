@@ -38,7 +38,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("inputs", ("quadimpact.inputs",)),
     ("results", ("quadimpact.results",)),
     ("simulation", ("quadimpact.simulation",)),
-    ("sweep, viz", ("quadimpact.sweep", "quadimpact.viz")),
+    ("sweep, viz, envs", ("quadimpact.sweep", "quadimpact.viz", "quadimpact.envs")),
     ("experiments", ("quadimpact.experiments",)),
     ("recovery", ("quadimpact.recovery",)),
     ("paper", ("quadimpact.paper",)),

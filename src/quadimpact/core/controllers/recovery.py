@@ -126,21 +126,21 @@ def next_stage(
 
 
 @njit(cache=True)
-def staged_law(
+def staged_references(
     stage: int,
     a_ref_on: bool,
     x: np.ndarray,
-    omega: np.ndarray,
     normal: np.ndarray,
     ctrl: np.ndarray,
     veh: np.ndarray,
-    cmd: np.ndarray,
-) -> tuple[float, float]:
-    """Rotor commands (rad/s) of the staged law in ``stage`` (1-4); returns ``(q_e,x, q_e,y)``.
+) -> tuple[float, float, float, float, float]:
+    """The staged law's outer loop in ``stage`` (1-4): thrust, rate references, tilt error.
 
-    ``x``: state estimate; ``omega``: measured body rates (rad/s); ``normal``:
-    wall-normal estimate (inertial, unit, away from the wall); ``a_ref_on``:
-    whether stage 1's push away from the wall applies.
+    Returns ``(thrust, p_des, q_des, qe_x, qe_y)``: the collective thrust (N),
+    the body rate references (rad/s) and the tilt error quaternion's body x, y
+    parts. ``x``: state estimate; ``normal``: wall-normal estimate (inertial,
+    unit, away from the wall); ``a_ref_on``: whether stage 1's push away from
+    the wall applies.
     """
     p0 = C_PARAMS
     C = np.empty((3, 3))
@@ -182,11 +182,31 @@ def staged_law(
         qex = s * (C[0, 0] * cx + C[1, 0] * cy + C[2, 0] * cz)
         qey = s * (C[0, 1] * cx + C[1, 1] * cy + C[2, 1] * cz)
     k_att = ctrl[p0 + R_K_ATT]
-    p_des = k_att * qex
-    q_des = k_att * qey
+    return thrust, k_att * qex, k_att * qey, qex, qey
+
+
+@njit(cache=True)
+def rate_loop(
+    thrust: float,
+    p_des: float,
+    q_des: float,
+    r_des: float,
+    omega: np.ndarray,
+    ctrl: np.ndarray,
+    veh: np.ndarray,
+    cmd: np.ndarray,
+) -> None:
+    """The staged law's inner loop: thrust (N) and rate references (rad/s) to rotor speeds.
+
+    ``nu = K_rate (omega_des - omega)``, feedback-linearised torques, the
+    allocation (negative squares to zero) and the vehicle's rotor range
+    (``ctrl[C_OMEGA_MIN]``, ``ctrl[C_OMEGA_MAX]``); writes rad/s into ``cmd``.
+    ``omega``: measured body rates (rad/s).
+    """
+    p0 = C_PARAMS
     nu_p = ctrl[p0 + R_K_RATE] * (p_des - omega[0])
     nu_q = ctrl[p0 + R_K_RATE + 1] * (q_des - omega[1])
-    nu_r = ctrl[p0 + R_K_RATE + 2] * (0.0 - omega[2])
+    nu_r = ctrl[p0 + R_K_RATE + 2] * (r_des - omega[2])
     tx, ty, tz = linearised_torques(omega, veh, nu_p, nu_q, nu_r)
     allocate(ctrl, thrust, tx, ty, tz, cmd)
     lo = ctrl[C_OMEGA_MIN]
@@ -196,6 +216,29 @@ def staged_law(
             cmd[j] = lo
         elif cmd[j] > hi:
             cmd[j] = hi
+
+
+@njit(cache=True)
+def staged_law(
+    stage: int,
+    a_ref_on: bool,
+    x: np.ndarray,
+    omega: np.ndarray,
+    normal: np.ndarray,
+    ctrl: np.ndarray,
+    veh: np.ndarray,
+    cmd: np.ndarray,
+) -> tuple[float, float]:
+    """Rotor commands (rad/s) of the staged law in ``stage`` (1-4); returns ``(q_e,x, q_e,y)``.
+
+    ``x``: state estimate; ``omega``: measured body rates (rad/s); ``normal``:
+    wall-normal estimate (inertial, unit, away from the wall); ``a_ref_on``:
+    whether stage 1's push away from the wall applies. The outer loop
+    (:func:`staged_references`) then the inner loop (:func:`rate_loop`, with
+    ``r_des = 0``).
+    """
+    thrust, p_des, q_des, qex, qey = staged_references(stage, a_ref_on, x, normal, ctrl, veh)
+    rate_loop(thrust, p_des, q_des, 0.0, omega, ctrl, veh, cmd)
     return qex, qey
 
 

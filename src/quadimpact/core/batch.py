@@ -1,0 +1,666 @@
+"""Many runs stepped together under external rotor commands: the learning environments' core.
+
+The arrays of :mod:`step` for N runs are stacked along a first axis (``X``
+is (N, NX), ``LS`` (N, NLS), ``CS`` (N, 4 n_surf, NCS), ``NOISE`` (N, n, 6)
+...; row ``k`` is run ``k``'s array, as ``step.advance`` takes it). All runs of
+a batch have the same surfaces, output grid and buffer sizes; a run whose
+IMU draws no noise (an ideal IMU) has its noise rows padded with zeros, which
+the IMU multiplies by a zero standard deviation: the same arithmetic as no
+rows at all.
+
+Per control tick and run, :func:`step_batch` maps the agent's normalised
+action to a rotor command, sets the run's stage in force (reported by the
+policy, or from the observer below), runs one tick of ``step.tick`` with that
+command in ``ls[LS_EXT_CMD]`` (so the loop's slew limit, range and zero floor
+apply), then computes the run's next observation, reward and termination.
+:func:`reset_slot` starts a run and, in detection mode, runs its pre-impact
+behaviour with the built-in controller until the detector fires.
+
+Frames and units: inertial NED, body FRD, SI, rotor speeds in rad/s.
+
+Action maps (``a`` clipped to [-1, 1]):
+
+* rotors: ``omega_j = lo + (a_j + 1) h``, ``h = (hi - lo)/2``, with ``[lo, hi]``
+  the vehicle's rotor range (or ``[0, hi]``), evaluated by :func:`affine_map`;
+* ctbr: collective thrust ``T = T_max (a_0 + 1)/2`` (``T_max = 4 kt hi^2``), body
+  rate references ``a_1..3 * rate_max`` (rad/s), then the staged controller's
+  inner loop ``recovery.rate_loop`` (``K_rate`` feedback on the gyro,
+  feedback-linearised torques, allocation, rotor range).
+
+Observer (the stage record for a policy that reports no stages): stage 1 at
+the first tick at which the detector has fired (the takeover); then, over the
+ticks after it, the *level test* (the tilt error toward level of
+``recovery.staged_references`` in stage 2, ``|q_e,x|, |q_e,y| < q_tol``, and the
+gyro's ``|p|, |q| < rate_tol``) and the *recovered condition* (the level test
+and body z velocity ``w < w_tol``) must each hold for a confirmation window of
+``P_HOLD_TICKS`` ticks: stages 2 and 3 are entered at the first tick of the
+first window of the level test, stage 4 at the first tick of the first window
+of the recovered condition (written into the run's stage record once the
+window is complete). A policy that reports its stages (``staged_policy``) has
+its own stage record; with either, the episode ends as recovered once stage 4
+is reached and the recovered condition has held for the window.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .controllers.recovery import (
+    R_FIRST_TICK_LEVEL,
+    R_Q_TOL,
+    R_RATE_TOL,
+    R_W_TOL,
+    STAGE_DETECTED,
+    STAGE_PRE_IMPACT,
+    STAGE_RECOVERED,
+    STAGE_TILTED,
+    rate_loop,
+    recovery_step,
+    staged_references,
+)
+from .layout import (
+    C_OMEGA_MAX,
+    C_OMEGA_MIN,
+    C_PARAMS,
+    LS_DONE,
+    LS_EXT,
+    LS_EXT_CMD,
+    LS_K,
+    LS_T,
+    LS_T0,
+    LS_TF,
+    MEM_STAGE,
+    MS_DETECTED,
+    MS_IMU_F,
+    MS_IMU_W,
+    MS_NORMAL,
+    MS_T,
+    MS_T_DETECT,
+    MS_X,
+    NMEAS,
+    NX,
+    O_DT_CONTROL,
+    O_SLEW_MAX,
+    RIN_CMD,
+    ST_CRASH_T,
+    ST_STAGE_T,
+    ST_STAGE_X,
+    ST_STATUS,
+    STATUS_FAILED,
+    V_GRAVITY,
+    V_KT,
+    V_MASS,
+    X_OMEGA,
+    X_POS,
+    X_QUAT,
+    X_ROTOR,
+    X_VEL,
+)
+from .quaternion import normalise_quaternion, rotation_matrix
+from .step import finish, start, tick
+
+# ---------------------------------------------------------------- per-run env state (N, NB)
+B_ACTIVE = 0  # 1 while the episode runs
+B_STAGE = 1  # stage in force (the policy's or the observer's)
+B_POLICY = 2  # 1 once the policy has reported a stage this episode
+B_HOLD = 3  # consecutive ticks (after the takeover) the recovered condition has held
+B_H_REF = 4  # m, altitude at the takeover (height-loss reference)
+B_X_REF = 5  # m, CM X and Y at the takeover (distance reference)
+B_Y_REF = 6
+B_STEPS = 7  # steps taken this episode
+B_OUTCOME = 8  # OC_* below
+B_RETURN = 9  # sum of the rewards of the episode
+B_INEXACT = 10  # policy commands the action map could not give exactly (in the slew window)
+B_LEVEL_N = 11  # consecutive ticks (after the takeover) the level test has held
+B_LEVEL_T = 12  # s, first tick of that run
+B_LEVEL_P = 13  # 3: CM position there, inertial, m
+B_HOLD_T = 16  # s, first tick of the recovered condition's run
+B_HOLD_P = 17  # 3: CM position there, inertial, m
+NB = 20
+
+OC_RUNNING = 0
+OC_RECOVERED = 1
+OC_GROUND = 2
+OC_TILT = 3
+OC_ALTITUDE = 4
+OC_DISTANCE = 5
+OC_RATE = 6
+OC_TIME_LIMIT = 7
+OC_FAILED = 8
+
+# ---------------------------------------------------------------- parameters (NPAR)
+P_ACTION = 0  # ACT_* below
+P_OBSERVE = 1  # OBS_* below
+P_ZERO_LOW = 2  # 1: rotor actions map onto [0, hi] instead of the vehicle's [lo, hi]
+P_RATE_MAX = 3  # 3: ctbr rate reference scale (p, q, r), rad/s
+P_W_TILT = 6  # reward weights, per second of simulated time (rewards are w * cost * dt)
+P_W_RATE = 7
+P_W_VZ = 8
+P_W_HEIGHT = 9
+P_W_EFFORT = 10
+P_W_RECOVERY = 11  # bonus on the recovered termination
+P_W_FAILURE = 12  # penalty on a failure termination (ground, envelope)
+P_FAIL_REMAINING = 13  # 1: a failure also costs the largest cost rate for the time left
+P_S_RATE = 14  # rad/s, scale of the rate cost
+P_S_VZ = 15  # m/s, scale of the vertical-speed cost
+P_S_HEIGHT = 16  # m, scale of the height-loss cost
+P_MAX_TILT_COS = 17  # envelope: cos of the largest tilt from vertical
+P_MAX_DROP = 18  # m, envelope: altitude below the takeover altitude
+P_MAX_DIST = 19  # m, envelope: horizontal distance from the takeover position
+P_MAX_RATE = 20  # rad/s, envelope: |omega|
+P_HOLD_TICKS = 21  # confirmation window of the level test and the recovered condition, ticks
+P_END_ON_RECOVERY = 29  # 1: the episode ends once recovered (stage 4 and the window held)
+P_GROUND = 22  # 1: the first ground contact ends the episode
+P_OBS_F = 23  # observation scales: specific force m/s^2, rates rad/s, speed m/s, time s,
+P_OBS_W = 24  # position m; observations are clipped to +-P_OBS_CLIP
+P_OBS_V = 25
+P_OBS_T = 26
+P_OBS_POS = 27
+P_OBS_CLIP = 28
+NPAR = 32
+
+ACT_ROTORS = 0
+ACT_CTBR = 1
+OBS_IMU = 0
+OBS_STATE = 1
+N_OBS_IMU = 24
+N_OBS_STATE = 19
+
+
+# ---------------------------------------------------------------- action maps
+@njit(cache=True)
+def affine_map(a: float, lo: float, hi: float) -> float:
+    """``lo + (a + 1) (hi - lo)/2`` for ``a`` in [-1, 1], rounded as finely as floats allow.
+
+    Evaluated from the nearer end (``lo + (1 + a) h`` for ``a < -1/2``,
+    ``hi - (1 - a) h`` for ``a > 1/2``) or from the middle (``m + a h``), so that
+    ``1 + a`` and ``1 - a`` are exact: every float command from
+    ``lo + (hi - lo)/4`` to ``hi`` is the map of some float ``a``. Below, only a
+    part is (near ``a = -1`` floats are ``2^-53`` apart, which the map spreads
+    over more commands than there are floats ``a``). ``a = -1`` gives ``lo`` and
+    ``a = 1`` gives ``hi`` exactly.
+    """
+    h = 0.5 * (hi - lo)
+    if a < -0.5:
+        return lo + (1.0 + a) * h
+    if a > 0.5:
+        return hi - (1.0 - a) * h
+    return (lo + h) + a * h
+
+
+@njit(cache=True)
+def affine_inverse(w: float, lo: float, hi: float) -> tuple[float, bool]:
+    """The ``a`` in [-1, 1] whose :func:`affine_map` is ``w``; False if none (the nearest then).
+
+    Newton steps on the map, then a walk with ``nextafter`` to the exact value.
+    """
+    h = 0.5 * (hi - lo)
+    if w <= lo:
+        return -1.0, w == lo
+    if w >= hi:
+        return 1.0, w == hi
+    a = min(max((w - lo) / h - 1.0, -1.0), 1.0)
+    for _ in range(3):
+        a = min(max(a + (w - affine_map(a, lo, hi)) / h, -1.0), 1.0)
+    best = a
+    best_err = abs(affine_map(a, lo, hi) - w)
+    for _ in range(64):
+        m = affine_map(a, lo, hi)
+        if m == w:
+            return a, True
+        err = abs(m - w)
+        if err < best_err:
+            best = a
+            best_err = err
+        a = np.nextafter(a, 2.0) if m < w else np.nextafter(a, -2.0)
+        if a < -1.0 or a > 1.0:
+            break
+    return best, False
+
+
+@njit(cache=True)
+def rotor_range(ctrl: np.ndarray, par: np.ndarray) -> tuple[float, float]:
+    """The rotor-speed range (rad/s) that rotor actions map onto."""
+    lo = 0.0 if par[P_ZERO_LOW] > 0.5 else ctrl[C_OMEGA_MIN]
+    return lo, ctrl[C_OMEGA_MAX]
+
+
+@njit(cache=True)
+def max_thrust(veh: np.ndarray, ctrl: np.ndarray) -> float:
+    """``4 kt hi^2`` (N): all rotors at the top of the range."""
+    hi = ctrl[C_OMEGA_MAX]
+    return 4.0 * veh[V_KT] * hi * hi
+
+
+@njit(cache=True)
+def action_command(
+    action: np.ndarray, meas: np.ndarray, veh: np.ndarray, ctrl: np.ndarray, par: np.ndarray,
+    cmd: np.ndarray,
+) -> None:  # fmt: skip
+    """Rotor speed commands (rad/s) of a normalised action, into ``cmd``.
+
+    ``meas``: the tick's measurement record (the gyro for the ctbr rate loop).
+    """
+    a = np.empty(4)
+    for j in range(4):
+        v = action[j]
+        a[j] = -1.0 if not v >= -1.0 else (1.0 if v > 1.0 else v)  # NaN -> -1
+    if int(par[P_ACTION]) == ACT_CTBR:
+        thrust = affine_map(a[0], 0.0, max_thrust(veh, ctrl))
+        rates = (a[1] * par[P_RATE_MAX], a[2] * par[P_RATE_MAX + 1], a[3] * par[P_RATE_MAX + 2])
+        rate_loop(thrust, rates[0], rates[1], rates[2], meas[MS_IMU_W : MS_IMU_W + 3], ctrl, veh,
+                  cmd)  # fmt: skip
+    else:
+        lo, hi = rotor_range(ctrl, par)
+        for j in range(4):
+            cmd[j] = affine_map(a[j], lo, hi)
+
+
+# ---------------------------------------------------------------- observer
+@njit(cache=True)
+def level_test(
+    tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray
+) -> tuple[float, float, float, float, float]:
+    """``(q_e,x, q_e,y, p, q, w)`` of the tick: tilt error toward level, gyro rates, body w."""
+    x = tmeas[MS_X : MS_X + NX]
+    _, _, _, qex, qey = staged_references(STAGE_TILTED, False, x, tmeas[MS_NORMAL : MS_NORMAL + 3],
+                                          ctrl, veh)  # fmt: skip
+    return qex, qey, tmeas[MS_IMU_W], tmeas[MS_IMU_W + 1], x[X_VEL + 2]
+
+
+@njit(cache=True)
+def takeover_stage(stage: int, tmeas: np.ndarray) -> int:
+    """The observer's stage at a tick before its stage 2: 1 once the detector has fired."""
+    if stage == STAGE_PRE_IMPACT and tmeas[MS_DETECTED] > 0.5:
+        return STAGE_DETECTED
+    return stage
+
+
+@njit(cache=True)
+def level_and_recovered(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> tuple[bool, bool]:
+    """The level test of the tick, and the recovered condition (level and ``w < w_tol``)."""
+    qex, qey, p, q, w = level_test(tmeas, ctrl, veh)
+    p0 = C_PARAMS
+    qt = ctrl[p0 + R_Q_TOL]
+    rt = ctrl[p0 + R_RATE_TOL]
+    level = abs(qex) < qt and abs(qey) < qt and abs(p) < rt and abs(q) < rt
+    return level, level and w < ctrl[p0 + R_W_TOL]
+
+
+@njit(cache=True)
+def recovered_condition(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> bool:
+    """Level, slow (|p|, |q|) and body z velocity below ``w_tol``, all at this tick."""
+    return level_and_recovered(tmeas, ctrl, veh)[1]
+
+
+@njit(cache=True)
+def _enter(stats: np.ndarray, stage: int, t: float, p: np.ndarray) -> None:
+    """Write a stage entry (tick, CM position) into a run's stage record."""
+    stats[ST_STAGE_T + stage] = t
+    for i in range(3):
+        stats[ST_STAGE_X + 3 * stage + i] = p[i]
+
+
+@njit(cache=True)
+def _track_windows(env: np.ndarray, tmeas: np.ndarray, x: np.ndarray, ctrl: np.ndarray,
+                   veh: np.ndarray) -> None:  # fmt: skip
+    """Runs of the level test and of the recovered condition at the tick ``tmeas[MS_T]``."""
+    if env[B_STAGE] < STAGE_DETECTED:
+        env[B_LEVEL_N] = 0.0
+        env[B_HOLD] = 0.0
+        return
+    level, rec = level_and_recovered(tmeas, ctrl, veh)
+    _count(env, level, B_LEVEL_N, B_LEVEL_T, B_LEVEL_P, tmeas[MS_T], x)
+    _count(env, rec, B_HOLD, B_HOLD_T, B_HOLD_P, tmeas[MS_T], x)
+
+
+@njit(cache=True)
+def _count(env: np.ndarray, ok: bool, n_slot: int, t_slot: int, p_slot: int, t: float,
+           x: np.ndarray) -> None:  # fmt: skip
+    """One tick of a run: its length, and its first tick and position."""
+    if not ok:
+        env[n_slot] = 0.0
+        return
+    if env[n_slot] == 0.0:
+        env[t_slot] = t
+        for i in range(3):
+            env[p_slot + i] = x[X_POS + i]
+    env[n_slot] += 1.0
+
+
+@njit(cache=True)
+def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np.ndarray) -> None:
+    """The observer's stages 2-4, entered at the start of their completed windows."""
+    window = par[P_HOLD_TICKS]
+    stage = int(env[B_STAGE])
+    if stage == STAGE_DETECTED and env[B_LEVEL_N] >= window:
+        _enter(stats, STAGE_TILTED, env[B_LEVEL_T], env[B_LEVEL_P : B_LEVEL_P + 3])
+        _enter(stats, STAGE_TILTED + 1, env[B_LEVEL_T], env[B_LEVEL_P : B_LEVEL_P + 3])
+        stage = STAGE_TILTED + 1
+    if stage == STAGE_TILTED + 1 and env[B_HOLD] >= window:
+        _enter(stats, STAGE_RECOVERED, env[B_HOLD_T], env[B_HOLD_P : B_HOLD_P + 3])
+        stage = STAGE_RECOVERED
+    env[B_STAGE] = stage
+    mem[MEM_STAGE] = stage
+
+
+@njit(cache=True)
+def tick_measurement(x: np.ndarray, ls: np.ndarray, opts: np.ndarray, meas: np.ndarray,
+                     tmeas: np.ndarray) -> None:  # fmt: skip
+    """What a controller sees at the next tick: ``meas`` with the state and time of that tick.
+
+    The quaternion is normalised on a copy, as ``step.tick`` normalises the
+    state before the controller runs (the same arithmetic, so the same bits).
+    """
+    for i in range(NMEAS):
+        tmeas[i] = meas[i]
+    for i in range(NX):
+        tmeas[MS_X + i] = x[i]
+    normalise_quaternion(tmeas, MS_X + X_QUAT)
+    tmeas[MS_T] = ls[LS_T0] + int(ls[LS_K]) * opts[O_DT_CONTROL]
+
+
+# ---------------------------------------------------------------- observation, reward
+@njit(cache=True)
+def _clip(v: float, c: float) -> float:
+    if not v == v:  # NaN (a failed run)
+        return 0.0
+    return min(max(v, -c), c)
+
+
+@njit(cache=True)
+def observe(
+    tmeas: np.ndarray, rin: np.ndarray, ctrl: np.ndarray, par: np.ndarray, env: np.ndarray,
+    obs: np.ndarray,
+) -> None:  # fmt: skip
+    """The normalised observation of a tick (layouts in docs/LEARNING.md)."""
+    x = tmeas[MS_X : MS_X + NX]
+    C = np.empty((3, 3))
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
+    clip = par[P_OBS_CLIP]
+    vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
+    detected = tmeas[MS_DETECTED] > 0.5
+    since = tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0
+    lo, hi = rotor_range(ctrl, par)
+    h = 0.5 * (hi - lo)
+    if int(par[P_OBSERVE]) == OBS_STATE:
+        obs[0] = _clip(x[X_POS] / par[P_OBS_POS], clip)
+        obs[1] = _clip((x[X_POS + 1] - env[B_Y_REF]) / par[P_OBS_POS], clip)
+        obs[2] = _clip((-x[X_POS + 2] - env[B_H_REF]) / par[P_OBS_POS], clip)
+        for i in range(3):
+            obs[3 + i] = _clip(x[X_VEL + i] / par[P_OBS_V], clip)
+        sign = -1.0 if x[X_QUAT] < 0.0 else 1.0
+        for i in range(4):
+            obs[6 + i] = _clip(sign * x[X_QUAT + i], clip)
+        for i in range(3):
+            obs[10 + i] = _clip(x[X_OMEGA + i] / par[P_OBS_W], clip)
+        for j in range(4):
+            obs[13 + j] = _clip((x[X_ROTOR + j] - lo) / h - 1.0, clip)
+        obs[17] = _clip(since / par[P_OBS_T], clip)
+        obs[18] = 1.0 if detected else 0.0
+        return
+    for i in range(3):
+        obs[i] = _clip(tmeas[MS_IMU_F + i] / par[P_OBS_F], clip)
+        obs[3 + i] = _clip(tmeas[MS_IMU_W + i] / par[P_OBS_W], clip)
+    for r in range(3):
+        for c in range(3):
+            obs[6 + 3 * r + c] = _clip(C[r, c], clip)
+    obs[15] = _clip(-vz / par[P_OBS_V], clip)
+    obs[16] = _clip(since / par[P_OBS_T], clip)
+    obs[17] = 1.0 if detected else 0.0
+    obs[18] = _clip(tmeas[MS_NORMAL], clip)
+    obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
+    for j in range(4):
+        obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
+
+
+@njit(cache=True)
+def cost_rate(
+    x: np.ndarray, rin: np.ndarray, veh: np.ndarray, ctrl: np.ndarray, par: np.ndarray,
+    h_ref: float,
+) -> float:  # fmt: skip
+    """Weighted cost per second of a state and the command in force (each term in [0, 1])."""
+    q1 = x[X_QUAT + 1]
+    q2 = x[X_QUAT + 2]
+    n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
+    c22 = 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2  # cos of the tilt from vertical
+    tilt = 0.5 * (1.0 - c22)
+    w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
+    rate = min(w / par[P_S_RATE], 1.0)
+    C = np.empty((3, 3))
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
+    vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
+    vert = min(abs(vz) / par[P_S_VZ], 1.0)
+    height = min(max(h_ref + x[X_POS + 2], 0.0) / par[P_S_HEIGHT], 1.0)
+    hover = math.sqrt(veh[V_MASS] * veh[V_GRAVITY] / (4.0 * veh[V_KT]))
+    span = ctrl[C_OMEGA_MAX] - ctrl[C_OMEGA_MIN]
+    effort = 0.0
+    for j in range(4):
+        d = (rin[RIN_CMD + j] - hover) / span
+        effort += 0.25 * d * d
+    effort = min(effort, 1.0)
+    total = (par[P_W_TILT] * tilt + par[P_W_RATE] * rate + par[P_W_VZ] * vert
+             + par[P_W_HEIGHT] * height + par[P_W_EFFORT] * effort)  # fmt: skip
+    return total if total == total else max_cost_rate(par)
+
+
+@njit(cache=True)
+def max_cost_rate(par: np.ndarray) -> float:
+    """The largest cost per second (every term at 1)."""
+    return par[P_W_TILT] + par[P_W_RATE] + par[P_W_VZ] + par[P_W_HEIGHT] + par[P_W_EFFORT]
+
+
+@njit(cache=True)
+def envelope_outcome(x: np.ndarray, env: np.ndarray, par: np.ndarray) -> int:
+    """``OC_*`` of the first envelope limit the state breaks (``OC_RUNNING``: none)."""
+    q1 = x[X_QUAT + 1]
+    q2 = x[X_QUAT + 2]
+    n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
+    if 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2 < par[P_MAX_TILT_COS]:
+        return OC_TILT
+    if -x[X_POS + 2] < env[B_H_REF] - par[P_MAX_DROP]:
+        return OC_ALTITUDE
+    if math.hypot(x[X_POS] - env[B_X_REF], x[X_POS + 1] - env[B_Y_REF]) > par[P_MAX_DIST]:
+        return OC_DISTANCE
+    w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
+    if w > par[P_MAX_RATE]:
+        return OC_RATE
+    return OC_RUNNING
+
+
+# ---------------------------------------------------------------- reset and step
+@njit(cache=True)
+def _begin_episode(k: int, X, LS, RIN, MEAS, TMEAS, OPTS, CTRL, ENV, par, obs) -> None:  # fmt: skip
+    for i in range(ENV.shape[1]):
+        ENV[k, i] = 0.0
+    ENV[k, B_ACTIVE] = 1.0
+    ENV[k, B_H_REF] = -X[k, X_POS + 2]
+    ENV[k, B_X_REF] = X[k, X_POS]
+    ENV[k, B_Y_REF] = X[k, X_POS + 1]
+    tick_measurement(X[k], LS[k], OPTS[k], MEAS[k], TMEAS[k])
+    observe(TMEAS[k], RIN[k], CTRL[k], par, ENV[k], obs[k])
+
+
+@njit(cache=True)
+def reset_slot(
+    k: int, t0: float, tf: float, until_detection: bool,
+    X, LS, CS, RIN, MEM, MEAS, TMEAS, SST, VEH, SURF, OPTS, CTRL, SCFG,
+    sched_t, sched_rate, sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, ENV, par, obs,
+) -> bool:  # fmt: skip
+    """Start run ``k`` from ``X[k]`` (its initial state) and begin its episode.
+
+    ``until_detection``: first run the built-in controller (its pre-impact
+    behaviour) tick by tick until the detector has fired, so that the agent's
+    first action is applied at the tick where the built-in law would start.
+    Returns False if the run ended first (no detection): the episode is then
+    not begun.
+    """
+    start(X[k], t0, tf, LS[k], CS[k], RIN[k], MEM[k], MEAS[k], SST[k], VEH[k], SURF[k], OPTS[k],
+          SCFG[k], NOISE[k], T_OUT[k], OUT[k], IMU[k], STATS[k])  # fmt: skip
+    if until_detection:
+        nc = CS.shape[1]
+        w = _work(nc)
+        while MEAS[k, MS_DETECTED] < 0.5:
+            if LS[k, LS_DONE] > 0.5:
+                ENV[k, B_ACTIVE] = 0.0
+                return False
+            _tick(k, X, LS, CS, RIN, MEM, MEAS, SST, VEH, SURF, OPTS, CTRL, SCFG, sched_t,
+                  sched_rate, sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, w)  # fmt: skip
+        if LS[k, LS_DONE] > 0.5:
+            ENV[k, B_ACTIVE] = 0.0
+            return False
+    _begin_episode(k, X, LS, RIN, MEAS, TMEAS, OPTS, CTRL, ENV, par, obs)
+    return True
+
+
+@njit(cache=True)
+def _work(nc: int):
+    """Work arrays of ``step.tick``."""
+    return (np.empty(NX), np.empty(NX), np.empty(NX), np.empty(NX), np.zeros((7, NX)),
+            np.zeros((NX, 4)), np.zeros((3, 3)), np.zeros(4), np.zeros(4), np.zeros(nc),
+            np.zeros(nc), np.zeros(nc), np.zeros(nc), np.zeros(nc))  # fmt: skip
+
+
+@njit(cache=True)
+def _tick(k, X, LS, CS, RIN, MEM, MEAS, SST, VEH, SURF, OPTS, CTRL, SCFG, sched_t, sched_rate,
+          sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, w) -> None:  # fmt: skip
+    """``step.advance(1, ...)`` of run ``k`` with preallocated work arrays."""
+    tick(X[k], LS[k], CS[k], RIN[k], MEM[k], MEAS[k], SST[k], VEH[k], SURF[k], OPTS[k], CTRL[k],
+         SCFG[k], sched_t, sched_rate, sched_stop, NOISE[k], T_OUT[k], OUT[k], IMU[k],
+         EPISODES[k], STATS[k], w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9],
+         w[10], w[11], w[12], w[13])  # fmt: skip
+    if LS[k, LS_DONE] > 0.5:
+        finish(LS[k], CS[k], EPISODES[k], STATS[k])
+
+
+@njit(cache=True)
+def step_batch(
+    actions, reported,
+    X, LS, CS, RIN, MEM, MEAS, TMEAS, SST, VEH, SURF, OPTS, CTRL, SCFG,
+    sched_t, sched_rate, sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, ENV, par,
+    obs, reward, terminated, truncated,
+) -> None:  # fmt: skip
+    """One control tick of every active run under the actions ``actions`` (N, 4).
+
+    ``reported`` (N,): the stage the policy reports for this tick (< 0: none;
+    the observer's stage is used unless the policy has reported one this
+    episode). Writes ``obs`` (N, n_obs), ``reward``, ``terminated`` and
+    ``truncated`` (N,) of the active runs; a run that ends becomes inactive.
+    """
+    n = X.shape[0]
+    w = _work(CS.shape[1])
+    cmd = np.zeros(4)
+    for k in range(n):
+        if ENV[k, B_ACTIVE] < 0.5:
+            continue
+        veh = VEH[k]
+        ctrl = CTRL[k]
+        tmeas = TMEAS[k]
+        env = ENV[k]
+        action_command(actions[k], tmeas, veh, ctrl, par, cmd)
+        # the stage in force at this tick
+        if reported[k] >= 0.0:
+            env[B_STAGE] = reported[k]
+            env[B_POLICY] = 1.0
+        elif env[B_POLICY] < 0.5:
+            env[B_STAGE] = takeover_stage(int(env[B_STAGE]), tmeas)
+        MEM[k, MEM_STAGE] = env[B_STAGE]
+        LS[k, LS_EXT] = 1.0
+        for j in range(4):
+            LS[k, LS_EXT_CMD + j] = cmd[j]
+        t_before = LS[k, LS_T]
+        _tick(k, X, LS, CS, RIN, MEM, MEAS, SST, VEH, SURF, OPTS, CTRL, SCFG, sched_t, sched_rate,
+              sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, w)  # fmt: skip
+        LS[k, LS_EXT] = 0.0
+        x = X[k]
+        tick_measurement(x, LS[k], OPTS[k], MEAS[k], tmeas)
+        env[B_STEPS] += 1.0
+        dt = LS[k, LS_T] - t_before
+        r = -dt * cost_rate(x, RIN[k], veh, ctrl, par, env[B_H_REF])
+        # termination: recovered and held, the ground, the envelope; truncation: the run's end
+        finite = np.isfinite(x).all()
+        if finite:
+            _track_windows(env, tmeas, x, ctrl, veh)
+            if env[B_POLICY] < 0.5:
+                _observe_stages(env, STATS[k], MEM[k], par)
+        stage = int(env[B_STAGE])
+        outcome = OC_RUNNING
+        if not finite:
+            outcome = OC_FAILED
+        elif (par[P_END_ON_RECOVERY] > 0.5 and stage >= STAGE_RECOVERED
+              and env[B_HOLD] >= par[P_HOLD_TICKS]):  # fmt: skip
+            outcome = OC_RECOVERED
+        elif par[P_GROUND] > 0.5 and not np.isnan(STATS[k, ST_CRASH_T]):
+            outcome = OC_GROUND
+        else:
+            outcome = envelope_outcome(x, env, par)
+        if outcome == OC_RUNNING and LS[k, LS_DONE] > 0.5:
+            outcome = OC_FAILED if STATS[k, ST_STATUS] == STATUS_FAILED else OC_TIME_LIMIT
+        term = outcome != OC_RUNNING and outcome != OC_TIME_LIMIT and outcome != OC_FAILED
+        if outcome == OC_RECOVERED:
+            r += par[P_W_RECOVERY]
+        elif term:
+            r -= par[P_W_FAILURE]
+            if par[P_FAIL_REMAINING] > 0.5:
+                r -= max_cost_rate(par) * max(LS[k, LS_TF] - LS[k, LS_T], 0.0)
+        reward[k] = r
+        env[B_RETURN] += r
+        terminated[k] = term
+        truncated[k] = outcome == OC_TIME_LIMIT or outcome == OC_FAILED
+        observe(tmeas, RIN[k], ctrl, par, env, obs[k])
+        if outcome != OC_RUNNING:
+            env[B_OUTCOME] = outcome
+            env[B_ACTIVE] = 0.0
+            finish(LS[k], CS[k], EPISODES[k], STATS[k])
+
+
+# ---------------------------------------------------------------- the built-in law as a policy
+@njit(cache=True)
+def staged_policy(
+    active, TMEAS, VEH, CTRL, OPTS, PMEM, par, actions, stages, ENV,
+) -> None:  # fmt: skip
+    """The ``recovery`` controller as a policy: actions (N, 4) and stages (N,) of each active run.
+
+    Runs ``recovery_step`` on the tick's measurement with the policy's own
+    memory ``PMEM`` (N, NMEM), then chooses the action whose map gives its
+    command exactly when one exists (rotors), or its thrust and rate
+    references (ctbr). Counts in ``ENV[:, B_INEXACT]`` the commands inside the
+    slew window that the rotor map cannot give exactly.
+    """
+    cmd = np.zeros(4)
+    for k in range(TMEAS.shape[0]):
+        if not active[k]:
+            continue
+        tmeas = TMEAS[k]
+        ctrl = CTRL[k]
+        mem = PMEM[k]
+        before = int(mem[MEM_STAGE])
+        recovery_step(tmeas[MS_T], tmeas, ctrl, mem, VEH[k], OPTS[k, O_DT_CONTROL], cmd)
+        stage = int(mem[MEM_STAGE])
+        stages[k] = stage
+        if int(par[P_ACTION]) == ACT_CTBR:
+            if stage == STAGE_PRE_IMPACT:
+                actions[k, 0] = -1.0
+                for i in range(1, 4):
+                    actions[k, i] = 0.0
+                continue
+            first = before == STAGE_PRE_IMPACT
+            a_ref_on = not (first and ctrl[C_PARAMS + R_FIRST_TICK_LEVEL] > 0.5)
+            x = tmeas[MS_X : MS_X + NX]
+            thrust, p_des, q_des, _, _ = staged_references(
+                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, VEH[k]
+            )
+            actions[k, 0], _ = affine_inverse(thrust, 0.0, max_thrust(VEH[k], ctrl))
+            actions[k, 1] = min(max(p_des / par[P_RATE_MAX], -1.0), 1.0)
+            actions[k, 2] = min(max(q_des / par[P_RATE_MAX + 1], -1.0), 1.0)
+            actions[k, 3] = 0.0
+            continue
+        lo, hi = rotor_range(ctrl, par)
+        slew = OPTS[k, O_SLEW_MAX] * OPTS[k, O_DT_CONTROL]
+        for j in range(4):
+            a, exact = affine_inverse(cmd[j], lo, hi)
+            actions[k, j] = a
+            prev = tmeas[MS_X + X_ROTOR + j]
+            if not exact and (slew <= 0.0 or abs(cmd[j] - prev) <= slew):
+                ENV[k, B_INEXACT] += 1.0

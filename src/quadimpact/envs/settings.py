@@ -1,0 +1,263 @@
+"""What an impact-recovery environment is made of: its trials, reward, envelope and spaces.
+
+* :class:`TrialDistribution`: the impact trials ``reset`` draws (default: the
+  authors' distribution of docs/RECOVERY.md section 5.1, the Navi);
+* :class:`RewardWeights`: the reward's terms and weights;
+* :class:`Envelope`: the limits whose crossing ends an episode as a failure;
+* :func:`pack_parameters`: all of it, with the action and observation modes,
+  as the compiled core's parameter vector (``core.batch.P_*``).
+
+Units: SI, angles in degrees where a name says ``_deg``; frames inertial NED
+and body FRD (docs/MODEL.md section 1).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from quadimpact.core import batch as B
+from quadimpact.inputs.scenarios import ImpactTrial
+
+__all__ = [
+    "ACTION_MODES",
+    "OBSERVATION_MODES",
+    "Envelope",
+    "RewardWeights",
+    "TrialDistribution",
+    "pack_parameters",
+]
+
+ACTION_MODES = ("rotors", "ctbr")
+OBSERVATION_MODES = ("imu", "state")
+CTBR_RATE_MAX_RAD_S = (32.0, 32.0, 8.0)  # powers of two: the scaling of a rate action is exact
+
+Range = float | tuple[float, float]
+
+
+def _uniform(rng: np.random.Generator, r: Range) -> float:
+    """One draw of a field: a fixed value, or uniform in ``[lo, hi]`` (always one draw)."""
+    u = float(rng.uniform(0.0, 1.0))
+    if isinstance(r, (int, float)):
+        return float(r)
+    lo, hi = (float(v) for v in r)
+    return lo + u * (hi - lo)
+
+
+def _choice(rng: np.random.Generator, options: str | Sequence[str]) -> str:
+    """One of ``options`` (uniform; always one draw), or the single value given."""
+    k = int(rng.integers(0, 1 << 30))
+    if isinstance(options, str):
+        return options
+    return str(options[k % len(options)])
+
+
+@dataclass(frozen=True)
+class TrialDistribution:
+    """The impact trials an environment draws at ``reset`` (docs/RECOVERY.md section 5.1).
+
+    Each range is a fixed value or ``(lo, hi)`` (uniform); each choice a value
+    or a sequence of values (uniform). Every trial makes the same draws in the
+    same order from the environment's generator (``np_random``): roll, pitch,
+    yaw, speed, friction, vehicle, model, IMU preset, then the trial's own
+    seed (its IMU noise and bias), so a seed gives the same trials whatever is
+    fixed.
+
+    Attributes
+    ----------
+    roll_deg, pitch_deg, yaw_deg : float or (float, float)
+        Initial attitude (ZYX), deg. Default the authors': roll +-15, pitch
+        +-45, yaw +-45.
+    speed_m_s : float or (float, float)
+        Initial speed toward the wall, m/s. Default 0.5-2.5.
+    friction : float or (float, float)
+        Coulomb friction coefficient at the bumpers. Default 0.3.
+    vehicle : str or sequence of str
+        Bundled vehicle names (``"navi"``, ``"spiri"``) or vehicle file paths.
+    model : str or sequence of str
+        Model variants: ``"default"`` or ``"recovery-replica"``.
+    imu : str or sequence of str
+        IMU presets: ``"ideal"`` or ``"noisy"``.
+    start_distance_m, altitude_m, final_time_s : float
+        Start of the CM from the wall (m), its altitude (m), the trial's end (s).
+    controller_params : mapping
+        The ``recovery`` controller's parameters (docs/RECOVERY.md 3.5): its
+        stage tolerances are the observer's, its ``k_rate_1_s`` the ctbr rate
+        loop's.
+    overrides : mapping
+        Any other :class:`~quadimpact.inputs.scenarios.ImpactTrial` field
+        (e.g. ``{"detection": {"threshold_g": 1.0}}``, ``{"imu": {"position": "cm"}}``
+        replaces the preset choice).
+    """
+
+    roll_deg: Range = (-15.0, 15.0)
+    pitch_deg: Range = (-45.0, 45.0)
+    yaw_deg: Range = (-45.0, 45.0)
+    speed_m_s: Range = (0.5, 2.5)
+    friction: Range = 0.3
+    vehicle: str | Sequence[str] = "navi"
+    model: str | Sequence[str] = "default"
+    imu: str | Sequence[str] = "ideal"
+    start_distance_m: float = 0.32
+    altitude_m: float = 5.0
+    final_time_s: float = 3.0
+    controller_params: Mapping[str, Any] = field(default_factory=dict)
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+
+    def imu_choices(self) -> list[Any]:
+        """The IMU settings a trial can have (presets, or the override's table)."""
+        if "imu" in self.overrides:
+            return [self.overrides["imu"]]
+        return [self.imu] if isinstance(self.imu, str) else list(self.imu)
+
+    def draw(self, rng: np.random.Generator) -> dict[str, Any]:
+        """The drawn fields of one trial (the :class:`ImpactTrial` keywords that vary)."""
+        fields: dict[str, Any] = {
+            "roll_deg": _uniform(rng, self.roll_deg),
+            "pitch_deg": _uniform(rng, self.pitch_deg),
+            "yaw_deg": _uniform(rng, self.yaw_deg),
+            "speed_m_s": _uniform(rng, self.speed_m_s),
+            "friction_coefficient": _uniform(rng, self.friction),
+            "vehicle": _choice(rng, self.vehicle),
+            "model": _choice(rng, self.model),
+            "imu": _choice(rng, self.imu),
+        }
+        if "imu" in self.overrides:  # a full IMU table replaces the preset choice
+            fields["imu"] = self.overrides["imu"]
+        fields["seed"] = int(rng.integers(0, 2**63 - 1))
+        return fields
+
+    def trial(self, fields: Mapping[str, Any], *, ground: bool, record: bool) -> ImpactTrial:
+        """The validated trial of drawn (or given) fields.
+
+        ``ground``: the ground is a contact surface (its first contact ends the
+        episode); ``record``: keep the 1-kHz time series (otherwise only the
+        start and end rows, which the metrics do not need).
+        """
+        values: dict[str, Any] = {
+            "start_distance_m": self.start_distance_m,
+            "altitude_m": self.altitude_m,
+            "final_time_s": self.final_time_s,
+            "controller_params": dict(self.controller_params),
+            **dict(self.overrides),
+            **dict(fields),
+        }
+        values.setdefault("ground", "contact" if ground else "none")
+        if not record:
+            values["output_rate_hz"] = 1.0 / float(values["final_time_s"])
+        return ImpactTrial(**values)
+
+
+@dataclass(frozen=True)
+class RewardWeights:
+    """The reward (docs/LEARNING.md section 4): costs per second, a bonus, a penalty.
+
+    Per control period of length ``dt`` (5 ms) the reward is
+    ``-dt * (tilt * c_tilt + rate * c_rate + vertical_speed * c_vz
+    + height_loss * c_height + effort * c_effort)``, each cost in [0, 1] at the
+    state reached:
+
+    * ``c_tilt = (1 - cos tilt)/2`` (tilt of the body z axis from vertical);
+    * ``c_rate = min(|omega| / rate_scale_rad_s, 1)``;
+    * ``c_vz = min(|h_dot| / vertical_speed_scale_m_s, 1)``;
+    * ``c_height = min(max(h_takeover - h, 0) / height_scale_m, 1)``;
+    * ``c_effort`` = mean over the rotors of ``((Omega_cmd - Omega_hover) / span)^2``
+      (``span`` the rotor range, ``Omega_hover`` the level-hover speed).
+
+    On the recovered termination ``+ recovery_bonus``; on a failure (ground,
+    envelope) ``- failure_penalty`` and, if ``failure_remaining``, the largest
+    cost rate times the time left in the trial (so failing never costs less
+    than going on). Costs only (no positive per-step term), so an episode that
+    ends recovered is never worth less than one that drags on.
+    """
+
+    tilt: float = 1.0
+    rate: float = 0.5
+    vertical_speed: float = 0.5
+    height_loss: float = 0.5
+    effort: float = 0.1
+    recovery_bonus: float = 1.0
+    failure_penalty: float = 1.0
+    failure_remaining: bool = True
+    rate_scale_rad_s: float = 10.0
+    vertical_speed_scale_m_s: float = 1.0
+    height_scale_m: float = 1.0
+
+
+@dataclass(frozen=True)
+class Envelope:
+    """Limits whose crossing ends an episode as a failure (checked at every tick).
+
+    Attributes
+    ----------
+    max_tilt_deg : float
+        Tilt of the body z axis from vertical, deg.
+    max_drop_m : float
+        Altitude below the altitude at the takeover, m.
+    max_distance_m : float
+        Horizontal distance of the CM from its position at the takeover, m.
+    max_rate_rad_s : float
+        Angular-rate magnitude ``|omega|``, rad/s.
+    """
+
+    max_tilt_deg: float = 150.0
+    max_drop_m: float = 10.0
+    max_distance_m: float = 10.0
+    max_rate_rad_s: float = 40.0
+
+
+def pack_parameters(
+    *,
+    action: Literal["rotors", "ctbr"],
+    observe: Literal["imu", "state"],
+    rotor_floor: Literal["vehicle", "zero"],
+    reward: RewardWeights,
+    envelope: Envelope,
+    hold_s: float,
+    end_on_recovery: bool,
+    ground: bool,
+    dt_s: float = 0.005,
+) -> np.ndarray:
+    """The compiled environment's parameter vector (``core.batch.P_*``)."""
+    if action not in ACTION_MODES:
+        raise ValueError(f"action: one of {ACTION_MODES} (got {action!r})")
+    if observe not in OBSERVATION_MODES:
+        raise ValueError(f"observe: one of {OBSERVATION_MODES} (got {observe!r})")
+    if rotor_floor not in ("vehicle", "zero"):
+        raise ValueError(f"rotor_floor: 'vehicle' or 'zero' (got {rotor_floor!r})")
+    if not hold_s > 0.0:
+        raise ValueError(f"hold_s: > 0 s (got {hold_s!r})")
+    par = np.zeros(B.NPAR)
+    par[B.P_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
+    par[B.P_OBSERVE] = B.OBS_STATE if observe == "state" else B.OBS_IMU
+    par[B.P_ZERO_LOW] = 1.0 if rotor_floor == "zero" else 0.0
+    par[B.P_RATE_MAX : B.P_RATE_MAX + 3] = CTBR_RATE_MAX_RAD_S
+    par[B.P_W_TILT] = reward.tilt
+    par[B.P_W_RATE] = reward.rate
+    par[B.P_W_VZ] = reward.vertical_speed
+    par[B.P_W_HEIGHT] = reward.height_loss
+    par[B.P_W_EFFORT] = reward.effort
+    par[B.P_W_RECOVERY] = reward.recovery_bonus
+    par[B.P_W_FAILURE] = reward.failure_penalty
+    par[B.P_FAIL_REMAINING] = 1.0 if reward.failure_remaining else 0.0
+    par[B.P_S_RATE] = reward.rate_scale_rad_s
+    par[B.P_S_VZ] = reward.vertical_speed_scale_m_s
+    par[B.P_S_HEIGHT] = reward.height_scale_m
+    par[B.P_MAX_TILT_COS] = math.cos(math.radians(envelope.max_tilt_deg))
+    par[B.P_MAX_DROP] = envelope.max_drop_m
+    par[B.P_MAX_DIST] = envelope.max_distance_m
+    par[B.P_MAX_RATE] = envelope.max_rate_rad_s
+    par[B.P_HOLD_TICKS] = max(1.0, round(hold_s / dt_s))
+    par[B.P_END_ON_RECOVERY] = 1.0 if end_on_recovery else 0.0
+    par[B.P_GROUND] = 1.0 if ground else 0.0
+    par[B.P_OBS_F] = 9.81
+    par[B.P_OBS_W] = 10.0
+    par[B.P_OBS_V] = 2.0
+    par[B.P_OBS_T] = 1.0
+    par[B.P_OBS_POS] = 1.0
+    par[B.P_OBS_CLIP] = 10.0
+    return par
