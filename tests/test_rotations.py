@@ -185,3 +185,14 @@ def test_rotation_vector_of_a_known_rotation() -> None:
     C = rz(0.3) @ rx(0.0)
     np.testing.assert_allclose(matrix_to_rotvec(C[None]), [[0.0, 0.0, 0.3]], atol=1e-12)
     np.testing.assert_allclose(matrix_to_rotvec(np.eye(3)[None]), [[0.0, 0.0, 0.0]])
+
+
+def test_single_quaternion_path_is_the_array_path_bit_for_bit() -> None:
+    """One quaternion goes through Python floats; it must equal the vectorised path exactly."""
+    rng = np.random.default_rng(7)
+    qs = rng.normal(size=(2000, 4)) * rng.uniform(0.01, 100.0, size=(2000, 1))
+    stacked = quat_to_matrix(qs)  # the array path
+    for q, c in zip(qs, stacked, strict=True):
+        assert np.array_equal(quat_to_matrix(q), c)
+    with pytest.raises(ValueError, match="zero norm"):
+        quat_to_matrix(np.zeros(4))

@@ -76,8 +76,31 @@ def quat_to_matrix(q: ArrayLike) -> NDArray[np.float64]:
         ``C`` such that ``a_I = C @ a_B``. Column ``k`` of ``C`` is the body
         axis ``k`` expressed in the inertial frame.
     """
+    if type(q) is np.ndarray and q.shape == (4,) and q.dtype == np.float64:
+        return _single_quat_matrix(q)
     a = _as_quat(q)
     return _unit_quat_matrix(a[..., 0], a[..., 1], a[..., 2], a[..., 3])
+
+
+def _single_quat_matrix(q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """:func:`quat_to_matrix` of one quaternion with Python floats (about 10x faster).
+
+    The same operations in the same order as the array path (the norm summed
+    first to last, as NumPy's reduction of four elements does), so the result
+    is the same bit for bit (tested).
+    """
+    a0, a1, a2, a3 = q.tolist()
+    norm = math.sqrt(((a0 * a0 + a1 * a1) + a2 * a2) + a3 * a3)
+    if norm == 0.0:
+        raise ValueError("quaternion of zero norm cannot represent a rotation")
+    q0, q1, q2, q3 = a0 / norm, a1 / norm, a2 / norm, a3 / norm
+    return np.array(
+        [
+            [1.0 - 2.0 * (q2 * q2 + q3 * q3), 2.0 * (q1 * q2 - q0 * q3), 2.0 * (q1 * q3 + q0 * q2)],
+            [2.0 * (q1 * q2 + q0 * q3), 1.0 - 2.0 * (q1 * q1 + q3 * q3), 2.0 * (q2 * q3 - q0 * q1)],
+            [2.0 * (q1 * q3 - q0 * q2), 2.0 * (q2 * q3 + q0 * q1), 1.0 - 2.0 * (q1 * q1 + q2 * q2)],
+        ]
+    )
 
 
 def quat_xyzw_to_matrix(q: ArrayLike) -> NDArray[np.float64]:

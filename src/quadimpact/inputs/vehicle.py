@@ -17,6 +17,7 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -236,7 +237,20 @@ class Vehicle(BaseModel):
         return self
 
     def plausibility_warnings(self) -> list[str]:
-        """Valid but unusual values for a bumper-protected quadrotor (one sentence each)."""
+        """Valid but unusual values for a bumper-protected quadrotor (one sentence each).
+
+        Computed once per vehicle object (the model is frozen).
+        """
+        cached = _PLAUSIBILITY.get(id(self))
+        if cached is not None and cached[0] is self:
+            return list(cached[1])
+        out = self._plausibility_warnings()
+        if len(_PLAUSIBILITY) >= _CACHE_LIMIT:
+            _PLAUSIBILITY.pop(next(iter(_PLAUSIBILITY)))
+        _PLAUSIBILITY[id(self)] = (self, tuple(out))  # the reference keeps the id unique
+        return list(out)
+
+    def _plausibility_warnings(self) -> list[str]:
         out = []
         arms = np.linalg.norm(self.rotor_positions[:, :2], axis=1)
         if not 0.3 * arms.mean() <= self.bumper_radius_m <= 3.0 * arms.mean():
@@ -401,12 +415,17 @@ def _bundled_names() -> list[str]:
     return _BUNDLED
 
 
+@functools.cache
 def _vehicle_folder() -> Any:
-    """The package folder of bundled vehicle files (an importlib.resources Traversable)."""
+    """The package folder of bundled vehicle files (an importlib.resources Traversable).
+
+    Looked up once per process (about 0.3 ms a time).
+    """
     return resources.files("quadimpact.inputs").joinpath("vehicles")
 
 
 _CACHE: dict[tuple[str, int, int], Vehicle] = {}
+_PLAUSIBILITY: dict[int, tuple[Vehicle, tuple[str, ...]]] = {}
 _OVERRIDDEN: dict[tuple[int, str], tuple[Vehicle, Vehicle]] = {}
 _CACHE_LIMIT = 64
 
