@@ -279,18 +279,18 @@ def test_killed_fork_server(tmp_path, tmpdir_env, reference):
 
 HANG_SCRIPT = """
 import time
-import quadimpact
+from quadimpact.simulation.batch import BatchRunner
 
-real = quadimpact.simulate
+real = BatchRunner.summary
 
 
-def hanging(scenario, **kwargs):  # imported again in each worker (forkserver/spawn)
+def hanging(self, scenario):  # imported again in each worker (forkserver/spawn)
     if scenario.inclination_deg == 7:
         time.sleep(600)  # never returns in time, on any worker
-    return real(scenario, **kwargs)
+    return real(self, scenario)
 
 
-quadimpact.simulate = hanging
+BatchRunner.summary = hanging  # what a sweep worker runs
 
 if __name__ == "__main__":
     from quadimpact.sweep import SweepSpec, run_sweep
