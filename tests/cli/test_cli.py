@@ -163,8 +163,10 @@ def test_format_summary_for_people() -> None:
         "leading_bumpers": [4],
         "n_episodes": 5,
         "crash_time_s": 1.875,
+        "response_type": "D",
     }
     text = format_summary(summary, Path("results/run"))
+    assert "response type  D" in text and "detection" not in text
     assert "status         crashed (CM reached the ground)" in text
     assert "delta_init     12.35 mm" in text
     assert "peak force     3.21 N" in text
@@ -175,6 +177,34 @@ def test_format_summary_for_people() -> None:
     assert text.splitlines()[-1].startswith("output         results/run (summary.json")
     quiet = format_summary({"status": "completed", "crash_time_s": None}, Path("o"))
     assert "crash time     no crash" in quiet and "delta_init     n/a" in quiet
+    assert "response type  n/a" in quiet
+
+
+def test_format_summary_of_a_recovery_run() -> None:
+    """A recovery run says when the impact was detected and when stage 4 was reached."""
+    from quadimpact.cli import format_summary
+
+    summary = {"status": "completed", "controller": "recovery", "response_type": "A",
+               "t_detect_s": 0.045, "detection_latency_s": 0.0049, "t_stage4_s": 0.77,
+               "time_to_recover_s": 0.725}  # fmt: skip
+    text = format_summary(summary, Path("o"))
+    assert "detection      at 0.045 s (4.9 ms after the first contact)" in text
+    assert "recovered      stage 4 at 0.77 s (0.725 s after the detection)" in text
+    missed = format_summary({"controller": "recovery", "t_detect_s": None}, Path("o"))
+    assert "detection      no detection" in missed
+    assert "recovered      stage 4 not reached" in missed
+
+
+def test_a_failed_run_exits_3(tmp_path: Path) -> None:
+    """A numerical failure is not a success: status 3 (documented in --help), folder written."""
+    proc = run_cli("run", "--friction", "1e308", "--final-time", "1", "--out", "out",
+                   cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 3, proc.stderr
+    assert "status         failed (state became NaN or infinite)" in proc.stdout
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["status"] == "failed"
+    assert "Traceback" not in proc.stderr
+    helptext = run_cli("run", "--help", cwd=tmp_path).stdout
+    assert "Exit status" in helptext and "3  the run failed numerically" in helptext
 
 
 @pytest.mark.slow

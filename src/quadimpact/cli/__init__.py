@@ -10,7 +10,9 @@
 Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
 commands, so that ``quadimpact --help`` answers at once. Every input problem
 ends the program with one line on stderr, ``quadimpact: error: ...``, and
-exit status 2; set ``QUADIMPACT_DEBUG=1`` to see tracebacks.
+exit status 2; set ``QUADIMPACT_DEBUG=1`` to see tracebacks. ``quadimpact
+run`` exits with status 3 when the run failed numerically (its status is
+``"failed"``).
 """
 
 from __future__ import annotations
@@ -62,6 +64,10 @@ def cli() -> None:
 
     Frames: inertial NED (X toward the wall, Y right, Z down; altitude = -Z),
     body FRD (x forward, y right, z down). Units: SI, angles in degrees.
+
+    Exit status: 0 success; 1 an unexpected error (one line; set
+    QUADIMPACT_DEBUG=1 for the traceback); 2 bad input (one line naming the
+    flag, file or field); 3 'quadimpact run' of a run that failed numerically.
 
     Start with:  quadimpact run --help
     """

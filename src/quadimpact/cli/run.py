@@ -12,7 +12,7 @@ import click
 from quadimpact.cli.options import CONTROLLER, MODEL, file_argument, number_option, out_option
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
-__all__ = ["build_scenario", "format_summary", "run"]
+__all__ = ["EXIT_RUN_FAILED", "build_scenario", "format_summary", "run"]
 
 # click parameter name -> (scenario field, flag as typed)
 _FLAGS: dict[str, tuple[str, str]] = {
@@ -41,6 +41,8 @@ _WALL_ONLY = {
     "wall_distance_m",
     "altitude_m",
 }
+#: Exit status of a run whose status is "failed" (numerical failure; see ``run --help``).
+EXIT_RUN_FAILED = 3
 _OUTPUT_FILES = (
     "summary.json, scenario.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, "
     "fig6.png, imu.png"
@@ -155,6 +157,14 @@ def run(
 
     Writes summary.json, scenario.json (the world that ran), timeseries.parquet,
     episodes.csv, imu.parquet and the figures.
+
+    \b
+    Exit status:
+      0  the run completed or crashed (a simulated crash is a result)
+      1  an unexpected error, or the result folder could not be written
+      2  bad input (flag, file, value); nothing was simulated
+      3  the run failed numerically (status "failed", e.g. the state became
+         NaN); its folder is still written, with the reason in summary.json
     """
     built = build_scenario(scenario, flags, options)
     vehicle = built.build_vehicle()
@@ -171,6 +181,8 @@ def run(
 
         for path in make_all(out, result):
             click.echo(f"picture        {path}")
+    if result.summary.get("status") == "failed":
+        click.get_current_context().exit(EXIT_RUN_FAILED)
 
 
 def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
@@ -282,6 +294,25 @@ def _fmt(value: Any, scale: float = 1.0, unit: str = "", digits: int = 4) -> str
     return str(value)
 
 
+def _recovery_lines(summary: Mapping[str, Any]) -> list[str]:
+    """Detection and stage 4 of a recovery run, for people."""
+    t_detect = summary.get("t_detect_s")
+    if t_detect is None:
+        detected = "no detection"
+    else:
+        latency = summary.get("detection_latency_s")
+        detected = f"at {_fmt(t_detect, unit='s')}"
+        if summary.get("false_detection"):
+            detected += " (before any contact: a false detection)"
+        elif latency is not None:
+            detected += f" ({_fmt(latency, 1000.0, 'ms', 3)} after the first contact)"
+    t4 = summary.get("t_stage4_s")
+    recovered = "stage 4 not reached" if t4 is None else f"stage 4 at {_fmt(t4, unit='s')}"
+    if t4 is not None and summary.get("time_to_recover_s") is not None:
+        recovered += f" ({_fmt(summary['time_to_recover_s'], unit='s')} after the detection)"
+    return [f"detection      {detected}", f"recovered      {recovered}"]
+
+
 def format_summary(summary: Mapping[str, Any], out: Path) -> str:
     """The short human summary printed after a run.
 
@@ -308,9 +339,12 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         f"delta_init     {_fmt(summary.get('delta_init_m'), 1000.0, 'mm')}",
         f"peak force     {_fmt(summary.get('peak_force_n'), unit='N')}",
         f"leading bumper {leading if leading is not None else 'n/a'}",
+        f"response type  {summary.get('response_type') or 'n/a'}",
         f"episodes       {_fmt(summary.get('n_episodes'))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]
+    if summary.get("controller") == "recovery" or summary.get("t_detect_s") is not None:
+        lines += _recovery_lines(summary)
     for warning in summary.get("warnings") or []:
         lines.append(f"warning        {one_line(str(warning))}")
     lines.append(f"output         {out} ({_OUTPUT_FILES})")
