@@ -217,11 +217,94 @@ def test_experiments_writes_table3(tmp_path: Path) -> None:
     missing = tmp_path / "no-data"
     missing.mkdir()
     args = ["experiments", "--out", "exp", "--samples", "0", "--log-samples", "0", "--workers", "1"]
-    proc = run_cli(*args, "--data", str(missing), cwd=tmp_path, timeout=300)
+    proc = run_cli(*args, cwd=tmp_path, timeout=300, env={"QUADIMPACT_DATA": str(missing)})
     assert proc.returncode == 0, proc.stderr
+    assert "QUADIMPACT_DATA" in proc.stderr and "holds none of the crash logs" in proc.stderr
     table = pd.read_csv(tmp_path / "exp" / "table3.csv")
     assert list(table.columns) == [*TABLE3_COLUMNS, *EXTRA_COLUMNS] and len(table) == 7
     # no logs in that folder: the log columns are empty, the simulations are not
     assert table["attitude_rms_deg_0_3s"].isna().all() and table["type_log"].isna().all()
     assert table["type_ours"].notna().all()
     assert "ours_at_log" in proc.stdout and "table3.csv" in proc.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["--data", "/nonexistent"], ["--data /nonexistent: no such folder"]),
+        (["--data", "empty"], ["--data empty: holds none of the crash logs"]),
+        (["--scheduler", "nonsense"], ["--scheduler: must be an address like tcp://HOST:PORT"]),
+        (["--scheduler", "tcp://127.0.0.1:1"], ["no Dask scheduler answers there"]),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], ["give one or the other"]),
+        (["--out", "afile/sub"], ["--out afile/sub: cannot be created: afile is a file"]),
+        (["--out", "run"], ["--out run: holds a run (summary.json); use a new or empty"]),
+    ],
+)
+def test_experiments_refuses_bad_options_before_any_work(
+    tmp_path: Path, args: list[str], fragments: list[str]
+) -> None:
+    """A given --data without logs, a bad --scheduler or --out: one line, at once."""
+    import time
+
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "afile").write_text("x")
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "summary.json").write_text("{}")
+    start = time.monotonic()
+    proc = run_cli("experiments", *args, cwd=tmp_path)
+    assert_input_error(proc, *fragments)
+    assert time.monotonic() - start < 15  # nothing simulated (that takes 30 s and more)
+    assert not (tmp_path / "results").exists()
+
+
+@pytest.mark.parametrize("command", ["reproduce", "sweep"])
+def test_reproduce_and_sweep_check_the_scheduler_first(tmp_path: Path, command: str) -> None:
+    extra = ["--grid", "speed_m_s=0.5,1", "--out", "s"] if command == "sweep" else []
+    proc = run_cli(command, *extra, "--scheduler", "tcp://127.0.0.1:1", cwd=tmp_path)
+    assert_input_error(proc, "--scheduler tcp://127.0.0.1:1: no Dask scheduler answers there")
+    assert not (tmp_path / "s").exists() and not (tmp_path / "results").exists()
+
+
+def test_out_folders_of_another_kind_are_refused_before_simulating(tmp_path: Path) -> None:
+    """run --out into a sweep folder, sweep --out into a run folder, --out under a file."""
+    (tmp_path / "sweep").mkdir()
+    (tmp_path / "sweep" / "sweep.json").write_text("{}")
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "summary.json").write_text("{}")
+    (tmp_path / "afile").write_text("x")
+    proc = run_cli("run", "--out", "sweep", cwd=tmp_path)
+    assert_input_error(proc, "--out sweep: holds a sweep (sweep.json); use a new or empty folder")
+    proc = run_cli("run", "--out", "afile/sub", cwd=tmp_path)
+    assert_input_error(proc, "--out afile/sub: cannot be created: afile is a file, not a folder")
+    proc = run_cli("run", "--out", "x" * 5000, cwd=tmp_path)
+    assert_input_error(proc, "(5000 characters): path too long")
+    assert len(proc.stderr) < 300
+    proc = run_cli("sweep", "--grid", "speed_m_s=0.5,1", "--out", "run", cwd=tmp_path)
+    assert_input_error(proc, "run: holds a run (summary.json); use a new or empty folder")
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["summary.json"]
+
+
+def test_disk_full_during_run_leaves_no_half_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The parquet writer fails part-way: one line, exit 1, no folder, no hidden stage left."""
+    import errno
+
+    import quadimpact.results.files as files
+    from quadimpact.cli import main
+
+    def full(_df: object, path: Path) -> None:
+        Path(path).write_bytes(b"PAR1 half")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(files, "write_timeseries_parquet", full)
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as info:
+        main(["run", "--final-time", "0.6", "--out", str(out)])
+    assert info.value.code == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == (
+        f"quadimpact: error: {out}: the result folder could not be written (No space left on "
+        "device); nothing was changed there"
+    )
+    assert list(tmp_path.iterdir()) == []

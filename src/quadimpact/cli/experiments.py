@@ -15,8 +15,9 @@ from quadimpact.cli.options import data_option, defaulted_option, out_option, pa
     "Output folder: table3.csv, one folder per crash, the sensitivity sweeps.",
 )
 @data_option(
-    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat) "
-    "[default: $QUADIMPACT_DATA, else ../shared/data beside the project]."
+    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
+    "must hold the logs [default: $QUADIMPACT_DATA, else ../shared/data beside the "
+    "project; without them the comparisons with the logs are left out]."
 )
 @defaulted_option(
     "--samples",
@@ -50,8 +51,12 @@ def experiments(
     the crash is run again at the log's own pre-impact estimates (speed,
     heading, roll, pitch) and over their uncertainty.
     """
-    from quadimpact.experiments.table3 import run_experiments
+    from quadimpact.experiments.table3 import check_data_dir, run_experiments
+    from quadimpact.results.files import check_out_dir
 
+    check_out_dir(out, "experiments")
+    if data is not None:
+        check_data_dir(data)
     table = run_experiments(
         out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
         scheduler=scheduler, progress=not no_progress,

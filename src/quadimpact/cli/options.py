@@ -2,15 +2,33 @@
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
 
+from quadimpact.errors import InputError, format_value
+
 
 def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``."""
+    """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``.
+
+    Both are checked before the command starts any work: ``--workers`` and
+    ``--scheduler`` together are refused, and a scheduler address must be
+    ``SCHEME://HOST:PORT``; a ``tcp://`` one must accept a connection.
+    """
+
+    @functools.wraps(command)
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        scheduler = kwargs.get("scheduler")
+        if scheduler is not None:
+            if kwargs.get("workers") is not None:
+                raise InputError("--workers and --scheduler: give one or the other")
+            check_scheduler(scheduler)
+        return command(*args, **kwargs)
+
     options = [
         click.option(
             "--workers",
@@ -26,9 +44,40 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
         ),
         click.option("--no-progress", is_flag=True, help="Do not show the progress bar."),
     ]
+    wrapped: Callable[..., Any] = checked
     for option in reversed(options):
-        command = option(command)
-    return command
+        wrapped = option(wrapped)
+    return wrapped
+
+
+def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
+    """Refuse a Dask scheduler address that is malformed or (``tcp://``) not listening.
+
+    Raises
+    ------
+    InputError
+        One line naming ``--scheduler`` and what is wrong.
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    form = "must be an address like tcp://HOST:PORT"
+    try:
+        parts = urlsplit(address)
+        port = parts.port
+    except ValueError:
+        parts, port = None, None
+    if parts is None or not parts.scheme or not parts.hostname or port is None:
+        raise InputError(f"--scheduler: {form} (got {format_value(address)})")
+    if parts.scheme != "tcp":
+        return
+    try:
+        socket.create_connection((parts.hostname, port), timeout=timeout_s).close()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise InputError(
+            f"--scheduler {address}: no Dask scheduler answers there ({reason})"
+        ) from None
 
 
 Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]

@@ -42,7 +42,13 @@ def reproduce(
     verdict computed from the data, and shows which of the replica's
     differences causes each disagreement.
     """
+    from quadimpact.experiments.table3 import check_data_dir
     from quadimpact.paper.study import reproduce as run_study
+    from quadimpact.results.files import check_out_dir
+
+    check_out_dir(out, "report")
+    if data is not None and not no_experiments:
+        check_data_dir(data)
 
     result = run_study(
         out, workers=workers, scheduler=scheduler, progress=not no_progress,

@@ -130,7 +130,11 @@ _OUTPUT_FILES = (
     "--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]"
 )
 @number_option("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
-@out_option("results/run", "Output folder (created if needed).")
+@out_option(
+    "results/run",
+    "Output folder (created if needed). A folder holding an earlier run is replaced: its "
+    "files and the pictures drawn from it go; one holding anything else is refused.",
+)
 @click.option(
     "--viz",
     is_flag=True,
@@ -166,15 +170,23 @@ def run(
       3  the run failed numerically (status "failed", e.g. the state became
          NaN); its folder is still written, with the reason in summary.json
     """
+    from quadimpact.results.files import check_out_dir
+
     built = build_scenario(scenario, flags, options)
+    check_out_dir(out, "run")
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
 
     from quadimpact.simulation import simulate
 
     result = simulate(built)
-    out.mkdir(parents=True, exist_ok=True)
-    result.write(out)
+    try:
+        result.write(out)
+    except OSError as exc:
+        raise click.ClickException(
+            f"{out}: the result folder could not be written ({exc.strerror or exc}); "
+            "nothing was changed there"
+        ) from None
     click.echo(format_summary(result.summary, out))
     if viz:
         from quadimpact.cli.viz import make_all

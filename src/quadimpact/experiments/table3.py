@@ -108,6 +108,63 @@ def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
     return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
 
 
+def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | None:
+    """The data folder to read the logs from, checked before any work.
+
+    Parameters
+    ----------
+    data : path or None
+        A folder given explicitly (``--data``): it must hold at least one of
+        the seven crashes' logs, else this is an input error. ``None``: the
+        default folder (:func:`quadimpact.experiments.logs.data_dir`), if any;
+        a ``$QUADIMPACT_DATA`` that holds no logs is said in a warning on
+        stderr (the log columns then stay empty).
+    where : str
+        How the folder was given, for the message.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The folder holding ``spiri-crash-set-1/`` (None: no logs).
+
+    Raises
+    ------
+    InputError
+        A given folder that is absent, is a file or holds none of the logs.
+    """
+    import os
+    import sys
+
+    from quadimpact.errors import InputError
+    from quadimpact.experiments.logs import DATA_ENV_VAR
+
+    logs = [c.log_file for c in TABLE3]
+    if data is None:
+        found = data_dir()
+        env = os.environ.get(DATA_ENV_VAR)
+        if found is None and env:
+            print(f"quadimpact: warning: ${DATA_ENV_VAR}={env} holds none of the crash logs "
+                  f"({logs[0]}, ...): the comparisons with the logs are left out",
+                  file=sys.stderr)  # fmt: skip
+        return found
+    root = Path(data)
+    if not root.exists():
+        raise InputError(f"{where} {root}: no such folder")
+    if not root.is_dir():
+        raise InputError(f"{where} {root}: is a file, not a folder")
+    if any((root / name).is_file() for name in logs):
+        return root
+    if any((root / Path(name).name).is_file() for name in logs):
+        raise InputError(
+            f"{where} {root}: is the crash set's own folder; give the folder that holds it, "
+            f"{root.resolve().parent}"
+        )
+    raise InputError(
+        f"{where} {root}: holds none of the crash logs (expected {logs[0]} ... "
+        f"{Path(logs[-1]).name})"
+    )
+
+
 def read_log(crash: Crash, data: str | Path | None = None) -> SpiriMatLog | None:
     """The crash's flight log, None where the data folder or the file is absent."""
     root = Path(data) if data is not None else data_dir()
@@ -214,7 +271,8 @@ def run_experiments(
     data_dir : path, optional
         The data folder holding ``spiri-crash-set-1/`` (default: found by
         :func:`quadimpact.experiments.logs.data_dir`); without it the log
-        columns stay empty.
+        columns stay empty. A folder given here that holds none of the logs
+        is an input error (:func:`check_data_dir`), raised before any run.
     samples, log_samples : int
         Runs per crash over Table III's uncertainty, and over the log
         estimates' uncertainty (0: none).
@@ -227,9 +285,11 @@ def run_experiments(
         The table written to ``table3.csv``.
     """
     from quadimpact.experiments.logs_compare import attitude_rms_for_crash
+    from quadimpact.results.files import check_out_dir
 
     sweep_options = {"workers": workers, "scheduler": scheduler, "progress": progress}
-    out = Path(out_dir)
+    data_dir = check_data_dir(data_dir, "data_dir")
+    out = check_out_dir(Path(out_dir), "experiments", where="")
     out.mkdir(parents=True, exist_ok=True)
     rows: list[dict[str, Any]] = []
     for crash in TABLE3:

@@ -92,8 +92,13 @@ def reproduce(
     (``experiments/table3.py``, into ``out_dir/experiments``), compared with
     their logs when ``data_dir`` (or the default data folder) holds them.
     """
+    from quadimpact.experiments.table3 import check_data_dir
+    from quadimpact.results.files import check_out_dir
+
     start = time.perf_counter()
-    out = Path(out_dir)
+    out = check_out_dir(Path(out_dir), "report", where="")
+    if experiments and data_dir is not None:
+        data_dir = check_data_dir(data_dir, "data_dir")
     out.mkdir(parents=True, exist_ok=True)
     tables: dict[str, pd.DataFrame] = {}
     found: dict[str, list[Finding]] = {}

@@ -193,27 +193,49 @@ class SimulationResult:
         """Write the result folder and return its path.
 
         Files, in this order so that a plotting failure loses no data:
-        ``summary.json`` (the summary plus ``references`` and ``stats`` unless
-        it already has those keys), ``scenario.json`` (the world record, when
-        there is one), ``episodes.csv``, ``timeseries.parquet``,
-        ``imu.parquet`` (when there are IMU samples), ``fig5.png``,
-        ``fig6.png``, ``imu.png``. A figure that fails is not written (a stale
-        one from an earlier write is removed); the failure is printed as a
-        one-line warning on stderr and listed under ``plot_errors`` in
-        ``summary.json`` (and in ``self.summary``).
+        ``summary.json`` (the summary plus ``references``, and the integrator
+        counters ``integrator`` unless it already has those keys),
+        ``scenario.json`` (the world record, when there is one),
+        ``episodes.csv``, ``timeseries.parquet``, ``imu.parquet`` (when there
+        are IMU samples), ``fig5.png``, ``fig6.png``, ``imu.png``. A figure
+        that fails is not written; the failure is printed as a one-line
+        warning on stderr and listed under ``plot_errors`` in ``summary.json``
+        (and in ``self.summary``).
+
+        The folder is written beside its place and moved there when complete
+        (:func:`~quadimpact.results.files.staged_folder`): a failure (a full
+        disk) leaves no half folder, and an existing run folder as it was.
+        Written into a run folder, the new run replaces the old one: its
+        files, and the pictures drawn from it (snapshots, animation, viewer,
+        a log comparison: :data:`~quadimpact.results.files.DERIVED_FILES`),
+        which showed the old run, are removed; other files are left. A folder
+        holding anything else (a sweep, a report, files that are not
+        quadimpact's) is refused.
+
+        Raises
+        ------
+        InputError
+            ``out_dir`` cannot be a run folder (one line: what it holds).
+        OSError
+            Writing failed (the folder is left as it was).
         """
         d = Path(out_dir)
-        d.mkdir(parents=True, exist_ok=True)
+        files.check_out_dir(d, "run", where="")
+        with files.staged_folder(d, replaces=files.RUN_FILES + files.DERIVED_FILES) as stage:
+            self._write_files(stage)
+        return d
+
+    def _write_files(self, d: Path) -> None:
+        """Every file of the folder into ``d`` (a new, empty folder)."""
         summary = dict(self.summary)
         summary.pop("plot_errors", None)
         summary.setdefault("references", dict(self.references))
-        summary.setdefault("stats", dict(self.stats))
+        if self.stats:
+            summary.setdefault("integrator", dict(self.stats))
         files.write_summary_json(summary, d / files.SUMMARY_JSON)
         world = self.world
         if world:
             files.write_summary_json(world, d / files.SCENARIO_JSON)
-        else:
-            (d / files.SCENARIO_JSON).unlink(missing_ok=True)
         timeseries = self._columns("timeseries")
         imu = self._columns("imu")
         files.write_episodes_csv(self._columns("episodes"), d / files.EPISODES_CSV)
@@ -221,8 +243,6 @@ class SimulationResult:
         has_imu = imu is not None and len(imu["t_s"]) > 0
         if has_imu:
             files.write_imu_parquet(imu, d / files.IMU_PARQUET)
-        else:
-            (d / files.IMU_PARQUET).unlink(missing_ok=True)
 
         from quadimpact.results import figures as plots  # matplotlib only when drawing
 
@@ -243,8 +263,6 @@ class SimulationResult:
                     lambda p: plots.plot_imu(imu, timeseries, p, summary=self.summary, title=title),
                 ),
             )
-        else:
-            (d / IMU_PNG).unlink(missing_ok=True)
         errors: list[str] = []
         for name, job in jobs:
             try:
@@ -260,15 +278,16 @@ class SimulationResult:
             files.write_summary_json(summary, d / files.SUMMARY_JSON)
         else:
             self.summary.pop("plot_errors", None)
-        return d
 
 
 def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     """Load a result folder written by :meth:`SimulationResult.write`.
 
     Returns a :class:`SimulationResult` with ``summary``,
-    ``episodes``, ``timeseries``, ``imu``, ``references``/``stats`` taken from
-    the summary (empty dicts if absent) and ``world`` from ``scenario.json``
+    ``episodes``, ``timeseries``, ``imu``, ``references`` and ``stats`` taken
+    from the summary (``stats`` from its ``integrator`` table, or from the
+    ``stats`` copy that older folders hold; empty dicts if
+    absent) and ``world`` from ``scenario.json``
     (empty for a folder written before that file existed); ``scenario`` is
     ``None``. Enough to re-plot and redraw the folder.
     """
@@ -283,7 +302,7 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     world_path = d / files.SCENARIO_JSON
     world = files.read_summary_json(world_path) if world_path.is_file() else {}
     references = dict(summary.get("references") or {})
-    stats = dict(summary.get("stats") or {})
+    stats = dict(summary.get("integrator") or summary.pop("stats", None) or {})
     return SimulationResult(
         summary=summary,
         episodes=episodes,

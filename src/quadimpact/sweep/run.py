@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from quadimpact.errors import InputError, format_value
+from quadimpact.results.files import check_out_dir
 from quadimpact.sweep.backends import (
     chunk_size,
     dask_session,
@@ -96,9 +97,7 @@ def run_sweep(
     spec.validate()
     schema = schema_of(spec)
 
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"{out}: not a folder")
+    out = check_out_dir(Path(out_dir), "sweep", where="")
 
     def warn(message: str) -> None:
         print(f"quadimpact: warning: {message}", file=sys.stderr)
