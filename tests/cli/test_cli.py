@@ -308,3 +308,86 @@ def test_disk_full_during_run_leaves_no_half_folder(
         "device); nothing was changed there"
     )
     assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("files", "args", "fragments"),
+    [
+        ({"k.toml": 'kind = ["flight"]\n'}, ["run", "k.toml"],
+         ["k.toml: kind: must be one of 'wall-approach', 'flight', 'impact-trial'",
+          "(got ['flight'])"]),
+        ({}, ["sweep", "--grid", "vehicle_overrides=1", "--out", "s"],
+         ["vehicle_overrides: must be a table of vehicle field = value (got 1.0)"]),
+        ({"s.toml": "[sample]\nn = 3\nranges = [1, 2]\n"}, ["sweep", "s.toml", "--out", "s"],
+         ["s.toml: sample.ranges: must be a table of field = values (got [1, 2])"]),
+        ({"s.toml": '[sample]\nn = 3\nchoices = "abc"\n'}, ["sweep", "s.toml", "--out", "s"],
+         ["s.toml: sample.choices: must be a table of field = values (got 'abc')"]),
+        ({"s.toml": 'base = {kind = ["flight"]}\n[grid]\nspeed_m_s = [1, 2]\n'},
+         ["sweep", "s.toml", "--out", "s"], ["s.toml: base: kind: must be one of"]),
+        ({"d.toml": "a = " + "[" * 3000 + "]" * 3000 + "\n"}, ["run", "d.toml"],
+         ["d.toml: invalid TOML: nested too deeply"]),
+        ({"d.toml": "a = " + "{x = " * 600 + "1" + "}" * 600 + "\n"}, ["run", "d.toml"],
+         ["d.toml: invalid TOML: nested too deeply"]),
+        ({"d.toml": "vehicle_overrides = " + "[" * 400 + "]" * 400 + "\n"}, ["run", "d.toml"],
+         ["d.toml: tables and lists nested 17 deep; no input has more than 16 levels"]),
+        ({"b.toml": "heading_deg = " + "9" * 5000 + "\n"}, ["run", "b.toml"],
+         ["b.toml: invalid TOML: Exceeds the limit (4300 digits)"]),
+        ({}, ["run", "a" * 5000 + ".toml"], ["(5005 characters): cannot read file (File name"]),
+    ],
+)
+def test_malformed_inputs_are_one_line_input_errors(
+    tmp_path: Path, files: dict[str, str], args: list[str], fragments: list[str]
+) -> None:
+    """Types no rule expected (a list for a name, a number for a table...), sizes beyond reason."""
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    proc = run_cli(*args, cwd=tmp_path)
+    assert_input_error(proc, *fragments)
+    assert len(proc.stderr) < 400 and not (tmp_path / "s").exists()
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("short") / "run"
+    proc = run_cli("run", "--final-time", "0.8", "--out", str(out), cwd=out.parent)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+@pytest.mark.parametrize(
+    ("damage", "fragment"),
+    [
+        ("array", "summary.json: must be a JSON object of summary fields (got a JSON array)"),
+        ("json", "summary.json: cannot be read (JSONDecodeError: Expecting"),
+        ("columns", "timeseries.parquet: missing column(s) q0, delta2_m: not a time series"),
+        ("parquet", "timeseries.parquet: cannot be read (ArrowInvalid:"),
+    ],
+)
+@pytest.mark.parametrize("command", ["view", "snapshots", "animate"])
+def test_damaged_result_folders_are_named_in_one_line(
+    short_run: Path, tmp_path: Path, damage: str, fragment: str, command: str
+) -> None:
+    import shutil
+
+    import pandas as pd
+
+    d = tmp_path / "run"
+    shutil.copytree(short_run, d)
+    if damage == "array":
+        (d / "summary.json").write_text("[1, 2]\n")
+    elif damage == "json":
+        (d / "summary.json").write_text("{bad json\n")
+    elif damage == "columns":
+        ts = pd.read_parquet(d / "timeseries.parquet").drop(columns=["q0", "delta2_m"])
+        ts.to_parquet(d / "timeseries.parquet")
+    else:
+        (d / "timeseries.parquet").write_text("not parquet")
+    assert_input_error(run_cli(command, "run", cwd=tmp_path), fragment)
+
+
+def test_a_garbage_crash_log_is_named_before_any_run(tmp_path: Path) -> None:
+    (tmp_path / "data" / "spiri-crash-set-1").mkdir(parents=True)
+    (tmp_path / "data" / "spiri-crash-set-1" / "crash_3.mat").write_text("garbage")
+    proc = run_cli("experiments", "--data", "data", "--samples", "0", "--out", "x", cwd=tmp_path)
+    assert_input_error(proc, "crash_3.mat: not a readable crash log of the set (MatReadError")
+    assert not (tmp_path / "x" / "crash_1").exists()

@@ -171,9 +171,13 @@ def test_plot_failure_keeps_data_and_is_reported(
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary["plot_errors"]) == 1 and "KeyError" in summary["plot_errors"][0]
     assert res.summary["plot_errors"] == summary["plot_errors"]
-    back = read_result(out)
-    pd.testing.assert_frame_equal(back.timeseries, ts)
-    assert len(back.episodes) == 2
+    from quadimpact.errors import InputError
+    from quadimpact.results.files import read_episodes_csv, read_timeseries_parquet
+
+    pd.testing.assert_frame_equal(read_timeseries_parquet(out / "timeseries.parquet"), ts)
+    assert len(read_episodes_csv(out / "episodes.csv")) == 2
+    with pytest.raises(InputError, match="timeseries.parquet: missing column.s. delta3_m"):
+        read_result(out)  # a series that cannot be drawn is refused when read back
 
 
 def test_read_result_missing_folder(tmp_path: Path) -> None:

@@ -87,6 +87,7 @@ def _camera(
 def _scene(result_dir: Path, vehicle: str | None) -> Any:
     """The scene of a result folder, with input errors as one line."""
     from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET
+    from quadimpact.results.result import read_result
     from quadimpact.viz.scene import Scene
 
     if not result_dir.is_dir():
@@ -99,8 +100,9 @@ def _scene(result_dir: Path, vehicle: str | None) -> Any:
         from quadimpact.inputs.vehicle import load_vehicle
 
         veh = load_vehicle(vehicle)
+    result = read_result(result_dir)  # a file that cannot be read: one line naming it
     try:
-        return Scene.from_dir(result_dir, vehicle=veh)
+        return Scene.from_result(result, vehicle=veh)
     except InputError as exc:
         raise InputError(f"{exc} (pass --vehicle with the run's vehicle file)") from None
     except ValueError as exc:

@@ -49,6 +49,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
 from quadimpact.errors import InputError
+from quadimpact.errors import short_path as _short
 from quadimpact.results.schema import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS, TIMESERIES_COLUMNS
 
 __all__ = [
@@ -115,7 +116,6 @@ _KIND_WORDS = {
     "run": "a run",
     "other": "files that are not quadimpact's",
 }
-_MAX_PATH_CHARS = 80
 
 #: Schema metadata key holding ``{column: unit}`` as a JSON string.
 UNITS_METADATA_KEY = "quadimpact.units"
@@ -259,15 +259,6 @@ def atomic_write(
     if durable:
         _fsync(target.parent)
     return target
-
-
-def _short(path: str | os.PathLike[str]) -> str:
-    """A path for a one-line message: cut in the middle when very long."""
-    text = os.fspath(path)
-    if len(text) <= _MAX_PATH_CHARS:
-        return text
-    half = (_MAX_PATH_CHARS - 5) // 2
-    return f"{text[:half]}...{text[-half:]} ({len(text)} characters)"
 
 
 def folder_kind(path: str | os.PathLike[str]) -> tuple[str | None, list[str]]:

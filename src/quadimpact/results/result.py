@@ -18,10 +18,17 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import pandas as pd
 
+from quadimpact.errors import InputError, one_line
 from quadimpact.results import files
 
 __all__ = ["FIG5_PNG", "FIG6_PNG", "IMU_PNG", "SimulationResult", "read_result"]
 
+#: Time-series columns a folder must have to be read back (plotted and drawn).
+READ_COLUMNS: tuple[str, ...] = (
+    "t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "altitude_m",
+    "roll_deg", "pitch_deg", "yaw_deg",
+    *(f"delta{j}_m" for j in (1, 2, 3, 4)), *(f"force{j}_n" for j in (1, 2, 3, 4)),
+)  # fmt: skip
 FIG5_PNG = "fig5.png"
 FIG6_PNG = "fig6.png"
 IMU_PNG = "imu.png"
@@ -290,17 +297,41 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     absent) and ``world`` from ``scenario.json``
     (empty for a folder written before that file existed); ``scenario`` is
     ``None``. Enough to re-plot and redraw the folder.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such folder.
+    InputError
+        A file that is missing or cannot be parsed, a ``summary.json`` that is
+        not a JSON object, a time series without the columns of
+        :data:`READ_COLUMNS`: one line naming the file.
     """
     d = Path(directory)
     if not d.is_dir():
         raise FileNotFoundError(f"result folder not found: {d}")
-    summary = files.read_summary_json(d / files.SUMMARY_JSON)
-    episodes = files.read_episodes_csv(d / files.EPISODES_CSV)
-    timeseries = files.read_timeseries_parquet(d / files.TIMESERIES_PARQUET)
+    summary = _read(d / files.SUMMARY_JSON, files.read_summary_json)
+    if not isinstance(summary, dict):
+        raise InputError(
+            f"{d / files.SUMMARY_JSON}: must be a JSON object of summary fields "
+            f"(got a JSON {_json_kind(summary)})"
+        )
+    episodes = _read(d / files.EPISODES_CSV, files.read_episodes_csv)
+    timeseries = _read(d / files.TIMESERIES_PARQUET, files.read_timeseries_parquet)
+    missing = [c for c in READ_COLUMNS if c not in timeseries.columns]
+    if missing:
+        more = f" and {len(missing) - 4} more" if len(missing) > 4 else ""
+        shown = ", ".join(missing[:4]) + more
+        raise InputError(
+            f"{d / files.TIMESERIES_PARQUET}: missing column(s) {shown}: not a time series "
+            "written by 'quadimpact run'"
+        )
     imu_path = d / files.IMU_PARQUET
-    imu = files.read_timeseries_parquet(imu_path) if imu_path.is_file() else None
+    imu = _read(imu_path, files.read_timeseries_parquet) if imu_path.is_file() else None
     world_path = d / files.SCENARIO_JSON
-    world = files.read_summary_json(world_path) if world_path.is_file() else {}
+    world = _read(world_path, files.read_summary_json) if world_path.is_file() else {}
+    if not isinstance(world, dict):
+        raise InputError(f"{world_path}: must be a JSON object (got a JSON {_json_kind(world)})")
     references = dict(summary.get("references") or {})
     stats = dict(summary.get("integrator") or summary.pop("stats", None) or {})
     return SimulationResult(
@@ -313,3 +344,25 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
         imu=imu,
         world=world,
     )
+
+
+def _json_kind(value: Any) -> str:
+    """``list``, ``number``... : what a JSON value is, in JSON's words."""
+    if isinstance(value, list):
+        return "array"
+    if isinstance(value, bool):
+        return "true/false"
+    if isinstance(value, (int, float)):
+        return "number"
+    return "string" if isinstance(value, str) else "null"
+
+
+def _read(path: Path, reader: Callable[[Path], Any]) -> Any:
+    """``reader(path)``, a file that cannot be read or parsed as one line naming it."""
+    try:
+        return reader(path)
+    except FileNotFoundError:
+        raise InputError(f"{path}: missing (not a folder written by 'quadimpact run')") from None
+    except (OSError, ValueError) as exc:  # JSON and Arrow errors are ValueErrors
+        reason = one_line(str(exc)).split(". ")[0]
+        raise InputError(f"{path}: cannot be read ({type(exc).__name__}: {reason})") from None
