@@ -43,7 +43,7 @@ def test_help_and_version(tmp_path: Path) -> None:
     [
         (["run", "--model", "best"], ["'--model'", "'best' is not one of"]),
         (["run", "--controller", "lqr"], ["'--controller'", "'lqr'"]),
-        (["run", "--heading", "abc"], ["'--heading'", "'abc' is not a valid float"]),
+        (["run", "--heading", "abc"], ["'--heading'", "'abc' is not a valid number"]),
         (["run", "--heading", "500"], ["--heading: must be <= 360 (got 500.0)"]),
         (["run", "--inclination", "-75"], ["--inclination: must be >= -60 (got -75.0)"]),
         (["run", "--speed", "0"], ["--speed: must be > 0 (got 0.0)"]),
@@ -55,6 +55,13 @@ def test_help_and_version(tmp_path: Path) -> None:
         (["run", "--vehicle", "spirit"], ["vehicle 'spirit': unknown vehicle name"]),
         (["launch"], ["No such command 'launch'"]),
         (["experiments", "--log-samples", "-1"], ["'--log-samples'", "-1 is not in the range"]),
+        (["run", "--heading", "nan"], ["'--heading'", "'nan' is not a finite number"]),
+        (["run", "--friction", "inf"], ["'--friction'", "'inf' is not a finite number"]),
+        (["view", "r", "--rate", "nan"], ["'--rate'", "'nan' is not a finite number"]),
+        (["view", "r", "--azimuth", "nan"], ["'--azimuth'", "'nan' is not a finite number"]),
+        (["snapshots", "r", "--elevation", "-inf"], ["'--elevation'", "'-inf' is not a finite"]),
+        (["animate", "r", "--fps", "nan"], ["'--fps'", "'nan' is not a finite number"]),
+        (["animate", "r", "--start", "nan"], ["'--start'", "'nan' is not a finite number"]),
     ],
 )
 def test_bad_flags_exit_2_with_one_line(tmp_path: Path, args: list[str], fragments) -> None:

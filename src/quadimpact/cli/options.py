@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -83,7 +84,30 @@ def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
 Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
 
 
-def number_option(flag: str, metavar: str | None, help: str, type: Any = float) -> Decorator:
+class FiniteFloat(click.FloatRange):
+    """A number that must be finite (``nan`` and ``inf`` refused), optionally in a range.
+
+    Parameters are those of :class:`click.FloatRange` (no range by default).
+    Every numeric flag of the commands takes this type, so that no NaN reaches
+    a camera, a clock or a scenario.
+    """
+
+    name = "number"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        number = super().convert(value, param, ctx)  # the range check (NaN passes it)
+        if not math.isfinite(number):
+            self.fail(f"{format_value(str(value))} is not a finite number", param, ctx)
+        return number
+
+    def __repr__(self) -> str:
+        return "FiniteFloat" if self.min is None and self.max is None else super().__repr__()
+
+
+FINITE = FiniteFloat()
+
+
+def number_option(flag: str, metavar: str | None, help: str, type: Any = FINITE) -> Decorator:
     """``FLAG NUMBER`` without a default: ``None`` when not given (the help says the default)."""
     return click.option(flag, type=type, metavar=metavar, help=help)
 

@@ -18,6 +18,7 @@ from typing import Any
 import click
 
 from quadimpact.cli.options import (
+    FiniteFloat,
     defaulted_option,
     number_option,
     result_dir_argument,
@@ -148,11 +149,11 @@ def _parse_size(text: str) -> tuple[int, int]:
 @click.command("animate")
 @result_dir_argument
 @defaulted_option(
-    "--fps", click.FloatRange(min=1, max=240), 30.0, "Frames per second of the movie."
+    "--fps", FiniteFloat(min=1, max=240), 30.0, "Frames per second of the movie."
 )
 @defaulted_option(
     "--slow",
-    click.FloatRange(min=0.01, max=1000),
+    FiniteFloat(min=0.01, max=1000),
     1.0,
     "Slow-down factor: 1 = real time, 4 = four times slower.",
 )
@@ -268,7 +269,7 @@ def snapshots(
 @result_dir_argument
 @defaulted_option(
     "--rate",
-    click.FloatRange(min=1, max=10000),
+    FiniteFloat(min=1, max=10000),
     250.0,
     "Frames per simulated second in the page.",
 )
