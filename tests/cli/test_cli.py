@@ -398,3 +398,20 @@ def test_a_garbage_crash_log_is_named_before_any_run(tmp_path: Path) -> None:
     proc = run_cli("experiments", "--data", "data", "--samples", "0", "--out", "x", cwd=tmp_path)
     assert_input_error(proc, "crash_3.mat: not a readable crash log of the set (MatReadError")
     assert not (tmp_path / "x" / "crash_1").exists()
+
+
+def test_every_run_flag_is_also_named_by_its_file_key(tmp_path: Path) -> None:
+    """--heading and --heading-deg, --friction and --friction-coefficient...: both work."""
+    from quadimpact.cli.run import _FLAGS, run
+
+    names = {p.name: p.opts for p in run.params}
+    for param, (field, flag) in _FLAGS.items():
+        key_flag = "--" + field.replace("_", "-")
+        assert flag in names[param] and key_flag in names[param], (param, names[param])
+    args = ["--heading-deg", "10", "--speed-m-s", "0.6", "--friction-coefficient", "0.2",
+            "--final-time-s", "0.7", "--output-rate-hz", "200"]  # fmt: skip
+    proc = run_cli("run", *args, "--inclination", "5", "--out", "out", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    sc = json.loads((tmp_path / "out" / "scenario.json").read_text())["scenario"]
+    assert (sc["heading_deg"], sc["speed_m_s"], sc["friction_coefficient"]) == (10, 0.6, 0.2)
+    assert (sc["final_time_s"], sc["output_rate_hz"], sc["inclination_deg"]) == (0.7, 200, 5)

@@ -100,6 +100,12 @@ class FiniteFloat(click.FloatRange):
             self.fail(f"{format_value(str(value))} is not a finite number", param, ctx)
         return number
 
+    def _describe_range(self) -> str:
+        """The range shown in ``--help`` (nothing without one)."""
+        if self.min is None and self.max is None:
+            return ""
+        return super()._describe_range()
+
     def __repr__(self) -> str:
         return "FiniteFloat" if self.min is None and self.max is None else super().__repr__()
 
@@ -107,9 +113,17 @@ class FiniteFloat(click.FloatRange):
 FINITE = FiniteFloat()
 
 
-def number_option(flag: str, metavar: str | None, help: str, type: Any = FINITE) -> Decorator:
-    """``FLAG NUMBER`` without a default: ``None`` when not given (the help says the default)."""
-    return click.option(flag, type=type, metavar=metavar, help=help)
+def number_option(
+    flag: str, metavar: str | None, help: str, type: Any = FINITE, *, alias: str | None = None
+) -> Decorator:
+    """``FLAG NUMBER`` without a default: ``None`` when not given (the help says the default).
+
+    ``alias``: a second name of the flag (``--heading-deg`` beside ``--heading``);
+    the value keeps the name of ``flag``.
+    """
+    name = flag.lstrip("-").replace("-", "_")
+    decls = (flag, alias, name) if alias else (flag, name)
+    return click.option(*decls, type=type, metavar=metavar, help=help)
 
 
 def defaulted_option(flag: str, type: Any, default: Any, help: str) -> Decorator:

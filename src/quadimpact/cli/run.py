@@ -49,34 +49,41 @@ _OUTPUT_FILES = (
 )
 
 
+def _flag(flag: str, metavar: str | None, help: str) -> Any:
+    """A number flag of ``run``, also under its scenario file key (``--heading-deg``)."""
+    field = next(f for f, typed in _FLAGS.values() if typed == flag)
+    alias = "--" + field.replace("_", "-")
+    return number_option(flag, metavar, help, alias=None if alias == flag else alias)
+
+
 @click.command("run")
 @file_argument("scenario", "[SCENARIO.toml]")
-@number_option(
+@_flag(
     "--heading",
     "DEG",
     "Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
     "wall (bumpers 1 and 4 lead). [default: 0]",
 )
-@number_option(
+@_flag(
     "--inclination",
     "DEG",
     "Tilt of the body z axis toward the wall, in the vertical plane through the wall "
     "normal, deg in [-60, 60]. [default: 0]",
 )
-@number_option(
+@_flag(
     "--speed",
     "M/S",
     "Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
     "[default: 0.75]",
 )
-@number_option(
+@_flag(
     "--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]"
 )
-@number_option("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
-@number_option(
+@_flag("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
+@_flag(
     "--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]"
 )
-@number_option("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
+@_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--model",
     type=MODEL,
@@ -113,7 +120,7 @@ _OUTPUT_FILES = (
     help="'ideal': commanded rotor speeds apply at once (the paper); 'first-order': "
     "motor lag with the vehicle's time constant. [default: ideal]",
 )
-@number_option(
+@_flag(
     "--friction", "MU", "Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). "
     "[default: 0]"
 )
@@ -123,13 +130,13 @@ _OUTPUT_FILES = (
     help="'crash': reaching the ground ends the run; 'contact': the ground is a contact "
     "surface; 'none': no ground. [default: crash]",
 )
-@number_option(
+@_flag(
     "--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]"
 )
-@number_option(
+@_flag(
     "--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]"
 )
-@number_option("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
+@_flag("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
 @out_option(
     "results/run",
     "Output folder (created if needed). A folder holding an earlier run is replaced: its "
@@ -145,6 +152,9 @@ def run(
     scenario: Path | None, out: Path, options: tuple[str, ...], viz: bool, **flags: Any
 ) -> None:
     """Simulate one scenario and write its results to --out.
+
+    Every flag is also named by its scenario file key (--heading-deg for
+    heading_deg, --friction-coefficient for friction_coefficient...).
 
     Without SCENARIO.toml this is the paper's wall approach: the Spiri holds
     the given heading, inclination and altitude and is started so that its
