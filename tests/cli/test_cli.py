@@ -415,3 +415,37 @@ def test_every_run_flag_is_also_named_by_its_file_key(tmp_path: Path) -> None:
     sc = json.loads((tmp_path / "out" / "scenario.json").read_text())["scenario"]
     assert (sc["heading_deg"], sc["speed_m_s"], sc["friction_coefficient"]) == (10, 0.6, 0.2)
     assert (sc["final_time_s"], sc["output_rate_hz"], sc["inclination_deg"]) == (0.7, 200, 5)
+
+
+def _rewrite_series(src: Path, dst: Path, change) -> Path:
+    import shutil
+
+    import pandas as pd
+
+    shutil.copytree(src, dst)
+    ts = change(pd.read_parquet(dst / "timeseries.parquet"))
+    ts.to_parquet(dst / "timeseries.parquet")
+    return dst
+
+
+@pytest.mark.parametrize("command", ["animate", "view", "snapshots"])
+def test_no_library_warnings_leak_from_the_drawing_commands(
+    short_run: Path, tmp_path: Path, command: str
+) -> None:
+    """All-NaN samples: one line saying so (no ffmpeg, NumPy or cast messages); one sample: no
+    Matplotlib warning."""
+    import numpy as np
+
+    def all_nan(ts):
+        return ts.assign(**{c: np.nan for c in ts.columns if c != "t_s"})
+
+    _rewrite_series(short_run, tmp_path / "nan", all_nan)
+    extra = ["--size", "320x180"] if command == "animate" else []
+    proc = run_cli(command, "nan", *extra, cwd=tmp_path)
+    assert_input_error(proc, "nan: nothing to draw: every sample of the run is NaN or infinite")
+    _rewrite_series(short_run, tmp_path / "one", lambda ts: ts.iloc[:1])
+    extra += ["--times", "-0.5"] if command == "snapshots" else []
+    proc = run_cli(command, "one", *extra, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "Warning" not in proc.stderr and "frames have been written" not in proc.stderr
+

@@ -311,3 +311,13 @@ def test_check_out_dir_says_what_is_wrong_in_one_line(tmp_path: Path) -> None:
     with pytest.raises(InputError, match="holds a run .*this sweep's own folder"):
         check_out_dir(tmp_path / "run", "sweep")
     assert check_out_dir(tmp_path, "sweep") == tmp_path  # a sweep may go among other files
+
+
+def test_a_one_sample_run_is_plotted_without_warnings(tmp_path: Path) -> None:
+    """A run of one sample: its figures, and no Matplotlib warning about singular limits."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = make_result(timeseries=make_timeseries(1)).write(tmp_path / "one")
+    assert (out / "fig5.png").is_file() and (out / "fig6.png").is_file()

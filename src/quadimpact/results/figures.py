@@ -49,6 +49,7 @@ __all__ = [
     "plot_fig5",
     "plot_fig6",
     "save_figure",
+    "set_time_limits",
     "sorted_levels",
     "stage_label",
     "type_map_figure",
@@ -117,6 +118,14 @@ def _fig_margins(
     }
 
 
+def set_time_limits(ax: Any, t: Any) -> None:
+    """The time axis from the first to the last finite sample (a run of one sample: as is)."""
+    t = np.asarray(t, dtype=np.float64)
+    t = t[np.isfinite(t)]
+    if len(t) and t[-1] > t[0]:
+        ax.set_xlim(float(t[0]), float(t[-1]))
+
+
 def break_wraps(
     t: np.ndarray, angle_deg: np.ndarray, jump_deg: float = 180.0
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -160,8 +169,7 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     ax.set_ylabel("Bumper deflection (mm)")
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best")
-    if len(t):
-        ax.set_xlim(float(t[0]), float(t[-1]))
+    set_time_limits(ax, t)
     if title:
         ax.set_title(title)
     return fig
@@ -239,8 +247,7 @@ def make_fig6(
             ax.legend(loc="best", fontsize="small")
     for ax in axes[-1, :]:
         ax.set_xlabel("Time (s)")
-    if len(t):
-        axes[0, 0].set_xlim(float(t[0]), float(t[-1]))
+    set_time_limits(axes[0, 0], t)
     if title:
         fig.suptitle(title)
     return fig
@@ -352,8 +359,7 @@ def make_imu(
     ax_w.legend(loc="upper right", fontsize="small", ncols=3)
     for ax in (ax_f, ax_w):
         ax.grid(True, alpha=0.4)
-    if len(t):
-        first.set_xlim(float(t[0]), float(t[-1]))
+    set_time_limits(first, t)
     if title:
         fig.suptitle(title)
     return fig

@@ -422,6 +422,27 @@ class SceneFrame:
     forces: np.ndarray = field(default_factory=lambda: np.zeros(4))
 
 
+def _drawable_rows(ts: pd.DataFrame) -> pd.DataFrame:
+    """The samples that can be drawn: time, pose, deflections, forces and attitude finite.
+
+    Raises
+    ------
+    ValueError
+        When no sample can be drawn (a run whose state is NaN throughout).
+    """
+    columns = ["t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "roll_deg", "pitch_deg",
+               "yaw_deg", *(f"delta{j}_m" for j in (1, 2, 3, 4)),
+               *(f"force{j}_n" for j in (1, 2, 3, 4))]  # fmt: skip
+    present = [c for c in columns if c in ts]
+    ok = np.all(np.isfinite(ts[present].to_numpy(dtype=float)), axis=1)
+    if not ok.any():
+        raise ValueError(
+            "nothing to draw: every sample of the run is NaN or infinite "
+            "(its summary.json says why: status and reason)"
+        )
+    return ts if ok.all() else ts[ok]
+
+
 _STATE_COLUMNS = (
     ["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3"]
     + ["p_rad_s", "q_rad_s", "r_rad_s"]
@@ -481,7 +502,7 @@ class Scene:
             self.surf = pack_surfaces(self.surfaces)
         else:
             self.surf = np.zeros((0, L.NSURF))
-        ts = timeseries
+        ts = _drawable_rows(timeseries)
         self.t = ts["t_s"].to_numpy(dtype=float)
         self.states = np.zeros((len(ts), L.NX))
         for k, col in enumerate(_STATE_COLUMNS):
@@ -502,7 +523,7 @@ class Scene:
         stage = ts["stage"].to_numpy(dtype=float) if "stage" in ts else None
         self.stages: np.ndarray | None = None
         if stage is not None and (summary.get("controller") == "recovery" or np.any(stage != 0)):
-            self.stages = np.rint(stage).astype(int)
+            self.stages = np.rint(np.nan_to_num(stage)).astype(int)
         self.anchor = self.state_at(
             self.t[0] if self.first_contact_s is None else self.first_contact_s
         )[0:3].copy()
