@@ -417,6 +417,27 @@ def test_worker_crash_is_a_failed_row(tmp_path):
     assert len(table) == 11 and table["delta_init_m"].notna().sum() == 10
 
 
+UNGUARDED_SCRIPT = """
+from quadimpact.sweep import run_sweep
+
+run_sweep({"grid": {"speed_m_s": [0.5, 1.0], "inclination_deg": [0, 5]}}, "out", workers=2)
+"""
+
+
+def test_a_script_without_the_main_guard_is_told_so_first(tmp_path):
+    """Workers re-run an unguarded script: the first line says what to do, no worker traceback."""
+    (tmp_path / "sweep.py").write_text(UNGUARDED_SCRIPT)
+    proc = subprocess.run(
+        [sys.executable, "sweep.py"], cwd=tmp_path, env=_env(), capture_output=True, text=True,
+        timeout=300,
+    )  # fmt: skip
+    assert proc.returncode != 0
+    lines = proc.stderr.strip().splitlines()
+    assert lines[0].startswith("quadimpact: error: a sweep worker, starting up, ran the script")
+    assert 'if __name__ == "__main__":' in lines[0]
+    assert "multiprocessing" not in proc.stderr and len(lines) < 20, proc.stderr
+
+
 def test_rerun_and_other_sweep_in_the_folder(serial_table, tmp_path):
     out = tmp_path / "r"
     spec = SweepSpec(base=BASE, grid=SMALL_GRID)

@@ -34,6 +34,27 @@ from quadimpact.sweep.store import (
 
 
 # --------------------------------------------------------------- run_sweep
+def _refuse_in_a_starting_worker() -> None:
+    """Stop a worker that, starting up, runs the main script again and reaches a sweep.
+
+    A worker process (forkserver or spawn) imports the main script before it
+    can work; a script without ``if __name__ == "__main__":`` then calls
+    ``run_sweep`` inside the worker. Say so in one line, first, and end the
+    worker quietly (instead of a traceback per worker).
+    """
+    import multiprocessing
+
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        print(
+            "quadimpact: error: a sweep worker, starting up, ran the script's top level "
+            "again: guard the code that runs the sweep with `if __name__ == \"__main__\":` "
+            "(README, 'Sweeps from Python')",
+            file=sys.stderr,
+            flush=True,
+        )
+        raise SystemExit(1)
+
+
 def _resolve_workers(workers: int | None) -> int:
     if workers is None:
         return os.cpu_count() or 1
@@ -88,6 +109,7 @@ def run_sweep(
         A bad sweep (before anything runs), a folder holding another sweep,
         a bad ``workers``/``scheduler``.
     """
+    _refuse_in_a_starting_worker()
     start = time.perf_counter()
     if not isinstance(spec, SweepSpec):
         spec = SweepSpec.from_dict(spec)
