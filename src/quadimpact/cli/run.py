@@ -127,8 +127,9 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
 @click.option(
     "--ground",
     type=click.Choice(["crash", "contact", "none"]),
-    help="'crash': reaching the ground ends the run; 'contact': the ground is a contact "
-    "surface; 'none': no ground. [default: crash]",
+    help="'crash': the CM reaching the ground ends the run; 'contact': the ground is a "
+    "contact surface for the bumper rims only (the body passes through it: docs/MODEL.md "
+    "4.9); 'none': no ground. [default: crash]",
 )
 @_flag(
     "--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]"
@@ -365,7 +366,7 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         f"episodes       {_fmt(summary.get('n_episodes'))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]
-    if summary.get("controller") == "recovery" or summary.get("t_detect_s") is not None:
+    if summary.get("controller") == "recovery":
         lines += _recovery_lines(summary)
     for warning in summary.get("warnings") or []:
         lines.append(f"warning        {one_line(str(warning))}")
