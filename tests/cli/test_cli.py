@@ -449,3 +449,25 @@ def test_no_library_warnings_leak_from_the_drawing_commands(
     assert proc.returncode == 0, proc.stderr
     assert "Warning" not in proc.stderr and "frames have been written" not in proc.stderr
 
+
+
+def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) -> None:
+    """The compiled loop's cache index is looked for where Numba itself puts it."""
+    from numba.core.caching import UserProvidedCacheLocator
+
+    import quadimpact.core as core
+    from quadimpact.cli.options import announce_compilation
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert not core.cache_is_warm()
+    announce_compilation()
+    assert capsys.readouterr().err == (
+        "quadimpact: compiling the simulator (first run only, about 40 s) ...\n"
+    )
+    run_py = str(Path(core.__file__).parent / "run.py")
+    where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
+    where.mkdir(parents=True)
+    (where / "run.run_builtin-52.py311.nbi").write_bytes(b"")
+    assert core.cache_is_warm()
+    announce_compilation()
+    assert capsys.readouterr().err == ""

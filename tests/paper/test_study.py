@@ -8,8 +8,16 @@ from quadimpact.simulation.metrics import RESPONSE_TYPES
 
 
 @pytest.mark.slow
-def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path):
-    r = reproduce(tmp_path, ablation=False, experiments=False, workers=2)
+def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, capsys):
+    r = reproduce(tmp_path, ablation=False, experiments=False, workers=2, progress=True)
+    err = capsys.readouterr().err.splitlines()
+    stages = [line for line in err if line.startswith("reproduce: ")]
+    assert stages == [
+        "reproduce: Figure 4 sweep and the example run, paper-replica",
+        "reproduce: Figure 4 sweep and the example run, default",
+        "reproduce: figures, tables and the report",
+    ]
+    assert err[err.index(stages[0]) + 1] == "sweep: 246 runs to do"  # each sweep is named
     text = r.report.read_text()
     f = r.findings
     assert set(f["variant"]) == {"paper-replica", "default"}

@@ -6,7 +6,13 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import data_option, defaulted_option, out_option, parallel_options
+from quadimpact.cli.options import (
+    announce_compilation,
+    data_option,
+    defaulted_option,
+    out_option,
+    parallel_options,
+)
 
 
 @click.command("experiments")
@@ -57,6 +63,7 @@ def experiments(
     check_out_dir(out, "experiments")
     if data is not None:
         check_data_dir(data)
+    announce_compilation()
     table = run_experiments(
         out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
         scheduler=scheduler, progress=not no_progress,

@@ -51,6 +51,25 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     return wrapped
 
 
+#: What a first run takes to compile the simulator (measured on 2 cores: 40 s of CPU).
+COMPILE_SECONDS = 40
+
+
+def announce_compilation() -> None:
+    """Say on stderr, before a first run, that the simulator is being compiled.
+
+    On a fresh checkout (or after its sources changed) Numba's cache is cold and
+    the first simulation compiles the loop: tens of seconds of silence otherwise.
+    """
+    from quadimpact.core import cache_is_warm
+
+    if not cache_is_warm():
+        click.echo(
+            f"quadimpact: compiling the simulator (first run only, about {COMPILE_SECONDS} s) ...",
+            err=True,
+        )
+
+
 def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
     """Refuse a Dask scheduler address that is malformed or (``tcp://``) not listening.
 

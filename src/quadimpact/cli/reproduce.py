@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import data_option, out_option, parallel_options
+from quadimpact.cli.options import announce_compilation, data_option, out_option, parallel_options
 
 
 @click.command("reproduce")
@@ -49,6 +49,7 @@ def reproduce(
     check_out_dir(out, "report")
     if data is not None and not no_experiments:
         check_data_dir(data)
+    announce_compilation()
 
     result = run_study(
         out, workers=workers, scheduler=scheduler, progress=not no_progress,

@@ -9,7 +9,14 @@ from typing import Any
 
 import click
 
-from quadimpact.cli.options import CONTROLLER, MODEL, file_argument, number_option, out_option
+from quadimpact.cli.options import (
+    CONTROLLER,
+    MODEL,
+    announce_compilation,
+    file_argument,
+    number_option,
+    out_option,
+)
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
 __all__ = ["EXIT_RUN_FAILED", "build_scenario", "format_summary", "run"]
@@ -187,6 +194,7 @@ def run(
     check_out_dir(out, "run")
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
+    announce_compilation()
 
     from quadimpact.simulation import simulate
 

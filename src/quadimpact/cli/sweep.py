@@ -10,7 +10,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import file_argument, parallel_options
+from quadimpact.cli.options import announce_compilation, file_argument, parallel_options
 from quadimpact.errors import InputError
 
 __all__ = ["sweep"]
@@ -98,6 +98,7 @@ def sweep(
         spec = SweepSpec(grid=extra, where="sweep")
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
+    announce_compilation()
     info = run_sweep(
         spec,
         out,

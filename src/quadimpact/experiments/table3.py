@@ -23,6 +23,7 @@ files and the comparison plots) and the sensitivity sweeps (resumable).
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -133,7 +134,6 @@ def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | Non
         A given folder that is absent, is a file or holds none of the logs.
     """
     import os
-    import sys
 
     from quadimpact.errors import InputError
     from quadimpact.experiments.logs import DATA_ENV_VAR
@@ -294,6 +294,9 @@ def run_experiments(
     logs = {crash.number: read_log(crash, data_dir) for crash in TABLE3}  # a bad file: now
     rows: list[dict[str, Any]] = []
     for crash in TABLE3:
+        if progress:
+            print(f"experiments: crash {crash.number} of {len(TABLE3)}: both variants, then "
+                  "the runs over the uncertainty", file=sys.stderr, flush=True)  # fmt: skip
         folder = out / f"crash_{crash.number}"
         types: dict[str, str | None] = {}
         results = {}

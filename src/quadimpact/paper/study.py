@@ -19,6 +19,7 @@ replica with each of its six differences switched off in turn. It writes:
 
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -56,6 +57,12 @@ class StudyResult:
     findings: pd.DataFrame
     ablation: pd.DataFrame
     elapsed_s: float
+
+
+def _stage(progress: bool, text: str) -> None:
+    """Name the stage that starts (on stderr, with the progress)."""
+    if progress:
+        print(f"reproduce: {text}", file=sys.stderr, flush=True)
 
 
 def _ablation_name(switch: str) -> str:
@@ -103,6 +110,7 @@ def reproduce(
     tables: dict[str, pd.DataFrame] = {}
     found: dict[str, list[Finding]] = {}
     for variant in VARIANTS:
+        _stage(progress, f"Figure 4 sweep and the example run, {variant}")
         table, ex = _run_variant(variant, {"model": variant}, out, workers, scheduler, progress)
         ex.write(out / f"example-{variant}")
         write_snapshots(out / f"example-{variant}", scene=Scene.from_result(ex))
@@ -110,7 +118,8 @@ def reproduce(
         found[variant] = evaluate(table, (ex.summary, ex.episodes, ex.timeseries))
     ablation_rows = []
     if ablation:
-        for switch in SWITCHES:
+        for k, switch in enumerate(SWITCHES, 1):
+            _stage(progress, f"ablation {k} of {len(SWITCHES)}: the replica without {switch}")
             name = _ablation_name(switch)
             base = {
                 "model": "paper-replica",
@@ -126,11 +135,13 @@ def reproduce(
     if experiments:
         from quadimpact.experiments.table3 import run_experiments
 
+        _stage(progress, "Table III: the seven real crashes")
         table3 = run_experiments(
             out / "experiments", data_dir=data_dir, workers=workers, scheduler=scheduler,
             progress=progress,
         )  # fmt: skip
 
+    _stage(progress, "figures, tables and the report")
     # tables behind the report
     pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
     table2(tables).to_parquet(out / "table2.parquet")
