@@ -29,6 +29,7 @@ from matplotlib.patches import Patch
 
 from quadimpact.errors import InputError
 from quadimpact.results.files import atomic_write
+from quadimpact.rotations import unwrap_deg
 
 if TYPE_CHECKING:  # pandas only where a table is drawn
     import pandas as pd
@@ -40,6 +41,7 @@ __all__ = [
     "STAGE_NAMES",
     "TYPE_COLOURS",
     "break_wraps",
+    "unwrap_deg",
     "check_columns",
     "facet_panels",
     "format_level",
@@ -186,7 +188,8 @@ def make_fig6(
     Six panels sharing the time axis: left column X (with the wall plane
     ``X = wall_x_m`` dashed), Y, altitude (with its reference dashed), all in
     metres (inertial NED position; altitude = -Z); right column roll, pitch,
-    yaw (ZYX Euler, degrees) each with its reference dashed.
+    yaw (ZYX Euler, degrees) each with its reference dashed; roll and yaw
+    unwrapped (:func:`unwrap_deg`), so that they do not jump at +-180 deg.
 
     Parameters
     ----------
@@ -230,13 +233,18 @@ def make_fig6(
 
     deg = 180.0 / math.pi
     right = (
-        ("roll_deg", "Roll φ (deg)", ref_value("roll_rad", deg)),
-        ("pitch_deg", "Pitch θ (deg)", ref_value("pitch_rad", deg)),
-        ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg)),
+        ("roll_deg", "Roll φ (deg)", ref_value("roll_rad", deg), True),
+        ("pitch_deg", "Pitch θ (deg)", ref_value("pitch_rad", deg), False),
+        ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg), True),
     )
-    for ax, (col, label, ref) in zip(axes[:, 1], right, strict=True):
-        tt, yy = break_wraps(t, np.asarray(ts[col], dtype=np.float64))
-        ax.plot(tt, yy, color="tab:blue", label="simulated")
+    for ax, (col, label, ref, wrapped) in zip(axes[:, 1], right, strict=True):
+        yy = np.asarray(ts[col], dtype=np.float64)
+        if wrapped:  # continuous through +-180 deg; the reference on the same branch
+            yy = unwrap_deg(yy)
+            first = yy[np.isfinite(yy)][:1]
+            if ref is not None and len(first):
+                ref += 360.0 * round((float(first[0]) - ref) / 360.0)
+        ax.plot(t, yy, color="tab:blue", label="simulated")
         if ref is not None:
             ax.axhline(ref, label="reference", **_REF_STYLE)
         ax.set_ylabel(label)

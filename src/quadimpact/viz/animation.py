@@ -30,7 +30,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import break_wraps, set_time_limits, stage_label
+from quadimpact.results.figures import set_time_limits, stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene
@@ -142,7 +142,7 @@ class AnimationFigure:
         self.att_live = []
         self.att_data = []
         for k, name in enumerate(("roll", "pitch", "yaw")):
-            tb, yb = break_wraps(t, scene.euler_deg[:, k])
+            tb, yb = t, scene.euler_deg[:, k]  # roll and yaw unwrapped (Scene)
             c = _ATTITUDE_COLORS[name]
             ax_a.plot(tb, yb, color=c, alpha=0.2, linewidth=1.0)
             self.att_live.append(ax_a.plot([], [], color=c, linewidth=1.4, label=name)[0])

@@ -44,7 +44,7 @@ from quadimpact.core import layout as L
 from quadimpact.errors import input_error_from_validation
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import GROUND, Plane
-from quadimpact.rotations import quat_to_matrix
+from quadimpact.rotations import quat_to_matrix, unwrap_deg
 from quadimpact.simulation.packing import pack_surface_records, pack_surfaces, pack_vehicle
 
 __all__ = [
@@ -510,9 +510,11 @@ class Scene:
                 self.states[:, k] = ts[col].to_numpy(dtype=float)
         self.deltas = np.stack([ts[f"delta{j}_m"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
         self.forces = np.stack([ts[f"force{j}_n"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
+        # roll and yaw continuous through +-180 deg (drawn and interpolated so)
         self.euler_deg = np.stack(
-            [ts[c].to_numpy(dtype=float) for c in ("roll_deg", "pitch_deg", "yaw_deg")], 1
-        )
+            [unwrap_deg(ts["roll_deg"]), ts["pitch_deg"].to_numpy(dtype=float),
+             unwrap_deg(ts["yaw_deg"])], 1
+        )  # fmt: skip
         self.altitude = -self.states[:, 2]
         fc = summary.get("first_contact_s")
         self.first_contact_s: float | None = None if fc is None else float(fc)
