@@ -69,7 +69,7 @@ def experiments(
         scheduler=scheduler, progress=not no_progress,
     )  # fmt: skip
     cols = ["crash", "type_paper_experiment", "type_paper_simulation", "type_ours", "type_replica",
-            "attitude_rms_deg_0_3s", "type_log", "type_log_conditions"]  # fmt: skip
+            "attitude_rms_deg_0_3s", "type_log", "type_log_conditions", "verdict"]  # fmt: skip
     shown = table[cols].rename(
         columns={"type_paper_experiment": "experiment", "type_paper_simulation": "paper_sim",
                  "type_ours": "ours", "type_replica": "replica", "type_log": "log",

@@ -77,10 +77,36 @@ LOG_COLUMNS = (
     "attitude_rms_log_conditions_deg_0_3s",
     "log_max_penetration_mm",
 )
+#: How each Euler angle moved in the first 0.3 s after the impact (signed largest
+#: departure from its value at the impact, deg; roll and yaw unwrapped), in our
+#: nominal run (default model) and in the log: where the motions differ.
+MOTION_COLUMNS = tuple(
+    f"{side}_{angle}_change_deg_0_3s"
+    for angle in ("roll", "pitch", "yaw")
+    for side in ("sim", "log")
+)
+#: The row's verdict (``agrees``, ``partly``, ``disagrees``: :func:`crash_verdict`) and why.
+VERDICT_COLUMNS = ("verdict", "verdict_reason")
 #: Columns of ``table3.csv`` after ``TABLE3_COLUMNS``: the deepest bumper
 #: deflection of our nominal run (default model, mm; beyond the bumper radius,
-#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``.
-EXTRA_COLUMNS = ("max_penetration_mm", *LOG_COLUMNS)
+#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``, ``MOTION_COLUMNS``
+#: and ``VERDICT_COLUMNS``.
+EXTRA_COLUMNS = ("max_penetration_mm", *LOG_COLUMNS, *MOTION_COLUMNS, *VERDICT_COLUMNS)
+#: A run matches the crash in motion when its attitude error against the log over
+#: the first 0.3 s (RMS of the rotation angle) is at most this, deg.
+MOTION_RMS_DEG = 20.0
+#: A different type at the nominal conditions is ``partly`` when the experiment's
+#: type occurs in at least this share of the runs over the stated uncertainty.
+TYPE_SHARE_PARTLY = 0.2
+#: The rule of :func:`crash_verdict`, as the report states it.
+VERDICT_RULE = (
+    f"agrees: ours (default) has the experiment's type and its attitude error against the "
+    f"log over the first 0.3 s is at most {MOTION_RMS_DEG:g}° RMS (or there is no log); "
+    f"partly: the same type with a larger attitude error (the type matches, the motion "
+    f"does not), or another type at the nominal conditions while the experiment's occurs in "
+    f"at least {TYPE_SHARE_PARTLY:.0%} of the runs over the stated uncertainty; disagrees: "
+    "otherwise"
+)
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
@@ -107,6 +133,39 @@ def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
     """Share of each response type among a sweep's runs, as ``{prefix + type: share}``."""
     counts = sweep["response_type"].value_counts()
     return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
+
+
+def crash_verdict(row: Any) -> tuple[str, str]:
+    """Our nominal run against the experiment, for one row of Table III (:data:`VERDICT_RULE`).
+
+    Parameters
+    ----------
+    row : mapping
+        A row of the table (``type_ours``, ``type_paper_experiment``,
+        ``attitude_rms_deg_0_3s``, ``share_<type>``).
+
+    Returns
+    -------
+    (str, str)
+        The verdict and its reason, with the measure and the threshold.
+    """
+    ours, exp = row["type_ours"], row["type_paper_experiment"]
+    rms = float(row["attitude_rms_deg_0_3s"])
+    if ours == exp:
+        if math.isnan(rms):
+            return "agrees", f"type {ours} (no log to compare the motion with)"
+        if rms <= MOTION_RMS_DEG:
+            return "agrees", f"type {ours}; attitude RMS {rms:.1f}° ≤ {MOTION_RMS_DEG:g}°"
+        return "partly", (
+            f"type {ours}, but not the motion: attitude RMS {rms:.1f}° > {MOTION_RMS_DEG:g}°"
+        )
+    share = float(row.get(f"share_{exp}", math.nan))
+    if math.isnan(share):
+        return "disagrees", f"type {ours}, not {exp} (no runs over the uncertainty)"
+    seen = f"type {ours}, not {exp}; {exp} in {share:.0%} of the runs over the uncertainty"
+    if share >= TYPE_SHARE_PARTLY:
+        return "partly", f"{seen} (≥ {TYPE_SHARE_PARTLY:.0%})"
+    return "disagrees", f"{seen} (< {TYPE_SHARE_PARTLY:.0%})"
 
 
 def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | None:
@@ -284,7 +343,7 @@ def run_experiments(
     pandas.DataFrame
         The table written to ``table3.csv``.
     """
-    from quadimpact.experiments.logs_compare import attitude_rms_for_crash
+    from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
     from quadimpact.results.files import check_out_dir
 
     sweep_options = {"workers": workers, "scheduler": scheduler, "progress": progress}
@@ -314,22 +373,28 @@ def run_experiments(
             )
             shares = _shares(sweep, "share_")
         log = logs[crash.number]
-        rms = attitude_rms_for_crash(crash, results["default"], log, folder)
-        rows.append(
-            {
-                "crash": crash.number,
-                "heading_deg": crash.heading_deg,
-                "speed_m_s": crash.speed_m_s,
-                "inclination_deg": crash.inclination_deg,
-                "type_paper_experiment": crash.type_experiment,
-                "type_paper_simulation": crash.type_paper_simulation,
-                **types,
-                **shares,
-                "attitude_rms_deg_0_3s": rms,
-                "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
-                **_log_row(crash, log, folder, out, log_samples, sweep_options),
-            }
-        )
+        comparison = compare_crash(crash, results["default"], log, folder)
+        motion = {c: math.nan for c in MOTION_COLUMNS}
+        if comparison is not None:
+            for angle, (sim, logged) in comparison.departures(0.3).items():
+                motion[f"sim_{angle}_change_deg_0_3s"] = sim
+                motion[f"log_{angle}_change_deg_0_3s"] = logged
+        row = {
+            "crash": crash.number,
+            "heading_deg": crash.heading_deg,
+            "speed_m_s": crash.speed_m_s,
+            "inclination_deg": crash.inclination_deg,
+            "type_paper_experiment": crash.type_experiment,
+            "type_paper_simulation": crash.type_paper_simulation,
+            **types,
+            **shares,
+            "attitude_rms_deg_0_3s": attitude_rms(comparison),
+            "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
+            **_log_row(crash, log, folder, out, log_samples, sweep_options),
+            **motion,
+        }
+        row["verdict"], row["verdict_reason"] = crash_verdict(row)
+        rows.append(row)
     table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *EXTRA_COLUMNS])
     table.to_csv(out / "table3.csv", index=False)
     table.to_parquet(out / "table3.parquet")
