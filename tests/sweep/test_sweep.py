@@ -538,7 +538,7 @@ def test_cli_sweep(tmp_path):
         cwd=tmp_path,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
-    assert "runs    6 (0 failed" in proc.stdout
+    assert "runs    6 (0 failed, 0 deeper than the bumper radius; " in proc.stdout
     assert "types   A" in proc.stdout
     table = read_runs(tmp_path / "o")
     assert len(table) == 6 and table["final_time_s"].eq(1.0).all()
@@ -584,3 +584,29 @@ def test_plots(serial_table, tmp_path):
     fig4 = {"heading_deg": [0, 45], "inclination_deg": list(range(-20, 21)), "speed_m_s": [1, 2, 3]}
     kinds = dict.fromkeys(fig4, "f")
     assert choose_plot_fields(kinds, fig4) == ("inclination_deg", "speed_m_s", "heading_deg")
+
+
+def test_plots_say_what_they_show(serial_table):
+    """Units in the labels, the fixed parameters in the title, the cells' numbers in the
+    legend, runs deeper than the bumper radius marked."""
+    from quadimpact.sweep.plots import fixed_parameters, plot_metric, plot_type_map
+
+    spec = SweepSpec(base={**BASE, "vehicle_overrides": {"restitution": 0.7}}, grid=SMALL_GRID)
+    fixed = fixed_parameters(spec)
+    assert fixed == ("model paper-replica, controller paper, vehicle spiri, impact speed V_c = "
+                     "0.75 m/s, ground crash, final time = 1 s, restitution = 0.7")  # fmt: skip
+    table = serial_table.copy()
+    table.loc[table.index[0], "bumper_model_valid"] = False
+    fig = plot_metric(table, "inclination_deg", by="heading_deg", title=fixed)
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "inclination ι (deg)" and ax.get_ylabel() == "δ_init (mm)"
+    labels = [line.get_label() for line in ax.lines]
+    assert labels == ["heading ψ = 0 deg", "heading ψ = 45 deg",
+                      "run deeper than the bumper radius (the bumper model does not hold)"]
+    assert fig.get_suptitle() == fixed
+    fig = plot_type_map(table, "inclination_deg", "heading_deg", title=fixed)
+    names = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "number: subsequent impacts" in names
+    assert "run deeper than the bumper radius (the bumper model does not hold)" in names
+    assert fig.axes[0].get_ylabel() == "heading ψ (deg)"
+    assert sum(p.get_hatch() == "//" for p in fig.axes[0].patches) == 1

@@ -122,7 +122,7 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
     import pyarrow.parquet as pq
 
     path = out / "runs.parquet"
-    t = pq.read_table(path, columns=["status", "response_type"]).to_pandas()
+    t = pq.read_table(path, columns=["status", "response_type", "bumper_model_valid"]).to_pandas()
     n = len(t)
     status = t["status"].value_counts()
     types = t["response_type"].value_counts()
@@ -136,7 +136,8 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
         resumed = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
         ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{resumed}"
     lines = [
-        f"runs    {n} ({int(status.get('failed', 0))} failed; {ran})",
+        f"runs    {n} ({int(status.get('failed', 0))} failed, "
+        f"{int(t['bumper_model_valid'].eq(False).sum())} deeper than the bumper radius; {ran})",
         f"status  {status_text}",
         f"types   {type_text}",
         f"table   {path}",

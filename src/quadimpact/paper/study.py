@@ -194,4 +194,5 @@ def type_map_figure(table: pd.DataFrame, variant: str) -> Figure:
     return figures.type_map_figure(
         table, "inclination_deg", "speed_m_s", facet="heading_deg", label=type_label,
         title=f"Table II, {variant}: response type (C/D with the number of subsequent impacts)",
+        text_meaning="C3, D4...: the type and the number of subsequent impacts",
     )  # fmt: skip

@@ -74,6 +74,7 @@ __all__ = [
     "read_summary_json",
     "read_timeseries_parquet",
     "read_timeseries_units",
+    "split_unit",
     "to_jsonable",
     "write_episodes_csv",
     "write_imu_parquet",
@@ -130,6 +131,9 @@ _UNIT_SUFFIXES: tuple[tuple[str, str], ...] = (
     ("_rad_s", "rad/s"),
     ("_m_s", "m/s"),
     ("_rpm", "rpm"),
+    ("_kg_m2", "kg m^2"),
+    ("_kg", "kg"),
+    ("_hz", "Hz"),
     ("_deg", "deg"),
     ("_rad", "rad"),
     ("_mm", "mm"),
@@ -140,16 +144,25 @@ _UNIT_SUFFIXES: tuple[tuple[str, str], ...] = (
 )
 
 
+def split_unit(name: str) -> tuple[str, str]:
+    """A column name as (stem, unit): ``speed_m_s`` -> ``("speed", "m/s")``.
+
+    The unit is that of :func:`column_unit` (``"1"`` when dimensionless, and
+    the stem is then the whole name).
+    """
+    for suffix, unit in _UNIT_SUFFIXES:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return name[: -len(suffix)], unit
+    return name, "1"
+
+
 def column_unit(name: str) -> str:
     """Unit of a column from its name's suffix (``"1"`` when dimensionless).
 
     ``t_s`` -> ``s``, ``vx_m_s`` -> ``m/s``, ``p_rad_s`` -> ``rad/s``,
     ``force1_n`` -> ``N``, ``roll_deg`` -> ``deg``, ``q0`` -> ``1``.
     """
-    for suffix, unit in _UNIT_SUFFIXES:
-        if name.endswith(suffix) and len(name) > len(suffix):
-            return unit
-    return "1"
+    return split_unit(name)[1]
 
 
 def to_jsonable(obj: Any, *, finite: bool = True, strict: bool = True) -> Any:

@@ -187,7 +187,23 @@ class SimulationResult:
         return None
 
     def plot_title(self) -> str | None:
-        """Short title naming the approach (heading, speed, inclination), if known."""
+        """Short title naming the run: the approach (heading, speed, inclination) of a wall
+        approach, the initial attitude and speed of an impact trial, the surfaces of a flight;
+        None when the folder does not say."""
+        kind = self._scenario_value("kind")
+        if kind == "flight":
+            surfaces = self._scenario_value("surfaces") or []
+            names = [str(s.get("name", "?")) if isinstance(s, Mapping) else str(getattr(
+                s, "name", "?")) for s in surfaces]  # fmt: skip
+            ground = self._scenario_value("ground")
+            what = ", ".join(names) if names else "no surface"
+            return f"flight: {what}; ground {ground}" if ground else f"flight: {what}"
+        if kind == "impact-trial":
+            values = [self._scenario_value(k) for k in ("roll_deg", "pitch_deg", "speed_m_s")]
+            if all(isinstance(v, numbers.Real) for v in values):
+                roll, pitch, speed = values
+                return f"impact trial: roll {roll:g}°, pitch {pitch:g}°, {speed:g} m/s"
+            return "impact trial"
         heading = self._scenario_value("heading_deg")
         speed = self._scenario_value("speed_m_s")
         incl = self._scenario_value("inclination_deg")
