@@ -652,6 +652,22 @@ class Scene:
                 )
         return marks
 
+    def first_contact_points(self) -> dict[str, np.ndarray]:
+        """Where each surface was touched at the run's first contact (NED), by surface name.
+
+        A wall panel is drawn cut there (``render.wall_range``, the viewer), so
+        that its edge is where the vehicle met it, whatever the camera follows.
+        """
+        if self.first_contact_s is None:
+            return {}
+        points: dict[str, np.ndarray] = {}
+        for dt in (0.0, 1e-3, 5e-3):  # at the onset the deflection may still be zero
+            for c in self.frame(min(self.first_contact_s + dt, self.t_end)).contacts:
+                points.setdefault(c.surface, np.asarray(c.surface_point, dtype=float))
+            if points:
+                break
+        return points
+
     def target(self, t: float, camera: Camera) -> np.ndarray:
         """Point at the picture centre at time ``t`` for ``camera``."""
         if camera.follow == "vehicle":
