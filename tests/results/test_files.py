@@ -321,3 +321,16 @@ def test_a_one_sample_run_is_plotted_without_warnings(tmp_path: Path) -> None:
         warnings.simplefilter("error")
         out = make_result(timeseries=make_timeseries(1)).write(tmp_path / "one")
     assert (out / "fig5.png").is_file() and (out / "fig6.png").is_file()
+
+
+def test_summary_json_holds_the_integrator_counters_once(tmp_path: Path) -> None:
+    """No "stats" copy of "integrator" in the file; older folders with only "stats" still read."""
+    out = make_result().write(tmp_path / "run")
+    summary = json.loads((out / "summary.json").read_text())
+    assert "stats" not in summary and summary["integrator"] == {"n_steps": 1234, "n_rejected": 5}
+    assert read_result(out).stats == {"n_steps": 1234, "n_rejected": 5}
+    old = dict(summary)
+    old["stats"] = old.pop("integrator")  # as older versions wrote it
+    (out / "summary.json").write_text(json.dumps(old))
+    back = read_result(out)
+    assert back.stats == {"n_steps": 1234, "n_rejected": 5} and "stats" not in back.summary
