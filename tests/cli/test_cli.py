@@ -32,7 +32,8 @@ def test_help_and_version(tmp_path: Path) -> None:
     assert proc.returncode == 0 and "run" in proc.stdout and "NED" in proc.stdout
     proc = run_cli("run", "--help", cwd=tmp_path)
     assert proc.returncode == 0
-    for text in ("--heading DEG", "--inclination DEG", "--speed M/S", "--model", "results/run"):
+    for text in ("--heading, --heading-deg DEG", "--inclination, --inclination-deg DEG",
+                 "--speed, --speed-m-s M/S", "--model", "results/run"):
         assert text in proc.stdout
     proc = run_cli("--version", cwd=tmp_path)
     assert proc.returncode == 0 and proc.stdout.startswith("quadimpact ")
