@@ -403,13 +403,18 @@ if __name__ == "__main__":
 """
 
 
+def _run_script(folder: Path, text: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    """Run ``text`` as the main script ``script.py`` in ``folder`` (worker processes import it)."""
+    (folder / "script.py").write_text(text)
+    return subprocess.run(
+        [sys.executable, "script.py"], cwd=folder, env=_env(), capture_output=True, text=True,
+        timeout=timeout,
+    )  # fmt: skip
+
+
 def test_worker_crash_is_a_failed_row(tmp_path):
     """A run that kills its worker process: that run failed, every other run done."""
-    (tmp_path / "crash.py").write_text(CRASH_SCRIPT)
-    proc = subprocess.run(
-        [sys.executable, "crash.py"], cwd=tmp_path, env=_env(), capture_output=True, text=True,
-        timeout=120,
-    )  # fmt: skip
+    proc = _run_script(tmp_path, CRASH_SCRIPT)
     assert proc.returncode == 0, proc.stderr
     table = read_runs(tmp_path / "out")
     assert list(table.loc[table["status"] == "failed", "inclination_deg"]) == [7.0]
@@ -426,11 +431,7 @@ run_sweep({"grid": {"speed_m_s": [0.5, 1.0], "inclination_deg": [0, 5]}}, "out",
 
 def test_a_script_without_the_main_guard_is_told_so_first(tmp_path):
     """Workers re-run an unguarded script: the first line says what to do, no worker traceback."""
-    (tmp_path / "sweep.py").write_text(UNGUARDED_SCRIPT)
-    proc = subprocess.run(
-        [sys.executable, "sweep.py"], cwd=tmp_path, env=_env(), capture_output=True, text=True,
-        timeout=300,
-    )  # fmt: skip
+    proc = _run_script(tmp_path, UNGUARDED_SCRIPT, timeout=300)
     assert proc.returncode != 0
     lines = proc.stderr.strip().splitlines()
     assert lines[0].startswith("quadimpact: error: a sweep worker, starting up, ran the script")
