@@ -1,5 +1,7 @@
 """The paper's study, end to end (reduced where it costs)."""
 
+import re
+
 import pandas as pd
 import pytest
 
@@ -23,7 +25,12 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, capsys):
     assert set(f["variant"]) == {"paper-replica", "default"}
     assert len(f) == 2 * 10 and set(f["verdict"]) <= {"agrees", "partly", "disagrees", "n/a"}
     for _, row in f.iterrows():  # every verdict in the report is the computed one
-        assert f"**{row['verdict']}**: {row['measured']}" in text
+        measured = row["measured"].replace("|", "\\|")  # escaped in the Markdown table
+        assert f"**{row['verdict']}**: {measured}" in text
+    rows = [line for line in text.splitlines() if line.startswith("| ") and "**" in line
+            and line.split(" | ")[0][2:] in set(f["key"])]  # fmt: skip
+    assert len(rows) == 10  # one per finding, five cells each: no "|" of |Y| splits a cell
+    assert all(len(re.findall(r"(?<!\\)\|", line)) == 6 for line in rows)
     # the replica reproduces the paper's Figure 5 pattern and Figure 4's peak
     rep = f[f["variant"] == "paper-replica"].set_index("key")
     assert rep.loc["figure5", "verdict"] == "agrees"

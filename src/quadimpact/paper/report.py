@@ -39,8 +39,13 @@ def table2_markdown(table: pd.DataFrame) -> str:
 
 
 # ------------------------------------------------------------------ report
+def _md(text: str) -> str:
+    """Text for a Markdown table cell (a ``|`` in it, as in ``|Y|``, would split the cell)."""
+    return str(text).replace("|", "\\|")
+
+
 def _cell(f: pd.Series) -> str:
-    return f"**{f['verdict']}**: {f['measured']}"
+    return f"**{f['verdict']}**: {_md(f['measured'])}"
 
 
 def render_report(
@@ -76,7 +81,7 @@ def render_report(
     for key in rep.index:
         rule = rep.loc[key, "rule"] if "rule" in rep.columns else ""
         lines.append(f"| {key} | {rep.loc[key, 'claim']} | {_cell(rep.loc[key])} | "
-                     f"{_cell(dft.loc[key])} | {rule} |")  # fmt: skip
+                     f"{_cell(dft.loc[key])} | {_md(rule)} |")  # fmt: skip
     lines += ["", "## Where the variants disagree", ""]
     differ = [k for k in rep.index if rep.loc[k, "verdict"] != dft.loc[k, "verdict"]]
     if not differ:
