@@ -36,8 +36,11 @@ def states(out: np.ndarray) -> np.ndarray:
     return out[:, L.OUT_X : L.OUT_X + L.NX]
 
 
-def run_cli(*args: str, cwd, timeout: float = 120):
-    """Run ``python -m quadimpact.cli ARGS`` in a subprocess (the installed or the src package)."""
+def run_cli(*args: str, cwd, timeout: float = 120, env: dict | None = None, umask=None):
+    """Run ``python -m quadimpact.cli ARGS`` in a subprocess (the installed or the src package).
+
+    ``env``: variables set on top of this process's; ``umask``: the child's umask.
+    """
     import os
     import subprocess
     import sys
@@ -46,10 +49,11 @@ def run_cli(*args: str, cwd, timeout: float = 120):
     import quadimpact
 
     src = Path(quadimpact.__file__).resolve().parents[1]
-    env = dict(os.environ)
+    env = {**os.environ, **(env or {})}
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(src), env.get("PYTHONPATH")]))
     env.pop("QUADIMPACT_DEBUG", None)
     return subprocess.run(
         [sys.executable, "-m", "quadimpact.cli", *args],
         cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout,
+        preexec_fn=None if umask is None else (lambda: os.umask(umask)),
     )  # fmt: skip

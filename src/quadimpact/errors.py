@@ -18,9 +18,10 @@ import difflib
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-__all__ = ["InputError", "input_error_from_validation", "one_line", "format_value"]
+__all__ = ["InputError", "format_value", "input_error_from_validation", "one_line", "short_path"]
 
 _MAX_VALUE_CHARS = 60
+_MAX_PATH_CHARS = 80
 
 
 class InputError(ValueError):
@@ -79,6 +80,28 @@ def format_value(value: Any) -> str:
     if len(text) > _MAX_VALUE_CHARS:
         text = text[: _MAX_VALUE_CHARS - 3] + "..."
     return text
+
+
+def short_path(path: Any) -> str:
+    """A path for a one-line message: cut in the middle when longer than 80 characters.
+
+    Parameters
+    ----------
+    path : str or path-like
+        Any path.
+
+    Returns
+    -------
+    str
+        The path, or its two ends around ``...`` with its length in characters.
+    """
+    import os
+
+    text = os.fspath(path) if isinstance(path, os.PathLike) else str(path)
+    if len(text) <= _MAX_PATH_CHARS:
+        return text
+    half = (_MAX_PATH_CHARS - 5) // 2
+    return f"{text[:half]}...{text[-half:]} ({len(text)} characters)"
 
 
 def _rule(error: Mapping[str, Any]) -> tuple[str, bool]:

@@ -36,6 +36,7 @@ __all__ = [
     "quat_to_euler_zyx",
     "quat_to_matrix",
     "quat_xyzw_to_matrix",
+    "unwrap_deg",
     "wrap_angle_deg",
     "wrap_angle_rad",
 ]
@@ -147,6 +148,19 @@ def _wrap(angle: ArrayLike, half_turn: float) -> NDArray[np.float64]:
 def wrap_angle_rad(angle: ArrayLike) -> NDArray[np.float64]:
     """Wrap angle(s) to the interval (-pi, pi] (radians)."""
     return _wrap(angle, np.pi)
+
+
+def unwrap_deg(angle_deg: ArrayLike) -> NDArray[np.float64]:
+    """An angle made continuous through +-180 deg (whole turns added), NaN samples kept.
+
+    How roll and yaw are drawn and compared: a yaw going from 179 to -179 deg
+    becomes 179 to 181, not a jump of a turn.
+    """
+    y = np.array(angle_deg, dtype=np.float64)
+    ok = np.isfinite(y)
+    if ok.any():
+        y[ok] = np.degrees(np.unwrap(np.radians(y[ok])))
+    return y
 
 
 def wrap_angle_deg(angle: ArrayLike) -> NDArray[np.float64]:

@@ -32,7 +32,8 @@ def test_help_and_version(tmp_path: Path) -> None:
     assert proc.returncode == 0 and "run" in proc.stdout and "NED" in proc.stdout
     proc = run_cli("run", "--help", cwd=tmp_path)
     assert proc.returncode == 0
-    for text in ("--heading DEG", "--inclination DEG", "--speed M/S", "--model", "results/run"):
+    for text in ("--heading, --heading-deg DEG", "--inclination, --inclination-deg DEG",
+                 "--speed, --speed-m-s M/S", "--model", "results/run"):
         assert text in proc.stdout
     proc = run_cli("--version", cwd=tmp_path)
     assert proc.returncode == 0 and proc.stdout.startswith("quadimpact ")
@@ -43,7 +44,7 @@ def test_help_and_version(tmp_path: Path) -> None:
     [
         (["run", "--model", "best"], ["'--model'", "'best' is not one of"]),
         (["run", "--controller", "lqr"], ["'--controller'", "'lqr'"]),
-        (["run", "--heading", "abc"], ["'--heading'", "'abc' is not a valid float"]),
+        (["run", "--heading", "abc"], ["'--heading'", "'abc' is not a valid number"]),
         (["run", "--heading", "500"], ["--heading: must be <= 360 (got 500.0)"]),
         (["run", "--inclination", "-75"], ["--inclination: must be >= -60 (got -75.0)"]),
         (["run", "--speed", "0"], ["--speed: must be > 0 (got 0.0)"]),
@@ -55,6 +56,13 @@ def test_help_and_version(tmp_path: Path) -> None:
         (["run", "--vehicle", "spirit"], ["vehicle 'spirit': unknown vehicle name"]),
         (["launch"], ["No such command 'launch'"]),
         (["experiments", "--log-samples", "-1"], ["'--log-samples'", "-1 is not in the range"]),
+        (["run", "--heading", "nan"], ["'--heading'", "'nan' is not a finite number"]),
+        (["run", "--friction", "inf"], ["'--friction'", "'inf' is not a finite number"]),
+        (["view", "r", "--rate", "nan"], ["'--rate'", "'nan' is not a finite number"]),
+        (["view", "r", "--azimuth", "nan"], ["'--azimuth'", "'nan' is not a finite number"]),
+        (["snapshots", "r", "--elevation", "-inf"], ["'--elevation'", "'-inf' is not a finite"]),
+        (["animate", "r", "--fps", "nan"], ["'--fps'", "'nan' is not a finite number"]),
+        (["animate", "r", "--start", "nan"], ["'--start'", "'nan' is not a finite number"]),
     ],
 )
 def test_bad_flags_exit_2_with_one_line(tmp_path: Path, args: list[str], fragments) -> None:
@@ -163,8 +171,10 @@ def test_format_summary_for_people() -> None:
         "leading_bumpers": [4],
         "n_episodes": 5,
         "crash_time_s": 1.875,
+        "response_type": "D",
     }
     text = format_summary(summary, Path("results/run"))
+    assert "response type  D" in text and "detection" not in text
     assert "status         crashed (CM reached the ground)" in text
     assert "delta_init     12.35 mm" in text
     assert "peak force     3.21 N" in text
@@ -175,6 +185,34 @@ def test_format_summary_for_people() -> None:
     assert text.splitlines()[-1].startswith("output         results/run (summary.json")
     quiet = format_summary({"status": "completed", "crash_time_s": None}, Path("o"))
     assert "crash time     no crash" in quiet and "delta_init     n/a" in quiet
+    assert "response type  n/a" in quiet
+
+
+def test_format_summary_of_a_recovery_run() -> None:
+    """A recovery run says when the impact was detected and when stage 4 was reached."""
+    from quadimpact.cli import format_summary
+
+    summary = {"status": "completed", "controller": "recovery", "response_type": "A",
+               "t_detect_s": 0.045, "detection_latency_s": 0.0049, "t_stage4_s": 0.77,
+               "time_to_recover_s": 0.725}  # fmt: skip
+    text = format_summary(summary, Path("o"))
+    assert "detection      at 0.045 s (4.9 ms after the first contact)" in text
+    assert "recovered      stage 4 at 0.77 s (0.725 s after the detection)" in text
+    missed = format_summary({"controller": "recovery", "t_detect_s": None}, Path("o"))
+    assert "detection      no detection" in missed
+    assert "recovered      stage 4 not reached" in missed
+
+
+def test_a_failed_run_exits_3(tmp_path: Path) -> None:
+    """A numerical failure is not a success: status 3 (documented in --help), folder written."""
+    proc = run_cli("run", "--friction", "1e308", "--final-time", "1", "--out", "out",
+                   cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 3, proc.stderr
+    assert "status         failed (state became NaN or infinite)" in proc.stdout
+    assert json.loads((tmp_path / "out" / "summary.json").read_text())["status"] == "failed"
+    assert "Traceback" not in proc.stderr
+    helptext = run_cli("run", "--help", cwd=tmp_path).stdout
+    assert "Exit status" in helptext and "3  the run failed numerically" in helptext
 
 
 @pytest.mark.slow
@@ -187,11 +225,250 @@ def test_experiments_writes_table3(tmp_path: Path) -> None:
     missing = tmp_path / "no-data"
     missing.mkdir()
     args = ["experiments", "--out", "exp", "--samples", "0", "--log-samples", "0", "--workers", "1"]
-    proc = run_cli(*args, "--data", str(missing), cwd=tmp_path, timeout=300)
+    proc = run_cli(*args, cwd=tmp_path, timeout=300, env={"QUADIMPACT_DATA": str(missing)})
     assert proc.returncode == 0, proc.stderr
+    assert "QUADIMPACT_DATA" in proc.stderr and "holds none of the crash logs" in proc.stderr
     table = pd.read_csv(tmp_path / "exp" / "table3.csv")
     assert list(table.columns) == [*TABLE3_COLUMNS, *EXTRA_COLUMNS] and len(table) == 7
     # no logs in that folder: the log columns are empty, the simulations are not
     assert table["attitude_rms_deg_0_3s"].isna().all() and table["type_log"].isna().all()
     assert table["type_ours"].notna().all()
     assert "ours_at_log" in proc.stdout and "table3.csv" in proc.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["--data", "/nonexistent"], ["--data /nonexistent: no such folder"]),
+        (["--data", "empty"], ["--data empty: holds none of the crash logs"]),
+        (["--scheduler", "nonsense"], ["--scheduler: must be an address like tcp://HOST:PORT"]),
+        (["--scheduler", "tcp://127.0.0.1:1"], ["no Dask scheduler answers there"]),
+        (["--workers", "2", "--scheduler", "tcp://127.0.0.1:1"], ["give one or the other"]),
+        (["--out", "afile/sub"], ["--out afile/sub: cannot be created: afile is a file"]),
+        (["--out", "run"], ["--out run: holds a run (summary.json); use a new or empty"]),
+    ],
+)
+def test_experiments_refuses_bad_options_before_any_work(
+    tmp_path: Path, args: list[str], fragments: list[str]
+) -> None:
+    """A given --data without logs, a bad --scheduler or --out: one line, at once."""
+    import time
+
+    (tmp_path / "empty").mkdir()
+    (tmp_path / "afile").write_text("x")
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "summary.json").write_text("{}")
+    start = time.monotonic()
+    proc = run_cli("experiments", *args, cwd=tmp_path)
+    assert_input_error(proc, *fragments)
+    assert time.monotonic() - start < 15  # nothing simulated (that takes 30 s and more)
+    assert not (tmp_path / "results").exists()
+
+
+@pytest.mark.parametrize("command", ["reproduce", "sweep"])
+def test_reproduce_and_sweep_check_the_scheduler_first(tmp_path: Path, command: str) -> None:
+    extra = ["--grid", "speed_m_s=0.5,1", "--out", "s"] if command == "sweep" else []
+    proc = run_cli(command, *extra, "--scheduler", "tcp://127.0.0.1:1", cwd=tmp_path)
+    assert_input_error(proc, "--scheduler tcp://127.0.0.1:1: no Dask scheduler answers there")
+    assert not (tmp_path / "s").exists() and not (tmp_path / "results").exists()
+
+
+def test_out_folders_of_another_kind_are_refused_before_simulating(tmp_path: Path) -> None:
+    """run --out into a sweep folder, sweep --out into a run folder, --out under a file."""
+    (tmp_path / "sweep").mkdir()
+    (tmp_path / "sweep" / "sweep.json").write_text("{}")
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "summary.json").write_text("{}")
+    (tmp_path / "afile").write_text("x")
+    proc = run_cli("run", "--out", "sweep", cwd=tmp_path)
+    assert_input_error(proc, "--out sweep: holds a sweep (sweep.json); use a new or empty folder")
+    proc = run_cli("run", "--out", "afile/sub", cwd=tmp_path)
+    assert_input_error(proc, "--out afile/sub: cannot be created: afile is a file, not a folder")
+    proc = run_cli("run", "--out", "x" * 5000, cwd=tmp_path)
+    assert_input_error(proc, "(5000 characters): path too long")
+    assert len(proc.stderr) < 300
+    proc = run_cli("sweep", "--grid", "speed_m_s=0.5,1", "--out", "run", cwd=tmp_path)
+    assert_input_error(proc, "run: holds a run (summary.json); use a new or empty folder")
+    assert sorted(p.name for p in (tmp_path / "run").iterdir()) == ["summary.json"]
+
+
+def test_disk_full_during_run_leaves_no_half_folder(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The parquet writer fails part-way: one line, exit 1, no folder, no hidden stage left."""
+    import errno
+
+    import quadimpact.results.files as files
+    from quadimpact.cli import main
+
+    def full(_df: object, path: Path) -> None:
+        Path(path).write_bytes(b"PAR1 half")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(files, "write_timeseries_parquet", full)
+    out = tmp_path / "run"
+    with pytest.raises(SystemExit) as info:
+        main(["run", "--final-time", "0.6", "--out", str(out)])
+    assert info.value.code == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == (
+        f"quadimpact: error: {out}: the result folder could not be written (No space left on "
+        "device); nothing was changed there"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    ("files", "args", "fragments"),
+    [
+        ({"k.toml": 'kind = ["flight"]\n'}, ["run", "k.toml"],
+         ["k.toml: kind: must be one of 'wall-approach', 'flight', 'impact-trial'",
+          "(got ['flight'])"]),
+        ({}, ["sweep", "--grid", "vehicle_overrides=1", "--out", "s"],
+         ["vehicle_overrides: must be a table of vehicle field = value (got 1.0)"]),
+        ({"s.toml": "[sample]\nn = 3\nranges = [1, 2]\n"}, ["sweep", "s.toml", "--out", "s"],
+         ["s.toml: sample.ranges: must be a table of field = values (got [1, 2])"]),
+        ({"s.toml": '[sample]\nn = 3\nchoices = "abc"\n'}, ["sweep", "s.toml", "--out", "s"],
+         ["s.toml: sample.choices: must be a table of field = values (got 'abc')"]),
+        ({"s.toml": 'base = {kind = ["flight"]}\n[grid]\nspeed_m_s = [1, 2]\n'},
+         ["sweep", "s.toml", "--out", "s"], ["s.toml: base: kind: must be one of"]),
+        ({"d.toml": "a = " + "[" * 3000 + "]" * 3000 + "\n"}, ["run", "d.toml"],
+         ["d.toml: invalid TOML: nested too deeply"]),
+        ({"d.toml": "a = " + "{x = " * 600 + "1" + "}" * 600 + "\n"}, ["run", "d.toml"],
+         ["d.toml: invalid TOML: nested too deeply"]),
+        ({"d.toml": "vehicle_overrides = " + "[" * 400 + "]" * 400 + "\n"}, ["run", "d.toml"],
+         ["d.toml: tables and lists nested 17 deep; no input has more than 16 levels"]),
+        ({"b.toml": "heading_deg = " + "9" * 5000 + "\n"}, ["run", "b.toml"],
+         ["b.toml: invalid TOML: Exceeds the limit (4300 digits)"]),
+        ({}, ["run", "a" * 5000 + ".toml"], ["(5005 characters): cannot read file (File name"]),
+    ],
+)
+def test_malformed_inputs_are_one_line_input_errors(
+    tmp_path: Path, files: dict[str, str], args: list[str], fragments: list[str]
+) -> None:
+    """Types no rule expected (a list for a name, a number for a table...), sizes beyond reason."""
+    for name, text in files.items():
+        (tmp_path / name).write_text(text)
+    proc = run_cli(*args, cwd=tmp_path)
+    assert_input_error(proc, *fragments)
+    assert len(proc.stderr) < 400 and not (tmp_path / "s").exists()
+
+
+@pytest.fixture(scope="module")
+def short_run(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    out = tmp_path_factory.mktemp("short") / "run"
+    proc = run_cli("run", "--final-time", "0.8", "--out", str(out), cwd=out.parent)
+    assert proc.returncode == 0, proc.stderr
+    return out
+
+
+@pytest.mark.parametrize(
+    ("damage", "fragment"),
+    [
+        ("array", "summary.json: must be a JSON object of summary fields (got a JSON array)"),
+        ("json", "summary.json: cannot be read (JSONDecodeError: Expecting"),
+        ("columns", "timeseries.parquet: missing column(s) q0, delta2_m: not a time series"),
+        ("parquet", "timeseries.parquet: cannot be read (ArrowInvalid:"),
+    ],
+)
+@pytest.mark.parametrize("command", ["view", "snapshots", "animate"])
+def test_damaged_result_folders_are_named_in_one_line(
+    short_run: Path, tmp_path: Path, damage: str, fragment: str, command: str
+) -> None:
+    import shutil
+
+    import pandas as pd
+
+    d = tmp_path / "run"
+    shutil.copytree(short_run, d)
+    if damage == "array":
+        (d / "summary.json").write_text("[1, 2]\n")
+    elif damage == "json":
+        (d / "summary.json").write_text("{bad json\n")
+    elif damage == "columns":
+        ts = pd.read_parquet(d / "timeseries.parquet").drop(columns=["q0", "delta2_m"])
+        ts.to_parquet(d / "timeseries.parquet")
+    else:
+        (d / "timeseries.parquet").write_text("not parquet")
+    assert_input_error(run_cli(command, "run", cwd=tmp_path), fragment)
+
+
+def test_a_garbage_crash_log_is_named_before_any_run(tmp_path: Path) -> None:
+    (tmp_path / "data" / "spiri-crash-set-1").mkdir(parents=True)
+    (tmp_path / "data" / "spiri-crash-set-1" / "crash_3.mat").write_text("garbage")
+    proc = run_cli("experiments", "--data", "data", "--samples", "0", "--out", "x", cwd=tmp_path)
+    assert_input_error(proc, "crash_3.mat: not a readable crash log of the set (MatReadError")
+    assert not (tmp_path / "x" / "crash_1").exists()
+
+
+def test_every_run_flag_is_also_named_by_its_file_key(tmp_path: Path) -> None:
+    """--heading and --heading-deg, --friction and --friction-coefficient...: both work."""
+    from quadimpact.cli.run import _FLAGS, run
+
+    names = {p.name: p.opts for p in run.params}
+    for param, (field, flag) in _FLAGS.items():
+        key_flag = "--" + field.replace("_", "-")
+        assert flag in names[param] and key_flag in names[param], (param, names[param])
+    args = ["--heading-deg", "10", "--speed-m-s", "0.6", "--friction-coefficient", "0.2",
+            "--final-time-s", "0.7", "--output-rate-hz", "200"]  # fmt: skip
+    proc = run_cli("run", *args, "--inclination", "5", "--out", "out", cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    sc = json.loads((tmp_path / "out" / "scenario.json").read_text())["scenario"]
+    assert (sc["heading_deg"], sc["speed_m_s"], sc["friction_coefficient"]) == (10, 0.6, 0.2)
+    assert (sc["final_time_s"], sc["output_rate_hz"], sc["inclination_deg"]) == (0.7, 200, 5)
+
+
+def _rewrite_series(src: Path, dst: Path, change) -> Path:
+    import shutil
+
+    import pandas as pd
+
+    shutil.copytree(src, dst)
+    ts = change(pd.read_parquet(dst / "timeseries.parquet"))
+    ts.to_parquet(dst / "timeseries.parquet")
+    return dst
+
+
+@pytest.mark.parametrize("command", ["animate", "view", "snapshots"])
+def test_no_library_warnings_leak_from_the_drawing_commands(
+    short_run: Path, tmp_path: Path, command: str
+) -> None:
+    """All-NaN samples: one line saying so (no ffmpeg, NumPy or cast messages); one sample: no
+    Matplotlib warning."""
+    import numpy as np
+
+    def all_nan(ts):
+        return ts.assign(**{c: np.nan for c in ts.columns if c != "t_s"})
+
+    _rewrite_series(short_run, tmp_path / "nan", all_nan)
+    extra = ["--size", "320x180"] if command == "animate" else []
+    proc = run_cli(command, "nan", *extra, cwd=tmp_path)
+    assert_input_error(proc, "nan: nothing to draw: every sample of the run is NaN or infinite")
+    _rewrite_series(short_run, tmp_path / "one", lambda ts: ts.iloc[:1])
+    extra += ["--times", "-0.5"] if command == "snapshots" else []
+    proc = run_cli(command, "one", *extra, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stderr
+    assert "Warning" not in proc.stderr and "frames have been written" not in proc.stderr
+
+
+
+def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) -> None:
+    """The compiled loop's cache index is looked for where Numba itself puts it."""
+    from numba.core.caching import UserProvidedCacheLocator
+
+    import quadimpact.core as core
+    from quadimpact.cli.options import announce_compilation
+
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    assert not core.cache_is_warm()
+    announce_compilation()
+    assert capsys.readouterr().err == (
+        "quadimpact: compiling the simulator (first run only, about 40 s) ...\n"
+    )
+    run_py = str(Path(core.__file__).parent / "run.py")
+    where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
+    where.mkdir(parents=True)
+    (where / "run.run_builtin-52.py311.nbi").write_bytes(b"")
+    assert core.cache_is_warm()
+    announce_compilation()
+    assert capsys.readouterr().err == ""

@@ -122,3 +122,39 @@ def test_real_log_comparison_runs(tmp_path):
     assert c.log_response is not None and c.log_response.type in {"B", "unknown"}
     assert not c.notes  # like with like: no heading warning
     c.plot(tmp_path / "real.png")
+
+
+def test_angles_are_unwrapped_onto_one_branch():
+    """A yaw that crosses +-180 deg: the log is drawn and compared on the run's branch."""
+    run = simulate(WallApproach(heading_deg=179, inclination_deg=10, speed_m_s=0.5,
+                                final_time_s=1.0))  # fmt: skip
+    assert np.abs(np.diff(run.timeseries["yaw_deg"])).max() > 350  # wrapped: it jumps a turn
+    c = compare(run, synthetic_log(run, offsets={"yaw_deg": 5.0}), windows=WINDOWS)
+    log_yaw = c.log_pose["yaw_deg"].to_numpy()
+    assert np.abs(np.diff(log_yaw)).max() < 30  # continuous, as plotted
+    sim_yaw = np.interp(c.log_pose["tau_s"], c.sim["tau_s"], c.sim["yaw_deg"])
+    inside = (c.log_pose["tau_s"] >= c.sim["tau_s"].min()).to_numpy()
+    np.testing.assert_allclose((log_yaw - sim_yaw)[inside], 5.0, atol=1e-6)
+    for w in WINDOWS:
+        assert c.error("attitude", w, "yaw", "max_abs") == pytest.approx(5.0, abs=1e-6)
+    # a log a whole turn off is the same attitude: no error
+    turned = compare(run, synthetic_log(run, offsets={"yaw_deg": 360.0}), windows=WINDOWS)
+    assert turned.error("attitude", 0.5, "yaw", "max_abs") == pytest.approx(0.0, abs=1e-6)
+    sim_dep, log_dep = c.departures(0.5)["yaw"]
+    assert sim_dep == pytest.approx(log_dep, abs=1e-6) and abs(sim_dep) > 1  # across 180
+
+
+def test_errors_beyond_half_a_turn_are_not_folded_back():
+    """A logged roll that turns away from the run's, 400 deg/s, wrapped as a log is: at
+    0.5 s it is 200 deg apart (unwrapped), not 160."""
+    from quadimpact.rotations import wrap_angle_deg
+
+    from synthetic_log import SyntheticLog
+
+    run = simulate(WallApproach(heading_deg=10, inclination_deg=15, speed_m_s=1.0,
+                                final_time_s=1.0))  # fmt: skip
+    ts = run.timeseries.copy()
+    t0 = run.summary["first_contact_s"]
+    ts["roll_deg"] = wrap_angle_deg(ts["roll_deg"] + 400.0 * np.clip(ts["t_s"] - t0, 0.0, None))
+    c = compare(run, SyntheticLog(ts, t0), windows=WINDOWS)
+    assert c.error("attitude", 0.5, "roll", "max_abs") == pytest.approx(200.0, abs=1e-6)

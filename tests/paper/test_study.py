@@ -1,5 +1,7 @@
 """The paper's study, end to end (reduced where it costs)."""
 
+import re
+
 import pandas as pd
 import pytest
 
@@ -10,18 +12,37 @@ from quadimpact.simulation.metrics import RESPONSE_TYPES
 
 
 @pytest.mark.slow
-def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch):
+def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch, capsys):
     # the recovery part at 40 and 20 trials instead of 2,000 and 1,000 (its grid and crashes
     # in full)
     monkeypatch.setattr(study, "RECOVERY_N", 40)
     monkeypatch.setattr(study, "RECOVERY_COMPARE_N", 20)
-    r = reproduce(tmp_path, ablation=False, experiments=False, workers=2)
+    r = reproduce(tmp_path, ablation=False, experiments=False, workers=2, progress=True)
+    err = capsys.readouterr().err.splitlines()
+    stages = [line for line in err if line.startswith("reproduce: ")]
+    assert stages == [
+        "reproduce: Figure 4 sweep and the example run, paper-replica",
+        "reproduce: Figure 4 sweep and the example run, default",
+        "reproduce: recovery: 40 impact trials of the Navi, default",
+        "reproduce: recovery: 40 impact trials of the Navi, recovery-replica",
+        "reproduce: recovery: 20 trials with the noisy IMU, 20 of the Spiri",
+        "reproduce: recovery: the Figure 4 grid with the recovery controller, paper-replica",
+        "reproduce: recovery: the Figure 4 grid with the recovery controller, default",
+        "reproduce: recovery: the crashes without their power-off, nominal and recovery",
+        "reproduce: figures, tables and the report",
+    ]
+    assert err[err.index(stages[0]) + 1] == "sweep: 246 runs to do"  # each sweep is named
     text = r.report.read_text()
     f = r.findings
     assert set(f["variant"]) == {"paper-replica", "default"}
     assert len(f) == 2 * 10 and set(f["verdict"]) <= {"agrees", "partly", "disagrees", "n/a"}
     for _, row in f.iterrows():  # every verdict in the report is the computed one
-        assert f"**{row['verdict']}**: {row['measured']}" in text
+        measured = row["measured"].replace("|", "\\|")  # escaped in the Markdown table
+        assert f"**{row['verdict']}**: {measured}" in text
+    rows = [line for line in text.splitlines() if line.startswith("| ") and "**" in line
+            and line.split(" | ")[0][2:] in set(f["key"])]  # fmt: skip
+    assert len(rows) == 10  # one per finding, five cells each: no "|" of |Y| splits a cell
+    assert all(len(re.findall(r"(?<!\\)\|", line)) == 6 for line in rows)
     # the replica reproduces the paper's Figure 5 pattern and Figure 4's peak
     rep = f[f["variant"] == "paper-replica"].set_index("key")
     assert rep.loc["figure5", "verdict"] == "agrees"

@@ -6,6 +6,7 @@ from pathlib import Path
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+import pytest
 
 from quadimpact.results.figures import break_wraps, make_fig5, make_fig6, plot_fig5, plot_fig6
 
@@ -101,6 +102,18 @@ def test_wrapped_yaw_is_broken_not_joined() -> None:
     assert np.isnan(yy[2]) and np.isnan(tt[2])
     t2, y2 = break_wraps(t, np.array([0.0, 10.0, 20.0, 30.0]))
     np.testing.assert_array_equal(y2, [0.0, 10.0, 20.0, 30.0])
+
+
+def test_fig6_draws_roll_and_yaw_unwrapped() -> None:
+    """Yaw from 170 through 180 to -170 deg: one continuous line 170..190, reference on it."""
+    ts = make_ts()
+    n = len(ts)
+    ts["yaw_deg"] = ((np.linspace(170.0, 190.0, n) + 180.0) % 360.0) - 180.0
+    fig = make_fig6(ts, {**REFS, "yaw_rad": np.radians(-175.0)})
+    ax_yaw = fig.axes[5]
+    y = ax_yaw.lines[0].get_ydata()
+    np.testing.assert_allclose(y, np.linspace(170.0, 190.0, n), atol=1e-9)
+    assert ax_yaw.lines[1].get_ydata()[0] == pytest.approx(185.0)  # -175 on the line's branch
 
 
 def test_files_written_and_no_pyplot_state(tmp_path: Path) -> None:

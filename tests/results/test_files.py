@@ -171,9 +171,13 @@ def test_plot_failure_keeps_data_and_is_reported(
     summary = json.loads((out / "summary.json").read_text())
     assert len(summary["plot_errors"]) == 1 and "KeyError" in summary["plot_errors"][0]
     assert res.summary["plot_errors"] == summary["plot_errors"]
-    back = read_result(out)
-    pd.testing.assert_frame_equal(back.timeseries, ts)
-    assert len(back.episodes) == 2
+    from quadimpact.errors import InputError
+    from quadimpact.results.files import read_episodes_csv, read_timeseries_parquet
+
+    pd.testing.assert_frame_equal(read_timeseries_parquet(out / "timeseries.parquet"), ts)
+    assert len(read_episodes_csv(out / "episodes.csv")) == 2
+    with pytest.raises(InputError, match="timeseries.parquet: missing column.s. delta3_m"):
+        read_result(out)  # a series that cannot be drawn is refused when read back
 
 
 def test_read_result_missing_folder(tmp_path: Path) -> None:
@@ -202,3 +206,131 @@ def test_atomic_write_leaves_the_old_file_on_failure(tmp_path: Path) -> None:
     with pytest.raises(RuntimeError, match="disk full"):
         atomic_write(target, fail, suffix=".mp4")
     assert target.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["table.bin"]
+
+
+# ------------------------------------------------------------------ the folder as a whole
+def _disk_full(*_args: object, **_kwargs: object) -> None:
+    import errno
+
+    raise OSError(errno.ENOSPC, "No space left on device")
+
+
+def test_a_failed_write_leaves_no_half_folder(tmp_path: Path, monkeypatch) -> None:
+    """Disk full while writing the time series: no folder with summary.json but no data."""
+    import quadimpact.results.files as files
+
+    monkeypatch.setattr(files, "write_timeseries_parquet", _disk_full)
+    with pytest.raises(OSError, match="No space left"):
+        make_result().write(tmp_path / "run")
+    assert list(tmp_path.iterdir()) == []  # neither the folder nor its hidden stage
+    # an existing run folder is left exactly as it was
+    monkeypatch.undo()
+    old = make_result().write(tmp_path / "old")
+    before = {p.name: p.read_bytes() for p in old.iterdir()}
+    monkeypatch.setattr(files, "write_timeseries_parquet", _disk_full)
+    with pytest.raises(OSError):
+        make_result(summary={"status": "crashed"}).write(old)
+    assert {p.name: p.read_bytes() for p in old.iterdir()} == before
+    assert [p.name for p in tmp_path.iterdir()] == ["old"]
+
+
+def test_a_run_written_over_a_run_replaces_it_and_its_pictures(tmp_path: Path) -> None:
+    from quadimpact.results.files import DERIVED_FILES
+
+    out = make_result().write(tmp_path / "run")
+    (out / "imu.parquet").write_bytes(b"old run's IMU")  # the new run has none
+    for name in ("animation.mp4", "viewer.html", "snapshots.png", "snapshots.pdf"):
+        (out / name).write_bytes(b"picture of the old run")
+    (out / "notes.txt").write_text("mine")
+    make_result(summary={"status": "crashed"}).write(out)
+    names = {p.name for p in out.iterdir()}
+    assert names == {"summary.json", "episodes.csv", "timeseries.parquet", "fig5.png",
+                     "fig6.png", "notes.txt"}  # fmt: skip
+    assert not names & set(DERIVED_FILES)
+    assert json.loads((out / "summary.json").read_text())["status"] == "crashed"
+    assert [p.name for p in tmp_path.iterdir()] == ["run"]
+
+
+def test_drawing_commands_write_only_listed_derived_files() -> None:
+    """What a new run removes from a run folder names every picture the viz commands write."""
+    from quadimpact.experiments.logs_compare import COMPARE_CSV, COMPARE_PNG
+    from quadimpact.results.files import DERIVED_FILES, RUN_FILES
+    from quadimpact.results.result import FIG5_PNG, FIG6_PNG, IMU_PNG
+    from quadimpact.viz.animation import ANIMATION_GIF, ANIMATION_MP4
+    from quadimpact.viz.snapshots import SNAPSHOTS_PDF, SNAPSHOTS_PNG
+    from quadimpact.viz.viewer import VIEWER_HTML
+
+    assert {ANIMATION_GIF, ANIMATION_MP4, SNAPSHOTS_PDF, SNAPSHOTS_PNG, VIEWER_HTML,
+            COMPARE_CSV, COMPARE_PNG} == set(DERIVED_FILES)  # fmt: skip
+    assert {FIG5_PNG, FIG6_PNG, IMU_PNG} < set(RUN_FILES)
+
+
+@pytest.mark.parametrize(
+    ("names", "kind", "fragment"),
+    [
+        (["sweep.json", "runs.parquet"], "a sweep", "sweep.json, runs.parquet"),
+        (["report.md"], "a study report", "report.md"),
+        (["table3.csv"], "the crash experiments", "table3.csv"),
+        (["thesis.tex"], "files that are not quadimpact's", "thesis.tex"),
+    ],
+)
+def test_a_run_refuses_a_folder_of_another_kind(
+    tmp_path: Path, names: list[str], kind: str, fragment: str
+) -> None:
+    from quadimpact.errors import InputError
+
+    for name in names:
+        (tmp_path / name).write_text("x")
+    with pytest.raises(InputError, match=f"holds {kind} \\({fragment}\\); use a new or empty"):
+        make_result().write(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
+
+
+def test_check_out_dir_says_what_is_wrong_in_one_line(tmp_path: Path) -> None:
+    from quadimpact.errors import InputError
+    from quadimpact.results.files import check_out_dir, folder_kind
+
+    (tmp_path / "file").write_text("x")
+    cases = [
+        (tmp_path / "file" / "sub", "cannot be created: "),
+        (tmp_path / "file", "is a file, not a folder"),
+        (tmp_path / ("a" * 5000), "path too long"),
+        (tmp_path / ("b" * 300) / "c", "longer than 255 bytes|path too long"),
+    ]
+    for path, rule in cases:
+        with pytest.raises(InputError, match=rule) as info:
+            check_out_dir(path, "run")
+        assert "\n" not in str(info.value) and len(str(info.value)) < 300
+    assert check_out_dir(tmp_path / "new" / "run", "run") == tmp_path / "new" / "run"
+    assert not (tmp_path / "new").exists()  # checking makes nothing
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / ".hidden").write_text("x")
+    assert folder_kind(tmp_path / "run") == (None, [])
+    (tmp_path / "run" / "summary.json").write_text("{}")
+    assert folder_kind(tmp_path / "run") == ("run", ["summary.json"])
+    with pytest.raises(InputError, match="holds a run .*this sweep's own folder"):
+        check_out_dir(tmp_path / "run", "sweep")
+    assert check_out_dir(tmp_path, "sweep") == tmp_path  # a sweep may go among other files
+
+
+def test_a_one_sample_run_is_plotted_without_warnings(tmp_path: Path) -> None:
+    """A run of one sample: its figures, and no Matplotlib warning about singular limits."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = make_result(timeseries=make_timeseries(1)).write(tmp_path / "one")
+    assert (out / "fig5.png").is_file() and (out / "fig6.png").is_file()
+
+
+def test_summary_json_holds_the_integrator_counters_once(tmp_path: Path) -> None:
+    """No "stats" copy of "integrator" in the file; older folders with only "stats" still read."""
+    out = make_result().write(tmp_path / "run")
+    summary = json.loads((out / "summary.json").read_text())
+    assert "stats" not in summary and summary["integrator"] == {"n_steps": 1234, "n_rejected": 5}
+    assert read_result(out).stats == {"n_steps": 1234, "n_rejected": 5}
+    old = dict(summary)
+    old["stats"] = old.pop("integrator")  # as older versions wrote it
+    (out / "summary.json").write_text(json.dumps(old))
+    back = read_result(out)
+    assert back.stats == {"n_steps": 1234, "n_rejected": 5} and "stats" not in back.summary

@@ -126,3 +126,13 @@ def test_ground_contacts_are_not_impacts():
 def test_summary_carries_the_type(kw, expected):
     s = simulate(WallApproach(heading_deg=45, **kw)).summary
     assert s["response_type"] == expected
+
+
+def test_sinking_into_the_ground_is_explained_in_the_warning() -> None:
+    """ground = "contact": only the rims touch; the paper example sinks its body into the floor."""
+    s = simulate(WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75,
+                              ground="contact")).summary  # fmt: skip
+    assert s["max_penetration_m"] > 0.3 and s["min_altitude_m"] < -0.1  # the CM below the floor
+    (deep,) = [w for w in s["warnings"] if w.startswith("penetration")]
+    assert "mm into the ground, beyond the bumper radius 110 mm" in deep
+    assert "only the bumper rims can touch a surface" in deep and 'ground = "crash"' in deep

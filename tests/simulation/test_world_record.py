@@ -103,3 +103,19 @@ def test_wall_approach_and_stepping_record_the_same_world() -> None:
                     "is_ground": False, "kind": "plane"}  # fmt: skip
     assert result.world["resolved"]["controller_params"]["attitude_pid"] == [7.2, 4.0, 4.2]
     assert Simulation(sc).run().world == result.world
+
+
+def test_every_kind_of_run_has_a_plot_title(flight_result) -> None:
+    """Figures 5 and 6 of a flight or an impact trial are titled too, also when read back."""
+    from quadimpact import ImpactTrial, WallApproach
+
+    assert flight_result.plot_title() == "flight: slope, side; ground contact"
+    trial = simulate(ImpactTrial(pitch_deg=-20, final_time_s=0.3))
+    assert trial.plot_title() == "impact trial: roll 0°, pitch -20°, 1.5 m/s"
+    wall = simulate(WallApproach(heading_deg=45, final_time_s=0.8))
+    assert wall.plot_title() == "ψ = 45°, V_c = 0.75 m/s, inclination = 0°"
+
+
+def test_a_flight_read_back_keeps_its_title(flight_result, tmp_path) -> None:
+    back = read_result(flight_result.write(tmp_path / "run"))
+    assert back.plot_title() == "flight: slope, side; ground contact"

@@ -494,18 +494,40 @@ if __name__ == "__main__":
 """
 
 
+def _run_script(folder: Path, text: str, timeout: float = 120) -> subprocess.CompletedProcess:
+    """Run ``text`` as the main script ``script.py`` in ``folder`` (worker processes import it)."""
+    (folder / "script.py").write_text(text)
+    return subprocess.run(
+        [sys.executable, "script.py"], cwd=folder, env=_env(), capture_output=True, text=True,
+        timeout=timeout,
+    )  # fmt: skip
+
+
 def test_worker_crash_is_a_failed_row(tmp_path):
     """A run that kills its worker process: that run failed, every other run done."""
-    (tmp_path / "crash.py").write_text(CRASH_SCRIPT)
-    proc = subprocess.run(
-        [sys.executable, "crash.py"], cwd=tmp_path, env=_env(), capture_output=True, text=True,
-        timeout=120,
-    )  # fmt: skip
+    proc = _run_script(tmp_path, CRASH_SCRIPT)
     assert proc.returncode == 0, proc.stderr
     table = read_runs(tmp_path / "out")
     assert list(table.loc[table["status"] == "failed", "inclination_deg"]) == [7.0]
     assert table.loc[7, "reason"].startswith("worker process died")
     assert len(table) == 11 and table["delta_init_m"].notna().sum() == 10
+
+
+UNGUARDED_SCRIPT = """
+from quadimpact.sweep import run_sweep
+
+run_sweep({"grid": {"speed_m_s": [0.5, 1.0], "inclination_deg": [0, 5]}}, "out", workers=2)
+"""
+
+
+def test_a_script_without_the_main_guard_is_told_so_first(tmp_path):
+    """Workers re-run an unguarded script: the first line says what to do, no worker traceback."""
+    proc = _run_script(tmp_path, UNGUARDED_SCRIPT, timeout=300)
+    assert proc.returncode != 0
+    lines = proc.stderr.strip().splitlines()
+    assert lines[0].startswith("quadimpact: error: a sweep worker, starting up, ran the script")
+    assert 'if __name__ == "__main__":' in lines[0]
+    assert "multiprocessing" not in proc.stderr and len(lines) < 20, proc.stderr
 
 
 def test_rerun_and_other_sweep_in_the_folder(serial_table, tmp_path):
@@ -539,7 +561,7 @@ def test_cli_sweep(tmp_path):
         cwd=tmp_path,
     )  # fmt: skip
     assert proc.returncode == 0, proc.stderr
-    assert "runs    6 (0 failed" in proc.stdout
+    assert "runs    6 (0 failed, 0 deeper than the bumper radius; " in proc.stdout
     assert "types   A" in proc.stdout
     table = read_runs(tmp_path / "o")
     assert len(table) == 6 and table["final_time_s"].eq(1.0).all()
@@ -585,3 +607,29 @@ def test_plots(serial_table, tmp_path):
     fig4 = {"heading_deg": [0, 45], "inclination_deg": list(range(-20, 21)), "speed_m_s": [1, 2, 3]}
     kinds = dict.fromkeys(fig4, "f")
     assert choose_plot_fields(kinds, fig4) == ("inclination_deg", "speed_m_s", "heading_deg")
+
+
+def test_plots_say_what_they_show(serial_table):
+    """Units in the labels, the fixed parameters in the title, the cells' numbers in the
+    legend, runs deeper than the bumper radius marked."""
+    from quadimpact.sweep.plots import fixed_parameters, plot_metric, plot_type_map
+
+    spec = SweepSpec(base={**BASE, "vehicle_overrides": {"restitution": 0.7}}, grid=SMALL_GRID)
+    fixed = fixed_parameters(spec)
+    assert fixed == ("model paper-replica, controller paper, vehicle spiri, impact speed V_c = "
+                     "0.75 m/s, ground crash, final time = 1 s, restitution = 0.7")  # fmt: skip
+    table = serial_table.copy()
+    table.loc[table.index[0], "bumper_model_valid"] = False
+    fig = plot_metric(table, "inclination_deg", by="heading_deg", title=fixed)
+    ax = fig.axes[0]
+    assert ax.get_xlabel() == "inclination ι (deg)" and ax.get_ylabel() == "δ_init (mm)"
+    labels = [line.get_label() for line in ax.lines]
+    assert labels == ["heading ψ = 0 deg", "heading ψ = 45 deg",
+                      "run deeper than the bumper radius (the bumper model does not hold)"]
+    assert fig.get_suptitle() == fixed
+    fig = plot_type_map(table, "inclination_deg", "heading_deg", title=fixed)
+    names = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert "number: subsequent impacts" in names
+    assert "run deeper than the bumper radius (the bumper model does not hold)" in names
+    assert fig.axes[0].get_ylabel() == "heading ψ (deg)"
+    assert sum(p.get_hatch() == "//" for p in fig.axes[0].patches) == 1

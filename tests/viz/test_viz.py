@@ -360,7 +360,7 @@ def test_commands_write_their_files(run_dir: Path, tmp_path: Path) -> None:
     [
         (("view", "no-such-dir"), "result folder not found"),
         (("snapshots", "{d}", "--times", "0,abc"), "--times"),
-        (("snapshots", "{d}", "--times", "5,6"), "outside the run"),
+        (("snapshots", "{d}", "--times", "5,6"), "snapshot times (5 to 6 s after"),
         (("snapshots", "{d}", "--times", "0", "--paper-figure", "7"), "not both"),
         (("animate", "{d}", "--size", "321x240"), "--size"),
         (("view", "{d}", "--elevation", "95"), "elevation"),
@@ -645,3 +645,55 @@ def test_viewer_shows_the_stage_in_chromium(trial_dir: Path, run_dir: Path, tmp_
     shutil.copytree(run_dir, plain)
     dom = browse(write_viewer(plain).resolve().as_uri() + "#t=0.6", tmp_path, "--dump-dom").stdout
     assert 'data-stage=""' in dom and "stage" not in re.search(r'id="clock">([^<]*)<', dom)[1]
+
+
+# ------------------------------------------------------------------ readable defaults
+@pytest.mark.parametrize(
+    ("camera", "paper_figure"),
+    [
+        ("snapshots", 7),
+        ("snapshots", 8),
+        ("animation", 7),
+        ("viewer", 8),
+    ],
+)
+def test_default_views_read(run_dir: Path, camera: str, paper_figure: int) -> None:
+    """At the default cameras: the wall panel beside the vehicle, cut where it was first
+    touched; bumper numbers and force values inside the frame, never on each other."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from quadimpact.viz.animation import DEFAULT_ANIMATION_CAMERA
+    from quadimpact.viz.snapshots import DEFAULT_SNAPSHOT_CAMERA, PAPER_FIGURE_TIMES
+    from quadimpact.viz.viewer import DEFAULT_VIEWER_CAMERA
+
+    cam = {"snapshots": DEFAULT_SNAPSHOT_CAMERA, "animation": DEFAULT_ANIMATION_CAMERA,
+           "viewer": DEFAULT_VIEWER_CAMERA}[camera]  # fmt: skip
+    sc = Scene.from_dir(run_dir)
+    cut = sc.first_contact_points()["wall"]
+    assert cut[0] == pytest.approx(WALL_D)
+    fig = Figure(figsize=(4, 4))
+    FigureCanvasAgg(fig)
+    art = SceneArtists(fig.add_subplot(), sc, cam)
+    right, _, _ = cam.basis()
+    for tau in PAPER_FIGURE_TIMES[paper_figure]:
+        t = sc.t_ref + tau
+        art.update(t)
+        target = sc.target(t, cam)
+        wall = next(poly for _p, _m, (w, _n), poly, _g in art.planes if w is not None)
+        xs = wall.get_xy()[:, 0]
+        edge = cam.project(cut, target)[0]
+        # one vertical edge of the panel is at the first contact point, the panel on the
+        # side of it away from the vehicle (whose centre projects on the other side)
+        assert min(abs(xs - edge)) < 1e-9
+        centre = cam.project(sc.state_at(t)[0:3], target)[0]
+        assert (xs.mean() - edge) * (centre - edge) < 0
+        labels = np.array([lab.get_position() for lab in art.labels])
+        for x, y in labels:
+            assert abs(x) < art.half_w and abs(y) < art.half_h
+        for txt in art.force_texts:
+            if txt.get_visible() and txt.get_text():
+                x, y = txt.get_position()
+                assert abs(x) < art.half_w and abs(y) < art.half_h
+                gaps = np.hypot(labels[:, 0] - x, labels[:, 1] - y)
+                assert gaps.min() > 0.02 * 2 * art.half_h, (tau, txt.get_text())

@@ -11,7 +11,9 @@
 Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
 commands, so that ``quadimpact --help`` answers at once. Every input problem
 ends the program with one line on stderr, ``quadimpact: error: ...``, and
-exit status 2; set ``QUADIMPACT_DEBUG=1`` to see tracebacks.
+exit status 2; set ``QUADIMPACT_DEBUG=1`` to see tracebacks. ``quadimpact
+run`` exits with status 3 when the run failed numerically (its status is
+``"failed"``).
 """
 
 from __future__ import annotations
@@ -19,6 +21,8 @@ from __future__ import annotations
 import os
 import sys
 import traceback
+import warnings
+from typing import Any
 
 import click
 
@@ -64,6 +68,10 @@ def cli() -> None:
     Frames: inertial NED (X toward the wall, Y right, Z down; altitude = -Z),
     body FRD (x forward, y right, z down). Units: SI, angles in degrees.
 
+    Exit status: 0 success; 1 an unexpected error (one line; set
+    QUADIMPACT_DEBUG=1 for the traceback); 2 bad input (one line naming the
+    flag, file or field); 3 'quadimpact run' of a run that failed numerically.
+
     Start with:  quadimpact run --help
     """
 
@@ -84,12 +92,29 @@ def _fail(message: str, code: int) -> None:
     sys.exit(code)
 
 
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: Any = None,
+    line: str | None = None,
+) -> None:
+    """A Python warning (NumPy, Matplotlib...) as one line, without its source line."""
+    where = f"{os.path.basename(filename)}:{lineno}"
+    click.echo(
+        f"quadimpact: warning: {one_line(str(message))} ({category.__name__} at {where})",
+        err=True,
+    )
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``quadimpact`` command.
 
     Input errors (bad flag, value, file) print one line and exit with status 2;
     unexpected failures print one line and exit with status 1 (set
-    ``QUADIMPACT_DEBUG=1`` for the traceback).
+    ``QUADIMPACT_DEBUG=1`` for the traceback). A Python warning from a library
+    (NumPy, Matplotlib) is printed as one line too, without its source line.
 
     Parameters
     ----------
@@ -97,6 +122,8 @@ def main(argv: list[str] | None = None) -> None:
         Arguments; default ``sys.argv[1:]``.
     """
     debug = os.environ.get("QUADIMPACT_DEBUG", "") not in ("", "0")
+    if not debug:
+        warnings.showwarning = _show_warning
     try:
         code = cli.main(args=argv, prog_name="quadimpact", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as exc:

@@ -6,7 +6,13 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import data_option, defaulted_option, out_option, parallel_options
+from quadimpact.cli.options import (
+    announce_compilation,
+    data_option,
+    defaulted_option,
+    out_option,
+    parallel_options,
+)
 
 
 @click.command("experiments")
@@ -15,8 +21,9 @@ from quadimpact.cli.options import data_option, defaulted_option, out_option, pa
     "Output folder: table3.csv, one folder per crash, the sensitivity sweeps.",
 )
 @data_option(
-    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat) "
-    "[default: $QUADIMPACT_DATA, else ../shared/data beside the project]."
+    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
+    "must hold the logs [default: $QUADIMPACT_DATA, else ../shared/data beside the "
+    "project; without them the comparisons with the logs are left out]."
 )
 @defaulted_option(
     "--samples",
@@ -50,14 +57,19 @@ def experiments(
     the crash is run again at the log's own pre-impact estimates (speed,
     heading, roll, pitch) and over their uncertainty.
     """
-    from quadimpact.experiments.table3 import run_experiments
+    from quadimpact.experiments.table3 import check_data_dir, run_experiments
+    from quadimpact.results.files import check_out_dir
 
+    check_out_dir(out, "experiments")
+    if data is not None:
+        check_data_dir(data)
+    announce_compilation()
     table = run_experiments(
         out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
         scheduler=scheduler, progress=not no_progress,
     )  # fmt: skip
     cols = ["crash", "type_paper_experiment", "type_paper_simulation", "type_ours", "type_replica",
-            "attitude_rms_deg_0_3s", "type_log", "type_log_conditions"]  # fmt: skip
+            "attitude_rms_deg_0_3s", "type_log", "type_log_conditions", "verdict"]  # fmt: skip
     shown = table[cols].rename(
         columns={"type_paper_experiment": "experiment", "type_paper_simulation": "paper_sim",
                  "type_ours": "ours", "type_replica": "replica", "type_log": "log",

@@ -2,15 +2,34 @@
 
 from __future__ import annotations
 
+import functools
+import math
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import click
 
+from quadimpact.errors import InputError, format_value
+
 
 def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
-    """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``."""
+    """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``.
+
+    Both are checked before the command starts any work: ``--workers`` and
+    ``--scheduler`` together are refused, and a scheduler address must be
+    ``SCHEME://HOST:PORT``; a ``tcp://`` one must accept a connection.
+    """
+
+    @functools.wraps(command)
+    def checked(*args: Any, **kwargs: Any) -> Any:
+        scheduler = kwargs.get("scheduler")
+        if scheduler is not None:
+            if kwargs.get("workers") is not None:
+                raise InputError("--workers and --scheduler: give one or the other")
+            check_scheduler(scheduler)
+        return command(*args, **kwargs)
+
     options = [
         click.option(
             "--workers",
@@ -27,17 +46,104 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
         ),
         click.option("--no-progress", is_flag=True, help="Do not show the progress bar."),
     ]
+    wrapped: Callable[..., Any] = checked
     for option in reversed(options):
-        command = option(command)
-    return command
+        wrapped = option(wrapped)
+    return wrapped
+
+
+#: What a first run takes to compile the simulator (measured on 2 cores: 40 s of CPU).
+COMPILE_SECONDS = 40
+
+
+def announce_compilation() -> None:
+    """Say on stderr, before a first run, that the simulator is being compiled.
+
+    On a fresh checkout (or after its sources changed) Numba's cache is cold and
+    the first simulation compiles the loop: tens of seconds of silence otherwise.
+    """
+    from quadimpact.core import cache_is_warm
+
+    if not cache_is_warm():
+        click.echo(
+            f"quadimpact: compiling the simulator (first run only, about {COMPILE_SECONDS} s) ...",
+            err=True,
+        )
+
+
+def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
+    """Refuse a Dask scheduler address that is malformed or (``tcp://``) not listening.
+
+    Raises
+    ------
+    InputError
+        One line naming ``--scheduler`` and what is wrong.
+    """
+    import socket
+    from urllib.parse import urlsplit
+
+    form = "must be an address like tcp://HOST:PORT"
+    try:
+        parts = urlsplit(address)
+        port = parts.port
+    except ValueError:
+        parts, port = None, None
+    if parts is None or not parts.scheme or not parts.hostname or port is None:
+        raise InputError(f"--scheduler: {form} (got {format_value(address)})")
+    if parts.scheme != "tcp":
+        return
+    try:
+        socket.create_connection((parts.hostname, port), timeout=timeout_s).close()
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise InputError(
+            f"--scheduler {address}: no Dask scheduler answers there ({reason})"
+        ) from None
 
 
 Decorator = Callable[[Callable[..., Any]], Callable[..., Any]]
 
 
-def number_option(flag: str, metavar: str | None, help: str, type: Any = float) -> Decorator:
-    """``FLAG NUMBER`` without a default: ``None`` when not given (the help says the default)."""
-    return click.option(flag, type=type, metavar=metavar, help=help)
+class FiniteFloat(click.FloatRange):
+    """A number that must be finite (``nan`` and ``inf`` refused), optionally in a range.
+
+    Parameters are those of :class:`click.FloatRange` (no range by default).
+    Every numeric flag of the commands takes this type, so that no NaN reaches
+    a camera, a clock or a scenario.
+    """
+
+    name = "number"
+
+    def convert(self, value: Any, param: click.Parameter | None, ctx: click.Context | None) -> Any:
+        number = super().convert(value, param, ctx)  # the range check (NaN passes it)
+        if not math.isfinite(number):
+            self.fail(f"{format_value(str(value))} is not a finite number", param, ctx)
+        return number
+
+    def _describe_range(self) -> str:
+        """The range shown in ``--help`` (nothing without one)."""
+        if self.min is None and self.max is None:
+            return ""
+        return super()._describe_range()
+
+    def __repr__(self) -> str:
+        return "FiniteFloat" if self.min is None and self.max is None else super().__repr__()
+
+
+FINITE = FiniteFloat()
+
+
+def number_option(
+    flag: str, metavar: str | None, help: str, type: Any = FINITE, *, alias: str | None = None
+) -> Decorator:
+    """``FLAG NUMBER`` without a default: ``None`` when not given (the help says the default).
+
+    ``alias``: a second name of the flag (``--heading-deg`` beside ``--heading``);
+    the value keeps the name of ``flag``.
+    """
+    name = flag.lstrip("-").replace("-", "_")
+    decls = (flag, alias, name) if alias else (flag, name)
+    return click.option(*decls, type=type, metavar=metavar, help=help)
 
 
 def defaulted_option(flag: str, type: Any, default: Any, help: str) -> Decorator:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import data_option, out_option, parallel_options
+from quadimpact.cli.options import announce_compilation, data_option, out_option, parallel_options
 
 
 @click.command("reproduce")
@@ -52,7 +52,14 @@ def reproduce(
     variant), the Figure 4 grid and the seven crashes without power-off,
     nominal against recovery (docs/RECOVERY.md).
     """
+    from quadimpact.experiments.table3 import check_data_dir
     from quadimpact.paper.study import reproduce as run_study
+    from quadimpact.results.files import check_out_dir
+
+    check_out_dir(out, "report")
+    if data is not None and not no_experiments:
+        check_data_dir(data)
+    announce_compilation()
 
     result = run_study(
         out, workers=workers, scheduler=scheduler, progress=not no_progress,

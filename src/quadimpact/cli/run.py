@@ -9,10 +9,17 @@ from typing import Any
 
 import click
 
-from quadimpact.cli.options import CONTROLLER, MODEL, file_argument, number_option, out_option
+from quadimpact.cli.options import (
+    CONTROLLER,
+    MODEL,
+    announce_compilation,
+    file_argument,
+    number_option,
+    out_option,
+)
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
-__all__ = ["build_scenario", "format_summary", "run"]
+__all__ = ["EXIT_RUN_FAILED", "build_scenario", "format_summary", "run"]
 
 # click parameter name -> (scenario field, flag as typed)
 _FLAGS: dict[str, tuple[str, str]] = {
@@ -41,40 +48,49 @@ _WALL_ONLY = {
     "wall_distance_m",
     "altitude_m",
 }
+#: Exit status of a run whose status is "failed" (numerical failure; see ``run --help``).
+EXIT_RUN_FAILED = 3
 _OUTPUT_FILES = (
     "summary.json, scenario.json, timeseries.parquet, episodes.csv, imu.parquet, fig5.png, "
     "fig6.png, imu.png"
 )
 
 
+def _flag(flag: str, metavar: str | None, help: str) -> Any:
+    """A number flag of ``run``, also under its scenario file key (``--heading-deg``)."""
+    field = next(f for f, typed in _FLAGS.values() if typed == flag)
+    alias = "--" + field.replace("_", "-")
+    return number_option(flag, metavar, help, alias=None if alias == flag else alias)
+
+
 @click.command("run")
 @file_argument("scenario", "[SCENARIO.toml]")
-@number_option(
+@_flag(
     "--heading",
     "DEG",
     "Yaw relative to the wall normal, deg in [-360, 360]; 0 points the nose at the "
     "wall (bumpers 1 and 4 lead). [default: 0]",
 )
-@number_option(
+@_flag(
     "--inclination",
     "DEG",
     "Tilt of the body z axis toward the wall, in the vertical plane through the wall "
     "normal, deg in [-60, 60]. [default: 0]",
 )
-@number_option(
+@_flag(
     "--speed",
     "M/S",
     "Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
     "[default: 0.75]",
 )
-@number_option(
+@_flag(
     "--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]"
 )
-@number_option("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
-@number_option(
+@_flag("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
+@_flag(
     "--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]"
 )
-@number_option("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
+@_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--model",
     type=MODEL,
@@ -111,24 +127,29 @@ _OUTPUT_FILES = (
     help="'ideal': commanded rotor speeds apply at once (the paper); 'first-order': "
     "motor lag with the vehicle's time constant. [default: ideal]",
 )
-@number_option(
+@_flag(
     "--friction", "MU", "Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). "
     "[default: 0]"
 )
 @click.option(
     "--ground",
     type=click.Choice(["crash", "contact", "none"]),
-    help="'crash': reaching the ground ends the run; 'contact': the ground is a contact "
-    "surface; 'none': no ground. [default: crash]",
+    help="'crash': the CM reaching the ground ends the run; 'contact': the ground is a "
+    "contact surface for the bumper rims only (the body passes through it: docs/MODEL.md "
+    "4.9); 'none': no ground. [default: crash]",
 )
-@number_option(
+@_flag(
     "--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]"
 )
-@number_option(
+@_flag(
     "--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]"
 )
-@number_option("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
-@out_option("results/run", "Output folder (created if needed).")
+@_flag("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
+@out_option(
+    "results/run",
+    "Output folder (created if needed). A folder holding an earlier run is replaced: its "
+    "files and the pictures drawn from it go; one holding anything else is refused.",
+)
 @click.option(
     "--viz",
     is_flag=True,
@@ -139,6 +160,9 @@ def run(
     scenario: Path | None, out: Path, options: tuple[str, ...], viz: bool, **flags: Any
 ) -> None:
     """Simulate one scenario and write its results to --out.
+
+    Every flag is also named by its scenario file key (--heading-deg for
+    heading_deg, --friction-coefficient for friction_coefficient...).
 
     Without SCENARIO.toml this is the paper's wall approach: the Spiri holds
     the given heading, inclination and altitude and is started so that its
@@ -155,22 +179,41 @@ def run(
 
     Writes summary.json, scenario.json (the world that ran), timeseries.parquet,
     episodes.csv, imu.parquet and the figures.
+
+    \b
+    Exit status:
+      0  the run completed or crashed (a simulated crash is a result)
+      1  an unexpected error, or the result folder could not be written
+      2  bad input (flag, file, value); nothing was simulated
+      3  the run failed numerically (status "failed", e.g. the state became
+         NaN); its folder is still written, with the reason in summary.json
     """
+    from quadimpact.results.files import check_out_dir
+
     built = build_scenario(scenario, flags, options)
+    check_out_dir(out, "run")
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
+    announce_compilation()
 
     from quadimpact.simulation import simulate
 
     result = simulate(built)
-    out.mkdir(parents=True, exist_ok=True)
-    result.write(out)
+    try:
+        result.write(out)
+    except OSError as exc:
+        raise click.ClickException(
+            f"{out}: the result folder could not be written ({exc.strerror or exc}); "
+            "nothing was changed there"
+        ) from None
     click.echo(format_summary(result.summary, out))
     if viz:
         from quadimpact.cli.viz import make_all
 
         for path in make_all(out, result):
             click.echo(f"picture        {path}")
+    if result.summary.get("status") == "failed":
+        click.get_current_context().exit(EXIT_RUN_FAILED)
 
 
 def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
@@ -282,6 +325,25 @@ def _fmt(value: Any, scale: float = 1.0, unit: str = "", digits: int = 4) -> str
     return str(value)
 
 
+def _recovery_lines(summary: Mapping[str, Any]) -> list[str]:
+    """Detection and stage 4 of a recovery run, for people."""
+    t_detect = summary.get("t_detect_s")
+    if t_detect is None:
+        detected = "no detection"
+    else:
+        latency = summary.get("detection_latency_s")
+        detected = f"at {_fmt(t_detect, unit='s')}"
+        if summary.get("false_detection"):
+            detected += " (before any contact: a false detection)"
+        elif latency is not None:
+            detected += f" ({_fmt(latency, 1000.0, 'ms', 3)} after the first contact)"
+    t4 = summary.get("t_stage4_s")
+    recovered = "stage 4 not reached" if t4 is None else f"stage 4 at {_fmt(t4, unit='s')}"
+    if t4 is not None and summary.get("time_to_recover_s") is not None:
+        recovered += f" ({_fmt(summary['time_to_recover_s'], unit='s')} after the detection)"
+    return [f"detection      {detected}", f"recovered      {recovered}"]
+
+
 def format_summary(summary: Mapping[str, Any], out: Path) -> str:
     """The short human summary printed after a run.
 
@@ -308,9 +370,12 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         f"delta_init     {_fmt(summary.get('delta_init_m'), 1000.0, 'mm')}",
         f"peak force     {_fmt(summary.get('peak_force_n'), unit='N')}",
         f"leading bumper {leading if leading is not None else 'n/a'}",
+        f"response type  {summary.get('response_type') or 'n/a'}",
         f"episodes       {_fmt(summary.get('n_episodes'))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]
+    if summary.get("controller") == "recovery":
+        lines += _recovery_lines(summary)
     for warning in summary.get("warnings") or []:
         lines.append(f"warning        {one_line(str(warning))}")
     lines.append(f"output         {out} ({_OUTPUT_FILES})")

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import file_argument, parallel_options
+from quadimpact.cli.options import announce_compilation, file_argument, parallel_options
 from quadimpact.errors import InputError
 
 __all__ = ["sweep"]
@@ -127,6 +127,7 @@ def sweep(
         spec = SweepSpec(grid=extra, where="sweep")
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
+    announce_compilation()
     # once stopped by a signal, every later one is ignored until the program has ended
     with stop_signals(restore_after_stop=False):
         try:
@@ -172,7 +173,7 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
     import pyarrow.parquet as pq
 
     path = out / "runs.parquet"
-    t = pq.read_table(path, columns=["status", "response_type"]).to_pandas()
+    t = pq.read_table(path, columns=["status", "response_type", "bumper_model_valid"]).to_pandas()
     n = len(t)
     status = t["status"].value_counts()
     types = t["response_type"].value_counts()
@@ -186,7 +187,8 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
         resumed = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
         ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{resumed}"
     lines = [
-        f"runs    {n} ({int(status.get('failed', 0))} failed; {ran})",
+        f"runs    {n} ({int(status.get('failed', 0))} failed, "
+        f"{int(t['bumper_model_valid'].eq(False).sum())} deeper than the bumper radius; {ran})",
         f"status  {status_text}",
         f"types   {type_text}",
         f"table   {path}",

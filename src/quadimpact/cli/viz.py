@@ -18,6 +18,7 @@ from typing import Any
 import click
 
 from quadimpact.cli.options import (
+    FiniteFloat,
     defaulted_option,
     number_option,
     result_dir_argument,
@@ -87,6 +88,7 @@ def _camera(
 def _scene(result_dir: Path, vehicle: str | None) -> Any:
     """The scene of a result folder, with input errors as one line."""
     from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET
+    from quadimpact.results.result import read_result
     from quadimpact.viz.scene import Scene
 
     if not result_dir.is_dir():
@@ -99,8 +101,9 @@ def _scene(result_dir: Path, vehicle: str | None) -> Any:
         from quadimpact.inputs.vehicle import load_vehicle
 
         veh = load_vehicle(vehicle)
+    result = read_result(result_dir)  # a file that cannot be read: one line naming it
     try:
-        return Scene.from_dir(result_dir, vehicle=veh)
+        return Scene.from_result(result, vehicle=veh)
     except InputError as exc:
         raise InputError(f"{exc} (pass --vehicle with the run's vehicle file)") from None
     except ValueError as exc:
@@ -146,11 +149,11 @@ def _parse_size(text: str) -> tuple[int, int]:
 @click.command("animate")
 @result_dir_argument
 @defaulted_option(
-    "--fps", click.FloatRange(min=1, max=240), 30.0, "Frames per second of the movie."
+    "--fps", FiniteFloat(min=1, max=240), 30.0, "Frames per second of the movie."
 )
 @defaulted_option(
     "--slow",
-    click.FloatRange(min=0.01, max=1000),
+    FiniteFloat(min=0.01, max=1000),
     1.0,
     "Slow-down factor: 1 = real time, 4 = four times slower.",
 )
@@ -266,7 +269,7 @@ def snapshots(
 @result_dir_argument
 @defaulted_option(
     "--rate",
-    click.FloatRange(min=1, max=10000),
+    FiniteFloat(min=1, max=10000),
     250.0,
     "Frames per simulated second in the page.",
 )

@@ -22,7 +22,8 @@ Numba's on-disk cache checks only the file of each cached function, not the
 files of the functions it calls and inlines: an edited ``controllers/paper.py``
 would leave ``run.py``'s cached loop stale. ``ensure_fresh_cache`` (run on import)
 keeps a hash of all the core sources next to the cache and clears the core's
-cache files when it changes.
+cache files when it changes. ``cache_is_warm`` says whether a first run will
+compile (the command line announces it).
 """
 
 from __future__ import annotations
@@ -35,14 +36,30 @@ _HERE = Path(__file__).resolve().parent
 _STAMP = "quadimpact-core-sources.sha256"
 
 
-def _cache_dirs() -> list[Path]:
-    packages = [_HERE] + sorted(p.parent for p in _HERE.rglob("__init__.py") if p.parent != _HERE)
-    dirs = [p / "__pycache__" for p in packages]
+def _numba_dir(package: Path) -> Path:
+    """Where Numba caches the functions of one source folder.
+
+    ``<folder>/__pycache__``; with ``NUMBA_CACHE_DIR``, the folder Numba names
+    there: ``<name>_<sha1 of the folder's absolute path>``.
+    """
     custom = os.environ.get("NUMBA_CACHE_DIR")
     if custom:
-        # Numba mirrors the source folder's absolute path below NUMBA_CACHE_DIR
-        dirs += [Path(custom) / p.relative_to(p.anchor) for p in packages]
-    return dirs
+        digest = hashlib.sha1(os.path.abspath(package).encode()).hexdigest()
+        return Path(custom) / f"{package.name}_{digest}"
+    return package / "__pycache__"
+
+
+def _cache_dirs() -> list[Path]:
+    packages = [_HERE] + sorted(p.parent for p in _HERE.rglob("__init__.py") if p.parent != _HERE)
+    return [_numba_dir(p) for p in packages]
+
+
+def cache_is_warm() -> bool:
+    """Whether the compiled loop is in Numba's on-disk cache (else the first run compiles it).
+
+    Cheap: looks for the index file of ``run.run_builtin`` (no Numba import).
+    """
+    return any(_numba_dir(_HERE).glob("run.run_builtin-*.nbi"))
 
 
 def ensure_fresh_cache() -> None:

@@ -10,7 +10,7 @@ and largest absolute error per quantity and per group:
 group     quantities                                       unit
 ========  ===============================================  =====
 position  X, Y, altitude: displacement since the impact    m
-attitude  roll, pitch, yaw (differences wrapped to +-180)  deg
+attitude  roll, pitch, yaw (unwrapped, see below)        deg
 rates     body rates p, q, r                               rad/s
 motors    rotor speeds 1-4 (log samples with the motor on) rad/s
 ========  ===============================================  =====
@@ -18,6 +18,15 @@ motors    rotor speeds 1-4 (log samples with the motor on) rad/s
 Positions are compared as displacements from each one's own position at the
 impact (``relative_position=True``): the log's motion-capture origin and the
 simulated wall distance and altitude differ by construction.
+
+Roll and yaw are unwrapped on both sides (continuous through +-180 deg), and
+the log's are moved by whole turns onto the simulation's branch at the
+impact: a yaw of -175 deg against a logged +175 deg is 10 deg apart, not 350,
+in the errors and in the plot. The errors are the differences of the
+unwrapped angles (not wrapped again), so two motions that turn apart by more
+than half a turn show it. Near 90 deg of pitch roll and yaw themselves jump
+by 180 deg (the Euler angles' singularity); the ``rotation`` error (the angle
+between the two attitudes) has no such jumps.
 
 :func:`log_response` classifies the log's response type (docs/STUDIES.md section
 3) from the log's own motion, where the motion capture allows it, and says
@@ -39,7 +48,7 @@ import pandas as pd
 
 from quadimpact.experiments.estimation import MOCAP_GAP_S, bumper_rim_extent
 from quadimpact.experiments.logs import FlightLog, PreImpact
-from quadimpact.rotations import quat_to_matrix, wrap_angle_deg
+from quadimpact.rotations import quat_to_matrix, unwrap_deg, wrap_angle_deg
 from quadimpact.simulation.metrics import classify_response
 
 __all__ = [
@@ -301,9 +310,43 @@ class Comparison:
             raise KeyError((group, quantity, window_s))
         return float(row[stat].iloc[0])
 
+    def departures(self, window_s: float = 0.3) -> dict[str, tuple[float, float]]:
+        """How far each Euler angle moved after the impact, in the run and in the log.
+
+        Parameters
+        ----------
+        window_s : float
+            The window ``[0, window_s]`` after the impact.
+
+        Returns
+        -------
+        dict
+            ``{"roll": (sim, log), "pitch": ..., "yaw": ...}``, deg: the signed
+            largest departure from the value at the impact (roll and yaw
+            unwrapped), each on its own samples; nan where a side has none.
+        """
+        out = {}
+        for name, col, _ in GROUPS["attitude"][1]:
+            pair = []
+            for table in (self.sim, self.log_pose):
+                if col not in table:
+                    pair.append(math.nan)
+                    continue
+                tau, y = table["tau_s"].to_numpy(), table[col].to_numpy(dtype=float)
+                ok = np.isfinite(y)
+                inside = ok & (tau >= 0.0) & (tau <= window_s)
+                if not inside.any():
+                    pair.append(math.nan)
+                    continue
+                y0 = float(np.interp(0.0, tau[ok], y[ok]))
+                d = y[inside] - y0
+                pair.append(float(d[int(np.argmax(np.abs(d)))]))
+            out[name] = (pair[0], pair[1])
+        return out
+
     def plot(self, path: str | os.PathLike[str], title: str | None = None) -> Path:
         """Side-by-side panels (sim lines, log markers) written as a PNG; returns the path."""
-        from quadimpact.results.figures import break_wraps, new_figure, save_figure
+        from quadimpact.results.figures import new_figure, save_figure
 
         fig = new_figure(15, 13)
         axes = fig.subplots(4, 3)
@@ -312,22 +355,19 @@ class Comparison:
         panels = [
             ("x_m", "X - X(impact) (m)"), ("y_m", "Y - Y(impact) (m)"),
             ("altitude_m", "altitude - at impact (m)"),
-            ("roll_deg", "roll (deg)"), ("pitch_deg", "pitch (deg)"), ("yaw_deg", "yaw (deg)"),
+            ("roll_deg", "roll, unwrapped (deg)"), ("pitch_deg", "pitch (deg)"),
+            ("yaw_deg", "yaw, unwrapped (deg)"),
             ("p_rad_s", "p (rad/s)"), ("q_rad_s", "q (rad/s)"), ("r_rad_s", "r (rad/s)"),
         ]  # fmt: skip
         sim = self.sim[(self.sim.tau_s >= tmin) & (self.sim.tau_s <= tmax)]
         lp = self.log_pose[(self.log_pose.tau_s >= tmin) & (self.log_pose.tau_s <= tmax)]
         lm = self.log_motors[(self.log_motors.tau_s >= tmin) & (self.log_motors.tau_s <= tmax)]
         for ax, (col, label) in zip(axes.flat[:9], panels, strict=True):
-            wrapped = col in ("roll_deg", "yaw_deg")
+            # roll and yaw: both unwrapped, the log on the simulation's branch (compare())
             if col in sim:
-                x, y = sim.tau_s.to_numpy(), sim[col].to_numpy()
-                if wrapped:
-                    x, y = break_wraps(x, wrap_angle_deg(y))
-                ax.plot(x, y, "-", color="tab:blue", lw=1.2, label="simulation")
+                ax.plot(sim.tau_s, sim[col], "-", color="tab:blue", lw=1.2, label="simulation")
             if col in lp:
-                y = wrap_angle_deg(lp[col].to_numpy()) if wrapped else lp[col]
-                ax.plot(lp.tau_s, y, "o", color="tab:red", ms=3, label="log")
+                ax.plot(lp.tau_s, lp[col], "o", color="tab:red", ms=3, label="log")
             ax.set_ylabel(label)
         colors = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
         for ax, motors in zip(axes.flat[9:11], ((1, 2), (3, 4)), strict=True):
@@ -404,8 +444,9 @@ def compare(
     -------
     Comparison
         Errors: the simulation interpolated linearly onto the log's samples
-        with ``0 <= tau <= w`` (angles unwrapped before interpolating, angle
-        differences wrapped to +-180 deg); samples where either side is nan
+        with ``0 <= tau <= w`` (roll and yaw unwrapped on both sides, the
+        log's on the simulation's branch at the impact, differences not
+        wrapped: the module docstring); samples where either side is nan
         (log tracking gaps, powered-off motors, outside the run) are left out
         and counted in ``n`` only when used.
     """
@@ -423,7 +464,7 @@ def compare(
         for _, col, wrapped in quantities:
             if col in ts:
                 v = ts[col].to_numpy(dtype=float)
-                sim[col] = np.degrees(np.unwrap(np.radians(v))) if wrapped else v
+                sim[col] = unwrap_deg(v) if wrapped else v
     quats = ["q0", "q1", "q2", "q3"]
     for c in quats:
         if c in ts:
@@ -441,6 +482,10 @@ def compare(
                 "rear-first and the run front-first (or the reverse); read the log with "
                 "front_first=True to compare like with like"
             )
+    for _, col, wrapped in GROUPS["attitude"][1]:
+        if wrapped and col in sim and col in pose and len(pose):
+            pose[col] = _unwrap_onto(pose["tau_s"].to_numpy(), pose[col].to_numpy(dtype=float),
+                                     float(np.interp(0.0, sim["tau_s"], sim[col])))  # fmt: skip
     motors = log.motors().copy()
     motors.insert(0, "tau_s", motors["t_s"].to_numpy(dtype=float) - t_log0)
 
@@ -464,15 +509,13 @@ def compare(
             src = motors if group == "motors" else pose
             sel = src[(src["tau_s"] >= 0.0) & (src["tau_s"] <= w)]
             all_err: list[np.ndarray] = []
-            for qname, col, wrapped in quantities:
+            for qname, col, _wrapped in quantities:
                 if col not in sel or col not in sim:
                     continue
                 y_log = sel[col].to_numpy(dtype=float)
                 y_sim = np.interp(sel["tau_s"].to_numpy(), sim["tau_s"], sim[col],
                                   left=np.nan, right=np.nan)  # fmt: skip
-                err = y_sim - y_log
-                if wrapped:
-                    err = wrap_angle_deg(err)
+                err = y_sim - y_log  # roll, yaw: both unwrapped, on the same branch
                 err = err[np.isfinite(err)]
                 all_err.append(err)
                 rows.append(_row(group, qname, unit, w, err))
@@ -496,6 +539,19 @@ def compare(
         log_response=resp,
         notes=notes,
     )
+
+
+def _unwrap_onto(tau: np.ndarray, angle_deg: np.ndarray, reference_deg: float) -> np.ndarray:
+    """A logged angle unwrapped (its finite samples), moved by whole turns near ``reference_deg``
+    at the impact (``tau = 0``)."""
+    out = unwrap_deg(angle_deg)
+    ok = np.isfinite(out)
+    if not ok.any():
+        return out
+    at_impact = out[ok][int(np.argmin(np.abs(tau[ok])))]
+    if math.isfinite(reference_deg):
+        out[ok] += 360.0 * round((reference_deg - at_impact) / 360.0)
+    return out
 
 
 def _rotation_error(sim: pd.DataFrame, sel: pd.DataFrame) -> np.ndarray:

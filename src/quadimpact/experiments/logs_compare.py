@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from quadimpact.experiments.compare import compare
+from quadimpact.experiments.compare import Comparison, compare
 from quadimpact.experiments.crashes import Crash
 from quadimpact.experiments.logs import FlightLog
 from quadimpact.results.result import SimulationResult
@@ -14,20 +14,34 @@ COMPARE_PNG = "compare.png"
 COMPARE_CSV = "compare.csv"
 
 
-def attitude_rms_for_crash(
+def compare_crash(
     crash: Crash, result: SimulationResult, log: FlightLog | None, folder: Path
-) -> float:
-    """RMS attitude error (deg) over the first 0.3 s after impact, NaN without the log.
+) -> Comparison | None:
+    """The run against its log (None without the log); table and plot written into ``folder``.
 
-    The error is the angle of the rotation between the simulated and the logged
-    attitude (free of the Euler angles' singularity near 90 deg of pitch). The
-    comparison table and plot are written into ``folder``. The scenarios fly
-    rear first as the real vehicle did, so the log is read in its own frame.
+    The scenarios fly rear first as the real vehicle did, so the log is read
+    in its own frame.
     """
     if log is None:
-        return math.nan
+        return None
     comparison = compare(result, log)
     folder.mkdir(parents=True, exist_ok=True)
     comparison.table().to_csv(folder / COMPARE_CSV, index=False)
     comparison.plot(folder / COMPARE_PNG, title=f"Crash {crash.number}: simulation vs log")
-    return comparison.error("attitude", 0.3, "rotation")
+    return comparison
+
+
+def attitude_rms(comparison: Comparison | None) -> float:
+    """RMS attitude error (deg) over the first 0.3 s after impact, NaN without the log.
+
+    The error is the angle of the rotation between the simulated and the logged
+    attitude (free of the Euler angles' singularity near 90 deg of pitch).
+    """
+    return math.nan if comparison is None else comparison.error("attitude", 0.3, "rotation")
+
+
+def attitude_rms_for_crash(
+    crash: Crash, result: SimulationResult, log: FlightLog | None, folder: Path
+) -> float:
+    """:func:`attitude_rms` of :func:`compare_crash` (table and plot written into ``folder``)."""
+    return attitude_rms(compare_crash(crash, result, log, folder))

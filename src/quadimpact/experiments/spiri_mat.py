@@ -148,6 +148,11 @@ class SpiriMatLog(FlightLog):
         Motion-capture minus on-board clock, used only when neither the
         contact nor the wall extrapolation is available.
 
+    Raises
+    ------
+    InputError
+        The file is not a MATLAB file of the set's layout (one line naming it).
+
     Notes
     -----
     Reference clock: the on-board one (accel, gyros, angles, motors, cmd are
@@ -171,8 +176,16 @@ class SpiriMatLog(FlightLog):
         self.front_first = bool(front_first)
         self._wall_x_default = float(wall_x_m)
         self._offset_default = float(mocap_clock_offset_s)
-        self._mat = loadmat(self.path, squeeze_me=True)
-        self._raw = self._read_raw()
+        try:
+            self._mat = loadmat(self.path, squeeze_me=True)
+            self._raw = self._read_raw()
+        except Exception as exc:  # scipy's MatReadError, a missing or malformed variable...
+            from quadimpact.errors import InputError, one_line
+
+            raise InputError(
+                f"{self.path}: not a readable crash log of the set ({type(exc).__name__}: "
+                f"{one_line(str(exc))})"
+            ) from None
         self._impact, self._impact_bracket, self._power_off = find_impact(
             self._raw.get("accel"), self._raw.get("motors"), self.path.name
         )

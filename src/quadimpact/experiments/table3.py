@@ -23,6 +23,7 @@ files and the comparison plots) and the sensitivity sweeps (resumable).
 from __future__ import annotations
 
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -76,10 +77,36 @@ LOG_COLUMNS = (
     "attitude_rms_log_conditions_deg_0_3s",
     "log_max_penetration_mm",
 )
+#: How each Euler angle moved in the first 0.3 s after the impact (signed largest
+#: departure from its value at the impact, deg; roll and yaw unwrapped), in our
+#: nominal run (default model) and in the log: where the motions differ.
+MOTION_COLUMNS = tuple(
+    f"{side}_{angle}_change_deg_0_3s"
+    for angle in ("roll", "pitch", "yaw")
+    for side in ("sim", "log")
+)
+#: The row's verdict (``agrees``, ``partly``, ``disagrees``: :func:`crash_verdict`) and why.
+VERDICT_COLUMNS = ("verdict", "verdict_reason")
 #: Columns of ``table3.csv`` after ``TABLE3_COLUMNS``: the deepest bumper
 #: deflection of our nominal run (default model, mm; beyond the bumper radius,
-#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``.
-EXTRA_COLUMNS = ("max_penetration_mm", *LOG_COLUMNS)
+#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``, ``MOTION_COLUMNS``
+#: and ``VERDICT_COLUMNS``.
+EXTRA_COLUMNS = ("max_penetration_mm", *LOG_COLUMNS, *MOTION_COLUMNS, *VERDICT_COLUMNS)
+#: A run matches the crash in motion when its attitude error against the log over
+#: the first 0.3 s (RMS of the rotation angle) is at most this, deg.
+MOTION_RMS_DEG = 20.0
+#: A different type at the nominal conditions is ``partly`` when the experiment's
+#: type occurs in at least this share of the runs over the stated uncertainty.
+TYPE_SHARE_PARTLY = 0.2
+#: The rule of :func:`crash_verdict`, as the report states it.
+VERDICT_RULE = (
+    f"agrees: ours (default) has the experiment's type and its attitude error against the "
+    f"log over the first 0.3 s is at most {MOTION_RMS_DEG:g}° RMS (or there is no log); "
+    f"partly: the same type with a larger attitude error (the type matches, the motion "
+    f"does not), or another type at the nominal conditions while the experiment's occurs in "
+    f"at least {TYPE_SHARE_PARTLY:.0%} of the runs over the stated uncertainty; disagrees: "
+    "otherwise"
+)
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
@@ -106,6 +133,95 @@ def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
     """Share of each response type among a sweep's runs, as ``{prefix + type: share}``."""
     counts = sweep["response_type"].value_counts()
     return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
+
+
+def crash_verdict(row: Any) -> tuple[str, str]:
+    """Our nominal run against the experiment, for one row of Table III (:data:`VERDICT_RULE`).
+
+    Parameters
+    ----------
+    row : mapping
+        A row of the table (``type_ours``, ``type_paper_experiment``,
+        ``attitude_rms_deg_0_3s``, ``share_<type>``).
+
+    Returns
+    -------
+    (str, str)
+        The verdict and its reason, with the measure and the threshold.
+    """
+    ours, exp = row["type_ours"], row["type_paper_experiment"]
+    rms = float(row["attitude_rms_deg_0_3s"])
+    if ours == exp:
+        if math.isnan(rms):
+            return "agrees", f"type {ours} (no log to compare the motion with)"
+        if rms <= MOTION_RMS_DEG:
+            return "agrees", f"type {ours}; attitude RMS {rms:.1f}° ≤ {MOTION_RMS_DEG:g}°"
+        return "partly", (
+            f"type {ours}, but not the motion: attitude RMS {rms:.1f}° > {MOTION_RMS_DEG:g}°"
+        )
+    share = float(row.get(f"share_{exp}", math.nan))
+    if math.isnan(share):
+        return "disagrees", f"type {ours}, not {exp} (no runs over the uncertainty)"
+    seen = f"type {ours}, not {exp}; {exp} in {share:.0%} of the runs over the uncertainty"
+    if share >= TYPE_SHARE_PARTLY:
+        return "partly", f"{seen} (≥ {TYPE_SHARE_PARTLY:.0%})"
+    return "disagrees", f"{seen} (< {TYPE_SHARE_PARTLY:.0%})"
+
+
+def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | None:
+    """The data folder to read the logs from, checked before any work.
+
+    Parameters
+    ----------
+    data : path or None
+        A folder given explicitly (``--data``): it must hold at least one of
+        the seven crashes' logs, else this is an input error. ``None``: the
+        default folder (:func:`quadimpact.experiments.logs.data_dir`), if any;
+        a ``$QUADIMPACT_DATA`` that holds no logs is said in a warning on
+        stderr (the log columns then stay empty).
+    where : str
+        How the folder was given, for the message.
+
+    Returns
+    -------
+    pathlib.Path or None
+        The folder holding ``spiri-crash-set-1/`` (None: no logs).
+
+    Raises
+    ------
+    InputError
+        A given folder that is absent, is a file or holds none of the logs.
+    """
+    import os
+
+    from quadimpact.errors import InputError
+    from quadimpact.experiments.logs import DATA_ENV_VAR
+
+    logs = [c.log_file for c in TABLE3]
+    if data is None:
+        found = data_dir()
+        env = os.environ.get(DATA_ENV_VAR)
+        if found is None and env:
+            print(f"quadimpact: warning: ${DATA_ENV_VAR}={env} holds none of the crash logs "
+                  f"({logs[0]}, ...): the comparisons with the logs are left out",
+                  file=sys.stderr)  # fmt: skip
+        return found
+    root = Path(data)
+    if not root.exists():
+        raise InputError(f"{where} {root}: no such folder")
+    if not root.is_dir():
+        raise InputError(f"{where} {root}: is a file, not a folder")
+    if any((root / name).is_file() for name in logs):
+        return root
+    if any((root / Path(name).name).is_file() for name in logs):
+        raise InputError(
+            f"{where} {root}: is the crash set's own folder; give the folder that holds it, "
+            f"{root.resolve().parent}"
+        )
+    raise InputError(
+        f"{where} {root}: holds none of the crash logs (expected {logs[0]} ... "
+        f"{Path(logs[-1]).name})"
+    )
 
 
 def read_log(crash: Crash, data: str | Path | None = None) -> SpiriMatLog | None:
@@ -214,7 +330,8 @@ def run_experiments(
     data_dir : path, optional
         The data folder holding ``spiri-crash-set-1/`` (default: found by
         :func:`quadimpact.experiments.logs.data_dir`); without it the log
-        columns stay empty.
+        columns stay empty. A folder given here that holds none of the logs
+        is an input error (:func:`check_data_dir`), raised before any run.
     samples, log_samples : int
         Runs per crash over Table III's uncertainty, and over the log
         estimates' uncertainty (0: none).
@@ -226,13 +343,19 @@ def run_experiments(
     pandas.DataFrame
         The table written to ``table3.csv``.
     """
-    from quadimpact.experiments.logs_compare import attitude_rms_for_crash
+    from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
+    from quadimpact.results.files import check_out_dir
 
     sweep_options = {"workers": workers, "scheduler": scheduler, "progress": progress}
-    out = Path(out_dir)
+    data_dir = check_data_dir(data_dir, "data_dir")
+    out = check_out_dir(Path(out_dir), "experiments", where="")
     out.mkdir(parents=True, exist_ok=True)
+    logs = {crash.number: read_log(crash, data_dir) for crash in TABLE3}  # a bad file: now
     rows: list[dict[str, Any]] = []
     for crash in TABLE3:
+        if progress:
+            print(f"experiments: crash {crash.number} of {len(TABLE3)}: both variants, then "
+                  "the runs over the uncertainty", file=sys.stderr, flush=True)  # fmt: skip
         folder = out / f"crash_{crash.number}"
         types: dict[str, str | None] = {}
         results = {}
@@ -249,23 +372,29 @@ def run_experiments(
                 **sweep_options,
             )
             shares = _shares(sweep, "share_")
-        log = read_log(crash, data_dir)
-        rms = attitude_rms_for_crash(crash, results["default"], log, folder)
-        rows.append(
-            {
-                "crash": crash.number,
-                "heading_deg": crash.heading_deg,
-                "speed_m_s": crash.speed_m_s,
-                "inclination_deg": crash.inclination_deg,
-                "type_paper_experiment": crash.type_experiment,
-                "type_paper_simulation": crash.type_paper_simulation,
-                **types,
-                **shares,
-                "attitude_rms_deg_0_3s": rms,
-                "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
-                **_log_row(crash, log, folder, out, log_samples, sweep_options),
-            }
-        )
+        log = logs[crash.number]
+        comparison = compare_crash(crash, results["default"], log, folder)
+        motion = {c: math.nan for c in MOTION_COLUMNS}
+        if comparison is not None:
+            for angle, (sim, logged) in comparison.departures(0.3).items():
+                motion[f"sim_{angle}_change_deg_0_3s"] = sim
+                motion[f"log_{angle}_change_deg_0_3s"] = logged
+        row = {
+            "crash": crash.number,
+            "heading_deg": crash.heading_deg,
+            "speed_m_s": crash.speed_m_s,
+            "inclination_deg": crash.inclination_deg,
+            "type_paper_experiment": crash.type_experiment,
+            "type_paper_simulation": crash.type_paper_simulation,
+            **types,
+            **shares,
+            "attitude_rms_deg_0_3s": attitude_rms(comparison),
+            "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
+            **_log_row(crash, log, folder, out, log_samples, sweep_options),
+            **motion,
+        }
+        row["verdict"], row["verdict_reason"] = crash_verdict(row)
+        rows.append(row)
     table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *EXTRA_COLUMNS])
     table.to_csv(out / "table3.csv", index=False)
     table.to_parquet(out / "table3.parquet")

@@ -17,9 +17,13 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
-from quadimpact.errors import InputError
+from quadimpact.errors import InputError, format_value, one_line, short_path
 
-__all__ = ["apply_overrides", "locate_vehicle", "read_toml_file"]
+__all__ = ["MAX_DEPTH", "apply_overrides", "locate_vehicle", "read_toml_file"]
+
+#: Deepest nesting of tables and lists in an input file (the deepest input,
+#: a sweep run's vehicle inertia matrix, has 5 levels).
+MAX_DEPTH = 16
 
 
 def read_toml_file(path: Any, where: str | None = None) -> dict[str, Any]:
@@ -42,22 +46,49 @@ def read_toml_file(path: Any, where: str | None = None) -> dict[str, Any]:
     InputError
         ``<where>: file not found`` (or ``is a directory, not a file``),
         ``<where>: cannot read file (...)``, ``<where>: invalid TOML: ...`` (with
-        line and column).
+        line and column; also an integer of more than 4300 digits), tables
+        and lists nested deeper than :data:`MAX_DEPTH`. A long path is cut in
+        the middle.
     """
     if isinstance(path, str):
         path = Path(path)
-    where = str(path) if where is None else where
-    if not path.is_file():
-        reason = "is a directory, not a file" if path.is_dir() else "file not found"
-        raise InputError(f"{where}: {reason}")
+    where = short_path(path) if where is None else where
     try:
+        if not path.is_file():
+            reason = "is a directory, not a file" if path.is_dir() else "file not found"
+            raise InputError(f"{where}: {reason}")
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{where}: cannot read file ({exc})") from None
+        reason = getattr(exc, "strerror", None) or str(exc)
+        raise InputError(f"{where}: cannot read file ({reason})") from None
     try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise InputError(f"{where}: invalid TOML: {exc}") from None
+    except RecursionError:
+        raise InputError(f"{where}: invalid TOML: nested too deeply") from None
+    except ValueError as exc:  # e.g. an integer of more than 4300 digits
+        raise InputError(f"{where}: invalid TOML: {one_line(str(exc)).split(';')[0]}") from None
+    depth = _depth(data)
+    if depth > MAX_DEPTH:
+        raise InputError(
+            f"{where}: tables and lists nested {depth} deep; no input has more than "
+            f"{MAX_DEPTH} levels"
+        )
+    return data
+
+
+def _depth(data: Any) -> int:
+    """How deep tables and lists nest in ``data`` (a scalar: 0), without recursion."""
+    deepest, stack = 0, [(data, 1)]
+    while stack:
+        value, level = stack.pop()
+        if isinstance(value, (Mapping, list)):
+            deepest = max(deepest, level)
+            children = value.values() if isinstance(value, Mapping) else value
+            if level <= MAX_DEPTH:  # deeper than that is refused: no need to look further
+                stack.extend((child, level + 1) for child in children)
+    return deepest
 
 
 def locate_vehicle(data: Mapping[str, Any], folder: str | Path) -> dict[str, Any]:
@@ -115,7 +146,14 @@ def apply_overrides(
     vehicle_fields = set(vehicle_fields)
     overrides = dict(out.get("vehicle_overrides") or {})
     if "vehicle_overrides" in fields:
-        overrides = dict(fields["vehicle_overrides"] or {})
+        given = fields["vehicle_overrides"]
+        if given is not None and not isinstance(given, Mapping):
+            raise InputError(
+                "vehicle_overrides: must be a table of vehicle field = value "
+                f"(got {format_value(given)}); to sweep a vehicle field, name it "
+                "(e.g. --grid restitution=0.5,0.9)"
+            )
+        overrides = dict(given or {})
     for name, value in fields.items():
         if name == "vehicle_overrides":
             continue

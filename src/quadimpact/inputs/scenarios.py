@@ -51,7 +51,7 @@ from typing import Any, ClassVar, Literal
 
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
-from quadimpact.errors import InputError, input_error_from_validation, near_miss
+from quadimpact.errors import InputError, format_value, input_error_from_validation, near_miss
 from quadimpact.inputs.controllers import (
     controller_entry,
     controller_names,
@@ -627,9 +627,9 @@ def scenario_from_dict(data: Mapping[str, Any], where: str = "scenario") -> Scen
         The validated scenario.
     """
     kind = data.get("kind", "wall-approach")
-    if kind not in _KINDS:
+    if not isinstance(kind, str) or kind not in _KINDS:
         known = ", ".join(repr(k) for k in _KINDS)
-        raise InputError(f"{where}: kind: must be one of {known} (got {kind!r})")
+        raise InputError(f"{where}: kind: must be one of {known} (got {format_value(kind)})")
     cls = _KINDS[kind]
     try:
         return cls.model_validate(dict(data))

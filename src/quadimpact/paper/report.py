@@ -13,6 +13,7 @@ import pandas as pd
 from quadimpact import __version__
 from quadimpact.inputs.vehicle import load_vehicle
 from quadimpact.recovery.report import percent, rate_text
+from quadimpact.rotations import wrap_angle_deg
 from quadimpact.simulation.metrics import RESPONSE_TYPES
 
 __all__ = [
@@ -47,8 +48,13 @@ def table2_markdown(table: pd.DataFrame) -> str:
 
 
 # ------------------------------------------------------------------ report
+def _md(text: str) -> str:
+    """Text for a Markdown table cell (a ``|`` in it, as in ``|Y|``, would split the cell)."""
+    return str(text).replace("|", "\\|")
+
+
 def _cell(f: pd.Series) -> str:
-    return f"**{f['verdict']}**: {f['measured']}"
+    return f"**{f['verdict']}**: {_md(f['measured'])}"
 
 
 def render_report(
@@ -78,14 +84,15 @@ def render_report(
         "",
         "## Findings",
         "",
-        "| finding | paper | paper-replica | default |",
-        "|---|---|---|---|",
+        "| finding | paper | paper-replica | default | measure and verdict rule |",
+        "|---|---|---|---|---|",
     ]
     rep = findings[findings["variant"] == "paper-replica"].set_index("key")
     dft = findings[findings["variant"] == "default"].set_index("key")
     for key in rep.index:
+        rule = rep.loc[key, "rule"] if "rule" in rep.columns else ""
         lines.append(f"| {key} | {rep.loc[key, 'claim']} | {_cell(rep.loc[key])} | "
-                     f"{_cell(dft.loc[key])} |")  # fmt: skip
+                     f"{_cell(dft.loc[key])} | {_md(rule)} |")  # fmt: skip
     lines += ["", "## Where the variants disagree", ""]
     differ = [k for k in rep.index if rep.loc[k, "verdict"] != dft.loc[k, "verdict"]]
     if not differ:
@@ -311,8 +318,54 @@ def _depth(x: float, rb_mm: float) -> str:
     return "–" if x != x else f"{x:.0f}" + (" †" if x > rb_mm else "")
 
 
+def _front_first(heading_deg: float) -> float:
+    """A rear-first heading (log frame, scenario files) as Table III gives it, in (-180, 180]."""
+    return float(wrap_angle_deg(heading_deg + 180.0))
+
+
+def _motion_note(r: pd.Series, threshold_deg: float) -> str:
+    """Why a row of the same type as the experiment is not the same motion, from the data."""
+    note = (
+        f"- Crash {r['crash']}: the type is the experiment's ({r['type_ours']}), the motion is "
+        f"not: the attitude differs from the log's by {r['attitude_rms_deg_0_3s']:.1f}° RMS over "
+        f"the first 0.3 s after the impact (a match needs at most {threshold_deg:g}°)."
+    )
+    moved = []
+    for angle in ("roll", "pitch", "yaw"):
+        sim, log = r.get(f"sim_{angle}_change_deg_0_3s"), r.get(f"log_{angle}_change_deg_0_3s")
+        if sim is None or log is None or sim != sim or log != log:
+            continue
+        moved.append((angle, float(sim), float(log)))
+    if moved:
+        note += " In that time the log turns " + ", ".join(
+            f"{a} {lg:+.0f}°" for a, _, lg in moved
+        ) + "; ours " + ", ".join(f"{a} {sm:+.0f}°" for a, sm, _ in moved) + "."
+        opposite = [a for a, sm, lg in moved if sm * lg < 0 and min(abs(sm), abs(lg)) > 5.0]
+        if opposite:
+            verb = "turns" if len(opposite) == 1 else "turn"
+            note += f" Ours {verb} the other way in {' and '.join(opposite)}."
+        if any(max(abs(sm), abs(lg)) > 180.0 for a, sm, lg in moved if a != "pitch"):
+            note += (
+                " Roll and yaw change by more than half a turn: the pitch nears 90°, where "
+                "they are ill-defined (the Euler angles' singularity); the RMS above is of the "
+                "rotation angle, which is not."
+            )
+    no_contact = isinstance(r.get("type_log"), str) and r.get("log_speed_m_s") != r.get(
+        "log_speed_m_s"
+    )
+    if no_contact:
+        note += (
+            " The log does not show the wall contact (the motion capture misses it), so its "
+            "impact time is the on-board estimate and the two may not be aligned on the same "
+            "event; the log's own type is unknown."
+        )
+    return note
+
+
 def table3_markdown(table: pd.DataFrame) -> str:
     """Table III, ours beside the paper's, and each differing row explained by the data."""
+    from quadimpact.experiments.table3 import MOTION_RMS_DEG, VERDICT_RULE, crash_verdict
+
     rb_mm = 1e3 * load_vehicle("spiri").bumper_radius_m
     has_log = "type_log_conditions" in table.columns
     head = (
@@ -322,8 +375,14 @@ def table3_markdown(table: pd.DataFrame) -> str:
     lines = [head, "|---" * 10 + "|"]
     if has_log:
         lines = [head + " deepest δ (mm) |", "|---" * 11 + "|"]
-    notes = []
+    lines = [lines[0] + " ours vs the experiment |", lines[1] + "---|"]
+    notes, motion_notes = [], []
     for _, r in table.iterrows():
+        verdict, reason = (
+            (r["verdict"], r["verdict_reason"])
+            if isinstance(r.get("verdict"), str)
+            else crash_verdict(r)
+        )
         dist = _share_text(r, "share_")
         rms = (
             "no log"
@@ -336,7 +395,10 @@ def table3_markdown(table: pd.DataFrame) -> str:
             f"| {r['type_paper_experiment']} | {r['type_paper_simulation']} | {r['type_ours']} "
             f"| {r['type_replica']} | {dist or 'not run'} | {rms} |"
             + (f" {_depth(r['max_penetration_mm'], rb_mm)} |" if has_log else "")
+            + f" **{verdict}**: {reason} |"
         )
+        if r["type_ours"] == r["type_paper_experiment"] and verdict != "agrees":
+            motion_notes.append(_motion_note(r, MOTION_RMS_DEG))
         if r["type_ours"] != r["type_paper_experiment"]:
             key = f"share_{r['type_paper_experiment']}"
             seen = r[key] if key in r and r[key] == r[key] else float("nan")
@@ -367,6 +429,10 @@ def table3_markdown(table: pd.DataFrame) -> str:
                     else "."
                 )
             notes.append(note)
+    lines += ["", f"Verdict of each row: {VERDICT_RULE}."]
+    if motion_notes:
+        lines += ["", "Rows where our type is the experiment's but the motion is not:", "",
+                  *motion_notes]  # fmt: skip
     if notes:
         lines += ["", "Rows where our type differs from the experiment's:", "", *notes]
     if has_log:
@@ -382,8 +448,10 @@ def table3_markdown(table: pd.DataFrame) -> str:
         lines += [
             "",
             "At the logs' own pre-impact estimates (motion capture at the observed contact; "
-            "heading in the log frame, flown rear first; docs/EXPERIMENTS.md explains why "
-            f"they differ from Table III).{spread}",
+            "docs/EXPERIMENTS.md explains why they differ from Table III). ψ is given as in "
+            "Table III above: the heading of the equivalent front-first approach (the "
+            "flights went into the wall rear first, at ψ − 180° in the log frame and in the "
+            f"scenario files).{spread}",
             "",
             "| crash | ψ (°) | V_c (m/s) | ι (°) | roll / pitch (°) | log's own type "
             "| ours at the log's estimates | over their uncertainty (±2σ) "
@@ -396,7 +464,8 @@ def table3_markdown(table: pd.DataFrame) -> str:
                 lines.append(f"| {r['crash']} | {why} | | | | {r['type_log'] or '–'} | | | | |")
                 continue
             lines.append(
-                f"| {r['crash']} | {_deg(r['log_heading_deg'])} | {r['log_speed_m_s']:.2f} "
+                f"| {r['crash']} | {_deg(_front_first(r['log_heading_deg']))} "
+                f"| {r['log_speed_m_s']:.2f} "
                 f"| {_deg(r['log_inclination_deg'])} "
                 f"| {_deg(r['log_roll_deg'])} / {_deg(r['log_pitch_deg'])} | {r['type_log']} "
                 f"| {r['type_log_conditions']} | {_share_text(r, 'log_share_') or 'not run'} "

@@ -31,6 +31,7 @@ recovery. It writes ``recovery/<study>/`` (the trials, resumable),
 
 from __future__ import annotations
 
+import sys
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -106,6 +107,12 @@ class RecoveryPart:
     elapsed_s: float
 
 
+def _stage(progress: bool, text: str) -> None:
+    """Name the stage that starts (on stderr, with the progress)."""
+    if progress:
+        print(f"reproduce: {text}", file=sys.stderr, flush=True)
+
+
 def _ablation_name(switch: str) -> str:
     return f"replica-without-{switch}"
 
@@ -142,12 +149,18 @@ def reproduce(
     their logs when ``data_dir`` (or the default data folder) holds them.
     With ``recovery``, "Beyond the paper: recovery" (:func:`recovery_part`).
     """
+    from quadimpact.experiments.table3 import check_data_dir
+    from quadimpact.results.files import check_out_dir
+
     start = time.perf_counter()
-    out = Path(out_dir)
+    out = check_out_dir(Path(out_dir), "report", where="")
+    if experiments and data_dir is not None:
+        data_dir = check_data_dir(data_dir, "data_dir")
     out.mkdir(parents=True, exist_ok=True)
     tables: dict[str, pd.DataFrame] = {}
     found: dict[str, list[Finding]] = {}
     for variant in VARIANTS:
+        _stage(progress, f"Figure 4 sweep and the example run, {variant}")
         table, ex = _run_variant(variant, {"model": variant}, out, workers, scheduler, progress)
         ex.write(out / f"example-{variant}")
         write_snapshots(out / f"example-{variant}", scene=Scene.from_result(ex))
@@ -155,7 +168,8 @@ def reproduce(
         found[variant] = evaluate(table, (ex.summary, ex.episodes, ex.timeseries))
     ablation_rows = []
     if ablation:
-        for switch in SWITCHES:
+        for k, switch in enumerate(SWITCHES, 1):
+            _stage(progress, f"ablation {k} of {len(SWITCHES)}: the replica without {switch}")
             name = _ablation_name(switch)
             base = {
                 "model": "paper-replica",
@@ -171,6 +185,7 @@ def reproduce(
     if experiments:
         from quadimpact.experiments.table3 import run_experiments
 
+        _stage(progress, "Table III: the seven real crashes")
         table3 = run_experiments(
             out / "experiments", data_dir=data_dir, workers=workers, scheduler=scheduler,
             progress=progress,
@@ -178,6 +193,7 @@ def reproduce(
 
     part = recovery_part(out, tables, workers, scheduler, progress) if recovery else None
 
+    _stage(progress, "figures, tables and the report")
     # tables behind the report
     pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
     table2(tables).to_parquet(out / "table2.parquet")
@@ -206,9 +222,11 @@ def recovery_part(
     rec = out / "recovery"
     trials: dict[str, pd.DataFrame] = {}
     for v in RECOVERY_VARIANTS:
+        _stage(progress, f"recovery: {RECOVERY_N:,} impact trials of the Navi, {v}")
         trials[f"navi, {v}"] = run_trials(RecoveryStudy(n=RECOVERY_N, model=v),
                                           rec / f"navi-{v}", **par)[1]  # fmt: skip
     m = RECOVERY_COMPARE_N
+    _stage(progress, f"recovery: {m:,} trials with the noisy IMU, {m:,} of the Spiri")
     trials["navi, noisy IMU"] = run_trials(RecoveryStudy(n=m, imu="noisy"), rec / "navi-noisy",
                                            **par)[1]  # fmt: skip
     trials["spiri"] = run_trials(RecoveryStudy(vehicle="spiri", n=m), rec / "spiri", **par)[1]
@@ -224,6 +242,7 @@ def recovery_part(
 
     grid, runs = {}, []
     for variant in VARIANTS:
+        _stage(progress, f"recovery: the Figure 4 grid with the recovery controller, {variant}")
         table = run_sweep(
             SweepSpec(base=recovery_base({"model": variant}), grid=FIG4_GRID),
             out / "sweeps" / f"recovery-{variant}", **par,
@@ -231,6 +250,7 @@ def recovery_part(
         both = grid_comparison(tables[variant], table, list(FIG4_GRID))
         grid[variant] = saved_by_type(both)
         runs.append(both.assign(variant=variant))
+    _stage(progress, "recovery: the crashes without their power-off, nominal and recovery")
     crashes = crashes_without_power_off(VARIANTS)
 
     pd.concat([t.assign(study=k) for k, t in trials.items()]).to_parquet(
@@ -284,4 +304,5 @@ def type_map_figure(table: pd.DataFrame, variant: str) -> Figure:
     return figures.type_map_figure(
         table, "inclination_deg", "speed_m_s", facet="heading_deg", label=type_label,
         title=f"Table II, {variant}: response type (C/D with the number of subsequent impacts)",
+        text_meaning="C3, D4...: the type and the number of subsequent impacts",
     )  # fmt: skip

@@ -25,10 +25,11 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.colors import ListedColormap
 from matplotlib.figure import Figure
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
 
 from quadimpact.errors import InputError
-from quadimpact.results.files import atomic_write
+from quadimpact.results.files import atomic_write, split_unit
+from quadimpact.rotations import unwrap_deg
 
 if TYPE_CHECKING:  # pandas only where a table is drawn
     import pandas as pd
@@ -40,15 +41,21 @@ __all__ = [
     "STAGE_NAMES",
     "TYPE_COLOURS",
     "break_wraps",
+    "unwrap_deg",
     "check_columns",
     "facet_panels",
+    "field_label",
+    "field_name",
+    "field_value",
     "format_level",
+    "invalid_runs",
     "make_fig5",
     "make_fig6",
     "new_figure",
     "plot_fig5",
     "plot_fig6",
     "save_figure",
+    "set_time_limits",
     "sorted_levels",
     "stage_label",
     "type_map_figure",
@@ -117,6 +124,14 @@ def _fig_margins(
     }
 
 
+def set_time_limits(ax: Any, t: Any) -> None:
+    """The time axis from the first to the last finite sample (a run of one sample: as is)."""
+    t = np.asarray(t, dtype=np.float64)
+    t = t[np.isfinite(t)]
+    if len(t) and t[-1] > t[0]:
+        ax.set_xlim(float(t[0]), float(t[-1]))
+
+
 def break_wraps(
     t: np.ndarray, angle_deg: np.ndarray, jump_deg: float = 180.0
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -160,8 +175,7 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     ax.set_ylabel("Bumper deflection (mm)")
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best")
-    if len(t):
-        ax.set_xlim(float(t[0]), float(t[-1]))
+    set_time_limits(ax, t)
     if title:
         ax.set_title(title)
     return fig
@@ -178,7 +192,8 @@ def make_fig6(
     Six panels sharing the time axis: left column X (with the wall plane
     ``X = wall_x_m`` dashed), Y, altitude (with its reference dashed), all in
     metres (inertial NED position; altitude = -Z); right column roll, pitch,
-    yaw (ZYX Euler, degrees) each with its reference dashed.
+    yaw (ZYX Euler, degrees) each with its reference dashed; roll and yaw
+    unwrapped (:func:`unwrap_deg`), so that they do not jump at +-180 deg.
 
     Parameters
     ----------
@@ -222,13 +237,18 @@ def make_fig6(
 
     deg = 180.0 / math.pi
     right = (
-        ("roll_deg", "Roll φ (deg)", ref_value("roll_rad", deg)),
-        ("pitch_deg", "Pitch θ (deg)", ref_value("pitch_rad", deg)),
-        ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg)),
+        ("roll_deg", "Roll φ (deg)", ref_value("roll_rad", deg), True),
+        ("pitch_deg", "Pitch θ (deg)", ref_value("pitch_rad", deg), False),
+        ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg), True),
     )
-    for ax, (col, label, ref) in zip(axes[:, 1], right, strict=True):
-        tt, yy = break_wraps(t, np.asarray(ts[col], dtype=np.float64))
-        ax.plot(tt, yy, color="tab:blue", label="simulated")
+    for ax, (col, label, ref, wrapped) in zip(axes[:, 1], right, strict=True):
+        yy = np.asarray(ts[col], dtype=np.float64)
+        if wrapped:  # continuous through +-180 deg; the reference on the same branch
+            yy = unwrap_deg(yy)
+            first = yy[np.isfinite(yy)][:1]
+            if ref is not None and len(first):
+                ref += 360.0 * round((float(first[0]) - ref) / 360.0)
+        ax.plot(t, yy, color="tab:blue", label="simulated")
         if ref is not None:
             ax.axhline(ref, label="reference", **_REF_STYLE)
         ax.set_ylabel(label)
@@ -239,8 +259,7 @@ def make_fig6(
             ax.legend(loc="best", fontsize="small")
     for ax in axes[-1, :]:
         ax.set_xlabel("Time (s)")
-    if len(t):
-        axes[0, 0].set_xlim(float(t[0]), float(t[-1]))
+    set_time_limits(axes[0, 0], t)
     if title:
         fig.suptitle(title)
     return fig
@@ -352,8 +371,7 @@ def make_imu(
     ax_w.legend(loc="upper right", fontsize="small", ncols=3)
     for ax in (ax_f, ax_w):
         ax.grid(True, alpha=0.4)
-    if len(t):
-        first.set_xlim(float(t[0]), float(t[-1]))
+    set_time_limits(first, t)
     if title:
         fig.suptitle(title)
     return fig
@@ -371,11 +389,61 @@ def plot_imu(
 
 
 # ------------------------------------------------------ sweep tables: helpers
+#: Names of the usual fields in plots (the rest: the field's name in words).
+FIELD_NAMES: dict[str, str] = {
+    "heading_deg": "heading ψ",
+    "inclination_deg": "inclination ι",
+    "speed_m_s": "impact speed V_c",
+    "delta_init_m": "δ_init",
+    "max_penetration_m": "deepest penetration",
+    "peak_force_n": "peak force",
+    "friction_coefficient": "friction coefficient μ",
+}
+_PLOT_UNITS = {"m": ("mm", 1e3), "1": ("", 1.0)}  # lengths of a sweep are drawn in mm
+
+
+def field_name(field: str) -> str:
+    """A field in words, without its unit: ``inclination_deg`` -> ``inclination ι``."""
+    return FIELD_NAMES.get(field, split_unit(field)[0].replace("_", " "))
+
+
+def field_unit(field: str) -> tuple[str, float]:
+    """The unit a field is drawn in, and the scale from its stored unit (metres as mm)."""
+    unit = split_unit(field)[1]
+    return _PLOT_UNITS.get(unit, (unit, 1.0))
+
+
+def field_label(field: str) -> str:
+    """An axis label: ``inclination ι (deg)``, ``δ_init (mm)``, ``restitution``."""
+    unit, _ = field_unit(field)
+    return f"{field_name(field)} ({unit})" if unit else field_name(field)
+
+
+def field_value(field: str, value: Any) -> str:
+    """A field's value for a legend or a panel: ``impact speed V_c = 0.5 m/s``."""
+    unit, scale = field_unit(field)
+    shown = format_level(value * scale if isinstance(value, numbers.Real) else value)
+    return f"{field_name(field)} = {shown}{' ' + unit if unit else ''}"
+
+
 def format_level(value: Any) -> str:
     """A field's value as an axis or panel label (floats without trailing zeros)."""
     if isinstance(value, (float, np.floating)):
         return f"{float(value):g}"
     return str(value)
+
+
+def invalid_runs(table: pd.DataFrame) -> pd.Series:
+    """Runs deeper than the bumper radius (``bumper_model_valid`` false: the model's answer,
+    not a prediction); all false without that column."""
+    import pandas as pd
+
+    if "bumper_model_valid" not in table:
+        return pd.Series(False, index=table.index)
+    return table["bumper_model_valid"].astype(object).eq(False)
+
+
+INVALID_LABEL = "run deeper than the bumper radius (the bumper model does not hold)"
 
 
 def check_columns(table: pd.DataFrame, *names: str | None) -> None:
@@ -426,6 +494,7 @@ def type_map_figure(
     *,
     title: str | None = None,
     label: Callable[[pd.Series], str] | None = None,
+    text_meaning: str | None = None,
     path: str | os.PathLike[str] | None = None,
 ) -> Figure:
     """Response type over two fields (categorical colours), one panel per ``facet`` value.
@@ -444,6 +513,9 @@ def type_map_figure(
     label : callable, optional
         The text of a cell from its run's row (the paper's Table II writes
         ``C3``: the type and the count); default ``n_subsequent_impacts``.
+    text_meaning : str, optional
+        What a cell's text is, for the legend; default (with the default
+        ``label``) "number: subsequent impacts".
     path : path-like, optional
         Also write the figure there as PNG.
 
@@ -456,23 +528,28 @@ def type_map_figure(
     A cell holding several runs (other fields varying) shows the most
     frequent type. Cells show their text (``n_subsequent_impacts``, the paper's
     Table II count, or ``label``) when a panel has at most
-    :data:`MAX_TEXT_CELLS` cells; failed runs (black) have none.
+    :data:`MAX_TEXT_CELLS` cells, as large as the cell allows; failed runs
+    (black) have none. A cell holding a run deeper than the bumper radius
+    (``bumper_model_valid`` false) is hatched. Axes and panels are labelled
+    with the fields' names and units (:func:`field_label`).
     """
     check_columns(table, x, y, facet, "response_type", "status")
     xs, ys = sorted_levels(table[x]), sorted_levels(table[y])
     if not xs or not ys:
         raise InputError("plot: type map of an empty table")
     panels = facet_panels(table, facet)
-    width = min(18.0, 1.8 + 0.32 * len(xs))
-    height = 0.9 + len(panels) * (0.6 + 0.32 * len(ys))
-    fig = new_figure(width, height + 0.4)
+    width = min(18.0, 1.8 + 0.36 * len(xs))
+    cell_h = 0.4
+    height = 0.9 + len(panels) * (0.6 + cell_h * len(ys))
+    fig = new_figure(width, height + 0.6)
+    cell_pt = 72.0 * min(cell_h, (width - 1.8) / max(1, len(xs)))
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
     cmap = ListedColormap([TYPE_COLOURS[t] for t in _TYPES])
     col = {v: i for i, v in enumerate(xs)}
     row = {v: i for i, v in enumerate(ys)}
     present: set[str] = set()
     show_text = len(xs) * len(ys) <= MAX_TEXT_CELLS
-    fontsize = max(5.0, min(8.0, 9.0 - 0.05 * len(xs)))
+    any_text = any_invalid = False
     for ax, (fv, sub) in zip(axes, panels, strict=True):
         kind = sub["response_type"].astype(object).where(sub["status"] != "failed", "failed")
         import pandas as pd
@@ -483,6 +560,7 @@ def type_map_figure(
                 "y": sub[y].to_numpy(),
                 "t": kind.to_numpy(),
                 "n": _cell_texts(sub, label),
+                "bad": invalid_runs(sub).to_numpy(),
             }
         ).dropna(subset=["x", "y"])
         grid = np.full((len(ys), len(xs)), np.nan)
@@ -492,17 +570,26 @@ def type_map_figure(
                 continue
             present.add(t)
             grid[row[yv], col[xv]] = _TYPES.index(t)
+            if g["bad"].any():
+                any_invalid = True
+                ax.add_patch(Rectangle((col[xv] - 0.5, row[yv] - 0.5), 1.0, 1.0, fill=False,
+                                       hatch="//", edgecolor="0.25", linewidth=0.0,
+                                       zorder=3))  # fmt: skip
             if show_text and t != "failed":
                 text = g.loc[g["t"] == t, "n"].iloc[0]
                 if text is not None:
+                    any_text = True
+                    # as large as the cell allows: height, and width for the text's length
+                    size = min(0.45 * cell_pt, 0.9 * cell_pt / (0.62 * max(1, len(str(text)))))
                     ax.text(
                         col[xv],
                         row[yv],
                         text,
                         ha="center",
                         va="center",
-                        fontsize=fontsize,
+                        fontsize=max(5.0, min(12.0, size)),
                         color="white" if t in ("B", "D") else "black",
+                        zorder=4,
                     )
         ax.pcolormesh(
             np.arange(len(xs) + 1) - 0.5,
@@ -519,13 +606,22 @@ def type_map_figure(
         ax.set_yticks(range(len(ys)), [format_level(v) for v in ys], fontsize=8)
         ax.set_xlim(-0.5, len(xs) - 0.5)
         ax.set_ylim(-0.5, len(ys) - 0.5)
-        ax.set_xlabel(x)
-        ax.set_ylabel(y)
+        ax.set_xlabel(field_label(x))
+        ax.set_ylabel(field_label(y))
         if fv is not None:
-            ax.set_title(f"{facet} = {format_level(fv)}", fontsize=10)
+            ax.set_title(field_value(facet, fv), fontsize=10)
     handles = [Patch(color=TYPE_COLOURS[t], label=t) for t in _TYPES if t in present]
+    if any_text:
+        meaning = text_meaning or (
+            "number: subsequent impacts" if label is None else "cell text: the run's label"
+        )
+        handles.append(Patch(facecolor="white", edgecolor="0.6", label=meaning))
+    if any_invalid:
+        handles.append(Patch(facecolor="white", edgecolor="0.25", hatch="//",
+                             label=INVALID_LABEL))  # fmt: skip
     if handles:
-        fig.legend(handles=handles, loc="outside lower center", ncols=len(handles), fontsize=8)
+        fig.legend(handles=handles, loc="outside lower center", fontsize=8,
+                   ncols=min(len(handles), 5 if width >= 9.0 else 2))  # fmt: skip
     if title:
         fig.suptitle(title)
     if path is not None:

@@ -3,8 +3,8 @@
 A result folder holds:
 
 - ``summary.json``: the run summary (NaN and infinities written as ``null``),
-  plus the attitude/altitude ``references`` and integrator ``stats`` so the
-  folder can be re-plotted;
+  with the attitude/altitude ``references`` and the ``integrator`` counters,
+  so the folder can be re-plotted;
 - ``scenario.json``: the world that ran (the validated scenario, what its
   settings resolved to, the vehicle with its overrides applied, the contact
   surfaces as packed), so the folder can be drawn as it ran;
@@ -16,7 +16,12 @@ A result folder holds:
 Every file quadimpact writes (these, the figures, the pictures, a sweep's
 parts and table) is written by :func:`atomic_write`: a temporary file next to
 the target, renamed into place (``os.replace``), so a reader never sees a
-half-written file. :func:`to_jsonable` is the one conversion of values to
+half-written file. A whole result folder is written by :func:`staged_folder`:
+into a hidden folder beside it, moved into place only when every file is
+there. :func:`check_out_dir` refuses, before any work, an output folder that
+cannot be made or that holds something of another kind (:func:`folder_kind`).
+Files and folders are created with the process's umask (never a private
+mode), so a group can share them. :func:`to_jsonable` is the one conversion of values to
 plain JSON types (the summary here; a sweep's inputs and table rows).
 
 pandas and pyarrow are imported by the functions that need them, so that
@@ -27,12 +32,14 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import errno
 import json
 import math
 import os
 import secrets
+import shutil
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -41,6 +48,8 @@ import numpy as np
 if TYPE_CHECKING:
     import pandas as pd
 
+from quadimpact.errors import InputError
+from quadimpact.errors import short_path as _short
 from quadimpact.results.schema import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS, TIMESERIES_COLUMNS
 
 __all__ = [
@@ -53,12 +62,19 @@ __all__ = [
     "TIMESERIES_COLUMNS",
     "TIMESERIES_PARQUET",
     "UNITS_METADATA_KEY",
+    "DERIVED_FILES",
+    "FOLDER_MARKERS",
+    "RUN_FILES",
     "atomic_write",
+    "check_out_dir",
     "column_unit",
+    "folder_kind",
+    "staged_folder",
     "read_episodes_csv",
     "read_summary_json",
     "read_timeseries_parquet",
     "read_timeseries_units",
+    "split_unit",
     "to_jsonable",
     "write_episodes_csv",
     "write_imu_parquet",
@@ -74,6 +90,34 @@ EPISODES_CSV = "episodes.csv"
 TIMESERIES_PARQUET = "timeseries.parquet"
 IMU_PARQUET = "imu.parquet"
 
+#: Every file of a run folder that :meth:`SimulationResult.write` writes (data, then figures).
+RUN_FILES: tuple[str, ...] = (
+    SUMMARY_JSON, SCENARIO_JSON, EPISODES_CSV, TIMESERIES_PARQUET, IMU_PARQUET,
+    "fig5.png", "fig6.png", "imu.png",
+)  # fmt: skip
+#: Files drawn from a run folder afterwards (``quadimpact snapshots``, ``animate``,
+#: ``view``, the crash experiments' comparison with the log): a new run written into
+#: the folder removes them, since they show the old run.
+DERIVED_FILES: tuple[str, ...] = (
+    "snapshots.png", "snapshots.pdf", "animation.mp4", "animation.gif", "viewer.html",
+    "compare.csv", "compare.png",
+)  # fmt: skip
+#: What each kind of output folder holds (any one of these names marks it), in the
+#: order they are recognised.
+FOLDER_MARKERS: dict[str, tuple[str, ...]] = {
+    "sweep": ("sweep.json", "runs.parquet", "parts"),
+    "report": ("report.md", "findings.parquet"),
+    "experiments": ("table3.csv", "table3.parquet"),
+    "run": (SUMMARY_JSON, TIMESERIES_PARQUET),
+}
+_KIND_WORDS = {
+    "sweep": "a sweep",
+    "report": "a study report",
+    "experiments": "the crash experiments",
+    "run": "a run",
+    "other": "files that are not quadimpact's",
+}
+
 #: Schema metadata key holding ``{column: unit}`` as a JSON string.
 UNITS_METADATA_KEY = "quadimpact.units"
 
@@ -87,6 +131,9 @@ _UNIT_SUFFIXES: tuple[tuple[str, str], ...] = (
     ("_rad_s", "rad/s"),
     ("_m_s", "m/s"),
     ("_rpm", "rpm"),
+    ("_kg_m2", "kg m^2"),
+    ("_kg", "kg"),
+    ("_hz", "Hz"),
     ("_deg", "deg"),
     ("_rad", "rad"),
     ("_mm", "mm"),
@@ -97,16 +144,25 @@ _UNIT_SUFFIXES: tuple[tuple[str, str], ...] = (
 )
 
 
+def split_unit(name: str) -> tuple[str, str]:
+    """A column name as (stem, unit): ``speed_m_s`` -> ``("speed", "m/s")``.
+
+    The unit is that of :func:`column_unit` (``"1"`` when dimensionless, and
+    the stem is then the whole name).
+    """
+    for suffix, unit in _UNIT_SUFFIXES:
+        if name.endswith(suffix) and len(name) > len(suffix):
+            return name[: -len(suffix)], unit
+    return name, "1"
+
+
 def column_unit(name: str) -> str:
     """Unit of a column from its name's suffix (``"1"`` when dimensionless).
 
     ``t_s`` -> ``s``, ``vx_m_s`` -> ``m/s``, ``p_rad_s`` -> ``rad/s``,
     ``force1_n`` -> ``N``, ``roll_deg`` -> ``deg``, ``q0`` -> ``1``.
     """
-    for suffix, unit in _UNIT_SUFFIXES:
-        if name.endswith(suffix) and len(name) > len(suffix):
-            return unit
-    return "1"
+    return split_unit(name)[1]
 
 
 def to_jsonable(obj: Any, *, finite: bool = True, strict: bool = True) -> Any:
@@ -216,6 +272,170 @@ def atomic_write(
     if durable:
         _fsync(target.parent)
     return target
+
+
+def folder_kind(path: str | os.PathLike[str]) -> tuple[str | None, list[str]]:
+    """What an output folder holds, and the names that say so.
+
+    Parameters
+    ----------
+    path : path-like
+        A folder (it need not exist).
+
+    Returns
+    -------
+    (str or None, list of str)
+        ``None`` when the folder is absent or empty (hidden entries, such as a
+        writer's temporary files, are not counted); ``"sweep"``, ``"report"``,
+        ``"experiments"`` or ``"run"`` (:data:`FOLDER_MARKERS`); a folder
+        holding only files a run writes or that are drawn from one
+        (:data:`RUN_FILES`, :data:`DERIVED_FILES`) is a ``"run"`` too; anything
+        else is ``"other"``. The list holds the names found (at most three).
+    """
+    d = Path(path)
+    if not d.is_dir():
+        return None, []
+    names = sorted(e.name for e in os.scandir(d) if not e.name.startswith("."))
+    if not names:
+        return None, []
+    present = set(names)
+    for kind, markers in FOLDER_MARKERS.items():
+        found = [m for m in markers if m in present]
+        if found:
+            return kind, found[:3]
+    if present <= set(RUN_FILES) | set(DERIVED_FILES):
+        return "run", names[:3]
+    return "other", [n for n in names if n not in RUN_FILES and n not in DERIVED_FILES][:3]
+
+
+def check_out_dir(
+    path: str | os.PathLike[str],
+    kind: str,
+    *,
+    where: str = "--out",
+    refuse_other: bool | None = None,
+) -> Path:
+    """Check, before any work, that ``path`` can be the output folder of a ``kind``.
+
+    Parameters
+    ----------
+    path : path-like
+        The output folder (created later, if absent).
+    kind : str
+        ``"run"``, ``"sweep"``, ``"report"`` or ``"experiments"``.
+    where : str, keyword
+        How the folder was given, for the message (``"--out"``).
+    refuse_other : bool, keyword
+        Refuse a folder that holds files of no kind (default: only for a run,
+        whose files would be mixed with them).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+
+    Raises
+    ------
+    InputError
+        One line: the path is too long, a parent is a file, the folder cannot
+        be created (permissions), it is a file, or it holds another kind of
+        output (what it holds and what to do).
+    """
+    d = Path(path)
+    label = f"{where} {_short(d)}" if where else _short(d)
+    try:
+        exists = d.exists()
+        if exists and not d.is_dir():
+            raise InputError(f"{label}: is a file, not a folder")
+        ancestor = d
+        while not ancestor.exists() and ancestor != ancestor.parent:
+            ancestor = ancestor.parent
+    except OSError as exc:
+        if exc.errno == errno.ENAMETOOLONG:
+            raise InputError(f"{label}: path too long for the file system") from None
+        raise InputError(f"{label}: cannot be used ({exc.strerror or exc})") from None
+    if not exists:
+        if not ancestor.is_dir():
+            raise InputError(
+                f"{label}: cannot be created: {_short(ancestor)} is a file, not a folder"
+            )
+        if not os.access(ancestor, os.W_OK | os.X_OK):
+            raise InputError(
+                f"{label}: cannot be created: no write permission in {_short(ancestor)}"
+            )
+        for part in d.relative_to(ancestor).parts if ancestor != d else ():
+            if len(os.fsencode(part)) > 255:
+                raise InputError(f"{label}: a folder name is longer than 255 bytes")
+        return d
+    if not os.access(d, os.W_OK | os.X_OK):
+        raise InputError(f"{label}: no write permission in the folder")
+    held, names = folder_kind(d)
+    if refuse_other is None:
+        refuse_other = kind == "run"
+    if held is None or held == kind or (held == "other" and not refuse_other):
+        return d
+    advice = {
+        "run": "a new or empty folder, or a run folder (whose run it replaces)",
+        "sweep": "a new or empty folder, or this sweep's own folder (to resume it)",
+    }.get(kind, "a new or empty folder")
+    raise InputError(
+        f"{label}: holds {_KIND_WORDS[held]} ({', '.join(names)}); "
+        f"use {advice}"
+    )
+
+
+@contextlib.contextmanager
+def staged_folder(
+    path: str | os.PathLike[str], replaces: tuple[str, ...] = ()
+) -> Iterator[Path]:
+    """Write a folder completely, then move it into place (never a half-written folder).
+
+    Yields a new hidden folder beside ``path`` (``.<name>.partial-<pid>-<random>``,
+    created with the umask) to write into. When the block ends normally its
+    files are moved into ``path``: the folder itself is renamed there when
+    ``path`` is absent; otherwise (the folder and its permissions are kept)
+    each file replaces its namesake (``os.replace``) and the names in
+    ``replaces`` that the new folder lacks are removed from ``path`` (other
+    files in ``path`` are left). When the block raises, the hidden folder is
+    removed and ``path`` is left as it was. (A process killed meanwhile
+    leaves the hidden folder, which can be deleted.)
+
+    Parameters
+    ----------
+    path : path-like
+        The folder to write (its parent is created if needed).
+    replaces : tuple of str
+        Names in ``path`` that belong to what is being written (the old
+        run's files): removed when the new folder does not have them.
+    """
+    target = Path(path)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    stage = target.parent / f".{target.name}.partial-{os.getpid()}-{secrets.token_hex(4)}"
+    os.mkdir(stage)
+    try:
+        yield stage
+        if not target.exists():
+            try:
+                os.rename(stage, target)  # the complete folder appears at once
+                return
+            except OSError:
+                if not target.is_dir():  # made meanwhile: move the files in, below
+                    raise
+        staged = {e.name for e in os.scandir(stage)}
+        for name in sorted(staged):
+            try:
+                os.replace(stage / name, target / name)
+            except OSError as exc:
+                if exc.errno != errno.EXDEV:  # another file system (a mount point)
+                    raise
+                shutil.move(stage / name, target / name)
+        for name in replaces:
+            if name not in staged:
+                (target / name).unlink(missing_ok=True)
+        stage.rmdir()
+    finally:
+        if stage.exists():
+            shutil.rmtree(stage, ignore_errors=True)
 
 
 def write_summary_json(summary: Mapping[str, Any], path: str | os.PathLike[str]) -> Path:

@@ -18,10 +18,17 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     import pandas as pd
 
+from quadimpact.errors import InputError, one_line
 from quadimpact.results import files
 
 __all__ = ["FIG5_PNG", "FIG6_PNG", "IMU_PNG", "SimulationResult", "read_result"]
 
+#: Time-series columns a folder must have to be read back (plotted and drawn).
+READ_COLUMNS: tuple[str, ...] = (
+    "t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "altitude_m",
+    "roll_deg", "pitch_deg", "yaw_deg",
+    *(f"delta{j}_m" for j in (1, 2, 3, 4)), *(f"force{j}_n" for j in (1, 2, 3, 4)),
+)  # fmt: skip
 FIG5_PNG = "fig5.png"
 FIG6_PNG = "fig6.png"
 IMU_PNG = "imu.png"
@@ -180,7 +187,23 @@ class SimulationResult:
         return None
 
     def plot_title(self) -> str | None:
-        """Short title naming the approach (heading, speed, inclination), if known."""
+        """Short title naming the run: the approach (heading, speed, inclination) of a wall
+        approach, the initial attitude and speed of an impact trial, the surfaces of a flight;
+        None when the folder does not say."""
+        kind = self._scenario_value("kind")
+        if kind == "flight":
+            surfaces = self._scenario_value("surfaces") or []
+            names = [str(s.get("name", "?")) if isinstance(s, Mapping) else str(getattr(
+                s, "name", "?")) for s in surfaces]  # fmt: skip
+            ground = self._scenario_value("ground")
+            what = ", ".join(names) if names else "no surface"
+            return f"flight: {what}; ground {ground}" if ground else f"flight: {what}"
+        if kind == "impact-trial":
+            values = [self._scenario_value(k) for k in ("roll_deg", "pitch_deg", "speed_m_s")]
+            if all(isinstance(v, numbers.Real) for v in values):
+                roll, pitch, speed = values
+                return f"impact trial: roll {roll:g}°, pitch {pitch:g}°, {speed:g} m/s"
+            return "impact trial"
         heading = self._scenario_value("heading_deg")
         speed = self._scenario_value("speed_m_s")
         incl = self._scenario_value("inclination_deg")
@@ -193,27 +216,49 @@ class SimulationResult:
         """Write the result folder and return its path.
 
         Files, in this order so that a plotting failure loses no data:
-        ``summary.json`` (the summary plus ``references`` and ``stats`` unless
-        it already has those keys), ``scenario.json`` (the world record, when
-        there is one), ``episodes.csv``, ``timeseries.parquet``,
-        ``imu.parquet`` (when there are IMU samples), ``fig5.png``,
-        ``fig6.png``, ``imu.png``. A figure that fails is not written (a stale
-        one from an earlier write is removed); the failure is printed as a
-        one-line warning on stderr and listed under ``plot_errors`` in
-        ``summary.json`` (and in ``self.summary``).
+        ``summary.json`` (the summary plus ``references``, and the integrator
+        counters ``integrator`` unless it already has those keys),
+        ``scenario.json`` (the world record, when there is one),
+        ``episodes.csv``, ``timeseries.parquet``, ``imu.parquet`` (when there
+        are IMU samples), ``fig5.png``, ``fig6.png``, ``imu.png``. A figure
+        that fails is not written; the failure is printed as a one-line
+        warning on stderr and listed under ``plot_errors`` in ``summary.json``
+        (and in ``self.summary``).
+
+        The folder is written beside its place and moved there when complete
+        (:func:`~quadimpact.results.files.staged_folder`): a failure (a full
+        disk) leaves no half folder, and an existing run folder as it was.
+        Written into a run folder, the new run replaces the old one: its
+        files, and the pictures drawn from it (snapshots, animation, viewer,
+        a log comparison: :data:`~quadimpact.results.files.DERIVED_FILES`),
+        which showed the old run, are removed; other files are left. A folder
+        holding anything else (a sweep, a report, files that are not
+        quadimpact's) is refused.
+
+        Raises
+        ------
+        InputError
+            ``out_dir`` cannot be a run folder (one line: what it holds).
+        OSError
+            Writing failed (the folder is left as it was).
         """
         d = Path(out_dir)
-        d.mkdir(parents=True, exist_ok=True)
+        files.check_out_dir(d, "run", where="")
+        with files.staged_folder(d, replaces=files.RUN_FILES + files.DERIVED_FILES) as stage:
+            self._write_files(stage)
+        return d
+
+    def _write_files(self, d: Path) -> None:
+        """Every file of the folder into ``d`` (a new, empty folder)."""
         summary = dict(self.summary)
         summary.pop("plot_errors", None)
         summary.setdefault("references", dict(self.references))
-        summary.setdefault("stats", dict(self.stats))
+        if self.stats:
+            summary.setdefault("integrator", dict(self.stats))
         files.write_summary_json(summary, d / files.SUMMARY_JSON)
         world = self.world
         if world:
             files.write_summary_json(world, d / files.SCENARIO_JSON)
-        else:
-            (d / files.SCENARIO_JSON).unlink(missing_ok=True)
         timeseries = self._columns("timeseries")
         imu = self._columns("imu")
         files.write_episodes_csv(self._columns("episodes"), d / files.EPISODES_CSV)
@@ -221,8 +266,6 @@ class SimulationResult:
         has_imu = imu is not None and len(imu["t_s"]) > 0
         if has_imu:
             files.write_imu_parquet(imu, d / files.IMU_PARQUET)
-        else:
-            (d / files.IMU_PARQUET).unlink(missing_ok=True)
 
         from quadimpact.results import figures as plots  # matplotlib only when drawing
 
@@ -243,8 +286,6 @@ class SimulationResult:
                     lambda p: plots.plot_imu(imu, timeseries, p, summary=self.summary, title=title),
                 ),
             )
-        else:
-            (d / IMU_PNG).unlink(missing_ok=True)
         errors: list[str] = []
         for name, job in jobs:
             try:
@@ -260,30 +301,55 @@ class SimulationResult:
             files.write_summary_json(summary, d / files.SUMMARY_JSON)
         else:
             self.summary.pop("plot_errors", None)
-        return d
 
 
 def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     """Load a result folder written by :meth:`SimulationResult.write`.
 
     Returns a :class:`SimulationResult` with ``summary``,
-    ``episodes``, ``timeseries``, ``imu``, ``references``/``stats`` taken from
-    the summary (empty dicts if absent) and ``world`` from ``scenario.json``
+    ``episodes``, ``timeseries``, ``imu``, ``references`` and ``stats`` taken
+    from the summary (``stats`` from its ``integrator`` table, or from the
+    ``stats`` copy that older folders hold; empty dicts if
+    absent) and ``world`` from ``scenario.json``
     (empty for a folder written before that file existed); ``scenario`` is
     ``None``. Enough to re-plot and redraw the folder.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such folder.
+    InputError
+        A file that is missing or cannot be parsed, a ``summary.json`` that is
+        not a JSON object, a time series without the columns of
+        :data:`READ_COLUMNS`: one line naming the file.
     """
     d = Path(directory)
     if not d.is_dir():
         raise FileNotFoundError(f"result folder not found: {d}")
-    summary = files.read_summary_json(d / files.SUMMARY_JSON)
-    episodes = files.read_episodes_csv(d / files.EPISODES_CSV)
-    timeseries = files.read_timeseries_parquet(d / files.TIMESERIES_PARQUET)
+    summary = _read(d / files.SUMMARY_JSON, files.read_summary_json)
+    if not isinstance(summary, dict):
+        raise InputError(
+            f"{d / files.SUMMARY_JSON}: must be a JSON object of summary fields "
+            f"(got a JSON {_json_kind(summary)})"
+        )
+    episodes = _read(d / files.EPISODES_CSV, files.read_episodes_csv)
+    timeseries = _read(d / files.TIMESERIES_PARQUET, files.read_timeseries_parquet)
+    missing = [c for c in READ_COLUMNS if c not in timeseries.columns]
+    if missing:
+        more = f" and {len(missing) - 4} more" if len(missing) > 4 else ""
+        shown = ", ".join(missing[:4]) + more
+        raise InputError(
+            f"{d / files.TIMESERIES_PARQUET}: missing column(s) {shown}: not a time series "
+            "written by 'quadimpact run'"
+        )
     imu_path = d / files.IMU_PARQUET
-    imu = files.read_timeseries_parquet(imu_path) if imu_path.is_file() else None
+    imu = _read(imu_path, files.read_timeseries_parquet) if imu_path.is_file() else None
     world_path = d / files.SCENARIO_JSON
-    world = files.read_summary_json(world_path) if world_path.is_file() else {}
+    world = _read(world_path, files.read_summary_json) if world_path.is_file() else {}
+    if not isinstance(world, dict):
+        raise InputError(f"{world_path}: must be a JSON object (got a JSON {_json_kind(world)})")
     references = dict(summary.get("references") or {})
-    stats = dict(summary.get("stats") or {})
+    stats = dict(summary.get("integrator") or summary.pop("stats", None) or {})
     return SimulationResult(
         summary=summary,
         episodes=episodes,
@@ -294,3 +360,25 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
         imu=imu,
         world=world,
     )
+
+
+def _json_kind(value: Any) -> str:
+    """``list``, ``number``... : what a JSON value is, in JSON's words."""
+    if isinstance(value, list):
+        return "array"
+    if isinstance(value, bool):
+        return "true/false"
+    if isinstance(value, (int, float)):
+        return "number"
+    return "string" if isinstance(value, str) else "null"
+
+
+def _read(path: Path, reader: Callable[[Path], Any]) -> Any:
+    """``reader(path)``, a file that cannot be read or parsed as one line naming it."""
+    try:
+        return reader(path)
+    except FileNotFoundError:
+        raise InputError(f"{path}: missing (not a folder written by 'quadimpact run')") from None
+    except (OSError, ValueError) as exc:  # JSON and Arrow errors are ValueErrors
+        reason = one_line(str(exc)).split(". ")[0]
+        raise InputError(f"{path}: cannot be read ({type(exc).__name__}: {reason})") from None

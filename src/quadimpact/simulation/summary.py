@@ -86,10 +86,7 @@ def build_summary(
     crash_pos = st[L.ST_CRASH_X : L.ST_CRASH_X + 3]
     max_pen = float(st[L.ST_MAX_DELTA])
     if max_pen > rb:
-        warnings.append(
-            f"penetration {max_pen * 1e3:.1f} mm exceeds the bumper radius {rb * 1e3:.0f} mm: "
-            "the body itself would be in the surface, beyond what the bumper model covers"
-        )
+        warnings.append(_too_deep(setup, episodes, max_pen, rb))
     if st[L.ST_MISSED_ONSETS] > 0:
         warnings.append(
             f"{int(st[L.ST_MISSED_ONSETS])} contact(s) found already penetrating "
@@ -190,6 +187,23 @@ def build_summary(
     )
     summary["outcome"] = describe_outcome(summary)
     return summary
+
+
+def _too_deep(setup: RunSetup, episodes: Any, max_pen: float, rb: float) -> str:
+    """The warning of a penetration beyond the bumper radius (plainer for the ground)."""
+    peaks = np.asarray(episodes["peak_delta_m"], dtype=float)
+    surface = str(episodes["surface"][int(np.nanargmax(peaks))]) if np.any(peaks > rb) else ""
+    if surface and surface not in _obstacle_names(setup):
+        return (
+            f"penetration {max_pen * 1e3:.1f} mm into the {surface}, beyond the bumper radius "
+            f"{rb * 1e3:.0f} mm: only the bumper rims can touch a surface, so the body (and the "
+            "CM) passed through the ground; ground contact shows the bumpers' touch-down, and "
+            'ground = "crash" (the default) ends a run when the CM reaches the ground'
+        )
+    return (
+        f"penetration {max_pen * 1e3:.1f} mm exceeds the bumper radius {rb * 1e3:.0f} mm: "
+        "the body itself would be in the surface, beyond what the bumper model covers"
+    )
 
 
 def _obstacle_names(setup: RunSetup) -> list[str]:

@@ -24,10 +24,14 @@ from matplotlib.figure import Figure
 
 from quadimpact.errors import InputError
 from quadimpact.results.figures import (
+    INVALID_LABEL,
     TYPE_COLOURS,
     check_columns,
     facet_panels,
-    format_level,
+    field_label,
+    field_unit,
+    field_value,
+    invalid_runs,
     new_figure,
     save_figure,
     sorted_levels,
@@ -40,12 +44,6 @@ __all__ = ["TYPE_COLORS", "plot_metric", "plot_type_map", "auto_plots"]
 TYPE_COLORS = TYPE_COLOURS
 """The type map's colours (:data:`quadimpact.results.figures.TYPE_COLOURS`)."""
 
-# metric -> (axis label, scale)
-_LABELS = {
-    "delta_init_m": ("δ_init (mm)", 1e3),
-    "max_penetration_m": ("max penetration (mm)", 1e3),
-    "peak_force_n": ("peak force (N)", 1.0),
-}
 MAX_AUTO_RUNS = 50_000
 """``auto_plots`` does nothing for larger sweeps (keep ``quadimpact sweep`` cheap)."""
 
@@ -70,8 +68,9 @@ def plot_metric(
     x : str
         Swept field on the horizontal axis.
     metric : str
-        Column on the vertical axis (``delta_init_m`` is drawn in mm).
-        Failed runs (null metric) leave gaps.
+        Column on the vertical axis (lengths are drawn in mm). Failed runs
+        (null metric) leave gaps; runs deeper than the bumper radius
+        (``bumper_model_valid`` false) are marked with a black cross.
     by : str, optional
         One curve per value of this field.
     path : path-like, optional
@@ -86,18 +85,21 @@ def plot_metric(
     matplotlib.figure.Figure
     """
     check_columns(table, x, metric, by, facet)
-    label, scale = _LABELS.get(metric, (metric, 1.0))
+    label, scale = field_label(metric), field_unit(metric)[1]
     panels = facet_panels(table, facet)
     if not panels:
         raise InputError(f"plot: {facet}: no values")
     fig = new_figure(1.0 + 4.2 * len(panels), 3.6)
     axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
+    marked = False  # the mark of runs deeper than the bumper radius, in the legend once
     for ax, (fv, sub) in zip(axes, panels, strict=True):
         groups = (
             [(None, sub)]
             if by is None
             else [(v, sub[sub[by] == v]) for v in sorted_levels(sub[by])]
         )
+        bad_x: list[Any] = []
+        bad_y: list[float] = []
         for bv, g in groups:
             g = g.sort_values(x)
             y = pd.to_numeric(g[metric], errors="coerce").to_numpy(dtype=float) * scale
@@ -107,13 +109,20 @@ def plot_metric(
                 marker="o",
                 markersize=3,
                 linewidth=1.2,
-                label=None if bv is None else f"{by} = {format_level(bv)}",
+                label=None if bv is None else field_value(by, bv),
             )
-        ax.set_xlabel(x)
+            bad = invalid_runs(g).to_numpy()
+            bad_x.extend(g[x].to_numpy()[bad])
+            bad_y.extend(y[bad])
+        if bad_x:  # after the curves: last in the legend
+            ax.plot(bad_x, bad_y, "x", color="black", markersize=6, zorder=5,
+                    label=INVALID_LABEL if not marked else None)  # fmt: skip
+            marked = True
+        ax.set_xlabel(field_label(x))
         if fv is not None:
-            ax.set_title(f"{facet} = {format_level(fv)}", fontsize=10)
+            ax.set_title(field_value(facet, fv), fontsize=10)
         ax.grid(True, alpha=0.3)
-        if by is not None:
+        if by is not None or marked:
             ax.legend(fontsize=8)
     axes[0].set_ylabel(label)
     if title:
@@ -187,13 +196,48 @@ def auto_plots(out_dir: str | os.PathLike[str], spec: Any) -> list[Path]:
     table = read_runs(out_dir)
     folder = Path(out_dir) / "plots"
     folder.mkdir(parents=True, exist_ok=True)
+    fixed = fixed_parameters(spec)
     written = []
     if by is None or len(spec.grid[by]) <= 12:
         path = folder / f"delta_init_m_vs_{x}.png"
-        plot_metric(table, x, "delta_init_m", by=by, facet=facet, path=path)
+        title = f"Initial deflection δ_init; {fixed}"
+        plot_metric(table, x, "delta_init_m", by=by, facet=facet, path=path, title=title)
         written.append(path)
     if by is not None and len(spec.grid[by]) <= 200:
         path = folder / f"types_{x}_{by}.png"
-        plot_type_map(table, x, by, path=path, facet=facet)
+        plot_type_map(table, x, by, path=path, facet=facet, title=f"Response type; {fixed}")
         written.append(path)
     return written
+
+
+#: Scenario fields a sweep plot's title names when they are not swept.
+TITLE_FIELDS = ("model", "controller", "vehicle", "heading_deg", "inclination_deg", "speed_m_s",
+                "ground")  # fmt: skip
+
+
+def fixed_parameters(spec: Any) -> str:
+    """What a sweep's runs share, for a plot's title: ``model default, speed V_c = 0.75 m/s``.
+
+    The usual scenario fields (:data:`TITLE_FIELDS`) that are not swept, at
+    their value in the base scenario (its defaults filled in), then every other
+    field the base sets and every vehicle override (``vehicle_overrides``).
+    """
+    from quadimpact.inputs.scenarios import scenario_from_dict
+
+    varied = set(spec.varying_fields()) | {k for e in spec.runs or [] for k in e}
+    if spec.sample is not None:
+        varied |= set(spec.sample["ranges"]) | set(spec.sample["choices"])
+    scenario = scenario_from_dict(spec.base, where="sweep: base").model_dump(mode="json")
+    scenario.update({k: v[0] for k, v in spec.grid.items() if len(v) == 1})
+    names = [f for f in TITLE_FIELDS if f in scenario]
+    names += [f for f in spec.base if f not in names and f != "vehicle_overrides"]
+    names += [f for f in spec.grid if len(spec.grid[f]) == 1 and f not in names]
+    parts = []
+    for name in names:
+        value = scenario.get(name, spec.grid.get(name, [None])[0])
+        if name in varied or isinstance(value, (dict, list)) or value is None:
+            continue
+        parts.append(f"{name} {value}" if isinstance(value, str) else field_value(name, value))
+    overrides = dict(spec.base.get("vehicle_overrides") or {})
+    parts += [field_value(k, v) for k, v in overrides.items() if not isinstance(v, (list, dict))]
+    return ", ".join(parts) if parts else "the paper's wall approach"

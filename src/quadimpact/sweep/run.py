@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from quadimpact.errors import InputError, format_value
+from quadimpact.results.files import check_out_dir
 from quadimpact.sweep.backends import (
     Sink,
     chunk_size,
@@ -60,6 +61,27 @@ def default_workers() -> int:
         return len(os.sched_getaffinity(0)) or 1
     except (AttributeError, OSError):
         return os.cpu_count() or 1
+
+
+def _refuse_in_a_starting_worker() -> None:
+    """Stop a worker that, starting up, runs the main script again and reaches a sweep.
+
+    A worker process (forkserver or spawn) imports the main script before it
+    can work; a script without ``if __name__ == "__main__":`` then calls
+    ``run_sweep`` inside the worker. Say so in one line, first, and end the
+    worker quietly (instead of a traceback per worker).
+    """
+    import multiprocessing
+
+    if getattr(multiprocessing.current_process(), "_inheriting", False):
+        print(
+            "quadimpact: error: a sweep worker, starting up, ran the script's top level "
+            "again: guard the code that runs the sweep with `if __name__ == \"__main__\":` "
+            "(README, 'Sweeps from Python')",
+            file=sys.stderr,
+            flush=True,
+        )
+        raise SystemExit(1)
 
 
 def _resolve_workers(workers: int | None) -> int:
@@ -143,6 +165,7 @@ def run_sweep(
     WorkerError
         Worker processes could not be started (the finished runs are saved).
     """
+    _refuse_in_a_starting_worker()
     start = time.perf_counter()
     if not isinstance(spec, SweepSpec):
         spec = SweepSpec.from_dict(spec)
@@ -155,9 +178,7 @@ def run_sweep(
             f"{spec.where}: {spec.n_runs} runs, more than {LARGE_SWEEP_RUNS}: confirm with "
             "--allow-large (allow_large=True) to run it"
         )
-    out = Path(out_dir)
-    if out.exists() and not out.is_dir():
-        raise InputError(f"{out}: not a folder")
+    out = check_out_dir(Path(out_dir), "sweep", where="")
 
     saved = 0  # finished runs in the folder, as far as known
     try:

@@ -238,9 +238,10 @@ class SweepSpec:
         self.where = where
         self.base = self._read_base(base)
         kind = self.base.get("kind", "wall-approach")
-        if kind not in _KINDS:
+        if not isinstance(kind, str) or kind not in _KINDS:
+            known = ", ".join(repr(k) for k in _KINDS)
             raise InputError(
-                f"{where}: base: kind: must be 'wall-approach' or 'flight' (got {kind!r})"
+                f"{where}: base: kind: must be one of {known} (got {format_value(kind)})"
             )
         self._scenario_fields = [f for f in _KINDS[kind].model_fields if f != "kind"]
         self._vehicle_fields = [f for f in Vehicle.model_fields if f not in self._scenario_fields]
@@ -385,6 +386,10 @@ class SweepSpec:
             )
         if not isinstance(seed, int) or isinstance(seed, bool) or seed < 0:
             raise InputError(f"{w}: seed: must be an integer >= 0 (got {format_value(seed)})")
+        for key in ("ranges", "choices"):
+            if not isinstance(sample.get(key) or {}, Mapping):
+                raise InputError(f"{w}.{key}: must be a table of field = values "
+                                 f"(got {format_value(sample[key])})")  # fmt: skip
         ranges: dict[str, list[float]] = {}
         for name, bounds in dict(sample.get("ranges") or {}).items():
             self._check_field(name, "sample.ranges")

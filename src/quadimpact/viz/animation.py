@@ -18,6 +18,7 @@ four times slower than real time.
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import time
@@ -29,7 +30,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import break_wraps, stage_label
+from quadimpact.results.figures import set_time_limits, stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene
@@ -141,7 +142,7 @@ class AnimationFigure:
         self.att_live = []
         self.att_data = []
         for k, name in enumerate(("roll", "pitch", "yaw")):
-            tb, yb = break_wraps(t, scene.euler_deg[:, k])
+            tb, yb = t, scene.euler_deg[:, k]  # roll and yaw unwrapped (Scene)
             c = _ATTITUDE_COLORS[name]
             ax_a.plot(tb, yb, color=c, alpha=0.2, linewidth=1.0)
             self.att_live.append(ax_a.plot([], [], color=c, linewidth=1.4, label=name)[0])
@@ -151,7 +152,7 @@ class AnimationFigure:
         ax_a.legend(loc="upper right", fontsize=8, ncol=3)
         for ax in (ax_d, ax_a):
             ax.grid(True, alpha=0.35)
-            ax.set_xlim(t0, t1)
+            set_time_limits(ax, [t0, t1])
             if scene.first_contact_s is not None:
                 ax.axvline(scene.first_contact_s, color="k", linestyle=":", linewidth=0.8)
             if scene.crash_time_s is not None:
@@ -297,18 +298,27 @@ def write_animation(
                 ffmpeg_log_level="error",
             )
             writer.send(None)
+        sent = 0
         try:
             for k, t in enumerate(times):
                 pixels = fig.render(float(t))
                 if writer is not None:
                     writer.send(pixels.tobytes())
+                    sent += 1
                 if gif and k % gif_step == 0:
                     gif_frames.append(_gif_frame(pixels, gif_width))
                 if progress is not None:
                     progress(k + 1, len(times))
         finally:
             if writer is not None:
-                writer.close()
+                # failed before the first frame: the error says why, not ffmpeg's
+                # "No frames have been written" (the half movie is removed anyway)
+                log = logging.getLogger("imageio_ffmpeg")
+                quiet, log.disabled = log.disabled, log.disabled or sent == 0
+                try:
+                    writer.close()
+                finally:
+                    log.disabled = quiet
 
     mp4_path = out / ANIMATION_MP4
     if mp4:

@@ -10,6 +10,8 @@ direction; altitude is up.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.collections import LineCollection
@@ -29,19 +31,28 @@ MAX_CONTACTS = 8  # drawn at once (4 bumpers x 2 surfaces)
 WALL_WIDTH_M = 1.0  # walls: a panel this wide, from the view centre away from the camera
 
 
-def wall_range(normal: np.ndarray, forward: np.ndarray) -> tuple[float, float] | None:
+def wall_range(
+    normal: np.ndarray, forward: np.ndarray, right: np.ndarray | None = None
+) -> tuple[float, float] | None:
     """Extent of a wall panel along its horizontal axis, from the view centre.
 
     A wall (a steep plane) is drawn cut by the vertical plane through the view
-    centre that contains the wall normal: only the part beyond it, seen from
-    the camera, is drawn, so the cut edge is where the vehicle meets the wall
-    and nothing of the wall hides the vehicle. Flat planes (the ground): ``None``
-    (a square around the centre).
+    centre that contains the wall normal, and only one half is drawn, so that
+    the cut edge is where the vehicle meets the wall. The half is the one on
+    the side of the picture away from the vehicle: the vehicle stands out from
+    the wall along the wall normal, which the camera sees pointing to one side
+    of the picture (``right``: the screen's right, NED), so the other side's
+    half lies beside the vehicle, not behind it, and the contact reads at the
+    edge. Seen straight on (the normal along the view), the half beyond the
+    view centre. Flat planes (the ground): ``None`` (a square around the centre).
     """
     m = np.asarray(normal, dtype=float)
     if abs(m[2]) / np.linalg.norm(m) > 0.7:
         return None
     e1, _ = plane_axes(m)
+    side = float(e1 @ right) * float(m @ right) if right is not None else 0.0
+    if abs(side) > 1e-3:  # the normal shows on screen: the half on the other side of it
+        return (0.0, WALL_WIDTH_M) if side < 0.0 else (-WALL_WIDTH_M, 0.0)
     return (0.0, WALL_WIDTH_M) if float(e1 @ forward) > 0.0 else (-WALL_WIDTH_M, 0.0)
 
 
@@ -94,11 +105,12 @@ class SceneArtists:
         lw = linewidth
 
         # planes: the contact surfaces, and the ground plane for reference
-        self.planes: list[tuple[np.ndarray, np.ndarray, float | None, Polygon, LineCollection]] = []
-        planes = [(s.point_m, s.normal, s.is_ground) for s in scene.surfaces]
+        self.planes: list[tuple[np.ndarray, np.ndarray, Any, Polygon, LineCollection]] = []
+        planes = [(s.point_m, s.normal, s.is_ground, s.name) for s in scene.surfaces]
         if not any(s.is_ground for s in scene.surfaces):
-            planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True))
-        for point, normal, is_ground in planes:
+            planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True, ""))
+        self._cuts = scene.first_contact_points()
+        for point, normal, is_ground, name in planes:
             p = np.asarray(point, float)
             m = np.asarray(normal, float) / np.linalg.norm(normal)
             color = GROUND_COLOR if is_ground else WALL_COLOR
@@ -119,7 +131,7 @@ class SceneArtists:
             )
             ax.add_patch(poly)
             ax.add_collection(grid)
-            self.planes.append((p, m, wall_range(m, forward), poly, grid))
+            self.planes.append((p, m, (wall_range(m, forward, right), name), poly, grid))
 
         self.discs = [
             Polygon(
@@ -206,7 +218,9 @@ class SceneArtists:
                 zorder=12,
             )
             ax.add_patch(arrow)
-            txt = ax.text(0, 0, "", fontsize=7, color=FORCE_COLOR, zorder=12)
+            txt = ax.text(0, 0, "", fontsize=7, color=FORCE_COLOR, zorder=12, va="center",
+                          bbox={"boxstyle": "round,pad=0.12", "facecolor": "white",
+                                "edgecolor": "none", "alpha": 0.75})  # fmt: skip
             self.points.append(pt)
             self.deflections.append(dl)
             self.arrows.append(arrow)
@@ -270,18 +284,23 @@ class SceneArtists:
             return cam.project(points, target)
 
         half = 2.5 * max(self.half_w, self.half_h)
-        for p, m, width, poly, grid in self.planes:
-            outline, segs = plane_grid(p, m, target, half, step=0.1, range1=width)
+        for p, m, (width, name), poly, grid in self.planes:
+            centre = target
+            if width is not None and name in self._cuts:  # cut where the vehicle met it
+                e1 = plane_axes(m)[0]
+                centre = target + float((self._cuts[name] - target) @ e1) * e1
+            outline, segs = plane_grid(p, m, centre, half, step=0.1, range1=width)
             poly.set_xy(P(outline[:4]))
             grid.set_segments(list(P(segs)) if len(segs) else [])
 
         depth = cam.depth(fr.circles.mean(axis=1), target)
         order = np.argsort(-depth)  # far first
+        label_xy = self._inside(P(fr.label_points))
         for rank, j in enumerate(order):
             self.circles[j].set_data(*P(fr.circles[j]).T)
             self.circles[j].set_zorder(5 + 0.1 * rank)
             self.discs[j].set_xy(P(fr.discs[j]))
-            self.labels[j].set_position(P(fr.label_points[j]))
+            self.labels[j].set_position(label_xy[j])
         self.arms.set_segments(list(P(fr.arms)))
         self.hub.set_data(*P(fr.hub).T)
         for k in range(3):
@@ -303,15 +322,49 @@ class SceneArtists:
             self.deflections[i].set_data([pc[0], ps[0]], [pc[1], ps[1]])
             self.deflections[i].set_color(BUMPER_COLORS_HEX[c.bumper])
             self.arrows[i].set_positions(tuple(ps), tuple(tip))
-            self.force_texts[i].set_position(tip + 0.01 * 2 * self.half_h)
+            xy, ha = self._force_text_place(ps, tip, label_xy)
+            self.force_texts[i].set_position(xy)
+            self.force_texts[i].set_horizontalalignment(ha)
             show = self.show_force_text and c.force_n >= 0.05
             self.force_texts[i].set_text(f"{c.force_n:.1f} N" if show else "")
         return self.artists()
 
+    def _inside(self, xy: np.ndarray) -> np.ndarray:
+        """Screen points moved just inside the frame (a label half out of it is cut)."""
+        margin = 0.035 * 2 * self.half_h
+        out = np.array(xy, dtype=float)
+        out[..., 0] = np.clip(out[..., 0], -self.half_w + margin, self.half_w - margin)
+        out[..., 1] = np.clip(out[..., 1], -self.half_h + margin, self.half_h - margin)
+        return out
+
+    def _force_text_place(
+        self, base: np.ndarray, tip: np.ndarray, labels: np.ndarray
+    ) -> tuple[np.ndarray, str]:
+        """Where a force value goes: beside its arrow, on the side away from the bumper numbers.
+
+        The two sides of the arrow's middle are tried; the one farther from the
+        nearest bumper number wins (so the value never sits on a number), and
+        it is kept inside the frame. Returns the point and the alignment.
+        """
+        d = np.asarray(tip, float) - np.asarray(base, float)
+        length = float(np.hypot(*d))
+        d = d / length if length > 1e-9 else np.array([0.0, 1.0])
+        perp = np.array([-d[1], d[0]])
+        mid = 0.5 * (np.asarray(base, float) + np.asarray(tip, float))
+        gap = 0.03 * 2 * self.half_h
+        best = None
+        for sign in (1.0, -1.0):
+            p = self._inside(mid + sign * gap * perp)
+            clearance = float(np.min(np.hypot(*(labels - p).T))) if len(labels) else np.inf
+            if best is None or clearance > best[0]:
+                best = (clearance, p, sign * perp[0])
+        _, point, side = best
+        return point, ("left" if side >= 0.0 else "right")
+
     def artists(self) -> list:
         """Every artist this view draws (for blitting: all change between frames
         or lie over ones that do), in drawing order (by zorder)."""
-        arts = [a for _p, _m, _r, poly, grid in self.planes for a in (poly, grid)]
+        arts = [a for _p, _m, _w, poly, grid in self.planes for a in (poly, grid)]
         arts += [*self.discs, self.arms, self.hub, *self.axes_lines, *self.axes_text]
         arts += [*self.circles, *self.labels, *self.points, *self.deflections, *self.arrows]
         arts += [*self.force_texts, *self.compass]

@@ -44,7 +44,7 @@ from quadimpact.core import layout as L
 from quadimpact.errors import input_error_from_validation
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import GROUND, Plane
-from quadimpact.rotations import quat_to_matrix
+from quadimpact.rotations import quat_to_matrix, unwrap_deg
 from quadimpact.simulation.packing import pack_surface_records, pack_surfaces, pack_vehicle
 
 __all__ = [
@@ -422,6 +422,27 @@ class SceneFrame:
     forces: np.ndarray = field(default_factory=lambda: np.zeros(4))
 
 
+def _drawable_rows(ts: pd.DataFrame) -> pd.DataFrame:
+    """The samples that can be drawn: time, pose, deflections, forces and attitude finite.
+
+    Raises
+    ------
+    ValueError
+        When no sample can be drawn (a run whose state is NaN throughout).
+    """
+    columns = ["t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "roll_deg", "pitch_deg",
+               "yaw_deg", *(f"delta{j}_m" for j in (1, 2, 3, 4)),
+               *(f"force{j}_n" for j in (1, 2, 3, 4))]  # fmt: skip
+    present = [c for c in columns if c in ts]
+    ok = np.all(np.isfinite(ts[present].to_numpy(dtype=float)), axis=1)
+    if not ok.any():
+        raise ValueError(
+            "nothing to draw: every sample of the run is NaN or infinite "
+            "(its summary.json says why: status and reason)"
+        )
+    return ts if ok.all() else ts[ok]
+
+
 _STATE_COLUMNS = (
     ["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3"]
     + ["p_rad_s", "q_rad_s", "r_rad_s"]
@@ -481,7 +502,7 @@ class Scene:
             self.surf = pack_surfaces(self.surfaces)
         else:
             self.surf = np.zeros((0, L.NSURF))
-        ts = timeseries
+        ts = _drawable_rows(timeseries)
         self.t = ts["t_s"].to_numpy(dtype=float)
         self.states = np.zeros((len(ts), L.NX))
         for k, col in enumerate(_STATE_COLUMNS):
@@ -489,9 +510,11 @@ class Scene:
                 self.states[:, k] = ts[col].to_numpy(dtype=float)
         self.deltas = np.stack([ts[f"delta{j}_m"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
         self.forces = np.stack([ts[f"force{j}_n"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
+        # roll and yaw continuous through +-180 deg (drawn and interpolated so)
         self.euler_deg = np.stack(
-            [ts[c].to_numpy(dtype=float) for c in ("roll_deg", "pitch_deg", "yaw_deg")], 1
-        )
+            [unwrap_deg(ts["roll_deg"]), ts["pitch_deg"].to_numpy(dtype=float),
+             unwrap_deg(ts["yaw_deg"])], 1
+        )  # fmt: skip
         self.altitude = -self.states[:, 2]
         fc = summary.get("first_contact_s")
         self.first_contact_s: float | None = None if fc is None else float(fc)
@@ -502,7 +525,7 @@ class Scene:
         stage = ts["stage"].to_numpy(dtype=float) if "stage" in ts else None
         self.stages: np.ndarray | None = None
         if stage is not None and (summary.get("controller") == "recovery" or np.any(stage != 0)):
-            self.stages = np.rint(stage).astype(int)
+            self.stages = np.rint(np.nan_to_num(stage)).astype(int)
         self.anchor = self.state_at(
             self.t[0] if self.first_contact_s is None else self.first_contact_s
         )[0:3].copy()
@@ -628,6 +651,22 @@ class Scene:
                     )
                 )
         return marks
+
+    def first_contact_points(self) -> dict[str, np.ndarray]:
+        """Where each surface was touched at the run's first contact (NED), by surface name.
+
+        A wall panel is drawn cut there (``render.wall_range``, the viewer), so
+        that its edge is where the vehicle met it, whatever the camera follows.
+        """
+        if self.first_contact_s is None:
+            return {}
+        points: dict[str, np.ndarray] = {}
+        for dt in (0.0, 1e-3, 5e-3):  # at the onset the deflection may still be zero
+            for c in self.frame(min(self.first_contact_s + dt, self.t_end)).contacts:
+                points.setdefault(c.surface, np.asarray(c.surface_point, dtype=float))
+            if points:
+                break
+        return points
 
     def target(self, t: float, camera: Camera) -> np.ndarray:
         """Point at the picture centre at time ``t`` for ``camera``."""

@@ -49,6 +49,18 @@ DEFAULT_SNAPSHOT_CAMERA = Camera(azimuth_deg=120.0, elevation_deg=20.0, follow="
 SNAPSHOT_DPI = 150
 
 
+def requested_times(
+    times: Sequence[float] | None = None, paper_figure: int | None = None
+) -> list[float]:
+    """The times after impact asked for: ``times``, else the paper figure's (default 8)."""
+    if times is not None:
+        return [float(t) for t in times]
+    fig = 8 if paper_figure is None else int(paper_figure)
+    if fig not in PAPER_FIGURE_TIMES:
+        raise ValueError(f"paper figure must be 7 or 8 (got {paper_figure})")
+    return [float(t) for t in PAPER_FIGURE_TIMES[fig]]
+
+
 def select_times(
     scene: Scene, times: Sequence[float] | None = None, paper_figure: int | None = None
 ) -> tuple[list[float], list[str]]:
@@ -56,13 +68,8 @@ def select_times(
 
     ``times`` wins over ``paper_figure``; with neither, Figure 8's times.
     """
-    if times is None:
-        fig = 8 if paper_figure is None else int(paper_figure)
-        if fig not in PAPER_FIGURE_TIMES:
-            raise ValueError(f"paper figure must be 7 or 8 (got {paper_figure})")
-        times = PAPER_FIGURE_TIMES[fig]
     kept, warnings = [], []
-    for tau in times:
+    for tau in requested_times(times, paper_figure):
         t = scene.t_ref + float(tau)
         if scene.t_start - 1e-9 <= t <= scene.t_end + 1e-9:
             kept.append(float(tau))
@@ -154,7 +161,14 @@ def write_snapshots(
     scene = scene or Scene.from_dir(result_dir)
     kept, warnings = select_times(scene, times, paper_figure)
     if not kept:
-        raise ValueError("none of the snapshot times falls inside the run: " + "; ".join(warnings))
+        asked = requested_times(times, paper_figure)
+        first, last = min(asked), max(asked)
+        raise ValueError(
+            f"none of the snapshot times ({first:g} to {last:g} s after the impact at "
+            f"t = {scene.t_ref:.3f} s) falls inside the run [{scene.t_start:.3f}, "
+            f"{scene.t_end:.3f}] s; times from {scene.t_start - scene.t_ref:.3g} to "
+            f"{scene.t_end - scene.t_ref:.3g} s after the impact are inside it"
+        )
     fig = make_snapshots(scene, kept, camera)
     out = Path(out_dir if out_dir is not None else result_dir)
     out.mkdir(parents=True, exist_ok=True)

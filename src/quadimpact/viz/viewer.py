@@ -97,6 +97,7 @@ def viewer_data(
     d = scene.drawing
     # a coarser circle is plenty on screen
     step = max(1, (d.circles.shape[1] - 1) // 48)
+    cuts = scene.first_contact_points()  # a wall panel's edge: where it was first touched
     surfaces = [
         {
             "name": s.name,
@@ -104,6 +105,7 @@ def viewer_data(
             "normal": list(map(float, np.asarray(s.normal) / np.linalg.norm(s.normal))),
             "ground": bool(s.is_ground),
             "contact": True,
+            "cut": _r(cuts[s.name], 5) if s.name in cuts else None,
         }
         for s in scene.surfaces
     ]
