@@ -37,6 +37,7 @@ _EXPORTS = {
     "InputError": "quadimpact.errors",
     "simulate": "quadimpact.simulation",
     "Simulation": "quadimpact.simulation",
+    "simulate_batch": "quadimpact.simulation",
     "read_result": "quadimpact.results.result",
 }
 

@@ -12,8 +12,9 @@
   one control interval at a time from Python.
 """
 
+from quadimpact.simulation.batch import simulate_batch
 from quadimpact.simulation.simulate import run_setup, simulate
 from quadimpact.simulation.stepping import Simulation
 from quadimpact.simulation.summary import build_summary
 
-__all__ = ["Simulation", "build_summary", "run_setup", "simulate"]
+__all__ = ["Simulation", "build_summary", "run_setup", "simulate", "simulate_batch"]
