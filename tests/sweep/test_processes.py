@@ -328,6 +328,19 @@ def _start(log: Path, tmp: Path, *args: str) -> subprocess.Popen:
         )  # fmt: skip
 
 
+def _wait_for_port(port: int, proc: subprocess.Popen, log: Path, limit_s: float = 60.0) -> None:
+    """Wait until ``proc`` listens on 127.0.0.1:``port`` (a Dask scheduler takes a few seconds)."""
+    end = time.monotonic() + limit_s
+    while time.monotonic() < end:
+        assert proc.poll() is None, log.read_text()
+        try:
+            with socket.create_connection(("127.0.0.1", port), timeout=1.0):
+                return
+        except OSError:
+            time.sleep(0.1)
+    raise AssertionError(f"nothing listens on port {port} after {limit_s} s:\n{log.read_text()}")
+
+
 def _group_cpu(proc: subprocess.Popen) -> float:
     try:
         root = psutil.Process(proc.pid)
@@ -358,6 +371,7 @@ def test_dask_without_workers_says_so(tmp_path, tmpdir_env, reference):
                    "--local-directory", str(tmp_path))  # fmt: skip
     scheduler = _start(tmp_path / "scheduler.log", tmp_path, "distributed.cli.dask_scheduler",
                        "--host", "127.0.0.1", "--port", str(port), "--no-dashboard")  # fmt: skip
+    _wait_for_port(port, scheduler, tmp_path / "scheduler.log")  # the sweep checks it at once
     worker = _start(tmp_path / "worker.log", tmp_path, *worker_args)
     try:
         sweep = Sweep(tmp_path / "out", tmpdir_env, "--scheduler", address, workers=None)
