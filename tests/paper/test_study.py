@@ -19,7 +19,12 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     monkeypatch.setattr(study, "RECOVERY_COMPARE_N", 20)
     r = reproduce(tmp_path, ablation=False, experiments=False, workers=2, progress=True)
     err = capsys.readouterr().err.splitlines()
-    stages = [line for line in err if line.startswith("reproduce: ")]
+    timed = re.compile(r"^(reproduce: .+): (\d+\.\d) s$")  # a stage's end, with its time
+    stages = [line for line in err if line.startswith("reproduce: ") and not timed.match(line)]
+    ends = [timed.match(line) for line in err if timed.match(line)]
+    assert [m.group(1) for m in ends] == stages  # each stage ends, in order, with its time
+    assert [name for name, _ in r.stage_times] == [s.removeprefix("reproduce: ") for s in stages]
+    assert sum(t for _, t in r.stage_times) <= r.elapsed_s
     assert stages == [
         "reproduce: Figure 4 sweep and the example run, paper-replica",
         "reproduce: Figure 4 sweep and the example run, default",
@@ -33,6 +38,9 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     ]
     assert err[err.index(stages[0]) + 1] == "sweep: 246 runs to do"  # each sweep is named
     text = r.report.read_text()
+    assert "## Time per stage" in text
+    for name, seconds in r.stage_times:
+        assert f"| {name} | {seconds:.1f} |" in text
     f = r.findings
     assert set(f["variant"]) == {"paper-replica", "default"}
     assert len(f) == 2 * 10 and set(f["verdict"]) <= {"agrees", "partly", "disagrees", "n/a"}

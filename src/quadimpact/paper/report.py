@@ -64,12 +64,14 @@ def render_report(
     elapsed_s: float,
     table3: pd.DataFrame | None = None,
     recovery: Any = None,
+    stage_times: list[tuple[str, float]] | None = None,
 ) -> str:
     """The Markdown report: findings, ablation, figures, Table II, Table III, recovery.
 
     The variants are those of ``findings`` (in its order) and the ablation's
     switches those of ``ablation``; ``recovery`` is the study's
-    ``RecoveryPart`` (:func:`recovery_markdown`), or None.
+    ``RecoveryPart`` (:func:`recovery_markdown`), or None; ``stage_times``,
+    (stage, wall time in s) in order, ends the report with the time per stage.
     """
     variants = list(dict.fromkeys(findings["variant"]))
     switches = list(dict.fromkeys(ablation["switch"])) if not ablation.empty else []
@@ -142,6 +144,11 @@ def render_report(
         lines += ["## Table III: the seven real crashes", "", table3_markdown(table3), ""]
     if recovery is not None:
         lines += [recovery_markdown(recovery, elapsed_s), ""]
+    if stage_times:
+        lines += ["## Time per stage", "", "Wall time of each stage of this run.", "",
+                  "| stage | time (s) |", "|---|---|"]  # fmt: skip
+        lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in stage_times]
+        lines += [f"| whole study | {elapsed_s:.1f} |", ""]
     return "\n".join(lines) + "\n"
 
 

@@ -33,7 +33,7 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
@@ -87,6 +87,7 @@ class StudyResult:
     ablation: pd.DataFrame
     elapsed_s: float
     recovery: RecoveryPart | None = None
+    stage_times: list[tuple[str, float]] = field(default_factory=list)
 
 
 @dataclass
@@ -107,10 +108,36 @@ class RecoveryPart:
     elapsed_s: float
 
 
-def _stage(progress: bool, text: str) -> None:
-    """Name the stage that starts (on stderr, with the progress)."""
-    if progress:
-        print(f"reproduce: {text}", file=sys.stderr, flush=True)
+class StageClock:
+    """Names each stage of the study as it starts and times it (wall clock, s).
+
+    With ``progress`` each stage is named on stderr when it starts and its
+    time given when it ends (``reproduce: <stage>: 3.2 s``); ``times`` holds
+    (stage, seconds) in order, for the report.
+    """
+
+    def __init__(self, progress: bool) -> None:
+        self.progress = progress
+        self.times: list[tuple[str, float]] = []
+        self._current: tuple[str, float] | None = None
+
+    def start(self, text: str) -> None:
+        """End the running stage (if any) and start the one named ``text``."""
+        self.stop()
+        self._current = (text, time.perf_counter())
+        if self.progress:
+            print(f"reproduce: {text}", file=sys.stderr, flush=True)
+
+    def stop(self) -> None:
+        """End the running stage (if any) and record its time."""
+        if self._current is None:
+            return
+        text, t0 = self._current
+        self._current = None
+        seconds = time.perf_counter() - t0
+        self.times.append((text, seconds))
+        if self.progress:
+            print(f"reproduce: {text}: {seconds:.1f} s", file=sys.stderr, flush=True)
 
 
 def _ablation_name(switch: str) -> str:
@@ -153,6 +180,7 @@ def reproduce(
     from quadimpact.results.files import check_out_dir
 
     start = time.perf_counter()
+    clock = StageClock(progress)
     out = check_out_dir(Path(out_dir), "report", where="")
     if experiments and data_dir is not None:
         data_dir = check_data_dir(data_dir, "data_dir")
@@ -160,7 +188,7 @@ def reproduce(
     tables: dict[str, pd.DataFrame] = {}
     found: dict[str, list[Finding]] = {}
     for variant in VARIANTS:
-        _stage(progress, f"Figure 4 sweep and the example run, {variant}")
+        clock.start(f"Figure 4 sweep and the example run, {variant}")
         table, ex = _run_variant(variant, {"model": variant}, out, workers, scheduler, progress)
         ex.write(out / f"example-{variant}")
         write_snapshots(out / f"example-{variant}", scene=Scene.from_result(ex))
@@ -169,7 +197,7 @@ def reproduce(
     ablation_rows = []
     if ablation:
         for k, switch in enumerate(SWITCHES, 1):
-            _stage(progress, f"ablation {k} of {len(SWITCHES)}: the replica without {switch}")
+            clock.start(f"ablation {k} of {len(SWITCHES)}: the replica without {switch}")
             name = _ablation_name(switch)
             base = {
                 "model": "paper-replica",
@@ -185,15 +213,15 @@ def reproduce(
     if experiments:
         from quadimpact.experiments.table3 import run_experiments
 
-        _stage(progress, "Table III: the seven real crashes")
+        clock.start("Table III: the seven real crashes")
         table3 = run_experiments(
             out / "experiments", data_dir=data_dir, workers=workers, scheduler=scheduler,
             progress=progress,
         )  # fmt: skip
 
-    part = recovery_part(out, tables, workers, scheduler, progress) if recovery else None
+    part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
 
-    _stage(progress, "figures, tables and the report")
+    clock.start("figures, tables and the report")
     # tables behind the report
     pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
     table2(tables).to_parquet(out / "table2.parquet")
@@ -202,10 +230,13 @@ def reproduce(
     for variant in VARIANTS:
         fig4_figure(tables[variant], variant).savefig(out / f"fig4_{variant}.png", dpi=120)
         type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
+    clock.stop()
     elapsed = time.perf_counter() - start
     report = out / "report.md"
-    report.write_text(render_report(tables, findings, ablation_df, elapsed, table3, part))
-    return StudyResult(out, report, tables, findings, ablation_df, elapsed, part)
+    report.write_text(
+        render_report(tables, findings, ablation_df, elapsed, table3, part, clock.times)
+    )
+    return StudyResult(out, report, tables, findings, ablation_df, elapsed, part, clock.times)
 
 
 # ---------------------------------------------------------------- recovery
@@ -215,18 +246,23 @@ def recovery_part(
     workers: int | None,
     scheduler: str | None,
     progress: bool,
+    clock: StageClock | None = None,
 ) -> RecoveryPart:
-    """Beyond the paper: recovery (see the module docstring); ``tables``: the Figure 4 sweeps."""
+    """Beyond the paper: recovery (see the module docstring); ``tables``: the Figure 4 sweeps.
+
+    ``clock`` names and times the stages (default: a new one, with ``progress``).
+    """
     start = time.perf_counter()
+    clock = clock if clock is not None else StageClock(progress)
     par = {"workers": workers, "scheduler": scheduler, "progress": progress}
     rec = out / "recovery"
     trials: dict[str, pd.DataFrame] = {}
     for v in RECOVERY_VARIANTS:
-        _stage(progress, f"recovery: {RECOVERY_N:,} impact trials of the Navi, {v}")
+        clock.start(f"recovery: {RECOVERY_N:,} impact trials of the Navi, {v}")
         trials[f"navi, {v}"] = run_trials(RecoveryStudy(n=RECOVERY_N, model=v),
                                           rec / f"navi-{v}", **par)[1]  # fmt: skip
     m = RECOVERY_COMPARE_N
-    _stage(progress, f"recovery: {m:,} trials with the noisy IMU, {m:,} of the Spiri")
+    clock.start(f"recovery: {m:,} trials with the noisy IMU, {m:,} of the Spiri")
     trials["navi, noisy IMU"] = run_trials(RecoveryStudy(n=m, imu="noisy"), rec / "navi-noisy",
                                            **par)[1]  # fmt: skip
     trials["spiri"] = run_trials(RecoveryStudy(vehicle="spiri", n=m), rec / "spiri", **par)[1]
@@ -242,7 +278,7 @@ def recovery_part(
 
     grid, runs = {}, []
     for variant in VARIANTS:
-        _stage(progress, f"recovery: the Figure 4 grid with the recovery controller, {variant}")
+        clock.start(f"recovery: the Figure 4 grid with the recovery controller, {variant}")
         table = run_sweep(
             SweepSpec(base=recovery_base({"model": variant}), grid=FIG4_GRID),
             out / "sweeps" / f"recovery-{variant}", **par,
@@ -250,7 +286,7 @@ def recovery_part(
         both = grid_comparison(tables[variant], table, list(FIG4_GRID))
         grid[variant] = saved_by_type(both)
         runs.append(both.assign(variant=variant))
-    _stage(progress, "recovery: the crashes without their power-off, nominal and recovery")
+    clock.start("recovery: the crashes without their power-off, nominal and recovery")
     crashes = crashes_without_power_off(VARIANTS)
 
     pd.concat([t.assign(study=k) for k, t in trials.items()]).to_parquet(
