@@ -471,6 +471,8 @@ def facet_panels(table: pd.DataFrame, facet: str | None) -> list[tuple[Any, pd.D
 
 # ------------------------------------------------------ sweep tables: type map
 def _mode(values: pd.Series) -> Any:
+    if len(values) == 1:  # one run per cell (a grid): no counting needed
+        return values.iloc[0]
     counts = values.value_counts(dropna=False)
     return counts.index[0] if len(counts) else None
 
