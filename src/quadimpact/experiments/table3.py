@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import sys
+import time
 from pathlib import Path
 from typing import Any
 
@@ -311,6 +312,58 @@ def _log_row(
     return row
 
 
+def _crash_row(
+    crash: Crash,
+    log: SpiriMatLog | None,
+    out: Path,
+    samples: int,
+    log_samples: int,
+    sweep_options: dict[str, Any],
+) -> tuple[dict[str, Any], float]:
+    """One crash of Table III: its runs, files and sweeps in ``out``; its row and wall time, s."""
+    from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
+
+    start = time.perf_counter()
+    folder = out / f"crash_{crash.number}"
+    types: dict[str, str | None] = {}
+    results = {}
+    for model, key in (("default", "type_ours"), ("paper-replica", "type_replica")):
+        r = simulate(crash.scenario(model))
+        r.write(folder / model)
+        results[model] = r
+        types[key] = r.summary["response_type"]
+    shares: dict[str, float] = {f"share_{t}": math.nan for t in RESPONSE_TYPES}
+    if samples > 0:
+        sweep = run_sweep(
+            sensitivity_spec(crash, samples),
+            out / "sensitivity" / f"crash_{crash.number}",
+            **sweep_options,
+        )
+        shares = _shares(sweep, "share_")
+    comparison = compare_crash(crash, results["default"], log, folder)
+    motion = {c: math.nan for c in MOTION_COLUMNS}
+    if comparison is not None:
+        for angle, (sim, logged) in comparison.departures(0.3).items():
+            motion[f"sim_{angle}_change_deg_0_3s"] = sim
+            motion[f"log_{angle}_change_deg_0_3s"] = logged
+    row = {
+        "crash": crash.number,
+        "heading_deg": crash.heading_deg,
+        "speed_m_s": crash.speed_m_s,
+        "inclination_deg": crash.inclination_deg,
+        "type_paper_experiment": crash.type_experiment,
+        "type_paper_simulation": crash.type_paper_simulation,
+        **types,
+        **shares,
+        "attitude_rms_deg_0_3s": attitude_rms(comparison),
+        "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
+        **_log_row(crash, log, folder, out, log_samples, sweep_options),
+        **motion,
+    }
+    row["verdict"], row["verdict_reason"] = crash_verdict(row)
+    return row, time.perf_counter() - start
+
+
 def run_experiments(
     out_dir: str | Path,
     *,
@@ -335,66 +388,58 @@ def run_experiments(
     samples, log_samples : int
         Runs per crash over Table III's uncertainty, and over the log
         estimates' uncertainty (0: none).
-    workers, scheduler, progress
-        As for :func:`quadimpact.sweep.run_sweep`.
+    workers : int, optional
+        Local processes (default: the cores this process may use). With more
+        than one, the crashes run one per process
+        (:func:`quadimpact.sweep.tasks.run_tasks`), each with its sweeps in
+        its own process; with 1, one after the other in this process. The
+        table is the same either way.
+    scheduler : str, optional
+        A Dask scheduler's address: the crashes then run one after the other
+        here and their sweeps on the cluster.
+    progress : bool
+        Say on stderr what runs (and show the sweeps' progress when the
+        crashes run here).
 
     Returns
     -------
     pandas.DataFrame
         The table written to ``table3.csv``.
     """
-    from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
     from quadimpact.results.files import check_out_dir
+    from quadimpact.sweep.run import _resolve_workers
+    from quadimpact.sweep.tasks import run_tasks
 
-    sweep_options = {"workers": workers, "scheduler": scheduler, "progress": progress}
     data_dir = check_data_dir(data_dir, "data_dir")
     out = check_out_dir(Path(out_dir), "experiments", where="")
     out.mkdir(parents=True, exist_ok=True)
     logs = {crash.number: read_log(crash, data_dir) for crash in TABLE3}  # a bad file: now
-    rows: list[dict[str, Any]] = []
-    for crash in TABLE3:
+    n = len(TABLE3)
+    processes = 1 if scheduler is not None else _resolve_workers(workers)
+    if processes > 1:  # one crash per process, each with its sweeps in that process
+        sweep_options = {"workers": 1, "scheduler": None, "progress": False}
         if progress:
-            print(f"experiments: crash {crash.number} of {len(TABLE3)}: both variants, then "
-                  "the runs over the uncertainty", file=sys.stderr, flush=True)  # fmt: skip
-        folder = out / f"crash_{crash.number}"
-        types: dict[str, str | None] = {}
-        results = {}
-        for model, key in (("default", "type_ours"), ("paper-replica", "type_replica")):
-            r = simulate(crash.scenario(model))
-            r.write(folder / model)
-            results[model] = r
-            types[key] = r.summary["response_type"]
-        shares: dict[str, float] = {f"share_{t}": math.nan for t in RESPONSE_TYPES}
-        if samples > 0:
-            sweep = run_sweep(
-                sensitivity_spec(crash, samples),
-                out / "sensitivity" / f"crash_{crash.number}",
-                **sweep_options,
-            )
-            shares = _shares(sweep, "share_")
-        log = logs[crash.number]
-        comparison = compare_crash(crash, results["default"], log, folder)
-        motion = {c: math.nan for c in MOTION_COLUMNS}
-        if comparison is not None:
-            for angle, (sim, logged) in comparison.departures(0.3).items():
-                motion[f"sim_{angle}_change_deg_0_3s"] = sim
-                motion[f"log_{angle}_change_deg_0_3s"] = logged
-        row = {
-            "crash": crash.number,
-            "heading_deg": crash.heading_deg,
-            "speed_m_s": crash.speed_m_s,
-            "inclination_deg": crash.inclination_deg,
-            "type_paper_experiment": crash.type_experiment,
-            "type_paper_simulation": crash.type_paper_simulation,
-            **types,
-            **shares,
-            "attitude_rms_deg_0_3s": attitude_rms(comparison),
-            "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
-            **_log_row(crash, log, folder, out, log_samples, sweep_options),
-            **motion,
-        }
-        row["verdict"], row["verdict_reason"] = crash_verdict(row)
-        rows.append(row)
+            print(f"experiments: the {n} crashes on {min(processes, n)} processes (each: both "
+                  "variants, then the runs over the uncertainty)",
+                  file=sys.stderr, flush=True)  # fmt: skip
+
+        def done(i: int, result: tuple[dict[str, Any], float]) -> None:
+            if progress:
+                print(f"experiments: crash {TABLE3[i].number} of {n} done in {result[1]:.1f} s",
+                      file=sys.stderr, flush=True)  # fmt: skip
+
+        tasks = [(c, logs[c.number], out, samples, log_samples, sweep_options) for c in TABLE3]
+        rows = [row for row, _ in run_tasks(_crash_row, tasks, processes, done)]
+    else:
+        sweep_options = {"workers": workers, "scheduler": scheduler, "progress": progress}
+        rows = []
+        for crash in TABLE3:
+            if progress:
+                print(f"experiments: crash {crash.number} of {n}: both variants, then "
+                      "the runs over the uncertainty", file=sys.stderr, flush=True)  # fmt: skip
+            row, _ = _crash_row(crash, logs[crash.number], out, samples, log_samples,
+                                sweep_options)  # fmt: skip
+            rows.append(row)
     table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *EXTRA_COLUMNS])
     table.to_csv(out / "table3.csv", index=False)
     table.to_parquet(out / "table3.parquet")

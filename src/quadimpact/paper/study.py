@@ -55,6 +55,7 @@ from quadimpact.recovery.study import RecoveryStudy, run_trials
 from quadimpact.results import figures
 from quadimpact.simulation import simulate
 from quadimpact.sweep import SweepSpec, run_sweep
+from quadimpact.sweep.run import warm_pool
 from quadimpact.viz.scene import Scene
 from quadimpact.viz.snapshots import write_snapshots
 
@@ -185,6 +186,7 @@ def reproduce(
     if experiments and data_dir is not None:
         data_dir = check_data_dir(data_dir, "data_dir")
     out.mkdir(parents=True, exist_ok=True)
+    warm_pool(workers, scheduler)  # the sweeps below find the pool's server ready
     tables: dict[str, pd.DataFrame] = {}
     found: dict[str, list[Finding]] = {}
     for variant in VARIANTS:

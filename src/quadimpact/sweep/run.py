@@ -46,6 +46,9 @@ LARGE_SWEEP_RUNS = 1_000_000
 """Sweeps with more runs than this need ``allow_large=True`` (``--allow-large``)."""
 FINISH_HERE_S = 1.0
 """A default sweep finishes in this process when its runs left would take less than this, s."""
+FINISH_HERE_WARM_S = 0.25
+"""The same when this process's pool server is already warm (an earlier sweep, or
+:func:`warm_pool`): workers then start in milliseconds, s."""
 MEASURE_S = 0.25
 """A default sweep measures the idle cores over its first runs for this long, s."""
 START_HERE_MAX_S = 3.0
@@ -265,7 +268,8 @@ def _start_here(
     The sweep process loads the kernel and does runs, timing them and
     measuring how idle the cores it may use are (``/proc/stat``). It
     finishes the sweep itself when the runs left would take less than
-    :data:`FINISH_HERE_S` here, or when after :data:`MEASURE_S` fewer than
+    :data:`FINISH_HERE_S` here (:data:`FINISH_HERE_WARM_S` when the pool's
+    server is already warm), or when after :data:`MEASURE_S` fewer than
     one other core is idle (a pool would only compete with the other work
     for the same cores). Otherwise it starts the pool's fork server with one
     worker per idle core (and this one) and goes on here until the server has
@@ -280,6 +284,9 @@ def _start_here(
     """
     warm_up()
     ctx = pool_context()
+    # a server this process already warmed (an earlier sweep, warm_pool) starts workers at once
+    warm = ctx.get_start_method() == "forkserver" and server_ready(ctx)
+    finish_here_s = FINISH_HERE_WARM_S if warm else FINISH_HERE_S
     started: float | None = None
     workers = 1
     busy, n_here = 0.0, 0
@@ -290,7 +297,7 @@ def _start_here(
         now = time.perf_counter()
         busy += now - t
         n_here += 1
-        if (n_todo - n_here) * busy / n_here < FINISH_HERE_S:
+        if (n_todo - n_here) * busy / n_here < finish_here_s:
             break  # less than that left: finish here
         if started is None:
             if now - t0 < MEASURE_S:
@@ -304,6 +311,24 @@ def _start_here(
             return n_here, workers
     run_serial(make_chunks(spec, todo, 16), sink)
     return n_todo, 1
+
+
+def warm_pool(workers: int | None = None, scheduler: Any = None) -> None:
+    """Start the local pool's fork server now, for the default sweeps to come (a study).
+
+    A program that will run several sweeps (``quadimpact reproduce``) calls
+    this first: the server imports the simulator and loads the kernel on
+    another core while the program goes on, so that its sweeps find it warm
+    and use the pool from :data:`FINISH_HERE_WARM_S` of work on. Nothing
+    happens for a Dask ``scheduler``, one worker, or where there is no fork
+    server. The server ends with this process, as for any sweep.
+    """
+    if scheduler is not None or (workers is not None and workers < 2) or default_workers() < 2:
+        return
+    _refuse_in_a_starting_worker()
+    ctx = pool_context()
+    if ctx.get_start_method() == "forkserver":
+        start_server(ctx)
 
 
 def pool_size(idle: float | None, cores: int) -> int:

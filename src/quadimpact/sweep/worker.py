@@ -104,10 +104,14 @@ def warm_up() -> None:
     if _WARM:
         return
     from quadimpact import simulate  # noqa: F401  (the simulator: pandas, analysis...)
-    from quadimpact.inputs.scenarios import WallApproach
-    from quadimpact.simulation.setup import prepare
+    from quadimpact.inputs.scenarios import ImpactTrial, WallApproach
+    from quadimpact.simulation.batch import BatchRunner
 
-    prepare(WallApproach(final_time_s=0.6, impact_time_s=0.1))  # runs the kernel
+    # a short run of each kind through the summary path: every compiled function a
+    # sweep's run calls is loaded here, once, not in each worker forked from here
+    runner = BatchRunner()
+    runner.summary(WallApproach(final_time_s=0.6, impact_time_s=0.1))
+    runner.summary(ImpactTrial(controller="recovery", final_time_s=0.3))
     _WARM = True
 
 

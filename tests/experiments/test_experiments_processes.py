@@ -1,0 +1,109 @@
+"""``quadimpact experiments`` runs its crashes on worker processes: Ctrl-C or kill -9
+of the command leaves no process and no temporary folder behind."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import psutil
+import pytest
+
+import quadimpact
+
+SRC = Path(quadimpact.__file__).resolve().parents[1]
+GONE_S = 5.0
+
+
+def _alive(p: psutil.Process) -> bool:
+    try:
+        return p.is_running() and p.status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
+
+
+def _cpu(p: psutil.Process) -> float:
+    try:
+        t = p.cpu_times()
+        return t.user + t.system
+    except psutil.Error:
+        return 0.0
+
+
+def _start(out: Path, tmp: Path) -> subprocess.Popen:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+    env["TMPDIR"] = str(tmp)
+    env.pop("QUADIMPACT_DEBUG", None)
+    return subprocess.Popen(
+        [sys.executable, "-m", "quadimpact.cli", "experiments", "--out", str(out),
+         "--workers", "2"],
+        env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+    )  # fmt: skip
+
+
+def _busy_workers(proc: subprocess.Popen, seen: dict[int, psutil.Process]) -> None:
+    """Wait until two of the command's grandchildren (the task workers) are busy."""
+    end = time.monotonic() + 90
+    while time.monotonic() < end:
+        assert proc.poll() is None, proc.stderr.read().decode()
+        found = psutil.Process(proc.pid).children(recursive=True)
+        seen.update((p.pid, p) for p in found)
+        if sum(1 for p in found if p.ppid() != proc.pid and _cpu(p) >= 0.3) >= 2:
+            return
+        time.sleep(0.05)
+    raise AssertionError("the crashes' workers never got busy")
+
+
+def _all_gone(seen: dict[int, psutil.Process], tmp: Path) -> None:
+    end = time.monotonic() + GONE_S
+    alive = list(seen.values())
+    while alive and time.monotonic() < end:
+        alive = [p for p in alive if _alive(p)]
+        time.sleep(0.05)
+    names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if _alive(p)]
+    for p in alive:
+        p.kill()
+    assert not names, f"left running: {names}"
+    assert len(seen) >= 3, seen  # the fork server and two workers were seen
+    assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
+
+
+@pytest.fixture
+def tmpdir_env():
+    path = Path(tempfile.mkdtemp(prefix="qi-"))  # short: a Unix socket's path is limited
+    yield path
+    shutil.rmtree(path, ignore_errors=True)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("how", ["ctrl-c", "kill-9"])
+def test_stopping_experiments_leaves_nothing_running(tmp_path, tmpdir_env, how):
+    proc = _start(tmp_path / "out", tmpdir_env)
+    seen: dict[int, psutil.Process] = {}
+    try:
+        _busy_workers(proc, seen)
+        t = time.monotonic()
+        if how == "ctrl-c":
+            os.killpg(proc.pid, signal.SIGINT)  # a terminal sends it to the group
+            assert proc.wait(timeout=15) == 130
+            assert time.monotonic() - t < 10
+            err = proc.stderr.read().decode()
+            assert "Traceback" not in err and "Exception ignored" not in err, err
+        else:
+            proc.kill()  # the command alone
+            proc.wait(timeout=10)
+        _all_gone(seen, tmpdir_env)
+    finally:
+        for p in [proc, *seen.values()]:
+            try:
+                os.kill(p.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+        proc.wait(timeout=10)
