@@ -19,15 +19,21 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     monkeypatch.setattr(study, "RECOVERY_COMPARE_N", 20)
     r = reproduce(tmp_path, ablation=False, experiments=False, workers=2, progress=True)
     err = capsys.readouterr().err.splitlines()
-    timed = re.compile(r"^(reproduce: .+): (\d+\.\d) s$")  # a stage's end, with its time
+    timed = re.compile(r"^reproduce: (.+): (\d+\.\d) s$")  # a stage's or a piece's end
     stages = [line for line in err if line.startswith("reproduce: ") and not timed.match(line)]
-    ends = [timed.match(line) for line in err if timed.match(line)]
-    assert [m.group(1) for m in ends] == stages  # each stage ends, in order, with its time
-    assert [name for name, _ in r.stage_times] == [s.removeprefix("reproduce: ") for s in stages]
+    ends = [timed.match(line).group(1) for line in err if timed.match(line)]
+    pieces = ["Figure 4 sweep and the example run, paper-replica",
+              "Figure 4 sweep and the example run, default"]  # fmt: skip
+    # the two pieces (on two processes, in the order they finish), then each stage's end
+    assert sorted(ends[:2]) == sorted(pieces) and sorted(n for n, _ in r.piece_times) == sorted(
+        pieces
+    )
+    assert ends[2:] == [s.removeprefix("reproduce: ") for s in stages]  # in order, timed
+    assert [name for name, _ in r.stage_times] == ends[2:]
     assert sum(t for _, t in r.stage_times) <= r.elapsed_s
     assert stages == [
-        "reproduce: Figure 4 sweep and the example run, paper-replica",
-        "reproduce: Figure 4 sweep and the example run, default",
+        "reproduce: the paper's runs: 2 pieces on 2 processes (Figure 4 and the example in "
+        "both variants)",
         "reproduce: recovery: 40 impact trials of the Navi, default",
         "reproduce: recovery: 40 impact trials of the Navi, recovery-replica",
         "reproduce: recovery: 20 trials with the noisy IMU, 20 of the Spiri",
@@ -36,10 +42,10 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
         "reproduce: recovery: the crashes without their power-off, nominal and recovery",
         "reproduce: figures, tables and the report",
     ]
-    assert err[err.index(stages[0]) + 1] == "sweep: 246 runs to do"  # each sweep is named
+    assert err[err.index(stages[1]) + 1] == "sweep: 40 runs to do"  # each sweep is named
     text = r.report.read_text()
     assert "## Time per stage" in text
-    for name, seconds in r.stage_times:
+    for name, seconds in r.stage_times + r.piece_times:
         assert f"| {name} | {seconds:.1f} |" in text
     f = r.findings
     assert set(f["variant"]) == {"paper-replica", "default"}
@@ -87,3 +93,20 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     crashes = pd.read_parquet(tmp_path / "recovery_crashes.parquet")
     assert len(crashes) == 14 and (tmp_path / "recovery_by_inclination.png").is_file()
     assert f"This part took {part.elapsed_s:.1f} s" in text
+
+
+@pytest.mark.slow
+def test_reproduce_tables_do_not_depend_on_the_processes(tmp_path, capsys):
+    """The paper's pieces on two processes or one after the other here: the same tables."""
+    kw = {"ablation": False, "experiments": False, "recovery": False, "progress": True}
+    two = reproduce(tmp_path / "two", workers=2, **kw)
+    one = reproduce(tmp_path / "one", workers=1, **kw)
+    err = capsys.readouterr().err
+    assert "reproduce: Figure 4 sweep and the example run, default\nsweep: 246 runs to do" in err
+    assert not one.piece_times and len(two.piece_times) == 2
+    for name in ("fig4.parquet", "table2.parquet", "findings.parquet",
+                 "example-default/timeseries.parquet"):  # fmt: skip
+        pd.testing.assert_frame_equal(
+            pd.read_parquet(tmp_path / "two" / name), pd.read_parquet(tmp_path / "one" / name)
+        )
+

@@ -50,9 +50,10 @@ def reproduce(
     differences causes each disagreement. Beyond the paper, it runs the
     recovery controller: a Monte Carlo of impact trials of the Navi (2,000 per
     variant), the Figure 4 grid and the seven crashes without power-off,
-    nominal against recovery (docs/RECOVERY.md). Each stage is named on
-    stderr when it starts and timed when it ends; the report ends with the
-    time per stage.
+    nominal against recovery (docs/RECOVERY.md). The pieces before the
+    recovery part run side by side on the local cores (--workers 1: one
+    after the other here). Each stage is named on stderr when it starts and
+    timed when it ends; the report ends with the time per stage.
     """
     from quadimpact.experiments.table3 import check_data_dir
     from quadimpact.paper.study import reproduce as run_study

@@ -406,14 +406,10 @@ def run_experiments(
     pandas.DataFrame
         The table written to ``table3.csv``.
     """
-    from quadimpact.results.files import check_out_dir
     from quadimpact.sweep.run import _resolve_workers
     from quadimpact.sweep.tasks import run_tasks
 
-    data_dir = check_data_dir(data_dir, "data_dir")
-    out = check_out_dir(Path(out_dir), "experiments", where="")
-    out.mkdir(parents=True, exist_ok=True)
-    logs = {crash.number: read_log(crash, data_dir) for crash in TABLE3}  # a bad file: now
+    out, logs = prepare_experiments(out_dir, data_dir)
     n = len(TABLE3)
     processes = 1 if scheduler is not None else _resolve_workers(workers)
     if processes > 1:  # one crash per process, each with its sweeps in that process
@@ -429,7 +425,7 @@ def run_experiments(
                       file=sys.stderr, flush=True)  # fmt: skip
 
         tasks = [(c, logs[c.number], out, samples, log_samples, sweep_options) for c in TABLE3]
-        rows = [row for row, _ in run_tasks(_crash_row, tasks, processes, done)]
+        rows = [row for row, _ in run_tasks(crash_task, tasks, processes, done)]
     else:
         sweep_options = {"workers": workers, "scheduler": scheduler, "progress": progress}
         rows = []
@@ -440,6 +436,46 @@ def run_experiments(
             row, _ = _crash_row(crash, logs[crash.number], out, samples, log_samples,
                                 sweep_options)  # fmt: skip
             rows.append(row)
+    return write_table3(rows, out)
+
+
+def prepare_experiments(
+    out_dir: str | Path, data_dir: str | Path | None
+) -> tuple[Path, dict[int, SpiriMatLog | None]]:
+    """The experiments' folder (checked, created) and each crash's log (None where absent).
+
+    A ``data_dir`` given that holds no logs, a folder of another kind, or a
+    log that cannot be read is an error here, before any run.
+    """
+    from quadimpact.results.files import check_out_dir
+
+    data_dir = check_data_dir(data_dir, "data_dir")
+    out = check_out_dir(Path(out_dir), "experiments", where="")
+    out.mkdir(parents=True, exist_ok=True)
+    return out, {crash.number: read_log(crash, data_dir) for crash in TABLE3}
+
+
+def crash_task(
+    crash: Crash,
+    log: SpiriMatLog | None,
+    out: Path,
+    samples: int = SENSITIVITY_RUNS,
+    log_samples: int = LOG_SENSITIVITY_RUNS,
+    sweep_options: dict[str, Any] | None = None,
+) -> tuple[dict[str, Any], float]:
+    """One crash's runs, files and sweeps in ``out``: its row of Table III and its wall time, s.
+
+    The piece of work a study hands to a process
+    (:func:`quadimpact.sweep.tasks.run_tasks`); ``sweep_options`` go to its
+    sweeps (default: in this process, no progress).
+    """
+    options = sweep_options or {"workers": 1, "scheduler": None, "progress": False}
+    return _crash_row(crash, log, out, samples, log_samples, options)
+
+
+def write_table3(rows: list[dict[str, Any]], out: Path) -> pd.DataFrame:
+    """Table III from the crashes' rows (in crash order), written to ``out``
+    (``table3.csv``, ``table3.parquet``)."""
     table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *EXTRA_COLUMNS])
     table.to_csv(out / "table3.csv", index=False)
     table.to_parquet(out / "table3.parquet")

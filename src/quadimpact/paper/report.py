@@ -65,13 +65,15 @@ def render_report(
     table3: pd.DataFrame | None = None,
     recovery: Any = None,
     stage_times: list[tuple[str, float]] | None = None,
+    piece_times: list[tuple[str, float]] | None = None,
 ) -> str:
     """The Markdown report: findings, ablation, figures, Table II, Table III, recovery.
 
     The variants are those of ``findings`` (in its order) and the ablation's
     switches those of ``ablation``; ``recovery`` is the study's
     ``RecoveryPart`` (:func:`recovery_markdown`), or None; ``stage_times``,
-    (stage, wall time in s) in order, ends the report with the time per stage.
+    (stage, wall time in s) in order, ends the report with the time per stage,
+    and ``piece_times`` with those of the pieces that ran on worker processes.
     """
     variants = list(dict.fromkeys(findings["variant"]))
     switches = list(dict.fromkeys(ablation["switch"])) if not ablation.empty else []
@@ -149,6 +151,12 @@ def render_report(
                   "| stage | time (s) |", "|---|---|"]  # fmt: skip
         lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in stage_times]
         lines += [f"| whole study | {elapsed_s:.1f} |", ""]
+    if piece_times:
+        lines += ["The pieces that ran on worker processes, each with its own wall time "
+                  "(they ran side by side, so these overlap):", "",
+                  "| piece | time (s) |", "|---|---|"]  # fmt: skip
+        lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in piece_times]
+        lines.append("")
     return "\n".join(lines) + "\n"
 
 

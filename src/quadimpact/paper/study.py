@@ -35,6 +35,7 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 from matplotlib.figure import Figure
@@ -89,6 +90,7 @@ class StudyResult:
     elapsed_s: float
     recovery: RecoveryPart | None = None
     stage_times: list[tuple[str, float]] = field(default_factory=list)
+    piece_times: list[tuple[str, float]] = field(default_factory=list)
 
 
 @dataclass
@@ -114,12 +116,15 @@ class StageClock:
 
     With ``progress`` each stage is named on stderr when it starts and its
     time given when it ends (``reproduce: <stage>: 3.2 s``); ``times`` holds
-    (stage, seconds) in order, for the report.
+    (stage, seconds) in order, for the report, and ``pieces`` the same for the
+    pieces of a stage that ran on worker processes (their own wall times,
+    which overlap).
     """
 
     def __init__(self, progress: bool) -> None:
         self.progress = progress
         self.times: list[tuple[str, float]] = []
+        self.pieces: list[tuple[str, float]] = []
         self._current: tuple[str, float] | None = None
 
     def start(self, text: str) -> None:
@@ -128,6 +133,12 @@ class StageClock:
         self._current = (text, time.perf_counter())
         if self.progress:
             print(f"reproduce: {text}", file=sys.stderr, flush=True)
+
+    def piece(self, text: str, seconds: float) -> None:
+        """A piece of the running stage finished (on a worker process) in ``seconds``."""
+        self.pieces.append((text, seconds))
+        if self.progress:
+            print(f"reproduce: {text}: {seconds:.1f} s", file=sys.stderr, flush=True)
 
     def stop(self) -> None:
         """End the running stage (if any) and record its time."""
@@ -145,18 +156,26 @@ def _ablation_name(switch: str) -> str:
     return f"replica-without-{switch}"
 
 
-def _run_variant(
-    name: str, base: dict, out: Path, workers: int | None, scheduler: str | None, progress: bool
-) -> tuple[pd.DataFrame, tuple[dict, pd.DataFrame, pd.DataFrame]]:
-    table = run_sweep(
-        SweepSpec(base=base, grid=FIG4_GRID),
-        out / "sweeps" / name,
-        workers=workers,
-        scheduler=scheduler,
-        progress=progress,
-    )
+def _variant_task(
+    name: str, base: dict, out: Path, write_example: bool, sweep_options: dict[str, Any]
+) -> tuple[tuple[pd.DataFrame, list[Finding]], float]:
+    """One variant's Figure 4 sweep and example run (written when ``write_example``),
+    evaluated: ((its sweep table, its findings), wall time in s)."""
+    start = time.perf_counter()
+    table = run_sweep(SweepSpec(base=base, grid=FIG4_GRID), out / "sweeps" / name, **sweep_options)
     example = simulate(WallApproach(**EXAMPLE, **base))
-    return table, example
+    if write_example:
+        example.write(out / f"example-{name}")
+        write_snapshots(out / f"example-{name}", scene=Scene.from_result(example))
+    found = evaluate(table, (example.summary, example.episodes, example.timeseries))
+    return (table, found), time.perf_counter() - start
+
+
+def _paper_task(kind: str, *args: Any) -> tuple[Any, float]:
+    """A piece of the paper's study (``"variant"`` or ``"crash"``), for ``run_tasks``."""
+    from quadimpact.experiments.table3 import crash_task
+
+    return _variant_task(*args) if kind == "variant" else crash_task(*args)
 
 
 def reproduce(
@@ -177,8 +196,17 @@ def reproduce(
     their logs when ``data_dir`` (or the default data folder) holds them.
     With ``recovery``, "Beyond the paper: recovery" (:func:`recovery_part`).
     """
-    from quadimpact.experiments.table3 import check_data_dir
+    from quadimpact.experiments.table3 import (
+        LOG_SENSITIVITY_RUNS,
+        SENSITIVITY_RUNS,
+        TABLE3,
+        check_data_dir,
+        prepare_experiments,
+        write_table3,
+    )
     from quadimpact.results.files import check_out_dir
+    from quadimpact.sweep.run import _resolve_workers
+    from quadimpact.sweep.tasks import run_tasks
 
     start = time.perf_counter()
     clock = StageClock(progress)
@@ -187,39 +215,64 @@ def reproduce(
         data_dir = check_data_dir(data_dir, "data_dir")
     out.mkdir(parents=True, exist_ok=True)
     warm_pool(workers, scheduler)  # the sweeps below find the pool's server ready
-    tables: dict[str, pd.DataFrame] = {}
-    found: dict[str, list[Finding]] = {}
-    for variant in VARIANTS:
-        clock.start(f"Figure 4 sweep and the example run, {variant}")
-        table, ex = _run_variant(variant, {"model": variant}, out, workers, scheduler, progress)
-        ex.write(out / f"example-{variant}")
-        write_snapshots(out / f"example-{variant}", scene=Scene.from_result(ex))
-        tables[variant] = table
-        found[variant] = evaluate(table, (ex.summary, ex.episodes, ex.timeseries))
-    ablation_rows = []
+    processes = 1 if scheduler is not None else _resolve_workers(workers)
+    here = {"workers": workers, "scheduler": scheduler, "progress": progress}
+    inside = {"workers": 1, "scheduler": None, "progress": False}  # a piece's own sweeps
+    options = inside if processes > 1 else here
+    # the pieces of the paper's part, independent of each other: (stage name, task)
+    pieces: list[tuple[str, tuple[Any, ...]]] = [
+        (f"Figure 4 sweep and the example run, {v}",
+         ("variant", v, {"model": v}, out, True, options))
+        for v in VARIANTS
+    ]  # fmt: skip
     if ablation:
         for k, switch in enumerate(SWITCHES, 1):
-            clock.start(f"ablation {k} of {len(SWITCHES)}: the replica without {switch}")
-            name = _ablation_name(switch)
-            base = {
-                "model": "paper-replica",
-                "model_options": {switch: MODEL_VARIANTS["default"][switch]},
-            }
-            table, ex = _run_variant(name, base, out, workers, scheduler, progress)
-            tables[name] = table
-            fs = evaluate(table, (ex.summary, ex.episodes, ex.timeseries))
+            base = {"model": "paper-replica",
+                    "model_options": {switch: MODEL_VARIANTS["default"][switch]}}  # fmt: skip
+            task = ("variant", _ablation_name(switch), base, out, False, options)
+            pieces.append((f"ablation {k} of {len(SWITCHES)}: the replica without {switch}", task))
+    if experiments:
+        exp_out, logs = prepare_experiments(out / "experiments", data_dir)
+        pieces += [
+            (f"Table III: crash {c.number} of {len(TABLE3)}",
+             ("crash", c, logs[c.number], exp_out, SENSITIVITY_RUNS, LOG_SENSITIVITY_RUNS, options))
+            for c in TABLE3
+        ]  # fmt: skip
+    if processes > 1:
+        # the crashes first (the longest pieces): the processes end together
+        order = sorted(range(len(pieces)), key=lambda i: pieces[i][1][0] != "crash")
+        clock.start(f"the paper's runs: {len(pieces)} pieces on {min(processes, len(pieces))} "
+                    "processes (Figure 4 and the example in both variants"
+                    + (", the ablations" if ablation else "")
+                    + (", the crashes of Table III" if experiments else "") + ")")  # fmt: skip
+
+        def done(k: int, result: tuple[Any, float]) -> None:
+            clock.piece(pieces[order[k]][0], result[1])
+
+        ran = run_tasks(_paper_task, [pieces[i][1] for i in order], processes, done)
+        results = [r for _, r in sorted(zip(order, ran, strict=True))]
+    else:
+        results = []
+        for name, task in pieces:
+            clock.start(name)
+            results.append(_paper_task(*task))
+    tables: dict[str, pd.DataFrame] = {}
+    found: dict[str, list[Finding]] = {}
+    ablation_rows, crash_rows = [], []
+    for (_, task), (value, _seconds) in zip(pieces, results, strict=True):
+        if task[0] == "crash":
+            crash_rows.append(value)
+            continue
+        name, (table, fs) = task[1], value
+        tables[name] = table
+        if task[4]:  # a variant of the paper, not an ablation
+            found[name] = fs
+        else:
+            switch = name.removeprefix(_ablation_name(""))
             ablation_rows += [{"switch": switch, **f.__dict__} for f in fs]
     ablation_df = pd.DataFrame(ablation_rows)
     findings = findings_frame(found)
-    table3 = None
-    if experiments:
-        from quadimpact.experiments.table3 import run_experiments
-
-        clock.start("Table III: the seven real crashes")
-        table3 = run_experiments(
-            out / "experiments", data_dir=data_dir, workers=workers, scheduler=scheduler,
-            progress=progress,
-        )  # fmt: skip
+    table3 = write_table3(crash_rows, exp_out) if experiments else None
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
 
@@ -236,9 +289,12 @@ def reproduce(
     elapsed = time.perf_counter() - start
     report = out / "report.md"
     report.write_text(
-        render_report(tables, findings, ablation_df, elapsed, table3, part, clock.times)
+        render_report(tables, findings, ablation_df, elapsed, table3, part, clock.times,
+                      clock.pieces)  # fmt: skip
     )
-    return StudyResult(out, report, tables, findings, ablation_df, elapsed, part, clock.times)
+    return StudyResult(
+        out, report, tables, findings, ablation_df, elapsed, part, clock.times, clock.pieces
+    )
 
 
 # ---------------------------------------------------------------- recovery
