@@ -112,6 +112,8 @@ def warm_up() -> None:
     runner = BatchRunner()
     runner.summary(WallApproach(final_time_s=0.6, impact_time_s=0.1))
     runner.summary(ImpactTrial(controller="recovery", final_time_s=0.3))
+    import scipy.optimize  # noqa: F401  (a late start's root search: 0.25 s to import, once)
+
     _WARM = True
 
 
