@@ -8,9 +8,14 @@ e.g. ``pytest -m "not slow and not data"``.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from pathlib import Path
+
 import pytest
 
 from quadimpact.experiments.logs import DATA_ENV_VAR, data_dir
+
+from helpers import short_tmpdir
 
 DATA_MISSING = (
     f"shared crash data absent (set {DATA_ENV_VAR} to the folder holding "
@@ -25,3 +30,11 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if item.get_closest_marker("data") is not None:
             item.add_marker(skip)
+
+
+@pytest.fixture
+def tmpdir_env() -> Iterator[Path]:
+    """A short private folder for a command's ``TMPDIR`` (``helpers.short_tmpdir``)."""
+    with short_tmpdir() as path:
+        yield path
+

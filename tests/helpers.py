@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import shutil
+import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
+import psutil
 
 import quadimpact
 from quadimpact.core import layout as L
@@ -57,3 +62,33 @@ def run_cli(*args: str, cwd, timeout: float = 120, env: dict | None = None, umas
         cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout,
         preexec_fn=None if umask is None else (lambda: os.umask(umask)),
     )  # fmt: skip
+
+
+# ------------------------------------------------------------- processes
+def process_cpu_s(p: psutil.Process) -> float:
+    """CPU time (user + system, s) a process has used; 0 when it is gone."""
+    try:
+        t = p.cpu_times()
+        return t.user + t.system
+    except psutil.Error:
+        return 0.0
+
+
+def process_alive(p: psutil.Process) -> bool:
+    """Whether a process still runs (a zombie, waiting to be reaped, does not)."""
+    try:
+        return p.is_running() and p.status() != psutil.STATUS_ZOMBIE
+    except psutil.Error:
+        return False
+
+
+@contextmanager
+def short_tmpdir() -> Iterator[Path]:
+    """A short private folder for a command's ``TMPDIR`` (a Unix socket's path must stay
+    under 108 bytes, and multiprocessing's ``pymp-*`` folders of that command land in it)."""
+    path = Path(tempfile.mkdtemp(prefix="qi-"))
+    try:
+        yield path
+    finally:
+        shutil.rmtree(path, ignore_errors=True)
+

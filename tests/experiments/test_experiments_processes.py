@@ -4,11 +4,9 @@ of the command leaves no process and no temporary folder behind."""
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -17,23 +15,10 @@ import pytest
 
 import quadimpact
 
+from helpers import process_alive, process_cpu_s
+
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 GONE_S = 5.0
-
-
-def _alive(p: psutil.Process) -> bool:
-    try:
-        return p.is_running() and p.status() != psutil.STATUS_ZOMBIE
-    except psutil.Error:
-        return False
-
-
-def _cpu(p: psutil.Process) -> float:
-    try:
-        t = p.cpu_times()
-        return t.user + t.system
-    except psutil.Error:
-        return 0.0
 
 
 def _start(out: Path, tmp: Path) -> subprocess.Popen:
@@ -55,7 +40,7 @@ def _busy_workers(proc: subprocess.Popen, seen: dict[int, psutil.Process]) -> No
         assert proc.poll() is None, proc.stderr.read().decode()
         found = psutil.Process(proc.pid).children(recursive=True)
         seen.update((p.pid, p) for p in found)
-        if sum(1 for p in found if p.ppid() != proc.pid and _cpu(p) >= 0.3) >= 2:
+        if sum(1 for p in found if p.ppid() != proc.pid and process_cpu_s(p) >= 0.3) >= 2:
             return
         time.sleep(0.05)
     raise AssertionError("the crashes' workers never got busy")
@@ -65,21 +50,14 @@ def _all_gone(seen: dict[int, psutil.Process], tmp: Path) -> None:
     end = time.monotonic() + GONE_S
     alive = list(seen.values())
     while alive and time.monotonic() < end:
-        alive = [p for p in alive if _alive(p)]
+        alive = [p for p in alive if process_alive(p)]
         time.sleep(0.05)
-    names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if _alive(p)]
+    names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if process_alive(p)]
     for p in alive:
         p.kill()
     assert not names, f"left running: {names}"
     assert len(seen) >= 3, seen  # the fork server and two workers were seen
     assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
-
-
-@pytest.fixture
-def tmpdir_env():
-    path = Path(tempfile.mkdtemp(prefix="qi-"))  # short: a Unix socket's path is limited
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
 
 
 @pytest.mark.slow

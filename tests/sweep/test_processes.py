@@ -11,14 +11,11 @@ the sweep is still running then (its runs take several times longer).
 from __future__ import annotations
 
 import os
-import shutil
 import signal
 import socket
 import subprocess
 import sys
-import tempfile
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
@@ -27,6 +24,8 @@ import pytest
 
 import quadimpact
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+
+from helpers import process_alive, process_cpu_s
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 GRID = {"heading_deg": "0:359:1", "final_time_s": [1.0]}  # 360 runs, ~7 ms each
@@ -38,14 +37,6 @@ GONE_S = 5.0  # a child may outlive the sweep by this much at most
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory: pytest.TempPathFactory) -> pd.DataFrame:
     return run_sweep(SweepSpec(grid=GRID), tmp_path_factory.mktemp("ref") / "out", workers=2)
-
-
-@pytest.fixture
-def tmpdir_env() -> Iterator[Path]:
-    """A short private TMPDIR (a Unix socket's path must stay under 108 bytes)."""
-    path = Path(tempfile.mkdtemp(prefix="qi-"))
-    yield path
-    shutil.rmtree(path, ignore_errors=True)
 
 
 class Sweep:
@@ -83,7 +74,7 @@ class Sweep:
         end = time.monotonic() + timeout
         while time.monotonic() < end:
             assert self.proc.poll() is None, f"the sweep ended early: {self.err()}"
-            busy = [w for w in self.workers() if _cpu(w) >= 0.05]
+            busy = [w for w in self.workers() if process_cpu_s(w) >= 0.05]
             if len(busy) >= 2:
                 return busy
             time.sleep(0.02)
@@ -115,9 +106,9 @@ class Sweep:
         end = time.monotonic() + GONE_S
         alive = list(self.children.values())
         while alive and time.monotonic() < end:
-            alive = [p for p in alive if _alive(p)]
+            alive = [p for p in alive if process_alive(p)]
             time.sleep(0.05)
-        names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if _alive(p)]
+        names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if process_alive(p)]
         for p in alive:
             p.kill()
         assert not names, f"left running: {names}"
@@ -130,21 +121,6 @@ def _ppid(p: psutil.Process) -> int | None:
         return p.ppid()
     except psutil.Error:
         return None
-
-
-def _cpu(p: psutil.Process) -> float:
-    try:
-        t = p.cpu_times()
-        return t.user + t.system
-    except psutil.Error:
-        return 0.0
-
-
-def _alive(p: psutil.Process) -> bool:
-    try:
-        return p.is_running() and p.status() != psutil.STATUS_ZOMBIE
-    except psutil.Error:
-        return False
 
 
 def _parts_rows(out: Path) -> int:
@@ -344,7 +320,7 @@ def _wait_for_port(port: int, proc: subprocess.Popen, log: Path, limit_s: float 
 def _group_cpu(proc: subprocess.Popen) -> float:
     try:
         root = psutil.Process(proc.pid)
-        return sum(_cpu(p) for p in [root, *root.children(recursive=True)])
+        return sum(process_cpu_s(p) for p in [root, *root.children(recursive=True)])
     except psutil.Error:
         return 0.0
 
