@@ -312,17 +312,23 @@ def _log_row(
     return row
 
 
-def _crash_row(
+def crash_task(
     crash: Crash,
     log: SpiriMatLog | None,
     out: Path,
-    samples: int,
-    log_samples: int,
-    sweep_options: dict[str, Any],
+    samples: int = SENSITIVITY_RUNS,
+    log_samples: int = LOG_SENSITIVITY_RUNS,
+    sweep_options: dict[str, Any] | None = None,
 ) -> tuple[dict[str, Any], float]:
-    """One crash of Table III: its runs, files and sweeps in ``out``; its row and wall time, s."""
+    """One crash's runs, files and sweeps in ``out``: its row of Table III and its wall time, s.
+
+    The piece of work a study hands to a process
+    (:func:`quadimpact.sweep.tasks.run_tasks`); ``sweep_options`` go to its
+    sweeps (default: in this process, no progress).
+    """
     from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
 
+    sweep_options = sweep_options or {"workers": 1, "scheduler": None, "progress": False}
     start = time.perf_counter()
     folder = out / f"crash_{crash.number}"
     types: dict[str, str | None] = {}
@@ -433,7 +439,7 @@ def run_experiments(
             if progress:
                 print(f"experiments: crash {crash.number} of {n}: both variants, then "
                       "the runs over the uncertainty", file=sys.stderr, flush=True)  # fmt: skip
-            row, _ = _crash_row(crash, logs[crash.number], out, samples, log_samples,
+            row, _ = crash_task(crash, logs[crash.number], out, samples, log_samples,
                                 sweep_options)  # fmt: skip
             rows.append(row)
     return write_table3(rows, out)
@@ -453,24 +459,6 @@ def prepare_experiments(
     out = check_out_dir(Path(out_dir), "experiments", where="")
     out.mkdir(parents=True, exist_ok=True)
     return out, {crash.number: read_log(crash, data_dir) for crash in TABLE3}
-
-
-def crash_task(
-    crash: Crash,
-    log: SpiriMatLog | None,
-    out: Path,
-    samples: int = SENSITIVITY_RUNS,
-    log_samples: int = LOG_SENSITIVITY_RUNS,
-    sweep_options: dict[str, Any] | None = None,
-) -> tuple[dict[str, Any], float]:
-    """One crash's runs, files and sweeps in ``out``: its row of Table III and its wall time, s.
-
-    The piece of work a study hands to a process
-    (:func:`quadimpact.sweep.tasks.run_tasks`); ``sweep_options`` go to its
-    sweeps (default: in this process, no progress).
-    """
-    options = sweep_options or {"workers": 1, "scheduler": None, "progress": False}
-    return _crash_row(crash, log, out, samples, log_samples, options)
 
 
 def write_table3(rows: list[dict[str, Any]], out: Path) -> pd.DataFrame:

@@ -112,8 +112,6 @@ def warm_up() -> None:
     runner = BatchRunner()
     runner.summary(WallApproach(final_time_s=0.6, impact_time_s=0.1))
     runner.summary(ImpactTrial(controller="recovery", final_time_s=0.3))
-    import scipy.optimize  # noqa: F401  (a late start's root search: 0.25 s to import, once)
-
     _WARM = True
 
 
@@ -207,6 +205,10 @@ def preload() -> None:
         os.environ.setdefault(var, "1")
     with contextlib.suppress(BaseException):
         warm_up()
+        # a late start's root search imports SciPy's optimize (0.25 s): once here, not in
+        # each worker's first such run
+        import scipy.optimize  # noqa: F401
+
         if tempdir:  # tell the sweep that workers now start ready
             open(os.path.join(tempdir, SERVER_READY), "w").close()
 
