@@ -22,6 +22,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.geometry import bumper_contact
 from quadimpact.core.run import execute
 from quadimpact.rotations import inclination_deg, quat_to_matrix
+from quadimpact.simulation.roots import brentq
 
 __all__ = [
     "APPROACH_MAX_ITER",
@@ -214,8 +215,6 @@ def solve_approach(
         def residual(t_start: float) -> float:
             _, xe = shoot(t_start, 0.0, 0.0)
             return _inertial_velocity(xe)[0] - vc
-
-        from scipy.optimize import brentq  # only for a late start (import costs ~0.3 s)
 
         t0 = brentq(residual, 0.0, tc - 1e-9, xtol=1e-14, rtol=4 * np.finfo(float).eps)
         v0, x_start, dv, x0 = solve_from(t0, 0.0)

@@ -205,10 +205,6 @@ def preload() -> None:
         os.environ.setdefault(var, "1")
     with contextlib.suppress(BaseException):
         warm_up()
-        # a late start's root search imports SciPy's optimize (0.25 s): once here, not in
-        # each worker's first such run
-        import scipy.optimize  # noqa: F401
-
         if tempdir:  # tell the sweep that workers now start ready
             open(os.path.join(tempdir, SERVER_READY), "w").close()
 
