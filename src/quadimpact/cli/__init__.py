@@ -58,12 +58,15 @@ def _print_version(ctx: click.Context, _param: click.Parameter, value: bool) -> 
     help="Print the version and exit.",
 )
 def cli() -> None:
-    """Simulate a bumper-protected quadrotor colliding with a wall.
+    """Simulate a bumper-protected quadrotor colliding with its surroundings.
 
     quadimpact implements the model of "Dynamics of a quadrotor undergoing
     impact with a wall" (the Spiri quadrotor, Hunt-Crossley bumper contact,
     the authors' PID controller) with a physically consistent default model
-    and a "paper-replica" variant that reproduces the authors' simulator.
+    and a "paper-replica" variant that reproduces the authors' simulator;
+    and what the paper was for: an IMU, impact detection and a staged
+    recovery controller (the Navi quadrotor, 'quadimpact recovery', and the
+    "recovery-replica" variant of the authors' later simulator).
 
     Frames: inertial NED (X toward the wall, Y right, Z down; altitude = -Z),
     body FRD (x forward, y right, z down). Units: SI, angles in degrees.
