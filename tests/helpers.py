@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import shutil
 import tempfile
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -91,4 +92,19 @@ def short_tmpdir() -> Iterator[Path]:
         yield path
     finally:
         shutil.rmtree(path, ignore_errors=True)
+
+
+def assert_all_gone(procs: list[psutil.Process], tmp: Path, within_s: float = 5.0) -> None:
+    """No process of ``procs`` is alive within ``within_s`` (those left are killed, and the
+    assertion names them); no multiprocessing ``pymp-*`` folder is left in ``tmp``."""
+    end = time.monotonic() + within_s
+    alive = list(procs)
+    while alive and time.monotonic() < end:
+        alive = [p for p in alive if process_alive(p)]
+        time.sleep(0.05)
+    names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if process_alive(p)]
+    for p in alive:
+        p.kill()
+    assert not names, f"left running: {names}"
+    assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
 

@@ -15,7 +15,7 @@ import pytest
 
 import quadimpact
 
-from helpers import process_alive, process_cpu_s
+from helpers import assert_all_gone, process_cpu_s
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 GONE_S = 5.0
@@ -46,20 +46,6 @@ def _busy_workers(proc: subprocess.Popen, seen: dict[int, psutil.Process]) -> No
     raise AssertionError("the crashes' workers never got busy")
 
 
-def _all_gone(seen: dict[int, psutil.Process], tmp: Path) -> None:
-    end = time.monotonic() + GONE_S
-    alive = list(seen.values())
-    while alive and time.monotonic() < end:
-        alive = [p for p in alive if process_alive(p)]
-        time.sleep(0.05)
-    names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if process_alive(p)]
-    for p in alive:
-        p.kill()
-    assert not names, f"left running: {names}"
-    assert len(seen) >= 3, seen  # the fork server and two workers were seen
-    assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("how", ["ctrl-c", "kill-9"])
 def test_stopping_experiments_leaves_nothing_running(tmp_path, tmpdir_env, how):
@@ -77,7 +63,8 @@ def test_stopping_experiments_leaves_nothing_running(tmp_path, tmpdir_env, how):
         else:
             proc.kill()  # the command alone
             proc.wait(timeout=10)
-        _all_gone(seen, tmpdir_env)
+        assert len(seen) >= 3, seen  # the fork server and two workers were seen
+        assert_all_gone(list(seen.values()), tmpdir_env, GONE_S)
     finally:
         for p in [proc, *seen.values()]:
             try:

@@ -25,7 +25,7 @@ import pytest
 import quadimpact
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 
-from helpers import process_alive, process_cpu_s
+from helpers import assert_all_gone, process_cpu_s
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 GRID = {"heading_deg": "0:359:1", "final_time_s": [1.0]}  # 360 runs, ~7 ms each
@@ -103,17 +103,8 @@ class Sweep:
     def assert_all_gone(self) -> None:
         """No descendant seen is alive a few seconds later; no pymp-* folder is left."""
         self.workers()
-        end = time.monotonic() + GONE_S
-        alive = list(self.children.values())
-        while alive and time.monotonic() < end:
-            alive = [p for p in alive if process_alive(p)]
-            time.sleep(0.05)
-        names = [(p.pid, " ".join(p.cmdline())[-60:]) for p in alive if process_alive(p)]
-        for p in alive:
-            p.kill()
-        assert not names, f"left running: {names}"
         assert len(self.children) >= 4, self.children  # tracker, server, 2 workers were seen
-        assert not list(self.tmp.glob("pymp-*")), list(self.tmp.iterdir())
+        assert_all_gone(list(self.children.values()), self.tmp, GONE_S)
 
 
 def _ppid(p: psutil.Process) -> int | None:
