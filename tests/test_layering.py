@@ -2,8 +2,9 @@
 relative) of every module, parsed with ``ast``, against the layer order.
 
 1. ``quadimpact.core`` imports nothing of quadimpact outside ``core``; the
-   base modules (``errors``, ``rotations``) import nothing of quadimpact but
-   ``errors`` (the package root and ``_legacy`` nothing but ``_legacy``);
+   base modules (``errors``, ``linalg``, ``rotations``) import nothing of
+   quadimpact but ``errors`` and ``linalg`` (the package root and ``_legacy``
+   nothing but ``_legacy``);
 2. no import cycle between modules anywhere in the package;
 3. no module imports a layer above its own (:data:`LAYERS`, lowest first);
    a module may import its own layer and the layers below.
@@ -32,6 +33,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("base", (
         "quadimpact.core",
         "quadimpact.errors",
+        "quadimpact.linalg",
         "quadimpact.rotations",
         "quadimpact._legacy",
     )),
@@ -49,7 +51,8 @@ BASE_ALLOWED: dict[str, tuple[str, ...]] = {
     "quadimpact": ("quadimpact._legacy",),
     "quadimpact._legacy": (),
     "quadimpact.errors": (),
-    "quadimpact.rotations": ("quadimpact.errors",),
+    "quadimpact.linalg": (),
+    "quadimpact.rotations": ("quadimpact.errors", "quadimpact.linalg"),
 }
 
 

@@ -25,6 +25,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from quadimpact.linalg import dot, matvec, norm
+
 __all__ = [
     "GIMBAL_LOCK_COS",
     "body_to_inertial",
@@ -118,7 +120,7 @@ def quat_xyzw_to_matrix(q: ArrayLike) -> NDArray[np.float64]:
         The same matrices as :func:`quat_to_matrix` of ``[w, x, y, z]``.
     """
     a = np.asarray(q, dtype=np.float64)
-    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    a = a / norm(a)[..., None]
     return _unit_quat_matrix(a[..., 3], a[..., 0], a[..., 1], a[..., 2])
 
 
@@ -255,7 +257,7 @@ def body_to_inertial(q: ArrayLike, v_body: ArrayLike) -> NDArray[np.float64]:
     if v.shape[-1:] != (3,):
         raise ValueError(f"vector array must have a last axis of length 3 (got {v.shape})")
     c = quat_to_matrix(q)
-    return np.einsum("...ij,...j->...i", c, v)
+    return matvec(c, v)
 
 
 # ----------------------------------------------------------- rotation matrices
@@ -296,12 +298,12 @@ def matrix_to_quat(C: ArrayLike) -> NDArray[np.float64]:
             s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
             q[i] = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s,
                     0.25 * s]  # fmt: skip
-    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    q /= norm(q)[:, None]
     if n:
         if q[0, 0] < 0:
             q[0] = -q[0]
         for i in range(1, n):  # continuity: q and -q are the same attitude
-            if np.dot(q[i], q[i - 1]) < 0:
+            if dot(q[i], q[i - 1]) < 0:
                 q[i] = -q[i]
     return q
 

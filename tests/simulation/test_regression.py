@@ -1,14 +1,20 @@
-"""Every summary number of the Figure 4 grid is what the first released version computed.
+"""Every summary number of the Figure 4 grid is pinned, bit for bit, on every machine.
 
 ``data/fig4_summaries_v0.1.json`` holds the summaries of 48 Figure 4 runs (both model
-variants, both headings, six inclinations, two speeds) as quadimpact 0.1 (before the
-layered architecture, the recovery work and the throughput work) wrote them. The
-runs are sensitive at the rounding level (a 1e-15 m change of the start point moves
-some numbers by 1e-7), so every number is compared exactly, except the attitude
-excursion, which is computed in compiled code now (a few units in the last place)
-and compared to 1e-12. Keys added since (detection and recovery metrics, new model
-switches) are not in the file and not compared; the ``outcome`` sentence now also
-tells the detection, so it is not compared either.
+variants, both headings, six inclinations, two speeds), first as quadimpact 0.1 wrote
+them; re-pinned once (2026-12-02) when the small linear algebra of the inputs
+(inverse inertia and allocation, trim, the approach's rotations) stopped going
+through BLAS/LAPACK, whose kernels are chosen per CPU (``quadimpact.linalg``): the
+old numbers held only with OpenBLAS's SkylakeX kernels; the re-pinned ones hold
+whatever kernels the machine's OpenBLAS picks (``OPENBLAS_CORETYPE``). That change
+moved numbers at the rounding level (``delta_init_m`` by at most 2e-11 relative;
+response types, bumpers and counts unchanged). The runs are sensitive at the
+rounding level (a 1e-15 m change of the start point moves some numbers by 1e-7),
+so every number is compared exactly, except the attitude excursion, which is
+computed in compiled code now (a few units in the last place) and compared to 1e-12.
+Keys added since (detection and recovery metrics, new model switches) are not in the
+file and not compared; the ``outcome`` sentence now also tells the detection, so it
+is not compared either.
 """
 
 from __future__ import annotations

@@ -21,6 +21,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import bumper_contact
 from quadimpact.core.run import execute
+from quadimpact.linalg import matvec, matvec_t
 from quadimpact.rotations import inclination_deg, quat_to_matrix
 from quadimpact.simulation.roots import brentq
 
@@ -82,7 +83,7 @@ def initial_state(
     """The kernel's state vector (layout ``X_*``) from inertial position and velocity."""
     x = np.zeros(L.NX)
     x[L.X_POS : L.X_POS + 3] = position
-    x[L.X_VEL : L.X_VEL + 3] = quat_to_matrix(q).T @ v_inertial
+    x[L.X_VEL : L.X_VEL + 3] = matvec_t(quat_to_matrix(q), v_inertial)
     x[L.X_QUAT : L.X_QUAT + 4] = q
     x[L.X_OMEGA : L.X_OMEGA + 3] = omega
     x[L.X_ROTOR : L.X_ROTOR + 4] = rotors
@@ -122,7 +123,7 @@ def _free_flight_end(
 
 
 def _inertial_velocity(x: np.ndarray) -> np.ndarray:
-    return quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]) @ x[L.X_VEL : L.X_VEL + 3]
+    return matvec(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]), x[L.X_VEL : L.X_VEL + 3])
 
 
 def bumper_depths(x: np.ndarray, veh: np.ndarray, surf: np.ndarray, s: int = 0) -> np.ndarray:

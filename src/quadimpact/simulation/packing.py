@@ -15,6 +15,7 @@ from quadimpact.inputs.controllers import ControllerEntry, PackContext
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
+from quadimpact.linalg import inverse, norm, solve
 
 CONTROL_RATE_HZ = 200.0
 RPM = 2.0 * np.pi / 60.0  # rad/s per rpm
@@ -56,7 +57,7 @@ def _pack_vehicle(v: Vehicle) -> np.ndarray:
     inertia = v.inertia
     veh[L.V_MASS] = v.mass_kg
     veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
-    veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
+    veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = inverse(inertia).ravel()
     veh[L.V_ROTOR_POS : L.V_ROTOR_POS + 12] = v.rotor_positions.ravel()
     veh[L.V_SPIN : L.V_SPIN + 4] = v.spins
     veh[L.V_KT] = v.thrust_coefficient
@@ -80,7 +81,7 @@ def pack_surfaces(surfaces: Sequence[Plane]) -> np.ndarray:
     for i, s in enumerate(surfaces):
         n = np.asarray(s.normal, dtype=float)
         surf[i, L.S_P0 : L.S_P0 + 3] = s.point_m
-        surf[i, L.S_NORMAL : L.S_NORMAL + 3] = n / np.linalg.norm(n)
+        surf[i, L.S_NORMAL : L.S_NORMAL + 3] = n / norm(n)
         surf[i, L.S_IS_GROUND] = 1.0 if s.is_ground else 0.0
         surf[i, L.S_KIND] = L.SURF_PLANE
     return surf
@@ -157,7 +158,7 @@ def allocation_matrix(v: Vehicle, yaw_paper: bool) -> np.ndarray:
 
 def trim_rotor_speeds(v: Vehicle, thrust_n: float, yaw_paper: bool) -> np.ndarray:
     """Rotor speeds (rad/s) giving total thrust ``thrust_n`` (N) and zero torques."""
-    w2 = np.linalg.solve(allocation_matrix(v, yaw_paper), [thrust_n, 0.0, 0.0, 0.0])
+    w2 = solve(allocation_matrix(v, yaw_paper), [thrust_n, 0.0, 0.0, 0.0])
     return np.sqrt(np.clip(w2, 0.0, None))
 
 
@@ -182,7 +183,7 @@ def pack_controller(
     ctrl[L.C_THETA_REF] = refs["pitch_rad"]
     ctrl[L.C_PSI_REF] = refs["yaw_rad"]
     ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = _memo(
-        f"alloc-inv-{yaw_paper}", v, lambda: np.linalg.inv(allocation_matrix(v, yaw_paper)).ravel()
+        f"alloc-inv-{yaw_paper}", v, lambda: inverse(allocation_matrix(v, yaw_paper)).ravel()
     )
     lo, hi = v.rotor_speed_range_rpm
     ctrl[L.C_OMEGA_MIN] = lo * RPM

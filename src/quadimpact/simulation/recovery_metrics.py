@@ -18,6 +18,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import bumper_contact
+from quadimpact.linalg import dot, norm
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.metrics import (
     GRAZE_DELTA_M,
@@ -140,7 +141,7 @@ def recovery_metrics(
     out["t_detect_s"] = _finite(t_detect)
     out["min_altitude_m"] = _finite(float(st[L.ST_MIN_ALT]))
     v = final_state[L.X_VEL : L.X_VEL + 3]
-    out["final_speed_m_s"] = _finite(float(np.sqrt(v @ v)))
+    out["final_speed_m_s"] = _finite(norm(v))
     stage_t = [float(st[L.ST_STAGE_T + k]) for k in range(L.N_STAGES)]
     for k in (1, 2, 3, 4):
         out[f"t_stage{k}_s"] = _finite(stage_t[k])
@@ -158,8 +159,8 @@ def recovery_metrics(
             x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
             n_true = contact_normal(x_onset, veh, surf, bumper - 1, s_index)
             n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
-            if np.linalg.norm(n_est) > 0:
-                c = float(np.clip(n_est @ n_true / np.linalg.norm(n_true), -1.0, 1.0))
+            if norm(n_est) > 0:
+                c = float(np.clip(dot(n_est, n_true) / norm(n_true), -1.0, 1.0))
                 out["normal_error_deg"] = math.degrees(math.acos(c))
     p_detect = st[L.ST_DETECT_X + L.X_POS : L.ST_DETECT_X + L.X_POS + 3]
     for k, name in ((2, "stage2"), (3, "stage3"), (4, None)):

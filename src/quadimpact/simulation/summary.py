@@ -15,6 +15,7 @@ import numpy as np
 from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.inputs.scenarios import WallApproach
+from quadimpact.linalg import dot, matvec
 from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.approach import inclination_deg_of
 from quadimpact.simulation.metrics import (
@@ -72,13 +73,13 @@ def build_summary(
     if not math.isnan(onset_t):
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
         q = xo[L.X_QUAT : L.X_QUAT + 4]
-        vel = quat_to_matrix(q) @ xo[L.X_VEL : L.X_VEL + 3]
+        vel = matvec(quat_to_matrix(q), xo[L.X_VEL : L.X_VEL + 3])
         first = first_obstacle_episode(episodes, _obstacle_names(setup))
         if first is not None:  # the contact normal there, from the contact geometry
             bumper, surface = first
             s_index = list(setup.surface_names).index(surface)
             normal = contact_normal(xo, setup.veh, setup.surf, bumper - 1, s_index)
-            speed = float(-vel @ normal)
+            speed = -dot(vel, normal)
         heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
         incl = inclination_deg_of(q)
 

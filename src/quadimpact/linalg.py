@@ -1,0 +1,95 @@
+"""Small dense linear algebra in a fixed order of operations: the same bits on every machine.
+
+NumPy's ``@``, ``dot``, ``linalg.inv``, ``linalg.solve`` and ``linalg.norm``
+call BLAS and LAPACK, whose kernels are chosen for the CPU at run time
+(OpenBLAS has SkylakeX, Haswell, Zen... kernels). Their results differ in the
+last bits from one machine to another, and a run through an impact amplifies
+such a difference (a 1e-16 change of the inverse allocation moves
+``delta_init_m`` by 1e-12, the response of a later impact by more). Every
+number that feeds a run, its summary or a study's table is computed with
+these functions instead: plain IEEE multiplications and additions in index
+order (NumPy's element-wise ufuncs, or Python floats), which every machine
+rounds alike.
+
+The sizes here are tiny (3x3 and 4x4); speed is not a concern.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = ["dot", "inverse", "matvec", "matvec_t", "norm", "solve"]
+
+
+def solve(a: ArrayLike, b: ArrayLike) -> np.ndarray:
+    """``x`` with ``A x = b`` (A square), by Gaussian elimination with partial pivoting.
+
+    Raises
+    ------
+    ValueError
+        ``A`` is singular (a zero pivot).
+    """
+    m = [[float(v) for v in row] for row in np.asarray(a, dtype=np.float64)]
+    rhs = np.asarray(b, dtype=np.float64)
+    cols = 1 if rhs.ndim == 1 else rhs.shape[1]
+    r = [[float(v) for v in np.atleast_1d(row)] for row in rhs.reshape(len(m), cols)]
+    n = len(m)
+    for k in range(n):
+        p = max(range(k, n), key=lambda i: abs(m[i][k]))
+        if m[p][k] == 0.0:
+            raise ValueError("solve: the matrix is singular")
+        if p != k:
+            m[k], m[p] = m[p], m[k]
+            r[k], r[p] = r[p], r[k]
+        for i in range(k + 1, n):
+            f = m[i][k] / m[k][k]
+            for j in range(k, n):
+                m[i][j] -= f * m[k][j]
+            for j in range(cols):
+                r[i][j] -= f * r[k][j]
+    x = [[0.0] * cols for _ in range(n)]
+    for i in reversed(range(n)):
+        for j in range(cols):
+            s = r[i][j]
+            for k in range(i + 1, n):
+                s -= m[i][k] * x[k][j]
+            x[i][j] = s / m[i][i]
+    out = np.array(x, dtype=np.float64)
+    return out[:, 0] if rhs.ndim == 1 else out
+
+
+def inverse(a: ArrayLike) -> np.ndarray:
+    """The inverse of a square matrix (:func:`solve` with the identity)."""
+    n = np.asarray(a).shape[0]
+    return solve(a, np.eye(n))
+
+
+def dot(a: ArrayLike, b: ArrayLike) -> np.ndarray | float:
+    """``sum_k a[..., k] b[..., k]`` over the last axis, summed in index order."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    s = a[..., 0] * b[..., 0]
+    for k in range(1, a.shape[-1]):
+        s = s + a[..., k] * b[..., k]
+    return float(s) if np.ndim(s) == 0 else s
+
+
+def norm(a: ArrayLike) -> np.ndarray | float:
+    """Euclidean norm over the last axis (``sqrt(dot(a, a))``)."""
+    s = dot(a, a)
+    return math.sqrt(s) if isinstance(s, float) else np.sqrt(s)
+
+
+def matvec(m: ArrayLike, v: ArrayLike) -> np.ndarray:
+    """``M v`` for matrices ``(..., r, c)`` and vectors ``(..., c)``, rows summed in index order."""
+    m = np.asarray(m, dtype=np.float64)
+    v = np.asarray(v, dtype=np.float64)
+    return dot(m, v[..., None, :])
+
+
+def matvec_t(m: ArrayLike, v: ArrayLike) -> np.ndarray:
+    """``M^T v`` for matrices ``(..., r, c)`` and vectors ``(..., r)``."""
+    return matvec(np.swapaxes(np.asarray(m, dtype=np.float64), -1, -2), v)
