@@ -59,7 +59,7 @@ def cache_is_warm() -> bool:
 
     Cheap: looks for the index file of ``run.run_builtin`` (no Numba import).
     """
-    return any(_numba_dir(_HERE).glob("run.run_builtin-*.nbi"))
+    return any(_numba_dir(_HERE).glob("run.run-*.nbi"))
 
 
 def ensure_fresh_cache() -> None:

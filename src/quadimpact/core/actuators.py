@@ -31,6 +31,7 @@ import numpy as np
 from numba import njit
 
 from .layout import (
+    N_ROTORS,
     O_OMEGA_MAX,
     O_OMEGA_MIN,
     O_SLEW_MAX,
@@ -50,7 +51,7 @@ ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
 def apply_segment(x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray) -> None:
     """Rotor inputs for segment ``seg``: prescribed rates, floored at zero speed."""
     rin[RIN_FIRST_ORDER] = 0.0
-    for j in range(4):
+    for j in range(N_ROTORS):
         if x[X_ROTOR + j] <= ZERO_SPEED:
             x[X_ROTOR + j] = 0.0
         r = sched_rate[seg, j]
@@ -66,7 +67,7 @@ def next_boundary(
 ) -> float:
     """Next instant (s) where the rotor inputs change: a segment start or a motor stopping."""
     t_b = t_p + sched_t[seg + 1] if seg + 1 < sched_t.shape[0] else math.inf
-    for j in range(4):
+    for j in range(N_ROTORS):
         r = rin[RIN_RATE + j]
         if r < 0.0 and x[X_ROTOR + j] > 0.0:
             t_b = min(t_b, t + x[X_ROTOR + j] / -r)
@@ -100,7 +101,7 @@ def apply_command(
     w_hi = opts[O_OMEGA_MAX]
     slew = opts[O_SLEW_MAX]
     first_order = rin[RIN_FIRST_ORDER] > 0.5
-    for j in range(4):
+    for j in range(N_ROTORS):
         prev = rin[RIN_PREV_CMD + j]
         w = cmd[j]
         if slew > 0.0:
@@ -128,8 +129,8 @@ def apply_command(
 def rotor_rates(x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray) -> None:
     """Rotor accelerations (rad/s^2) of the current rotor mode, into ``omega_dot``."""
     if rin[RIN_FIRST_ORDER] > 0.5:
-        for j in range(4):
+        for j in range(N_ROTORS):
             omega_dot[j] = (rin[RIN_CMD + j] - x[X_ROTOR + j]) / veh[V_TAU_M]
     else:
-        for j in range(4):
+        for j in range(N_ROTORS):
             omega_dot[j] = rin[RIN_RATE + j]

@@ -1,18 +1,19 @@
 """Many runs stepped together under external rotor commands: the learning environments' core.
 
-The arrays of :mod:`step` for N runs are stacked along a first axis (``X``
-is (N, NX), ``LS`` (N, NLS), ``CS`` (N, 4 n_surf, NCS), ``NOISE`` (N, n, 6)
-...; row ``k`` is run ``k``'s array, as ``step.advance`` takes it). All runs of
-a batch have the same surfaces, output grid and buffer sizes; a run whose
-IMU draws no noise (an ideal IMU) has its noise rows padded with zeros, which
-the IMU multiplies by a zero standard deviation: the same arithmetic as no
-rows at all.
+The records of :mod:`records` for N runs are stacked along a first axis
+(``M.x0`` is (N, NX), ``D.cs`` (N, n_pairs, NCS), ``M.noise`` (N, n, 6) ...;
+``model_row(M, k)`` is run ``k``'s model, as ``step.tick`` takes it); the
+environments' own arrays are the record :class:`Env`. All runs of a batch
+have the same features, shapes, output grid and buffer sizes; a run whose IMU
+draws no noise (an ideal IMU) has its noise rows padded with zeros, which the
+IMU multiplies by a zero standard deviation: the same arithmetic as no rows
+at all.
 
 Per control tick and run, :func:`step_batch` maps the agent's normalised
 action to a rotor command, sets the run's stage in force (reported by the
 policy, or from the observer below), runs one tick of ``step.tick`` with that
 command in ``ls[LS_EXT_CMD]`` (so the loop's slew limit, range and zero floor
-apply), then computes the run's next observation, reward and termination.
+apply), then computes the run's next observation, reward and termination (all in compiled code).
 :func:`reset_slot` starts a run and, in detection mode, runs its pre-impact
 behaviour with the built-in controller until the detector fires.
 
@@ -33,7 +34,7 @@ ticks after it, the *level test* (the tilt error toward level of
 ``recovery.staged_references`` in stage 2, ``|q_e,x|, |q_e,y| < q_tol``, and the
 gyro's ``|p|, |q| < rate_tol``) and the *recovered condition* (the level test
 and body z velocity ``w < w_tol``) must each hold for a confirmation window of
-``P_HOLD_TICKS`` ticks: stages 2 and 3 are entered at the first tick of the
+``EP_HOLD_TICKS`` ticks: stages 2 and 3 are entered at the first tick of the
 first window of the level test, stage 4 at the first tick of the first window
 of the recovered condition (written into the run's stage record once the
 window is complete). A policy that reports its stages (``staged_policy``) has
@@ -42,6 +43,7 @@ is reached and the recovered condition has held for the window.
 """
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numba import njit
@@ -78,7 +80,7 @@ from .layout import (
     MS_T,
     MS_T_DETECT,
     MS_X,
-    NMEAS,
+    N_ROTORS,
     NX,
     O_DT_CONTROL,
     O_SLEW_MAX,
@@ -96,28 +98,47 @@ from .layout import (
     X_QUAT,
     X_ROTOR,
     X_VEL,
+    Block,
 )
 from .quaternion import normalise_quaternion, rotation_matrix
+from .records import Data, Model, Output, Work, data_row, model_row, new_work, output_row
+from .sensors.measurement import measure
 from .step import finish, start, tick
 
+
+# ---------------------------------------------------------------- records
+class Env(NamedTuple):
+    """The environments' own arrays, stacked like the runs' records (row ``k``: run ``k``)."""
+
+    state: np.ndarray  # (N, NB) per-run episode state (B_*)
+    par: np.ndarray  # (NPAR,) parameters shared by the runs (EP_*)
+    tmeas: np.ndarray  # (N, NMEAS) the measurement record of each run's next tick
+    reported: np.ndarray  # (N,) the stage the policy reports for this tick (< 0: none)
+    obs: np.ndarray  # (N, n_obs) float32 observations
+    reward: np.ndarray  # (N,)
+    terminated: np.ndarray  # (N,) bool
+    truncated: np.ndarray  # (N,) bool
+
+
 # ---------------------------------------------------------------- per-run env state (N, NB)
-B_ACTIVE = 0  # 1 while the episode runs
-B_STAGE = 1  # stage in force (the policy's or the observer's)
-B_POLICY = 2  # 1 once the policy has reported a stage this episode
-B_HOLD = 3  # consecutive ticks (after the takeover) the recovered condition has held
-B_H_REF = 4  # m, altitude at the takeover (height-loss reference)
-B_X_REF = 5  # m, CM X and Y at the takeover (distance reference)
-B_Y_REF = 6
-B_STEPS = 7  # steps taken this episode
-B_OUTCOME = 8  # OC_* below
-B_RETURN = 9  # sum of the rewards of the episode
-B_INEXACT = 10  # policy commands the action map could not give exactly (in the slew window)
-B_LEVEL_N = 11  # consecutive ticks (after the takeover) the level test has held
-B_LEVEL_T = 12  # s, first tick of that run
-B_LEVEL_P = 13  # 3: CM position there, inertial, m
-B_HOLD_T = 16  # s, first tick of the recovered condition's run
-B_HOLD_P = 17  # 3: CM position there, inertial, m
-NB = 20
+_b = Block("env.state", "B_")
+B_ACTIVE = _b.slot("B_ACTIVE")  # 1 while the episode runs
+B_STAGE = _b.slot("B_STAGE")  # stage in force (the policy's or the observer's)
+B_POLICY = _b.slot("B_POLICY")  # 1 once the policy has reported a stage this episode
+B_HOLD = _b.slot("B_HOLD")  # consecutive ticks (after the takeover) the recovered condition held
+B_H_REF = _b.slot("B_H_REF")  # m, altitude at the takeover (height-loss reference)
+B_X_REF = _b.slot("B_X_REF")  # m, CM X and Y at the takeover (distance reference)
+B_Y_REF = _b.slot("B_Y_REF")
+B_STEPS = _b.slot("B_STEPS")  # steps taken this episode
+B_OUTCOME = _b.slot("B_OUTCOME")  # OC_* below
+B_RETURN = _b.slot("B_RETURN")  # sum of the rewards of the episode
+B_INEXACT = _b.slot("B_INEXACT")  # policy commands the action map could not give exactly
+B_LEVEL_N = _b.slot("B_LEVEL_N")  # consecutive ticks (after the takeover) the level test held
+B_LEVEL_T = _b.slot("B_LEVEL_T")  # s, first tick of that run
+B_LEVEL_P = _b.slot("B_LEVEL_P", 3)  # CM position there, inertial, m
+B_HOLD_T = _b.slot("B_HOLD_T")  # s, first tick of the recovered condition's run
+B_HOLD_P = _b.slot("B_HOLD_P", 3)  # CM position there, inertial, m
+NB = _b.end("NB")
 
 OC_RUNNING = 0
 OC_RECOVERED = 1
@@ -130,35 +151,36 @@ OC_TIME_LIMIT = 7
 OC_FAILED = 8
 
 # ---------------------------------------------------------------- parameters (NPAR)
-P_ACTION = 0  # ACT_* below
-P_OBSERVE = 1  # OBS_* below
-P_ZERO_LOW = 2  # 1: rotor actions map onto [0, hi] instead of the vehicle's [lo, hi]
-P_RATE_MAX = 3  # 3: ctbr rate reference scale (p, q, r), rad/s
-P_W_TILT = 6  # reward weights, per second of simulated time (rewards are w * cost * dt)
-P_W_RATE = 7
-P_W_VZ = 8
-P_W_HEIGHT = 9
-P_W_EFFORT = 10
-P_W_RECOVERY = 11  # bonus on the recovered termination
-P_W_FAILURE = 12  # penalty on a failure termination (ground, envelope)
-P_FAIL_REMAINING = 13  # 1: a failure also costs the largest cost rate for the time left
-P_S_RATE = 14  # rad/s, scale of the rate cost
-P_S_VZ = 15  # m/s, scale of the vertical-speed cost
-P_S_HEIGHT = 16  # m, scale of the height-loss cost
-P_MAX_TILT_COS = 17  # envelope: cos of the largest tilt from vertical
-P_MAX_DROP = 18  # m, envelope: altitude below the takeover altitude
-P_MAX_DIST = 19  # m, envelope: horizontal distance from the takeover position
-P_MAX_RATE = 20  # rad/s, envelope: |omega|
-P_HOLD_TICKS = 21  # confirmation window of the level test and the recovered condition, ticks
-P_END_ON_RECOVERY = 29  # 1: the episode ends once recovered (stage 4 and the window held)
-P_GROUND = 22  # 1: the first ground contact ends the episode
-P_OBS_F = 23  # observation scales: specific force m/s^2, rates rad/s, speed m/s, time s,
-P_OBS_W = 24  # position m; observations are clipped to +-P_OBS_CLIP
-P_OBS_V = 25
-P_OBS_T = 26
-P_OBS_POS = 27
-P_OBS_CLIP = 28
-NPAR = 32
+_ep = Block("env.par", "EP_")
+EP_ACTION = _ep.slot("EP_ACTION")  # ACT_* below
+EP_OBSERVE = _ep.slot("EP_OBSERVE")  # OBS_* below
+EP_ZERO_LOW = _ep.slot("EP_ZERO_LOW")  # 1: rotor actions map onto [0, hi], not [lo, hi]
+EP_RATE_MAX = _ep.slot("EP_RATE_MAX", 3)  # ctbr rate reference scale (p, q, r), rad/s
+EP_W_TILT = _ep.slot("EP_W_TILT")  # reward weights per second of simulated time
+EP_W_RATE = _ep.slot("EP_W_RATE")
+EP_W_VZ = _ep.slot("EP_W_VZ")
+EP_W_HEIGHT = _ep.slot("EP_W_HEIGHT")
+EP_W_EFFORT = _ep.slot("EP_W_EFFORT")
+EP_W_RECOVERY = _ep.slot("EP_W_RECOVERY")  # bonus on the recovered termination
+EP_W_FAILURE = _ep.slot("EP_W_FAILURE")  # penalty on a failure termination (ground, envelope)
+EP_FAIL_REMAINING = _ep.slot("EP_FAIL_REMAINING")  # 1: a failure costs the top rate to the end
+EP_S_RATE = _ep.slot("EP_S_RATE")  # rad/s, scale of the rate cost
+EP_S_VZ = _ep.slot("EP_S_VZ")  # m/s, scale of the vertical-speed cost
+EP_S_HEIGHT = _ep.slot("EP_S_HEIGHT")  # m, scale of the height-loss cost
+EP_MAX_TILT_COS = _ep.slot("EP_MAX_TILT_COS")  # envelope: cos of the largest tilt from vertical
+EP_MAX_DROP = _ep.slot("EP_MAX_DROP")  # m, envelope: altitude below the takeover altitude
+EP_MAX_DIST = _ep.slot("EP_MAX_DIST")  # m, envelope: horizontal distance from the takeover
+EP_MAX_RATE = _ep.slot("EP_MAX_RATE")  # rad/s, envelope: |omega|
+EP_HOLD_TICKS = _ep.slot("EP_HOLD_TICKS")  # confirmation window of the level test, ticks
+EP_GROUND = _ep.slot("EP_GROUND")  # 1: the first ground contact ends the episode
+EP_OBS_F = _ep.slot("EP_OBS_F")  # observation scales: specific force m/s^2, rates rad/s,
+EP_OBS_W = _ep.slot("EP_OBS_W")  # speed m/s, time s, position m; observations are
+EP_OBS_V = _ep.slot("EP_OBS_V")  # clipped to +-EP_OBS_CLIP
+EP_OBS_T = _ep.slot("EP_OBS_T")
+EP_OBS_POS = _ep.slot("EP_OBS_POS")
+EP_OBS_CLIP = _ep.slot("EP_OBS_CLIP")
+EP_END_ON_RECOVERY = _ep.slot("EP_END_ON_RECOVERY")  # 1: the episode ends once recovered
+NPAR = _ep.end("NPAR")
 
 ACT_ROTORS = 0
 ACT_CTBR = 1
@@ -222,7 +244,7 @@ def affine_inverse(w: float, lo: float, hi: float) -> tuple[float, bool]:
 @njit(cache=True)
 def rotor_range(ctrl: np.ndarray, par: np.ndarray) -> tuple[float, float]:
     """The rotor-speed range (rad/s) that rotor actions map onto."""
-    lo = 0.0 if par[P_ZERO_LOW] > 0.5 else ctrl[C_OMEGA_MIN]
+    lo = 0.0 if par[EP_ZERO_LOW] > 0.5 else ctrl[C_OMEGA_MIN]
     return lo, ctrl[C_OMEGA_MAX]
 
 
@@ -246,9 +268,9 @@ def action_command(
     for j in range(4):
         v = action[j]
         a[j] = -1.0 if not v >= -1.0 else (1.0 if v > 1.0 else v)  # NaN -> -1
-    if int(par[P_ACTION]) == ACT_CTBR:
+    if int(par[EP_ACTION]) == ACT_CTBR:
         thrust = affine_map(a[0], 0.0, max_thrust(veh, ctrl))
-        rates = (a[1] * par[P_RATE_MAX], a[2] * par[P_RATE_MAX + 1], a[3] * par[P_RATE_MAX + 2])
+        rates = (a[1] * par[EP_RATE_MAX], a[2] * par[EP_RATE_MAX + 1], a[3] * par[EP_RATE_MAX + 2])
         rate_loop(thrust, rates[0], rates[1], rates[2], meas[MS_IMU_W : MS_IMU_W + 3], ctrl, veh,
                   cmd)  # fmt: skip
     else:
@@ -332,7 +354,7 @@ def _count(env: np.ndarray, ok: bool, n_slot: int, t_slot: int, p_slot: int, t: 
 @njit(cache=True)
 def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np.ndarray) -> None:
     """The observer's stages 2-4, entered at the start of their completed windows."""
-    window = par[P_HOLD_TICKS]
+    window = par[EP_HOLD_TICKS]
     stage = int(env[B_STAGE])
     if stage == STAGE_DETECTED and env[B_LEVEL_N] >= window:
         _enter(stats, STAGE_TILTED, env[B_LEVEL_T], env[B_LEVEL_P : B_LEVEL_P + 3])
@@ -346,19 +368,17 @@ def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np
 
 
 @njit(cache=True)
-def tick_measurement(x: np.ndarray, ls: np.ndarray, opts: np.ndarray, meas: np.ndarray,
-                     tmeas: np.ndarray) -> None:  # fmt: skip
-    """What a controller sees at the next tick: ``meas`` with the state and time of that tick.
+def tick_measurement(m: Model, d: Data, tmeas: np.ndarray) -> None:
+    """What a controller sees at the next tick: ``d.meas`` with the estimate of that tick.
 
-    The quaternion is normalised on a copy, as ``step.tick`` normalises the
-    state before the controller runs (the same arithmetic, so the same bits).
+    The state is renormalised on a copy, as ``step.tick`` renormalises it
+    before the estimator runs (the same arithmetic, so the same bits), and the
+    estimate written by the one writer of the measurement record.
     """
-    for i in range(NMEAS):
-        tmeas[i] = meas[i]
-    for i in range(NX):
-        tmeas[MS_X + i] = x[i]
-    normalise_quaternion(tmeas, MS_X + X_QUAT)
-    tmeas[MS_T] = ls[LS_T0] + int(ls[LS_K]) * opts[O_DT_CONTROL]
+    tmeas[:] = d.meas
+    x = d.x.copy()
+    normalise_quaternion(x, X_QUAT)
+    measure(d.ls[LS_T0] + int(d.ls[LS_K]) * m.opts[O_DT_CONTROL], x, tmeas)
 
 
 # ---------------------------------------------------------------- observation, reward
@@ -378,36 +398,36 @@ def observe(
     x = tmeas[MS_X : MS_X + NX]
     C = np.empty((3, 3))
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
-    clip = par[P_OBS_CLIP]
+    clip = par[EP_OBS_CLIP]
     vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
     detected = tmeas[MS_DETECTED] > 0.5
     since = tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0
     lo, hi = rotor_range(ctrl, par)
     h = 0.5 * (hi - lo)
-    if int(par[P_OBSERVE]) == OBS_STATE:
-        obs[0] = _clip(x[X_POS] / par[P_OBS_POS], clip)
-        obs[1] = _clip((x[X_POS + 1] - env[B_Y_REF]) / par[P_OBS_POS], clip)
-        obs[2] = _clip((-x[X_POS + 2] - env[B_H_REF]) / par[P_OBS_POS], clip)
+    if int(par[EP_OBSERVE]) == OBS_STATE:
+        obs[0] = _clip(x[X_POS] / par[EP_OBS_POS], clip)
+        obs[1] = _clip((x[X_POS + 1] - env[B_Y_REF]) / par[EP_OBS_POS], clip)
+        obs[2] = _clip((-x[X_POS + 2] - env[B_H_REF]) / par[EP_OBS_POS], clip)
         for i in range(3):
-            obs[3 + i] = _clip(x[X_VEL + i] / par[P_OBS_V], clip)
+            obs[3 + i] = _clip(x[X_VEL + i] / par[EP_OBS_V], clip)
         sign = -1.0 if x[X_QUAT] < 0.0 else 1.0
         for i in range(4):
             obs[6 + i] = _clip(sign * x[X_QUAT + i], clip)
         for i in range(3):
-            obs[10 + i] = _clip(x[X_OMEGA + i] / par[P_OBS_W], clip)
+            obs[10 + i] = _clip(x[X_OMEGA + i] / par[EP_OBS_W], clip)
         for j in range(4):
             obs[13 + j] = _clip((x[X_ROTOR + j] - lo) / h - 1.0, clip)
-        obs[17] = _clip(since / par[P_OBS_T], clip)
+        obs[17] = _clip(since / par[EP_OBS_T], clip)
         obs[18] = 1.0 if detected else 0.0
         return
     for i in range(3):
-        obs[i] = _clip(tmeas[MS_IMU_F + i] / par[P_OBS_F], clip)
-        obs[3 + i] = _clip(tmeas[MS_IMU_W + i] / par[P_OBS_W], clip)
+        obs[i] = _clip(tmeas[MS_IMU_F + i] / par[EP_OBS_F], clip)
+        obs[3 + i] = _clip(tmeas[MS_IMU_W + i] / par[EP_OBS_W], clip)
     for r in range(3):
         for c in range(3):
             obs[6 + 3 * r + c] = _clip(C[r, c], clip)
-    obs[15] = _clip(-vz / par[P_OBS_V], clip)
-    obs[16] = _clip(since / par[P_OBS_T], clip)
+    obs[15] = _clip(-vz / par[EP_OBS_V], clip)
+    obs[16] = _clip(since / par[EP_OBS_T], clip)
     obs[17] = 1.0 if detected else 0.0
     obs[18] = _clip(tmeas[MS_NORMAL], clip)
     obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
@@ -427,12 +447,12 @@ def cost_rate(
     c22 = 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2  # cos of the tilt from vertical
     tilt = 0.5 * (1.0 - c22)
     w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
-    rate = min(w / par[P_S_RATE], 1.0)
+    rate = min(w / par[EP_S_RATE], 1.0)
     C = np.empty((3, 3))
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
     vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
-    vert = min(abs(vz) / par[P_S_VZ], 1.0)
-    height = min(max(h_ref + x[X_POS + 2], 0.0) / par[P_S_HEIGHT], 1.0)
+    vert = min(abs(vz) / par[EP_S_VZ], 1.0)
+    height = min(max(h_ref + x[X_POS + 2], 0.0) / par[EP_S_HEIGHT], 1.0)
     hover = math.sqrt(veh[V_MASS] * veh[V_GRAVITY] / (4.0 * veh[V_KT]))
     span = ctrl[C_OMEGA_MAX] - ctrl[C_OMEGA_MIN]
     effort = 0.0
@@ -440,15 +460,15 @@ def cost_rate(
         d = (rin[RIN_CMD + j] - hover) / span
         effort += 0.25 * d * d
     effort = min(effort, 1.0)
-    total = (par[P_W_TILT] * tilt + par[P_W_RATE] * rate + par[P_W_VZ] * vert
-             + par[P_W_HEIGHT] * height + par[P_W_EFFORT] * effort)  # fmt: skip
+    total = (par[EP_W_TILT] * tilt + par[EP_W_RATE] * rate + par[EP_W_VZ] * vert
+             + par[EP_W_HEIGHT] * height + par[EP_W_EFFORT] * effort)  # fmt: skip
     return total if total == total else max_cost_rate(par)
 
 
 @njit(cache=True)
 def max_cost_rate(par: np.ndarray) -> float:
     """The largest cost per second (every term at 1)."""
-    return par[P_W_TILT] + par[P_W_RATE] + par[P_W_VZ] + par[P_W_HEIGHT] + par[P_W_EFFORT]
+    return par[EP_W_TILT] + par[EP_W_RATE] + par[EP_W_VZ] + par[EP_W_HEIGHT] + par[EP_W_EFFORT]
 
 
 @njit(cache=True)
@@ -457,38 +477,42 @@ def envelope_outcome(x: np.ndarray, env: np.ndarray, par: np.ndarray) -> int:
     q1 = x[X_QUAT + 1]
     q2 = x[X_QUAT + 2]
     n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
-    if 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2 < par[P_MAX_TILT_COS]:
+    if 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2 < par[EP_MAX_TILT_COS]:
         return OC_TILT
-    if -x[X_POS + 2] < env[B_H_REF] - par[P_MAX_DROP]:
+    if -x[X_POS + 2] < env[B_H_REF] - par[EP_MAX_DROP]:
         return OC_ALTITUDE
-    if math.hypot(x[X_POS] - env[B_X_REF], x[X_POS + 1] - env[B_Y_REF]) > par[P_MAX_DIST]:
+    if math.hypot(x[X_POS] - env[B_X_REF], x[X_POS + 1] - env[B_Y_REF]) > par[EP_MAX_DIST]:
         return OC_DISTANCE
     w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
-    if w > par[P_MAX_RATE]:
+    if w > par[EP_MAX_RATE]:
         return OC_RATE
     return OC_RUNNING
 
 
 # ---------------------------------------------------------------- reset and step
 @njit(cache=True)
-def _begin_episode(k: int, X, LS, RIN, MEAS, TMEAS, OPTS, CTRL, ENV, par, obs) -> None:  # fmt: skip
-    for i in range(ENV.shape[1]):
-        ENV[k, i] = 0.0
-    ENV[k, B_ACTIVE] = 1.0
-    ENV[k, B_H_REF] = -X[k, X_POS + 2]
-    ENV[k, B_X_REF] = X[k, X_POS]
-    ENV[k, B_Y_REF] = X[k, X_POS + 1]
-    tick_measurement(X[k], LS[k], OPTS[k], MEAS[k], TMEAS[k])
-    observe(TMEAS[k], RIN[k], CTRL[k], par, ENV[k], obs[k])
+def _begin_episode(k: int, m: Model, d: Data, E: Env) -> None:
+    env = E.state[k]
+    env[:] = 0.0
+    env[B_ACTIVE] = 1.0
+    env[B_H_REF] = -d.x[X_POS + 2]
+    env[B_X_REF] = d.x[X_POS]
+    env[B_Y_REF] = d.x[X_POS + 1]
+    tick_measurement(m, d, E.tmeas[k])
+    observe(E.tmeas[k], d.rin, m.ctrl, E.par, env, E.obs[k])
 
 
 @njit(cache=True)
-def reset_slot(
-    k: int, t0: float, tf: float, until_detection: bool,
-    X, LS, CS, RIN, MEM, MEAS, TMEAS, SST, VEH, SURF, OPTS, CTRL, SCFG,
-    sched_t, sched_rate, sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, ENV, par, obs,
-) -> bool:  # fmt: skip
-    """Start run ``k`` from ``X[k]`` (its initial state) and begin its episode.
+def _tick(m: Model, d: Data, o: Output, w: Work) -> None:
+    """``step.advance(1, ...)`` of one run with preallocated work space."""
+    tick(m, d, o, w)
+    if d.ls[LS_DONE] > 0.5:
+        finish(d, o)
+
+
+@njit(cache=True)
+def reset_slot(k: int, until_detection: bool, M: Model, D: Data, O: Output, E: Env) -> bool:
+    """Start run ``k`` of the stacked records from its model and begin its episode.
 
     ``until_detection``: first run the built-in controller (its pre-impact
     behaviour) tick by tick until the detector has fired, so that the agent's
@@ -496,150 +520,142 @@ def reset_slot(
     Returns False if the run ended first (no detection): the episode is then
     not begun.
     """
-    start(X[k], t0, tf, LS[k], CS[k], RIN[k], MEM[k], MEAS[k], SST[k], VEH[k], SURF[k], OPTS[k],
-          SCFG[k], NOISE[k], T_OUT[k], OUT[k], IMU[k], STATS[k])  # fmt: skip
+    m = model_row(M, k)
+    d = data_row(D, k)
+    o = output_row(O, k)
+    start(m, d, o)
     if until_detection:
-        nc = CS.shape[1]
-        w = _work(nc)
-        while MEAS[k, MS_DETECTED] < 0.5:
-            if LS[k, LS_DONE] > 0.5:
-                ENV[k, B_ACTIVE] = 0.0
+        w = new_work(m.pairs.shape[0])
+        while d.meas[MS_DETECTED] < 0.5:
+            if d.ls[LS_DONE] > 0.5:
+                E.state[k, B_ACTIVE] = 0.0
                 return False
-            _tick(k, X, LS, CS, RIN, MEM, MEAS, SST, VEH, SURF, OPTS, CTRL, SCFG, sched_t,
-                  sched_rate, sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, w)  # fmt: skip
-        if LS[k, LS_DONE] > 0.5:
-            ENV[k, B_ACTIVE] = 0.0
+            _tick(m, d, o, w)
+        if d.ls[LS_DONE] > 0.5:
+            E.state[k, B_ACTIVE] = 0.0
             return False
-    _begin_episode(k, X, LS, RIN, MEAS, TMEAS, OPTS, CTRL, ENV, par, obs)
+    _begin_episode(k, m, d, E)
     return True
 
 
 @njit(cache=True)
-def _work(nc: int):
-    """Work arrays of ``step.tick``."""
-    return (np.empty(NX), np.empty(NX), np.empty(NX), np.empty(NX), np.zeros((7, NX)),
-            np.zeros((NX, 4)), np.zeros((3, 3)), np.zeros(4), np.zeros(4), np.zeros(nc),
-            np.zeros(nc), np.zeros(nc), np.zeros(nc), np.zeros(nc))  # fmt: skip
+def _outcome(m: Model, d: Data, o: Output, env: np.ndarray, par: np.ndarray, finite: bool) -> int:
+    """``OC_*`` of a run after its tick: recovered and held, the ground, the envelope, its end."""
+    stage = int(env[B_STAGE])
+    outcome = OC_RUNNING
+    if not finite:
+        outcome = OC_FAILED
+    elif (par[EP_END_ON_RECOVERY] > 0.5 and stage >= STAGE_RECOVERED
+          and env[B_HOLD] >= par[EP_HOLD_TICKS]):  # fmt: skip
+        outcome = OC_RECOVERED
+    elif par[EP_GROUND] > 0.5 and not np.isnan(o.stats[ST_CRASH_T]):
+        outcome = OC_GROUND
+    else:
+        outcome = envelope_outcome(d.x, env, par)
+    if outcome == OC_RUNNING and d.ls[LS_DONE] > 0.5:
+        outcome = OC_FAILED if o.stats[ST_STATUS] == STATUS_FAILED else OC_TIME_LIMIT
+    return outcome
 
 
 @njit(cache=True)
-def _tick(k, X, LS, CS, RIN, MEM, MEAS, SST, VEH, SURF, OPTS, CTRL, SCFG, sched_t, sched_rate,
-          sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, w) -> None:  # fmt: skip
-    """``step.advance(1, ...)`` of run ``k`` with preallocated work arrays."""
-    tick(X[k], LS[k], CS[k], RIN[k], MEM[k], MEAS[k], SST[k], VEH[k], SURF[k], OPTS[k], CTRL[k],
-         SCFG[k], sched_t, sched_rate, sched_stop, NOISE[k], T_OUT[k], OUT[k], IMU[k],
-         EPISODES[k], STATS[k], w[0], w[1], w[2], w[3], w[4], w[5], w[6], w[7], w[8], w[9],
-         w[10], w[11], w[12], w[13])  # fmt: skip
-    if LS[k, LS_DONE] > 0.5:
-        finish(LS[k], CS[k], EPISODES[k], STATS[k])
+def _step_one(k: int, actions: np.ndarray, m: Model, d: Data, o: Output, E: Env, w: Work) -> None:
+    """One control tick of run ``k`` under its action; its reward, termination, observation."""
+    veh = m.veh
+    ctrl = m.ctrl
+    par = E.par
+    tmeas = E.tmeas[k]
+    env = E.state[k]
+    action_command(actions[k], tmeas, veh, ctrl, par, w.cmd)
+    # the stage in force at this tick
+    if E.reported[k] >= 0.0:
+        env[B_STAGE] = E.reported[k]
+        env[B_POLICY] = 1.0
+    elif env[B_POLICY] < 0.5:
+        env[B_STAGE] = takeover_stage(int(env[B_STAGE]), tmeas)
+    d.mem[MEM_STAGE] = env[B_STAGE]
+    d.ls[LS_EXT] = 1.0
+    d.ls[LS_EXT_CMD : LS_EXT_CMD + N_ROTORS] = w.cmd
+    t_before = d.ls[LS_T]
+    _tick(m, d, o, w)
+    d.ls[LS_EXT] = 0.0
+    tick_measurement(m, d, tmeas)
+    env[B_STEPS] += 1.0
+    r = -(d.ls[LS_T] - t_before) * cost_rate(d.x, d.rin, veh, ctrl, par, env[B_H_REF])
+    # termination: recovered and held, the ground, the envelope; truncation: the run's end
+    finite = np.isfinite(d.x).all()
+    if finite:
+        _track_windows(env, tmeas, d.x, ctrl, veh)
+        if env[B_POLICY] < 0.5:
+            _observe_stages(env, o.stats, d.mem, par)
+    outcome = _outcome(m, d, o, env, par, finite)
+    term = outcome != OC_RUNNING and outcome != OC_TIME_LIMIT and outcome != OC_FAILED
+    if outcome == OC_RECOVERED:
+        r += par[EP_W_RECOVERY]
+    elif term:
+        r -= par[EP_W_FAILURE]
+        if par[EP_FAIL_REMAINING] > 0.5:
+            r -= max_cost_rate(par) * max(d.ls[LS_TF] - d.ls[LS_T], 0.0)
+    E.reward[k] = r
+    env[B_RETURN] += r
+    E.terminated[k] = term
+    E.truncated[k] = outcome == OC_TIME_LIMIT or outcome == OC_FAILED
+    observe(tmeas, d.rin, ctrl, par, env, E.obs[k])
+    if outcome != OC_RUNNING:
+        env[B_OUTCOME] = outcome
+        env[B_ACTIVE] = 0.0
+        finish(d, o)
 
 
 @njit(cache=True)
-def step_batch(
-    actions, reported,
-    X, LS, CS, RIN, MEM, MEAS, TMEAS, SST, VEH, SURF, OPTS, CTRL, SCFG,
-    sched_t, sched_rate, sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, ENV, par,
-    obs, reward, terminated, truncated,
-) -> None:  # fmt: skip
+def step_batch(actions: np.ndarray, M: Model, D: Data, O: Output, E: Env) -> None:
     """One control tick of every active run under the actions ``actions`` (N, 4).
 
-    ``reported`` (N,): the stage the policy reports for this tick (< 0: none;
-    the observer's stage is used unless the policy has reported one this
-    episode). Writes ``obs`` (N, n_obs), ``reward``, ``terminated`` and
-    ``truncated`` (N,) of the active runs; a run that ends becomes inactive.
+    ``E.reported`` (N,): the stage the policy reports for this tick (< 0:
+    none; the observer's stage is used unless the policy has reported one this
+    episode). Writes ``E.obs`` (N, n_obs), ``E.reward``, ``E.terminated`` and
+    ``E.truncated`` (N,) of the active runs; a run that ends becomes inactive.
     """
-    n = X.shape[0]
-    w = _work(CS.shape[1])
-    cmd = np.zeros(4)
-    for k in range(n):
-        if ENV[k, B_ACTIVE] < 0.5:
+    w = new_work(M.pairs.shape[1])
+    for k in range(actions.shape[0]):
+        if E.state[k, B_ACTIVE] < 0.5:
             continue
-        veh = VEH[k]
-        ctrl = CTRL[k]
-        tmeas = TMEAS[k]
-        env = ENV[k]
-        action_command(actions[k], tmeas, veh, ctrl, par, cmd)
-        # the stage in force at this tick
-        if reported[k] >= 0.0:
-            env[B_STAGE] = reported[k]
-            env[B_POLICY] = 1.0
-        elif env[B_POLICY] < 0.5:
-            env[B_STAGE] = takeover_stage(int(env[B_STAGE]), tmeas)
-        MEM[k, MEM_STAGE] = env[B_STAGE]
-        LS[k, LS_EXT] = 1.0
-        for j in range(4):
-            LS[k, LS_EXT_CMD + j] = cmd[j]
-        t_before = LS[k, LS_T]
-        _tick(k, X, LS, CS, RIN, MEM, MEAS, SST, VEH, SURF, OPTS, CTRL, SCFG, sched_t, sched_rate,
-              sched_stop, NOISE, T_OUT, OUT, IMU, EPISODES, STATS, w)  # fmt: skip
-        LS[k, LS_EXT] = 0.0
-        x = X[k]
-        tick_measurement(x, LS[k], OPTS[k], MEAS[k], tmeas)
-        env[B_STEPS] += 1.0
-        dt = LS[k, LS_T] - t_before
-        r = -dt * cost_rate(x, RIN[k], veh, ctrl, par, env[B_H_REF])
-        # termination: recovered and held, the ground, the envelope; truncation: the run's end
-        finite = np.isfinite(x).all()
-        if finite:
-            _track_windows(env, tmeas, x, ctrl, veh)
-            if env[B_POLICY] < 0.5:
-                _observe_stages(env, STATS[k], MEM[k], par)
-        stage = int(env[B_STAGE])
-        outcome = OC_RUNNING
-        if not finite:
-            outcome = OC_FAILED
-        elif (par[P_END_ON_RECOVERY] > 0.5 and stage >= STAGE_RECOVERED
-              and env[B_HOLD] >= par[P_HOLD_TICKS]):  # fmt: skip
-            outcome = OC_RECOVERED
-        elif par[P_GROUND] > 0.5 and not np.isnan(STATS[k, ST_CRASH_T]):
-            outcome = OC_GROUND
-        else:
-            outcome = envelope_outcome(x, env, par)
-        if outcome == OC_RUNNING and LS[k, LS_DONE] > 0.5:
-            outcome = OC_FAILED if STATS[k, ST_STATUS] == STATUS_FAILED else OC_TIME_LIMIT
-        term = outcome != OC_RUNNING and outcome != OC_TIME_LIMIT and outcome != OC_FAILED
-        if outcome == OC_RECOVERED:
-            r += par[P_W_RECOVERY]
-        elif term:
-            r -= par[P_W_FAILURE]
-            if par[P_FAIL_REMAINING] > 0.5:
-                r -= max_cost_rate(par) * max(LS[k, LS_TF] - LS[k, LS_T], 0.0)
-        reward[k] = r
-        env[B_RETURN] += r
-        terminated[k] = term
-        truncated[k] = outcome == OC_TIME_LIMIT or outcome == OC_FAILED
-        observe(tmeas, RIN[k], ctrl, par, env, obs[k])
-        if outcome != OC_RUNNING:
-            env[B_OUTCOME] = outcome
-            env[B_ACTIVE] = 0.0
-            finish(LS[k], CS[k], EPISODES[k], STATS[k])
+        _step_one(k, actions, model_row(M, k), data_row(D, k), output_row(O, k), E, w)
 
 
 # ---------------------------------------------------------------- the built-in law as a policy
 @njit(cache=True)
 def staged_policy(
-    active, TMEAS, VEH, CTRL, OPTS, PMEM, par, actions, stages, ENV,
-) -> None:  # fmt: skip
+    active: np.ndarray,
+    M: Model,
+    E: Env,
+    pmem: np.ndarray,
+    actions: np.ndarray,
+    stages: np.ndarray,
+) -> None:
     """The ``recovery`` controller as a policy: actions (N, 4) and stages (N,) of each active run.
 
-    Runs ``recovery_step`` on the tick's measurement with the policy's own
-    memory ``PMEM`` (N, NMEM), then chooses the action whose map gives its
-    command exactly when one exists (rotors), or its thrust and rate
-    references (ctbr). Counts in ``ENV[:, B_INEXACT]`` the commands inside the
-    slew window that the rotor map cannot give exactly.
+    Runs ``recovery_step`` on the tick's measurement record (``E.tmeas``, the
+    policy's observation of the state) with the policy's own memory ``pmem``
+    (N, NMEM), then chooses the action whose map gives its command exactly when
+    one exists (rotors), or its thrust and rate references (ctbr). Counts in
+    ``E.state[:, B_INEXACT]`` the commands inside the slew window that the
+    rotor map cannot give exactly.
     """
-    cmd = np.zeros(4)
-    for k in range(TMEAS.shape[0]):
+    cmd = np.zeros(N_ROTORS)
+    par = E.par
+    for k in range(E.tmeas.shape[0]):
         if not active[k]:
             continue
-        tmeas = TMEAS[k]
-        ctrl = CTRL[k]
-        mem = PMEM[k]
+        tmeas = E.tmeas[k]
+        ctrl = M.ctrl[k]
+        veh = M.veh[k]
+        opts = M.opts[k]
+        mem = pmem[k]
         before = int(mem[MEM_STAGE])
-        recovery_step(tmeas[MS_T], tmeas, ctrl, mem, VEH[k], OPTS[k, O_DT_CONTROL], cmd)
+        recovery_step(tmeas[MS_T], tmeas, ctrl, mem, veh, opts[O_DT_CONTROL], cmd)
         stage = int(mem[MEM_STAGE])
         stages[k] = stage
-        if int(par[P_ACTION]) == ACT_CTBR:
+        if int(par[EP_ACTION]) == ACT_CTBR:
             if stage == STAGE_PRE_IMPACT:
                 actions[k, 0] = -1.0
                 for i in range(1, 4):
@@ -649,18 +665,18 @@ def staged_policy(
             a_ref_on = not (first and ctrl[C_PARAMS + R_FIRST_TICK_LEVEL] > 0.5)
             x = tmeas[MS_X : MS_X + NX]
             thrust, p_des, q_des, _, _ = staged_references(
-                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, VEH[k]
+                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh
             )
-            actions[k, 0], _ = affine_inverse(thrust, 0.0, max_thrust(VEH[k], ctrl))
-            actions[k, 1] = min(max(p_des / par[P_RATE_MAX], -1.0), 1.0)
-            actions[k, 2] = min(max(q_des / par[P_RATE_MAX + 1], -1.0), 1.0)
+            actions[k, 0], _ = affine_inverse(thrust, 0.0, max_thrust(veh, ctrl))
+            actions[k, 1] = min(max(p_des / par[EP_RATE_MAX], -1.0), 1.0)
+            actions[k, 2] = min(max(q_des / par[EP_RATE_MAX + 1], -1.0), 1.0)
             actions[k, 3] = 0.0
             continue
         lo, hi = rotor_range(ctrl, par)
-        slew = OPTS[k, O_SLEW_MAX] * OPTS[k, O_DT_CONTROL]
-        for j in range(4):
+        slew = opts[O_SLEW_MAX] * opts[O_DT_CONTROL]
+        for j in range(N_ROTORS):
             a, exact = affine_inverse(cmd[j], lo, hi)
             actions[k, j] = a
             prev = tmeas[MS_X + X_ROTOR + j]
             if not exact and (slew <= 0.0 or abs(cmd[j] - prev) <= slew):
-                ENV[k, B_INEXACT] += 1.0
+                E.state[k, B_INEXACT] += 1.0

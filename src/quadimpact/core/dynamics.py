@@ -11,6 +11,7 @@ from numba import njit
 from .actuators import rotor_rates
 from .contact import contact_wrench
 from .layout import (
+    N_ROTORS,
     O_SPINUP_PAPER,
     O_YAW_REACTION_PAPER,
     RIN_FF,
@@ -21,45 +22,43 @@ from .layout import (
     X_ROTOR,
 )
 from .quaternion import rotation_matrix
+from .records import Data, Model, Work
 from .rigid_body import rigid_body_derivative
 from .rotors import rotor_wrench
 
 
 @njit(cache=True)
-def state_derivative(
-    x: np.ndarray,
-    xdot: np.ndarray,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-    rin: np.ndarray,
-    cs: np.ndarray,
-    C: np.ndarray,
-    omega_dot: np.ndarray,
-) -> None:
+def state_derivative(x: np.ndarray, xdot: np.ndarray, m: Model, d: Data, w: Work) -> None:
     """Full state derivative ``xdot = f(x)`` (the system is autonomous).
 
-    ``rin`` holds the rotor inputs of the interval, ``cs`` the contact pairs
-    (which are in an episode, with which damping). ``C`` (3x3) and
-    ``omega_dot`` (4,) are work arrays; on return ``C`` is the rotation of ``x``.
+    ``m`` is the run (vehicle, features, shapes, options), ``d.rin`` the rotor
+    inputs of the interval, ``d.cs`` the contact pairs (which are in an
+    episode, with which damping). Uses ``w.C`` and ``w.wdot`` as work space; on
+    return ``w.C`` is the rotation of ``x`` and ``w.wdot`` the rotor rates used
+    in the reaction torque.
     """
+    C = w.C
+    omega_dot = w.wdot
+    veh = m.veh
+    rin = d.rin
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
     rotor_rates(x, veh, rin, omega_dot)
-    for j in range(4):
+    for j in range(N_ROTORS):
         xdot[X_ROTOR + j] = omega_dot[j]
     if rin[RIN_FIRST_ORDER] < 0.5:
         # ideal / scheduled rotors: the reaction torque uses the prescribed rate
-        for j in range(4):
+        for j in range(N_ROTORS):
             omega_dot[j] = rin[RIN_FF + j]
     mg = veh[V_MASS] * veh[V_GRAVITY]
     fx = mg * C[2, 0]
     fy = mg * C[2, 1]
     fz = mg * C[2, 2]
+    opts = m.opts
     tz, mx, my, mz = rotor_wrench(
         x, omega_dot, veh, opts[O_YAW_REACTION_PAPER] > 0.5, opts[O_SPINUP_PAPER] > 0.5
     )
     fz += tz
-    cfx, cfy, cfz, cmx, cmy, cmz = contact_wrench(x, C, veh, surf, opts, cs)
+    cfx, cfy, cfz, cmx, cmy, cmz = contact_wrench(x, C, m, d.cs)
     rigid_body_derivative(
         x, xdot, C, veh, fx + cfx, fy + cfy, fz + cfz, mx + cmx, my + cmy, mz + cmz
     )

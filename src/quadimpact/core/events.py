@@ -2,25 +2,27 @@
 
 Events of a run (docs/NUMERICS.md):
 
-* ``EV_GAP``: the contact gap of one bumper-surface pair crosses 0 (contact
-  onset upward, contact end downward): the penetration ``delta``, or with the
+* ``EV_GAP``: the contact gap of one contact pair crosses 0 (contact onset
+  upward, contact end downward): the penetration ``delta``, or with the
   recovery replica's gate ``min(delta, gate - d_CM)`` (``contact.contact_gap``);
 * ``EV_RATE``: ``delta_dot`` of an active contact crosses 0 downward (the
   peak deflection of the episode: located, not sampled);
 * ``EV_ALTITUDE``: the CM altitude ``h = -Z`` crosses the crash level.
 
-Roots are found on the dense output of the accepted step with the Illinois
-variant of regula falsi, bracketing all along, to ``EVENT_TOL`` in time.
+Roots are found on the dense output of the accepted step (the step from the
+state ``d.x`` with the coefficients ``w.Q``) with the Illinois variant of
+regula falsi, bracketing all along, to ``opts[O_EVENT_TOL]`` in time.
 """
 
 import numpy as np
 from numba import njit
 
 from .contact import contact_gap
-from .geometry import bumper_depth
+from .geometry import pair_depth
 from .integrator import dense_eval
-from .layout import X_POS, X_QUAT
+from .layout import CS_ACTIVE, O_EVENT_TOL, X_POS, X_QUAT
 from .quaternion import rotation_matrix
+from .records import Data, Model, Work
 
 EV_GAP = 0
 EV_RATE = 1
@@ -30,23 +32,17 @@ NEAR_GRAZE_SAMPLES = 3  # interior dense-output checks of near-grazing contacts
 
 
 @njit(cache=True)
-def event_value(
-    kind: int,
-    c: int,
-    xs: np.ndarray,
-    C: np.ndarray,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-    level: float,
-) -> float:
-    """Value of event function ``kind`` for contact ``c = 4 s + j`` at state ``xs``."""
+def event_value(kind: int, c: int, level: float, xs: np.ndarray, C: np.ndarray, m: Model) -> float:
+    """Value of event function ``kind`` for pair ``c`` (or level ``level``) at state ``xs``.
+
+    ``C`` is work space (it receives the rotation of ``xs``).
+    """
     if kind == EV_ALTITUDE:
         return -xs[X_POS + 2] - level
     rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
-    d, dd = bumper_depth(xs, C, veh, c % 4, surf, c // 4)
+    d, dd = pair_depth(xs, C, m.feat, m.shapes, m.pairs, c)
     if kind == EV_GAP:
-        return contact_gap(xs, d, surf, c // 4, opts)
+        return contact_gap(xs, d, m, c)
     return dd
 
 
@@ -54,27 +50,23 @@ def event_value(
 def locate(
     kind: int,
     c: int,
-    x_old: np.ndarray,
-    Q: np.ndarray,
+    level: float,
+    m: Model,
+    d: Data,
+    w: Work,
     h: float,
     ga: float,
     gb: float,
     sb: float,
-    tol: float,
-    xs: np.ndarray,
-    C: np.ndarray,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-    level: float,
 ) -> float:
-    """Root of an event function on ``[0, sb]`` (fractions of the step ``h``).
+    """Root of an event function on ``[0, sb]`` (fractions of the step ``h`` from ``d.x``).
 
     ``ga`` is its value at 0 and ``gb`` at ``sb``, of opposite "sides"
     (``ga <= 0 < gb`` or ``ga > 0 >= gb``). Returns the fraction of the step at
     the root, on the side where the event has happened (the sign of ``gb``),
-    within ``tol`` seconds.
+    within ``opts[O_EVENT_TOL]`` seconds.
     """
+    tol = m.opts[O_EVENT_TOL]
     sa = 0.0
     side_b = gb > 0.0
     fa = ga
@@ -87,8 +79,8 @@ def locate(
         s = sb - fb * (sb - sa) / denom if denom != 0.0 else 0.5 * (sa + sb)
         if not (sa < s < sb):
             s = 0.5 * (sa + sb)
-        dense_eval(x_old, Q, h, s, xs)
-        fs = event_value(kind, c, xs, C, veh, surf, opts, level)
+        dense_eval(d.x, w.Q, h, s, w.xs)
+        fs = event_value(kind, c, level, w.xs, w.C, m)
         if (fs > 0.0) == side_b:
             sb = s
             fb = fs
@@ -105,48 +97,33 @@ def locate(
 
 
 @njit(cache=True)
-def contact_event(
-    c: int,
-    active: bool,
-    ga: float,
-    gb: float,
-    gda: float,
-    gdb: float,
-    x_old: np.ndarray,
-    Q: np.ndarray,
-    h: float,
-    tol: float,
-    xs: np.ndarray,
-    C: np.ndarray,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-) -> float:
-    """Fraction of the step at which contact ``c`` begins or ends (``NO_EVENT``: neither).
+def contact_event(c: int, m: Model, d: Data, w: Work, h: float) -> float:
+    """Fraction of the step at which pair ``c`` begins or ends (``NO_EVENT``: neither).
 
-    ``ga``/``gb`` are its gap at the step's start and end, ``gda``/``gdb``
-    the penetration rates there. An inactive contact begins where ``delta`` rises through 0;
-    if both ends are negative but within the distance the contact point can
-    travel in the step, the dense output is also sampled inside the step so that
-    a graze is not stepped over. An active contact ends where ``delta`` falls
-    through 0 (at once if it never penetrated after its onset).
+    ``w.g_a[c]``/``w.g_b[c]`` are its gap at the step's start and end,
+    ``w.gd_a[c]``/``w.gd_b[c]`` the penetration rates there. An inactive
+    contact begins where the gap rises through 0; if both ends are negative but
+    within the distance the contact point can travel in the step, the dense
+    output is also sampled inside the step so that a graze is not stepped over.
+    An active contact ends where the gap falls through 0 (at once if it never
+    penetrated after its onset).
     """
-    if not active:
+    ga = w.g_a[c]
+    gb = w.g_b[c]
+    if d.cs[c, CS_ACTIVE] < 0.5:
         if gb > 0.0:
-            return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, opts, 0.0)
-        band = h * (abs(gda) + abs(gdb))
+            return locate(EV_GAP, c, 0.0, m, d, w, h, ga, gb, 1.0)
+        band = h * (abs(w.gd_a[c]) + abs(w.gd_b[c]))
         if -ga < band or -gb < band:
-            for m in range(1, NEAR_GRAZE_SAMPLES + 1):
-                sm = m / (NEAR_GRAZE_SAMPLES + 1.0)
-                dense_eval(x_old, Q, h, sm, xs)
-                gm = event_value(EV_GAP, c, xs, C, veh, surf, opts, 0.0)
+            for k in range(1, NEAR_GRAZE_SAMPLES + 1):
+                sm = k / (NEAR_GRAZE_SAMPLES + 1.0)
+                dense_eval(d.x, w.Q, h, sm, w.xs)
+                gm = event_value(EV_GAP, c, 0.0, w.xs, w.C, m)
                 if gm > 0.0:
-                    return locate(
-                        EV_GAP, c, x_old, Q, h, ga, gm, sm, tol, xs, C, veh, surf, opts, 0.0
-                    )
+                    return locate(EV_GAP, c, 0.0, m, d, w, h, ga, gm, sm)
         return NO_EVENT
     if gb > 0.0:
         return NO_EVENT
     if ga > 0.0:
-        return locate(EV_GAP, c, x_old, Q, h, ga, gb, 1.0, tol, xs, C, veh, surf, opts, 0.0)
+        return locate(EV_GAP, c, 0.0, m, d, w, h, ga, gb, 1.0)
     return 0.0  # touched and left at once (a graze)

@@ -1,295 +1,435 @@
-"""Layout of the flat arrays exchanged between the Python layer and the compiled core.
+"""The slots of every array the compiled core exchanges: one checked contract.
 
-The compiled kernel takes no Python objects: vehicles, surfaces, options and
-controller settings are packed into ``float64`` arrays whose slots are named
-here. Numba treats these module-level integers as compile-time constants.
+The compiled loop takes no Python objects: it takes a few named records of
+``float64`` arrays (``core/records.py``), and every slot of those arrays is
+declared here, block by block, with :class:`Block`. A block hands out
+consecutive offsets in the order its slots are declared, so two slots of a
+block cannot overlap and its size always covers them;
+``tests/core/test_layout.py`` checks every registered block (the
+controllers' parameter blocks and the learning environment's blocks, which
+are declared with their code, included) and that no constant of a block's
+prefix escapes its declaration. Numba reads these module-level integers as
+compile-time constants.
+
+Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
+reason) are plain integer constants for the compiled code (Numba cannot
+store an ``IntEnum`` member in a float array) with an ``IntEnum`` of the
+same values for the Python side (``FeatureKind``, ``ShapeKind``, ``Status``...).
 
 Everything is SI; frames as in docs/MODEL.md section 1 (inertial NED, body FRD).
 """
 
-# --------------------------------------------------------------------------
-# State vector x (length NX). Rotor speeds are always part of the state: in
-# ideal and power-off modes their derivative is prescribed (zero or a
-# schedule rate), in first-order mode it is (cmd - Omega) / tau.
-# --------------------------------------------------------------------------
-X_POS = 0  # p, CM position, inertial (3)
-X_VEL = 3  # v, CM velocity, body (3)
-X_QUAT = 6  # q = [q0, q1, q2, q3], scalar first, body -> inertial (4)
-X_OMEGA = 10  # omega = [p, q, r], body angular velocity (3)
-X_ROTOR = 13  # Omega_1..4, rotor speeds in rad/s (4)
-NX = 17
-N_RIGID = 13
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from enum import IntEnum
+from typing import ClassVar
+
+__all__ = ["Block"]  # and every slot constant below
+
+
+@dataclass
+class Block:
+    """Consecutive slots of one array (or of a part of one), declared in order.
+
+    Parameters
+    ----------
+    array : str
+        What the slots index: a record field (``"veh"``, ``"stats"``...), or
+        ``"ctrl.params.<controller>"`` for a parameter block inside ``ctrl``.
+    prefix : str
+        The prefix of every slot constant of the block (``"V_"``).
+    start : int
+        Offset of the first slot (a block may continue another one).
+    capacity : int, optional
+        An upper bound the block must fit in (a controller's parameter block
+        must fit in ``NPARAM``).
+    """
+
+    array: str
+    prefix: str
+    start: int = 0
+    capacity: int | None = None
+    slots: dict[str, tuple[int, int]] = field(default_factory=dict)
+    size_name: str | None = None
+    registry: ClassVar[dict[str, Block]] = {}
+
+    def __post_init__(self) -> None:
+        self.next = self.start
+        key = f"{self.array}:{self.prefix}"
+        if key in Block.registry:
+            raise ValueError(f"layout: block {key} declared twice")
+        Block.registry[key] = self
+
+    def slot(self, name: str, width: int = 1) -> int:
+        """Declare the next slot (``width`` consecutive numbers); return its offset."""
+        if not name.startswith(self.prefix):
+            raise ValueError(f"layout: slot {name} must start with {self.prefix}")
+        if name in self.slots or width < 1:
+            raise ValueError(f"layout: slot {name} declared twice or with width < 1")
+        offset = self.next
+        self.slots[name] = (offset, width)
+        self.next += width
+        if self.capacity is not None and self.next > self.capacity:
+            raise ValueError(f"layout: block {self.array} overflows its {self.capacity} slots")
+        return offset
+
+    def end(self, size_name: str) -> int:
+        """Close the block; return its size (the first offset after its last slot)."""
+        self.size_name = size_name
+        return self.next
+
 
 # --------------------------------------------------------------------------
-# Vehicle vector veh (length NVEH)
+# Kinds
 # --------------------------------------------------------------------------
-V_MASS = 0
-V_INERTIA = 1  # 9, row-major
-V_INERTIA_INV = 10  # 9, row-major
-V_ROTOR_POS = 19  # 12, rotor j at V_ROTOR_POS + 3 j (body, m)
-V_SPIN = 31  # 4, +-1, spin sense about +z_B
-V_KT = 35  # thrust coefficient, N/(rad/s)^2
-V_DT = 36  # drag-torque coefficient, N m/(rad/s)^2
-V_JR = 37  # rotor inertia about its axis, kg m^2
-V_GRAVITY = 38  # m/s^2
-V_RB = 39  # bumper circle radius, m
-V_BUMP_C = 40  # 12, bumper centre j (body, m)
-V_BUMP_N = 52  # 12, circle plane unit normal n_j (body)
-V_K = 64  # contact stiffness, N/m^n
-V_N = 65  # contact exponent
-V_E = 66  # coefficient of restitution
-V_TAU_M = 67  # motor time constant, s (first-order rotor mode)
-NVEH = 68
+N_ROTORS = 4  # a quadrotor: rotor speeds, commands and rotor inputs have four entries
 
-# --------------------------------------------------------------------------
-# Surfaces: array surf of shape (n_surfaces, NSURF). A plane through p0 with
-# unit normal m pointing out of the obstacle into free space.
-# --------------------------------------------------------------------------
-S_P0 = 0  # 3
-S_NORMAL = 3  # 3
-S_IS_GROUND = 6  # 1.0 if this surface is the ground (first onset = crash)
-S_KIND = 7  # SURF_* below: which geometry (core/geometry.py dispatches on it)
-NSURF = 8
 
-SURF_PLANE = 0  # half-space: a plane through S_P0 with outward unit normal S_NORMAL
+class FeatureKind(IntEnum):
+    """Contact features of a vehicle (rows of ``feat``)."""
 
-# --------------------------------------------------------------------------
-# Options vector opts (length NOPT): model switches, integrator settings
-# --------------------------------------------------------------------------
-O_YAW_REACTION_PAPER = 0  # 1: replica rotor drag torque +s dt W^2 (and the allocation's yaw row)
-O_DOUBLE_BUMPER1_YAW = 1  # 1: replica counts bumper 1's contact yaw moment twice
-O_CRASH_RULE = 2  # CRASH_* below
-O_CRASH_ALTITUDE = 3  # m; crash when h <= this (paper-ticks rule) or crosses it
-O_ROTOR_MODE = 4  # ROTOR_* below
-O_OMEGA_MIN = 5  # rad/s, command lower limit (<= 0: none)
-O_OMEGA_MAX = 6  # rad/s, command upper limit (<= 0: none)
-O_SLEW_MAX = 7  # rad/s^2, command slew limit (<= 0: none)
-O_MU = 8  # friction coefficient (0: frictionless, the paper)
-O_V_REG = 9  # m/s, friction regularisation velocity
-O_V_MIN = 10  # m/s, floor of v_i in the damping coefficient
-O_DT_CONTROL = 11  # s, control period
-O_RTOL = 12
-O_ATOL = 13
-O_H_MAX = 14  # s, largest step (<= 0: the control period)
-O_MAX_STEPS = 15  # total accepted+rejected step budget
-O_EVENT_TOL = 16  # s, event time tolerance
-O_POWER_OFF_T = 17  # s, power-off trigger time (< 0: at the first contact; inf: never)
-O_STOP_ON_CRASH = 18  # 1: end the run at the crash
-O_SPINUP_PAPER = 19  # 1: spin-up reaction -Jr sum_j Omega_dot_j (no spin sign; paper replica)
-O_CONTACT_GATE = 20  # m; > 0: contact forces act only while the CM is within this of the plane
-NOPT = 21
+    RING = 0  # a bumper ring: centre, plane normal, radius
 
-CRASH_CM_GROUND = 0  # event: CM altitude crosses O_CRASH_ALTITUDE (default 0)
-CRASH_PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at control ticks only
-CRASH_NONE = 2  # no crash plane (ground may be a contact surface)
 
-ROTOR_IDEAL = 0
-ROTOR_FIRST_ORDER = 1
+class ShapeKind(IntEnum):
+    """Shapes of the world (rows of ``shapes``)."""
 
-# --------------------------------------------------------------------------
-# Controller vector ctrl (length NCTRL) and its memory (length NMEM)
-#
-# A common head (kind, references, allocation, rotor range) followed by a
-# block of NPARAM slots that each controller lays out for itself (see its
-# module in core/controllers/). Memory slot MEM_STAGE (the last) is reserved:
-# a controller with discrete stages writes its current stage there, and the
-# loop records it per output sample and the tick at which each stage was
-# first entered (ST_STAGE_T). Controllers written for the earlier 24-slot
-# memory never touch it.
-# --------------------------------------------------------------------------
-C_KIND = 0  # CTRL_* below
-C_H_REF = 1  # m, altitude reference
-C_PHI_REF = 2  # rad
-C_THETA_REF = 3  # rad
-C_PSI_REF = 4  # rad
-C_ALLOC_INV = 5  # 16: inverse allocation matrix, row-major
-C_OMEGA_MIN = 21  # rad/s, the vehicle's rotor speed range (controllers that limit themselves)
-C_OMEGA_MAX = 22
-C_PARAMS = 23  # start of the controller's own parameters
-NPARAM = 64
-NCTRL = C_PARAMS + NPARAM
+    PLANE = 0  # a half-space: a plane through a point, outward unit normal
 
-CTRL_NONE = 0  # rotors held at their initial speeds (no controller)
-CTRL_PAPER = 1
-CTRL_CASCADE_PID = 2
-CTRL_RECOVERY = 3
-CTRL_USER = 99  # a plug-in controller compiled with run.make_kernel
 
-NMEM = 64  # controller memory (previous errors, integrals, flags), zeroed at the start
-MEM_STAGE = NMEM - 1  # reserved: the controller's current stage (0 when it has none)
-N_STAGES = 8  # stages 0..7 have recorded entry ticks
+class ControllerKind(IntEnum):
+    """Built-in controllers (``ctrl[C_KIND]``)."""
 
-# --------------------------------------------------------------------------
-# Rotor input over the current sub-interval (array rin of length NRIN)
-# --------------------------------------------------------------------------
-RIN_CMD = 0  # 4: speed command in force (rad/s)
-RIN_RATE = 4  # 4: prescribed d(Omega)/dt of the rotor states (ideal: 0; power-off: rate)
-RIN_FF = 8  # 4: Omega_dot used in the reaction torque (ideal: finite difference)
-RIN_FIRST_ORDER = 12  # 1: rotor states follow (cmd - Omega) / tau instead
-RIN_PREV_CMD = 13  # 4: the command of the previous tick, after limits (rad/s)
-NRIN = 17
+    NONE = 0  # rotors held at their current speeds
+    PAPER = 1
+    CASCADE_PID = 2
+    RECOVERY = 3
+    USER = 99  # a plug-in compiled into its own loop (core/run.py, make_kernel)
 
-# --------------------------------------------------------------------------
-# Loop state (array ls of length NLS): what the run loop carries from one
-# control tick to the next besides the state, the rotor inputs, the contact
-# pairs and the controller memory. Counters live in stats (ST_*).
-# --------------------------------------------------------------------------
-LS_T = 0  # s, time reached
-LS_T0 = 1  # s, start of the run (tick k is at t0 + k dt)
-LS_TF = 2  # s, end of the run
-LS_K = 3  # index of the next control tick
-LS_H = 4  # s, step-size proposal for the next step
-LS_DONE = 5  # 1: the run has ended (final time, crash with stop, failure)
-LS_PO_ACTIVE = 6  # 1: the power-off schedule is in force
-LS_PO_T = 7  # s, its trigger time
-LS_PO_SEG = 8  # its segment in force
-LS_T_SCHED = 9  # s, next instant the scheduled rotor inputs change (inf: none)
-LS_STAGE = 10  # the controller's stage in force (from MEM_STAGE at the last tick)
-LS_EXT = 11  # 1: the next tick applies LS_EXT_CMD instead of the controller's command
-LS_EXT_CMD = 12  # 4: external rotor speed command (rad/s), e.g. from Python
-NLS = 16
 
-# --------------------------------------------------------------------------
-# Contact pairs (array cs of shape (4 n_surfaces, NCS)); pair c = 4 s + j is
-# bumper j against surface s. Changed only at located events.
-# --------------------------------------------------------------------------
-CS_ACTIVE = 0  # 1 while the pair is in a contact episode (force applied)
-CS_LAMBDA = 1  # damping coefficient fixed at the episode's onset
-CS_EPISODE = 2  # row of its episode in `episodes` (-1: none / beyond the buffer)
-NCS = 3
+class RotorMode(IntEnum):
+    IDEAL = 0
+    FIRST_ORDER = 1
 
-# --------------------------------------------------------------------------
-# Measurement record (array meas of length NMEAS): what a controller sees at
-# a control tick (core/sensors). The state estimate is the true state (an
-# ideal estimator); the IMU fields hold the latest sample and the detector's
-# verdict (zero / NaN until there is one).
-# --------------------------------------------------------------------------
-MS_X = 0  # NX: state estimate (today the true state at the tick)
-MS_T = MS_X + NX  # s, time of the tick
-MS_IMU_T = MS_T + 1  # s, time of the latest IMU sample (NaN: none yet)
-MS_IMU_F = MS_IMU_T + 1  # 3: measured specific force, body FRD, m/s^2
-MS_IMU_W = MS_IMU_F + 3  # 3: measured angular velocity, body FRD, rad/s
-MS_DETECTED = MS_IMU_W + 3  # 1 once an impact has been detected
-MS_T_DETECT = MS_DETECTED + 1  # s, time of the detecting sample (NaN: none)
-MS_NORMAL = MS_T_DETECT + 1  # 3: wall-normal estimate at detection, inertial, unit (away)
-NMEAS = MS_NORMAL + 3
 
-# --------------------------------------------------------------------------
-# Sensor configuration (array scfg of length NSCFG): the IMU and the impact
-# detector (core/sensors/imu.py, core/sensors/detection.py). All noise,
-# bias, saturation and filtering are off when their slots are 0.
-# --------------------------------------------------------------------------
-SC_RATE = 0  # Hz, IMU sample rate (0: no IMU, no detection)
-SC_POS = 1  # 3: IMU position from the CM, body FRD, m
-SC_NOISE_F = 4  # accelerometer white-noise standard deviation per axis, m/s^2
-SC_NOISE_W = 5  # gyro white-noise standard deviation per axis, rad/s
-SC_BIAS = 6  # 6: constant biases (f_x, f_y, f_z, w_x, w_y, w_z), drawn once per run
-SC_RANGE_F = 12  # m/s^2, accelerometer range (saturation, per axis; <= 0: none)
-SC_RANGE_W = 13  # rad/s, gyro range (<= 0: none)
-SC_FILTER = 14  # FILTER_* below
-SC_FILTER_PARAM = 15  # first-order: time constant, s; moving average: window, samples
-SC_DET_THRESHOLD = 16  # m/s^2, horizontal specific force that detects an impact (<= 0: off)
-SC_DET_WORLD = 17  # 1: world-horizontal |(C f)_XY| instead of body-horizontal |(f_x, f_y)|
-SC_DET_PERSIST = 18  # consecutive samples at or above the threshold (>= 1)
-NSCFG = 19
+class CrashRule(IntEnum):
+    CM_GROUND = 0  # event: the CM altitude crosses O_CRASH_ALTITUDE (default 0)
+    PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at the control ticks only
+    NONE = 2  # no crash plane (the ground may be a contact shape)
 
-FILTER_NONE = 0
-FILTER_FIRST_ORDER = 1
-FILTER_MOVING_AVERAGE = 2
-MAX_AVERAGE_WINDOW = 64  # samples
 
-# --------------------------------------------------------------------------
-# Sensor state (array sst of length NSST)
-# --------------------------------------------------------------------------
-SS_N = 0  # samples taken
-SS_NEXT_T = 1  # s, time of the next sample
-SS_COUNT = 2  # consecutive samples at or above the detection threshold
-SS_FILT = 3  # 6: low-pass state (first-order) / running sum (moving average)
-SS_RING = 9  # 6 * MAX_AVERAGE_WINDOW: moving-average window of the saturated samples
-NSST = SS_RING + 6 * MAX_AVERAGE_WINDOW
+class Filter(IntEnum):
+    NONE = 0
+    FIRST_ORDER = 1
+    MOVING_AVERAGE = 2
 
-# --------------------------------------------------------------------------
-# IMU samples (array imu_out of shape (n_imu, NIMU))
-# --------------------------------------------------------------------------
-I_T = 0  # s
-I_F = 1  # 3: measured specific force, body FRD, m/s^2
-I_W = 4  # 3: measured angular velocity, body FRD, rad/s
-I_F_TRUE = 7  # 3: true specific force at the IMU position, m/s^2
-I_W_TRUE = 10  # 3: true angular velocity, rad/s
-I_HORIZONTAL = 13  # the detector's horizontal measure of this sample, m/s^2
-NIMU = 14
 
-# --------------------------------------------------------------------------
-# Output time series columns (array out of shape (n_out, NOUT))
-# --------------------------------------------------------------------------
-OUT_T = 0
-OUT_X = 1  # NX state columns
-OUT_DELTA = OUT_X + NX  # 4: per-bumper deflection, max over surfaces, >= 0 (m)
-OUT_FORCE = OUT_DELTA + 4  # 4: per-bumper normal force, sum over surfaces (N)
-OUT_CMD = OUT_FORCE + 4  # 4: rotor speed command in force (rad/s)
-OUT_STAGE = OUT_CMD + 4  # the controller's stage in force (MEM_STAGE)
-NOUT = OUT_STAGE + 1
+class Status(IntEnum):
+    COMPLETED = 0
+    CRASHED = 1
+    FAILED = 2
 
-# --------------------------------------------------------------------------
-# Contact episodes (array episodes of shape (max_episodes, NEP))
-# --------------------------------------------------------------------------
-E_BUMPER = 0  # 0..3
-E_SURFACE = 1  # index into surf
-E_T_START = 2  # s, located onset
-E_T_END = 3  # s, located end (run end if still open)
-E_V_I = 4  # m/s, penetration rate at onset (before the v_min floor)
-E_PEAK_DELTA = 5  # m
-E_T_PEAK = 6  # s
-E_PEAK_FORCE = 7  # N
-E_T_PEAK_FORCE = 8  # s
-E_OPEN = 9  # 1 if the episode had not ended when the run stopped
-NEP = 10
 
-# --------------------------------------------------------------------------
-# Run statistics (array stats of length NSTAT)
-# --------------------------------------------------------------------------
-ST_STATUS = 0  # STATUS_* below
-ST_REASON = 1  # REASON_* below
-ST_T_END = 2  # s, time reached
-ST_N_STEPS = 3  # accepted steps
-ST_N_REJECTED = 4
-ST_N_RHS = 5  # right-hand-side evaluations
-ST_N_OUT = 6  # output rows written
-ST_N_EPISODES = 7
-ST_CRASH_T = 8  # s, NaN when none
-ST_CRASH_X = 9  # m, CM position at the crash
-ST_CRASH_Y = 10
-ST_CRASH_Z = 11
-ST_MAX_DELTA = 12  # m, largest penetration of any bumper on any surface
-ST_MISSED_ONSETS = 13  # contacts found already penetrating at a step start
-ST_EPISODES_DROPPED = 14  # episodes beyond the buffer
-ST_POWER_OFF_T = 15  # s, when the power-off schedule started (NaN: never)
-ST_N_TICKS = 16  # controller updates
-ST_ONSET_T = 17  # s, first contact onset on a non-ground surface (NaN: none)
-ST_ONSET_X = 18  # NX: full state at that onset
-ST_T_DETECT = ST_ONSET_X + NX  # s, first impact detection (NaN: none)
-ST_DETECT_X = ST_T_DETECT + 1  # NX: state at that detection sample
-ST_DETECT_NORMAL = ST_DETECT_X + NX  # 3: wall-normal estimate, inertial
-ST_N_DETECTIONS = ST_DETECT_NORMAL + 3  # rising edges of the detection condition
-ST_N_IMU = ST_N_DETECTIONS + 1  # IMU samples taken (also beyond the buffer)
-ST_STAGE_T = ST_N_IMU + 1  # N_STAGES: tick at which each stage was first entered (NaN)
-ST_STAGE_X = ST_STAGE_T + N_STAGES  # 3 N_STAGES: CM position there, inertial
-ST_MIN_ALT = ST_STAGE_X + 3 * N_STAGES  # m, lowest CM altitude (step ends and events)
-ST_MIN_TILT_COS = ST_MIN_ALT + 1  # after detection: lowest cos(tilt from vertical) (1: none)
-ST_MAX_RATE = ST_MIN_TILT_COS + 1  # after detection: largest |omega|, rad/s (0: none)
-NSTAT = ST_MAX_RATE + 1
+class Reason(IntEnum):
+    NONE = 0
+    STEP_TOO_SMALL = 1
+    MAX_STEPS = 2
+    NOT_FINITE = 3
 
-STATUS_COMPLETED = 0
-STATUS_CRASHED = 1
-STATUS_FAILED = 2
 
-REASON_NONE = 0
-REASON_STEP_TOO_SMALL = 1
-REASON_MAX_STEPS = 2
-REASON_NOT_FINITE = 3
+FEAT_RING = int(FeatureKind.RING)
+SHAPE_PLANE = int(ShapeKind.PLANE)
+CTRL_NONE = int(ControllerKind.NONE)
+CTRL_PAPER = int(ControllerKind.PAPER)
+CTRL_CASCADE_PID = int(ControllerKind.CASCADE_PID)
+CTRL_RECOVERY = int(ControllerKind.RECOVERY)
+CTRL_USER = int(ControllerKind.USER)
+ROTOR_IDEAL = int(RotorMode.IDEAL)
+ROTOR_FIRST_ORDER = int(RotorMode.FIRST_ORDER)
+CRASH_CM_GROUND = int(CrashRule.CM_GROUND)
+CRASH_PAPER_TICKS = int(CrashRule.PAPER_TICKS)
+CRASH_NONE = int(CrashRule.NONE)
+FILTER_NONE = int(Filter.NONE)
+FILTER_FIRST_ORDER = int(Filter.FIRST_ORDER)
+FILTER_MOVING_AVERAGE = int(Filter.MOVING_AVERAGE)
+STATUS_COMPLETED = int(Status.COMPLETED)
+STATUS_CRASHED = int(Status.CRASHED)
+STATUS_FAILED = int(Status.FAILED)
+REASON_NONE = int(Reason.NONE)
+REASON_STEP_TOO_SMALL = int(Reason.STEP_TOO_SMALL)
+REASON_MAX_STEPS = int(Reason.MAX_STEPS)
+REASON_NOT_FINITE = int(Reason.NOT_FINITE)
 REASON_TEXT = {
     REASON_NONE: "",
     REASON_STEP_TOO_SMALL: "step size fell below the floor (stiff or singular dynamics)",
     REASON_MAX_STEPS: "step budget exhausted",
     REASON_NOT_FINITE: "state became NaN or infinite",
 }
+
+# ==========================================================================
+# Model: per-run constants
+# ==========================================================================
+
+# ---- state vector x (NX). Rotor speeds are always states: in ideal and
+# power-off modes their derivative is prescribed (zero or a schedule rate), in
+# first-order mode it is (cmd - Omega) / tau.
+_x = Block("x", "X_")
+X_POS = _x.slot("X_POS", 3)  # p, CM position, inertial (m)
+X_VEL = _x.slot("X_VEL", 3)  # v, CM velocity, body (m/s)
+X_QUAT = _x.slot("X_QUAT", 4)  # q = [q0, q1, q2, q3], scalar first, body -> inertial
+X_OMEGA = _x.slot("X_OMEGA", 3)  # omega = [p, q, r], body angular velocity (rad/s)
+X_ROTOR = _x.slot("X_ROTOR", N_ROTORS)  # Omega_1..4, rotor speeds (rad/s)
+NX = _x.end("NX")
+N_RIGID = X_ROTOR  # the rigid-body states come first
+
+# ---- vehicle veh (NVEH): mass, inertia, rotors (the contact features are in feat)
+_veh = Block("veh", "V_")
+V_MASS = _veh.slot("V_MASS")  # kg
+V_INERTIA = _veh.slot("V_INERTIA", 9)  # kg m^2, row-major, body
+V_INERTIA_INV = _veh.slot("V_INERTIA_INV", 9)  # row-major
+V_ROTOR_POS = _veh.slot("V_ROTOR_POS", 3 * N_ROTORS)  # rotor j at V_ROTOR_POS + 3 j (body, m)
+V_SPIN = _veh.slot("V_SPIN", N_ROTORS)  # +-1, spin sense about +z_B
+V_KT = _veh.slot("V_KT")  # thrust coefficient, N/(rad/s)^2
+V_DT = _veh.slot("V_DT")  # drag-torque coefficient, N m/(rad/s)^2
+V_JR = _veh.slot("V_JR")  # rotor inertia about its axis, kg m^2
+V_GRAVITY = _veh.slot("V_GRAVITY")  # m/s^2
+V_TAU_M = _veh.slot("V_TAU_M")  # motor time constant, s (first-order rotor mode)
+NVEH = _veh.end("NVEH")
+
+# ---- contact features feat (n_features, NFEAT): the vehicle's protective
+# structure, body frame, each with its own contact law parameters
+_feat = Block("feat", "F_")
+F_KIND = _feat.slot("F_KIND")  # FEAT_*
+F_CENTRE = _feat.slot("F_CENTRE", 3)  # ring centre (body, m)
+F_NORMAL = _feat.slot("F_NORMAL", 3)  # ring plane unit normal (body)
+F_RADIUS = _feat.slot("F_RADIUS")  # ring radius, m
+F_K = _feat.slot("F_K")  # contact stiffness, N/m^n
+F_N = _feat.slot("F_N")  # contact exponent
+F_E = _feat.slot("F_E")  # coefficient of restitution
+F_MU = _feat.slot("F_MU")  # friction coefficient (0: frictionless)
+NFEAT = _feat.end("NFEAT")
+
+# ---- world shapes shapes (n_shapes, NSHAPE), inertial frame
+_shape = Block("shapes", "SH_")
+SH_KIND = _shape.slot("SH_KIND")  # SHAPE_*
+SH_IS_GROUND = _shape.slot("SH_IS_GROUND")  # 1: the ground (its first onset is the crash)
+SH_POINT = _shape.slot("SH_POINT", 3)  # plane: a point on it (m)
+SH_NORMAL = _shape.slot("SH_NORMAL", 3)  # plane: unit normal out of the obstacle
+NSHAPE = _shape.end("NSHAPE")
+
+# ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,
+# shape) pair, shape-major (pair c = shape * n_features + feature); built
+# once per run, the geometry function chosen by the two kinds (core/geometry)
+_pair = Block("pairs", "PR_")
+PR_FEATURE = _pair.slot("PR_FEATURE")  # row of feat
+PR_SHAPE = _pair.slot("PR_SHAPE")  # row of shapes
+PR_GEOMETRY = _pair.slot("PR_GEOMETRY")  # GEOM_* of core/geometry: the pair's function
+NPAIR = _pair.end("NPAIR")
+
+# ---- options opts (NOPT): model switches, integrator settings
+_opt = Block("opts", "O_")
+O_YAW_REACTION_PAPER = _opt.slot("O_YAW_REACTION_PAPER")  # 1: replica drag +s dt W^2
+O_DOUBLE_BUMPER1_YAW = _opt.slot("O_DOUBLE_BUMPER1_YAW")  # 1: feature 0's yaw moment twice
+O_CRASH_RULE = _opt.slot("O_CRASH_RULE")  # CRASH_*
+O_CRASH_ALTITUDE = _opt.slot("O_CRASH_ALTITUDE")  # m; crash when h <= this / crosses it
+O_ROTOR_MODE = _opt.slot("O_ROTOR_MODE")  # ROTOR_*
+O_OMEGA_MIN = _opt.slot("O_OMEGA_MIN")  # rad/s, command lower limit (<= 0: none)
+O_OMEGA_MAX = _opt.slot("O_OMEGA_MAX")  # rad/s, command upper limit (<= 0: none)
+O_SLEW_MAX = _opt.slot("O_SLEW_MAX")  # rad/s^2, command slew limit (<= 0: none)
+O_V_REG = _opt.slot("O_V_REG")  # m/s, friction regularisation velocity
+O_V_MIN = _opt.slot("O_V_MIN")  # m/s, floor of v_i in the damping coefficient
+O_DT_CONTROL = _opt.slot("O_DT_CONTROL")  # s, control period
+O_RTOL = _opt.slot("O_RTOL")
+O_ATOL = _opt.slot("O_ATOL")
+O_H_MAX = _opt.slot("O_H_MAX")  # s, largest step (<= 0: the control period)
+O_MAX_STEPS = _opt.slot("O_MAX_STEPS")  # total accepted + rejected step budget
+O_EVENT_TOL = _opt.slot("O_EVENT_TOL")  # s, event time tolerance
+O_POWER_OFF_T = _opt.slot("O_POWER_OFF_T")  # s, power-off trigger (< 0: first contact; inf: never)
+O_STOP_ON_CRASH = _opt.slot("O_STOP_ON_CRASH")  # 1: end the run at the crash
+O_SPINUP_PAPER = _opt.slot("O_SPINUP_PAPER")  # 1: spin-up reaction -Jr sum Omega_dot (replica)
+O_CONTACT_GATE = _opt.slot("O_CONTACT_GATE")  # m; > 0: forces only while the CM is this close
+NOPT = _opt.end("NOPT")
+
+# ---- controller ctrl (NCTRL): a common head, then NPARAM slots that each
+# controller lays out for itself with a Block of array "ctrl.params.<name>"
+# (core/controllers/)
+_ctrl = Block("ctrl", "C_")
+C_KIND = _ctrl.slot("C_KIND")  # CTRL_*
+C_H_REF = _ctrl.slot("C_H_REF")  # m, altitude reference
+C_PHI_REF = _ctrl.slot("C_PHI_REF")  # rad
+C_THETA_REF = _ctrl.slot("C_THETA_REF")  # rad
+C_PSI_REF = _ctrl.slot("C_PSI_REF")  # rad
+C_ALLOC_INV = _ctrl.slot("C_ALLOC_INV", 16)  # inverse allocation matrix, row-major
+C_OMEGA_MIN = _ctrl.slot("C_OMEGA_MIN")  # rad/s, the vehicle's rotor speed range
+C_OMEGA_MAX = _ctrl.slot("C_OMEGA_MAX")
+NPARAM = 64
+C_PARAMS = _ctrl.slot("C_PARAMS", NPARAM)  # the controller's own parameters
+NCTRL = _ctrl.end("NCTRL")
+
+# ---- sensors scfg (NSCFG): the IMU and the impact detector; noise, bias,
+# saturation and filtering are off when their slots are 0
+_scfg = Block("scfg", "SC_")
+SC_RATE = _scfg.slot("SC_RATE")  # Hz, IMU sample rate (0: no IMU, no detection)
+SC_POS = _scfg.slot("SC_POS", 3)  # IMU position from the CM, body FRD, m
+SC_NOISE_F = _scfg.slot("SC_NOISE_F")  # accelerometer white-noise std per axis, m/s^2
+SC_NOISE_W = _scfg.slot("SC_NOISE_W")  # gyro white-noise std per axis, rad/s
+SC_BIAS = _scfg.slot("SC_BIAS", 6)  # constant biases (f_x, f_y, f_z, w_x, w_y, w_z)
+SC_RANGE_F = _scfg.slot("SC_RANGE_F")  # m/s^2, accelerometer range (<= 0: none)
+SC_RANGE_W = _scfg.slot("SC_RANGE_W")  # rad/s, gyro range (<= 0: none)
+SC_FILTER = _scfg.slot("SC_FILTER")  # FILTER_*
+SC_FILTER_PARAM = _scfg.slot("SC_FILTER_PARAM")  # first-order: tau, s; moving average: window
+SC_DET_THRESHOLD = _scfg.slot("SC_DET_THRESHOLD")  # m/s^2, detecting specific force (<= 0: off)
+SC_DET_WORLD = _scfg.slot("SC_DET_WORLD")  # 1: world-horizontal |(C f)_XY|, else body |(f_x, f_y)|
+SC_DET_PERSIST = _scfg.slot("SC_DET_PERSIST")  # consecutive samples at or above the threshold
+NSCFG = _scfg.end("NSCFG")
+MAX_AVERAGE_WINDOW = 64  # samples
+
+# ---- the span of the run: span (NSPAN)
+_span = Block("span", "SPAN_")
+SPAN_T0 = _span.slot("SPAN_T0")  # s, start
+SPAN_TF = _span.slot("SPAN_TF")  # s, end
+NSPAN = _span.end("NSPAN")
+
+# ==========================================================================
+# Data: what the loop carries from one control tick to the next
+# ==========================================================================
+
+# ---- loop scalars ls (NLS); counters live in stats (ST_*)
+_ls = Block("ls", "LS_")
+LS_T = _ls.slot("LS_T")  # s, time reached
+LS_T0 = _ls.slot("LS_T0")  # s, start of the run (tick k is at t0 + k dt)
+LS_TF = _ls.slot("LS_TF")  # s, end of the run
+LS_K = _ls.slot("LS_K")  # index of the next control tick
+LS_H = _ls.slot("LS_H")  # s, step-size proposal for the next step
+LS_DONE = _ls.slot("LS_DONE")  # 1: the run has ended (final time, crash with stop, failure)
+LS_PO_ACTIVE = _ls.slot("LS_PO_ACTIVE")  # 1: the power-off schedule is in force
+LS_PO_T = _ls.slot("LS_PO_T")  # s, its trigger time
+LS_PO_SEG = _ls.slot("LS_PO_SEG")  # its segment in force
+LS_T_SCHED = _ls.slot("LS_T_SCHED")  # s, next instant the scheduled rotor inputs change
+LS_STAGE = _ls.slot("LS_STAGE")  # the controller's stage in force (MEM_STAGE at the last tick)
+LS_EXT = _ls.slot("LS_EXT")  # 1: the next tick applies LS_EXT_CMD instead of the controller
+LS_EXT_CMD = _ls.slot("LS_EXT_CMD", N_ROTORS)  # external rotor speed command (rad/s)
+NLS = _ls.end("NLS")
+
+# ---- contact pairs cs (n_pairs, NCS); changed only at located events
+_cs = Block("cs", "CS_")
+CS_ACTIVE = _cs.slot("CS_ACTIVE")  # 1 while the pair is in a contact episode (force applied)
+CS_LAMBDA = _cs.slot("CS_LAMBDA")  # damping coefficient fixed at the episode's onset
+CS_EPISODE = _cs.slot("CS_EPISODE")  # row of its episode in `episodes` (-1: none / dropped)
+NCS = _cs.end("NCS")
+
+# ---- rotor inputs over the current sub-interval rin (NRIN)
+_rin = Block("rin", "RIN_")
+RIN_CMD = _rin.slot("RIN_CMD", N_ROTORS)  # speed command in force (rad/s)
+RIN_RATE = _rin.slot("RIN_RATE", N_ROTORS)  # prescribed d(Omega)/dt of the rotor states
+RIN_FF = _rin.slot("RIN_FF", N_ROTORS)  # Omega_dot used in the reaction torque
+RIN_FIRST_ORDER = _rin.slot("RIN_FIRST_ORDER")  # 1: rotor states follow (cmd - Omega) / tau
+RIN_PREV_CMD = _rin.slot("RIN_PREV_CMD", N_ROTORS)  # the previous tick's command, limited
+NRIN = _rin.end("NRIN")
+
+# ---- controller memory mem (NMEM), zeroed at the start; each controller
+# lays out its slots with a Block of array "mem.<name>". The last slot is
+# reserved: a controller with stages writes its current stage there.
+NMEM = 64
+MEM_STAGE = NMEM - 1
+N_STAGES = 8  # stages 0..7 have recorded entry ticks
+
+# ---- measurement record meas (NMEAS): what a controller sees at a tick
+# (core/sensors/measurement.py writes the estimate; the IMU and the detector
+# their fields as the samples are taken)
+_ms = Block("meas", "MS_")
+MS_X = _ms.slot("MS_X", NX)  # state estimate (the ideal estimator: the true state at the tick)
+MS_T = _ms.slot("MS_T")  # s, time of the tick
+MS_IMU_T = _ms.slot("MS_IMU_T")  # s, time of the latest IMU sample (NaN: none yet)
+MS_IMU_F = _ms.slot("MS_IMU_F", 3)  # measured specific force, body FRD, m/s^2
+MS_IMU_W = _ms.slot("MS_IMU_W", 3)  # measured angular velocity, body FRD, rad/s
+MS_DETECTED = _ms.slot("MS_DETECTED")  # 1 once an impact has been detected
+MS_T_DETECT = _ms.slot("MS_T_DETECT")  # s, time of the detecting sample (NaN: none)
+MS_NORMAL = _ms.slot("MS_NORMAL", 3)  # wall-normal estimate at detection, inertial, unit
+NMEAS = _ms.end("NMEAS")
+
+# ---- sensor state sst (NSST)
+_sst = Block("sst", "SS_")
+SS_N = _sst.slot("SS_N")  # samples taken
+SS_NEXT_T = _sst.slot("SS_NEXT_T")  # s, time of the next sample
+SS_COUNT = _sst.slot("SS_COUNT")  # consecutive samples at or above the detection threshold
+SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
+SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
+NSST = _sst.end("NSST")
+
+# ==========================================================================
+# Output: what a run returns
+# ==========================================================================
+
+# ---- IMU samples imu (n_imu, NIMU)
+_imu = Block("imu", "I_")
+I_T = _imu.slot("I_T")  # s
+I_F = _imu.slot("I_F", 3)  # measured specific force, body FRD, m/s^2
+I_W = _imu.slot("I_W", 3)  # measured angular velocity, body FRD, rad/s
+I_F_TRUE = _imu.slot("I_F_TRUE", 3)  # true specific force at the IMU position, m/s^2
+I_W_TRUE = _imu.slot("I_W_TRUE", 3)  # true angular velocity, rad/s
+I_HORIZONTAL = _imu.slot("I_HORIZONTAL")  # the detector's horizontal measure, m/s^2
+NIMU = _imu.end("NIMU")
+
+# ---- time series out (n_out, NOUT + 2 n_features): the fixed columns, then
+# per feature its deflection (max over shapes, >= 0, m), then per feature its
+# normal force (sum over shapes, N); out_width() gives the row length
+_out = Block("out", "OUT_")
+OUT_T = _out.slot("OUT_T")  # s
+OUT_X = _out.slot("OUT_X", NX)  # state
+OUT_CMD = _out.slot("OUT_CMD", N_ROTORS)  # rotor speed command in force (rad/s)
+OUT_STAGE = _out.slot("OUT_STAGE")  # the controller's stage in force (MEM_STAGE)
+NOUT = _out.end("NOUT")
+OUT_DELTA = NOUT  # feature f's deflection at OUT_DELTA + f
+
+
+def out_width(n_features: int) -> int:
+    """Columns of an output row for ``n_features`` contact features."""
+    return NOUT + 2 * n_features
+
+
+# ---- contact episodes episodes (max_episodes, NEP)
+_ep = Block("episodes", "E_")
+E_FEATURE = _ep.slot("E_FEATURE")  # row of feat
+E_SHAPE = _ep.slot("E_SHAPE")  # row of shapes
+E_T_START = _ep.slot("E_T_START")  # s, located onset
+E_T_END = _ep.slot("E_T_END")  # s, located end (run end if still open)
+E_V_I = _ep.slot("E_V_I")  # m/s, penetration rate at onset (before the v_min floor)
+E_PEAK_DELTA = _ep.slot("E_PEAK_DELTA")  # m
+E_T_PEAK = _ep.slot("E_T_PEAK")  # s
+E_PEAK_FORCE = _ep.slot("E_PEAK_FORCE")  # N
+E_T_PEAK_FORCE = _ep.slot("E_T_PEAK_FORCE")  # s
+E_OPEN = _ep.slot("E_OPEN")  # 1 if the episode had not ended when the run stopped
+NEP = _ep.end("NEP")
+
+# ---- run statistics stats (NSTAT)
+_st = Block("stats", "ST_")
+ST_STATUS = _st.slot("ST_STATUS")  # STATUS_*
+ST_REASON = _st.slot("ST_REASON")  # REASON_*
+ST_T_END = _st.slot("ST_T_END")  # s, time reached
+ST_N_STEPS = _st.slot("ST_N_STEPS")  # accepted steps
+ST_N_REJECTED = _st.slot("ST_N_REJECTED")
+ST_N_RHS = _st.slot("ST_N_RHS")  # right-hand-side evaluations
+ST_N_OUT = _st.slot("ST_N_OUT")  # output rows written
+ST_N_EPISODES = _st.slot("ST_N_EPISODES")
+ST_CRASH_T = _st.slot("ST_CRASH_T")  # s, NaN when none
+ST_CRASH_X = _st.slot("ST_CRASH_X", 3)  # m, CM position at the crash
+ST_MAX_DELTA = _st.slot("ST_MAX_DELTA")  # m, deepest penetration of any pair
+ST_MISSED_ONSETS = _st.slot("ST_MISSED_ONSETS")  # contacts found already penetrating
+ST_EPISODES_DROPPED = _st.slot("ST_EPISODES_DROPPED")  # episodes beyond the buffer
+ST_POWER_OFF_T = _st.slot("ST_POWER_OFF_T")  # s, when the power-off schedule started (NaN)
+ST_N_TICKS = _st.slot("ST_N_TICKS")  # controller updates
+ST_ONSET_T = _st.slot("ST_ONSET_T")  # s, first contact onset on a non-ground shape (NaN)
+ST_ONSET_X = _st.slot("ST_ONSET_X", NX)  # full state at that onset
+ST_T_DETECT = _st.slot("ST_T_DETECT")  # s, first impact detection (NaN: none)
+ST_DETECT_X = _st.slot("ST_DETECT_X", NX)  # state at that detection sample
+ST_DETECT_NORMAL = _st.slot("ST_DETECT_NORMAL", 3)  # wall-normal estimate, inertial
+ST_N_DETECTIONS = _st.slot("ST_N_DETECTIONS")  # rising edges of the detection condition
+ST_N_IMU = _st.slot("ST_N_IMU")  # IMU samples taken (also beyond the buffer)
+ST_STAGE_T = _st.slot("ST_STAGE_T", N_STAGES)  # tick of each stage's first entry (NaN)
+ST_STAGE_X = _st.slot("ST_STAGE_X", 3 * N_STAGES)  # CM position there, inertial
+ST_MIN_ALT = _st.slot("ST_MIN_ALT")  # m, lowest CM altitude (step ends and events)
+ST_MIN_TILT_COS = _st.slot("ST_MIN_TILT_COS")  # after detection: lowest cos(tilt) (1: none)
+ST_MAX_RATE = _st.slot("ST_MAX_RATE")  # after detection: largest |omega|, rad/s (0: none)
+NSTAT = _st.end("NSTAT")

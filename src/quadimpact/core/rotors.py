@@ -16,7 +16,7 @@ spin-up term without the spin sign, ``-Jr sum_j Omega_dot_j``
 import numpy as np
 from numba import njit
 
-from .layout import V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
+from .layout import N_ROTORS, V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
 
 
 @njit(cache=True)
@@ -46,7 +46,7 @@ def rotor_wrench(
     my = 0.0
     mz = 0.0
     spin_sum = 0.0
-    for j in range(4):
+    for j in range(N_ROTORS):
         w = x[X_ROTOR + j]
         s = veh[V_SPIN + j]
         t = kt * w * w

@@ -1,99 +1,126 @@
-"""A whole run: the loop of ``step.advance`` from start to end, and its Python entries.
+"""A whole run, the kernels that run it, and its Python entry.
 
-``run_builtin`` (cached) runs one scenario with the built-in controllers;
-``make_kernel(step)`` compiles the same chain around a user's ``njit``
-controller step (see ``controllers`` for its signature). Inputs are the
-packed arrays of ``layout``; outputs are written into arrays the caller
-allocates:
+:func:`run` (compiled, cached on disk) is ``step.start`` plus ``step.advance``
+to the end with the built-in controllers and geometry: it takes the run's
+:class:`~quadimpact.core.records.Model` and fills its
+:class:`~quadimpact.core.records.Output`. A :class:`Kernel` bundles the
+compiled entry points of one loop (``run``, ``start``, ``advance``);
+:data:`BUILTIN` is the cached one.
 
-* ``out`` (n_out, NOUT): samples at the times ``t_out`` from the dense output;
-* ``imu_out`` (n_imu, NIMU): the IMU samples (when the IMU is on);
-* ``episodes`` (max_episodes, NEP): one row per bumper-surface contact episode;
-* ``stats`` (NSTAT): status, counters, crash, first-onset, detection and
-  stage records.
+:func:`make_kernel` compiles the loop again around plug-ins: a user's
+controller step (in place of the built-in dispatch) and the rows of the
+contact-geometry table registered at run time (``core.geometry``). It uses
+:func:`specialise`, which rebuilds every compiled core function that reaches
+a replaced global (Numba resolves globals at compile time); such a kernel is
+compiled once per process and not cached on disk.
 
-:func:`execute` (the classic three arrays) and :func:`execute_record` (all
-of them) allocate the outputs and call the kernel; ``quadimpact.simulation``
-calls them. A run that is advanced tick by tick from Python
-(``quadimpact.simulation.Simulation``) uses ``step.start`` and
-``step.advance`` directly on the same arrays.
+:func:`execute` allocates the outputs, runs a kernel and returns the filled
+parts as a :class:`~quadimpact.core.records.RawRecord`; ``quadimpact.simulation``
+calls it. A run advanced tick by tick from Python
+(``quadimpact.simulation.Simulation``) uses a kernel's ``start`` and ``advance``
+on the same records.
 """
 
+from __future__ import annotations
+
 import inspect
+import math
 import types
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-import numpy as np
 from numba import njit
+from numba.core.dispatcher import Dispatcher
 
-from . import step as _step_module
-from .layout import (
-    MS_X,
-    NCS,
-    NEP,
-    NIMU,
-    NLS,
-    NMEAS,
-    NMEM,
-    NOUT,
-    NRIN,
-    NSCFG,
-    NSST,
-    NSTAT,
-    NX,
-    ST_N_EPISODES,
-    ST_N_IMU,
-    ST_N_OUT,
-)
+from . import geometry as _geometry
+from .geometry.record import no_contact
+from .layout import MS_X, NX, SH_KIND
+from .records import Model, Output, RawRecord, new_data, new_output, raw_record
 from .step import advance, start
+
+__all__ = ["BUILTIN", "Kernel", "execute", "make_kernel", "run", "specialise"]
 
 
 @njit(cache=True)
-def run_builtin(
-    x0: np.ndarray,
-    t0: float,
-    tf: float,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-    ctrl: np.ndarray,
-    scfg: np.ndarray,
-    sched_t: np.ndarray,
-    sched_rate: np.ndarray,
-    sched_stop: np.ndarray,
-    noise: np.ndarray,
-    t_out: np.ndarray,
-    out: np.ndarray,
-    imu_out: np.ndarray,
-    episodes: np.ndarray,
-    stats: np.ndarray,
-) -> None:
-    """Run one scenario from ``(t0, x0)`` to ``tf`` (s) with the built-in controllers.
+def run(m: Model, o: Output) -> None:
+    """Run ``m`` from ``(t0, x0)`` to ``tf`` with the built-in controllers and geometry.
 
     The loop state is allocated here and dropped at the end; everything the
-    caller needs is in ``out``, ``imu_out``, ``episodes`` and ``stats``.
+    caller needs is in ``o``.
     """
-    x = x0.copy()
-    ls = np.zeros(NLS)
-    cs = np.zeros((4 * surf.shape[0], NCS))
-    rin = np.zeros(NRIN)
-    mem = np.zeros(NMEM)
-    meas = np.zeros(NMEAS)
-    sst = np.zeros(NSST)
-    start(x, t0, tf, ls, cs, rin, mem, meas, sst, veh, surf, opts, scfg, noise, t_out, out,
-          imu_out, stats)  # fmt: skip
-    advance(-1, x, ls, cs, rin, mem, meas, sst, veh, surf, opts, ctrl, scfg, sched_t, sched_rate,
-            sched_stop, noise, t_out, out, imu_out, episodes, stats)  # fmt: skip
+    d = new_data(m)
+    start(m, d, o)
+    advance(-1, m, d, o)
 
 
-def _rebound(fn: Callable, name: str, **globals_: object) -> Callable:
-    """A fresh (uncached) ``njit`` copy of ``fn`` whose module globals ``globals_`` are replaced."""
+@dataclass(frozen=True)
+class Kernel:
+    """The compiled entry points of one run loop.
+
+    ``run(m, o)``, ``start(m, d, o)``, ``advance(n, m, d, o) -> ticks``;
+    ``step``: the plug-in controller step compiled into it (None: built-ins).
+    """
+
+    run: Callable
+    start: Callable
+    advance: Callable
+    step: Callable | None = None
+
+
+BUILTIN = Kernel(run=run, start=start, advance=advance)
+"""The cached loop: built-in controllers, built-in geometry."""
+
+
+# ---------------------------------------------------------------- plug-ins
+def _global_names(code: types.CodeType) -> set[str]:
+    names = set(code.co_names)
+    for const in code.co_consts:
+        if isinstance(const, types.CodeType):
+            names |= _global_names(const)
+    return names
+
+
+def _rebound(fn: Dispatcher, scope_changes: Mapping[str, object]) -> Dispatcher:
+    """A fresh (uncached) ``njit`` copy of ``fn`` with some module globals replaced."""
     py = fn.py_func
     scope = dict(py.__globals__)
-    scope.update(globals_)
-    copy = types.FunctionType(py.__code__, scope, name, py.__defaults__)
-    return njit(copy)
+    scope.update(scope_changes)
+    copy = types.FunctionType(py.__code__, scope, py.__name__, py.__defaults__)
+    copy.__qualname__ = py.__qualname__
+    options = {k: v for k, v in fn.targetoptions.items() if k != "cache"}
+    return njit(**options)(copy)
+
+
+def specialise(
+    fn: Dispatcher,
+    replacements: Mapping[str, object],
+    memo: dict[Dispatcher, Dispatcher] | None = None,
+) -> Dispatcher:
+    """``fn`` compiled with the globals named in ``replacements`` replaced, at any depth.
+
+    Every compiled function of ``quadimpact.core`` that ``fn`` calls and that
+    (transitively) reads a replaced global is rebuilt the same way; the others
+    are shared. ``memo`` shares the rebuilt functions between several roots.
+    """
+    memo = {} if memo is None else memo
+    if fn in memo:
+        return memo[fn]
+    py = fn.py_func
+    changes: dict[str, object] = {}
+    for name in _global_names(py.__code__):
+        if name not in py.__globals__:
+            continue
+        if name in replacements:
+            changes[name] = replacements[name]
+            continue
+        target = py.__globals__[name]
+        if isinstance(target, Dispatcher) and target.py_func.__module__.startswith(__package__):
+            rebuilt = specialise(target, replacements, memo)
+            if rebuilt is not target:
+                changes[name] = rebuilt
+    result = _rebound(fn, changes) if changes else fn
+    memo[fn] = result
+    return result
 
 
 def _adapt_legacy(step: Callable) -> Callable:
@@ -110,131 +137,96 @@ def _adapt_legacy(step: Callable) -> Callable:
     return adapted
 
 
-def make_kernel(step: Callable) -> Callable:
-    """Compile the run loop around a user's ``njit`` controller ``step``.
-
-    ``step(t, meas, ctrl, mem, veh, dt, cmd)`` (the interface of
-    ``core.controllers``); a step of the earlier interface
-    ``step(x, ctrl, mem, veh, dt, cmd)`` is adapted (it gets the state estimate
-    as ``x``). The chain ``tick -> advance -> run`` is compiled again with the
-    controller bound in place of the built-in dispatch (Numba resolves globals
-    at compile time). The result has the signature of :func:`run_builtin`, plus
-    the attributes ``advance`` and ``step`` (for the stepping front end); it is
-    compiled on first call and not cached on disk (~10 s).
-    """
+def _checked_step(step: Callable) -> Callable:
+    if not hasattr(step, "py_func"):
+        raise TypeError("controller step: must be a numba.njit function")
     n_params = len(inspect.signature(step.py_func).parameters)
     if n_params == 6:
-        step = _adapt_legacy(step)
-    elif n_params != 7:
+        return _adapt_legacy(step)
+    if n_params != 7:
         raise TypeError(
             "controller step: expected step(t, meas, ctrl, mem, veh, dt, cmd) "
             f"(or the older step(x, ctrl, mem, veh, dt, cmd)); got {n_params} parameters"
         )
-    name = getattr(step, "__name__", "controller")
-    tick = _rebound(_step_module.tick, "tick_" + name, controller_step=step)
-    adv = _rebound(_step_module.advance, "advance_" + name, tick=tick)
-    kernel = _rebound(run_builtin, "run_" + name, advance=adv)
-    kernel.advance = adv
-    kernel.step = step
-    return kernel
+    return step
 
 
-@dataclass
-class RawRecord:
-    """What one compiled run returns: the filled parts of its output arrays.
+def _generated(source: str, scope: dict[str, object]) -> Callable:
+    """``njit`` (inlined) of the function ``dispatch`` defined by ``source``."""
+    exec(source, scope)  # noqa: S102 - generated from the registry's integer ids only
+    return njit(inline="always")(scope["dispatch"])
 
-    ``out`` (n_out, NOUT), ``episodes`` (n_episodes, NEP), ``stats`` (NSTAT) and
-    ``imu`` (n_imu, NIMU), layouts in ``core.layout``.
+
+def _contact_dispatch(entries: Mapping[int, Callable]) -> Callable:
+    """``plugin_contact`` for the registered geometries: a branch per geometry id."""
+    lines = ["def dispatch(g, x, C, feat, f, shapes, s):"]
+    scope: dict[str, object] = {"no_contact": no_contact}
+    for i, (gid, fn) in enumerate(sorted(entries.items())):
+        scope[f"fn{i}"] = fn
+        lines += [f"    if g == {int(gid)}:", f"        return fn{i}(x, C, feat, f, shapes, s)"]
+    lines.append("    return no_contact()")
+    return _generated("\n".join(lines), scope)
+
+
+def _distance_dispatch(entries: Mapping[int, Callable]) -> Callable:
+    """``plugin_distance`` for the registered shape kinds: a branch per kind."""
+    lines = ["def dispatch(px, py, pz, shapes, s):", "    kind = int(shapes[s, SH_KIND])"]
+    scope: dict[str, object] = {"SH_KIND": SH_KIND, "inf": math.inf}
+    for i, (kind, fn) in enumerate(sorted(entries.items())):
+        scope[f"fn{i}"] = fn
+        lines += [f"    if kind == {int(kind)}:", f"        return fn{i}(px, py, pz, shapes, s)"]
+    lines.append("    return inf")
+    return _generated("\n".join(lines), scope)
+
+
+def make_kernel(step: Callable | None = None, *, geometry: bool = False) -> Kernel:
+    """Compile the run loop around plug-ins.
+
+    Parameters
+    ----------
+    step : numba.njit function, optional
+        A controller step ``step(t, meas, ctrl, mem, veh, dt, cmd)`` (the
+        interface of ``core.controllers``; a step of the earlier interface
+        ``step(x, ctrl, mem, veh, dt, cmd)`` is adapted: it gets the state
+        estimate as ``x``), bound in place of the built-in dispatch.
+    geometry : bool
+        Compile in the rows of the contact-geometry table and the shape
+        distances registered so far (``core.geometry.register_geometry``).
+
+    Returns
+    -------
+    Kernel
+        Compiled on first call (about 10 s for a controller; a geometry
+        plug-in rebuilds most of the loop), not cached on disk.
     """
-
-    out: np.ndarray
-    episodes: np.ndarray
-    stats: np.ndarray
-    imu: np.ndarray
-
-
-def default_sensors() -> np.ndarray:
-    """Sensor configuration with no IMU (and so no detection)."""
-    return np.zeros(NSCFG)
-
-
-def execute_record(
-    x0: np.ndarray,
-    t0: float,
-    tf: float,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-    ctrl: np.ndarray,
-    t_out: np.ndarray,
-    max_episodes: int = 1024,
-    kernel: Callable | None = None,
-    sched_t: np.ndarray | None = None,
-    sched_rate: np.ndarray | None = None,
-    sched_stop: np.ndarray | None = None,
-    scfg: np.ndarray | None = None,
-    noise: np.ndarray | None = None,
-    n_imu: int = 0,
-) -> RawRecord:
-    """Allocate the outputs, run the compiled loop, return the filled parts.
-
-    ``sched_t``/``sched_rate``/``sched_stop``: the power-off schedule
-    (``core/actuators.py``), triggered at ``opts[O_POWER_OFF_T]`` (< 0: the
-    first contact). ``scfg``: sensor configuration (default: no IMU);
-    ``noise``: (n, 6) standard normal draws for the IMU; ``n_imu``: rows of the
-    IMU record to keep.
-    """
-    out = np.zeros((t_out.shape[0], NOUT))
-    episodes = np.zeros((max_episodes, NEP))
-    stats = np.zeros(NSTAT)
-    imu_out = np.zeros((max(int(n_imu), 0), NIMU))
-    (kernel or run_builtin)(
-        np.ascontiguousarray(x0, dtype=np.float64),
-        float(t0),
-        float(tf),
-        veh,
-        surf,
-        opts,
-        ctrl,
-        default_sensors() if scfg is None else np.ascontiguousarray(scfg, dtype=np.float64),
-        np.zeros(0) if sched_t is None else np.ascontiguousarray(sched_t, dtype=np.float64),
-        np.zeros((0, 4)) if sched_rate is None else np.ascontiguousarray(sched_rate, np.float64),
-        np.zeros(4) if sched_stop is None else np.ascontiguousarray(sched_stop, np.float64),
-        np.zeros((0, 6)) if noise is None else np.ascontiguousarray(noise, dtype=np.float64),
-        np.ascontiguousarray(t_out, dtype=np.float64),
-        out,
-        imu_out,
-        episodes,
-        stats,
-    )
-    n_imu_taken = min(int(stats[ST_N_IMU]), imu_out.shape[0])
-    return RawRecord(
-        out[: int(stats[ST_N_OUT])],
-        episodes[: int(stats[ST_N_EPISODES])],
-        stats,
-        imu_out[:n_imu_taken],
+    replacements: dict[str, object] = {}
+    if step is not None:
+        step = _checked_step(step)
+        replacements["controller_step"] = step
+    if geometry:
+        contact_fns = {g.id: g.fn for g in _geometry.plugin_geometries()}
+        replacements["plugin_contact"] = _contact_dispatch(contact_fns)
+        replacements["plugin_distance"] = _distance_dispatch(_geometry.plugin_distances())
+    if not replacements:
+        return BUILTIN
+    memo: dict[Dispatcher, Dispatcher] = {}
+    return Kernel(
+        run=specialise(run, replacements, memo),
+        start=specialise(start, replacements, memo),
+        advance=specialise(advance, replacements, memo),
+        step=step,
     )
 
 
+# ---------------------------------------------------------------- Python entry
 def execute(
-    x0: np.ndarray,
-    t0: float,
-    tf: float,
-    veh: np.ndarray,
-    surf: np.ndarray,
-    opts: np.ndarray,
-    ctrl: np.ndarray,
-    t_out: np.ndarray,
-    max_episodes: int = 1024,
-    kernel: Callable | None = None,
-    sched_t: np.ndarray | None = None,
-    sched_rate: np.ndarray | None = None,
-    sched_stop: np.ndarray | None = None,
-    **sensors: object,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Like :func:`execute_record`; returns ``(out, episodes, stats)`` only."""
-    rec = execute_record(
-        x0, t0, tf, veh, surf, opts, ctrl, t_out, max_episodes, kernel,
-        sched_t, sched_rate, sched_stop, **sensors,
-    )  # fmt: skip
-    return rec.out, rec.episodes, rec.stats
+    m: Model, *, n_imu: int = 0, max_episodes: int = 1024, kernel: Kernel | None = None
+) -> RawRecord:
+    """Allocate the outputs of ``m``, run the compiled loop, return the filled parts.
+
+    ``n_imu``: rows of the IMU record to keep; ``max_episodes``: size of the
+    contact-episode buffer (episodes beyond it are counted in the stats).
+    """
+    o = new_output(m, int(n_imu), int(max_episodes))
+    (kernel or BUILTIN).run(m, o)
+    return raw_record(o)

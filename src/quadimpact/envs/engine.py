@@ -18,7 +18,15 @@ import numpy as np
 
 from quadimpact.core import batch as B
 from quadimpact.core import layout as L
-from quadimpact.core.run import RawRecord
+from quadimpact.core.records import (
+    Data,
+    Output,
+    new_data,
+    new_output,
+    raw_record,
+    set_row,
+    stacked,
+)
 from quadimpact.core.step import finish
 from quadimpact.envs.settings import TrialDistribution
 from quadimpact.inputs.scenarios import ImpactTrial
@@ -82,46 +90,56 @@ class Slots:
         self.ground = ground
         self.record = record
         template = self._prepare(self._template_fields())
-        n_surf = template.surf.shape[0]
-        n_out = template.output_times().shape[0]
-        n_imu = int(template.n_imu)
         self.n_noise = max(
             self._prepare({**self._template_fields(), "imu": p}).noise.shape[0]
             for p in trials.imu_choices()
         )
-        nc = 4 * n_surf
-        self.X = np.zeros((n, L.NX))
-        self.LS = np.zeros((n, L.NLS))
-        self.CS = np.zeros((n, nc, L.NCS))
-        self.RIN = np.zeros((n, L.NRIN))
-        self.MEM = np.zeros((n, L.NMEM))
-        self.MEAS = np.zeros((n, L.NMEAS))
-        self.TMEAS = np.zeros((n, L.NMEAS))
-        self.SST = np.zeros((n, L.NSST))
-        self.VEH = np.zeros((n, L.NVEH))
-        self.SURF = np.zeros((n, n_surf, L.NSURF))
-        self.OPTS = np.zeros((n, L.NOPT))
-        self.CTRL = np.zeros((n, L.NCTRL))
-        self.SCFG = np.zeros((n, L.NSCFG))
-        self.NOISE = np.zeros((n, self.n_noise, 6))
-        self.T_OUT = np.zeros((n, n_out))
-        self.OUT = np.zeros((n, n_out, L.NOUT))
-        self.IMU = np.zeros((n, n_imu if record else 0, L.NIMU))
-        self.EPISODES = np.zeros((n, max_episodes, L.NEP))
-        self.STATS = np.zeros((n, L.NSTAT))
-        self.ENV = np.zeros((n, B.NB))
-        self.sched = (np.zeros(0), np.zeros((0, 4)), np.zeros(4))
-        n_obs = B.N_OBS_STATE if par[B.P_OBSERVE] == B.OBS_STATE else B.N_OBS_IMU
-        self.obs = np.zeros((n, n_obs), dtype=np.float32)
-        self.reward = np.zeros(n)
-        self.terminated = np.zeros(n, dtype=np.bool_)
-        self.truncated = np.zeros(n, dtype=np.bool_)
-        self.reported = np.full(n, -1.0)
+        m = template.model(noise=np.zeros((self.n_noise, 6)))
+        self.M = stacked(m, n)
+        self.D = stacked(new_data(m), n)
+        self.O = stacked(new_output(m, int(template.n_imu) if record else 0, max_episodes), n)
+        n_obs = B.N_OBS_STATE if par[B.EP_OBSERVE] == B.OBS_STATE else B.N_OBS_IMU
+        self.E = B.Env(
+            state=np.zeros((n, B.NB)),
+            par=par,
+            tmeas=np.zeros((n, L.NMEAS)),
+            reported=np.full(n, -1.0),
+            obs=np.zeros((n, n_obs), dtype=np.float32),
+            reward=np.zeros(n),
+            terminated=np.zeros(n, dtype=np.bool_),
+            truncated=np.zeros(n, dtype=np.bool_),
+        )
         self.episode_id = np.zeros(n, dtype=np.int64)  # increases at every reset of a row
         self.setups: list[RunSetup | None] = [None] * n
         self.scenarios: list[ImpactTrial | None] = [None] * n
         self.trial_fields: list[dict[str, Any]] = [{} for _ in range(n)]
         self.redraws = np.zeros(n, dtype=np.int64)
+
+    # ------------------------------------------------------------ views
+    @property
+    def obs(self) -> np.ndarray:
+        """The observations (N, n_obs), float32."""
+        return self.E.obs
+
+    @property
+    def reported(self) -> np.ndarray:
+        """The stages the policy reports for the next step (N,; < 0: none)."""
+        return self.E.reported
+
+    @property
+    def TMEAS(self) -> np.ndarray:  # noqa: N802 - the core's name for the stacked records
+        """The measurement record of each row's next tick (N, NMEAS)."""
+        return self.E.tmeas
+
+    @property
+    def ENV(self) -> np.ndarray:  # noqa: N802
+        """Each row's episode state (N, NB), layout ``core.batch.B_*``."""
+        return self.E.state
+
+    @property
+    def par(self) -> np.ndarray:
+        """The packed environment parameters (``core.batch.EP_*``)."""
+        return self.E.par
 
     # ------------------------------------------------------------ trials
     def _template_fields(self) -> dict[str, Any]:
@@ -148,25 +166,22 @@ class Slots:
             fields = dict(trial)
             scenario = self.trials.trial(fields, ground=self.ground, record=self.record)
         s = prepare(scenario)
-        same_grid = s.output_times().shape[0] == self.T_OUT.shape[1]
-        if s.surf.shape != self.SURF.shape[1:] or not same_grid or s.tf != self.trials.final_time_s:
+        m = s.model()
+        same_grid = m.t_out.shape[0] == self.M.t_out.shape[1]
+        if (m.shapes.shape != self.M.shapes.shape[1:] or m.feat.shape != self.M.feat.shape[1:]
+                or not same_grid or s.tf != self.trials.final_time_s):  # fmt: skip
             raise ValueError(
-                "trial: its surfaces and final time must be those of the environment's trials "
-                f"({self.SURF.shape[1]} surfaces, {self.trials.final_time_s:g} s)"
+                "trial: its vehicle's features, its surfaces and its final time must be those "
+                f"of the environment's trials ({self.M.shapes.shape[1]} surfaces, "
+                f"{self.trials.final_time_s:g} s)"
             )
         if s.noise.shape[0] > self.n_noise:
             raise ValueError("trial: a noisy IMU in an environment made for ideal IMUs")
         if s.kernel is not None or s.controller != "recovery":
             raise ValueError("trial: the environment's trials run the 'recovery' controller")
-        self.X[k] = s.x0
-        self.VEH[k] = s.veh
-        self.SURF[k] = s.surf
-        self.OPTS[k] = s.opts
-        self.CTRL[k] = s.ctrl
-        self.SCFG[k] = s.scfg
-        self.NOISE[k] = 0.0
-        self.NOISE[k, : s.noise.shape[0]] = s.noise
-        self.T_OUT[k] = s.output_times()
+        noise = np.zeros((self.n_noise, 6))
+        noise[: s.noise.shape[0]] = s.noise
+        set_row(self.M, k, m._replace(noise=noise))
         self.setups[k] = s
         self.scenarios[k] = scenario
         self.trial_fields[k] = fields
@@ -184,13 +199,7 @@ class Slots:
         self.redraws[k] = 0
         while True:
             self.load(k, trial if trial is not None else self.trials.draw(rng))
-            s = self.setups[k]
-            ok = B.reset_slot(
-                k, float(s.t0), float(s.tf), self.until_detection, self.X, self.LS, self.CS,
-                self.RIN, self.MEM, self.MEAS, self.TMEAS, self.SST, self.VEH, self.SURF,
-                self.OPTS, self.CTRL, self.SCFG, *self.sched, self.NOISE, self.T_OUT, self.OUT,
-                self.IMU, self.EPISODES, self.STATS, self.ENV, self.par, self.obs,
-            )  # fmt: skip
+            ok = B.reset_slot(k, self.until_detection, self.M, self.D, self.O, self.E)
             if ok:
                 break
             if trial is not None:
@@ -204,26 +213,21 @@ class Slots:
     # ------------------------------------------------------------ stepping
     def step(self, actions: np.ndarray) -> None:
         """One tick of every active row (compiled); clears the reported stages."""
-        B.step_batch(
-            actions, self.reported, self.X, self.LS, self.CS, self.RIN, self.MEM, self.MEAS,
-            self.TMEAS, self.SST, self.VEH, self.SURF, self.OPTS, self.CTRL, self.SCFG,
-            *self.sched, self.NOISE, self.T_OUT, self.OUT, self.IMU, self.EPISODES, self.STATS,
-            self.ENV, self.par, self.obs, self.reward, self.terminated, self.truncated,
-        )  # fmt: skip
+        B.step_batch(actions, self.M, self.D, self.O, self.E)
         self.reported[:] = -1.0
 
     def active(self) -> np.ndarray:
         """Rows whose episode runs (bool, N)."""
-        return self.ENV[:, B.B_ACTIVE] > 0.5
+        return self.E.state[:, B.B_ACTIVE] > 0.5
 
     # ------------------------------------------------------------ reading
     def stage(self, k: int) -> int:
         """The stage in force in row ``k`` (policy's or observer's)."""
-        return int(self.ENV[k, B.B_STAGE])
+        return int(self.E.state[k, B.B_STAGE])
 
     def time(self, k: int) -> float:
         """Simulated time reached in row ``k``, s."""
-        return float(self.LS[k, L.LS_T])
+        return float(self.D.ls[k, L.LS_T])
 
     def metrics(self, k: int) -> dict[str, Any]:
         """Row ``k``'s episode metrics: docs/RECOVERY.md 6's keys, outcome, return, steps.
@@ -232,43 +236,37 @@ class Slots:
         stats and episodes, as in every summary (``analyse``).
         """
         s = self.setups[k]
-        st = self.STATS[k].copy()
+        st = self.O.stats[k].copy()
         n_ep = int(st[L.ST_N_EPISODES])
-        episodes = episode_columns(self.EPISODES[k], n_ep, s.surface_names)
-        obstacles = [n for i, n in enumerate(s.surface_names) if s.surf[i, L.S_IS_GROUND] < 0.5]
+        episodes = episode_columns(self.O.episodes[k], n_ep, s.shape_names, len(s.feature_names))
+        obstacles = [
+            n for i, n in enumerate(s.shape_names) if s.shapes[i, L.SH_IS_GROUND] < 0.5
+        ]
         # the state at the end: the output row at the final time when the run got there
         # (as analyse reads it), else the state reached
         n_out = int(st[L.ST_N_OUT])
-        if n_out == self.T_OUT.shape[1]:
-            final = self.OUT[k, n_out - 1, L.OUT_X : L.OUT_X + L.NX].copy()
+        if n_out == self.M.t_out.shape[1]:
+            final = self.O.out[k, n_out - 1, L.OUT_X : L.OUT_X + L.NX].copy()
         else:
-            final = self.X[k].copy()
+            final = self.D.x[k].copy()
         out = recovery_metrics(
-            st, episodes, veh=s.veh, surf=s.surf, surface_names=s.surface_names,
+            st, episodes, feat=s.feat, shapes=s.shapes, surface_names=s.shape_names,
             obstacle_names=obstacles, final_state=final,
         )  # fmt: skip
         out = {key: out[key] for key in RECOVERY_KEYS}
-        out["outcome"] = OUTCOMES[int(self.ENV[k, B.B_OUTCOME])]
-        out["episode_return"] = float(self.ENV[k, B.B_RETURN])
-        out["episode_steps"] = int(self.ENV[k, B.B_STEPS])
-        out["t_end_s"] = float(self.LS[k, L.LS_T])
-        out["stage_source"] = "policy" if self.ENV[k, B.B_POLICY] > 0.5 else "observer"
-        out["inexact_commands"] = int(self.ENV[k, B.B_INEXACT])
+        out["outcome"] = OUTCOMES[int(self.E.state[k, B.B_OUTCOME])]
+        out["episode_return"] = float(self.E.state[k, B.B_RETURN])
+        out["episode_steps"] = int(self.E.state[k, B.B_STEPS])
+        out["t_end_s"] = float(self.D.ls[k, L.LS_T])
+        out["stage_source"] = "policy" if self.E.state[k, B.B_POLICY] > 0.5 else "observer"
+        out["inexact_commands"] = int(self.E.state[k, B.B_INEXACT])
         return out
 
     def result(self, k: int) -> SimulationResult:
         """Row ``k``'s run so far as ``simulate`` returns it (``analyse`` of its record)."""
         s = self.setups[k]
-        ls = self.LS[k].copy()
-        cs = self.CS[k].copy()
-        episodes = self.EPISODES[k].copy()
-        stats = self.STATS[k].copy()
-        finish(ls, cs, episodes, stats)
-        n_imu = min(int(stats[L.ST_N_IMU]), self.IMU.shape[1])
-        rec = RawRecord(
-            self.OUT[k, : int(stats[L.ST_N_OUT])].copy(),
-            episodes[: int(stats[L.ST_N_EPISODES])],
-            stats,
-            self.IMU[k, :n_imu].copy(),
-        )
+        d = Data(*(a[k].copy() for a in self.D))
+        o = Output(*(a[k].copy() for a in self.O))
+        finish(d, o)
+        rec = raw_record(o)
         return analyse(s, self.scenarios[k], rec)

@@ -77,8 +77,7 @@ class RecoveryPolicy:
         self._mem[fresh] = 0.0
         self._seen[:] = s.episode_id
         active = s.active()
-        B.staged_policy(active, s.TMEAS, s.VEH, s.CTRL, s.OPTS, self._mem, s.par, self._actions,
-                        self._stages, s.ENV)  # fmt: skip
+        B.staged_policy(active, s.M, s.E, self._mem, self._actions, self._stages)
         if _batched(self._base):
             self._base.report_stages(np.where(active, self._stages, -1.0))
         elif active[0]:
@@ -117,9 +116,9 @@ class HoverPolicy:
         s = self._s
         a = np.zeros((s.n, 4))
         for k in range(s.n):
-            veh, ctrl = s.VEH[k], s.CTRL[k]
+            veh, ctrl = s.M.veh[k], s.M.ctrl[k]
             weight = veh[L.V_MASS] * veh[L.V_GRAVITY]
-            if s.par[B.P_ACTION] == B.ACT_CTBR:
+            if s.par[B.EP_ACTION] == B.ACT_CTBR:
                 a[k, 0] = B.affine_inverse(weight, 0.0, B.max_thrust(veh, ctrl))[0]
                 continue
             inv = ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16].reshape(4, 4)

@@ -232,32 +232,32 @@ def pack_parameters(
     if not hold_s > 0.0:
         raise ValueError(f"hold_s: > 0 s (got {hold_s!r})")
     par = np.zeros(B.NPAR)
-    par[B.P_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
-    par[B.P_OBSERVE] = B.OBS_STATE if observe == "state" else B.OBS_IMU
-    par[B.P_ZERO_LOW] = 1.0 if rotor_floor == "zero" else 0.0
-    par[B.P_RATE_MAX : B.P_RATE_MAX + 3] = CTBR_RATE_MAX_RAD_S
-    par[B.P_W_TILT] = reward.tilt
-    par[B.P_W_RATE] = reward.rate
-    par[B.P_W_VZ] = reward.vertical_speed
-    par[B.P_W_HEIGHT] = reward.height_loss
-    par[B.P_W_EFFORT] = reward.effort
-    par[B.P_W_RECOVERY] = reward.recovery_bonus
-    par[B.P_W_FAILURE] = reward.failure_penalty
-    par[B.P_FAIL_REMAINING] = 1.0 if reward.failure_remaining else 0.0
-    par[B.P_S_RATE] = reward.rate_scale_rad_s
-    par[B.P_S_VZ] = reward.vertical_speed_scale_m_s
-    par[B.P_S_HEIGHT] = reward.height_scale_m
-    par[B.P_MAX_TILT_COS] = math.cos(math.radians(envelope.max_tilt_deg))
-    par[B.P_MAX_DROP] = envelope.max_drop_m
-    par[B.P_MAX_DIST] = envelope.max_distance_m
-    par[B.P_MAX_RATE] = envelope.max_rate_rad_s
-    par[B.P_HOLD_TICKS] = max(1.0, round(hold_s / dt_s))
-    par[B.P_END_ON_RECOVERY] = 1.0 if end_on_recovery else 0.0
-    par[B.P_GROUND] = 1.0 if ground else 0.0
-    par[B.P_OBS_F] = 9.81
-    par[B.P_OBS_W] = 10.0
-    par[B.P_OBS_V] = 2.0
-    par[B.P_OBS_T] = 1.0
-    par[B.P_OBS_POS] = 1.0
-    par[B.P_OBS_CLIP] = 10.0
+    par[B.EP_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
+    par[B.EP_OBSERVE] = B.OBS_STATE if observe == "state" else B.OBS_IMU
+    par[B.EP_ZERO_LOW] = 1.0 if rotor_floor == "zero" else 0.0
+    par[B.EP_RATE_MAX : B.EP_RATE_MAX + 3] = CTBR_RATE_MAX_RAD_S
+    par[B.EP_W_TILT] = reward.tilt
+    par[B.EP_W_RATE] = reward.rate
+    par[B.EP_W_VZ] = reward.vertical_speed
+    par[B.EP_W_HEIGHT] = reward.height_loss
+    par[B.EP_W_EFFORT] = reward.effort
+    par[B.EP_W_RECOVERY] = reward.recovery_bonus
+    par[B.EP_W_FAILURE] = reward.failure_penalty
+    par[B.EP_FAIL_REMAINING] = 1.0 if reward.failure_remaining else 0.0
+    par[B.EP_S_RATE] = reward.rate_scale_rad_s
+    par[B.EP_S_VZ] = reward.vertical_speed_scale_m_s
+    par[B.EP_S_HEIGHT] = reward.height_scale_m
+    par[B.EP_MAX_TILT_COS] = math.cos(math.radians(envelope.max_tilt_deg))
+    par[B.EP_MAX_DROP] = envelope.max_drop_m
+    par[B.EP_MAX_DIST] = envelope.max_distance_m
+    par[B.EP_MAX_RATE] = envelope.max_rate_rad_s
+    par[B.EP_HOLD_TICKS] = max(1.0, round(hold_s / dt_s))
+    par[B.EP_END_ON_RECOVERY] = 1.0 if end_on_recovery else 0.0
+    par[B.EP_GROUND] = 1.0 if ground else 0.0
+    par[B.EP_OBS_F] = 9.81
+    par[B.EP_OBS_W] = 10.0
+    par[B.EP_OBS_V] = 2.0
+    par[B.EP_OBS_T] = 1.0
+    par[B.EP_OBS_POS] = 1.0
+    par[B.EP_OBS_CLIP] = 10.0
     return par

@@ -157,7 +157,7 @@ class ImpactRecoveryEnv(gym.Env):
             raise RuntimeError("step: the episode has ended; call reset()")
         self._act[0] = action
         s.step(self._act)
-        info: dict[str, Any] = {"t": float(s.LS[0, L.LS_T]), "stage": int(s.ENV[0, B.B_STAGE])}
+        info: dict[str, Any] = {"t": float(s.D.ls[0, L.LS_T]), "stage": int(s.ENV[0, B.B_STAGE])}
         terminated = bool(s.terminated[0])
         truncated = bool(s.truncated[0])
         if terminated or truncated:

@@ -146,7 +146,7 @@ class BatchedImpactRecoveryEnv(VectorEnv):
                 self._reset_row(int(k))
             self._autoreset = ended
         infos["stage"] = s.ENV[:, B.B_STAGE].astype(np.int64)
-        infos["t"] = s.LS[:, L.LS_T].copy()
+        infos["t"] = s.D.ls[:, L.LS_T].copy()
         s.terminated[:] = False
         s.truncated[:] = False
         s.reward[:] = 0.0

@@ -29,6 +29,7 @@ import numpy as np
 from pydantic import BaseModel, Field, ValidationError, field_validator, model_validator
 
 from quadimpact.errors import InputError, input_error_from_validation, near_miss
+from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec3, Vec4
 
@@ -321,6 +322,44 @@ class Vehicle(BaseModel):
         )
         return centres, u, n
 
+    def contact_features(self) -> tuple[ContactFeature, ...]:
+        """The vehicle's contact features: its four bumper rings, named ``"1"`` to ``"4"``.
+
+        Each ring has the geometry of :meth:`bumper_frames` (centre, plane
+        normal, radius ``bumper_radius_m``) and the vehicle's contact law
+        (``contact_stiffness``, ``contact_exponent``, ``restitution``); its
+        friction coefficient is the scenario's. Computed once per vehicle
+        object (the model is frozen).
+        """
+        cached = _FEATURES.get(id(self))
+        if cached is not None and cached[0] is self:
+            return cached[1]
+        if len(_FEATURES) >= _CACHE_LIMIT:
+            _FEATURES.pop(next(iter(_FEATURES)))
+        features = self._rings()
+        _FEATURES[id(self)] = (self, features)  # the reference keeps the id unique
+        return features
+
+    def feature_names(self) -> tuple[str, ...]:
+        """Names of :meth:`contact_features`, in order (the output columns' suffixes)."""
+        return tuple(f.name for f in self.contact_features())
+
+    def _rings(self) -> tuple[ContactFeature, ...]:
+        centres, _, n = self.bumper_frames()
+        return tuple(
+            ContactFeature(
+                name=str(j + 1),
+                kind="ring",
+                centre_m=tuple(centres[j]),
+                normal=tuple(n[j]),
+                radius_m=self.bumper_radius_m,
+                stiffness=self.contact_stiffness,
+                exponent=self.contact_exponent,
+                restitution=self.restitution,
+            )
+            for j in range(4)
+        )
+
     # ---------------------------------------------------------------- variants
     def with_overrides(self, **fields: Any) -> Vehicle:
         """Return a copy with some fields replaced, validated again.
@@ -425,6 +464,7 @@ def _vehicle_folder() -> Any:
 
 
 _CACHE: dict[tuple[str, int, int], Vehicle] = {}
+_FEATURES: dict[int, tuple[Vehicle, tuple[ContactFeature, ...]]] = {}
 _PLAUSIBILITY: dict[int, tuple[Vehicle, tuple[str, ...]]] = {}
 _OVERRIDDEN: dict[tuple[int, str], tuple[Vehicle, Vehicle]] = {}
 _CACHE_LIMIT = 64

@@ -13,14 +13,14 @@ Brent's method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial).
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import bumper_contact
-from quadimpact.core.run import execute
+from quadimpact.core.geometry import contact_record
+from quadimpact.core.records import Model
+from quadimpact.core.run import Kernel, execute
 from quadimpact.linalg import matvec, matvec_t
 from quadimpact.rotations import inclination_deg, quat_to_matrix
 from quadimpact.simulation.roots import brentq
@@ -30,7 +30,7 @@ __all__ = [
     "APPROACH_TOL_M_S",
     "PAPER_FIT_OFFSET_RAD",
     "PAPER_FIT_SCALE",
-    "bumper_depths",
+    "feature_depths",
     "inclination_deg_of",
     "initial_state",
     "solve_approach",
@@ -92,53 +92,52 @@ def initial_state(
 
 # ------------------------------------------------------------------ shooting
 def _free_flight_end(
-    veh: np.ndarray,
-    ctrl: np.ndarray,
-    schedule: Mapping[str, np.ndarray],
+    run: Model,
     x0: np.ndarray,
     t0: float,
     t_end: float,
     free_opts: np.ndarray,
-    kernel: Callable | None = None,
+    kernel: Kernel | None = None,
 ) -> np.ndarray:
-    """State at ``t_end`` of a run from ``(t0, x0)`` with no surfaces and no crash."""
-    out, _, stats = execute(
-        x0,
-        t0,
-        t_end,
-        veh,
-        np.zeros((0, L.NSURF)),
-        free_opts,
-        ctrl,
-        np.array([t_end]),
-        max_episodes=1,
-        kernel=kernel,
-        **schedule,
+    """State at ``t_end`` of the run ``run`` from ``(t0, x0)`` with no shapes, no IMU, no crash."""
+    span = np.zeros(L.NSPAN)
+    span[L.SPAN_T0] = t0
+    span[L.SPAN_TF] = t_end
+    m = run._replace(
+        x0=np.ascontiguousarray(x0, dtype=np.float64),
+        span=span,
+        shapes=np.zeros((0, L.NSHAPE)),
+        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        opts=free_opts,
+        scfg=np.zeros(L.NSCFG),
+        noise=np.zeros((0, 6)),
+        t_out=np.array([t_end]),
     )
-    if stats[L.ST_STATUS] == L.STATUS_FAILED or out.shape[0] != 1:
+    rec = execute(m, max_episodes=1, kernel=kernel)
+    if rec.stats[L.ST_STATUS] == L.STATUS_FAILED or rec.out.shape[0] != 1:
         raise RuntimeError(
-            "approach shooting run failed: " + L.REASON_TEXT[int(stats[L.ST_REASON])]
+            "approach shooting run failed: " + L.REASON_TEXT[int(rec.stats[L.ST_REASON])]
         )
-    return out[0, L.OUT_X : L.OUT_X + L.NX]
+    return rec.out[0, L.OUT_X : L.OUT_X + L.NX]
 
 
 def _inertial_velocity(x: np.ndarray) -> np.ndarray:
     return matvec(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]), x[L.X_VEL : L.X_VEL + 3])
 
 
-def bumper_depths(x: np.ndarray, veh: np.ndarray, surf: np.ndarray, s: int = 0) -> np.ndarray:
-    """Penetration (m) of the four bumpers into surface ``s`` at state ``x``
-    (the compiled contact geometry, called from Python)."""
+def feature_depths(x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, s: int = 0) -> np.ndarray:
+    """Penetration (m) of every contact feature into shape ``s`` at the state ``x``.
+
+    The compiled contact geometry (``core.geometry``), called from Python.
+    """
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
-    return np.array([bumper_contact(xq, C, veh, j, surf, s)[0] for j in range(4)])
+    return np.array([contact_record(xq, C, feat, shapes, f, s)[0] for f in range(feat.shape[0])])
 
 
 def solve_approach(
     *,
-    veh: np.ndarray,
-    ctrl: np.ndarray,
-    schedule: Mapping[str, np.ndarray],
+    run: Model,
     free_opts: np.ndarray,
     wall: np.ndarray,
     q: np.ndarray,
@@ -147,15 +146,17 @@ def solve_approach(
     impact_time_s: float,
     speed_m_s: float,
     late_start: bool,
-    kernel: Callable | None = None,
+    kernel: Kernel | None = None,
 ) -> tuple[np.ndarray, float, dict[str, Any]]:
     """Initial state and time that bring the first contact at ``T_c`` with ``V_X = V_c``.
 
     Parameters
     ----------
-    veh, ctrl, schedule, free_opts : numpy.ndarray
-        The packed run (``free_opts``: no crash, ``T_c`` as the duration).
-    wall : numpy.ndarray, shape (1, NSURF)
+    run : Model
+        The packed run (its vehicle, features, controller and power-off schedule).
+    free_opts : numpy.ndarray
+        Its options without a crash, ``T_c`` as the duration.
+    wall : numpy.ndarray, shape (1, NSHAPE)
         The packed wall alone.
     q, rotors : numpy.ndarray
         Attitude held and initial rotor speeds.
@@ -167,7 +168,7 @@ def solve_approach(
         The ``late-start`` rule: start later at rest whenever ``v0 < 0`` would be
         needed; otherwise (the authors' rule) only when the start would lie
         beyond the wall.
-    kernel : callable, optional
+    kernel : Kernel, optional
         The run loop of a plug-in controller (default: the built-in kernel).
 
     Returns
@@ -186,7 +187,7 @@ def solve_approach(
     def shoot(t0: float, v0: float, x_start: float) -> tuple[np.ndarray, np.ndarray]:
         pos = start + np.array([x_start, 0.0, 0.0])
         x0 = initial_state(pos, np.array([v0, 0.0, 0.0]), q, np.zeros(3), rotors)
-        return x0, _free_flight_end(veh, ctrl, schedule, x0, t0, tc, free_opts, kernel)
+        return x0, _free_flight_end(run, x0, t0, tc, free_opts, kernel)
 
     def solve_from(t0: float, v0: float) -> tuple[float, float, float, np.ndarray]:
         """Correct v0 (unless at rest) and X0 until the residuals vanish."""
@@ -194,7 +195,7 @@ def solve_approach(
         for _ in range(APPROACH_MAX_ITER):
             x0, xe = shoot(t0, v0, x_start)
             dv = vc - _inertial_velocity(xe)[0]
-            depth = bumper_depths(xe, veh, wall).max()
+            depth = feature_depths(xe, run.feat, wall).max()
             if abs(dv) <= APPROACH_TOL_M_S and abs(depth) <= APPROACH_TOL_M_S:
                 break
             if t0 == 0.0 or v0 != 0.0:
@@ -210,7 +211,7 @@ def solve_approach(
     if v0 < 0.0:
         late = late_start
         if not late:  # the authors' rule: start later only from beyond the wall
-            late = bumper_depths(x0, veh, wall).max() > 0.0
+            late = feature_depths(x0, run.feat, wall).max() > 0.0
     if late:
 
         def residual(t_start: float) -> float:

@@ -19,7 +19,8 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.run import RawRecord, default_sensors, run_builtin
+from quadimpact.core.records import Model, Output, RawRecord, raw_record
+from quadimpact.core.run import BUILTIN
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
 
@@ -27,48 +28,33 @@ __all__ = ["BatchRunner", "simulate_batch"]
 
 
 class _Buffers:
-    """Output arrays reused from run to run (grown on demand; zeroed where the kernel reads)."""
+    """Output arrays reused from run to run (grown on demand; the loop zeroes what it reads)."""
 
     def __init__(self, max_episodes: int) -> None:
-        self.out = np.zeros((0, L.NOUT))
+        self.out = np.zeros((0, 0))
         self.imu = np.zeros((0, L.NIMU))
         self.episodes = np.zeros((max_episodes, L.NEP))
         self.stats = np.zeros(L.NSTAT)
 
-    def sized(self, n_out: int, n_imu: int) -> tuple[np.ndarray, np.ndarray]:
-        if self.out.shape[0] < n_out:
-            self.out = np.zeros((n_out, L.NOUT))
+    def output(self, m: Model, n_imu: int) -> Output:
+        """An :class:`Output` for the run ``m`` in the buffers (views of their first rows)."""
+        n_out, width = m.t_out.shape[0], L.out_width(m.feat.shape[0])
+        if self.out.shape[0] < n_out or self.out.shape[1] != width:
+            self.out = np.zeros((max(n_out, self.out.shape[0]), width))
         if self.imu.shape[0] < n_imu:
             self.imu = np.zeros((n_imu, L.NIMU))
-        return self.out[:n_out], self.imu[:n_imu]
+        return Output(self.out[:n_out], self.imu[:n_imu], self.episodes, self.stats)
 
 
 def _run(setup: RunSetup, buffers: _Buffers) -> tuple[RawRecord, float]:
     """The compiled loop of one prepared run into the shared buffers; copies of the filled parts."""
-    t_out = np.ascontiguousarray(setup.output_times(), dtype=np.float64)
-    out, imu = buffers.sized(t_out.shape[0], int(setup.n_imu))
-    kernel = setup.kernel or run_builtin
+    m = setup.model()
+    o = buffers.output(m, int(setup.n_imu))
+    kernel = setup.kernel or BUILTIN
     start = time.perf_counter()
-    kernel(
-        np.ascontiguousarray(setup.x0, dtype=np.float64), float(setup.t0), float(setup.tf),
-        setup.veh, setup.surf, setup.opts, setup.ctrl,
-        default_sensors() if setup.scfg is None else setup.scfg,
-        np.ascontiguousarray(setup.sched_t, dtype=np.float64),
-        np.ascontiguousarray(setup.sched_rate, dtype=np.float64),
-        np.ascontiguousarray(setup.sched_stop, dtype=np.float64),
-        np.ascontiguousarray(setup.noise, dtype=np.float64),
-        t_out, out, imu, buffers.episodes, buffers.stats,
-    )  # fmt: skip
+    kernel.run(m, o)
     wall = time.perf_counter() - start
-    st = buffers.stats.copy()
-    n_imu = min(int(st[L.ST_N_IMU]), imu.shape[0])
-    rec = RawRecord(
-        out[: int(st[L.ST_N_OUT])].copy(),
-        buffers.episodes[: int(st[L.ST_N_EPISODES])].copy(),
-        st,
-        imu[:n_imu].copy(),
-    )
-    return rec, wall
+    return raw_record(o, copy=True), wall
 
 
 class BatchRunner:

@@ -12,6 +12,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.inputs.controllers import ControllerEntry, PackContext
+from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
@@ -64,31 +65,52 @@ def _pack_vehicle(v: Vehicle) -> np.ndarray:
     veh[L.V_DT] = v.drag_torque_coefficient
     veh[L.V_JR] = v.rotor_inertia_kg_m2
     veh[L.V_GRAVITY] = v.gravity_m_s2
-    veh[L.V_RB] = v.bumper_radius_m
-    centres, _, n = v.bumper_frames()
-    veh[L.V_BUMP_C : L.V_BUMP_C + 12] = centres.ravel()
-    veh[L.V_BUMP_N : L.V_BUMP_N + 12] = n.ravel()
-    veh[L.V_K] = v.contact_stiffness
-    veh[L.V_N] = v.contact_exponent
-    veh[L.V_E] = v.restitution
     veh[L.V_TAU_M] = v.motor_time_constant_s
     return veh
 
 
+#: Feature kinds by their names in vehicle data (``core.layout.FeatureKind``).
+FEATURE_KINDS: dict[str, int] = {"ring": L.FEAT_RING}
+
+
+def pack_features(v: Vehicle, friction_coefficient: float) -> np.ndarray:
+    """The vehicle's contact features as an (n, NFEAT) array (body frame, SI).
+
+    ``friction_coefficient``: the scenario's, for the features that set none.
+    """
+    feat = _memo("feat", v, lambda: _pack_features(v.contact_features()))
+    feat[np.isnan(feat[:, L.F_MU]), L.F_MU] = friction_coefficient
+    return feat
+
+
+def _pack_features(features: Sequence[ContactFeature]) -> np.ndarray:
+    feat = np.zeros((len(features), L.NFEAT))
+    for i, f in enumerate(features):
+        feat[i, L.F_KIND] = FEATURE_KINDS[f.kind]
+        feat[i, L.F_CENTRE : L.F_CENTRE + 3] = f.centre_m
+        feat[i, L.F_NORMAL : L.F_NORMAL + 3] = f.normal
+        feat[i, L.F_RADIUS] = f.radius_m
+        feat[i, L.F_K] = f.stiffness
+        feat[i, L.F_N] = f.exponent
+        feat[i, L.F_E] = f.restitution
+        feat[i, L.F_MU] = np.nan if f.friction_coefficient is None else f.friction_coefficient
+    return feat
+
+
 def pack_surfaces(surfaces: Sequence[Plane]) -> np.ndarray:
-    """Surfaces as an (n, NSURF) array; normals normalised."""
-    surf = np.zeros((len(surfaces), L.NSURF))
+    """Surfaces as an (n, NSHAPE) array of world shapes; normals normalised."""
+    surf = np.zeros((len(surfaces), L.NSHAPE))
     for i, s in enumerate(surfaces):
         n = np.asarray(s.normal, dtype=float)
-        surf[i, L.S_P0 : L.S_P0 + 3] = s.point_m
-        surf[i, L.S_NORMAL : L.S_NORMAL + 3] = n / norm(n)
-        surf[i, L.S_IS_GROUND] = 1.0 if s.is_ground else 0.0
-        surf[i, L.S_KIND] = L.SURF_PLANE
+        surf[i, L.SH_POINT : L.SH_POINT + 3] = s.point_m
+        surf[i, L.SH_NORMAL : L.SH_NORMAL + 3] = n / norm(n)
+        surf[i, L.SH_IS_GROUND] = 1.0 if s.is_ground else 0.0
+        surf[i, L.SH_KIND] = L.SHAPE_PLANE
     return surf
 
 
-#: Surface kinds by the names written in ``scenario.json`` (``core.layout.SURF_*``).
-SURFACE_KINDS: dict[str, int] = {"plane": L.SURF_PLANE}
+#: Surface kinds by the names written in ``scenario.json`` (``core.layout.ShapeKind``).
+SURFACE_KINDS: dict[str, int] = {"plane": L.SHAPE_PLANE}
 
 
 def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, Any]]:
@@ -96,7 +118,7 @@ def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, An
 
     Parameters
     ----------
-    surf : numpy.ndarray, shape (n, NSURF)
+    surf : numpy.ndarray, shape (n, NSHAPE)
         Packed surfaces (:func:`pack_surfaces`).
     names : sequence of str
         Their names, in the same order.
@@ -113,10 +135,10 @@ def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, An
     return [
         {
             "name": str(name),
-            "point_m": [float(c) for c in row[L.S_P0 : L.S_P0 + 3]],
-            "normal": [float(c) for c in row[L.S_NORMAL : L.S_NORMAL + 3]],
-            "is_ground": bool(row[L.S_IS_GROUND] > 0.5),
-            "kind": kinds[int(row[L.S_KIND])],
+            "point_m": [float(c) for c in row[L.SH_POINT : L.SH_POINT + 3]],
+            "normal": [float(c) for c in row[L.SH_NORMAL : L.SH_NORMAL + 3]],
+            "is_ground": bool(row[L.SH_IS_GROUND] > 0.5),
+            "kind": kinds[int(row[L.SH_KIND])],
         }
         for name, row in zip(names, surf, strict=True)
     ]
@@ -130,17 +152,17 @@ def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
     ValueError
         A record with a kind not in :data:`SURFACE_KINDS`.
     """
-    surf = np.zeros((len(records), L.NSURF))
+    surf = np.zeros((len(records), L.NSHAPE))
     for i, r in enumerate(records):
         kind = r.get("kind", "plane")
         if kind not in SURFACE_KINDS:
             known = ", ".join(SURFACE_KINDS)
             name = r.get("name")
             raise ValueError(f"surface {name!r}: kind must be one of {known} (got {kind!r})")
-        surf[i, L.S_P0 : L.S_P0 + 3] = [float(c) for c in r["point_m"]]
-        surf[i, L.S_NORMAL : L.S_NORMAL + 3] = [float(c) for c in r["normal"]]
-        surf[i, L.S_IS_GROUND] = 1.0 if r.get("is_ground") else 0.0
-        surf[i, L.S_KIND] = SURFACE_KINDS[kind]
+        surf[i, L.SH_POINT : L.SH_POINT + 3] = [float(c) for c in r["point_m"]]
+        surf[i, L.SH_NORMAL : L.SH_NORMAL + 3] = [float(c) for c in r["normal"]]
+        surf[i, L.SH_IS_GROUND] = 1.0 if r.get("is_ground") else 0.0
+        surf[i, L.SH_KIND] = SURFACE_KINDS[kind]
     return surf
 
 
@@ -207,7 +229,6 @@ def pack_options(
     first_order_rotors: bool,
     omega_limits_rad_s: tuple[float, float] | None,
     slew_limit_rad_s2: float | None,
-    friction_coefficient: float,
     rtol: float | None,
     atol: float | None,
     duration_s: float,
@@ -225,7 +246,6 @@ def pack_options(
     if omega_limits_rad_s is not None:
         opts[L.O_OMEGA_MIN], opts[L.O_OMEGA_MAX] = omega_limits_rad_s
     opts[L.O_SLEW_MAX] = slew_limit_rad_s2 or 0.0
-    opts[L.O_MU] = friction_coefficient
     opts[L.O_V_REG] = FRICTION_V_REG_M_S
     opts[L.O_V_MIN] = V_MIN_M_S
     opts[L.O_DT_CONTROL] = 1.0 / CONTROL_RATE_HZ

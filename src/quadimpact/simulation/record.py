@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.inputs.features import feature_column
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
 from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
 
@@ -67,13 +68,17 @@ def _empty_episodes() -> pd.DataFrame:
     return pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
 
 
-def episode_columns(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> dict[str, np.ndarray]:
+def episode_columns(
+    raw: np.ndarray, n: int, surface_names: Sequence[str], n_features: int = len(BUMPERS)
+) -> dict[str, np.ndarray]:
     """The columns of :func:`episodes_frame` as NumPy arrays (no DataFrame), same order."""
     rows = _rows(raw, n, L.NEP, "episodes")
-    bumper_idx = np.rint(rows[:, L.E_BUMPER]).astype(np.int64)
-    if np.any((bumper_idx < 0) | (bumper_idx > 3)):
-        raise ValueError(f"episodes: bumper index outside 0..3 (got {sorted(set(bumper_idx))})")
-    surf_idx = np.rint(rows[:, L.E_SURFACE]).astype(np.int64)
+    bumper_idx = np.rint(rows[:, L.E_FEATURE]).astype(np.int64)
+    if np.any((bumper_idx < 0) | (bumper_idx >= n_features)):
+        raise ValueError(
+            f"episodes: feature index outside 0..{n_features - 1} (got {sorted(set(bumper_idx))})"
+        )
+    surf_idx = np.rint(rows[:, L.E_SHAPE]).astype(np.int64)
     names = list(surface_names)
     if np.any((surf_idx < 0) | (surf_idx >= len(names))):
         raise ValueError(
@@ -91,23 +96,28 @@ def episode_columns(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> di
     return {name: data[name] for name in EPISODE_COLUMNS}
 
 
-def episodes_frame(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> pd.DataFrame:
+def episodes_frame(
+    raw: np.ndarray, n: int, surface_names: Sequence[str], n_features: int = len(BUMPERS)
+) -> pd.DataFrame:
     """Contact-episode table from the kernel's episode array.
 
     Parameters
     ----------
     raw : numpy.ndarray, shape (max_episodes, NEP)
         Episode records with the ``E_*`` columns of :mod:`quadimpact.core.layout`
-        (bumper 0-based, surface as an index into the run's surfaces).
+        (feature 0-based, surface as an index into the run's shapes).
     n : int
         Number of valid rows (``stats[ST_N_EPISODES]``, capped by the buffer).
     surface_names : sequence of str
-        Name of each surface, in the order of the kernel's surface array.
+        Name of each surface, in the order of the kernel's shape array.
+    n_features : int
+        The vehicle's number of contact features (four bumper rings).
 
     Returns
     -------
     pandas.DataFrame
-        Columns :data:`EPISODE_COLUMNS`: ``bumper`` (1-4), ``surface`` (name),
+        Columns :data:`EPISODE_COLUMNS`: ``bumper`` (the feature, 1-based: the
+        bumper 1-4 of a ring vehicle), ``surface`` (name),
         times in s, ``v_i_m_s`` (penetration rate at onset, m/s),
         ``peak_delta_m`` (m), ``peak_force_n`` (N), ``open`` (bool: still in
         contact when the run stopped; ``t_end_s`` is then the run end).
@@ -115,22 +125,29 @@ def episodes_frame(raw: np.ndarray, n: int, surface_names: Sequence[str]) -> pd.
     """
     import pandas as pd
 
-    data = episode_columns(raw, n, surface_names)
+    data = episode_columns(raw, n, surface_names, n_features)
     if len(data["bumper"]) == 0:
         return _empty_episodes()
     data["surface"] = list(data["surface"])
     return pd.DataFrame(data, columns=list(EPISODE_COLUMNS))
 
 
-def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
+_RINGS = tuple(str(j) for j in BUMPERS)
+
+
+def timeseries_frame(
+    raw: np.ndarray, n: int, feature_names: Sequence[str] = _RINGS
+) -> pd.DataFrame:
     """Time-series table from the kernel's output samples.
 
     Parameters
     ----------
-    raw : numpy.ndarray, shape (max_out, NOUT)
+    raw : numpy.ndarray, shape (max_out, out_width(n_features))
         Output samples with the ``OUT_*`` columns of :mod:`quadimpact.core.layout`.
     n : int
         Number of valid rows (``stats[ST_N_OUT]``).
+    feature_names : sequence of str
+        The vehicle's contact features (default: the four bumpers ``"1"``..``"4"``).
 
     Returns
     -------
@@ -141,19 +158,24 @@ def timeseries_frame(raw: np.ndarray, n: int) -> pd.DataFrame:
         ``q0..q3`` (scalar first, body -> inertial, as integrated); body rates
         ``p/q/r_rad_s``; rotor speeds and commands (rad/s); ZYX Euler angles
         ``roll/pitch/yaw_deg`` (degrees; roll and yaw wrapped to (-180, 180],
-        pitch in [-90, 90]; not unwrapped); ``altitude_m = -z_m``; per-bumper
-        deflection ``delta1..4_m`` (m, max over surfaces) and normal force
-        ``force1..4_n`` (N, sum over surfaces); ``stage``, the controller's
-        stage in force (0 for controllers without stages).
+        pitch in [-90, 90]; not unwrapped); ``altitude_m = -z_m``; per contact
+        feature its deflection (``delta1..4_m`` for the four bumpers, m, max
+        over surfaces) and normal force (``force1..4_n``, N, sum over
+        surfaces); ``stage``, the controller's stage in force (0 for
+        controllers without stages).
     """
     import pandas as pd
 
-    return pd.DataFrame(timeseries_columns(raw, n))
+    return pd.DataFrame(timeseries_columns(raw, n, feature_names))
 
 
-def timeseries_columns(raw: np.ndarray, n: int) -> dict[str, np.ndarray]:
+def timeseries_columns(
+    raw: np.ndarray, n: int, feature_names: Sequence[str] = _RINGS
+) -> dict[str, np.ndarray]:
     """The columns of :func:`timeseries_frame` as NumPy arrays (no DataFrame)."""
-    rows = _rows(raw, n, L.NOUT, "timeseries")
+    names = list(feature_names)
+    nf = len(names)
+    rows = _rows(raw, n, L.out_width(nf), "timeseries")
     x0 = L.OUT_X
     pos = rows[:, x0 + L.X_POS : x0 + L.X_POS + 3]
     vel_b = rows[:, x0 + L.X_VEL : x0 + L.X_VEL + 3]
@@ -193,10 +215,10 @@ def timeseries_columns(raw: np.ndarray, n: int) -> dict[str, np.ndarray]:
     data["pitch_deg"] = np.degrees(pitch)
     data["yaw_deg"] = np.degrees(yaw)
     data["altitude_m"] = -pos[:, 2]
-    for j in BUMPERS:
-        data[f"delta{j}_m"] = rows[:, L.OUT_DELTA + j - 1]
-    for j in BUMPERS:
-        data[f"force{j}_n"] = rows[:, L.OUT_FORCE + j - 1]
+    for f, name in enumerate(names):
+        data[feature_column("delta", name, "m")] = rows[:, L.OUT_DELTA + f]
+    for f, name in enumerate(names):
+        data[feature_column("force", name, "n")] = rows[:, L.OUT_DELTA + nf + f]
     data["stage"] = rows[:, L.OUT_STAGE]
     return {k: np.array(v, dtype=np.float64) for k, v in data.items()}
 

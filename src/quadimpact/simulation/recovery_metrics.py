@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import bumper_contact
+from quadimpact.core.geometry import contact_record
 from quadimpact.linalg import dot, norm
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.metrics import (
@@ -67,15 +67,15 @@ def _finite(v: float) -> float | None:
 
 
 def contact_normal(
-    x: np.ndarray, veh: np.ndarray, surf: np.ndarray, bumper: int, surface: int
+    x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, feature: int, shape: int
 ) -> np.ndarray:
-    """The contact normal (inertial, unit, out of the obstacle) of a bumper-surface pair at ``x``.
+    """The contact normal (inertial, unit, out of the obstacle) of a feature-shape pair at ``x``.
 
-    From the compiled contact geometry, whatever the surface's kind.
+    From the compiled contact geometry, whatever the kinds (``core.geometry``).
     """
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
-    rec = bumper_contact(xq, C, veh, int(bumper), surf, int(surface))
+    rec = contact_record(xq, C, feat, shapes, int(feature), int(shape))
     return np.array(rec[8:11])
 
 
@@ -99,8 +99,8 @@ def recovery_metrics(
     st: np.ndarray,
     episodes: Table,
     *,
-    veh: np.ndarray,
-    surf: np.ndarray,
+    feat: np.ndarray,
+    shapes: np.ndarray,
     surface_names: Sequence[str],
     obstacle_names: Sequence[str],
     final_state: np.ndarray,
@@ -113,10 +113,10 @@ def recovery_metrics(
         The kernel's stats (layout ``ST_*``).
     episodes : table
         The episodes (``simulation.record.episodes_frame`` or ``episode_columns``).
-    veh, surf : numpy.ndarray
-        The packed vehicle and surfaces (for the true contact normal).
+    feat, shapes : numpy.ndarray
+        The packed contact features and shapes (for the true contact normal).
     surface_names : sequence of str
-        Names of the packed surfaces, in order.
+        Names of the packed shapes, in order.
     obstacle_names : sequence of str
         The surfaces that count as obstacles (the ground does not).
     final_state : numpy.ndarray (NX,)
@@ -157,7 +157,7 @@ def recovery_metrics(
             bumper, surface = first
             s_index = list(surface_names).index(surface)
             x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
-            n_true = contact_normal(x_onset, veh, surf, bumper - 1, s_index)
+            n_true = contact_normal(x_onset, feat, shapes, bumper - 1, s_index)
             n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
             if norm(n_est) > 0:
                 c = float(np.clip(dot(n_est, n_true) / norm(n_true), -1.0, 1.0))

@@ -10,14 +10,15 @@ wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approac
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.run import make_kernel
+from quadimpact.core.geometry import pair_table
+from quadimpact.core.records import Model, model
+from quadimpact.core.run import Kernel, make_kernel
 from quadimpact.inputs.controllers import PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
@@ -29,6 +30,7 @@ from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
     RPM,
     pack_controller,
+    pack_features,
     pack_options,
     pack_sensors,
     pack_surfaces,
@@ -43,16 +45,22 @@ PAPER_CRASH_ALTITUDE_M = -0.3  # docs/VARIANTS.md 4.5
 
 @dataclass
 class RunSetup:
-    """Everything the compiled loop takes, and what is needed to read its record."""
+    """Everything the compiled loop takes, and what is needed to read its record.
+
+    The packed arrays (layouts in ``core/layout.py``) become the run's
+    :class:`~quadimpact.core.records.Model` with :meth:`model`.
+    """
 
     x0: np.ndarray
     t0: float
     tf: float
     veh: np.ndarray
-    surf: np.ndarray
+    feat: np.ndarray
+    shapes: np.ndarray
     opts: np.ndarray
     ctrl: np.ndarray
-    surface_names: tuple[str, ...]
+    feature_names: tuple[str, ...]
+    shape_names: tuple[str, ...]
     references: dict[str, float]
     vehicle: Vehicle
     options: ModelOptions
@@ -67,23 +75,40 @@ class RunSetup:
     noise: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
     n_imu: int = 0
     controller: str = "paper"
-    kernel: Callable | None = None
+    kernel: Kernel | None = None
     resolved: dict[str, Any] = field(default_factory=dict)
     """What the scenario's settings resolved to, as plain data (``scenario.json``'s
     ``resolved``): the model variant and every switch, the controller and its
     parameters with defaults, the pre-impact behaviour, the IMU and the slew limit."""
 
-    def sensors(self) -> dict[str, Any]:
-        """The IMU and detector as keyword arguments of ``core.run.execute_record``."""
-        return {"scfg": self.scfg, "noise": self.noise, "n_imu": self.n_imu}
+    def model(self, **changes: Any) -> Model:
+        """The run as the compiled core's :class:`~quadimpact.core.records.Model`.
 
-    def schedule(self) -> dict[str, np.ndarray]:
-        """The power-off schedule as keyword arguments of ``core.run.execute``."""
-        return {
+        ``changes`` replace fields of the packed run (``x0``, ``t0``, ``tf``,
+        ``shapes``, ``opts``, ``t_out``...); the output times default to
+        :meth:`output_times` and the contact-pair table is built from the
+        features and shapes.
+        """
+        fields: dict[str, Any] = {
+            "x0": self.x0,
+            "t0": self.t0,
+            "tf": self.tf,
+            "veh": self.veh,
+            "feat": self.feat,
+            "shapes": self.shapes,
+            "opts": self.opts,
+            "ctrl": self.ctrl,
+            "scfg": self.scfg,
+            "noise": self.noise,
             "sched_t": self.sched_t,
             "sched_rate": self.sched_rate,
             "sched_stop": self.sched_stop,
         }
+        fields.update(changes)
+        if "t_out" not in fields:
+            fields["t_out"] = self.output_times()
+        fields["pairs"] = pair_table(fields["feat"], fields["shapes"])
+        return model(**fields)
 
     def output_times(self) -> np.ndarray:
         """Output grid: ``t0``, the multiples of 1/rate inside (t0, tf), and ``tf`` (s)."""
@@ -139,7 +164,6 @@ def _packed_options(
         first_order_rotors=s.rotor_mode == "first-order",
         omega_limits_rad_s=limits,
         slew_limit_rad_s2=_slew_limit_rad_s2(s, v),
-        friction_coefficient=s.friction_coefficient,
         rtol=s.rtol,
         atol=s.atol,
         duration_s=duration_s,
@@ -170,7 +194,7 @@ def _ground(s: RunSettings) -> list[Plane]:
     return []
 
 
-def _kernel(entry) -> Callable | None:
+def _kernel(entry) -> Kernel | None:
     """The compiled loop of a plug-in controller (once per process); None for built-ins."""
     if entry.step is None:
         return None
@@ -213,10 +237,12 @@ def _setup(
     setup = RunSetup(
         tf=float(s.final_time_s),
         veh=pack_vehicle(v),
-        surf=pack_surfaces(surfaces),
+        feat=pack_features(v, s.friction_coefficient),
+        shapes=pack_surfaces(surfaces),
         opts=_packed_options(s, o, v, duration_s),
         ctrl=pack_controller(entry, params, context, refs, yaw_paper),
-        surface_names=tuple(x.name for x in surfaces),
+        feature_names=v.feature_names(),
+        shape_names=tuple(x.name for x in surfaces),
         references=refs,
         vehicle=v,
         options=o,
@@ -287,9 +313,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
     setup = _setup(s, v, o, refs, surfaces, duration, x0=np.zeros(L.NX), t0=0.0, wall=wall)
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
     setup.x0, setup.t0, setup.approach = solve_approach(
-        veh=setup.veh,
-        ctrl=setup.ctrl,
-        schedule=setup.schedule(),
+        run=setup.model(),
         free_opts=_packed_options(s, o, v, float(s.impact_time_s), free=True),
         wall=pack_surfaces([wall]),
         q=euler_zyx_to_quat(roll, pitch, yaw),

@@ -9,12 +9,11 @@ runs the compiled loop once, and reads its raw record into tables
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
 from typing import Any
 
 from quadimpact import __version__
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute_record
+from quadimpact.core.run import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.packing import surface_records
@@ -36,7 +35,7 @@ def simulate(
     scenario: WallApproach | FlightScenario | ImpactTrial,
     *,
     max_episodes: int = 1024,
-    kernel: Callable | None = None,
+    kernel: Kernel | None = None,
 ) -> SimulationResult:
     """Run one scenario.
 
@@ -46,8 +45,8 @@ def simulate(
         Validated input (``quadimpact.inputs.scenarios``).
     max_episodes : int
         Size of the episode buffer; episodes beyond it are counted and reported.
-    kernel : callable, optional
-        A run loop from ``quadimpact.core.run.make_kernel`` (plug-in controller);
+    kernel : Kernel, optional
+        A run loop from ``quadimpact.core.run.make_kernel`` (plug-ins);
         default: the registered controller's (the cached kernel for built-ins).
 
     Returns
@@ -65,25 +64,12 @@ def run_setup(
     scenario: Any = None,
     *,
     max_episodes: int = 1024,
-    kernel: Callable | None = None,
+    kernel: Kernel | None = None,
 ) -> SimulationResult:
     """Run a prepared setup through the compiled loop and analyse the record."""
-    t_out = setup.output_times()
+    m = setup.model()
     wall_start = time.perf_counter()
-    rec = execute_record(
-        setup.x0,
-        setup.t0,
-        setup.tf,
-        setup.veh,
-        setup.surf,
-        setup.opts,
-        setup.ctrl,
-        t_out,
-        max_episodes=max_episodes,
-        kernel=kernel or setup.kernel,
-        **setup.schedule(),
-        **setup.sensors(),
-    )
+    rec = execute(m, n_imu=setup.n_imu, max_episodes=max_episodes, kernel=kernel or setup.kernel)
     wall_s = time.perf_counter() - wall_start
     return analyse(setup, scenario, rec, wall_s)
 
@@ -112,7 +98,7 @@ def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
         "scenario": scenario.model_dump(mode="json") if hasattr(scenario, "model_dump") else None,
         "resolved": dict(setup.resolved),
         "vehicle": setup.vehicle.model_dump(mode="json"),
-        "surfaces": surface_records(setup.surf, setup.surface_names),
+        "surfaces": surface_records(setup.shapes, setup.shape_names),
         "quadimpact_version": __version__,
     }
 
@@ -127,7 +113,8 @@ def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan
     out, ep, st = rec.out, rec.episodes, rec.stats
     x0 = L.OUT_X + L.X_QUAT
     quat = {f"q{k}": out[:, x0 + k] for k in range(4)}  # what the summary reads of the samples
-    episodes = episode_columns(ep, ep.shape[0], setup.surface_names)
+    nf = len(setup.feature_names)
+    episodes = episode_columns(ep, ep.shape[0], setup.shape_names, nf)
     final_state = out[-1, L.OUT_X : L.OUT_X + L.NX] if out.shape[0] else setup.x0
     summary = build_summary(setup, scenario, quat, episodes, st, final_state=final_state)
     stats = {
@@ -139,16 +126,17 @@ def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan
         "wall_time_s": wall_s,
     }
     summary["integrator"] = stats
-    names = setup.surface_names
+    names = setup.shape_names
+    features = setup.feature_names
     imu = rec.imu
 
     def tables(name: str) -> Any:
         if name == "timeseries":
-            return timeseries_frame(out, out.shape[0])
+            return timeseries_frame(out, out.shape[0], features)
         if name == "timeseries_columns":
-            return timeseries_columns(out, out.shape[0])
+            return timeseries_columns(out, out.shape[0], features)
         if name == "episodes":
-            return episodes_frame(ep, ep.shape[0], names)
+            return episodes_frame(ep, ep.shape[0], names, nf)
         if name == "episodes_columns":
             cols = dict(episodes)
             return cols

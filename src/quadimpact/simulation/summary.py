@@ -77,8 +77,8 @@ def build_summary(
         first = first_obstacle_episode(episodes, _obstacle_names(setup))
         if first is not None:  # the contact normal there, from the contact geometry
             bumper, surface = first
-            s_index = list(setup.surface_names).index(surface)
-            normal = contact_normal(xo, setup.veh, setup.surf, bumper - 1, s_index)
+            s_index = list(setup.shape_names).index(surface)
+            normal = contact_normal(xo, setup.feat, setup.shapes, bumper - 1, s_index)
             speed = -dot(vel, normal)
         heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
         incl = inclination_deg_of(q)
@@ -179,9 +179,9 @@ def build_summary(
         recovery_metrics(
             st,
             episodes,
-            veh=setup.veh,
-            surf=setup.surf,
-            surface_names=setup.surface_names,
+            feat=setup.feat,
+            shapes=setup.shapes,
+            surface_names=setup.shape_names,
             obstacle_names=_obstacle_names(setup),
             final_state=np.asarray(final_state, dtype=float),
         )
@@ -208,8 +208,8 @@ def _too_deep(setup: RunSetup, episodes: Any, max_pen: float, rb: float) -> str:
 
 
 def _obstacle_names(setup: RunSetup) -> list[str]:
-    """Names of the packed surfaces that are obstacles (not the ground)."""
-    return [n for k, n in enumerate(setup.surface_names) if setup.surf[k, L.S_IS_GROUND] < 0.5]
+    """Names of the packed shapes that are obstacles (not the ground)."""
+    return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, L.SH_IS_GROUND] < 0.5]
 
 
 

@@ -16,7 +16,7 @@ and the sampled states of a run:
   before: the wall ``X = wall_distance_m`` of the summary, the ground if an
   episode touched it, and the bundled vehicle named in the summary;
 * during contact, per bumper and surface, the deepest rim point given by the
-  compiled contact function :func:`quadimpact.core.geometry.bumper_contact`
+  compiled contact function :func:`quadimpact.core.geometry.contact_record`
   (so the drawing shows the point the simulation pushed on), the deflection
   (the segment from that point to the surface, of length delta) and the normal
   force as an arrow along the surface normal;
@@ -45,7 +45,7 @@ from quadimpact.errors import input_error_from_validation
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import quat_to_matrix, unwrap_deg
-from quadimpact.simulation.packing import pack_surface_records, pack_surfaces, pack_vehicle
+from quadimpact.simulation.packing import pack_features, pack_surface_records, pack_surfaces
 
 __all__ = [
     "AXIS_LENGTH_M",
@@ -127,7 +127,7 @@ class VehicleDrawing:
     label_points : numpy.ndarray, shape (4, 3)
         Where the bumper numbers go (outside each rim, along ``u_j``).
     packed : numpy.ndarray
-        The vehicle as the compiled core's ``V_*`` vector.
+        The vehicle's contact features as the compiled core's ``F_*`` table.
     """
 
     vehicle: Vehicle
@@ -175,7 +175,7 @@ class VehicleDrawing:
             arms=arms,
             axes=axes,
             label_points=label_points,
-            packed=pack_vehicle(vehicle),
+            packed=pack_features(vehicle, 0.0),
         )
 
 
@@ -256,7 +256,7 @@ def contact_points(
     depths : numpy.ndarray, shape (4, n_surfaces)
         Penetrations delta, m (positive in contact).
     """
-    from quadimpact.core.geometry import bumper_contact
+    from quadimpact.core.geometry import contact_record
 
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
@@ -265,7 +265,7 @@ def contact_points(
     depths = np.zeros((4, ns))
     for j in range(4):
         for s in range(ns):
-            d, _dd, rx, ry, rz, *_ = bumper_contact(xq, C, drawing.packed, j, surf, s)
+            d, _dd, rx, ry, rz, *_ = contact_record(xq, C, drawing.packed, surf, j, s)
             points[j, s] = xq[L.X_POS : L.X_POS + 3] + C @ np.array([rx, ry, rz])
             depths[j, s] = d
     return points, depths
@@ -501,7 +501,7 @@ class Scene:
         elif self.surfaces:
             self.surf = pack_surfaces(self.surfaces)
         else:
-            self.surf = np.zeros((0, L.NSURF))
+            self.surf = np.zeros((0, L.NSHAPE))
         ts = _drawable_rows(timeseries)
         self.t = ts["t_s"].to_numpy(dtype=float)
         self.states = np.zeros((len(ts), L.NX))
@@ -634,7 +634,7 @@ class Scene:
             weights = np.array([depths[j, s] ** n_exp for s in touching])
             weights = weights / weights.sum()
             for w, s in zip(weights, touching, strict=True):
-                m = self.surf[s, L.S_NORMAL : L.S_NORMAL + 3]
+                m = self.surf[s, L.SH_NORMAL : L.SH_NORMAL + 3]
                 delta = float(depths[j, s])
                 f = float(forces[j] * w)
                 on_surface = points[j, s] + delta * m

@@ -12,7 +12,7 @@ the rule responds to contact (and to lever-arm terms when the IMU is off the
 CM, and to noise).
 
 Wall-normal estimate at detection: the horizontal part of the measured
-inertial acceleration ``C f + g e_Z`` (attitude from the state estimate),
+inertial acceleration ``C f + g e_Z`` (``C`` the estimated attitude),
 normalised. It points roughly away from the obstacle; the thrust's horizontal
 part is in it too.
 
@@ -45,21 +45,23 @@ from ..layout import (
     ST_N_DETECTIONS,
     ST_T_DETECT,
 )
+from ..records import Data, Model, Output
 
 
 @njit(cache=True)
-def detect(
-    t: float,
-    x: np.ndarray,
-    C: np.ndarray,
-    veh: np.ndarray,
-    scfg: np.ndarray,
-    sst: np.ndarray,
-    meas: np.ndarray,
-    imu_out: np.ndarray,
-    stats: np.ndarray,
-) -> None:
-    """Apply the detection rule to the sample just taken at time ``t`` (state ``x``)."""
+def detect(t: float, x: np.ndarray, C_hat: np.ndarray, m: Model, d: Data, o: Output) -> None:
+    """Apply the detection rule to the sample just taken at time ``t`` (s).
+
+    ``C_hat`` is the estimated attitude at the sample (the estimator's, never
+    the simulator's truth unless the estimator is ideal); ``x``, the true
+    state, is only recorded (``ST_DETECT_X``) for the analysis.
+    """
+    C = C_hat
+    scfg = m.scfg
+    sst = d.sst
+    meas = d.meas
+    imu_out = o.imu
+    stats = o.stats
     fx = meas[MS_IMU_F]
     fy = meas[MS_IMU_F + 1]
     fz = meas[MS_IMU_F + 2]

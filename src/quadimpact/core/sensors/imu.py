@@ -59,6 +59,7 @@ from ..layout import (
     X_OMEGA,
     X_VEL,
 )
+from ..records import Data, Model, Output
 
 
 @njit(cache=True)
@@ -113,24 +114,21 @@ def _measure_axis(value: float, bias: float, sigma: float, z: float, rng: float)
 
 @njit(cache=True)
 def imu_sample(
-    t: float,
-    x: np.ndarray,
-    xdot: np.ndarray,
-    C: np.ndarray,
-    veh: np.ndarray,
-    scfg: np.ndarray,
-    sst: np.ndarray,
-    noise: np.ndarray,
-    meas: np.ndarray,
-    imu_out: np.ndarray,
-    stats: np.ndarray,
+    t: float, x: np.ndarray, xdot: np.ndarray, C: np.ndarray, m: Model, d: Data, o: Output
 ) -> None:
-    """Take IMU sample number ``sst[SS_N]`` at time ``t`` (s) and store it.
+    """Take IMU sample number ``d.sst[SS_N]`` at time ``t`` (s) from the true state ``x``.
 
-    Writes the measured sample into the measurement record (``MS_IMU_*``) and,
-    while there is room, a row of ``imu_out`` (layout ``I_*``); counts it in
-    ``stats[ST_N_IMU]`` and ``sst[SS_N]``.
+    ``xdot`` is the state derivative at ``x`` (inputs of the interval), ``C``
+    the rotation of ``x``. Writes the measured sample into the measurement
+    record (``MS_IMU_*``) and, while there is room, a row of ``o.imu`` (layout
+    ``I_*``); counts it in ``o.stats[ST_N_IMU]`` and ``d.sst[SS_N]``.
     """
+    veh = m.veh
+    scfg = m.scfg
+    noise = m.noise
+    sst = d.sst
+    meas = d.meas
+    imu_out = o.imu
     i = int(sst[SS_N])
     rx = scfg[SC_POS]
     ry = scfg[SC_POS + 1]
@@ -176,4 +174,4 @@ def imu_sample(
     if row:
         imu_out[i, I_T] = t
     sst[SS_N] = i + 1
-    stats[ST_N_IMU] = i + 1
+    o.stats[ST_N_IMU] = i + 1

@@ -1,0 +1,238 @@
+"""Contact geometry: one table of functions keyed on (feature kind, shape kind).
+
+A vehicle declares contact **features** (rows of ``feat``, layout ``F_*``;
+today rings, the bumpers), the world declares **shapes** (rows of
+``shapes``, layout ``SH_*``; today planes). A run's contact-pair table
+(``pairs``, built once by :func:`pair_table`, shape-major) names for every
+(feature, shape) pair the geometry function that computes its contact record
+(``record.py``): point, normal, depth, velocity. Everything else (events,
+forces, outputs) goes through :func:`pair_contact`; the force law
+(``core/contact.py``) never reads a shape.
+
+The table (:data:`GEOMETRIES`) maps ``(FeatureKind, ShapeKind)`` to a
+geometry id and its compiled function ``fn(x, C, feat, f, shapes, s) ->
+ContactRecord``; the compiled dispatch :func:`pair_contact` branches on the
+id. Each shape kind also has a point-distance function (the contact gate of
+the recovery replica): :data:`SHAPE_DISTANCES`.
+
+Built-in rows (one module per shape kind):
+
+============  ========  ======================  =================================
+feature       shape     function                method
+============  ========  ======================  =================================
+ring          plane     ``plane.ring_plane``    closed form (paper eqs. 10-15)
+============  ========  ======================  =================================
+
+**A new row** (a new feature or shape kind, a new pair): write the function
+in the shape's module; for a built-in, give it a ``GEOM_*`` id, a row in
+:data:`GEOMETRIES` and a branch in :func:`pair_contact` (and, for a new shape
+kind, a branch in :func:`shape_distance`); or register it at run time with
+:func:`register_geometry` (and :func:`register_shape_distance`): a run whose
+pairs use a registered row runs in a loop compiled around the registered
+functions (``core.run.make_kernel``), as a plug-in controller does.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    F_KIND,
+    FEAT_RING,
+    NPAIR,
+    PR_FEATURE,
+    PR_GEOMETRY,
+    PR_SHAPE,
+    SH_KIND,
+    SHAPE_PLANE,
+    FeatureKind,
+    ShapeKind,
+)
+from .plane import plane_distance, ring_plane
+from .record import ContactRecord, no_contact
+
+__all__ = [
+    "GEOMETRIES",
+    "SHAPE_DISTANCES",
+    "contact_record",
+    "geometry_id",
+    "pair_contact",
+    "pair_table",
+    "plugin_geometries",
+    "register_geometry",
+    "register_shape_distance",
+    "shape_distance",
+]
+
+GEOM_RING_PLANE = 0
+GEOM_PLUGIN = 1000  # registered rows get ids from here on
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """A row of the table: the compiled contact function of one (feature, shape) pair."""
+
+    feature: int
+    shape: int
+    id: int
+    fn: Callable
+    plugin: bool = False
+
+
+GEOMETRIES: dict[tuple[int, int], Geometry] = {
+    (FEAT_RING, SHAPE_PLANE): Geometry(FEAT_RING, SHAPE_PLANE, GEOM_RING_PLANE, ring_plane),
+}
+"""The table: (feature kind, shape kind) -> its geometry."""
+
+SHAPE_DISTANCES: dict[int, tuple[Callable, bool]] = {SHAPE_PLANE: (plane_distance, False)}
+"""Shape kind -> (its point-distance function, registered at run time)."""
+
+
+# ---------------------------------------------------------------- compiled dispatch
+@njit(cache=True, inline="always")
+def plugin_contact(
+    g: int, x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> ContactRecord:
+    """Registered rows (rebound by ``core.run.make_kernel``); none here: no contact."""
+    return no_contact()
+
+
+@njit(cache=True, inline="always")
+def pair_contact(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
+) -> ContactRecord:
+    """The contact record of pair ``c`` of the pair table at the state ``x``.
+
+    ``C`` is the body-to-inertial rotation of ``x``'s quaternion.
+    """
+    f = pairs[c, PR_FEATURE]
+    s = pairs[c, PR_SHAPE]
+    g = pairs[c, PR_GEOMETRY]
+    if g == GEOM_RING_PLANE:
+        return ring_plane(x, C, feat, f, shapes, s)
+    return plugin_contact(g, x, C, feat, f, shapes, s)
+
+
+@njit(cache=True, inline="always")
+def pair_depth(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
+) -> tuple[float, float]:
+    """Penetration ``delta`` (m) and its rate ``delta_dot`` (m/s) of pair ``c`` only."""
+    rec = pair_contact(x, C, feat, shapes, pairs, c)
+    return rec[0], rec[1]
+
+
+@njit(cache=True, inline="always")
+def plugin_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) -> float:
+    """Registered shape kinds (rebound by ``core.run.make_kernel``); none here."""
+    return math.inf
+
+
+@njit(cache=True, inline="always")
+def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) -> float:
+    """Signed distance (m) of the inertial point ``p`` from shape ``s``, positive outside."""
+    if int(shapes[s, SH_KIND]) == SHAPE_PLANE:
+        return plane_distance(px, py, pz, shapes, s)
+    return plugin_distance(px, py, pz, shapes, s)
+
+
+@njit(cache=True)
+def _contact_record(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
+) -> ContactRecord:
+    return pair_contact(x, C, feat, shapes, pairs, c)
+
+
+# ---------------------------------------------------------------- the table, from Python
+def geometry_id(feature_kind: int, shape_kind: int) -> int:
+    """The geometry id of a (feature kind, shape kind) pair; ``KeyError`` names a missing row."""
+    try:
+        return GEOMETRIES[(int(feature_kind), int(shape_kind))].id
+    except KeyError:
+        raise KeyError(
+            f"no contact geometry for feature kind {_kind_name(FeatureKind, feature_kind)} "
+            f"against shape kind {_kind_name(ShapeKind, shape_kind)}"
+        ) from None
+
+
+def _kind_name(enum: type, value: int) -> str:
+    try:
+        return enum(int(value)).name.lower()
+    except ValueError:
+        return str(int(value))
+
+
+def pair_table(feat: np.ndarray, shapes: np.ndarray) -> np.ndarray:
+    """The contact-pair table of a run: every (feature, shape) pair, shape-major (int64).
+
+    Pair ``c = s * n_features + f`` is feature ``f`` against shape ``s``; its
+    ``PR_GEOMETRY`` is the table's id for their kinds.
+    """
+    nf = feat.shape[0]
+    ns = shapes.shape[0]
+    pairs = np.zeros((nf * ns, NPAIR), dtype=np.int64)
+    for s in range(ns):
+        for f in range(nf):
+            c = s * nf + f
+            pairs[c, PR_FEATURE] = f
+            pairs[c, PR_SHAPE] = s
+            pairs[c, PR_GEOMETRY] = geometry_id(feat[f, F_KIND], shapes[s, SH_KIND])
+    return pairs
+
+
+def contact_record(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, f: int, s: int
+) -> ContactRecord:
+    """The contact record of feature ``f`` against shape ``s`` at ``x`` (from Python).
+
+    ``C`` is the body-to-inertial rotation of ``x``'s quaternion. Built-in rows
+    only (a registered row runs in its own compiled loop).
+    """
+    kind = (int(feat[f, F_KIND]), int(shapes[s, SH_KIND]))
+    pairs = np.array([[f, s, geometry_id(*kind)]], dtype=np.int64)
+    return _contact_record(
+        np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(C, dtype=np.float64),
+        feat, shapes, pairs, 0,
+    )  # fmt: skip
+
+
+# ---------------------------------------------------------------- registered rows
+def register_geometry(feature_kind: int, shape_kind: int, fn: Callable) -> int:
+    """Add a row to the table: ``fn(x, C, feat, f, shapes, s) -> ContactRecord`` (``njit``).
+
+    Returns its geometry id. A run whose pair table uses it runs in a loop
+    compiled around the registered rows (``core.run.make_kernel``; compiled
+    once per process, not cached on disk).
+    """
+    if not hasattr(fn, "py_func"):
+        raise TypeError("register_geometry: fn must be a numba.njit function")
+    key = (int(feature_kind), int(shape_kind))
+    if key in GEOMETRIES and not GEOMETRIES[key].plugin:
+        raise ValueError(f"register_geometry: {key} is a built-in row")
+    gid = GEOMETRIES[key].id if key in GEOMETRIES else GEOM_PLUGIN + len(plugin_geometries())
+    GEOMETRIES[key] = Geometry(key[0], key[1], gid, fn, plugin=True)
+    return gid
+
+
+def register_shape_distance(shape_kind: int, fn: Callable) -> None:
+    """The point-distance function ``fn(px, py, pz, shapes, s) -> float`` of a new shape kind."""
+    if not hasattr(fn, "py_func"):
+        raise TypeError("register_shape_distance: fn must be a numba.njit function")
+    if int(shape_kind) in SHAPE_DISTANCES and not SHAPE_DISTANCES[int(shape_kind)][1]:
+        raise ValueError(f"register_shape_distance: shape kind {shape_kind} is built in")
+    SHAPE_DISTANCES[int(shape_kind)] = (fn, True)
+
+
+def plugin_geometries() -> list[Geometry]:
+    """The registered rows, in id order."""
+    return sorted((g for g in GEOMETRIES.values() if g.plugin), key=lambda g: g.id)
+
+
+def plugin_distances() -> dict[int, Callable]:
+    """The registered shape kinds' distance functions."""
+    return {k: fn for k, (fn, plugin) in SHAPE_DISTANCES.items() if plugin}

@@ -1,0 +1,355 @@
+"""Integration of one control interval: Dormand-Prince 5(4) with located events.
+
+From the tick ``t_k`` to ``t_{k+1}`` the inputs are constant (zero-order
+hold), so the integrator is restarted at the tick and steps to the next one,
+also cut where the power-off schedule changes the rotor inputs. After each
+accepted step the event functions (the contact gap of every pair, the
+altitude for the crash) are checked at its end, and inside it for contacts
+within reach; the earliest onset, end or crash is located on the dense
+output, the step is cut there, every pair is re-examined at that instant
+(simultaneous onsets: at psi = 0 bumpers 1 and 4 start together), ``v_i`` is
+captured, and integration restarts from the cut. Output rows and IMU
+samples falling inside the step are written from the dense output; episode
+peaks are tracked (the deflection at the located zero of ``delta_dot``, the
+force at step ends and mid-steps). Contact state changes only at located
+events, so a trial step never integrates a force switched on mid-step.
+"""
+
+import numpy as np
+from numba import njit
+
+from .actuators import apply_segment, next_boundary, segment_at
+from .contact import contact_gap
+from .dynamics import state_derivative
+from .events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
+from .geometry import pair_depth
+from .integrator import dense_coefficients, dense_eval, error_norm, stage_state, step_factor
+from .layout import (
+    CRASH_CM_GROUND,
+    CS_ACTIVE,
+    CS_EPISODE,
+    LS_H,
+    LS_PO_ACTIVE,
+    LS_PO_SEG,
+    LS_PO_T,
+    LS_T,
+    LS_T_SCHED,
+    MS_DETECTED,
+    N_ROTORS,
+    NX,
+    O_ATOL,
+    O_CRASH_ALTITUDE,
+    O_CRASH_RULE,
+    O_DT_CONTROL,
+    O_EVENT_TOL,
+    O_H_MAX,
+    O_MAX_STEPS,
+    O_POWER_OFF_T,
+    O_RTOL,
+    O_STOP_ON_CRASH,
+    PR_SHAPE,
+    REASON_MAX_STEPS,
+    REASON_NOT_FINITE,
+    REASON_STEP_TOO_SMALL,
+    SH_IS_GROUND,
+    SS_NEXT_T,
+    ST_CRASH_T,
+    ST_MISSED_ONSETS,
+    ST_N_OUT,
+    ST_N_REJECTED,
+    ST_N_RHS,
+    ST_N_STEPS,
+    ST_ONSET_T,
+    ST_ONSET_X,
+    ST_POWER_OFF_T,
+    ST_REASON,
+    ST_STATUS,
+    ST_T_END,
+    STATUS_FAILED,
+    X_POS,
+    X_QUAT,
+    X_ROTOR,
+)
+from .quaternion import rotation_matrix
+from .recording import (
+    close_episode,
+    observe_peak,
+    open_episode,
+    record_crash,
+    track_extremes,
+    write_sample,
+)
+from .records import Data, Model, Output, Work
+from .sensors.stage import sample_at, take_sample
+
+MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
+
+RUNNING = 0  # what integrate_interval returns: the run goes on,
+ENDED = 1  # it ended (a crash with stop-on-crash),
+FAILED = 2  # or failed (status and reason in stats)
+
+
+@njit(cache=True)
+def contact_values(x: np.ndarray, m: Model, d: Data, w: Work, g: np.ndarray, gd: np.ndarray):
+    """Gap ``g`` and penetration rate ``gd`` of every pair at ``x`` (``w.C``: its rotation)."""
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
+    for c in range(g.shape[0]):
+        dp, dd = pair_depth(x, w.C, m.feat, m.shapes, m.pairs, c)
+        g[c] = contact_gap(x, dp, m, c)
+        gd[c] = dd
+
+
+@njit(cache=True)
+def _schedule_boundary(t: float, tiny: float, m: Model, d: Data, o: Output) -> None:
+    """The rotor inputs change at ``t``: power-off trigger, next segment, a motor stopping."""
+    ls = d.ls
+    x = d.x
+    if ls[LS_PO_ACTIVE] < 0.5:
+        ls[LS_PO_ACTIVE] = 1.0
+        ls[LS_PO_T] = t
+        o.stats[ST_POWER_OFF_T] = t
+        for j in range(N_ROTORS):
+            if m.sched_stop[j] > 0.5:
+                x[X_ROTOR + j] = 0.0
+    seg = segment_at(t + tiny, ls[LS_PO_T], m.sched_t)
+    ls[LS_PO_SEG] = seg
+    apply_segment(x, m.sched_rate, seg, d.rin)
+    ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin)
+
+
+@njit(cache=True)
+def _pending_onsets(d: Data, o: Output, w: Work) -> bool:
+    """Mark pairs already penetrating without a located onset (``w.ev_sig = 0``); any?"""
+    pending = False
+    for c in range(d.cs.shape[0]):
+        if d.cs[c, CS_ACTIVE] < 0.5 and w.g_a[c] > 0.0:
+            if w.g_a[c] > MISSED_ONSET_DEPTH:
+                o.stats[ST_MISSED_ONSETS] += 1.0
+            w.ev_sig[c] = 0.0
+            pending = True
+        else:
+            w.ev_sig[c] = NO_EVENT
+    return pending
+
+
+@njit(cache=True)
+def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
+    """A Dormand-Prince step of ``h`` (s) from ``d.x``: stages in ``w.K``, its end in ``w.x_new``.
+
+    ``fsal``: ``w.K[0]`` already holds the derivative at ``d.x``. Returns the
+    scaled error norm (<= 1: accept).
+    """
+    x = d.x
+    K = w.K
+    if not fsal:
+        state_derivative(x, K[0], m, d, w)
+    for st in range(1, 6):
+        stage_state(x, K, h, st, w.xs)
+        state_derivative(w.xs, K[st], m, d, w)
+    stage_state(x, K, h, 6, w.x_new)
+    state_derivative(w.x_new, K[6], m, d, w)
+    return error_norm(x, w.x_new, K, h, m.opts[O_RTOL], m.opts[O_ATOL])
+
+
+@njit(cache=True)
+def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
+    """Earliest event of the accepted step of ``h`` (s), and the crash's (fractions; NO_EVENT)."""
+    contact_values(w.x_new, m, d, w, w.g_b, w.gd_b)
+    sig_min = NO_EVENT
+    for c in range(d.cs.shape[0]):
+        sig = contact_event(c, m, d, w, h)
+        w.ev_sig[c] = sig
+        if sig < sig_min:
+            sig_min = sig
+    sig_crash = NO_EVENT
+    if int(m.opts[O_CRASH_RULE]) == CRASH_CM_GROUND:
+        level = m.opts[O_CRASH_ALTITUDE]
+        ha = -d.x[X_POS + 2] - level
+        hb = -w.x_new[X_POS + 2] - level
+        if ha > 0.0 and hb <= 0.0:
+            sig_crash = locate(EV_ALTITUDE, 0, level, m, d, w, h, ha, hb, 1.0)
+            if sig_crash < sig_min:
+                sig_min = sig_crash
+    return sig_min, sig_crash
+
+
+@njit(cache=True)
+def _dense_samples(
+    m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, fsal: bool, i_out: int
+) -> int:
+    """Output rows and IMU samples in ``(t, t_b]`` of the step of ``h`` (s); the next row."""
+    t_out = m.t_out
+    while i_out < t_out.shape[0] and t_out[i_out] <= t_b:
+        dense_eval(d.x, w.Q, h, (t_out[i_out] - t) / h, w.xs)
+        write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)
+        i_out += 1
+    sst = d.sst
+    while sst[SS_NEXT_T] <= t_b:
+        ts = sst[SS_NEXT_T]
+        if ts == t_b and fsal:
+            # at the end of an uncut step: its solution and derivative (FSAL)
+            rotation_matrix(w.x_b[X_QUAT : X_QUAT + 4], w.C)
+            take_sample(ts, w.x_b, w.K[6], m, d, o, w)
+            continue
+        dense_eval(d.x, w.Q, h, (ts - t) / h, w.xs)
+        sample_at(ts, w.xs, m, d, o, w)
+    return i_out
+
+
+@njit(cache=True)
+def _track_peaks(m: Model, d: Data, o: Output, w: Work, t: float, h: float, sig: float) -> None:
+    """Peaks of the active contacts over the step of ``h`` (s) from ``t`` up to fraction ``sig``."""
+    for c in range(d.cs.shape[0]):
+        e = int(d.cs[c, CS_EPISODE])
+        if d.cs[c, CS_ACTIVE] < 0.5 or e < 0:
+            continue
+        rate_end = observe_peak(m, d, o, w, e, c, sig, t, h)
+        # the force peaks before the deflection: look half-way too
+        observe_peak(m, d, o, w, e, c, 0.5 * sig, t, h)
+        if w.gd_a[c] > 0.0 and rate_end <= 0.0 and sig > 0.0:
+            sp = locate(EV_RATE, c, 0.0, m, d, w, h, w.gd_a[c], rate_end, sig)
+            observe_peak(m, d, o, w, e, c, sp, t, h)
+
+
+@njit(cache=True)
+def _process_events(
+    t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
+) -> tuple[bool, bool]:
+    """Onsets and ends located at ``t`` (fraction ``sig`` of the step, within ``tol_sig``).
+
+    ``d.x`` is the state there and ``w.g_a``, ``w.gd_a`` its gaps and rates.
+    Returns (any event, the run ends: a ground onset with stop-on-crash).
+    """
+    stats = o.stats
+    any_event = False
+    ended = False
+    for c in range(d.cs.shape[0]):
+        if w.ev_sig[c] >= NO_EVENT or w.ev_sig[c] > sig + tol_sig:
+            continue
+        any_event = True
+        if d.cs[c, CS_ACTIVE] >= 0.5:
+            close_episode(c, t, d, o)
+            continue
+        # onset: capture v_i at the located instant
+        open_episode(c, t, w.gd_a[c], m, d, o, w)
+        if m.shapes[m.pairs[c, PR_SHAPE], SH_IS_GROUND] > 0.5:
+            if np.isnan(stats[ST_CRASH_T]):
+                record_crash(t, d.x, stats)
+                ended = ended or m.opts[O_STOP_ON_CRASH] > 0.5
+        elif np.isnan(stats[ST_ONSET_T]):
+            stats[ST_ONSET_T] = t
+            for i in range(NX):
+                stats[ST_ONSET_X + i] = d.x[i]
+            first_contact = m.opts[O_POWER_OFF_T] < 0.0 and d.ls[LS_PO_ACTIVE] < 0.5
+            if m.sched_t.shape[0] > 0 and first_contact:
+                d.ls[LS_T_SCHED] = t  # power-off triggered by the first contact
+    return any_event, ended
+
+
+@njit(cache=True)
+def _fail(stats: np.ndarray, reason: int) -> int:
+    stats[ST_STATUS] = STATUS_FAILED
+    stats[ST_REASON] = reason
+    return FAILED
+
+
+@njit(cache=True)
+def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w: Work) -> int:
+    """Integrate from the tick ``t`` to ``t_next`` (s); ``RUNNING``, ``ENDED`` or ``FAILED``.
+
+    ``w.g_a``, ``w.gd_a`` hold the pairs' gaps and rates at ``(t, d.x)``.
+    """
+    ls = d.ls
+    stats = o.stats
+    h_max = m.opts[O_H_MAX] if m.opts[O_H_MAX] > 0.0 else m.opts[O_DT_CONTROL]
+    max_steps = int(m.opts[O_MAX_STEPS])
+    h = ls[LS_H]
+    i_out = int(stats[ST_N_OUT])
+    n_steps = int(stats[ST_N_STEPS])
+    n_rej = int(stats[ST_N_REJECTED])
+    n_rhs = int(stats[ST_N_RHS])
+    result = RUNNING
+    fsal = False
+    tiny = 1e-12 * max(1.0, abs(t_next))  # boundaries closer than this coincide
+    while result == RUNNING:
+        if t_next - t <= tiny:
+            t = t_next
+            break
+        if ls[LS_T_SCHED] - t <= tiny:
+            _schedule_boundary(t, tiny, m, d, o)
+            fsal = False
+        t_stop = min(t_next, ls[LS_T_SCHED])
+        pending = _pending_onsets(d, o, w)
+        if n_steps + n_rej >= max_steps:
+            result = _fail(stats, REASON_MAX_STEPS)
+            break
+        h_try = min(h, h_max, t_stop - t)
+        if t + 1.01 * h_try >= t_stop:
+            h_try = t_stop - t
+        if h_try <= 16.0 * 2.2e-16 * max(1.0, abs(t)) and t_stop - t > h_try:
+            result = _fail(stats, REASON_STEP_TOO_SMALL)
+            break
+        tol_sig = 0.0
+        if pending:
+            sig_min = 0.0
+            w.x_b[:] = d.x
+            t_b = t
+            h_new = h
+        else:
+            err = _trial_step(m, d, w, h_try, fsal)
+            n_rhs += 6 if fsal else 7
+            if not np.isfinite(err):
+                n_rej += 1
+                h = 0.2 * h_try
+                fsal = True
+                continue
+            if err > 1.0:
+                n_rej += 1
+                h = h_try * step_factor(err, True)
+                fsal = True
+                continue
+            n_steps += 1
+            tol_sig = m.opts[O_EVENT_TOL] / h_try
+            h_new = h_try * step_factor(err, True)
+            dense_coefficients(w.K, w.Q)
+            sig_min, sig_crash = _step_events(m, d, w, h_try)
+            if sig_min <= 1.0:
+                t_b = t + sig_min * h_try
+                dense_eval(d.x, w.Q, h_try, sig_min, w.x_b)
+                fsal = False
+            else:
+                sig_min = 1.0
+                t_b = t + h_try
+                w.x_b[:] = w.x_new
+                w.K[0, :] = w.K[6, :]
+                fsal = True
+            if t_stop - t_b < tiny:
+                t_b = t_stop
+            i_out = _dense_samples(m, d, o, w, t, h_try, t_b, fsal, i_out)
+            _track_peaks(m, d, o, w, t, h_try, sig_min)
+            if sig_crash <= sig_min:
+                record_crash(t_b, w.x_b, stats)
+                if m.opts[O_STOP_ON_CRASH] > 0.5:
+                    result = ENDED
+        # ---- advance to t_b and process the events located there ----
+        t = t_b
+        d.x[:] = w.x_b
+        if not np.isfinite(d.x).all():
+            result = _fail(stats, REASON_NOT_FINITE)
+            break
+        track_extremes(d.x, d.meas[MS_DETECTED] > 0.5, stats)
+        h = h_new
+        contact_values(d.x, m, d, w, w.g_a, w.gd_a)
+        any_event, ended = _process_events(t, sig_min, tol_sig, m, d, o, w)
+        if any_event:
+            fsal = False
+        if ended:
+            result = ENDED
+    ls[LS_T] = t
+    ls[LS_H] = h
+    stats[ST_T_END] = t
+    stats[ST_N_OUT] = i_out
+    stats[ST_N_STEPS] = n_steps
+    stats[ST_N_REJECTED] = n_rej
+    stats[ST_N_RHS] = n_rhs
+    return result

@@ -1,0 +1,182 @@
+"""What the loop records: output rows, contact episodes and their peaks, extremes, the crash.
+
+All functions write into the run's :class:`~quadimpact.core.records.Output`
+(layouts ``OUT_*``, ``E_*``, ``ST_*`` in ``core/layout.py``); none changes the
+dynamics. Per contact feature an output row holds its deflection (the
+deepest of its pairs, >= 0, m) and its normal force (the sum over its
+active pairs, N).
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from .contact import pair_damping, pair_normal_force
+from .geometry import pair_depth
+from .integrator import dense_eval
+from .layout import (
+    CS_ACTIVE,
+    CS_EPISODE,
+    CS_LAMBDA,
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_PEAK,
+    E_T_PEAK_FORCE,
+    E_T_START,
+    E_V_I,
+    LS_STAGE,
+    N_ROTORS,
+    NX,
+    O_V_MIN,
+    OUT_CMD,
+    OUT_DELTA,
+    OUT_STAGE,
+    OUT_T,
+    OUT_X,
+    PR_FEATURE,
+    PR_SHAPE,
+    RIN_CMD,
+    ST_CRASH_T,
+    ST_CRASH_X,
+    ST_EPISODES_DROPPED,
+    ST_MAX_RATE,
+    ST_MIN_ALT,
+    ST_MIN_TILT_COS,
+    ST_N_EPISODES,
+    ST_STATUS,
+    STATUS_CRASHED,
+    X_OMEGA,
+    X_POS,
+    X_QUAT,
+)
+from .quaternion import rotation_matrix
+from .records import Data, Model, Output, Work
+
+
+@njit(cache=True)
+def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
+    """Output row ``row`` at time ``t`` (s) of the state ``xs``: state, command, stage, contacts."""
+    out = o.out
+    nf = m.feat.shape[0]
+    out[row, OUT_T] = t
+    for i in range(NX):
+        out[row, OUT_X + i] = xs[i]
+    rotation_matrix(xs[X_QUAT : X_QUAT + 4], w.C)
+    for f in range(nf):
+        out[row, OUT_DELTA + f] = 0.0
+        out[row, OUT_DELTA + nf + f] = 0.0
+    for j in range(N_ROTORS):
+        out[row, OUT_CMD + j] = d.rin[RIN_CMD + j]
+    out[row, OUT_STAGE] = d.ls[LS_STAGE]
+    for c in range(d.cs.shape[0]):
+        f = m.pairs[c, PR_FEATURE]
+        dp, dd = pair_depth(xs, w.C, m.feat, m.shapes, m.pairs, c)
+        if dp > out[row, OUT_DELTA + f]:
+            out[row, OUT_DELTA + f] = dp
+        if d.cs[c, CS_ACTIVE] > 0.5:
+            out[row, OUT_DELTA + nf + f] += pair_normal_force(m, c, dp, dd, d.cs[c, CS_LAMBDA])
+
+
+@njit(cache=True)
+def track_peak(o: Output, e: int, t: float, delta: float, force: float) -> None:
+    """Update episode ``e``'s peak deflection (m) and peak force (N) with a new observation."""
+    if e < 0:
+        return
+    ep = o.episodes
+    if delta > ep[e, E_PEAK_DELTA]:
+        ep[e, E_PEAK_DELTA] = delta
+        ep[e, E_T_PEAK] = t
+    if force > ep[e, E_PEAK_FORCE]:
+        ep[e, E_PEAK_FORCE] = force
+        ep[e, E_T_PEAK_FORCE] = t
+
+
+@njit(cache=True)
+def observe_peak(
+    m: Model, d: Data, o: Output, w: Work, e: int, c: int, sigma: float, t: float, h: float
+) -> float:
+    """Track episode ``e``'s peaks with pair ``c`` at ``t + sigma h`` on the step's dense output.
+
+    The step starts at ``d.x`` (time ``t``, s) with size ``h`` (s) and
+    coefficients ``w.Q``. Returns the penetration rate there (m/s).
+    """
+    dense_eval(d.x, w.Q, h, sigma, w.xs)
+    rotation_matrix(w.xs[X_QUAT : X_QUAT + 4], w.C)
+    dp, dd = pair_depth(w.xs, w.C, m.feat, m.shapes, m.pairs, c)
+    track_peak(o, e, t + sigma * h, dp, pair_normal_force(m, c, dp, dd, d.cs[c, CS_LAMBDA]))
+    return dd
+
+
+@njit(cache=True)
+def open_episode(c: int, t: float, gd: float, m: Model, d: Data, o: Output, w: Work) -> None:
+    """Onset of pair ``c`` at ``t`` (s), state ``d.x``, rate ``gd`` (m/s): damping, episode."""
+    cs = d.cs
+    stats = o.stats
+    episodes = o.episodes
+    cs[c, CS_ACTIVE] = 1.0
+    cs[c, CS_LAMBDA] = pair_damping(m, c, gd, m.opts[O_V_MIN])
+    n_ep = int(stats[ST_N_EPISODES])
+    if n_ep < episodes.shape[0]:
+        rotation_matrix(d.x[X_QUAT : X_QUAT + 4], w.C)
+        dp, _ = pair_depth(d.x, w.C, m.feat, m.shapes, m.pairs, c)
+        e = n_ep
+        episodes[e, E_FEATURE] = m.pairs[c, PR_FEATURE]
+        episodes[e, E_SHAPE] = m.pairs[c, PR_SHAPE]
+        episodes[e, E_T_START] = t
+        episodes[e, E_T_END] = np.nan
+        episodes[e, E_V_I] = gd
+        episodes[e, E_PEAK_DELTA] = max(dp, 0.0)
+        episodes[e, E_T_PEAK] = t
+        episodes[e, E_PEAK_FORCE] = 0.0
+        episodes[e, E_T_PEAK_FORCE] = t
+        episodes[e, E_OPEN] = 1.0
+        cs[c, CS_EPISODE] = e
+        stats[ST_N_EPISODES] = n_ep + 1
+    else:
+        cs[c, CS_EPISODE] = -1.0
+        stats[ST_EPISODES_DROPPED] += 1.0
+
+
+@njit(cache=True)
+def close_episode(c: int, t: float, d: Data, o: Output) -> None:
+    """End of pair ``c``'s contact at ``t`` (s)."""
+    cs = d.cs
+    cs[c, CS_ACTIVE] = 0.0
+    cs[c, CS_LAMBDA] = 0.0
+    e = int(cs[c, CS_EPISODE])
+    if e >= 0:
+        o.episodes[e, E_T_END] = t
+        o.episodes[e, E_OPEN] = 0.0
+    cs[c, CS_EPISODE] = -1.0
+
+
+@njit(cache=True)
+def track_extremes(x: np.ndarray, detected: bool, stats: np.ndarray) -> None:
+    """Lowest altitude; after detection the largest tilt and rate (exact at step ends)."""
+    alt = -x[X_POS + 2]
+    if alt < stats[ST_MIN_ALT]:
+        stats[ST_MIN_ALT] = alt
+    if detected:
+        q1 = x[X_QUAT + 1]
+        q2 = x[X_QUAT + 2]
+        n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
+        c22 = 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2  # cos of the body z axis from vertical
+        if c22 < stats[ST_MIN_TILT_COS]:
+            stats[ST_MIN_TILT_COS] = c22
+        w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
+        if w > stats[ST_MAX_RATE]:
+            stats[ST_MAX_RATE] = w
+
+
+@njit(cache=True)
+def record_crash(t: float, x: np.ndarray, stats: np.ndarray) -> None:
+    """The crash at ``t`` (s) with the CM at ``x``'s position."""
+    stats[ST_CRASH_T] = t
+    for i in range(3):
+        stats[ST_CRASH_X + i] = x[X_POS + i]
+    stats[ST_STATUS] = STATUS_CRASHED

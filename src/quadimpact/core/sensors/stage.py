@@ -1,0 +1,37 @@
+"""The sensor stage of the loop: one IMU sample, the estimator's attitude there, detection.
+
+The run loop takes the samples on the dense output of each step (so a
+sample at a control tick precedes that tick's new command), at the times
+``t0 + n / rate``.
+"""
+
+import numpy as np
+from numba import njit
+
+from ..dynamics import state_derivative
+from ..estimators import attitude_at_sample
+from ..layout import LS_T0, SC_RATE, SS_N, SS_NEXT_T
+from ..records import Data, Model, Output, Work
+from .detection import detect
+from .imu import imu_sample
+
+
+@njit(cache=True)
+def take_sample(
+    t: float, xs: np.ndarray, xd: np.ndarray, m: Model, d: Data, o: Output, w: Work
+) -> None:
+    """IMU sample and detection at ``t`` (s) from the true state ``xs`` and its derivative ``xd``.
+
+    ``w.C`` must hold the rotation of ``xs``. Schedules the next sample.
+    """
+    imu_sample(t, xs, xd, w.C, m, d, o)
+    detect(t, xs, attitude_at_sample(t, xs, w.C, m, d), m, d, o)
+    d.sst[SS_NEXT_T] = d.ls[LS_T0] + d.sst[SS_N] / m.scfg[SC_RATE]
+
+
+@njit(cache=True)
+def sample_at(t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
+    """:func:`take_sample` at a state ``xs`` whose derivative is not known (interval inputs)."""
+    state_derivative(xs, w.xd, m, d, w)
+    # (not counted in ST_N_RHS: that is the integrator's own count)
+    take_sample(t, xs, w.xd, m, d, o, w)
