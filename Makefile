@@ -1,7 +1,7 @@
 # quadimpact: one-command entry points.
 #   make run    set up .venv (once) and reproduce the paper's study (report in results/paper)
 #   make test   set up .venv (once), install headless Chromium if missing (root only), run the tests
-#   make lint   ruff check
+#   make lint   ruff check and ruff format --check
 #   make bench  timing benchmark of the compiled core
 
 PYTHON ?= python3
@@ -45,7 +45,8 @@ test: $(STAMP) browser
 	$(BIN)/python -m pytest
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests
+	$(BIN)/ruff check src tests benchmarks examples
+	$(BIN)/ruff format --check src tests benchmarks examples
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_run.py

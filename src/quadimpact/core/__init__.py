@@ -1,22 +1,30 @@
 """Compiled core of quadimpact (Numba ``njit``).
 
-Arrays only: nothing here takes a Python object; every input and output is
-a ``float64`` array whose slots are named in ``layout`` (the contract with
-the Python side). One module per pipeline stage:
+No Python objects inside: a run is a few named records of ``float64`` arrays
+(``records``: ``Model``, ``Data``, ``Output``, ``Work``) whose slots are
+declared in ``layout`` (the contract with the Python side). One module per
+pipeline stage:
 
+* ``layout``: every slot of every array, in checked blocks; the kinds;
+* ``records``: the records, their factories and row views, the raw record;
 * ``rigid_body``: Newton-Euler in body axes, quaternion kinematics;
 * ``rotors``: thrust, rotor reaction torques, gyroscopic moment;
 * ``actuators``: rotor command limits and slew, rotor modes, power-off schedules;
-* ``geometry``: a bumper against a surface of a given kind (depth, rate,
-  point, normal), dispatched on the surface's kind;
+* ``geometry/``: the contact-geometry table keyed on (feature kind, shape
+  kind) and its contact record (point, normal, depth, velocity); one module
+  per shape kind;
 * ``contact``: the force laws (Hunt-Crossley, friction) and the contact wrench;
 * ``dynamics``: the right-hand side that sums gravity, rotors and contact;
-* ``sensors/``: the measurement record, the IMU, impact detection;
+* ``sensors/``: the measurement record, the IMU, impact detection, the sensor stage;
+* ``estimators/``: the estimation stage (the ideal estimator);
 * ``controllers/``: one module per built-in controller, their dispatch;
 * ``integrator``: Dormand-Prince 5(4) with dense output;
 * ``events``: event functions and their location on the dense output;
-* ``step``: one control interval at a time, all loop state in arrays;
-* ``run``: a whole run as a loop over ``step.advance``; Python entries.
+* ``interval``: one control interval: steps, events, contact onsets and ends;
+* ``recording``: output rows, episodes and peaks, extremes, the crash;
+* ``step``: one control tick, the pipeline of the stages above;
+* ``run``: a whole run, the kernels (plug-ins), the Python entry;
+* ``batch``: many runs stepped together under external commands (learning).
 
 Numba's on-disk cache checks only the file of each cached function, not the
 files of the functions it calls and inlines: an edited ``controllers/paper.py``

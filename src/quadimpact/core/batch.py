@@ -257,9 +257,13 @@ def max_thrust(veh: np.ndarray, ctrl: np.ndarray) -> float:
 
 @njit(cache=True)
 def action_command(
-    action: np.ndarray, meas: np.ndarray, veh: np.ndarray, ctrl: np.ndarray, par: np.ndarray,
+    action: np.ndarray,
+    meas: np.ndarray,
+    veh: np.ndarray,
+    ctrl: np.ndarray,
+    par: np.ndarray,
     cmd: np.ndarray,
-) -> None:  # fmt: skip
+) -> None:
     """Rotor speed commands (rad/s) of a normalised action, into ``cmd``.
 
     ``meas``: the tick's measurement record (the gyro for the ctbr rate loop).
@@ -271,8 +275,9 @@ def action_command(
     if int(par[EP_ACTION]) == ACT_CTBR:
         thrust = affine_map(a[0], 0.0, max_thrust(veh, ctrl))
         rates = (a[1] * par[EP_RATE_MAX], a[2] * par[EP_RATE_MAX + 1], a[3] * par[EP_RATE_MAX + 2])
-        rate_loop(thrust, rates[0], rates[1], rates[2], meas[MS_IMU_W : MS_IMU_W + 3], ctrl, veh,
-                  cmd)  # fmt: skip
+        rate_loop(
+            thrust, rates[0], rates[1], rates[2], meas[MS_IMU_W : MS_IMU_W + 3], ctrl, veh, cmd
+        )
     else:
         lo, hi = rotor_range(ctrl, par)
         for j in range(4):
@@ -286,8 +291,9 @@ def level_test(
 ) -> tuple[float, float, float, float, float]:
     """``(q_e,x, q_e,y, p, q, w)`` of the tick: tilt error toward level, gyro rates, body w."""
     x = tmeas[MS_X : MS_X + NX]
-    _, _, _, qex, qey = staged_references(STAGE_TILTED, False, x, tmeas[MS_NORMAL : MS_NORMAL + 3],
-                                          ctrl, veh)  # fmt: skip
+    _, _, _, qex, qey = staged_references(
+        STAGE_TILTED, False, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh
+    )
     return qex, qey, tmeas[MS_IMU_W], tmeas[MS_IMU_W + 1], x[X_VEL + 2]
 
 
@@ -325,8 +331,9 @@ def _enter(stats: np.ndarray, stage: int, t: float, p: np.ndarray) -> None:
 
 
 @njit(cache=True)
-def _track_windows(env: np.ndarray, tmeas: np.ndarray, x: np.ndarray, ctrl: np.ndarray,
-                   veh: np.ndarray) -> None:  # fmt: skip
+def _track_windows(
+    env: np.ndarray, tmeas: np.ndarray, x: np.ndarray, ctrl: np.ndarray, veh: np.ndarray
+) -> None:
     """Runs of the level test and of the recovered condition at the tick ``tmeas[MS_T]``."""
     if env[B_STAGE] < STAGE_DETECTED:
         env[B_LEVEL_N] = 0.0
@@ -338,8 +345,9 @@ def _track_windows(env: np.ndarray, tmeas: np.ndarray, x: np.ndarray, ctrl: np.n
 
 
 @njit(cache=True)
-def _count(env: np.ndarray, ok: bool, n_slot: int, t_slot: int, p_slot: int, t: float,
-           x: np.ndarray) -> None:  # fmt: skip
+def _count(
+    env: np.ndarray, ok: bool, n_slot: int, t_slot: int, p_slot: int, t: float, x: np.ndarray
+) -> None:
     """One tick of a run: its length, and its first tick and position."""
     if not ok:
         env[n_slot] = 0.0
@@ -391,9 +399,13 @@ def _clip(v: float, c: float) -> float:
 
 @njit(cache=True)
 def observe(
-    tmeas: np.ndarray, rin: np.ndarray, ctrl: np.ndarray, par: np.ndarray, env: np.ndarray,
+    tmeas: np.ndarray,
+    rin: np.ndarray,
+    ctrl: np.ndarray,
+    par: np.ndarray,
+    env: np.ndarray,
     obs: np.ndarray,
-) -> None:  # fmt: skip
+) -> None:
     """The normalised observation of a tick (layouts in docs/LEARNING.md)."""
     x = tmeas[MS_X : MS_X + NX]
     C = np.empty((3, 3))
@@ -437,9 +449,13 @@ def observe(
 
 @njit(cache=True)
 def cost_rate(
-    x: np.ndarray, rin: np.ndarray, veh: np.ndarray, ctrl: np.ndarray, par: np.ndarray,
+    x: np.ndarray,
+    rin: np.ndarray,
+    veh: np.ndarray,
+    ctrl: np.ndarray,
+    par: np.ndarray,
     h_ref: float,
-) -> float:  # fmt: skip
+) -> float:
     """Weighted cost per second of a state and the command in force (each term in [0, 1])."""
     q1 = x[X_QUAT + 1]
     q2 = x[X_QUAT + 2]
@@ -460,8 +476,13 @@ def cost_rate(
         d = (rin[RIN_CMD + j] - hover) / span
         effort += 0.25 * d * d
     effort = min(effort, 1.0)
-    total = (par[EP_W_TILT] * tilt + par[EP_W_RATE] * rate + par[EP_W_VZ] * vert
-             + par[EP_W_HEIGHT] * height + par[EP_W_EFFORT] * effort)  # fmt: skip
+    total = (
+        par[EP_W_TILT] * tilt
+        + par[EP_W_RATE] * rate
+        + par[EP_W_VZ] * vert
+        + par[EP_W_HEIGHT] * height
+        + par[EP_W_EFFORT] * effort
+    )
     return total if total == total else max_cost_rate(par)
 
 
@@ -545,8 +566,11 @@ def _outcome(m: Model, d: Data, o: Output, env: np.ndarray, par: np.ndarray, fin
     outcome = OC_RUNNING
     if not finite:
         outcome = OC_FAILED
-    elif (par[EP_END_ON_RECOVERY] > 0.5 and stage >= STAGE_RECOVERED
-          and env[B_HOLD] >= par[EP_HOLD_TICKS]):  # fmt: skip
+    elif (
+        par[EP_END_ON_RECOVERY] > 0.5
+        and stage >= STAGE_RECOVERED
+        and env[B_HOLD] >= par[EP_HOLD_TICKS]
+    ):
         outcome = OC_RECOVERED
     elif par[EP_GROUND] > 0.5 and not np.isnan(o.stats[ST_CRASH_T]):
         outcome = OC_GROUND

@@ -56,10 +56,7 @@ class Block:
 
     def __post_init__(self) -> None:
         self.next = self.start
-        key = f"{self.array}:{self.prefix}"
-        if key in Block.registry:
-            raise ValueError(f"layout: block {key} declared twice")
-        Block.registry[key] = self
+        Block.registry[f"{self.array}:{self.prefix}"] = self  # a module reloaded: the new one
 
     def slot(self, name: str, width: int = 1) -> int:
         """Declare the next slot (``width`` consecutive numbers); return its offset."""
@@ -210,12 +207,17 @@ F_E = _feat.slot("F_E")  # coefficient of restitution
 F_MU = _feat.slot("F_MU")  # friction coefficient (0: frictionless)
 NFEAT = _feat.end("NFEAT")
 
-# ---- world shapes shapes (n_shapes, NSHAPE), inertial frame
+# ---- world shapes shapes (n_shapes, NSHAPE), inertial frame; each kind
+# reads the slots it needs (core/geometry/<kind>.py)
 _shape = Block("shapes", "SH_")
 SH_KIND = _shape.slot("SH_KIND")  # SHAPE_*
 SH_IS_GROUND = _shape.slot("SH_IS_GROUND")  # 1: the ground (its first onset is the crash)
-SH_POINT = _shape.slot("SH_POINT", 3)  # plane: a point on it (m)
-SH_NORMAL = _shape.slot("SH_NORMAL", 3)  # plane: unit normal out of the obstacle
+SH_POINT = _shape.slot("SH_POINT", 3)  # a point: on a plane, on an axis, a centre (m)
+SH_NORMAL = _shape.slot("SH_NORMAL", 3)  # a unit vector: a plane's outward normal, an axis
+SH_RADIUS = _shape.slot("SH_RADIUS")  # m: a radius (cylinder, sphere)
+SH_LENGTH = _shape.slot("SH_LENGTH")  # m: a length along SH_NORMAL (inf: unbounded)
+SH_HALF = _shape.slot("SH_HALF", 3)  # m: half-extents along the shape's own axes (box)
+SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components, row-major
 NSHAPE = _shape.end("NSHAPE")
 
 # ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,
@@ -347,6 +349,8 @@ MS_IMU_W = _ms.slot("MS_IMU_W", 3)  # measured angular velocity, body FRD, rad/s
 MS_DETECTED = _ms.slot("MS_DETECTED")  # 1 once an impact has been detected
 MS_T_DETECT = _ms.slot("MS_T_DETECT")  # s, time of the detecting sample (NaN: none)
 MS_NORMAL = _ms.slot("MS_NORMAL", 3)  # wall-normal estimate at detection, inertial, unit
+N_USER_MEAS = 8
+MS_USER = _ms.slot("MS_USER", N_USER_MEAS)  # a plug-in sensor's readings (core/run.py, make_kernel)
 NMEAS = _ms.end("NMEAS")
 
 # ---- sensor state sst (NSST)

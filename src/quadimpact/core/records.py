@@ -44,9 +44,9 @@ from .layout import (
     NEP,
     NIMU,
     NLS,
-    NOUT,
     NMEAS,
     NMEM,
+    NOUT,
     NRIN,
     NSCFG,
     NSPAN,
@@ -241,9 +241,21 @@ def model(
 def model_row(M: Model, k: int) -> Model:
     """Run ``k`` of models stacked along a first axis."""
     return Model(
-        M.x0[k], M.span[k], M.veh[k], M.feat[k], M.shapes[k], M.pairs[k], M.opts[k], M.ctrl[k],
-        M.scfg[k], M.noise[k], M.sched_t[k], M.sched_rate[k], M.sched_stop[k], M.t_out[k],
-    )  # fmt: skip
+        M.x0[k],
+        M.span[k],
+        M.veh[k],
+        M.feat[k],
+        M.shapes[k],
+        M.pairs[k],
+        M.opts[k],
+        M.ctrl[k],
+        M.scfg[k],
+        M.noise[k],
+        M.sched_t[k],
+        M.sched_rate[k],
+        M.sched_stop[k],
+        M.t_out[k],
+    )
 
 
 @njit(cache=True)

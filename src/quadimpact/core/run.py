@@ -8,8 +8,9 @@ compiled entry points of one loop (``run``, ``start``, ``advance``);
 :data:`BUILTIN` is the cached one.
 
 :func:`make_kernel` compiles the loop again around plug-ins: a user's
-controller step (in place of the built-in dispatch) and the rows of the
-contact-geometry table registered at run time (``core.geometry``). It uses
+controller step (in place of the built-in dispatch), a sensor sampled with
+the IMU, and the rows of the contact-geometry table registered at run time
+(``core.geometry``). It uses
 :func:`specialise`, which rebuilds every compiled core function that reaches
 a replaced global (Numba resolves globals at compile time); such a kernel is
 compiled once per process and not cached on disk.
@@ -87,7 +88,7 @@ def _rebound(fn: Dispatcher, scope_changes: Mapping[str, object]) -> Dispatcher:
     scope.update(scope_changes)
     copy = types.FunctionType(py.__code__, scope, py.__name__, py.__defaults__)
     copy.__qualname__ = py.__qualname__
-    options = {k: v for k, v in fn.targetoptions.items() if k != "cache"}
+    options = {k: v for k, v in fn.targetoptions.items() if k not in ("cache", "nopython")}
     return njit(**options)(copy)
 
 
@@ -179,7 +180,9 @@ def _distance_dispatch(entries: Mapping[int, Callable]) -> Callable:
     return _generated("\n".join(lines), scope)
 
 
-def make_kernel(step: Callable | None = None, *, geometry: bool = False) -> Kernel:
+def make_kernel(
+    step: Callable | None = None, *, geometry: bool = False, sensor: Callable | None = None
+) -> Kernel:
     """Compile the run loop around plug-ins.
 
     Parameters
@@ -192,6 +195,12 @@ def make_kernel(step: Callable | None = None, *, geometry: bool = False) -> Kern
     geometry : bool
         Compile in the rows of the contact-geometry table and the shape
         distances registered so far (``core.geometry.register_geometry``).
+    sensor : numba.njit function, optional
+        A sensor ``sensor(t, x, xdot, C, m, d)`` sampled with the IMU (at
+        ``scfg[SC_RATE]``) from the true state ``x``, its derivative and
+        rotation; it writes its readings into the measurement record's user
+        block ``d.meas[MS_USER : MS_USER + N_USER_MEAS]``, which a controller
+        reads (``core/sensors/stage.py``).
 
     Returns
     -------
@@ -203,6 +212,10 @@ def make_kernel(step: Callable | None = None, *, geometry: bool = False) -> Kern
     if step is not None:
         step = _checked_step(step)
         replacements["controller_step"] = step
+    if sensor is not None:
+        if not hasattr(sensor, "py_func"):
+            raise TypeError("sensor: must be a numba.njit function")
+        replacements["plugin_sensor"] = sensor
     if geometry:
         contact_fns = {g.id: g.fn for g in _geometry.plugin_geometries()}
         replacements["plugin_contact"] = _contact_dispatch(contact_fns)

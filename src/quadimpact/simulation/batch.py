@@ -16,10 +16,8 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
-import numpy as np
-
 from quadimpact.core import layout as L
-from quadimpact.core.records import Model, Output, RawRecord, raw_record
+from quadimpact.core.records import Model, Output, RawRecord, new_output, raw_record
 from quadimpact.core.run import BUILTIN
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
@@ -28,22 +26,19 @@ __all__ = ["BatchRunner", "simulate_batch"]
 
 
 class _Buffers:
-    """Output arrays reused from run to run (grown on demand; the loop zeroes what it reads)."""
+    """Outputs reused from run to run (reallocated by the core's factory when a run needs more)."""
 
     def __init__(self, max_episodes: int) -> None:
-        self.out = np.zeros((0, 0))
-        self.imu = np.zeros((0, L.NIMU))
-        self.episodes = np.zeros((max_episodes, L.NEP))
-        self.stats = np.zeros(L.NSTAT)
+        self.max_episodes = int(max_episodes)
+        self.o: Output | None = None
 
     def output(self, m: Model, n_imu: int) -> Output:
         """An :class:`Output` for the run ``m`` in the buffers (views of their first rows)."""
         n_out, width = m.t_out.shape[0], L.out_width(m.feat.shape[0])
-        if self.out.shape[0] < n_out or self.out.shape[1] != width:
-            self.out = np.zeros((max(n_out, self.out.shape[0]), width))
-        if self.imu.shape[0] < n_imu:
-            self.imu = np.zeros((n_imu, L.NIMU))
-        return Output(self.out[:n_out], self.imu[:n_imu], self.episodes, self.stats)
+        o = self.o
+        if o is None or o.out.shape[0] < n_out or o.out.shape[1] != width or o.imu.shape[0] < n_imu:
+            o = self.o = new_output(m, n_imu, self.max_episodes)
+        return o._replace(out=o.out[:n_out], imu=o.imu[:n_imu])
 
 
 def _run(setup: RunSetup, buffers: _Buffers) -> tuple[RawRecord, float]:

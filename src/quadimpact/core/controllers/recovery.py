@@ -62,12 +62,14 @@ from ..layout import (
     MS_IMU_W,
     MS_NORMAL,
     MS_X,
+    NPARAM,
     NX,
     V_GRAVITY,
     V_MASS,
     X_QUAT,
     X_ROTOR,
     X_VEL,
+    Block,
 )
 from ..quaternion import rotation_matrix
 from .cascade_pid import cascade_pid_step
@@ -75,17 +77,18 @@ from .common import N_PID_MEM, N_PID_PARAMS, allocate, linearised_torques
 from .paper import paper_step
 
 # ---- parameters, at ctrl[C_PARAMS + ...] (the PID block of common.py comes first)
-R_NOMINAL_KIND = N_PID_PARAMS  # CTRL_PAPER or CTRL_CASCADE_PID (pre-impact nominal)
-R_PRE_IMPACT = N_PID_PARAMS + 1  # PRE_* below
-R_K_ATT = N_PID_PARAMS + 2  # 1/s, tilt error -> rate reference
-R_K_RATE = N_PID_PARAMS + 3  # 3: 1/s, rate error -> angular acceleration (p, q, r)
-R_A_MAG = N_PID_PARAMS + 6  # m/s^2, stage 1 push away from the wall
-R_K_Z = N_PID_PARAMS + 7  # 4: 1/s, vertical-velocity gain of stages 1-4
-R_Q_TOL = N_PID_PARAMS + 11  # tilt-error tolerance of the stage 1 and 2 tests
-R_RATE_TOL = N_PID_PARAMS + 12  # rad/s, |p|, |q| tolerance of the stage 1 and 2 tests
-R_W_TOL = N_PID_PARAMS + 13  # m/s, body z velocity below which stage 3 ends
-R_FIRST_TICK_LEVEL = N_PID_PARAMS + 14  # 1: a_ref = 0 at the detection tick (replica)
-N_RECOVERY_PARAMS = N_PID_PARAMS + 15
+_params = Block("ctrl.params", "R_", start=N_PID_PARAMS, capacity=NPARAM)
+R_NOMINAL_KIND = _params.slot("R_NOMINAL_KIND")  # CTRL_PAPER or CTRL_CASCADE_PID (pre-impact)
+R_PRE_IMPACT = _params.slot("R_PRE_IMPACT")  # PRE_* below
+R_K_ATT = _params.slot("R_K_ATT")  # 1/s, tilt error -> rate reference
+R_K_RATE = _params.slot("R_K_RATE", 3)  # 1/s, rate error -> angular acceleration (p, q, r)
+R_A_MAG = _params.slot("R_A_MAG")  # m/s^2, stage 1 push away from the wall
+R_K_Z = _params.slot("R_K_Z", 4)  # 1/s, vertical-velocity gain of stages 1-4
+R_Q_TOL = _params.slot("R_Q_TOL")  # tilt-error tolerance of the stage 1 and 2 tests
+R_RATE_TOL = _params.slot("R_RATE_TOL")  # rad/s, |p|, |q| tolerance of the stage 1 and 2 tests
+R_W_TOL = _params.slot("R_W_TOL")  # m/s, body z velocity below which stage 3 ends
+R_FIRST_TICK_LEVEL = _params.slot("R_FIRST_TICK_LEVEL")  # 1: a_ref = 0 at detection (replica)
+N_RECOVERY_PARAMS = _params.end("N_RECOVERY_PARAMS")
 
 PRE_NOMINAL = 0
 PRE_HOLD = 1
@@ -93,8 +96,10 @@ PRE_SPIN_DOWN = 2
 PRE_IMMEDIATE = 3
 
 # ---- memory (after the PID slots of the nominal controller)
-RM_QE_X = N_PID_MEM  # previous tick's tilt error quaternion, x and y
-RM_QE_Y = N_PID_MEM + 1
+_mem = Block("mem", "RM_", start=N_PID_MEM, capacity=MEM_STAGE)
+RM_QE_X = _mem.slot("RM_QE_X")  # previous tick's tilt error quaternion, x and y
+RM_QE_Y = _mem.slot("RM_QE_Y")
+N_RECOVERY_MEM = _mem.end("N_RECOVERY_MEM")
 
 STAGE_PRE_IMPACT = 0
 STAGE_DETECTED = 1
@@ -105,9 +110,16 @@ STAGE_RECOVERED = 4
 
 @njit(cache=True)
 def next_stage(
-    stage: int, qe_x: float, qe_y: float, p: float, q: float, w: float,
-    q_tol: float, rate_tol: float, w_tol: float,
-) -> int:  # fmt: skip
+    stage: int,
+    qe_x: float,
+    qe_y: float,
+    p: float,
+    q: float,
+    w: float,
+    q_tol: float,
+    rate_tol: float,
+    w_tol: float,
+) -> int:
     """The stage machine: the stage after this tick's test (at most one step up).
 
     ``qe_x``, ``qe_y``: the previous tick's tilt error quaternion (body x, y);
@@ -277,14 +289,27 @@ def recovery_step(
         first_tick = False
         w_body = x[X_VEL + 2]
         stage = next_stage(
-            stage, mem[RM_QE_X], mem[RM_QE_Y], meas[MS_IMU_W], meas[MS_IMU_W + 1], w_body,
-            ctrl[p0 + R_Q_TOL], ctrl[p0 + R_RATE_TOL], ctrl[p0 + R_W_TOL],
-        )  # fmt: skip
+            stage,
+            mem[RM_QE_X],
+            mem[RM_QE_Y],
+            meas[MS_IMU_W],
+            meas[MS_IMU_W + 1],
+            w_body,
+            ctrl[p0 + R_Q_TOL],
+            ctrl[p0 + R_RATE_TOL],
+            ctrl[p0 + R_W_TOL],
+        )
     a_ref_on = not (first_tick and ctrl[p0 + R_FIRST_TICK_LEVEL] > 0.5)
     qex, qey = staged_law(
-        stage, a_ref_on, x, meas[MS_IMU_W : MS_IMU_W + 3], meas[MS_NORMAL : MS_NORMAL + 3],
-        ctrl, veh, cmd,
-    )  # fmt: skip
+        stage,
+        a_ref_on,
+        x,
+        meas[MS_IMU_W : MS_IMU_W + 3],
+        meas[MS_NORMAL : MS_NORMAL + 3],
+        ctrl,
+        veh,
+        cmd,
+    )
     mem[RM_QE_X] = qex
     mem[RM_QE_Y] = qey
     mem[MEM_STAGE] = stage

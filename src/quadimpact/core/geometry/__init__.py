@@ -196,9 +196,13 @@ def contact_record(
     kind = (int(feat[f, F_KIND]), int(shapes[s, SH_KIND]))
     pairs = np.array([[f, s, geometry_id(*kind)]], dtype=np.int64)
     return _contact_record(
-        np.ascontiguousarray(x, dtype=np.float64), np.ascontiguousarray(C, dtype=np.float64),
-        feat, shapes, pairs, 0,
-    )  # fmt: skip
+        np.ascontiguousarray(x, dtype=np.float64),
+        np.ascontiguousarray(C, dtype=np.float64),
+        feat,
+        shapes,
+        pairs,
+        0,
+    )
 
 
 # ---------------------------------------------------------------- registered rows

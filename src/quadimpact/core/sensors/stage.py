@@ -2,7 +2,8 @@
 
 The run loop takes the samples on the dense output of each step (so a
 sample at a control tick precedes that tick's new command), at the times
-``t0 + n / rate``.
+``t0 + n / rate``. A plug-in sensor (``core.run.make_kernel(sensor=...)``) is
+sampled with the IMU and writes the measurement record's user block.
 """
 
 import numpy as np
@@ -16,6 +17,19 @@ from .detection import detect
 from .imu import imu_sample
 
 
+@njit(cache=True, inline="always")
+def plugin_sensor(
+    t: float, xs: np.ndarray, xd: np.ndarray, C: np.ndarray, m: Model, d: Data
+) -> None:
+    """A plug-in sensor's sample (rebound by ``core.run.make_kernel``); none here.
+
+    It reads the true state ``xs``, its derivative ``xd`` and rotation ``C`` at
+    the IMU sample ``t`` (s) and writes its readings into the measurement
+    record's user block ``d.meas[MS_USER : MS_USER + N_USER_MEAS]``.
+    """
+    return
+
+
 @njit(cache=True)
 def take_sample(
     t: float, xs: np.ndarray, xd: np.ndarray, m: Model, d: Data, o: Output, w: Work
@@ -26,6 +40,7 @@ def take_sample(
     """
     imu_sample(t, xs, xd, w.C, m, d, o)
     detect(t, xs, attitude_at_sample(t, xs, w.C, m, d), m, d, o)
+    plugin_sensor(t, xs, xd, w.C, m, d)
     d.sst[SS_NEXT_T] = d.ls[LS_T0] + d.sst[SS_N] / m.scfg[SC_RATE]
 
 

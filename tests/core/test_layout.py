@@ -1,0 +1,124 @@
+"""The layout of the compiled core's arrays is a checked contract (``core/layout.py``).
+
+Every slot of every array is declared in a ``Block`` (the core's records,
+the controllers' parameter and memory blocks, the learning environment's
+blocks): no two slots overlap, every size covers its slots, every constant of
+a block's prefix is one of its declared slots, and the records' factories
+allocate the declared sizes.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections import defaultdict
+
+import numpy as np
+import pytest
+
+from quadimpact.core import layout as L
+from quadimpact.core.records import new_data, new_output, new_work
+
+# every module that declares blocks (importing them registers their blocks)
+DECLARING = (
+    "quadimpact.core.layout",
+    "quadimpact.core.controllers.common",
+    "quadimpact.core.controllers.recovery",
+    "quadimpact.core.batch",
+)
+# constants that carry a block's prefix without being one of its slots
+NOT_SLOTS = {"OUT_DELTA"}  # the first per-feature column: the end of the fixed columns
+
+
+def _blocks() -> list[L.Block]:
+    for name in DECLARING:
+        importlib.import_module(name)
+    return list(L.Block.registry.values())
+
+
+def test_every_array_of_the_records_and_the_environment_is_declared():
+    arrays = {b.array for b in _blocks()}
+    expected = {
+        "x", "veh", "feat", "shapes", "pairs", "opts", "ctrl", "scfg", "span",  # Model
+        "ls", "cs", "rin", "meas", "sst", "mem",  # Data
+        "imu", "out", "episodes", "stats",  # Output
+        "ctrl.params",  # the controllers' parameter blocks
+        "env.state", "env.par",  # the learning environment
+    }  # fmt: skip
+    assert expected <= arrays, sorted(expected - arrays)
+
+
+def test_no_two_slots_overlap_and_every_size_covers_its_slots():
+    by_array: dict[str, list[tuple[int, int, str]]] = defaultdict(list)
+    for b in _blocks():
+        for name, (offset, width) in b.slots.items():
+            assert offset >= b.start and width >= 1
+            if b.capacity is not None:
+                assert offset + width <= b.capacity, name
+            by_array[b.array].append((offset, offset + width, name))
+    assert by_array
+    for array, spans in by_array.items():
+        spans.sort()
+        for (a0, a1, an), (b0, _, bn) in zip(spans, spans[1:], strict=False):
+            assert a1 <= b0, f"{array}: {an} [{a0}, {a1}) overlaps {bn} at {b0}"
+
+
+def test_declared_offsets_are_the_module_constants_and_nothing_escapes_a_block():
+    for modname in DECLARING:
+        module = importlib.import_module(modname)
+        declared = [b for b in L.Block.registry.values() if b.slots]
+        mine = [b for b in declared if any(hasattr(module, n) for n in b.slots)]
+        for b in mine:
+            for name, (offset, _) in b.slots.items():
+                if hasattr(module, name):
+                    assert getattr(module, name) == offset, f"{modname}.{name}"
+            if b.size_name and hasattr(module, b.size_name):
+                assert getattr(module, b.size_name) == b.next, f"{modname}.{b.size_name}"
+        prefixes = {b.prefix: b for b in mine}
+        for name, value in vars(module).items():
+            if not isinstance(value, int) or isinstance(value, bool) or name in NOT_SLOTS:
+                continue
+            for prefix, b in prefixes.items():
+                if name.startswith(prefix):
+                    assert name in b.slots, f"{modname}.{name} = {value} is not a slot of its block"
+
+
+def test_the_factories_allocate_the_declared_sizes():
+    m_feat, n_shapes, n_out = 3, 2, 5
+    from quadimpact.core.records import model
+
+    m = model(
+        x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
+        feat=np.zeros((m_feat, L.NFEAT)), shapes=np.zeros((n_shapes, L.NSHAPE)),
+        pairs=np.zeros((m_feat * n_shapes, L.NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
+        ctrl=np.zeros(L.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
+    )  # fmt: skip
+    assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
+    d = new_data(m)
+    assert [a.shape for a in d] == [
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (L.NRIN,), (L.NMEM,), (L.NMEAS,), (L.NSST,)
+    ]  # fmt: skip
+    o = new_output(m, 7, 11)
+    assert o.out.shape == (n_out, L.out_width(m_feat)) == (n_out, L.NOUT + 2 * m_feat)
+    assert o.imu.shape == (7, L.NIMU) and o.episodes.shape == (11, L.NEP)
+    assert o.stats.shape == (L.NSTAT,)
+    w = new_work(4)
+    assert w.K.shape == (7, L.NX) and w.ev_sig.shape == (4,)
+
+
+def test_a_block_refuses_a_bad_declaration():
+    b = L.Block("test.scratch", "T_", capacity=3)
+    assert b.slot("T_A", 2) == 0
+    with pytest.raises(ValueError, match="must start with"):
+        b.slot("U_B")
+    with pytest.raises(ValueError, match="twice"):
+        b.slot("T_A")
+    with pytest.raises(ValueError, match="overflows"):
+        b.slot("T_C", 2)
+    del L.Block.registry["test.scratch:T_"]
+
+
+def test_kinds_are_integers_with_names():
+    assert L.FEAT_RING == L.FeatureKind.RING and isinstance(L.FEAT_RING, int)
+    assert L.SHAPE_PLANE == L.ShapeKind.PLANE and type(L.SHAPE_PLANE) is int
+    assert L.Status(L.STATUS_FAILED).name == "FAILED"
+    assert set(L.REASON_TEXT) == {int(r) for r in L.Reason}
