@@ -87,12 +87,16 @@ class FeatureKind(IntEnum):
     """Contact features of a vehicle (rows of ``feat``)."""
 
     RING = 0  # a bumper ring: centre, plane normal, radius
+    SPHERE = 1  # a spherical cage or ball: centre, radius
+    POINT = 2  # a landing-gear foot, an arm tip, a body corner: a position
 
 
 class ShapeKind(IntEnum):
     """Shapes of the world (rows of ``shapes``)."""
 
     PLANE = 0  # a half-space: a plane through a point, outward unit normal
+    CYLINDER = 1  # a point on the axis (the centre), unit axis, radius, length (inf: unbounded)
+    BOX = 2  # a centre, half-extents along its own axes, those axes (rows of SH_ROT)
 
 
 class ControllerKind(IntEnum):
@@ -136,7 +140,11 @@ class Reason(IntEnum):
 
 
 FEAT_RING = int(FeatureKind.RING)
+FEAT_SPHERE = int(FeatureKind.SPHERE)
+FEAT_POINT = int(FeatureKind.POINT)
 SHAPE_PLANE = int(ShapeKind.PLANE)
+SHAPE_CYLINDER = int(ShapeKind.CYLINDER)
+SHAPE_BOX = int(ShapeKind.BOX)
 CTRL_NONE = int(ControllerKind.NONE)
 CTRL_PAPER = int(ControllerKind.PAPER)
 CTRL_CASCADE_PID = int(ControllerKind.CASCADE_PID)
@@ -198,9 +206,9 @@ NVEH = _veh.end("NVEH")
 # structure, body frame, each with its own contact law parameters
 _feat = Block("feat", "F_")
 F_KIND = _feat.slot("F_KIND")  # FEAT_*
-F_CENTRE = _feat.slot("F_CENTRE", 3)  # ring centre (body, m)
+F_CENTRE = _feat.slot("F_CENTRE", 3)  # ring or sphere centre, point position (body, m)
 F_NORMAL = _feat.slot("F_NORMAL", 3)  # ring plane unit normal (body)
-F_RADIUS = _feat.slot("F_RADIUS")  # ring radius, m
+F_RADIUS = _feat.slot("F_RADIUS")  # ring or sphere radius, m
 F_K = _feat.slot("F_K")  # contact stiffness, N/m^n
 F_N = _feat.slot("F_N")  # contact exponent
 F_E = _feat.slot("F_E")  # coefficient of restitution
@@ -217,7 +225,7 @@ SH_NORMAL = _shape.slot("SH_NORMAL", 3)  # a unit vector: a plane's outward norm
 SH_RADIUS = _shape.slot("SH_RADIUS")  # m: a radius (cylinder, sphere)
 SH_LENGTH = _shape.slot("SH_LENGTH")  # m: a length along SH_NORMAL (inf: unbounded)
 SH_HALF = _shape.slot("SH_HALF", 3)  # m: half-extents along the shape's own axes (box)
-SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components, row-major
+SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components: row i is axis i
 NSHAPE = _shape.end("NSHAPE")
 
 # ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,

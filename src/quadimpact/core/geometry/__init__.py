@@ -1,8 +1,9 @@
 """Contact geometry: one table of functions keyed on (feature kind, shape kind).
 
-A vehicle declares contact **features** (rows of ``feat``, layout ``F_*``;
-today rings, the bumpers), the world declares **shapes** (rows of
-``shapes``, layout ``SH_*``; today planes). A run's contact-pair table
+A vehicle declares contact **features** (rows of ``feat``, layout ``F_*``:
+rings, the bumpers; spheres, a cage or a ball; points, landing-gear feet, arm
+tips, body corners), the world declares **shapes** (rows of ``shapes``, layout
+``SH_*``: planes, cylinders, boxes). A run's contact-pair table
 (``pairs``, built once by :func:`pair_table`, shape-major) names for every
 (feature, shape) pair the geometry function that computes its contact record
 (``record.py``): point, normal, depth, velocity. Everything else (events,
@@ -17,11 +18,23 @@ the recovery replica): :data:`SHAPE_DISTANCES`.
 
 Built-in rows (one module per shape kind):
 
-============  ========  ======================  =================================
-feature       shape     function                method
-============  ========  ======================  =================================
-ring          plane     ``plane.ring_plane``    closed form (paper eqs. 10-15)
-============  ========  ======================  =================================
+========  ========  ============================  ======================================
+feature   shape     function                      method (accuracy; cost)
+========  ========  ============================  ======================================
+ring      plane     ``plane.ring_plane``          closed form, paper eqs. 10-15 (exact)
+sphere    plane     ``plane.sphere_plane``        closed form (exact)
+point     plane     ``plane.point_plane``         closed form (exact)
+ring      cylinder  ``ring.ring_solid``           certified search over the circle
+                                                  (within 1e-13 m; 3-6 point depths,
+                                                  rarely a branch and bound)
+sphere    cylinder  ``cylinder.sphere_cylinder``  closed form (exact)
+point     cylinder  ``cylinder.point_cylinder``   closed form (exact)
+ring      box       ``ring.ring_solid``           certified search (as for the cylinder)
+sphere    box       ``box.sphere_box``            closed form (exact)
+point     box       ``box.point_box``             closed form (exact)
+========  ========  ============================  ======================================
+
+docs/CONTACT.md gives each pair's method, accuracy and cost.
 
 **A new row** (a new feature or shape kind, a new pair): write the function
 in the shape's module; for a built-in, give it a ``GEOM_*`` id, a row in
@@ -43,18 +56,25 @@ from numba import njit
 
 from ..layout import (
     F_KIND,
+    FEAT_POINT,
     FEAT_RING,
+    FEAT_SPHERE,
     NPAIR,
     PR_FEATURE,
     PR_GEOMETRY,
     PR_SHAPE,
     SH_KIND,
+    SHAPE_BOX,
+    SHAPE_CYLINDER,
     SHAPE_PLANE,
     FeatureKind,
     ShapeKind,
 )
-from .plane import plane_distance, ring_plane
+from .box import box_distance, point_box, sphere_box
+from .cylinder import cylinder_distance, point_cylinder, sphere_cylinder
+from .plane import plane_distance, point_plane, ring_plane, sphere_plane
 from .record import ContactRecord, no_contact
+from .ring import ring_solid
 
 __all__ = [
     "GEOMETRIES",
@@ -70,6 +90,14 @@ __all__ = [
 ]
 
 GEOM_RING_PLANE = 0
+GEOM_SPHERE_PLANE = 1
+GEOM_POINT_PLANE = 2
+GEOM_RING_CYLINDER = 3
+GEOM_SPHERE_CYLINDER = 4
+GEOM_POINT_CYLINDER = 5
+GEOM_RING_BOX = 6
+GEOM_SPHERE_BOX = 7
+GEOM_POINT_BOX = 8
 GEOM_PLUGIN = 1000  # registered rows get ids from here on
 
 
@@ -86,10 +114,28 @@ class Geometry:
 
 GEOMETRIES: dict[tuple[int, int], Geometry] = {
     (FEAT_RING, SHAPE_PLANE): Geometry(FEAT_RING, SHAPE_PLANE, GEOM_RING_PLANE, ring_plane),
+    (FEAT_SPHERE, SHAPE_PLANE): Geometry(FEAT_SPHERE, SHAPE_PLANE, GEOM_SPHERE_PLANE, sphere_plane),
+    (FEAT_POINT, SHAPE_PLANE): Geometry(FEAT_POINT, SHAPE_PLANE, GEOM_POINT_PLANE, point_plane),
+    (FEAT_RING, SHAPE_CYLINDER): Geometry(
+        FEAT_RING, SHAPE_CYLINDER, GEOM_RING_CYLINDER, ring_solid
+    ),
+    (FEAT_SPHERE, SHAPE_CYLINDER): Geometry(
+        FEAT_SPHERE, SHAPE_CYLINDER, GEOM_SPHERE_CYLINDER, sphere_cylinder
+    ),
+    (FEAT_POINT, SHAPE_CYLINDER): Geometry(
+        FEAT_POINT, SHAPE_CYLINDER, GEOM_POINT_CYLINDER, point_cylinder
+    ),
+    (FEAT_RING, SHAPE_BOX): Geometry(FEAT_RING, SHAPE_BOX, GEOM_RING_BOX, ring_solid),
+    (FEAT_SPHERE, SHAPE_BOX): Geometry(FEAT_SPHERE, SHAPE_BOX, GEOM_SPHERE_BOX, sphere_box),
+    (FEAT_POINT, SHAPE_BOX): Geometry(FEAT_POINT, SHAPE_BOX, GEOM_POINT_BOX, point_box),
 }
 """The table: (feature kind, shape kind) -> its geometry."""
 
-SHAPE_DISTANCES: dict[int, tuple[Callable, bool]] = {SHAPE_PLANE: (plane_distance, False)}
+SHAPE_DISTANCES: dict[int, tuple[Callable, bool]] = {
+    SHAPE_PLANE: (plane_distance, False),
+    SHAPE_CYLINDER: (cylinder_distance, False),
+    SHAPE_BOX: (box_distance, False),
+}
 """Shape kind -> (its point-distance function, registered at run time)."""
 
 
@@ -115,6 +161,20 @@ def pair_contact(
     g = pairs[c, PR_GEOMETRY]
     if g == GEOM_RING_PLANE:
         return ring_plane(x, C, feat, f, shapes, s)
+    if g == GEOM_RING_CYLINDER or g == GEOM_RING_BOX:
+        return ring_solid(x, C, feat, f, shapes, s)
+    if g == GEOM_SPHERE_PLANE:
+        return sphere_plane(x, C, feat, f, shapes, s)
+    if g == GEOM_POINT_PLANE:
+        return point_plane(x, C, feat, f, shapes, s)
+    if g == GEOM_SPHERE_CYLINDER:
+        return sphere_cylinder(x, C, feat, f, shapes, s)
+    if g == GEOM_POINT_CYLINDER:
+        return point_cylinder(x, C, feat, f, shapes, s)
+    if g == GEOM_SPHERE_BOX:
+        return sphere_box(x, C, feat, f, shapes, s)
+    if g == GEOM_POINT_BOX:
+        return point_box(x, C, feat, f, shapes, s)
     return plugin_contact(g, x, C, feat, f, shapes, s)
 
 
@@ -136,8 +196,13 @@ def plugin_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int)
 @njit(cache=True, inline="always")
 def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) -> float:
     """Signed distance (m) of the inertial point ``p`` from shape ``s``, positive outside."""
-    if int(shapes[s, SH_KIND]) == SHAPE_PLANE:
+    kind = int(shapes[s, SH_KIND])
+    if kind == SHAPE_PLANE:
         return plane_distance(px, py, pz, shapes, s)
+    if kind == SHAPE_CYLINDER:
+        return cylinder_distance(px, py, pz, shapes, s)
+    if kind == SHAPE_BOX:
+        return box_distance(px, py, pz, shapes, s)
     return plugin_distance(px, py, pz, shapes, s)
 
 

@@ -14,7 +14,9 @@ paper's eqs. 10-15 without angles)::
     delta = -(p_C - p0) . m
     delta_dot = -(v + omega x r_C) . m   (inertial velocity of that rim point)
 
-Exact (a closed form), continuous in time, and a few dozen flops.
+Exact (a closed form), continuous in time, and a few dozen flops. A point
+feature (:func:`point_plane`) and a sphere (:func:`sphere_plane`: the point
+``centre - R m``, depth ``R - distance(centre)``) are closed forms too.
 """
 
 import math
@@ -98,3 +100,57 @@ def ring_plane(
         + (pz - shapes[s, SH_POINT + 2]) * mz
     )
     return material_record(x, C, delta, dx, dy, dz, mx, my, mz)
+
+
+@njit(cache=True, inline="always")
+def plane_depth(
+    px: float, py: float, pz: float, shapes: np.ndarray, s: int
+) -> tuple[float, float, float, float, int]:
+    """Depth (m, > 0 behind the plane) of the inertial point ``p``, its normal, piece -1."""
+    return (
+        -plane_distance(px, py, pz, shapes, s),
+        shapes[s, SH_NORMAL],
+        shapes[s, SH_NORMAL + 1],
+        shapes[s, SH_NORMAL + 2],
+        -1,
+    )
+
+
+@njit(cache=True, inline="always")
+def point_plane(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> ContactRecord:
+    """Point feature ``f`` (position ``F_CENTRE``, body) against plane ``s``: exact."""
+    cb0 = feat[f, F_CENTRE]
+    cb1 = feat[f, F_CENTRE + 1]
+    cb2 = feat[f, F_CENTRE + 2]
+    dx = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
+    dy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
+    dz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    g = -plane_distance(x[X_POS] + dx, x[X_POS + 1] + dy, x[X_POS + 2] + dz, shapes, s)
+    mx = shapes[s, SH_NORMAL]
+    my = shapes[s, SH_NORMAL + 1]
+    mz = shapes[s, SH_NORMAL + 2]
+    return material_record(x, C, g, dx, dy, dz, mx, my, mz)
+
+
+@njit(cache=True, inline="always")
+def sphere_plane(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> ContactRecord:
+    """Sphere feature ``f`` (centre ``F_CENTRE``, radius ``F_RADIUS``) against plane ``s``: exact.
+
+    The deepest point is ``centre - R m``; its depth ``R - distance(centre)``.
+    """
+    cb0 = feat[f, F_CENTRE]
+    cb1 = feat[f, F_CENTRE + 1]
+    cb2 = feat[f, F_CENTRE + 2]
+    ox = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
+    oy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
+    oz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    r = feat[f, F_RADIUS]
+    g = r - plane_distance(x[X_POS] + ox, x[X_POS + 1] + oy, x[X_POS + 2] + oz, shapes, s)
+    mx = shapes[s, SH_NORMAL]
+    my = shapes[s, SH_NORMAL + 1]
+    mz = shapes[s, SH_NORMAL + 2]
+    return material_record(x, C, g, ox - r * mx, oy - r * my, oz - r * mz, mx, my, mz)

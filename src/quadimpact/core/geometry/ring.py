@@ -1,0 +1,402 @@
+"""A ring against a convex solid (a cylinder, a box): the deepest point of a circle.
+
+The record of a ring is that of its deepest point: the maximum over the
+circle ``P(b) = c + R (cos b a + sin b b')`` of the depth ``g(P(b))`` of a
+point in the solid (``box.box_depth``, ``cylinder.cylinder_depth``). Against a
+plane this has a closed form (``plane.ring_plane``); against a cylinder or a
+box it has none (the authors solved a quartic for the pole), so it is
+searched, and the answer is **certified**.
+
+The certificate. The depth ``g`` of a convex solid is a concave function of
+the point (minus a convex signed distance), so at any point ``P_k`` with
+supergradient ``xi_k`` (minus the normal there; at a crease between two
+faces any convex combination of theirs)::
+
+    g(p) <= g(P_k) + xi_k . (p - P_k)          for every p in space
+
+and on the circle that bound is a sinusoid of ``b``, the *cut* of ``P_k``.
+Its maximum over the circle is ``g(P_k) + R (|xi_in| - xi_in . u_k)``, with
+``xi_in`` the part of ``xi_k`` in the ring's plane and ``u_k`` the radial unit
+vector at ``b_k``. So when ``xi_in`` points along ``u_k`` (the shortest way
+into the solid leans outward from the ring at that point, the ordinary case
+of a ring touching an obstacle from outside), ``b_k`` is the global maximum:
+the excess ``R (|xi_in| - xi_in . u_k)`` bounds how far any point of the ring
+can be deeper.
+
+The search (:func:`ring_deepest`):
+
+1. start at the angle where the cut of the ring's centre peaks; iterate the
+   secant method on ``dg/db`` (its first step goes to the peak of the
+   current point's cut), stopping as soon as the excess is below
+   :data:`TOL` (1e-13 m); when two iterates lie on two different pieces of
+   the solid's depth (two faces, a side and a cap) with slopes of opposite
+   signs, the crease between them is solved for (regula falsi on the
+   difference of the two pieces) and certified with the convex combination
+   of their normals whose slope along the ring is zero;
+2. if that does not certify within :data:`MAX_LOCAL` evaluations (a ring
+   around a pole or a bar, a maximum on the far side), a branch and bound
+   over arcs of the circle: every arc's bound is the largest value of the
+   lower of its two end cuts (closed form: the ends, the cuts' peaks and
+   their crossings); arcs whose bound exceeds the best point found by more
+   than :data:`TOL` are halved, until none is left (at most
+   :data:`MAX_EVALS` evaluations).
+
+Both return a point whose depth is within :data:`TOL` of the maximum over
+the circle, so the depth is continuous in time up to that tolerance (a jump
+of the arg-max between two equally deep points changes the point, not the
+depth). Cost: a typical evaluation is 3 to 6 point depths (one sine and
+cosine each); the branch and bound, rare, about 100 to 300.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    F_CENTRE,
+    F_NORMAL,
+    F_RADIUS,
+    SH_KIND,
+    SH_NORMAL,
+    SHAPE_BOX,
+    SHAPE_CYLINDER,
+    X_POS,
+)
+from .box import box_depth, box_piece
+from .cylinder import cylinder_depth, cylinder_piece
+from .plane import plane_depth, plane_distance
+from .record import ContactRecord, material_record
+
+TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum
+MAX_LOCAL = 16  # point depths of the local search before the branch and bound
+N_ARCS = 32  # initial arcs of the branch and bound
+MAX_EVALS = 4000  # point depths of the branch and bound at most
+STACK = 512
+TWO_PI = 2.0 * math.pi
+
+Ring = tuple[float, float, float, float, float, float, float, float, float, float]
+"""(cx, cy, cz, ax, ay, az, bx, by, bz, R): centre, two orthonormal in-plane axes, radius."""
+
+
+@njit(cache=True, inline="always")
+def solid_depth(
+    px: float, py: float, pz: float, shapes: np.ndarray, s: int
+) -> tuple[float, float, float, float, int]:
+    """Depth, outward normal and piece of the point ``p`` in the convex shape ``s``."""
+    kind = int(shapes[s, SH_KIND])
+    if kind == SHAPE_BOX:
+        return box_depth(px, py, pz, shapes, s)
+    if kind == SHAPE_CYLINDER:
+        return cylinder_depth(px, py, pz, shapes, s)
+    return plane_depth(px, py, pz, shapes, s)
+
+
+@njit(cache=True, inline="always")
+def solid_piece(
+    px: float, py: float, pz: float, shapes: np.ndarray, s: int, k: int
+) -> tuple[float, float, float, float]:
+    """Piece ``k``'s depth of ``p`` in shape ``s`` (extended beyond the piece) and its normal."""
+    kind = int(shapes[s, SH_KIND])
+    if kind == SHAPE_BOX:
+        return box_piece(px, py, pz, shapes, s, k)
+    if kind == SHAPE_CYLINDER:
+        return cylinder_piece(px, py, pz, shapes, s, k)
+    return (
+        -plane_distance(px, py, pz, shapes, s),
+        shapes[s, SH_NORMAL],
+        shapes[s, SH_NORMAL + 1],
+        shapes[s, SH_NORMAL + 2],
+    )
+
+
+@njit(cache=True, inline="always")
+def _point(ring: Ring, b: float) -> tuple[float, float, float, float, float, float]:
+    """The circle's point at angle ``b`` and its tangent ``dP/db``."""
+    cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
+    cb = math.cos(b)
+    sb = math.sin(b)
+    return (
+        cx + r * (cb * ax + sb * bx),
+        cy + r * (cb * ay + sb * by),
+        cz + r * (cb * az + sb * bz),
+        r * (-sb * ax + cb * bx),
+        r * (-sb * ay + cb * by),
+        r * (-sb * az + cb * bz),
+    )
+
+
+@njit(cache=True, inline="always")
+def _excess(ring: Ring, b: float, xx: float, xy: float, xz: float) -> float:
+    """How far the cut with supergradient ``xi`` at angle ``b`` rises above its value there (m)."""
+    _, _, _, ax, ay, az, bx, by, bz, r = ring
+    wa = xx * ax + xy * ay + xz * az
+    wb = xx * bx + xy * by + xz * bz
+    return r * (math.sqrt(wa * wa + wb * wb) - (wa * math.cos(b) + wb * math.sin(b)))
+
+
+@njit(cache=True, inline="always")
+def _cut(ring: Ring, b: float, g: float, mx: float, my: float, mz: float):
+    """The cut of the point at ``b`` (depth ``g``, normal ``m``): ``c + A cos + B sin``."""
+    _, _, _, ax, ay, az, bx, by, bz, r = ring
+    a_ = -r * (mx * ax + my * ay + mz * az)
+    b_ = -r * (mx * bx + my * by + mz * bz)
+    return g - a_ * math.cos(b) - b_ * math.sin(b), a_, b_
+
+
+@njit(cache=True, inline="always")
+def _min_cuts(c1, a1, b1, c2, a2, b2, t):
+    return min(c1 + a1 * math.cos(t) + b1 * math.sin(t), c2 + a2 * math.cos(t) + b2 * math.sin(t))
+
+
+@njit(cache=True)
+def _arc_bound(lo: float, hi: float, cuts: tuple) -> float:
+    """Largest value on ``[lo, hi]`` of the lower of two cuts (closed form)."""
+    c1, a1, b1, c2, a2, b2 = cuts
+    best = max(_min_cuts(c1, a1, b1, c2, a2, b2, lo), _min_cuts(c1, a1, b1, c2, a2, b2, hi))
+    cand = np.empty(4)
+    n = 0
+    if a1 != 0.0 or b1 != 0.0:
+        cand[n] = math.atan2(b1, a1)
+        n += 1
+    if a2 != 0.0 or b2 != 0.0:
+        cand[n] = math.atan2(b2, a2)
+        n += 1
+    da = a1 - a2
+    db = b1 - b2
+    amp = math.sqrt(da * da + db * db)
+    if amp > 0.0:
+        ratio = -(c1 - c2) / amp
+        if -1.0 <= ratio <= 1.0:
+            phi = math.atan2(db, da)
+            half = math.acos(ratio)
+            cand[n] = phi + half
+            cand[n + 1] = phi - half
+            n += 2
+    for i in range(n):
+        t = lo + ((cand[i] - lo) % TWO_PI)
+        if t <= hi:
+            best = max(best, _min_cuts(c1, a1, b1, c2, a2, b2, t))
+    return best
+
+
+@njit(cache=True)
+def _crease(ring: Ring, b1: float, k1: int, b2: float, k2: int, shapes: np.ndarray, s: int):
+    """The crease between pieces ``k1`` (active at ``b1``) and ``k2`` (at ``b2``), certified.
+
+    Returns (certified, angle, depth, normal).
+    """
+    lo = b1
+    hi = b2
+    p = _point(ring, lo)
+    f_lo = solid_piece(p[0], p[1], p[2], shapes, s, k1)[0]
+    f_lo -= solid_piece(p[0], p[1], p[2], shapes, s, k2)[0]
+    p = _point(ring, hi)
+    f_hi = solid_piece(p[0], p[1], p[2], shapes, s, k1)[0]
+    f_hi -= solid_piece(p[0], p[1], p[2], shapes, s, k2)[0]
+    mid = lo
+    side = 0
+    for _ in range(100):
+        if f_hi == f_lo or abs(hi - lo) <= 1e-15 * (1.0 + abs(hi)):
+            break
+        mid = hi - f_hi * (hi - lo) / (f_hi - f_lo)
+        if not (min(lo, hi) < mid < max(lo, hi)):
+            mid = 0.5 * (lo + hi)
+        p = _point(ring, mid)
+        fm = solid_piece(p[0], p[1], p[2], shapes, s, k1)[0]
+        fm -= solid_piece(p[0], p[1], p[2], shapes, s, k2)[0]
+        if fm == 0.0:
+            lo = mid
+            hi = mid
+            break
+        if (fm > 0.0) == (f_hi > 0.0):
+            hi = mid
+            f_hi = fm
+            if side == 1:
+                f_lo *= 0.5
+            side = 1
+        else:
+            lo = mid
+            f_lo = fm
+            if side == -1:
+                f_hi *= 0.5
+            side = -1
+    b = hi if abs(f_hi) <= abs(f_lo) else lo
+    px, py, pz, tx, ty, tz = _point(ring, b)
+    v1, n1x, n1y, n1z = solid_piece(px, py, pz, shapes, s, k1)
+    v2, n2x, n2y, n2z = solid_piece(px, py, pz, shapes, s, k2)
+    g, mx, my, mz, _ = solid_depth(px, py, pz, shapes, s)
+    s1 = -(n1x * tx + n1y * ty + n1z * tz)
+    s2 = -(n2x * tx + n2y * ty + n2z * tz)
+    if g < min(v1, v2) - TOL or s1 * s2 > 0.0:
+        return False, b, g, mx, my, mz
+    lam = 0.5 if s1 == s2 else s2 / (s2 - s1)
+    xx = -(lam * n1x + (1.0 - lam) * n2x)
+    xy = -(lam * n1y + (1.0 - lam) * n2y)
+    xz = -(lam * n1z + (1.0 - lam) * n2z)
+    return _excess(ring, b, xx, xy, xz) <= TOL, b, g, mx, my, mz
+
+
+@njit(cache=True)
+def _branch_and_bound(ring: Ring, shapes: np.ndarray, s: int, best: tuple):
+    """The global search over arcs (see the module docstring), from the best point so far."""
+    b_best, g_best, bmx, bmy, bmz = best
+    arcs = np.empty((STACK, 9))  # lo, hi, c1, a1, b1, c2, a2, b2, bound
+    b0 = b_best
+    step = TWO_PI / N_ARCS
+    prev = (0.0, 0.0, 0.0)
+    first = (0.0, 0.0, 0.0)
+    n = 0
+    evals = 0
+    for k in range(N_ARCS + 1):
+        b = b0 + k * step
+        if k < N_ARCS:
+            px, py, pz, _, _, _ = _point(ring, b)
+            g, mx, my, mz, _ = solid_depth(px, py, pz, shapes, s)
+            evals += 1
+            if g > g_best:
+                b_best, g_best, bmx, bmy, bmz = b, g, mx, my, mz
+            cut = _cut(ring, b, g, mx, my, mz)
+            if k == 0:
+                first = cut
+        else:
+            cut = first
+        if k > 0:
+            lo = b - step
+            cuts = (prev[0], prev[1], prev[2], cut[0], cut[1], cut[2])
+            arcs[n, 0] = lo
+            arcs[n, 1] = b
+            arcs[n, 2:8] = cuts
+            arcs[n, 8] = _arc_bound(lo, b, cuts)
+            n += 1
+        prev = cut
+    while n > 0 and evals < MAX_EVALS:
+        n -= 1
+        lo = arcs[n, 0]
+        hi = arcs[n, 1]
+        if arcs[n, 8] <= g_best + TOL or hi - lo <= 1e-13:
+            continue
+        left = (arcs[n, 2], arcs[n, 3], arcs[n, 4])
+        right = (arcs[n, 5], arcs[n, 6], arcs[n, 7])
+        b = 0.5 * (lo + hi)
+        px, py, pz, _, _, _ = _point(ring, b)
+        g, mx, my, mz, _ = solid_depth(px, py, pz, shapes, s)
+        evals += 1
+        if g > g_best:
+            b_best, g_best, bmx, bmy, bmz = b, g, mx, my, mz
+        cut = _cut(ring, b, g, mx, my, mz)
+        for half in range(2):
+            if n >= STACK:
+                break
+            if half == 0:
+                a_lo, a_hi = lo, b
+                cuts = (left[0], left[1], left[2], cut[0], cut[1], cut[2])
+            else:
+                a_lo, a_hi = b, hi
+                cuts = (cut[0], cut[1], cut[2], right[0], right[1], right[2])
+            bound = _arc_bound(a_lo, a_hi, cuts)
+            if bound > g_best + TOL:
+                arcs[n, 0] = a_lo
+                arcs[n, 1] = a_hi
+                arcs[n, 2:8] = cuts
+                arcs[n, 8] = bound
+                n += 1
+    return b_best, g_best, bmx, bmy, bmz
+
+
+@njit(cache=True)
+def ring_deepest(ring: Ring, shapes: np.ndarray, s: int):
+    """The deepest point of the circle ``ring`` in the convex shape ``s``, certified.
+
+    Returns ``(angle, depth, mx, my, mz)``: the angle on the circle, the depth
+    there (m, within :data:`TOL` of the circle's maximum) and the solid's
+    outward normal there.
+    """
+    cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
+    _, mx, my, mz, _ = solid_depth(cx, cy, cz, shapes, s)
+    wa = -(mx * ax + my * ay + mz * az)
+    wb = -(mx * bx + my * by + mz * bz)
+    b = math.atan2(wb, wa)
+    b_prev = 0.0
+    fp_prev = 0.0
+    k_prev = -2
+    best = (b, -math.inf, mx, my, mz)
+    for it in range(MAX_LOCAL):
+        px, py, pz, tx, ty, tz = _point(ring, b)
+        g, mx, my, mz, k = solid_depth(px, py, pz, shapes, s)
+        if g > best[1]:
+            best = (b, g, mx, my, mz)
+        if _excess(ring, b, -mx, -my, -mz) <= TOL:
+            return b, g, mx, my, mz
+        fp = -(mx * tx + my * ty + mz * tz)
+        if it > 0 and k != k_prev and k >= 0 and k_prev >= 0 and fp * fp_prev < 0.0:
+            ok, bk, gk, kx, ky, kz = _crease(ring, b_prev, k_prev, b, k, shapes, s)
+            if ok:
+                return bk, gk, kx, ky, kz
+            if gk > best[1]:
+                best = (bk, gk, kx, ky, kz)
+        if it > 0 and fp != fp_prev:
+            step = -fp * (b - b_prev) / (fp - fp_prev)
+        else:
+            target = math.atan2(-(mx * bx + my * by + mz * bz), -(mx * ax + my * ay + mz * az))
+            step = (target - b + math.pi) % TWO_PI - math.pi
+        step = max(-1.0, min(1.0, step))
+        b_prev = b
+        fp_prev = fp
+        k_prev = k
+        b = b + step
+    return _branch_and_bound(ring, shapes, s, best)
+
+
+@njit(cache=True, inline="always")
+def ring_frame(x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int) -> Ring:
+    """Ring feature ``f`` in inertial components: centre, two in-plane axes, radius.
+
+    The in-plane axes are fixed in the body (the normal crossed with its
+    least aligned body axis, and the normal crossed with that).
+    """
+    nb0 = feat[f, F_NORMAL]
+    nb1 = feat[f, F_NORMAL + 1]
+    nb2 = feat[f, F_NORMAL + 2]
+    a0 = abs(nb0)
+    a1 = abs(nb1)
+    a2 = abs(nb2)
+    if a0 <= a1 and a0 <= a2:
+        u0, u1, u2 = 0.0, nb2, -nb1
+    elif a1 <= a2:
+        u0, u1, u2 = -nb2, 0.0, nb0
+    else:
+        u0, u1, u2 = nb1, -nb0, 0.0
+    un = math.sqrt(u0 * u0 + u1 * u1 + u2 * u2)
+    u0 /= un
+    u1 /= un
+    u2 /= un
+    v0 = nb1 * u2 - nb2 * u1
+    v1 = nb2 * u0 - nb0 * u2
+    v2 = nb0 * u1 - nb1 * u0
+    cb0 = feat[f, F_CENTRE]
+    cb1 = feat[f, F_CENTRE + 1]
+    cb2 = feat[f, F_CENTRE + 2]
+    return (
+        x[X_POS] + C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2,
+        x[X_POS + 1] + C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2,
+        x[X_POS + 2] + C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2,
+        C[0, 0] * u0 + C[0, 1] * u1 + C[0, 2] * u2,
+        C[1, 0] * u0 + C[1, 1] * u1 + C[1, 2] * u2,
+        C[2, 0] * u0 + C[2, 1] * u1 + C[2, 2] * u2,
+        C[0, 0] * v0 + C[0, 1] * v1 + C[0, 2] * v2,
+        C[1, 0] * v0 + C[1, 1] * v1 + C[1, 2] * v2,
+        C[2, 0] * v0 + C[2, 1] * v1 + C[2, 2] * v2,
+        feat[f, F_RADIUS],
+    )
+
+
+@njit(cache=True)
+def ring_solid(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> ContactRecord:
+    """Ring feature ``f`` against the cylinder or box ``s``: the certified deepest point."""
+    ring = ring_frame(x, C, feat, f)
+    b, g, mx, my, mz = ring_deepest(ring, shapes, s)
+    px, py, pz, _, _, _ = _point(ring, b)
+    return material_record(x, C, g, px - x[X_POS], py - x[X_POS + 1], pz - x[X_POS + 2], mx, my, mz)

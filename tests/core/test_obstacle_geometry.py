@@ -1,0 +1,322 @@
+"""The contact geometry of every (feature, shape) pair against brute force and a library.
+
+For each pair, on random poses, the compiled record (``core.geometry``) is
+compared with an independent NumPy reference (``tests/geometry_reference.py``):
+
+* sphere and point features against planes, cylinders (finite and
+  infinite) and boxes: depth, point and normal against the reference depth
+  (a sphere's depth is its penetration, ``R`` minus the signed distance of
+  its centre) and brute force over the sphere's surface (dense sampling,
+  then local refinement), to 1e-9 m; where the collision library
+  ``python-fcl`` is installed (the ``dev`` extra), also against its
+  sphere-box, sphere-cylinder and sphere-halfspace contacts;
+* rings against cylinders (finite, infinite) and boxes: depth against brute
+  force over the circle (20,000 samples, golden-section refinement of the
+  best) to 1e-12 m; the point lies on the circle and is that deep; the
+  normal is the reference's (a numerical gradient) there;
+* the velocity of every record is the material velocity of its point.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from geometry_reference import (
+    box_row,
+    circle,
+    cylinder_row,
+    depth,
+    plane_row,
+    random_ring,
+    random_shape,
+    ring_brute_force,
+    rotation,
+)
+
+from quadimpact.core import geometry
+from quadimpact.core import layout as L
+from quadimpact.core.geometry.ring import ring_deepest
+
+SHAPES = ("plane", "box", "cylinder", "infinite cylinder")
+
+
+def _shape(rng, kind):
+    if kind == "plane":
+        return plane_row(rng.uniform(-0.1, 0.1, 3), rng.standard_normal(3))
+    return random_shape(rng, kind)
+
+
+def _state(rng):
+    """A random rigid-body state: position, body velocity, attitude, body rates."""
+    x = np.zeros(L.NX)
+    x[L.X_POS : L.X_POS + 3] = rng.uniform(-0.05, 0.05, 3)
+    x[L.X_VEL : L.X_VEL + 3] = rng.standard_normal(3)
+    q = rng.standard_normal(4)
+    x[L.X_QUAT : L.X_QUAT + 4] = q / np.linalg.norm(q)
+    x[L.X_OMEGA : L.X_OMEGA + 3] = 3.0 * rng.standard_normal(3)
+    return x
+
+
+def _rotation(x):
+    q0, q1, q2, q3 = x[L.X_QUAT : L.X_QUAT + 4]
+    return np.array(
+        [
+            [1 - 2 * (q2 * q2 + q3 * q3), 2 * (q1 * q2 - q0 * q3), 2 * (q1 * q3 + q0 * q2)],
+            [2 * (q1 * q2 + q0 * q3), 1 - 2 * (q1 * q1 + q3 * q3), 2 * (q2 * q3 - q0 * q1)],
+            [2 * (q1 * q3 - q0 * q2), 2 * (q2 * q3 + q0 * q1), 1 - 2 * (q1 * q1 + q2 * q2)],
+        ]
+    )
+
+
+def _feature(kind, centre, radius=0.0, normal=(0.0, 0.0, -1.0)):
+    feat = np.zeros((1, L.NFEAT))
+    feat[0, L.F_KIND] = {"ring": L.FEAT_RING, "sphere": L.FEAT_SPHERE, "point": L.FEAT_POINT}[kind]
+    feat[0, L.F_CENTRE : L.F_CENTRE + 3] = centre
+    feat[0, L.F_NORMAL : L.F_NORMAL + 3] = np.asarray(normal) / np.linalg.norm(normal)
+    feat[0, L.F_RADIUS] = radius
+    feat[0, [L.F_K, L.F_N, L.F_E]] = (100.0, 1.0, 0.9)
+    return feat
+
+
+def _record(x, feat, row):
+    C = _rotation(x)
+    rec = geometry.contact_record(x, C, feat, row[None, :], 0, 0)
+    delta, delta_dot = rec[0], rec[1]
+    rc = np.array(rec[2:5])
+    vc = np.array(rec[5:8])
+    n = np.array(rec[8:11])
+    return C, delta, delta_dot, rc, vc, n
+
+
+def _numerical_normal(p, row, h=1e-6):
+    """Minus the gradient of the reference depth (the outward normal), central differences."""
+    g = np.array([(depth(p + h * e, row) - depth(p - h * e, row)) / (2 * h) for e in np.eye(3)])
+    return -g / np.linalg.norm(g)
+
+
+def _check_velocity(x, C, rc, vc, n, delta_dot):
+    """The record's velocity is the material velocity of its point, delta_dot = -v . n."""
+    v_body = x[L.X_VEL : L.X_VEL + 3] + np.cross(x[L.X_OMEGA : L.X_OMEGA + 3], rc)
+    np.testing.assert_allclose(vc, C @ v_body, rtol=0, atol=1e-12)
+    assert delta_dot == pytest.approx(-vc @ n, abs=1e-12)
+
+
+def _sphere_brute_force(c, r, row, n=4000):
+    """The deepest point of a sphere: Fibonacci directions, then Nelder-Mead on two angles."""
+    from scipy.optimize import minimize
+
+    k = np.arange(n) + 0.5
+    polar = np.arccos(1 - 2 * k / n)
+    azim = math.pi * (1 + 5**0.5) * k
+
+    def points(a, b):
+        return c + r * np.stack([np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)], axis=-1)
+
+    vals = depth(points(polar, azim), row)
+    i = int(np.argmax(vals))
+    res = minimize(
+        lambda v: -float(depth(points(v[0], v[1]), row)),
+        [polar[i], azim[i]],
+        method="Nelder-Mead",
+        options={"xatol": 1e-13, "fatol": 1e-16, "maxiter": 4000},
+    )
+    return -res.fun, points(res.x[0], res.x[1])
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_points_against_the_reference_depth(shape):
+    rng = np.random.default_rng(11)
+    for _ in range(60):
+        row = _shape(rng, shape)
+        x = _state(rng)
+        feat = _feature("point", rng.uniform(-0.25, 0.25, 3))
+        C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
+        p = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+        np.testing.assert_allclose(x[L.X_POS : L.X_POS + 3] + C @ rc, p, atol=1e-12)
+        assert delta == pytest.approx(float(depth(p, row)), abs=1e-12)
+        np.testing.assert_allclose(n, _numerical_normal(p, row), atol=1e-8)
+        _check_velocity(x, C, rc, vc, n, delta_dot)
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_spheres_against_brute_force(shape):
+    """A sphere's depth is its penetration ``R - signed distance(centre)`` (what fcl reports).
+
+    Brute force over the sphere's surface: no point of the sphere is deeper
+    than that (the depth is 1-Lipschitz), and a sphere that does not
+    penetrate has its deepest point exactly that deep, at ``centre - R m``.
+    """
+    rng = np.random.default_rng(12)
+    separated = 0
+    for _ in range(40):
+        row = _shape(rng, shape)
+        x = _state(rng)
+        radius = float(rng.uniform(0.03, 0.15))
+        feat = _feature("sphere", rng.uniform(-0.3, 0.3, 3), radius)
+        C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
+        c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+        assert delta == pytest.approx(radius + float(depth(c, row)), abs=1e-12)
+        p = x[L.X_POS : L.X_POS + 3] + C @ rc
+        assert np.linalg.norm(p - c) == pytest.approx(radius, abs=1e-12)
+        np.testing.assert_allclose(n, _numerical_normal(c, row), atol=1e-8)
+        best, point = _sphere_brute_force(c, radius, row)
+        assert best <= delta + 1e-12
+        if delta <= 0.0:
+            separated += 1
+            assert best == pytest.approx(delta, abs=1e-9)
+            assert float(depth(p, row)) == pytest.approx(delta, abs=1e-12)
+            np.testing.assert_allclose(p, point, atol=1e-5)  # Nelder-Mead's point
+        _check_velocity(x, C, rc, vc, n, delta_dot)
+    assert separated >= 5
+
+
+@pytest.mark.parametrize("shape", ("box", "cylinder", "infinite cylinder"))
+def test_rings_against_brute_force_to_1e_12(shape):
+    rng = np.random.default_rng({"box": 21, "cylinder": 22, "infinite cylinder": 23}[shape])
+    worst = 0.0
+    for _ in range(80):
+        row = random_shape(rng, shape)
+        ring = random_ring(rng)
+        b, g, mx, my, mz = ring_deepest(ring, row[None, :], 0)
+        best, best_t = ring_brute_force(ring, row)
+        worst = max(worst, abs(g - best))
+        assert g == pytest.approx(best, abs=1e-12)
+        p = circle(ring, [b])[0]
+        assert float(depth(p, row)) == pytest.approx(g, abs=1e-12)
+        # the point: where the maximum is sharp it is the brute force's; a flat maximum
+        # fixes its point only to sqrt(1e-12 m / curvature)
+        assert (
+            np.linalg.norm(p - circle(ring, [best_t])[0]) < 2e-5
+            or abs(float(depth(circle(ring, [best_t])[0], row)) - g) < 1e-12
+        )
+    assert worst < 1e-12
+
+
+def test_ring_records_carry_the_point_normal_and_velocity():
+    rng = np.random.default_rng(31)
+    for shape in ("box", "cylinder", "infinite cylinder"):
+        for _ in range(20):
+            row = random_shape(rng, shape)
+            x = _state(rng)
+            normal = rng.standard_normal(3)
+            feat = _feature("ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), normal)
+            C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
+            p = x[L.X_POS : L.X_POS + 3] + C @ rc
+            centre = C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3] + x[L.X_POS : L.X_POS + 3]
+            nrm = C @ feat[0, L.F_NORMAL : L.F_NORMAL + 3]
+            assert np.linalg.norm(p - centre) == pytest.approx(feat[0, L.F_RADIUS], abs=1e-12)
+            assert (p - centre) @ nrm == pytest.approx(0.0, abs=1e-12)
+            assert float(depth(p, row)) == pytest.approx(delta, abs=1e-12)
+            if abs(float(depth(p, row))) > 1e-6:
+                # away from creases the normal is the gradient's; at a crease either face's
+                numerical = _numerical_normal(p, row)
+                if np.linalg.norm(numerical - n) > 1e-6:
+                    assert delta > 0 and shape != "infinite cylinder"
+            _check_velocity(x, C, rc, vc, n, delta_dot)
+
+
+def test_the_ring_plane_pair_is_unchanged_and_agrees_with_the_search():
+    """The closed form against a plane equals the certified search and the brute force."""
+    from quadimpact.core.geometry.ring import ring_frame
+
+    rng = np.random.default_rng(41)
+    for _ in range(40):
+        row = plane_row(rng.uniform(-0.1, 0.1, 3), rng.standard_normal(3))
+        x = _state(rng)
+        feat = _feature("ring", rng.uniform(-0.15, 0.15, 3), 0.125, rng.standard_normal(3))
+        C, delta, *_ = _record(x, feat, row)
+        ring = ring_frame(x, C, feat, 0)
+        assert ring_deepest(ring, row[None, :], 0)[1] == pytest.approx(delta, abs=1e-13)
+        assert ring_brute_force(ring, row, n=4000)[0] == pytest.approx(delta, abs=1e-12)
+
+
+def test_rings_around_a_bar_take_the_branch_and_bound_and_stay_exact():
+    """A bar through the ring's hole: the shortest way in leans inward, no one-point certificate."""
+    rng = np.random.default_rng(51)
+    for _ in range(20):
+        row = cylinder_row(rng.uniform(-0.01, 0.01, 3), rng.standard_normal(3), 0.03)
+        ring = random_ring(rng, spread=0.02)
+        _, g, *_ = ring_deepest(ring, row[None, :], 0)
+        assert g == pytest.approx(ring_brute_force(ring, row)[0], abs=1e-12)
+
+
+# ------------------------------------------------------------------ python-fcl
+def _fcl():
+    return pytest.importorskip(
+        "fcl", reason="python-fcl is not installed (pip install -e '.[dev]' brings it)"
+    )
+
+
+def _fcl_shape(fcl, row):
+    """The fcl geometry and transform of a shape row (an infinite cylinder: 100 m long)."""
+    kind = int(row[L.SH_KIND])
+    o = row[L.SH_POINT : L.SH_POINT + 3]
+    if kind == L.SHAPE_PLANE:
+        n = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+        # fcl's halfspace n . p <= d is the solid: ours is behind the outward normal
+        return fcl.Halfspace(n, float(n @ o)), fcl.Transform()
+    if kind == L.SHAPE_BOX:
+        axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
+        half = row[L.SH_HALF : L.SH_HALF + 3]
+        return fcl.Box(*(2 * half)), fcl.Transform(axes.T, o)
+    e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+    k = np.eye(3)[np.argmin(np.abs(e))]
+    a = np.cross(e, k)
+    a /= np.linalg.norm(a)
+    R = np.column_stack([a, np.cross(e, a), e])  # fcl's cylinder axis is its local z
+    length = row[L.SH_LENGTH] if np.isfinite(row[L.SH_LENGTH]) else 100.0
+    return fcl.Cylinder(row[L.SH_RADIUS], length), fcl.Transform(R, o)
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_spheres_and_points_agree_with_python_fcl(shape):
+    """fcl's sphere-box, sphere-cylinder and sphere-halfspace contacts (exact solvers)."""
+    fcl = _fcl()
+    rng = np.random.default_rng(61)
+    checked = 0
+    for _ in range(200):
+        row = _shape(rng, shape)
+        if shape == "plane":
+            row[L.SH_POINT : L.SH_POINT + 3] = 0.0
+        for kind in ("sphere", "point"):
+            radius = float(rng.uniform(0.03, 0.15)) if kind == "sphere" else 1e-4
+            x = _state(rng)
+            feat = _feature(kind, rng.uniform(-0.2, 0.2, 3), radius if kind == "sphere" else 0)
+            C, delta, _, rc, _, n = _record(x, feat, row)
+            c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+            geom, tf = _fcl_shape(fcl, row)
+            req = fcl.CollisionRequest(enable_contact=True, num_max_contacts=1)
+            res = fcl.CollisionResult()
+            hit = fcl.collide(
+                fcl.CollisionObject(fcl.Sphere(radius), fcl.Transform(c)),
+                fcl.CollisionObject(geom, tf),
+                req,
+                res,
+            )
+            own = delta + (radius if kind == "point" else 0.0)
+            if not hit or float(depth(c, row)) > 0.0:  # separated, or the centre inside
+                continue
+            contact = res.contacts[0]
+            assert own == pytest.approx(contact.penetration_depth, abs=1e-9)
+            np.testing.assert_allclose(n, -np.asarray(contact.normal), atol=1e-9)
+            if kind == "sphere":
+                p = x[L.X_POS : L.X_POS + 3] + C @ rc
+                mid = p + 0.5 * delta * n  # fcl reports the middle of the overlap
+                np.testing.assert_allclose(mid, contact.pos, atol=1e-9)
+            checked += 1
+    assert checked >= 20
+
+
+def test_box_axes_are_rows_and_depths_are_those_of_the_rotated_box():
+    """``SH_ROT``'s row i is the box's axis i: a box turned 90 degrees about Z swaps X and Y."""
+    R = rotation(np.random.default_rng(0))
+    row = box_row([0.0, 0.0, 0.0], [0.1, 0.2, 0.3], R)
+    p = 0.05 * R[1]  # along the box's second axis: 0.15 from its face
+    feat = _feature("point", [0.0, 0.0, 0.0])
+    x = np.zeros(L.NX)
+    x[L.X_POS : L.X_POS + 3] = p
+    x[L.X_QUAT] = 1.0
+    _, delta, *_ = _record(x, feat, row)
+    assert delta == pytest.approx(0.1, abs=1e-15)
