@@ -41,6 +41,13 @@ and read with :func:`load_scenario_file`::
     name = "wall"
     point_m = [1.5, 0.0, 0.0]
     normal = [-1.0, 0.0, 0.0]
+
+    [[obstacles]]                 # any scenario kind: planes, cylinders, boxes
+    kind = "cylinder"
+    name = "pole"
+    point_m = [0.0, 0.0, 0.0]
+    axis = [0.0, 0.0, 1.0]
+    radius_m = 0.1
 """
 
 from __future__ import annotations
@@ -62,7 +69,7 @@ from quadimpact.inputs.model import ModelName, ModelOptions, resolve_model_optio
 from quadimpact.inputs.sensors import DetectionSettings, ImuSettings
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec2, Vec3, Vec4
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
-from quadimpact.inputs.world import Plane
+from quadimpact.inputs.world import Obstacles, Plane
 
 __all__ = [
     "PowerOff",
@@ -197,6 +204,9 @@ class RunSettings(BaseModel):
         The impact detector working on the IMU samples.
     seed : int
         Seed of the run's random draws (IMU noise and bias), >= 0.
+    obstacles : tuple of Plane, Cylinder, Box
+        The world's obstacles (docs/OBSTACLES.md), names unique; the wall
+        approach and the impact trial keep their wall plane when empty.
     """
 
     model_config = MODEL_CONFIG
@@ -263,6 +273,35 @@ class RunSettings(BaseModel):
         default_factory=DetectionSettings, description="The impact detector."
     )
     seed: int = Field(0, ge=0, lt=2**63, description="Seed of the run's random draws.")
+    obstacles: Obstacles = Field(
+        (),
+        description="Obstacles ([[obstacles]]: kind = 'plane', 'cylinder' or 'box'); the wall "
+        "approach and the impact trial keep their wall when none is given.",
+    )
+
+    @field_validator("obstacles")
+    @classmethod
+    def _unique_obstacles(cls, value: tuple) -> tuple:
+        names = [o.name for o in value]
+        for name in names:
+            if names.count(name) > 1:
+                raise ValueError(f"obstacle names must be unique ({name!r} repeats)")
+        return value
+
+    @model_validator(mode="after")
+    def _ground_name_free(self) -> RunSettings:
+        names = [o.name for o in self.obstacles] + [p.name for p in getattr(self, "surfaces", ())]
+        for name in names:
+            if names.count(name) > 1:
+                raise ValueError(
+                    f"obstacles: names must differ from the surfaces' ({name!r} repeats)"
+                )
+        if self.ground == "contact" and "ground" in names:
+            raise ValueError(
+                "obstacles: 'ground' is the name of the ground of ground = 'contact'; "
+                "name the obstacle otherwise, or use ground = 'none'"
+            )
+        return self
 
     @field_validator("seed", mode="before")
     @classmethod
@@ -572,6 +611,14 @@ class ImpactTrial(RunSettings):
         Distance of the CM from the wall at the start, m.
     altitude_m : float
         Initial altitude ``h = -Z``, m (also the nominal controller's set-point).
+    lateral_offset_m : float
+        Sideways start (+Y, m) from the obstacle's centre line (docs/OBSTACLES.md 2).
+
+    With ``obstacles``, the trial flies toward the first one instead of the
+    wall: the CM starts ``start_distance_m`` before the point where the
+    line along +X through the obstacle's centre (a plane's point, a
+    cylinder's axis point, a box's centre) leaves it toward -X, displaced by
+    ``lateral_offset_m`` along +Y, at ``altitude_m``.
     """
 
     kind: Literal["impact-trial"] = Field("impact-trial", description="Scenario kind tag.")
@@ -596,6 +643,9 @@ class ImpactTrial(RunSettings):
         0.32, gt=0, le=100, description="CM distance from the wall at the start, m."
     )
     altitude_m: Real = Field(5.0, gt=0, description="Initial altitude, m.")
+    lateral_offset_m: Real = Field(
+        0.0, ge=-100, le=100, description="Sideways start (+Y) from the obstacle's centre line, m."
+    )
 
     _default_pre_impact: ClassVar[str] = "spin-down"
 

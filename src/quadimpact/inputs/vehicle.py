@@ -94,6 +94,12 @@ class Vehicle(BaseModel):
     rotor_slew_limit_rpm_per_s : float or None
         Largest rate of change of a rotor speed command, rpm/s; ``None``: not
         known (no limit). In force in impact trials.
+    features : tuple of ContactFeature or None
+        The vehicle's contact features (``[[features]]`` in a file: rings,
+        spheres, points, each with its own contact law and name), instead of
+        the four bumper rings; ``None`` (the Spiri, the Navi): the four rings
+        of ``bumper_*`` with ``contact_stiffness``, ``contact_exponent`` and
+        ``restitution``, which are then required.
     """
 
     model_config = MODEL_CONFIG
@@ -117,17 +123,23 @@ class Vehicle(BaseModel):
         gt=0, description="Jr: rotor + propeller inertia about the spin axis, kg m^2."
     )
     gravity_m_s2: Real = Field(gt=0, description="Gravitational acceleration g, m/s^2.")
-    bumper_radius_m: Real = Field(gt=0, description="Rb: bumper circle radius, m (at most 2 m).")
-    bumper_tilt_deg: Real = Field(
-        ge=0, lt=90, description="alpha: bumper tilt, deg; the outer rim is raised."
+    bumper_radius_m: Real | None = Field(
+        None, gt=0, description="Rb: bumper circle radius, m (at most 2 m)."
+    )
+    bumper_tilt_deg: Real | None = Field(
+        None, ge=0, lt=90, description="alpha: bumper tilt, deg; the outer rim is raised."
     )
     bumper_directions_deg: Vec4 = Field(
         (45.0, 135.0, 225.0, 315.0),
         description="Outward direction of each bumper in the body x-y plane, deg from +x_B.",
     )
-    contact_stiffness: Real = Field(gt=0, description="k: Hunt-Crossley stiffness, N/m^n.")
-    contact_exponent: Real = Field(gt=0, description="n: Hunt-Crossley exponent.")
-    restitution: Real = Field(gt=0, le=1, description="e: coefficient of restitution, (0, 1].")
+    contact_stiffness: Real | None = Field(
+        None, gt=0, description="k: Hunt-Crossley stiffness, N/m^n."
+    )
+    contact_exponent: Real | None = Field(None, gt=0, description="n: Hunt-Crossley exponent.")
+    restitution: Real | None = Field(
+        None, gt=0, le=1, description="e: coefficient of restitution, (0, 1]."
+    )
     rotor_speed_range_rpm: Vec2 = Field(
         (3000.0, 8000.0), description="Hardware rotor speed range [min, max], rpm."
     )
@@ -143,6 +155,11 @@ class Vehicle(BaseModel):
     )
     rotor_slew_limit_rpm_per_s: Real | None = Field(
         None, gt=0, description="Rotor speed command slew limit, rpm/s; None: not known."
+    )
+    features: tuple[ContactFeature, ...] | None = Field(
+        None,
+        description="Contact features ([[features]]: rings, spheres, points), replacing the "
+        "four bumper rings; None: the four rings of the bumper_* and contact_* keys.",
     )
 
     # ------------------------------------------------------------------ checks
@@ -163,9 +180,40 @@ class Vehicle(BaseModel):
             )
         return value
 
+    @field_validator("features")
+    @classmethod
+    def _check_features(cls, value: tuple | None) -> tuple | None:
+        if value is None:
+            return value
+        if not value:
+            raise ValueError("must list at least one feature")
+        names = [f.name for f in value]
+        for name in names:
+            if names.count(name) > 1:
+                raise ValueError(f"feature names must be unique ({name!r} repeats)")
+        return value
+
+    @model_validator(mode="after")
+    def _rings_or_features(self) -> Vehicle:
+        if self.features is None:
+            for key in (
+                "bumper_radius_m",
+                "bumper_tilt_deg",
+                "contact_stiffness",
+                "contact_exponent",
+                "restitution",
+            ):
+                if getattr(self, key) is None:
+                    raise ValueError(
+                        f"{key}: is required (a vehicle without [[features]] has four bumper rings)"
+                    )
+        return self
+
     @field_validator("bumper_radius_m")
     @classmethod
-    def _check_bumper_radius(cls, value: float) -> float:
+    def _check_bumper_radius(cls, value: float | None) -> float | None:
+        if value is None:
+            return value
         if value > 2.0:
             raise ValueError(
                 f"must be at most 2 m, a bumper around one rotor (got {value:g}; "
@@ -254,7 +302,9 @@ class Vehicle(BaseModel):
     def _plausibility_warnings(self) -> list[str]:
         out = []
         arms = np.linalg.norm(self.rotor_positions[:, :2], axis=1)
-        if not 0.3 * arms.mean() <= self.bumper_radius_m <= 3.0 * arms.mean():
+        if self.features is None and not (
+            0.3 * arms.mean() <= self.bumper_radius_m <= 3.0 * arms.mean()
+        ):
             out.append(
                 f"bumper_radius_m {self.bumper_radius_m:g} m is unusual for rotor arms of "
                 f"{arms.mean():.3g} m (a bumper circle around each rotor)"
@@ -266,8 +316,11 @@ class Vehicle(BaseModel):
                 f"thrust-to-weight ratio at the top rotor speed is {ratio:.3g} "
                 "(quadrotors fly with about 1.5 to 5)"
             )
-        if self.restitution < 0.3:
-            out.append(f"restitution {self.restitution:g} is unusually low for a bumper")
+        for f in self.contact_features():
+            if f.restitution < 0.3:
+                what = "a bumper" if self.features is None else f"feature {f.name!r}"
+                out.append(f"restitution {f.restitution:g} is unusually low for {what}")
+                break
         return out
 
     # ------------------------------------------------------------ derived data
@@ -323,7 +376,7 @@ class Vehicle(BaseModel):
         return centres, u, n
 
     def contact_features(self) -> tuple[ContactFeature, ...]:
-        """The vehicle's contact features: its four bumper rings, named ``"1"`` to ``"4"``.
+        """The vehicle's contact features: ``features``, or its four bumper rings ``"1"``-``"4"``.
 
         Each ring has the geometry of :meth:`bumper_frames` (centre, plane
         normal, radius ``bumper_radius_m``) and the vehicle's contact law
@@ -331,6 +384,8 @@ class Vehicle(BaseModel):
         friction coefficient is the scenario's. Computed once per vehicle
         object (the model is frozen).
         """
+        if self.features is not None:
+            return self.features
         cached = _FEATURES.get(id(self))
         if cached is not None and cached[0] is self:
             return cached[1]
@@ -343,6 +398,16 @@ class Vehicle(BaseModel):
     def feature_names(self) -> tuple[str, ...]:
         """Names of :meth:`contact_features`, in order (the output columns' suffixes)."""
         return tuple(f.name for f in self.contact_features())
+
+    def valid_depth_m(self) -> float:
+        """Deepest penetration the contact model covers, m: the shallowest feature's limit.
+
+        The bumper radius of a ring vehicle; a deeper run is flagged
+        (``bumper_model_valid``).
+        """
+        if self.features is None:
+            return self.bumper_radius_m
+        return min(f.depth_limit_m for f in self.features)
 
     def _rings(self) -> tuple[ContactFeature, ...]:
         centres, _, n = self.bumper_frames()
@@ -408,9 +473,7 @@ class Vehicle(BaseModel):
                 known = ", ".join(type(self).model_fields)
                 close = near_miss(str(key), list(type(self).model_fields))
                 hint = f"; did you mean {close!r}?" if close else ""
-                raise InputError(
-                    f"{where}: {field}: unknown vehicle field{hint} (known: {known})"
-                )
+                raise InputError(f"{where}: {field}: unknown vehicle field{hint} (known: {known})")
         try:
             key = (id(self), json.dumps(fields, sort_keys=True, default=repr))
         except (TypeError, ValueError):

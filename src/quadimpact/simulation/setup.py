@@ -16,9 +16,10 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import pair_table
+from quadimpact.core.geometry import pair_table, shape_distance
 from quadimpact.core.records import Model, model
 from quadimpact.core.run import Kernel, make_kernel
+from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
@@ -292,7 +293,7 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
         "pitch_rad": math.radians(ref_att[1]),
         "yaw_rad": math.radians(ref_att[2]),
     }
-    surfaces = [*s.surfaces, *_ground(s)]
+    surfaces = [*s.surfaces, *s.obstacles, *_ground(s)]
     duration = s.final_time_s - s.start_time_s
     return _setup(s, v, o, refs, surfaces, duration, x0=x0, t0=float(s.start_time_s))
 
@@ -308,7 +309,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
     refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
     wall = Plane.wall(s.wall_distance_m)
-    surfaces = [wall, *_ground(s)]
+    surfaces = [wall, *s.obstacles, *_ground(s)]
     duration = float(s.final_time_s)
     setup = _setup(s, v, o, refs, surfaces, duration, x0=np.zeros(L.NX), t0=0.0, wall=wall)
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
@@ -330,6 +331,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         )
     return setup
 
+
 # ---------------------------------------------------------------- impact trial
 def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     """The recovery benchmark's trial (docs/RECOVERY.md 5): the wall ``X = 0``, no shooting.
@@ -347,6 +349,8 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     rotors = trim_rotor_speeds(
         v, weight * math.cos(roll) * math.cos(pitch), o.yaw_reaction == "paper"
     )
+    if s.obstacles:
+        return _impact_trial_toward(s, v, o, (roll, pitch, yaw), rotors)
     x0 = initial_state(
         np.array([-float(s.start_distance_m), 0.0, -float(s.altitude_m)]),
         np.array([float(s.speed_m_s), 0.0, 0.0]),
@@ -358,6 +362,68 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     wall = Plane.wall(0.0)
     surfaces = [wall, *_ground(s)]
     return _setup(s, v, o, refs, surfaces, float(s.final_time_s), x0=x0, t0=0.0, wall=wall)
+
+
+def _impact_trial_toward(
+    s: ImpactTrial, v: Vehicle, o: ModelOptions, attitude: tuple, rotors: np.ndarray
+) -> RunSetup:
+    """The impact trial toward ``s.obstacles[0]`` (docs/OBSTACLES.md 2; the others stay)."""
+    roll, pitch, yaw = attitude
+    target = s.obstacles[0]
+    x_face, centre = obstacle_front(target)
+    start = np.array(
+        [
+            x_face - float(s.start_distance_m),
+            centre[1] + float(s.lateral_offset_m),
+            -float(s.altitude_m),
+        ]
+    )
+    x0 = initial_state(
+        start,
+        np.array([float(s.speed_m_s), 0.0, 0.0]),
+        euler_zyx_to_quat(roll, pitch, yaw),
+        np.zeros(3),
+        rotors,
+    )
+    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
+    surfaces = [*s.obstacles, *_ground(s)]
+    return _setup(s, v, o, refs, surfaces, float(s.final_time_s), x0=x0, t0=0.0)
+
+
+def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
+    """Where the line along +X through an obstacle's centre enters it, and that centre (m).
+
+    The centre is a plane's point, a cylinder's axis point or a box's
+    centre; the entry is found by bisection on the shape's signed distance
+    along -X from the centre (exact to rounding; a plane's point is on it).
+
+    Raises
+    ------
+    InputError
+        The obstacle does not face the vehicle (a plane whose normal has no -X part).
+    """
+    row = pack_surfaces([obstacle])
+    centre = np.array(row[0, L.SH_POINT : L.SH_POINT + 3])
+    if row[0, L.SH_KIND] == L.SHAPE_PLANE:
+        if not row[0, L.SH_NORMAL] < -1e-9:
+            raise InputError(
+                f"obstacles: obstacle 1 ({obstacle.name!r}): an impact trial flies along +X, "
+                "so its plane's normal must point toward -X"
+            )
+        return float(centre[0]), centre
+    inside = 0.0
+    outside = 1.0
+    while shape_distance(centre[0] - outside, centre[1], centre[2], row, 0) <= 0.0:
+        outside *= 2.0
+    for _ in range(200):
+        mid = 0.5 * (inside + outside)
+        if mid in (inside, outside):
+            break
+        if shape_distance(centre[0] - mid, centre[1], centre[2], row, 0) > 0.0:
+            outside = mid
+        else:
+            inside = mid
+    return float(centre[0] - inside), centre
 
 
 def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
