@@ -30,19 +30,23 @@ ROOT = Path(quadimpact.__file__).resolve().parent
 #: The layers, lowest first: a module may import its own layer and those below.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # and the package root, quadimpact/__init__.py
-    ("base", (
-        "quadimpact.core",
-        "quadimpact.errors",
-        "quadimpact.linalg",
-        "quadimpact.rotations",
-        "quadimpact._legacy",
-    )),
+    (
+        "base",
+        (
+            "quadimpact.core",
+            "quadimpact.errors",
+            "quadimpact.linalg",
+            "quadimpact.rotations",
+            "quadimpact._legacy",
+        ),
+    ),
     ("inputs", ("quadimpact.inputs",)),
     ("results", ("quadimpact.results",)),
     ("simulation", ("quadimpact.simulation",)),
     ("sweep, viz, envs", ("quadimpact.sweep", "quadimpact.viz", "quadimpact.envs")),
     ("experiments", ("quadimpact.experiments",)),
     ("recovery", ("quadimpact.recovery",)),
+    ("pole", ("quadimpact.pole",)),
     ("paper", ("quadimpact.paper",)),
     ("cli", ("quadimpact.cli",)),
 ]

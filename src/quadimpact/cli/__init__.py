@@ -26,7 +26,7 @@ from typing import Any
 
 import click
 
-from quadimpact.cli import experiments, recovery, reproduce, run, sweep, viz
+from quadimpact.cli import experiments, pole, recovery, reproduce, run, sweep, viz
 from quadimpact.cli.run import build_scenario, format_summary
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
@@ -88,6 +88,7 @@ cli.add_command(sweep.sweep)
 cli.add_command(reproduce.reproduce)
 cli.add_command(experiments.experiments)
 cli.add_command(recovery.recovery)
+cli.add_command(pole.pole)
 
 
 def _fail(message: str, code: int) -> None:

@@ -26,7 +26,11 @@ the Figure 4 grid with the recovery controller (pre-impact nominal, the
 the seven Table III crashes without the motor power-off, nominal against
 recovery. It writes ``recovery/<study>/`` (the trials, resumable),
 ``recovery_trials.parquet``, ``recovery_fig4.parquet``,
-``recovery_crashes.parquet`` and ``recovery_by_inclination.png``.
+``recovery_crashes.parquet`` and ``recovery_by_inclination.png``. It also
+adds "Beyond the paper: the pole" (:func:`pole_part`, docs/OBSTACLES.md 3):
+the authors' pole study on a coarser grid (:data:`POLE_GRID`: pitch 0 to
+-45 deg every 5 deg by offsets -0.35 to 0.35 m every 0.05 m, 150 points,
+both controllers), into ``pole/`` (its trials, maps and report).
 """
 
 from __future__ import annotations
@@ -68,7 +72,8 @@ FIG4_GRID: dict[str, list[float]] = {
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
 VARIANTS = ("paper-replica", "default")
 SWITCHES = tuple(
-    k for k in MODEL_VARIANTS["default"]
+    k
+    for k in MODEL_VARIANTS["default"]
     if MODEL_VARIANTS["default"][k] != MODEL_VARIANTS["paper-replica"][k]
 )  # the paper replica's six differences (its other switches are the default's)
 #: Trials of the Navi's recovery Monte Carlo in each variant (reduced from the study's 10,000).
@@ -89,6 +94,7 @@ class StudyResult:
     ablation: pd.DataFrame
     elapsed_s: float
     recovery: RecoveryPart | None = None
+    pole: Any = None
     stage_times: list[tuple[str, float]] = field(default_factory=list)
     piece_times: list[tuple[str, float]] = field(default_factory=list)
 
@@ -275,6 +281,7 @@ def reproduce(
     table3 = write_table3(crash_rows, exp_out) if experiments else None
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
+    pole = pole_part(out, workers, scheduler, progress, clock) if recovery else None
 
     clock.start("figures, tables and the report")
     # tables behind the report
@@ -289,11 +296,39 @@ def reproduce(
     elapsed = time.perf_counter() - start
     report = out / "report.md"
     report.write_text(
-        render_report(tables, findings, ablation_df, elapsed, table3, part, clock.times,
-                      clock.pieces)  # fmt: skip
+        render_report(
+            tables,
+            findings,
+            ablation_df,
+            elapsed,
+            table3,
+            part,
+            clock.times,
+            clock.pieces,
+            pole=pole,
+        )  # fmt: skip
     )
     return StudyResult(
-        out, report, tables, findings, ablation_df, elapsed, part, clock.times, clock.pieces
+        out, report, tables, findings, ablation_df, elapsed, part, pole, clock.times,
+        clock.pieces,
+    )  # fmt: skip
+
+
+#: The pole study's coarser grid in ``reproduce`` (the full one: ``quadimpact pole``).
+POLE_GRID = {"pitch_step_deg": 5.0, "offset_step_m": 0.05}
+
+
+def pole_part(
+    out: Path, workers: int | None, scheduler: str | None, progress: bool, clock: StageClock
+) -> Any:
+    """Beyond the paper: the pole study on :data:`POLE_GRID`, into ``out/pole``."""
+    from quadimpact.pole.study import PoleStudy, run_pole_study
+
+    study = PoleStudy(**POLE_GRID)
+    n = len(study.pitches()) * len(study.offsets())
+    clock.start(f"the pole: {n} grid points, without and with recovery")
+    return run_pole_study(
+        study, out / "pole", workers=workers, scheduler=scheduler, progress=progress
     )
 
 

@@ -67,6 +67,20 @@ FIG_DPI = 150
 #: Line colour of bumpers 1-4 (shared by every plot of bumper quantities).
 BUMPER_COLORS: dict[int, str] = {1: "tab:blue", 2: "tab:orange", 3: "tab:green", 4: "tab:red"}
 
+
+def _feature_lines(ts) -> list[tuple[str, str, str]]:
+    """(label, deflection column, colour) of every contact feature of a time series."""
+    from quadimpact.results.schema import feature_columns
+
+    out = []
+    for k, (name, delta, _) in enumerate(feature_columns(list(ts.keys()))):
+        if name.isdigit() and int(name) in BUMPER_COLORS:
+            out.append((f"Bumper {name}", delta, BUMPER_COLORS[int(name)]))
+        else:
+            out.append((name, delta, f"C{(k + 4) % 10}"))
+    return out
+
+
 _REF_STYLE = {"color": "k", "linestyle": "--", "linewidth": 1.0}
 
 #: Fill colour of each response type in type maps (failed runs: black).
@@ -81,7 +95,6 @@ TYPE_COLOURS: dict[str, str] = {
 _TYPES = list(TYPE_COLOURS)
 MAX_TEXT_CELLS = 400
 """Type maps write each cell's text up to this many cells per panel."""
-
 
 
 def new_figure(
@@ -168,11 +181,13 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     fig = new_figure(7.0, 3.8, margins=_fig_margins(7.0, 3.8, title))
     ax = fig.add_subplot()
     t = np.asarray(ts["t_s"], dtype=np.float64)
-    for j in (1, 2, 3, 4):
-        delta_mm = 1e3 * np.asarray(ts[f"delta{j}_m"], dtype=np.float64)
-        ax.plot(t, delta_mm, color=BUMPER_COLORS[j], linewidth=1.2, label=f"Bumper {j}")
+    lines = _feature_lines(ts)
+    for label, col, colour in lines:
+        delta_mm = 1e3 * np.asarray(ts[col], dtype=np.float64)
+        ax.plot(t, delta_mm, color=colour, linewidth=1.2, label=label)
     ax.set_xlabel("Time (s)")
-    ax.set_ylabel("Bumper deflection (mm)")
+    rings = all(label.startswith("Bumper ") for label, _, _ in lines)
+    ax.set_ylabel("Bumper deflection (mm)" if rings else "Deflection (mm)")
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best")
     set_time_limits(ax, t)
@@ -339,9 +354,9 @@ def make_imu(
     if n_panels == 3:
         ax = axes.pop(0)
         tt = np.asarray(ts["t_s"], dtype=np.float64)
-        for j in (1, 2, 3, 4):
-            ax.plot(tt, 1e3 * np.asarray(ts[f"delta{j}_m"], dtype=np.float64),
-                    color=BUMPER_COLORS[j], linewidth=1.0, label=f"Bumper {j}")  # fmt: skip
+        for label, col, colour in _feature_lines(ts):
+            ax.plot(tt, 1e3 * np.asarray(ts[col], dtype=np.float64),
+                    color=colour, linewidth=1.0, label=label)  # fmt: skip
         ax.set_ylabel("Deflection (mm)")
         mark_stages(ax, summary)
         ax.legend(loc="upper right", fontsize="small", ncols=2)

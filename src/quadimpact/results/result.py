@@ -27,8 +27,8 @@ __all__ = ["FIG5_PNG", "FIG6_PNG", "IMU_PNG", "SimulationResult", "read_result"]
 READ_COLUMNS: tuple[str, ...] = (
     "t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "altitude_m",
     "roll_deg", "pitch_deg", "yaw_deg",
-    *(f"delta{j}_m" for j in (1, 2, 3, 4)), *(f"force{j}_n" for j in (1, 2, 3, 4)),
 )  # fmt: skip
+"""And the deflection and force columns of at least one contact feature."""
 FIG5_PNG = "fig5.png"
 FIG6_PNG = "fig6.png"
 IMU_PNG = "imu.png"
@@ -335,6 +335,10 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     episodes = _read(d / files.EPISODES_CSV, files.read_episodes_csv)
     timeseries = _read(d / files.TIMESERIES_PARQUET, files.read_timeseries_parquet)
     missing = [c for c in READ_COLUMNS if c not in timeseries.columns]
+    features = files.feature_columns(timeseries.columns)
+    if not features:
+        missing.append("delta1_m")
+    missing += [c for _, d, f in features for c in (d, f) if c not in timeseries.columns]
     if missing:
         more = f" and {len(missing) - 4} more" if len(missing) > 4 else ""
         shown = ", ".join(missing[:4]) + more

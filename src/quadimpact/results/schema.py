@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 __all__ = [
     "BUMPERS",
+    "feature_columns",
     "EPISODE_COLUMNS",
     "IMU_COLUMNS",
     "Key",
@@ -32,6 +33,25 @@ __all__ = [
 
 #: Bumper numbers as printed everywhere outside the kernel (rotor j = bumper j).
 BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
+
+
+def feature_columns(columns) -> list[tuple[str, str, str]]:
+    """(feature name, deflection column, force column) of a time series, in column order.
+
+    A ring vehicle's are ``("1", "delta1_m", "force1_n")`` to ``"4"``; a
+    vehicle with named features has ``delta_<name>_m`` and ``force_<name>_n``
+    (``quadimpact.inputs.features.feature_column``).
+    """
+    import re
+
+    names = []
+    for c in columns:
+        m = re.fullmatch(r"delta(\d+)_m|delta_(\w+)_m", str(c))
+        if m and str(c) != "delta_init_m":
+            name = m.group(1) or m.group(2)
+            force = f"force{name}_n" if name.isdigit() else f"force_{name}_n"
+            names.append((name, str(c), force))
+    return names
 
 
 @dataclass(frozen=True)
@@ -139,6 +159,9 @@ SUMMARY_KEYS: tuple[Key, ...] = (
     _k("max_tilt_deg", "f", "deg", "after detection: largest tilt from vertical"),
     _k("max_rate_rad_s", "f", "rad/s", "after detection: largest body rate"),
     _k("final_speed_m_s", "f", "m/s", "CM speed at the end of the run"),
+    _k("final_altitude_m", "f", "m", "CM altitude at the end of the run"),
+    _k("first_contact_bumper", "i", "1", "feature (bumper) of the first obstacle contact"),
+    _k("first_contact_normal", "j", "1", "its contact normal there, inertial NED, unit"),
     _k("outcome", "s", "", "one sentence on what the run did"),
     _k("integrator__steps", "i", "1", "accepted steps"),
     _k("integrator__rejected_steps", "i", "1", "rejected steps"),
@@ -171,7 +194,8 @@ EPISODE_COLUMNS: tuple[str, ...] = (
     "open",
 )
 
-#: Columns of the time-series table, in order (docs/RESULTS.md).
+#: Columns of the time-series table of a ring vehicle, in order (docs/RESULTS.md); a
+#: vehicle with named features has ``delta_<name>_m`` and ``force_<name>_n`` instead.
 TIMESERIES_COLUMNS: tuple[str, ...] = (
     "t_s",
     "x_m",

@@ -132,6 +132,7 @@ def impact_metrics(
     episodes: Table,
     exclude_surfaces: Sequence[str] = ("ground",),
     min_peak_delta_m: float = 0.0,
+    n_features: int = len(BUMPERS),
 ) -> dict[str, Any]:
     """Initial-impact metrics and counts of subsequent impacts (docs/STUDIES.md section 2).
 
@@ -146,6 +147,9 @@ def impact_metrics(
     min_peak_delta_m : float
         Episodes whose peak deflection is below this (m) are grazes: left out
         of the impacts and their counts (``GRAZE_DELTA_M`` in the summary).
+    n_features : int
+        The vehicle's contact features (numbered 1..n in ``bumper``; four
+        bumper rings by default).
 
     Returns
     -------
@@ -155,8 +159,8 @@ def impact_metrics(
         ``initial_impact_start_s``, ``initial_impact_end_s``,
         ``initial_impact_duration_s`` (s).
         ``leading_bumpers``: sorted bumper numbers of the initial impact.
-        ``aft_bumpers``: the other bumpers among 1-4 (empty when there is no
-        impact at all).
+        ``aft_bumpers``: the other bumpers (features) among 1..n (empty when
+        there is no impact at all).
         ``n_episodes``: episodes on non-excluded surfaces.
         ``n_subsequent_impacts``: impacts (groups) after the initial one.
         ``n_subsequent_episodes``: episodes in those impacts.
@@ -204,7 +208,7 @@ def impact_metrics(
             "initial_impact_end_s": end,
             "initial_impact_duration_s": end - start,
             "leading_bumpers": leading,
-            "aft_bumpers": [b for b in BUMPERS if b not in leading],
+            "aft_bumpers": [b for b in range(1, n_features + 1) if b not in leading],
             "n_subsequent_impacts": len(groups) - 1,
             "n_subsequent_episodes": sum(len(g) for g in groups[1:]),
             "subsequent_impacts": [[int(bumper_col[i]) for i in g] for g in groups[1:]],

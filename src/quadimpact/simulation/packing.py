@@ -101,6 +101,36 @@ def _pack_features(features: Sequence[ContactFeature]) -> np.ndarray:
     return feat
 
 
+def feature_records(feat: np.ndarray, names: Sequence[str]) -> list[dict[str, Any]]:
+    """The packed contact features as plain data (``scenario.json``), body FRD, SI.
+
+    Per feature: ``name``, ``kind`` (ring, sphere, point), ``centre_m``,
+    ``normal`` (rings), ``radius_m``, ``stiffness``, ``exponent``,
+    ``restitution``, ``friction_coefficient`` (the one in force).
+    """
+    kinds = {v: k for k, v in FEATURE_KINDS.items()}
+    out = []
+    for name, row in zip(names, feat, strict=True):
+        kind = kinds[int(row[L.F_KIND])]
+        rec: dict[str, Any] = {
+            "name": str(name),
+            "kind": kind,
+            "centre_m": [float(c) for c in row[L.F_CENTRE : L.F_CENTRE + 3]],
+        }
+        if kind == "ring":
+            rec["normal"] = [float(c) for c in row[L.F_NORMAL : L.F_NORMAL + 3]]
+        if kind != "point":
+            rec["radius_m"] = float(row[L.F_RADIUS])
+        rec.update(
+            stiffness=float(row[L.F_K]),
+            exponent=float(row[L.F_N]),
+            restitution=float(row[L.F_E]),
+            friction_coefficient=float(row[L.F_MU]),
+        )
+        out.append(rec)
+    return out
+
+
 def pack_surfaces(surfaces: Sequence[Plane | Cylinder | Box]) -> np.ndarray:
     """Surfaces (planes, cylinders, boxes) as an (n, NSHAPE) array of world shapes.
 

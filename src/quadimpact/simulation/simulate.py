@@ -16,7 +16,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.run import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.result import SimulationResult
-from quadimpact.simulation.packing import surface_records
+from quadimpact.simulation.packing import feature_records, surface_records
 from quadimpact.simulation.record import (
     episode_columns,
     episodes_frame,
@@ -92,13 +92,16 @@ def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
         (:attr:`RunSetup.resolved`); ``vehicle``: every field of the vehicle
         with its overrides applied (body FRD, SI); ``surfaces``: every contact
         surface as packed for the kernel (the ground of ``ground = "contact"``
-        included; :func:`~quadimpact.simulation.packing.surface_records`).
+        included; :func:`~quadimpact.simulation.packing.surface_records`);
+        ``features``: the vehicle's contact features as packed
+        (:func:`~quadimpact.simulation.packing.feature_records`).
     """
     return {
         "scenario": scenario.model_dump(mode="json") if hasattr(scenario, "model_dump") else None,
         "resolved": dict(setup.resolved),
         "vehicle": setup.vehicle.model_dump(mode="json"),
         "surfaces": surface_records(setup.shapes, setup.shape_names),
+        "features": feature_records(setup.feat, setup.feature_names),
         "quadimpact_version": __version__,
     }
 

@@ -65,11 +65,13 @@ def build_summary(
     status = STATUS_NAMES[status_code]
     warnings = list(setup.warnings)
     reason = L.REASON_TEXT[int(st[L.ST_REASON])]
-    metrics = impact_metrics(episodes, min_peak_delta_m=GRAZE_DELTA_M)
-    rb = setup.vehicle.bumper_radius_m
+    n_features = len(setup.feature_names)
+    metrics = impact_metrics(episodes, min_peak_delta_m=GRAZE_DELTA_M, n_features=n_features)
+    rb = setup.vehicle.valid_depth_m()
 
     onset_t = float(st[L.ST_ONSET_T])
     speed = heading = incl = math.nan
+    first_normal = None
     if not math.isnan(onset_t):
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
         q = xo[L.X_QUAT : L.X_QUAT + 4]
@@ -80,6 +82,7 @@ def build_summary(
             s_index = list(setup.shape_names).index(surface)
             normal = contact_normal(xo, setup.feat, setup.shapes, bumper - 1, s_index)
             speed = -dot(vel, normal)
+            first_normal = (bumper, normal)
         heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
         incl = inclination_deg_of(q)
 
@@ -186,7 +189,14 @@ def build_summary(
             final_state=np.asarray(final_state, dtype=float),
         )
     )
-    summary["outcome"] = describe_outcome(summary)
+    summary["final_altitude_m"] = _nan_to_none(-float(final_state[L.X_POS + 2]))
+    summary["first_contact_bumper"] = None
+    summary["first_contact_normal"] = None
+    if first_normal is not None:
+        summary["first_contact_bumper"] = int(first_normal[0])
+        summary["first_contact_normal"] = [float(c) for c in first_normal[1]]
+    rings = setup.vehicle.features is None
+    summary["outcome"] = describe_outcome(summary, None if rings else setup.feature_names)
     return summary
 
 
@@ -212,18 +222,23 @@ def _obstacle_names(setup: RunSetup) -> list[str]:
     return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, L.SH_IS_GROUND] < 0.5]
 
 
+def describe_outcome(s: dict[str, Any], feature_names: Any = None) -> str:
+    """One sentence saying what the run did after the first impact.
 
-
-def describe_outcome(s: dict[str, Any]) -> str:
-    """One sentence saying what the run did after the first impact."""
+    ``feature_names``: the vehicle's named features (the leading ones are
+    named, not numbered); ``None`` for the four bumper rings.
+    """
     if s["status"] == "failed":
         return f"failed at t = {s['t_final_s']:.3f} s: {s['reason']}"
     if s["delta_init_m"] is None:
         first = "no contact"
     else:
-        lead = ", ".join(str(b) for b in s["leading_bumpers"])
+        if feature_names is None:
+            what = "bumper(s) " + ", ".join(str(b) for b in s["leading_bumpers"])
+        else:
+            what = "feature(s) " + ", ".join(feature_names[b - 1] for b in s["leading_bumpers"])
         first = (
-            f"initial impact on bumper(s) {lead} (delta_init {s['delta_init_m'] * 1e3:.2f} mm), "
+            f"initial impact on {what} (delta_init {s['delta_init_m'] * 1e3:.2f} mm), "
             f"then {s['n_subsequent_impacts']} subsequent impact(s) "
             f"({s['n_subsequent_episodes']} episode(s))"
         )
