@@ -1,6 +1,6 @@
 """Independent NumPy references for the contact geometry tests: shapes, depths, brute force.
 
-Written from the definitions (docs/CONTACT.md), not from the compiled code:
+Written from the definitions (docs/OBSTACLES.md), not from the compiled code:
 the depth of a point in a plane, a cylinder or a box (minus its signed
 distance, vectorised), and the deepest point of a ring by brute force (dense
 sampling of the circle, then golden-section refinement around the best

@@ -18,7 +18,8 @@ from matplotlib.collections import LineCollection
 from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Polygon
 
-from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene, plane_axes, plane_grid
+from quadimpact.core import layout as L
+from quadimpact.viz.scene import Camera, Scene, plane_axes, plane_grid, shape_lines
 
 __all__ = ["FORCE_COLOR", "GROUND_COLOR", "SceneArtists", "WALL_COLOR", "wall_range"]
 
@@ -27,7 +28,7 @@ GROUND_COLOR = "#c8b48a"
 FORCE_COLOR = "#7b2cbf"
 BODY_COLOR = "#222222"
 AXIS_COLORS = ("#444444", "#444444", "#444444")
-MAX_CONTACTS = 8  # drawn at once (4 bumpers x 2 surfaces)
+MAX_CONTACTS = 16  # drawn at once (4 bumpers x 2 surfaces, 8 features x 2...)
 WALL_WIDTH_M = 1.0  # walls: a panel this wide, from the view centre away from the camera
 
 
@@ -106,8 +107,14 @@ class SceneArtists:
 
         # planes: the contact surfaces, and the ground plane for reference
         self.planes: list[tuple[np.ndarray, np.ndarray, Any, Polygon, LineCollection]] = []
-        planes = [(s.point_m, s.normal, s.is_ground, s.name) for s in scene.surfaces]
-        if not any(s.is_ground for s in scene.surfaces):
+        sf = scene.surf
+        planes = [
+            (sf[k, L.SH_POINT : L.SH_POINT + 3], sf[k, L.SH_NORMAL : L.SH_NORMAL + 3],
+             sf[k, L.SH_IS_GROUND] > 0.5, s.name)
+            for k, s in enumerate(scene.surfaces)
+            if int(sf[k, L.SH_KIND]) == L.SHAPE_PLANE
+        ]  # fmt: skip
+        if not any(getattr(s, "is_ground", False) for s in scene.surfaces):
             planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True, ""))
         self._cuts = scene.first_contact_points()
         for point, normal, is_ground, name in planes:
@@ -132,6 +139,14 @@ class SceneArtists:
             ax.add_patch(poly)
             ax.add_collection(grid)
             self.planes.append((p, m, (wall_range(m, forward, right), name), poly, grid))
+        # cylinders and boxes: their rims, generators and edges
+        self.solids = [
+            k for k in range(scene.surf.shape[0]) if int(scene.surf[k, L.SH_KIND]) != L.SHAPE_PLANE
+        ]
+        self.solid_lines = LineCollection(
+            [], colors="#59636e", linewidths=0.9 * lw / 2, alpha=0.8, zorder=2
+        )
+        ax.add_collection(self.solid_lines)
 
         self.discs = [
             Polygon(
@@ -168,26 +183,28 @@ class SceneArtists:
             )
             for name in ("x", "y", "z")
         ]
+        d = scene.drawing
         self.circles = [
             ax.plot(
-                [], [], color=BUMPER_COLORS_HEX[j], linewidth=lw, zorder=5, solid_capstyle="round"
+                [], [], color=d.colors[int(f)], linewidth=lw if len(d.circles) <= 8 else 0.6 * lw,
+                zorder=5, solid_capstyle="round",
             )[0]
-            for j in (1, 2, 3, 4)
-        ]
+            for f in d.line_feature
+        ]  # fmt: skip
         self.labels = [
             ax.text(
                 0,
                 0,
-                str(j),
-                fontsize=9,
+                name,
+                fontsize=9 if len(name) <= 2 else 7,
                 fontweight="bold",
-                color=BUMPER_COLORS_HEX[j],
+                color=d.colors[j],
                 ha="center",
                 va="center",
                 zorder=7,
                 visible=labels,
             )
-            for j in (1, 2, 3, 4)
+            for j, name in enumerate(d.names)
         ]
         # contacts: deepest point, deflection segment, force arrow, force value
         self.points: list[Line2D] = []
@@ -293,14 +310,21 @@ class SceneArtists:
             poly.set_xy(P(outline[:4]))
             grid.set_segments(list(P(segs)) if len(segs) else [])
 
+        if self.solids:
+            segs = [
+                P(line) for k in self.solids for line in shape_lines(scene.surf[k], target, half)
+            ]
+            self.solid_lines.set_segments(segs)
         depth = cam.depth(fr.circles.mean(axis=1), target)
         order = np.argsort(-depth)  # far first
         label_xy = self._inside(P(fr.label_points))
         for rank, j in enumerate(order):
             self.circles[j].set_data(*P(fr.circles[j]).T)
-            self.circles[j].set_zorder(5 + 0.1 * rank)
+            self.circles[j].set_zorder(5 + 0.01 * rank)
+        for j in range(4):
             self.discs[j].set_xy(P(fr.discs[j]))
-            self.labels[j].set_position(label_xy[j])
+        for j, label in enumerate(self.labels):
+            label.set_position(label_xy[j])
         self.arms.set_segments(list(P(fr.arms)))
         self.hub.set_data(*P(fr.hub).T)
         for k in range(3):
@@ -320,7 +344,7 @@ class SceneArtists:
             pc, ps, tip = P(c.point), P(c.surface_point), P(c.arrow_tip)
             self.points[i].set_data([pc[0]], [pc[1]])
             self.deflections[i].set_data([pc[0], ps[0]], [pc[1], ps[1]])
-            self.deflections[i].set_color(BUMPER_COLORS_HEX[c.bumper])
+            self.deflections[i].set_color(scene.drawing.colors[c.bumper - 1])
             self.arrows[i].set_positions(tuple(ps), tuple(tip))
             xy, ha = self._force_text_place(ps, tip, label_xy)
             self.force_texts[i].set_position(xy)
@@ -365,6 +389,7 @@ class SceneArtists:
         """Every artist this view draws (for blitting: all change between frames
         or lie over ones that do), in drawing order (by zorder)."""
         arts = [a for _p, _m, _w, poly, grid in self.planes for a in (poly, grid)]
+        arts += [self.solid_lines]
         arts += [*self.discs, self.arms, self.hub, *self.axes_lines, *self.axes_text]
         arts += [*self.circles, *self.labels, *self.points, *self.deflections, *self.arrows]
         arts += [*self.force_texts, *self.compass]

@@ -5,21 +5,24 @@ Z down) from the world the run recorded (``scenario.json``: the vehicle with
 its overrides applied and the contact surfaces as the kernel received them)
 and the sampled states of a run:
 
-* the vehicle (:class:`VehicleDrawing`): the four bumper circles exactly as the
-  contact law defines them (docs/MODEL.md 4: circle ``j`` of radius ``Rb`` centred
-  on ``c_j``, the rotor hub or the vehicle's ``bumper_centres_m``, in-plane
-  outward ``u_j``, normal ``n_j``), the rotor discs, the hub, the arms and the
-  body axes, as body-frame polylines;
-* the contact surfaces (every plane of the run: walls, slopes, the ground when
-  it was a contact surface) and the ground plane ``altitude = 0`` for
-  reference. A folder written before ``scenario.json`` existed is drawn as
+* the vehicle (:class:`VehicleDrawing`): its contact features exactly as the
+  contact law defines them (the four bumper circles of docs/MODEL.md 4:
+  circle ``j`` of radius ``Rb`` centred on ``c_j``, the rotor hub or the
+  vehicle's ``bumper_centres_m``, in-plane outward ``u_j``, normal ``n_j``; or
+  the features of its file: rings, spheres as three great circles, points as
+  small circles), the rotor discs, the hub, the arms and the body axes, as
+  body-frame polylines;
+* the contact surfaces (every shape of the run: walls, slopes, the ground when
+  it was a contact surface, cylinders as their rims and generators, boxes as
+  their twelve edges; :func:`shape_lines`) and the ground plane
+  ``altitude = 0`` for reference. A folder written before ``scenario.json`` existed is drawn as
   before: the wall ``X = wall_distance_m`` of the summary, the ground if an
   episode touched it, and the bundled vehicle named in the summary;
-* during contact, per bumper and surface, the deepest rim point given by the
+* during contact, per feature and surface, the deepest point given by the
   compiled contact function :func:`quadimpact.core.geometry.contact_record`
   (so the drawing shows the point the simulation pushed on), the deflection
-  (the segment from that point to the surface, of length delta) and the normal
-  force as an arrow along the surface normal;
+  (the segment from that point along the contact normal, of length delta) and
+  the normal force as an arrow along the contact normal;
 * the camera (:class:`Camera`): an orthographic view from a given azimuth and
   elevation, altitude always up on screen and one metre the same length in
   every direction (equal scaling), following the vehicle or fixed at the
@@ -43,7 +46,7 @@ from pydantic import ValidationError
 from quadimpact.core import layout as L
 from quadimpact.errors import input_error_from_validation
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
-from quadimpact.inputs.world import GROUND, Plane
+from quadimpact.inputs.world import GROUND, Box, Cylinder, Plane, obstacle_from
 from quadimpact.rotations import quat_to_matrix, unwrap_deg
 from quadimpact.simulation.packing import pack_features, pack_surface_records, pack_surfaces
 
@@ -64,6 +67,7 @@ __all__ = [
     "rim_points",
     "scene_surfaces",
     "scene_vehicle",
+    "shape_lines",
     "to_inertial",
 ]
 
@@ -72,6 +76,18 @@ BUMPER_NAMES = {1: "starboard front", 2: "starboard rear", 3: "port rear", 4: "p
 
 #: Bumper colours, the same as the plots' ``BUMPER_COLORS`` (matplotlib tab10).
 BUMPER_COLORS_HEX = {1: "#1f77b4", 2: "#ff7f0e", 3: "#2ca02c", 4: "#d62728"}
+#: Colours of named features, in order (matplotlib tab10 after the bumpers').
+FEATURE_COLORS_HEX = ("#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
+#: Drawn radius of a point feature's marker circles, m.
+POINT_MARK_M = 0.012
+
+
+def feature_color(j: int, name: str) -> str:
+    """Colour of feature ``j`` (1-based): a bumper's ``"1"``-``"4"`` colour, else the palette's."""
+    if name.isdigit() and int(name) in BUMPER_COLORS_HEX:
+        return BUMPER_COLORS_HEX[int(name)]
+    return FEATURE_COLORS_HEX[(j - 1) % len(FEATURE_COLORS_HEX)]
+
 
 #: Rotor discs are drawn with this fraction of the bumper radius (a drawing
 #: choice: the parameter file has no propeller radius).
@@ -124,10 +140,17 @@ class VehicleDrawing:
         Segments from the CM to each rotor.
     axes : numpy.ndarray, shape (3, 3)
         Tips of the body x, y, z axes (rows).
-    label_points : numpy.ndarray, shape (4, 3)
-        Where the bumper numbers go (outside each rim, along ``u_j``).
+    label_points : numpy.ndarray, shape (n_features, 3)
+        Where the feature labels go (outside each rim, along ``u_j``).
     packed : numpy.ndarray
         The vehicle's contact features as the compiled core's ``F_*`` table.
+    line_feature : numpy.ndarray, shape (n_lines,)
+        The feature (0-based) each of ``circles`` draws (a sphere has three,
+        a point three small ones).
+    names : tuple of str
+        The features' names (``"1"``-``"4"`` for the bumpers).
+    colors : tuple of str
+        Their colours (:func:`feature_color`).
     """
 
     vehicle: Vehicle
@@ -142,10 +165,19 @@ class VehicleDrawing:
     axes: np.ndarray
     label_points: np.ndarray
     packed: np.ndarray
+    line_feature: np.ndarray = field(default_factory=lambda: np.arange(4))
+    names: tuple[str, ...] = ("1", "2", "3", "4")
+    colors: tuple[str, ...] = tuple(BUMPER_COLORS_HEX[j] for j in (1, 2, 3, 4))
+
+    @property
+    def n_features(self) -> int:
+        return len(self.names)
 
     @classmethod
     def from_vehicle(cls, vehicle: Vehicle, n_points: int = 72) -> VehicleDrawing:
         """Build the drawing of ``vehicle`` with ``n_points`` segments per circle."""
+        if vehicle.features is not None:
+            return cls._from_features(vehicle, n_points)
         centres, u, n = vehicle.bumper_frames()
         rb = float(vehicle.bumper_radius_m)
         beta = np.linspace(0.0, 2.0 * math.pi, n_points + 1)
@@ -178,6 +210,57 @@ class VehicleDrawing:
             packed=pack_features(vehicle, 0.0),
         )
 
+    @classmethod
+    def _from_features(cls, vehicle: Vehicle, n_points: int) -> VehicleDrawing:
+        """The drawing of a vehicle with its own ``[[features]]``."""
+        beta = np.linspace(0.0, 2.0 * math.pi, n_points + 1)
+        features = vehicle.contact_features()
+        lines, owner, labels = [], [], []
+        eye = np.eye(3)
+        for k, f in enumerate(features):
+            c = np.asarray(f.centre_m, dtype=float)
+            if f.kind == "ring":
+                nrm = np.asarray(f.normal, dtype=float)
+                u = np.cross(nrm, eye[int(np.argmin(np.abs(nrm)))])
+                u /= np.linalg.norm(u)
+                lines.append(rim_points(c, u, nrm, f.radius_m, beta))
+                owner.append(k)
+                labels.append(c + 1.3 * f.radius_m * u)
+                continue
+            radius = f.radius_m if f.kind == "sphere" else POINT_MARK_M
+            for axis in range(3):  # three great circles (a point: three small ones)
+                lines.append(rim_points(c, eye[(axis + 1) % 3], eye[axis], radius, beta))
+                owner.append(k)
+            outward = c / np.linalg.norm(c) if np.linalg.norm(c) > 1e-9 else eye[0]
+            labels.append(c + (radius + 0.03) * outward)
+        rotors = vehicle.rotor_positions
+        arm = float(np.mean(np.linalg.norm(rotors[:, :2], axis=1)))
+        e_z = np.array([0.0, 0.0, 1.0])
+        discs = np.stack([rim_points(rotors[j], eye[0], -e_z, 0.5 * arm, beta) for j in range(4)])
+        z_hub = float(np.mean(rotors[:, 2]))
+        h = HUB_HALF_M
+        hub = np.array(
+            [[h, h, z_hub], [-h, h, z_hub], [-h, -h, z_hub], [h, -h, z_hub], [h, h, z_hub]]
+        )
+        names = tuple(f.name for f in features)
+        return cls(
+            vehicle=vehicle,
+            centres=np.array([f.centre_m for f in features], dtype=float),
+            u=np.zeros((len(features), 3)),
+            n=np.array([f.normal for f in features], dtype=float),
+            radius_m=float(max(f.radius_m for f in features)),
+            circles=np.stack(lines),
+            discs=discs,
+            hub=hub,
+            arms=np.stack([np.stack([np.zeros(3), rotors[j]]) for j in range(4)]),
+            axes=AXIS_LENGTH_M * np.eye(3),
+            label_points=np.array(labels),
+            packed=pack_features(vehicle, 0.0),
+            line_feature=np.array(owner),
+            names=names,
+            colors=tuple(feature_color(k + 1, name) for k, name in enumerate(names)),
+        )
+
 
 def _world_part(world: Mapping[str, Any] | None, key: str) -> Any:
     return world.get(key) if isinstance(world, Mapping) else None
@@ -205,7 +288,7 @@ def scene_surfaces(
     summary: Mapping[str, Any],
     episodes: pd.DataFrame | None = None,
     world: Mapping[str, Any] | None = None,
-) -> list[Plane]:
+) -> list[Plane | Cylinder | Box]:
     """The contact surfaces of a run: the world record's, else from the summary and episodes.
 
     With a world record (``scenario.json``), exactly its ``surfaces``, in the
@@ -215,15 +298,7 @@ def scene_surfaces(
     """
     records = _world_part(world, "surfaces")
     if isinstance(records, Sequence):
-        return [
-            Plane(
-                name=str(r["name"]),
-                point_m=tuple(float(c) for c in r["point_m"]),
-                normal=tuple(float(c) for c in r["normal"]),
-                is_ground=bool(r.get("is_ground", False)),
-            )
-            for r in records
-        ]
+        return [_surface_of_record(r) for r in records]
     out: list[Plane] = []
     if summary.get("wall_distance_m") is not None:
         out.append(Plane.wall(summary["wall_distance_m"]))
@@ -235,10 +310,71 @@ def scene_surfaces(
     return out
 
 
+def _surface_of_record(r: Mapping[str, Any]) -> Plane | Cylinder | Box:
+    """The shape of a ``scenario.json`` surface record (its drawing; the kernel's numbers are
+    packed from the records themselves)."""
+    kind = r.get("kind", "plane")
+    if kind == "cylinder":
+        return obstacle_from(
+            {k: r[k] for k in ("name", "point_m", "axis", "radius_m", "length_m")}
+            | {"kind": "cylinder"}
+        )
+    if kind == "box":
+        # the box's axes as recorded: its drawing reads them from the packed row
+        return Box(name=str(r["name"]), centre_m=r["centre_m"], half_extents_m=r["half_extents_m"])
+    return Plane(
+        name=str(r["name"]),
+        point_m=tuple(float(c) for c in r["point_m"]),
+        normal=tuple(float(c) for c in r["normal"]),
+        is_ground=bool(r.get("is_ground", False)),
+    )
+
+
+def shape_lines(row: np.ndarray, centre: np.ndarray, extent: float = 1.5) -> list[np.ndarray]:
+    """Polylines (inertial NED) drawing a packed cylinder or box (``SH_*``); a plane: none.
+
+    A cylinder: its two end rims (an infinite one: ``extent`` m each way of
+    ``centre``'s axial coordinate) and eight generators; a box: its twelve
+    edges.
+    """
+    kind = int(row[L.SH_KIND])
+    o = row[L.SH_POINT : L.SH_POINT + 3]
+    if kind == L.SHAPE_CYLINDER:
+        e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+        r = float(row[L.SH_RADIUS])
+        length = float(row[L.SH_LENGTH])
+        if np.isfinite(length):
+            z0, z1 = -0.5 * length, 0.5 * length
+        else:
+            zc = float((np.asarray(centre, dtype=float) - o) @ e)
+            z0, z1 = zc - extent, zc + extent
+        k = np.eye(3)[int(np.argmin(np.abs(e)))]
+        u = np.cross(e, k)
+        u /= np.linalg.norm(u)
+        beta = np.linspace(0.0, 2.0 * math.pi, 73)
+        lines = [rim_points(o + z * e, u, e, r, beta) for z in (z0, z1)]
+        for b in np.linspace(0.0, 2.0 * math.pi, 8, endpoint=False):
+            p = rim_points(o, u, e, r, np.array([b]))[0]
+            lines.append(np.array([p + z0 * e, p + z1 * e]))
+        return lines
+    if kind == L.SHAPE_BOX:
+        axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
+        half = row[L.SH_HALF : L.SH_HALF + 3]
+        lines = []
+        for i in range(3):
+            j, k = (i + 1) % 3, (i + 2) % 3
+            for sj in (-1.0, 1.0):
+                for sk in (-1.0, 1.0):
+                    base = o + sj * half[j] * axes[j] + sk * half[k] * axes[k]
+                    lines.append(np.array([base - half[i] * axes[i], base + half[i] * axes[i]]))
+        return lines
+    return []
+
+
 def contact_points(
     x: np.ndarray, drawing: VehicleDrawing, surf: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Deepest rim point of every bumper against every surface, by the compiled contact law.
+    """Deepest point of every feature against every surface, by the compiled contact law.
 
     Parameters
     ----------
@@ -251,24 +387,30 @@ def contact_points(
 
     Returns
     -------
-    points : numpy.ndarray, shape (4, n_surfaces, 3)
-        Deepest rim points, inertial NED, m.
-    depths : numpy.ndarray, shape (4, n_surfaces)
+    points : numpy.ndarray, shape (n_features, n_surfaces, 3)
+        Deepest points, inertial NED, m.
+    depths : numpy.ndarray, shape (n_features, n_surfaces)
         Penetrations delta, m (positive in contact).
+    normals : numpy.ndarray, shape (n_features, n_surfaces, 3)
+        Contact normals (unit, out of the shape), inertial NED.
     """
     from quadimpact.core.geometry import contact_record
 
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
     ns = surf.shape[0]
-    points = np.zeros((4, ns, 3))
-    depths = np.zeros((4, ns))
-    for j in range(4):
+    nf = drawing.packed.shape[0]
+    points = np.zeros((nf, ns, 3))
+    depths = np.zeros((nf, ns))
+    normals = np.zeros((nf, ns, 3))
+    for j in range(nf):
         for s in range(ns):
-            d, _dd, rx, ry, rz, *_ = contact_record(xq, C, drawing.packed, surf, j, s)
-            points[j, s] = xq[L.X_POS : L.X_POS + 3] + C @ np.array([rx, ry, rz])
-            depths[j, s] = d
-    return points, depths
+            rec = contact_record(xq, C, drawing.packed, surf, j, s)
+            points[j, s] = xq[L.X_POS : L.X_POS + 3] + C @ np.array(rec[2:5])
+            depths[j, s] = rec[0]
+            m = np.array(rec[8:11])
+            normals[j, s] = m / np.linalg.norm(m)
+    return points, depths, normals
 
 
 def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -394,7 +536,7 @@ class Camera:
 class ContactMark:
     """One bumper touching one surface at one instant (inertial NED, SI)."""
 
-    bumper: int  # 1-4
+    bumper: int  # the feature, 1-based (bumpers 1-4)
     surface: str
     delta_m: float
     point: np.ndarray  # deepest rim point (inside the surface)
@@ -411,12 +553,12 @@ class SceneFrame:
     t: float
     position: np.ndarray
     C: np.ndarray
-    circles: np.ndarray  # (4, N+1, 3)
+    circles: np.ndarray  # (n_lines, N+1, 3): the features' rims
     discs: np.ndarray  # (4, N+1, 3)
     hub: np.ndarray  # (5, 3)
     arms: np.ndarray  # (4, 2, 3)
     axes: np.ndarray  # (3, 2, 3): CM -> tip of body x, y, z
-    label_points: np.ndarray  # (4, 3)
+    label_points: np.ndarray  # (n_features, 3)
     contacts: list[ContactMark] = field(default_factory=list)
     deltas: np.ndarray = field(default_factory=lambda: np.zeros(4))
     forces: np.ndarray = field(default_factory=lambda: np.zeros(4))
@@ -430,9 +572,11 @@ def _drawable_rows(ts: pd.DataFrame) -> pd.DataFrame:
     ValueError
         When no sample can be drawn (a run whose state is NaN throughout).
     """
+    from quadimpact.results.schema import feature_columns
+
+    per_feature = [c for _, d, f in feature_columns(ts.columns) for c in (d, f)]
     columns = ["t_s", "x_m", "y_m", "z_m", "q0", "q1", "q2", "q3", "roll_deg", "pitch_deg",
-               "yaw_deg", *(f"delta{j}_m" for j in (1, 2, 3, 4)),
-               *(f"force{j}_n" for j in (1, 2, 3, 4))]  # fmt: skip
+               "yaw_deg", *per_feature]  # fmt: skip
     present = [c for c in columns if c in ts]
     ok = np.all(np.isfinite(ts[present].to_numpy(dtype=float)), axis=1)
     if not ok.any():
@@ -508,8 +652,11 @@ class Scene:
         for k, col in enumerate(_STATE_COLUMNS):
             if col in ts:
                 self.states[:, k] = ts[col].to_numpy(dtype=float)
-        self.deltas = np.stack([ts[f"delta{j}_m"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
-        self.forces = np.stack([ts[f"force{j}_n"].to_numpy(dtype=float) for j in (1, 2, 3, 4)], 1)
+        from quadimpact.results.schema import feature_columns
+
+        cols = feature_columns(ts.columns)
+        self.deltas = np.stack([ts[d].to_numpy(dtype=float) for _, d, _ in cols], 1)
+        self.forces = np.stack([ts[f].to_numpy(dtype=float) for _, _, f in cols], 1)
         # roll and yaw continuous through +-180 deg (drawn and interpolated so)
         self.euler_deg = np.stack(
             [unwrap_deg(ts["roll_deg"]), ts["pitch_deg"].to_numpy(dtype=float),
@@ -622,10 +769,10 @@ class Scene:
         return frame
 
     def _contacts(self, x: np.ndarray, deltas: np.ndarray, forces: np.ndarray) -> list[ContactMark]:
-        points, depths = contact_points(x, self.drawing, self.surf)
-        n_exp = float(self.drawing.vehicle.contact_exponent)
+        points, depths, normals = contact_points(x, self.drawing, self.surf)
         marks: list[ContactMark] = []
-        for j in range(4):
+        for j in range(self.drawing.packed.shape[0]):
+            n_exp = float(self.drawing.packed[j, L.F_N])
             if not (deltas[j] > 0.0 or forces[j] > 0.0):
                 continue  # the simulation had no active contact on this bumper
             touching = [s for s in range(self.surf.shape[0]) if depths[j, s] > 0.0]
@@ -634,7 +781,7 @@ class Scene:
             weights = np.array([depths[j, s] ** n_exp for s in touching])
             weights = weights / weights.sum()
             for w, s in zip(weights, touching, strict=True):
-                m = self.surf[s, L.SH_NORMAL : L.SH_NORMAL + 3]
+                m = normals[j, s]
                 delta = float(depths[j, s])
                 f = float(forces[j] * w)
                 on_surface = points[j, s] + delta * m

@@ -30,10 +30,11 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.inputs.world import Plane
 from quadimpact.results.figures import stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.render import WALL_WIDTH_M
-from quadimpact.viz.scene import BUMPER_COLORS_HEX, BUMPER_NAMES, Camera, Scene
+from quadimpact.viz.scene import BUMPER_NAMES, Camera, Scene, shape_lines
 
 __all__ = ["DEFAULT_VIEWER_CAMERA", "VIEWER_HTML", "viewer_data", "viewer_html", "write_viewer"]
 
@@ -108,6 +109,16 @@ def viewer_data(
             "cut": _r(cuts[s.name], 5) if s.name in cuts else None,
         }
         for s in scene.surfaces
+        if isinstance(s, Plane)
+    ]
+    # cylinders and boxes as polylines fixed in space (an infinite cylinder: over the
+    # flight's extent along its axis)
+    centre = 0.5 * (scene.states[:, 0:3].min(axis=0) + scene.states[:, 0:3].max(axis=0))
+    extent = 1.0 + float(np.ptp(scene.states[:, 0:3], axis=0).max())
+    solids = [
+        {"name": s.name, "lines": [_r(x, 5) for x in shape_lines(scene.surf[k], centre, extent)]}
+        for k, s in enumerate(scene.surfaces)
+        if not isinstance(s, Plane)
     ]
     if not any(s["ground"] for s in surfaces):
         surfaces.append(
@@ -142,15 +153,22 @@ def viewer_data(
             "span": cam.span_m,
         },
         "surfaces": surfaces,
+        "solids": solids,
         # the stage of each frame and the names of the stages met (null: no stages)
         "stage_labels": None
         if stages is None
         else {str(k): stage_label(k) for k in sorted(set(stages.tolist()))},
         "vehicle": {
             "name": d.vehicle.name,
-            "colors": [BUMPER_COLORS_HEX[j] for j in (1, 2, 3, 4)],
-            "names": [BUMPER_NAMES[j] for j in (1, 2, 3, 4)],
+            "colors": list(d.colors),
+            "names": [BUMPER_NAMES[j] for j in (1, 2, 3, 4)]
+            if d.vehicle.features is None
+            else list(d.names),
+            "label_text": list(d.names),
+            "kind_name": "bumper" if d.vehicle.features is None else "feature",
             "centres": _r(d.centres, 6),
+            "line_centres": _r(d.circles.mean(axis=1), 6),
+            "line_feature": [int(f) for f in d.line_feature],
             "circles": _r(d.circles[:, ::step], 5),
             "discs": _r(d.discs[:, ::step], 5),
             "hub": _r(d.hub, 5),

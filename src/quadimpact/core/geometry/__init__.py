@@ -34,7 +34,7 @@ sphere    box       ``box.sphere_box``            closed form (exact)
 point     box       ``box.point_box``             closed form (exact)
 ========  ========  ============================  ======================================
 
-docs/CONTACT.md gives each pair's method, accuracy and cost.
+docs/OBSTACLES.md (section 2) gives each pair's method, accuracy and cost.
 
 **A new row** (a new feature or shape kind, a new pair): write the function
 in the shape's module; for a built-in, give it a ``GEOM_*`` id, a row in

@@ -13,7 +13,9 @@ that it costs no allocation)::
 * ``vc``: the velocity of the vehicle's material point there, inertial, m/s
   (gives ``delta_dot`` and the sliding velocity);
 * ``n``: unit normal of the shape at the contact, inertial, pointing from the
-  shape toward the vehicle.
+  shape toward the vehicle (a ring on a crease of a box or a finite cylinder:
+  the blend of the two faces' normals that is the depth's gradient, of length
+  a little under 1; ``ring.py``).
 
 The force law (``core/contact.py``) consumes this record and never reads a
 shape or a feature's geometry itself.

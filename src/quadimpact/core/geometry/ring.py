@@ -44,7 +44,11 @@ The search (:func:`ring_deepest`):
 Both return a point whose depth is within :data:`TOL` of the maximum over
 the circle, so the depth is continuous in time up to that tolerance (a jump
 of the arg-max between two equally deep points changes the point, not the
-depth). Cost: a typical evaluation is 3 to 6 point depths (one sine and
+depth). On a crease of the solid (two faces, or a side and a cap, equally
+near) the contact normal is the blend of the two that certifies the maximum
+(:func:`_crease_normal`; not of unit length there: the depth's gradient), so
+that the force does not flip between two faces from one evaluation to the
+next and stays conservative. Cost: a typical evaluation is 3 to 6 point depths (one sine and
 cosine each); the branch and bound, rare, about 100 to 300.
 """
 
@@ -58,6 +62,7 @@ from ..layout import (
     F_NORMAL,
     F_RADIUS,
     SH_KIND,
+    SH_LENGTH,
     SH_NORMAL,
     SHAPE_BOX,
     SHAPE_CYLINDER,
@@ -69,6 +74,7 @@ from .plane import plane_depth, plane_distance
 from .record import ContactRecord, material_record
 
 TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum
+CREASE_TOL = 1e-9  # m: two faces this close in depth at the deepest point: a crease
 MAX_LOCAL = 16  # point depths of the local search before the branch and bound
 N_ARCS = 32  # initial arcs of the branch and bound
 MAX_EVALS = 4000  # point depths of the branch and bound at most
@@ -309,9 +315,75 @@ def ring_deepest(ring: Ring, shapes: np.ndarray, s: int):
     """The deepest point of the circle ``ring`` in the convex shape ``s``, certified.
 
     Returns ``(angle, depth, mx, my, mz)``: the angle on the circle, the depth
-    there (m, within :data:`TOL` of the circle's maximum) and the solid's
-    outward normal there.
+    there (m, within :data:`TOL` of the circle's maximum) and the contact
+    normal there: the solid's outward normal, or on a crease the blend of
+    its two faces' normals whose slope along the ring is zero
+    (:func:`_crease_normal`).
     """
+    b, g, mx, my, mz = _search(ring, shapes, s)
+    return _crease_normal(ring, b, g, mx, my, mz, shapes, s)
+
+
+@njit(cache=True)
+def _crease_normal(
+    ring: Ring, b: float, g: float, mx: float, my: float, mz: float, shapes: np.ndarray, s: int
+):
+    """The contact normal at the deepest point ``b``: on a crease, the blend of two faces.
+
+    Inside a box or a finite cylinder the deepest point of a ring often sits
+    on a crease (two faces, or the side and a cap, equally near: the maximum
+    of the lower of two sinusoids), where the solid's own normal flips from
+    one face to the other. The contact normal there is the blend
+    ``lam m_i + (1 - lam) m_j`` whose slope along the ring is zero (the
+    supergradient that certifies the maximum), left unnormalised: it is the
+    gradient of the ring's depth with respect to the vehicle's motion, of
+    length between ``cos(half the faces' angle)`` and 1, so that
+    ``delta_dot = -v . n`` is the depth's exact rate and the elastic force
+    ``k delta^n n`` does exactly the work of its energy. It tends to ``m_i``
+    or ``m_j`` where the maximum leaves the crease, so the force's direction
+    is continuous too. Elsewhere: ``m`` unchanged (unit).
+    """
+    if g <= 0.0:
+        return b, g, mx, my, mz
+    kind = int(shapes[s, SH_KIND])
+    if kind == SHAPE_BOX:
+        n_pieces = 6
+    elif kind == SHAPE_CYLINDER and shapes[s, SH_LENGTH] < math.inf:
+        n_pieces = 3
+    else:
+        return b, g, mx, my, mz
+    px, py, pz, tx, ty, tz = _point(ring, b)
+    _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    j = -1
+    vj = math.inf
+    for i in range(n_pieces):
+        if i == k:
+            continue
+        v = solid_piece(px, py, pz, shapes, s, i)[0]
+        if v < vj:
+            vj = v
+            j = i
+    if j < 0 or vj > g + CREASE_TOL:
+        return b, g, mx, my, mz
+    _, nkx, nky, nkz = solid_piece(px, py, pz, shapes, s, k)
+    _, njx, njy, njz = solid_piece(px, py, pz, shapes, s, j)
+    sk = -(nkx * tx + nky * ty + nkz * tz)
+    sj = -(njx * tx + njy * ty + njz * tz)
+    if sk * sj > 0.0:
+        return b, g, mx, my, mz
+    lam = 0.5 if sk == sj else sj / (sj - sk)
+    return (
+        b,
+        g,
+        lam * nkx + (1.0 - lam) * njx,
+        lam * nky + (1.0 - lam) * njy,
+        lam * nkz + (1.0 - lam) * njz,
+    )
+
+
+@njit(cache=True)
+def _search(ring: Ring, shapes: np.ndarray, s: int):
+    """The certified deepest point: local secant search, then branch and bound if needed."""
     cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
     _, mx, my, mz, _ = solid_depth(cx, cy, cz, shapes, s)
     wa = -(mx * ax + my * ay + mz * az)
