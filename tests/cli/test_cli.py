@@ -468,7 +468,7 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
     run_py = str(Path(core.__file__).parent / "run.py")
     where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
     where.mkdir(parents=True)
-    (where / "run.run_builtin-52.py311.nbi").write_bytes(b"")
+    (where / "run.run-44.py311.nbi").write_bytes(b"")
     assert core.cache_is_warm()
     announce_compilation()
     assert capsys.readouterr().err == ""
