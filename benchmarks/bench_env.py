@@ -206,9 +206,11 @@ def main() -> None:
     actions, metrics = record_actions(trials)
     rows = {}
     rows["single env (ImpactRecoveryEnv)"] = replay_single(
-        E.ImpactRecoveryEnv(**SAME_TICKS), trials, actions, metrics)
+        E.ImpactRecoveryEnv(**SAME_TICKS), trials, actions, metrics
+    )
     rows["single env via gym.make (wrappers)"] = replay_single(
-        gym.make(E.ENV_ID, **SAME_TICKS), trials, actions, metrics)
+        gym.make(E.ENV_ID, **SAME_TICKS), trials, actions, metrics
+    )
     for n in (64, 256):
         if n <= len(trials):
             rows[f"batched env, N = {n}"] = replay_batched(n, trials, actions, metrics)

@@ -109,9 +109,11 @@ def main(argv: list[str] | None = None) -> None:
         print(f"RotorPy Environment.run {r['run_s'] * 1e3:7.1f} ms  = "
               f"{r['run_s'] / q['simulate_s']:.0f}x quadimpact's simulate(), "
               f"{r['run_s'] / q['kernel_s']:.0f}x its kernel")  # fmt: skip
-    print(f"roll after {FLIGHT_S:g} s (from {ROLL_DEG:g} deg): "
-          f"quadimpact {q['final_roll_deg']:.3f} deg"
-          + ("" if r is None else f", RotorPy {r['final_roll_deg']:.3f} deg"))
+    print(
+        f"roll after {FLIGHT_S:g} s (from {ROLL_DEG:g} deg): "
+        f"quadimpact {q['final_roll_deg']:.3f} deg"
+        + ("" if r is None else f", RotorPy {r['final_roll_deg']:.3f} deg")
+    )
     if args.json:
         args.json.write_text(json.dumps({"quadimpact": q, "rotorpy": r}, indent=2))
 

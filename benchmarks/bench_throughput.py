@@ -215,8 +215,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
     report = {
-        "machine": {"cpus": os.cpu_count(), "python": sys.version.split()[0],
-                    "numpy": np.__version__},  # fmt: skip
+        "machine": {
+            "cpus": os.cpu_count(),
+            "python": sys.version.split()[0],
+            "numpy": np.__version__,
+        },  # fmt: skip
         "simulate": bench_simulate(20 if args.quick else 60),
         "grid": bench_grid(),
         "commands": bench_commands(),

@@ -105,4 +105,3 @@ def assert_all_gone(procs: list[psutil.Process], tmp: Path, within_s: float = 5.
         p.kill()
     assert not names, f"left running: {names}"
     assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
-

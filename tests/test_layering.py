@@ -30,13 +30,16 @@ ROOT = Path(quadimpact.__file__).resolve().parent
 #: The layers, lowest first: a module may import its own layer and those below.
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     # and the package root, quadimpact/__init__.py
-    ("base", (
-        "quadimpact.core",
-        "quadimpact.errors",
-        "quadimpact.linalg",
-        "quadimpact.rotations",
-        "quadimpact._legacy",
-    )),
+    (
+        "base",
+        (
+            "quadimpact.core",
+            "quadimpact.errors",
+            "quadimpact.linalg",
+            "quadimpact.rotations",
+            "quadimpact._legacy",
+        ),
+    ),
     ("inputs", ("quadimpact.inputs",)),
     ("results", ("quadimpact.results",)),
     ("simulation", ("quadimpact.simulation",)),

@@ -96,6 +96,7 @@ def test_recovered_and_not_detected_are_separate():
 def test_seeds_make_the_noise():
     def imu(seed):
         return simulate(ImpactTrial(speed_m_s=1.0, imu="noisy", seed=seed)).imu
+
     a, b, c = imu(1), imu(1), imu(2)
     assert a.equals(b)
     assert not np.allclose(a["fx_m_s2"], c["fx_m_s2"])
