@@ -109,7 +109,7 @@ def recovery(
 
 
 def _summary(result) -> str:
-    from quadimpact.recovery.report import rate_text
+    from quadimpact.recovery.report import excluded_text, rate_text
 
     info, numbers = result.run_info, result.numbers
     c = numbers["classes"]
@@ -118,13 +118,17 @@ def _summary(result) -> str:
     else:
         before = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
         ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{before}"
-    return "\n".join([
-        f"trials    {numbers['n']} ({ran})",
-        f"success   {rate_text(numbers['success'])} (recovered / all trials, 95 % Wilson)",
-        f"detected  {rate_text(numbers['success_detected'])} (recovered / detected impacts)",
-        f"other     not detected {c['not detected']}, false detections {c['false detection']}, "
-        f"failed runs {c['failed']}",
-        f"table     {result.out_dir / 'trials.parquet'}",
-        f"report    {result.report}",
-        f"time      {result.elapsed_s:.1f} s",
-    ])  # fmt: skip
+    rows = [
+        ("trials", f"{numbers['n']} ({ran})"),
+        ("success", f"{rate_text(numbers['success'])} (recovered / valid trials, 95 % Wilson)"),
+        ("excluded", excluded_text(numbers)),
+        ("if detected", f"{rate_text(numbers['success_detected'])} (recovered / detected "
+                        "impacts)"),
+        ("other", f"recovered below ground level {c['recovered below ground level']} (not "
+                  f"successes), not detected {c['not detected']}, false detections "
+                  f"{c['false detection']}"),
+        ("table", str(result.out_dir / "trials.parquet")),
+        ("report", str(result.report)),
+        ("time", f"{result.elapsed_s:.1f} s"),
+    ]
+    return "\n".join(f"{label:<12}{text}" for label, text in rows)

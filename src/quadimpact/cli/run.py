@@ -341,6 +341,15 @@ def _recovery_lines(summary: Mapping[str, Any]) -> list[str]:
     recovered = "stage 4 not reached" if t4 is None else f"stage 4 at {_fmt(t4, unit='s')}"
     if t4 is not None and summary.get("time_to_recover_s") is not None:
         recovered += f" ({_fmt(summary['time_to_recover_s'], unit='s')} after the detection)"
+    low = summary.get("min_altitude_m")
+    if t4 is not None and low is not None and low < 0:
+        recovered += (
+            f", but below ground level on the way (lowest altitude {_fmt(low, unit='m', digits=3)}"
+            "; without a ground in the run it flew through where the ground would be: not a "
+            "success in the recovery study)"
+        )
+    if summary.get("bumper_model_valid") is False:
+        recovered += " (invalid: a bumper went deeper than its radius, beyond the bumper model)"
     return [f"detection      {detected}", f"recovered      {recovered}"]
 
 

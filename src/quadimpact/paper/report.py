@@ -169,7 +169,7 @@ def _quantile_pair(q: dict[str, float], digits: int = 2) -> str:
 
 def _monte_carlo_table(numbers: dict[str, dict], first: str) -> list[str]:
     lines = [
-        f"| {first} | trials | success (recovered / all) | recovered / detected "
+        f"| {first} | trials | success (recovered / valid trials) | recovered / detected "
         "| not detected | false detections | time to recover, median / p90 (s) "
         "| height loss, median / p90 (m) | drift, median / p90 (m) "
         "| detection latency, median (s) |",
