@@ -9,8 +9,6 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
-import pytest
-
 from quadimpact.cli import main
 
 
@@ -55,3 +53,30 @@ def test_run_says_when_a_recovery_went_below_ground_level() -> None:
                "t_stage4_s": 1.2, "time_to_recover_s": 1.15, "min_altitude_m": -3.9}  # fmt: skip
     text = format_summary(summary, Path("o"))
     assert "but below ground level on the way (lowest altitude -3.9 m" in text
+
+
+# ------------------------------------------------------------------ item 3
+def test_a_response_type_is_printed_only_where_it_applies_with_its_meaning() -> None:
+    from quadimpact import ImpactTrial, WallApproach
+    from quadimpact.cli import format_summary
+    from quadimpact.inputs.scenarios import FlightScenario
+
+    s = {"status": "completed", "response_type": "A", "crash_time_s": None}
+    text = format_summary(s, Path("o"), WallApproach())
+    assert "response type  A (no crash before the end of the run; says nothing of the " in text
+    for scenario in (ImpactTrial(), FlightScenario()):
+        text = format_summary(s, Path("o"), scenario)
+        assert "response type  n/a (a " in text and "defined for the wall approach" in text
+    text = format_summary(s, Path("o"), WallApproach(ground="none"))
+    assert "response type  n/a (no ground, so no crash rule" in text
+
+
+def test_the_viewer_title_names_its_speeds_and_types_only_wall_approaches() -> None:
+    from quadimpact import ImpactTrial, WallApproach, simulate
+    from quadimpact.viz.scene import Scene
+
+    wall = Scene.from_result(simulate(WallApproach(final_time_s=0.8))).describe()
+    assert "impact speed 0.75 m/s" in wall and "type A" in wall
+    trial = Scene.from_result(simulate(ImpactTrial(final_time_s=0.3))).describe()
+    assert trial.startswith("impact trial") and "initial speed 1.50 m/s" in trial
+    assert "impact speed" in trial and "type" not in trial

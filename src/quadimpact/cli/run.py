@@ -206,7 +206,7 @@ def run(
             f"{out}: the result folder could not be written ({exc.strerror or exc}); "
             "nothing was changed there"
         ) from None
-    click.echo(format_summary(result.summary, out))
+    click.echo(format_summary(result.summary, out, built))
     if viz:
         from quadimpact.cli.viz import make_all
 
@@ -353,7 +353,21 @@ def _recovery_lines(summary: Mapping[str, Any]) -> list[str]:
     return [f"detection      {detected}", f"recovered      {recovered}"]
 
 
-def format_summary(summary: Mapping[str, Any], out: Path) -> str:
+def _response_type(summary: Mapping[str, Any], scenario: Any) -> str:
+    """The response type with its meaning, or why there is none (docs/STUDIES.md 3)."""
+    from quadimpact.simulation.metrics import RESPONSE_TYPE_MEANINGS, response_type_applies
+
+    kind = getattr(scenario, "kind", None)
+    if scenario is not None and not response_type_applies(kind, getattr(scenario, "ground", None)):
+        why = f"a {kind} run" if kind != "wall-approach" else "no ground, so no crash rule"
+        return f"n/a ({why}: the types A-D are defined for the wall approach with a crash rule)"
+    rtype = summary.get("response_type")
+    if not rtype:
+        return "n/a"
+    return f"{rtype} ({RESPONSE_TYPE_MEANINGS.get(str(rtype), '')})"
+
+
+def format_summary(summary: Mapping[str, Any], out: Path, scenario: Any = None) -> str:
     """The short human summary printed after a run.
 
     Parameters
@@ -362,6 +376,9 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         The run's summary (the content of summary.json).
     out : pathlib.Path
         The output folder.
+    scenario : WallApproach or FlightScenario or ImpactTrial, optional
+        The run's scenario: a response type is printed only where it is
+        defined (a wall approach with a crash rule), with its meaning.
 
     Returns
     -------
@@ -379,7 +396,7 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         f"delta_init     {_fmt(summary.get('delta_init_m'), 1000.0, 'mm')}",
         f"peak force     {_fmt(summary.get('peak_force_n'), unit='N')}",
         f"leading bumper {leading if leading is not None else 'n/a'}",
-        f"response type  {summary.get('response_type') or 'n/a'}",
+        f"response type  {_response_type(summary, scenario)}",
         f"episodes       {_fmt(summary.get('n_episodes'))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]

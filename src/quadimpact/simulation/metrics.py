@@ -31,10 +31,12 @@ __all__ = [
     "RESPONSE_TYPES",
     "attitude_excursion_deg",
     "classify_response",
+    "RESPONSE_TYPE_MEANINGS",
     "graze_mask",
     "group_impacts",
     "impact_metrics",
     "impulse_scale",
+    "response_type_applies",
     "short_impacts",
 ]
 
@@ -359,6 +361,28 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
 GRAZE_IMPULSE_FRACTION = 0.01
 
 RESPONSE_TYPES: tuple[str, ...] = ("A", "B", "C", "D", "Other")
+
+#: What each response type says, in a few words (docs/STUDIES.md 3).
+RESPONSE_TYPE_MEANINGS: dict[str, str] = {
+    "A": "no crash before the end of the run; says nothing of the attitude or speed then",
+    "B": "crashed with no impact after the initial one",
+    "C": "another impact on the leading bumper(s), then the D pattern, then a crash",
+    "D": "flipped toward the wall, hit it with the aft bumper(s), then crashed",
+    "Other": "crashed, in none of the patterns B-D",
+}
+
+
+def response_type_applies(kind: str | None, ground: str | None) -> bool:
+    """Whether the paper's response types (docs/STUDIES.md 3) are defined for a run.
+
+    Only for the paper's wall approach (``kind = "wall-approach"``) with a
+    crash rule, i.e. a ground that can end the run (``ground`` not
+    ``"none"``): the types sort what follows an approach's first impact by
+    how it ends in a crash. An impact trial or a flight also gets a
+    ``response_type`` in its summary (the same rules), but it is not printed
+    as one.
+    """
+    return kind in (None, "wall-approach") and ground != "none"
 
 
 def classify_response(
