@@ -9,6 +9,8 @@ from __future__ import annotations
 import warnings
 from pathlib import Path
 
+import pytest
+
 from quadimpact.cli import main
 
 
@@ -80,3 +82,39 @@ def test_the_viewer_title_names_its_speeds_and_types_only_wall_approaches() -> N
     trial = Scene.from_result(simulate(ImpactTrial(final_time_s=0.3))).describe()
     assert trial.startswith("impact trial") and "initial speed 1.50 m/s" in trial
     assert "impact speed" in trial and "type" not in trial
+
+
+# ------------------------------------------------------------------ item 5
+@pytest.mark.slow
+@pytest.mark.parametrize(("signum", "code", "name"), [(15, 143, "SIGTERM"), (2, 130, "SIGINT")])
+def test_recovery_stops_on_a_signal_like_sweep(tmp_path, signum, code, name) -> None:
+    import os
+    import subprocess
+    import sys
+    import time
+
+    import quadimpact
+
+    env = dict(os.environ)
+    src = str(Path(quadimpact.__file__).resolve().parents[1])
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [src, env.get("PYTHONPATH")]))
+    env.pop("QUADIMPACT_DEBUG", None)
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "quadimpact.cli", "recovery", "--n", "5000", "--out", "r",
+         "--workers", "1", "--no-progress", "--no-animation"],
+        cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        end = time.monotonic() + 120
+        while not list((tmp_path / "r" / "sweep").glob("sweep.json")):
+            assert proc.poll() is None and time.monotonic() < end, proc.stderr.read()
+            time.sleep(0.1)
+        time.sleep(1.5)  # some trials run
+        proc.send_signal(signum)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == code, err
+    assert f"quadimpact: interrupted by {name}: " in err
+    assert " of 5000 runs saved in r/sweep; " in err
+    assert "run the same command again to resume" in err and "Traceback" not in err

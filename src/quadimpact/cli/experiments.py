@@ -12,6 +12,7 @@ from quadimpact.cli.options import (
     defaulted_option,
     out_option,
     parallel_options,
+    stoppable,
 )
 
 
@@ -56,6 +57,10 @@ def experiments(
     the first 0.3 s after impact), and where the log shows the wall contact
     the crash is run again at the log's own pre-impact estimates (speed,
     heading, roll, pitch) and over their uncertainty.
+
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
     """
     from quadimpact.experiments.table3 import check_data_dir, run_experiments
     from quadimpact.results.files import check_out_dir
@@ -64,10 +69,11 @@ def experiments(
     if data is not None:
         check_data_dir(data)
     announce_compilation()
-    table = run_experiments(
-        out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
-        scheduler=scheduler, progress=not no_progress,
-    )  # fmt: skip
+    with stoppable(out):
+        table = run_experiments(
+            out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
+            scheduler=scheduler, progress=not no_progress,
+        )  # fmt: skip
     cols = ["crash", "type_paper_experiment", "type_paper_simulation", "type_ours", "type_replica",
             "attitude_rms_deg_0_3s", "type_log", "type_log_conditions", "verdict"]  # fmt: skip
     shown = table[cols].rename(

@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -226,3 +227,50 @@ def model_names() -> tuple[str, ...]:
 
 CONTROLLER = RegistryChoice("controller", controller_names)
 MODEL = RegistryChoice("model", model_names)
+
+
+# ---------------------------------------------------------- stopping a study
+RESUME = "run the same command again to resume"
+
+
+def stopped(exc: BaseException, out: Path | None = None) -> int:
+    """Say why a study stopped, what is saved, that a rerun resumes; return the exit status.
+
+    ``exc``: a ``SweepInterrupted`` (Ctrl-C: 130, SIGTERM: 143) or a
+    ``WorkerError`` (1). A sweep's interruption knows how many runs it saved
+    and where; any other part of a study (a crash run on a worker, the
+    report) says that the finished sweeps are kept in ``out``.
+    """
+    from quadimpact.sweep import SweepInterrupted
+    from quadimpact.sweep.interrupt import signal_name
+
+    if getattr(exc, "saved", None) is not None:
+        resume = f"{exc.saved} of {exc.n_runs} runs saved in {exc.out_dir}; {RESUME}"
+    elif out is not None:
+        resume = f"every finished sweep is saved in {out}; {RESUME}"
+    else:
+        resume = RESUME
+    if isinstance(exc, SweepInterrupted):
+        click.echo(f"quadimpact: interrupted by {signal_name(exc.signum)}: {resume}", err=True)
+        return exc.exit_code
+    click.echo(f"quadimpact: error: {getattr(exc, 'cause', exc)}; {resume}", err=True)
+    return 1
+
+
+@contextlib.contextmanager
+def stoppable(out: Path | None = None) -> Iterator[None]:
+    """Ctrl-C and SIGTERM stop a study command as they stop ``quadimpact sweep``.
+
+    The first signal stops the work at once (every finished run kept), later
+    ones are ignored until the program has ended; the command then says what
+    was saved and how to resume, and exits with 130 (Ctrl-C) or 143
+    (SIGTERM); a worker that failed the study exits with 1.
+    """
+    from quadimpact.sweep import SweepInterrupted, WorkerError
+    from quadimpact.sweep.interrupt import stop_signals
+
+    with stop_signals(restore_after_stop=False):
+        try:
+            yield
+        except (SweepInterrupted, WorkerError) as exc:
+            raise click.exceptions.Exit(stopped(exc, out)) from None

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import out_option, parallel_options
+from quadimpact.cli.options import out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
 from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS
 
@@ -75,6 +75,10 @@ def recovery(
     trial (figure, viewer, animation) and DIR/report.md. The table is the
     same on any number of cores or a Dask cluster.
 
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
+
     \b
     Examples:
       quadimpact recovery --out results/recovery
@@ -101,10 +105,11 @@ def recovery(
             study = RecoveryStudy(**given)
         except InputError as exc:
             raise InputError(f"--{str(exc).replace('_', '-', 1)}") from None
-    result = run_study(
-        study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
-        animation=not no_animation,
-    )  # fmt: skip
+    with stoppable(out):
+        result = run_study(
+            study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
+            animation=not no_animation,
+        )  # fmt: skip
     click.echo(_summary(result))
 
 

@@ -6,7 +6,13 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import announce_compilation, data_option, out_option, parallel_options
+from quadimpact.cli.options import (
+    announce_compilation,
+    data_option,
+    out_option,
+    parallel_options,
+    stoppable,
+)
 
 
 @click.command("reproduce")
@@ -54,6 +60,10 @@ def reproduce(
     recovery part run side by side on the local cores (--workers 1: one
     after the other here). Each stage is named on stderr when it starts and
     timed when it ends; the report ends with the time per stage.
+
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
     """
     from quadimpact.experiments.table3 import check_data_dir
     from quadimpact.paper.study import reproduce as run_study
@@ -64,11 +74,12 @@ def reproduce(
         check_data_dir(data)
     announce_compilation()
 
-    result = run_study(
-        out, workers=workers, scheduler=scheduler, progress=not no_progress,
-        ablation=not no_ablation, experiments=not no_experiments, recovery=not no_recovery,
-        data_dir=data,
-    )  # fmt: skip
+    with stoppable(out):
+        result = run_study(
+            out, workers=workers, scheduler=scheduler, progress=not no_progress,
+            ablation=not no_ablation, experiments=not no_experiments, recovery=not no_recovery,
+            data_dir=data,
+        )  # fmt: skip
     f = result.findings
     click.echo(f"report         {result.report}")
     for variant, group in f.groupby("variant", sort=False):
