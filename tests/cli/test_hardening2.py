@@ -118,3 +118,23 @@ def test_recovery_stops_on_a_signal_like_sweep(tmp_path, signum, code, name) -> 
     assert f"quadimpact: interrupted by {name}: " in err
     assert " of 5000 runs saved in r/sweep; " in err
     assert "run the same command again to resume" in err and "Traceback" not in err
+
+
+# ------------------------------------------------------------------ item 6
+def test_workers_are_capped_at_four_per_core(tmp_path, capsys, monkeypatch) -> None:
+    from quadimpact.sweep import run as sweep_run
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(sweep_run, "default_workers", lambda: 2)
+    seen = {}
+
+    def fake_run_sweep(spec, out, **kw):
+        seen.update(kw)
+        raise SystemExit(0)
+
+    monkeypatch.setattr("quadimpact.sweep.run_sweep", fake_run_sweep)
+    code, _, err = cli(capsys, "sweep", "--grid", "heading_deg=0,45", "--out", "s",
+                       "--workers", "1000", "--no-plots")  # fmt: skip
+    assert seen["workers"] == 8
+    assert "quadimpact: warning: --workers 1000: capped at 8 (4 per core on the 2 core(s)" in err
+    assert sweep_run.cap_workers(8) == (8, "")

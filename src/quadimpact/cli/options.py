@@ -20,6 +20,7 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     Both are checked before the command starts any work: ``--workers`` and
     ``--scheduler`` together are refused, and a scheduler address must be
     ``SCHEME://HOST:PORT``; a ``tcp://`` one must accept a connection.
+    ``--workers`` above 4 per core is capped there, with a warning.
     """
 
     @functools.wraps(command)
@@ -29,6 +30,12 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
             if kwargs.get("workers") is not None:
                 raise InputError("--workers and --scheduler: give one or the other")
             check_scheduler(scheduler)
+        if kwargs.get("workers") is not None:
+            from quadimpact.sweep.run import cap_workers
+
+            kwargs["workers"], note = cap_workers(kwargs["workers"])
+            if note:
+                click.echo(f"quadimpact: warning: {note}", err=True)
         return command(*args, **kwargs)
 
     options = [
@@ -36,8 +43,9 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
             "--workers",
             type=click.IntRange(min=1),
             metavar="N",
-            help="Local worker processes (1: in this process). [default: all cores, after "
-            "a start in this process; a sweep that takes under a second stays in it]",
+            help="Local worker processes (1: in this process; at most 4 per core, more is "
+            "capped). [default: all cores, after a start in this process; a sweep that takes "
+            "under a second stays in it]",
         ),
         click.option(
             "--scheduler",

@@ -87,12 +87,35 @@ def _refuse_in_a_starting_worker() -> None:
         raise SystemExit(1)
 
 
+#: Most local worker processes per core: more only share the same cores and the memory.
+MAX_WORKERS_PER_CORE = 4
+
+
+def cap_workers(workers: int) -> tuple[int, str]:
+    """``workers`` capped at :data:`MAX_WORKERS_PER_CORE` per core, and a note if it was.
+
+    Each worker process holds its own compiled kernel and buffers (about 150
+    MB); a thousand of them on two cores gain nothing and take the memory.
+    """
+    cores = default_workers()
+    cap = MAX_WORKERS_PER_CORE * cores
+    if workers <= cap:
+        return workers, ""
+    return cap, (
+        f"--workers {workers}: capped at {cap} ({MAX_WORKERS_PER_CORE} per core on the {cores} "
+        "core(s) this process may use; more processes only share the same cores and memory)"
+    )
+
+
 def _resolve_workers(workers: int | None) -> int:
     if workers is None:
         return default_workers()
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InputError(f"--workers: must be an integer >= 1 (got {format_value(workers)})")
-    return workers
+    capped, note = cap_workers(workers)
+    if note:
+        _note(note)
+    return capped
 
 
 def _note(message: str, bar: Progress | None = None) -> None:
