@@ -11,7 +11,9 @@ import click
 
 from quadimpact.cli.options import (
     CONTROLLER,
+    MAX_RECORD_MB,
     MODEL,
+    FiniteFloat,
     announce_compilation,
     file_argument,
     number_option,
@@ -151,13 +153,27 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
     "files and the pictures drawn from it go; one holding anything else is refused.",
 )
 @click.option(
+    "--max-record-mb",
+    type=FiniteFloat(min=0, min_open=True),
+    default=MAX_RECORD_MB,
+    show_default=True,
+    metavar="MB",
+    help="Largest record (time series and IMU samples: final time x output rate) the run "
+    "may allocate; a larger one is refused before it starts, with its estimate.",
+)
+@click.option(
     "--viz",
     is_flag=True,
     help="Also write the pictures: snapshots.png/.pdf, animation.mp4 and viewer.html "
     "(as 'quadimpact snapshots', 'animate' and 'view' do).",
 )
 def run(
-    scenario: Path | None, out: Path, options: tuple[str, ...], viz: bool, **flags: Any
+    scenario: Path | None,
+    out: Path,
+    options: tuple[str, ...],
+    viz: bool,
+    max_record_mb: float,
+    **flags: Any,
 ) -> None:
     """Simulate one scenario and write its results to --out.
 
@@ -189,8 +205,10 @@ def run(
          NaN); its folder is still written, with the reason in summary.json
     """
     from quadimpact.results.files import check_out_dir
+    from quadimpact.simulation.checks import check_record_size
 
     built = build_scenario(scenario, flags, options)
+    check_record_size(built, max_record_mb, "--max-record-mb")
     check_out_dir(out, "run")
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)

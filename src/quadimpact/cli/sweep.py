@@ -11,6 +11,8 @@ from pathlib import Path
 import click
 
 from quadimpact.cli.options import (
+    MAX_RECORD_MB,
+    FiniteFloat,
     announce_compilation,
     file_argument,
     parallel_options,
@@ -74,6 +76,15 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
     is_flag=True,
     help="Allow a sweep of more than 1,000,000 runs (refused otherwise).",
 )
+@click.option(
+    "--max-record-mb",
+    type=FiniteFloat(min=0, min_open=True),
+    default=MAX_RECORD_MB,
+    show_default=True,
+    metavar="MB",
+    help="Largest record (time series and IMU samples) one run may allocate; a run above "
+    "it is refused before any starts.",
+)
 @click.option("--no-plots", is_flag=True, help="Do not write plots/.")
 def sweep(
     sweep_file: Path | None,
@@ -84,6 +95,7 @@ def sweep(
     no_progress: bool,
     timeout: float | None,
     allow_large: bool,
+    max_record_mb: float,
     no_plots: bool,
 ) -> None:
     """Run a sweep: one base scenario over a grid, a list or a random sample.
@@ -137,6 +149,7 @@ def sweep(
             load=False,
             timeout=timeout,
             allow_large=allow_large,
+            max_record_mb=max_record_mb,
         )
     plots: list[Path] = []
     if not no_plots:

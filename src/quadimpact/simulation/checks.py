@@ -13,13 +13,16 @@
   deflection nobody asked for.
 
 The messages say which bumper, which surface and how deep, and name the
-field to change. A sweep records such a run as failed with this message
+field to change. :func:`check_record_size` refuses, before any work, a run
+whose raw record would exceed :data:`MAX_RECORD_MB` (``quadimpact run`` and
+sweeps; ``--max-record-mb`` raises it). A sweep records such a run as failed with this message
 (its ``reason``); the recovery study classes it ``invalid: started in
 contact`` (:data:`STARTED_IN_CONTACT` is the phrase it looks for).
 """
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -28,7 +31,14 @@ from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.simulation.approach import bumper_depths
 
-__all__ = ["INITIAL_PENETRATION_TOL_M", "STARTED_IN_CONTACT", "check_initial_contact"]
+__all__ = [
+    "INITIAL_PENETRATION_TOL_M",
+    "MAX_RECORD_MB",
+    "STARTED_IN_CONTACT",
+    "check_initial_contact",
+    "check_record_size",
+    "record_size_bytes",
+]
 
 #: Deepest bumper penetration into a surface that an initial state may have, m.
 INITIAL_PENETRATION_TOL_M = 1e-3
@@ -71,3 +81,44 @@ def check_initial_contact(scenario: Any, setup: Any) -> None:
                 f"inside the {name}, more than the {INITIAL_PENETRATION_TOL_M * 1e3:g} mm "
                 "tolerance for a start in contact (move the start away from it)"
             )
+
+
+# ------------------------------------------------------------ output size
+#: The largest raw record (time series and IMU samples) a run may allocate by default, MB.
+MAX_RECORD_MB = 1024.0
+
+
+def record_size_bytes(scenario: Any) -> int:
+    """The memory of a run's raw record, bytes, from its scenario alone (before any work).
+
+    ``final time x output rate`` rows of the time series (``core/layout.py``'s
+    ``NOUT`` columns of 8 bytes) and ``final time x IMU rate`` IMU samples
+    (``NIMU`` columns); the tables built from them take about as much again.
+    """
+    from quadimpact.simulation.packing import CONTROL_RATE_HZ
+
+    duration = float(scenario.final_time_s) - float(getattr(scenario, "start_time_s", 0.0) or 0.0)
+    rows = math.ceil(max(duration, 0.0) * float(scenario.output_rate_hz)) + 2
+    imu_rate = getattr(getattr(scenario, "imu", None), "rate_hz", None) or CONTROL_RATE_HZ
+    samples = math.ceil(max(duration, 0.0) * float(imu_rate)) + 1
+    return 8 * (rows * L.NOUT + samples * L.NIMU)
+
+
+def check_record_size(scenario: Any, limit_mb: float = MAX_RECORD_MB, flag: str = "") -> None:
+    """Refuse a run whose raw record would exceed ``limit_mb`` (:func:`record_size_bytes`).
+
+    Raises
+    ------
+    InputError
+        With the estimate, what makes it (duration, rates) and how to raise the limit.
+    """
+    size = record_size_bytes(scenario)
+    if size <= limit_mb * 1e6:
+        return
+    duration = float(scenario.final_time_s) - float(getattr(scenario, "start_time_s", 0.0) or 0.0)
+    raise_it = f"; {flag} MB raises the limit" if flag else ""
+    raise InputError(
+        f"output: the run's record would take {size / 2**30:.1f} GiB ({duration:g} s at "
+        f"output_rate_hz = {float(scenario.output_rate_hz):g}), more than the "
+        f"{limit_mb:g} MB limit: lower output_rate_hz or final_time_s{raise_it}"
+    )

@@ -136,6 +136,7 @@ def run_sweep(
     load: bool = True,
     timeout: float | None = None,
     allow_large: bool = False,
+    max_record_mb: float | None = None,
 ) -> Any:
     """Run a sweep into ``out_dir`` (resuming whatever is already there) and return its table.
 
@@ -172,6 +173,10 @@ def run_sweep(
         applied to runs in this process (``workers=1``).
     allow_large : bool, keyword
         Allow more than :data:`LARGE_SWEEP_RUNS` runs.
+    max_record_mb : float, keyword
+        Largest raw record one run may allocate, MB (default
+        ``simulation.checks.MAX_RECORD_MB``): a run above it is refused before
+        any starts.
 
     Returns
     -------
@@ -213,7 +218,7 @@ def run_sweep(
                 start_server(pool_context())  # it loads the kernel while the runs are checked
             if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
                 _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
-            spec.validate()
+            spec.validate(max_record_mb=max_record_mb)
             schema = schema_of(spec)
             client, threads = (
                 stack.enter_context(dask_session(scheduler)) if scheduler is not None else (None, 0)
