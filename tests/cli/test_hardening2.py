@@ -169,3 +169,64 @@ def test_snapshots_and_animate_refuse_pictures_beyond_reason(tmp_path, capsys) -
                 "--max-frames N")  # fmt: skip
     input_error(cli(capsys, "animate", str(tmp_path), "--size", "100000x100000"),
                 "a frame of 10,000 Mpx (37.3 GiB to draw) is larger than 8K")  # fmt: skip
+
+
+# ------------------------------------------------------------------ item 8
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from quadimpact import WallApproach, simulate
+
+    out = tmp_path_factory.mktemp("h2run") / "run"
+    simulate(WallApproach(final_time_s=0.7)).write(out)
+    return out
+
+
+def test_one_folder_rule_for_every_command(tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    Path("mine").mkdir()
+    Path("mine/notes.txt").write_text("mine")
+    for command in (["sweep", "--grid", "heading_deg=0"], ["recovery", "--n", "2"],
+                    ["experiments"], ["reproduce"], ["run"]):  # fmt: skip
+        input_error(cli(capsys, *command, "--out", "mine"),
+                    "--out mine: holds files that are not quadimpact's (notes.txt)")  # fmt: skip
+    input_error(cli(capsys, "sweep", "--grid", "heading_deg=0", "--out", "/proc/x"),
+                "--out /proc/x: cannot be created in /proc")  # fmt: skip
+    Path("s").mkdir()
+    Path("s/sweep.json").write_text("{}")
+    input_error(cli(capsys, "recovery", "--n", "2", "--out", "s"), "--out s: holds a sweep")
+    Path("r").mkdir()
+    Path("r/trials.parquet").write_text("")
+    input_error(cli(capsys, "sweep", "--grid", "heading_deg=0", "--out", "r"),
+                "--out r: holds a recovery study")  # fmt: skip
+
+
+@pytest.mark.parametrize("command", ["view", "snapshots", "animate"])
+def test_the_drawing_commands_refuse_a_folder_they_cannot_write(
+    run_dir, capsys, monkeypatch, command
+) -> None:
+    import tempfile
+
+    def refuse(*_args, **_kw):
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    input_error(cli(capsys, command, str(run_dir)),
+                "the pictures cannot be written there (Permission denied)")  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [('{"scenario": 5}', "scenario: must be a JSON object (got a JSON number)"),
+     ('{"surfaces": [{"kind": "plane"}]}', "surfaces.0: must be a surface record"),
+     ('{"surfaces": [{"name": "w", "point_m": 1, "normal": [1, 0, 0], "is_ground": false, '
+      '"kind": "plane"}]}', "damaged or not written by quadimpact (TypeError")],
+)  # fmt: skip
+def test_a_damaged_scenario_json_is_named_in_one_line(
+    run_dir, tmp_path, capsys, text, fragment
+) -> None:
+    import shutil
+
+    d = tmp_path / "copy"
+    shutil.copytree(run_dir, d)
+    (d / "scenario.json").write_text(text)
+    input_error(cli(capsys, "view", str(d)), "scenario.json", fragment)

@@ -86,6 +86,9 @@ def recovery(
       quadimpact recovery --sweep my-trials.toml --out results/mine
     """
     from quadimpact.recovery.study import RecoveryStudy, run_study
+    from quadimpact.results.files import check_out_dir
+
+    check_out_dir(out, "recovery")
 
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")

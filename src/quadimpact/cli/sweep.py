@@ -124,6 +124,7 @@ def sweep(
           --grid speed_m_s=0.5,0.75,1.0 --grid model=paper-replica --out fig4
       quadimpact sweep study.toml --grid restitution=0.2:0.8:0.1 --out restitution
     """
+    from quadimpact.results.files import check_out_dir
     from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
 
     extra = _parse_grid(grid)
@@ -137,6 +138,7 @@ def sweep(
         spec = SweepSpec(grid=extra, where="sweep")
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
+    check_out_dir(out, "sweep")
     announce_compilation()
     # once stopped by a signal, every later one is ignored until the program has ended
     with stoppable():

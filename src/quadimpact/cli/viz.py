@@ -10,6 +10,7 @@ folder written by ``quadimpact run`` and writes into it:
 
 from __future__ import annotations
 
+import errno
 import functools
 from collections.abc import Callable
 from pathlib import Path
@@ -87,7 +88,7 @@ def _camera(
 
 def _scene(result_dir: Path, vehicle: str | None) -> Any:
     """The scene of a result folder, with input errors as one line."""
-    from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET
+    from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET, check_writable
     from quadimpact.results.result import read_result
     from quadimpact.viz.scene import Scene
 
@@ -102,21 +103,34 @@ def _scene(result_dir: Path, vehicle: str | None) -> Any:
 
         veh = load_vehicle(vehicle)
     result = read_result(result_dir)  # a file that cannot be read: one line naming it
+    check_writable(result_dir, f"{result_dir}: the pictures cannot be written there")
     try:
         return Scene.from_result(result, vehicle=veh)
     except InputError as exc:
         raise InputError(f"{exc} (pass --vehicle with the run's vehicle file)") from None
     except ValueError as exc:
         raise InputError(f"{result_dir}: {exc}") from None
+    except (KeyError, TypeError, AttributeError, IndexError) as exc:  # a hand-edited record
+        raise InputError(
+            f"{result_dir / 'scenario.json'}: damaged or not written by quadimpact "
+            f"({type(exc).__name__}: {exc})"
+        ) from None
 
 
 def _value_errors(func: Callable[..., Any]) -> Callable[..., Any]:
+    """A ValueError, or a folder that refuses the files, as an input error (exit 2)."""
+
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
         except ValueError as exc:
             raise InputError(str(exc)) from None
+        except OSError as exc:
+            if exc.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
+                raise
+            where = exc.filename or kwargs.get("result_dir") or "the result folder"
+            raise InputError(f"{where}: cannot be written ({exc.strerror or exc})") from None
 
     return wrapper
 
