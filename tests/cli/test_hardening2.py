@@ -230,3 +230,18 @@ def test_a_damaged_scenario_json_is_named_in_one_line(
     shutil.copytree(run_dir, d)
     (d / "scenario.json").write_text(text)
     input_error(cli(capsys, "view", str(d)), "scenario.json", fragment)
+
+
+# ------------------------------------------------------------------ item 9
+def test_numeric_model_switches_are_parsed_from_the_flag() -> None:
+    from quadimpact.cli.run import build_scenario
+
+    for text, value in (("0.3", 0.3), ("1", 1.0), ("2.5e-1", 0.25)):
+        s = build_scenario(None, {}, (f"contact_gate_m={text}",))
+        assert s.model_options.contact_gate_m == value
+    s = build_scenario(None, {}, ("crash_rule=cm-ground", "bumper1_yaw_twice=TRUE"))
+    assert s.model_options.crash_rule == "cm-ground" and s.model_options.bumper1_yaw_twice is True
+    from quadimpact.errors import InputError
+
+    with pytest.raises(InputError, match="contact_gate_m: must be a number .got 'nan'"):
+        build_scenario(None, {}, ("contact_gate_m=nan",))

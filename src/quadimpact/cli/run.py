@@ -234,15 +234,35 @@ def run(
         click.get_current_context().exit(EXIT_RUN_FAILED)
 
 
+def _option_value(text: str) -> Any:
+    """A ``--option`` value as the scenario file would read it: a number, a boolean, a word.
+
+    ``0.3`` is the number 0.3 and ``true``/``false`` (any case) booleans, as in
+    a TOML file; a quoted TOML string is its content; anything else is the
+    text itself (``crash_rule=cm-ground``).
+    """
+    import tomllib
+
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except (tomllib.TOMLDecodeError, KeyError):
+        return text
+    if isinstance(value, float) and not math.isfinite(value):
+        return text  # nan, inf: refused by the field's own check, with the text shown
+    return value if isinstance(value, (int, float, str, bool)) else text
+
+
 def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
-    """``NAME=VALUE`` pairs of ``--option`` to a dict (``true``/``false`` become bools)."""
+    """``NAME=VALUE`` pairs of ``--option`` to a dict (values read as in a file)."""
     parsed: dict[str, Any] = {}
     for item in options:
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             raise InputError(f"--option: must be NAME=VALUE (got {item!r})")
-        text = value.strip()
-        parsed[name.strip()] = {"true": True, "false": False}.get(text.lower(), text)
+        parsed[name.strip()] = _option_value(value.strip())
     return parsed
 
 
