@@ -1,7 +1,9 @@
 """Checks of a prepared run before it runs: the initial state must not start inside a surface.
 
-:func:`check_initial_contact` is called once by ``simulation.setup.prepare``
-(so by ``simulate``, ``Simulation``, sweeps and the learning environment):
+:func:`check_prepared` is called once by ``simulation.setup.prepare`` (so by
+``simulate``, ``Simulation``, sweeps and the learning environment): the IMU
+must sit on the vehicle and read its hover (:func:`check_imu`), and the run
+must not start in contact (:func:`check_initial_contact`):
 
 * an **impact trial** starts its vehicle away from the wall (docs/RECOVERY.md
   5.1): a bumper already touching or in the wall at the start (depth > 0) is
@@ -35,7 +37,9 @@ __all__ = [
     "INITIAL_PENETRATION_TOL_M",
     "MAX_RECORD_MB",
     "STARTED_IN_CONTACT",
+    "check_imu",
     "check_initial_contact",
+    "check_prepared",
     "check_record_size",
     "record_size_bytes",
 ]
@@ -44,6 +48,67 @@ __all__ = [
 INITIAL_PENETRATION_TOL_M = 1e-3
 #: The phrase of the impact trial's error (what the recovery study's classes look for).
 STARTED_IN_CONTACT = "starts in contact with the wall"
+
+
+def check_prepared(scenario: Any, setup: Any) -> None:
+    """Every check of a prepared run (``simulation.setup.prepare`` calls this once).
+
+    :func:`check_initial_contact` and :func:`check_imu`.
+    """
+    check_imu(setup)
+    check_initial_contact(scenario, setup)
+
+
+def check_imu(setup: Any) -> None:
+    """Refuse an IMU that cannot serve the run: off the vehicle, or saturated at hover.
+
+    Rules (the vehicle's gravity ``g``, its rotor arms and bumper radius):
+
+    * the IMU sits on the vehicle: no farther from the CM than the rotors'
+      reach (the longest arm plus the bumper radius);
+    * the accelerometer range is at least ``g``: it reads ``g`` in hover, so
+      a smaller range saturates in level flight;
+    * the detector's threshold can be reached within the range: at most
+      ``sqrt(2)`` times the range (two saturated horizontal axes; ``sqrt(3)``
+      in world axes), else detection is impossible.
+
+    Raises
+    ------
+    InputError
+        The rule, the value and the limit, naming the ``[imu]`` field.
+    """
+    scfg = setup.scfg
+    if scfg is None or not scfg[L.SC_RATE] > 0.0:
+        return
+    vehicle = setup.vehicle
+    position = np.asarray(scfg[L.SC_POS : L.SC_POS + 3], dtype=float)
+    arms = np.linalg.norm(vehicle.rotor_positions, axis=1)
+    reach = float(arms.max()) + float(vehicle.bumper_radius_m)
+    distance = float(np.linalg.norm(position))
+    if distance > reach:
+        shown = ", ".join(f"{c:g}" for c in position)
+        raise InputError(
+            f"imu: position: ({shown}) m is {distance:.3g} m from the CM, off the vehicle (its "
+            f"rotors and bumpers reach {reach:.3g} m): the IMU must sit on the vehicle"
+        )
+    g = float(vehicle.gravity_m_s2)
+    accel_range = float(scfg[L.SC_RANGE_F])
+    if accel_range <= 0.0:
+        return
+    if accel_range < g:
+        raise InputError(
+            f"imu: accel_range_m_s2: must be at least g = {g:g} m/s^2, what the accelerometer "
+            f"reads in hover (got {accel_range:g}): it would saturate in level flight"
+        )
+    threshold = float(scfg[L.SC_DET_THRESHOLD])
+    reachable = accel_range * (math.sqrt(3.0) if scfg[L.SC_DET_WORLD] > 0.5 else math.sqrt(2.0))
+    if threshold > reachable:
+        raise InputError(
+            f"detection: threshold_g: {threshold / g:g} g = {threshold:.4g} m/s^2 can never be "
+            f"read by an accelerometer of range {accel_range:g} m/s^2 per axis (at most "
+            f"{reachable:.4g} m/s^2 horizontally): detection would be impossible; raise "
+            "imu.accel_range_m_s2 or lower the threshold"
+        )
 
 
 def check_initial_contact(scenario: Any, setup: Any) -> None:

@@ -25,7 +25,7 @@ from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
-from quadimpact.simulation.checks import check_initial_contact
+from quadimpact.simulation.checks import check_prepared
 from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
     RPM,
@@ -338,12 +338,12 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
 
 
 def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
-    """Validated scenario -> packed run (refused if it starts in contact: ``checks.py``)."""
+    """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``)."""
     if isinstance(scenario, WallApproach):
         setup = prepare_wall_approach(scenario)
     elif isinstance(scenario, ImpactTrial):
         setup = prepare_impact_trial(scenario)
     else:
         setup = prepare_flight(scenario)
-    check_initial_contact(scenario, setup)
+    check_prepared(scenario, setup)
     return setup
