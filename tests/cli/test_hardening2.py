@@ -245,3 +245,12 @@ def test_numeric_model_switches_are_parsed_from_the_flag() -> None:
 
     with pytest.raises(InputError, match="contact_gate_m: must be a number .got 'nan'"):
         build_scenario(None, {}, ("contact_gate_m=nan",))
+
+
+# ------------------------------------------------------------------ item 11
+def test_recovery_names_a_vehicle_file_as_typed(tmp_path, capsys, monkeypatch) -> None:
+    monkeypatch.chdir(tmp_path)
+    Path("veh_x.toml").write_text("mass_kg = -1\n")
+    line = input_error(cli(capsys, "recovery", "--vehicle", "veh_x.toml", "--out", "r"),
+                       "--vehicle: ", "veh_x.toml")  # fmt: skip
+    assert "veh-x" not in line

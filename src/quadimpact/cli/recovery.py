@@ -106,8 +106,9 @@ def recovery(
     else:
         try:
             study = RecoveryStudy(**given)
-        except InputError as exc:
-            raise InputError(f"--{str(exc).replace('_', '-', 1)}") from None
+        except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
+            field, sep, rest = str(exc).partition(":")
+            raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
     with stoppable(out):
         result = run_study(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
