@@ -40,6 +40,8 @@ __all__ = [
     "check_imu",
     "check_initial_contact",
     "check_prepared",
+    "check_scenario_type",
+    "whole_ticks",
     "check_record_size",
     "record_size_bytes",
 ]
@@ -187,3 +189,43 @@ def check_record_size(scenario: Any, limit_mb: float = MAX_RECORD_MB, flag: str 
         f"output_rate_hz = {float(scenario.output_rate_hz):g}), more than the "
         f"{limit_mb:g} MB limit: lower output_rate_hz or final_time_s{raise_it}"
     )
+
+
+# ------------------------------------------------------------ Python calls
+def check_scenario_type(scenario: Any) -> None:
+    """Refuse anything but a validated scenario, saying what is accepted and how to get one.
+
+    Raises
+    ------
+    TypeError
+        For ``None``, a mapping, a file path or any other object.
+    """
+    from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
+
+    if isinstance(scenario, (WallApproach, FlightScenario, ImpactTrial)):
+        return
+    got = f"{type(scenario).__name__} {scenario!r}"
+    if len(got) > 80:
+        got = got[:77] + "..."
+    hint = ""
+    if isinstance(scenario, (str, bytes)) or hasattr(scenario, "__fspath__"):
+        hint = "; for a file: quadimpact.inputs.scenarios.load_scenario_file(path)"
+    elif isinstance(scenario, dict):
+        hint = (
+            "; for a mapping of scenario-file keys: "
+            "quadimpact.inputs.scenarios.scenario_from_dict(d)"
+        )
+    raise TypeError(
+        f"scenario: must be a WallApproach, FlightScenario or ImpactTrial (got {got}){hint}"
+    )
+
+
+def whole_ticks(n_ticks: Any) -> int:
+    """A number of control ticks: an integer (``-1``: to the end); 1.5 or ``True`` refused."""
+    import numbers
+
+    if isinstance(n_ticks, bool) or not isinstance(n_ticks, numbers.Integral):
+        raise TypeError(f"n_ticks: must be a whole number of control ticks (got {n_ticks!r})")
+    if n_ticks < -1:
+        raise ValueError(f"n_ticks: must be >= 0, or -1 for to the end (got {n_ticks!r})")
+    return int(n_ticks)

@@ -27,6 +27,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core import step as core_step
 from quadimpact.results.result import SimulationResult
+from quadimpact.simulation.checks import whole_ticks
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
 
@@ -107,6 +108,7 @@ class Simulation:
             Rotor speed commands (rad/s) to apply at each of these ticks instead
             of the controller's (the loop's generic limits still apply).
         """
+        n_ticks = whole_ticks(n_ticks)
         s = self.setup
         args = (
             self._x, self._ls, self._cs, self._rin, self._mem, self._meas, self._sst,
