@@ -68,7 +68,7 @@ def test_a_response_type_is_printed_only_where_it_applies_with_its_meaning() -> 
     assert "response type  A (no crash before the end of the run; says nothing of the " in text
     for scenario in (ImpactTrial(), FlightScenario()):
         text = format_summary(s, Path("o"), scenario)
-        assert "response type  n/a (a " in text and "defined for the wall approach" in text
+        assert "response type  n/a (a" in text and "defined for the wall approach" in text
     text = format_summary(s, Path("o"), WallApproach(ground="none"))
     assert "response type  n/a (no ground, so no crash rule" in text
 
@@ -254,3 +254,23 @@ def test_recovery_names_a_vehicle_file_as_typed(tmp_path, capsys, monkeypatch) -
     line = input_error(cli(capsys, "recovery", "--vehicle", "veh_x.toml", "--out", "r"),
                        "--vehicle: ", "veh_x.toml")  # fmt: skip
     assert "veh-x" not in line
+
+
+# ------------------------------------------------------------------ items 14, 18
+def test_run_has_flags_for_an_impact_trial_and_controller_parameters() -> None:
+    from quadimpact.cli.run import build_scenario
+    from quadimpact.errors import InputError
+
+    flags = {"roll": 5.0, "pitch": -20.0, "yaw": 30.0, "speed": 1.5, "imu": "noisy",
+             "seed": 7, "start_distance": 0.4, "vehicle": "spiri"}  # fmt: skip
+    s = build_scenario(None, flags, kind="impact-trial", params=("k_att_1_s=25",))
+    assert (s.kind, s.roll_deg, s.pitch_deg, s.yaw_deg, s.speed_m_s) == (
+        "impact-trial", 5.0, -20.0, 30.0, 1.5)  # fmt: skip
+    assert (s.imu.preset, s.seed, s.start_distance_m, s.vehicle) == ("noisy", 7, 0.4, "spiri")
+    assert s.controller_params["k_att_1_s"] == 25
+    with pytest.raises(InputError, match="--yaw: applies to impact trials only"):
+        build_scenario(None, {"yaw": 3.0})
+    with pytest.raises(InputError, match="--heading: applies to wall-approach scenarios only"):
+        build_scenario(None, {"heading": 3.0}, kind="impact-trial")
+    with pytest.raises(InputError, match="--param: k_att_1_s: must be >= 0"):
+        build_scenario(None, {}, kind="impact-trial", params=("k_att_1_s=-1",))

@@ -41,6 +41,12 @@ _FLAGS: dict[str, tuple[str, str]] = {
     "output_rate": ("output_rate_hz", "--output-rate"),
     "rtol": ("rtol", "--rtol"),
     "atol": ("atol", "--atol"),
+    "roll": ("roll_deg", "--roll"),
+    "pitch": ("pitch_deg", "--pitch"),
+    "yaw": ("yaw_deg", "--yaw"),
+    "start_distance": ("start_distance_m", "--start-distance"),
+    "imu": ("imu", "--imu"),
+    "seed": ("seed", "--seed"),
 }
 _WALL_ONLY = {
     "heading_deg",
@@ -58,11 +64,12 @@ _OUTPUT_FILES = (
 )
 
 
-def _flag(flag: str, metavar: str | None, help: str) -> Any:
-    """A number flag of ``run``, also under its scenario file key (``--heading-deg``)."""
+def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
+    """A flag of ``run`` (a number by default), also named by its file key (``--roll-deg``)."""
     field = next(f for f, typed in _FLAGS.values() if typed == flag)
     alias = "--" + field.replace("_", "-")
-    return number_option(flag, metavar, help, alias=None if alias == flag else alias)
+    extra = {} if type is None else {"type": type}
+    return number_option(flag, metavar, help, alias=None if alias == flag else alias, **extra)
 
 
 @click.command("run")
@@ -94,6 +101,27 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
 )
 @_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
+    "--kind",
+    type=click.Choice(["wall-approach", "impact-trial"]),
+    help="Scenario kind without a file: the paper's wall approach, or an impact trial of "
+    "the recovery benchmark (the Navi 0.32 m from the wall at 5 m, docs/RECOVERY.md 5.1; "
+    "--roll, --pitch, --yaw, --speed, --start-distance, --altitude set it). A file sets "
+    "its own kind. [default: wall-approach]",
+)
+@_flag("--roll", "DEG", "Initial roll, deg (ZYX): an impact trial's, or a wall approach's "
+       "attitude instead of its heading/inclination mapping (with --pitch). [default: 0]")
+@_flag("--pitch", "DEG", "Initial pitch, deg in (-90, 90) (ZYX); the inclination toward the "
+       "wall is about -pitch. [default: 0]")
+@_flag("--yaw", "DEG", "Impact trial: initial yaw, deg in [-180, 180]. [default: 0]")
+@_flag("--start-distance", "M", "Impact trial: CM distance from the wall at the start, m; "
+       "no bumper may touch the wall then. [default: 0.32]")
+@_flag(
+    "--imu", "PRESET", "IMU preset: 'ideal' or 'noisy' (docs/RECOVERY.md 1.4). [default: ideal]",
+    type=click.Choice(["ideal", "noisy"]),
+)
+@_flag("--seed", "S", "Seed of the run's random draws (the IMU's noise and biases), an "
+       "integer >= 0. [default: 0]", type=click.IntRange(min=0, max=2**63 - 1))
+@click.option(
     "--model",
     type=MODEL,
     help="Model variant: 'default' is physically consistent; 'paper-replica' reproduces "
@@ -109,6 +137,15 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
     "Switches: yaw_reaction, spinup_reaction, bumper1_yaw_twice, initial_rotor_speeds, "
     "attitude_mapping, crash_rule, approach_start, detection_tick_reference, "
     "contact_gate_m, pre_impact (docs/VARIANTS.md).",
+)
+@click.option(
+    "--param",
+    "params",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="Set one parameter of the controller (repeatable), as [controller_params] of a "
+    "scenario file does, e.g. --controller recovery --param k_att_1_s=25 "
+    "(docs/RECOVERY.md 3.5, docs/CONTROLLERS.md).",
 )
 @click.option(
     "--controller",
@@ -171,6 +208,8 @@ def run(
     scenario: Path | None,
     out: Path,
     options: tuple[str, ...],
+    params: tuple[str, ...],
+    kind: str | None,
     viz: bool,
     max_record_mb: float,
     **flags: Any,
@@ -207,7 +246,7 @@ def run(
     from quadimpact.results.files import check_out_dir
     from quadimpact.simulation.checks import check_record_size
 
-    built = build_scenario(scenario, flags, options)
+    built = build_scenario(scenario, flags, options, params=params, kind=kind)
     check_record_size(built, max_record_mb, "--max-record-mb")
     check_out_dir(out, "run")
     vehicle = built.build_vehicle()
@@ -255,19 +294,24 @@ def _option_value(text: str) -> Any:
     return value if isinstance(value, (int, float, str, bool)) else text
 
 
-def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
-    """``NAME=VALUE`` pairs of ``--option`` to a dict (values read as in a file)."""
+def _parse_options(options: tuple[str, ...], flag: str = "--option") -> dict[str, Any]:
+    """``NAME=VALUE`` pairs of ``--option`` (``--param``) to a dict (values read as in a file)."""
     parsed: dict[str, Any] = {}
     for item in options:
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
-            raise InputError(f"--option: must be NAME=VALUE (got {item!r})")
+            raise InputError(f"{flag}: must be NAME=VALUE (got {item!r})")
         parsed[name.strip()] = _option_value(value.strip())
     return parsed
 
 
 def build_scenario(
-    scenario_path: Path | None, flags: Mapping[str, Any], options: tuple[str, ...] = ()
+    scenario_path: Path | None,
+    flags: Mapping[str, Any],
+    options: tuple[str, ...] = (),
+    *,
+    params: tuple[str, ...] = (),
+    kind: str | None = None,
 ) -> Any:
     """Build the scenario of a ``run``: the file's values, then the flags on top.
 
@@ -279,6 +323,10 @@ def build_scenario(
         Click parameter name -> value (``None``: not given).
     options : tuple of str
         ``NAME=VALUE`` model switches from ``--option``.
+    params : tuple of str, keyword
+        ``NAME=VALUE`` controller parameters from ``--param``.
+    kind : str, keyword
+        ``--kind``: the scenario kind without a file (a file's own kind must match).
 
     Returns
     -------
@@ -299,17 +347,34 @@ def build_scenario(
     data: dict[str, Any] = {}
     if scenario_path is not None:
         data = load_scenario_file(scenario_path).model_dump()
+        if kind is not None and data.get("kind", "wall-approach") != kind:
+            raise InputError(
+                f"--kind {kind}: {scenario_path} has kind = {data.get('kind')!r} (a file sets "
+                "its own kind; leave --kind out)"
+            )
+    elif kind is not None:
+        data = {"kind": kind}
     kind = data.get("kind", "wall-approach")
     cls = _KINDS[kind]
 
     given = {_FLAGS[key][0]: value for key, value in flags.items() if value is not None}
     rename = {field: flag for field, flag in _FLAGS.values()}
     for field in given:
-        if field in _WALL_ONLY and field not in cls.model_fields:
-            raise InputError(
-                f"{rename[field]}: applies to wall-approach scenarios only "
-                f"({scenario_path} has kind = {kind!r})"
-            )
+        if field not in cls.model_fields:
+            named = {"wall-approach": "a wall approach", "impact-trial": "an impact trial"}
+            where = (
+                f"{scenario_path} has kind = {kind!r}" if scenario_path
+                else named.get(kind, f"a {kind}")
+            )  # fmt: skip
+            if field in _WALL_ONLY:
+                rule = "applies to wall-approach scenarios only"
+            else:
+                rule = "applies to impact trials only (--kind impact-trial, or a file's kind)"
+            raise InputError(f"{rename[field]}: {rule} ({where})")
+    parsed_params: dict[str, Any] = {}
+    if params:
+        parsed_params = _parse_options(params, "--param")
+        data["controller_params"] = {**(data.get("controller_params") or {}), **parsed_params}
     if options:
         parsed = _parse_options(options)
         try:
@@ -322,6 +387,10 @@ def build_scenario(
         return cls.model_validate(data)
     except ValidationError as exc:
         loc = exc.errors()[0].get("loc", ())
+        text = str(input_error_from_validation(exc, "", model=cls))
+        name = text.removeprefix("controller_params.").partition(":")[0]
+        if params and text.startswith("controller_params.") and name in parsed_params:
+            raise InputError("--param: " + text.removeprefix("controller_params.")) from None
         if not loc and given:  # a cross-field rule (e.g. impact before final time)
             message = str(input_error_from_validation(exc))
             field = message.partition(":")[0]
@@ -397,7 +466,10 @@ def _response_type(summary: Mapping[str, Any], scenario: Any) -> str:
 
     kind = getattr(scenario, "kind", None)
     if scenario is not None and not response_type_applies(kind, getattr(scenario, "ground", None)):
-        why = f"a {kind} run" if kind != "wall-approach" else "no ground, so no crash rule"
+        words = {"impact-trial": "an impact trial", "flight": "a flight"}
+        why = words.get(kind, f"a {kind}") if kind != "wall-approach" else (
+            "no ground, so no crash rule"
+        )
         return f"n/a ({why}: the types A-D are defined for the wall approach with a crash rule)"
     rtype = summary.get("response_type")
     if not rtype:
