@@ -274,3 +274,22 @@ def test_run_has_flags_for_an_impact_trial_and_controller_parameters() -> None:
         build_scenario(None, {"heading": 3.0}, kind="impact-trial")
     with pytest.raises(InputError, match="--param: k_att_1_s: must be >= 0"):
         build_scenario(None, {}, kind="impact-trial", params=("k_att_1_s=-1",))
+
+
+# ------------------------------------------------------------------ item 16
+def test_the_flight_log_folder_used_is_said(tmp_path, monkeypatch) -> None:
+    from quadimpact.experiments import logs
+    from quadimpact.experiments.table3 import logs_source
+
+    data = tmp_path / "data"
+    (data / "spiri-crash-set-1").mkdir(parents=True)
+    monkeypatch.setenv(logs.DATA_ENV_VAR, str(data))
+    assert logs_source(None) == f"flight logs read from {data} (found: $QUADIMPACT_DATA)"
+    assert logs_source(data) == f"flight logs read from {data} (--data)"
+    monkeypatch.setenv(logs.DATA_ENV_VAR, str(tmp_path / "nothing"))
+    assert logs_source(None).startswith("no flight logs: $QUADIMPACT_DATA=")
+    from quadimpact.cli.experiments import experiments
+
+    data_help = next(p.help for p in experiments.params if p.name == "data")
+    assert "$QUADIMPACT_DATA" in data_help and "/work/shared/data" in data_help
+    assert "The folder used is printed" in data_help

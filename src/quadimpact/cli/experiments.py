@@ -23,8 +23,9 @@ from quadimpact.cli.options import (
 )
 @data_option(
     "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
-    "must hold the logs [default: $QUADIMPACT_DATA, else ../shared/data beside the "
-    "project; without them the comparisons with the logs are left out]."
+    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
+    "shared/data beside the checkout's folder, else /work/shared/data; without logs the "
+    "comparisons with them are left out] The folder used is printed."
 )
 @defaulted_option(
     "--samples",
@@ -62,12 +63,13 @@ def experiments(
     finished run (exit status 130, 143 for SIGTERM), saying how many; run the
     same command again to resume.
     """
-    from quadimpact.experiments.table3 import check_data_dir, run_experiments
+    from quadimpact.experiments.table3 import check_data_dir, logs_source, run_experiments
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "experiments")
     if data is not None:
         check_data_dir(data)
+    click.echo(f"quadimpact: {logs_source(data)}", err=True)
     announce_compilation()
     with stoppable(out):
         table = run_experiments(

@@ -32,8 +32,10 @@ from quadimpact.cli.options import (
     "the crashes with the recovery controller).",
 )
 @data_option(
-    "Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
-    "../shared/data beside the project]; without it the comparisons are left out."
+    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
+    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
+    "shared/data beside the checkout's folder, else /work/shared/data; without logs the "
+    "comparisons with them are left out] The folder used is printed."
 )
 @parallel_options
 def reproduce(
@@ -65,13 +67,15 @@ def reproduce(
     finished run (exit status 130, 143 for SIGTERM), saying how many; run the
     same command again to resume.
     """
-    from quadimpact.experiments.table3 import check_data_dir
+    from quadimpact.experiments.table3 import check_data_dir, logs_source
     from quadimpact.paper.study import reproduce as run_study
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "report")
     if data is not None and not no_experiments:
         check_data_dir(data)
+    if not no_experiments:
+        click.echo(f"quadimpact: {logs_source(data)}", err=True)
     announce_compilation()
 
     with stoppable(out):

@@ -143,7 +143,10 @@ def render_report(
                   f"![Snapshots after impact (the paper's Figure 8 times), {v}]"
                   f"(example-{v}/snapshots.png)", ""]  # fmt: skip
     if table3 is not None:
-        lines += ["## Table III: the seven real crashes", "", table3_markdown(table3), ""]
+        logs = table3.attrs.get("logs")
+        lines += ["## Table III: the seven real crashes", ""]
+        lines += [f"The {logs} (docs/EXPERIMENTS.md).", ""] if logs else []
+        lines += [table3_markdown(table3), ""]
     if recovery is not None:
         lines += [recovery_markdown(recovery, elapsed_s), ""]
     if stage_times:

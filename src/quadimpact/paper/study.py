@@ -202,6 +202,7 @@ def reproduce(
         TABLE3,
         check_data_dir,
         prepare_experiments,
+        logs_source,
         write_table3,
     )
     from quadimpact.results.files import check_out_dir
@@ -273,6 +274,8 @@ def reproduce(
     ablation_df = pd.DataFrame(ablation_rows)
     findings = findings_frame(found)
     table3 = write_table3(crash_rows, exp_out) if experiments else None
+    if table3 is not None:
+        table3.attrs["logs"] = logs_source(data_dir)  # said in the report's Table III
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
 
