@@ -93,3 +93,18 @@ def test_every_relative_link_resolves():
                 if path and not (page.parent / path).exists():
                     broken.append(f"{page.relative_to(ROOT)}:{n + 1}: {target}")
     assert not broken, "\n".join(broken)
+
+
+def test_no_tracked_symlink_points_outside_the_repository():
+    """Issue 20 item 17: the repository tracked .venv-int, a link to another checkout's venv."""
+    out = subprocess.run(["git", "ls-files", "-s"], cwd=ROOT, capture_output=True, text=True)
+    if out.returncode != 0:  # not a git checkout
+        return
+    links = [line.split("\t", 1)[1] for line in out.stdout.splitlines()
+             if line.startswith("120000 ")]  # fmt: skip
+    bad = []
+    for name in links:
+        target = (ROOT / name).resolve()
+        if not target.exists() or ROOT not in target.parents:
+            bad.append(name)
+    assert not bad, bad

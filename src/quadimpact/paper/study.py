@@ -201,8 +201,8 @@ def reproduce(
         SENSITIVITY_RUNS,
         TABLE3,
         check_data_dir,
-        prepare_experiments,
         logs_source,
+        prepare_experiments,
         write_table3,
     )
     from quadimpact.results.files import check_out_dir
