@@ -79,7 +79,8 @@ def announce_compilation() -> None:
 
     if not cache_is_warm():
         click.echo(
-            f"quadimpact: compiling the simulator (first run only, about {COMPILE_SECONDS} s) ...",
+            "quadimpact: compiling the simulator (first run only: about "
+            f"{COMPILE_SECONDS} s of CPU on a 2-core machine, more on a slower one) ...",
             err=True,
         )
 
