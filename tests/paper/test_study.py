@@ -110,3 +110,23 @@ def test_reproduce_tables_do_not_depend_on_the_processes(tmp_path, capsys):
             pd.read_parquet(tmp_path / "two" / name), pd.read_parquet(tmp_path / "one" / name)
         )
 
+
+
+def test_a_long_stage_of_pieces_is_never_silent(capsys, monkeypatch) -> None:
+    """Issue 20 item 20: make run printed nothing for ~85 s (a compile and the first piece)."""
+    import time
+
+    from quadimpact.paper.study import StageClock
+
+    monkeypatch.setattr(StageClock, "HEARTBEAT_S", 0.2)
+    clock = StageClock(progress=True)
+    clock.start("the paper's runs: 3 pieces on 2 processes", n_pieces=3)
+    time.sleep(1.6)
+    clock.piece("piece 1", 1.5)
+    clock.stop()
+    err = capsys.readouterr().err
+    assert "reproduce: the paper's runs: 3 pieces on 2 processes: still running (0 of 3 " \
+           "pieces done, 1 s so far)" in err  # fmt: skip
+    assert err.rstrip().endswith("s") and "piece 1: 1.5 s" in err
+    time.sleep(1.2)  # stopped: no more lines
+    assert capsys.readouterr().err == ""
