@@ -69,7 +69,6 @@ def experiments(
     check_out_dir(out, "experiments")
     if data is not None:
         check_data_dir(data)
-    click.echo(f"quadimpact: {logs_source(data)}", err=True)
     announce_compilation()
     with stoppable(out):
         table = run_experiments(
@@ -85,3 +84,4 @@ def experiments(
     )  # fmt: skip
     click.echo(shown.to_string(index=False, float_format="%.1f"))
     click.echo(f"table          {out / 'table3.csv'}")
+    click.echo(f"logs           {logs_source(data)}")

@@ -65,6 +65,18 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
 #: ``--help`` imports nothing heavy; a test checks that the two agree).
 MAX_RECORD_MB = 1024.0
 
+def max_record_option(help: str) -> Decorator:
+    """``--max-record-mb MB``: the largest record a run may allocate (``run``, ``sweep``)."""
+    return click.option(
+        "--max-record-mb",
+        type=FiniteFloat(min=0, min_open=True),
+        default=MAX_RECORD_MB,
+        show_default=True,
+        metavar="MB",
+        help=help,
+    )
+
+
 #: What a first run takes to compile the simulator (measured on 2 cores: 40 s of CPU).
 COMPILE_SECONDS = 40
 

@@ -74,8 +74,6 @@ def reproduce(
     check_out_dir(out, "report")
     if data is not None and not no_experiments:
         check_data_dir(data)
-    if not no_experiments:
-        click.echo(f"quadimpact: {logs_source(data)}", err=True)
     announce_compilation()
 
     with stoppable(out):
@@ -86,6 +84,8 @@ def reproduce(
         )  # fmt: skip
     f = result.findings
     click.echo(f"report         {result.report}")
+    if not no_experiments:
+        click.echo(f"logs           {logs_source(data)}")
     for variant, group in f.groupby("variant", sort=False):
         counts = group["verdict"].value_counts()
         click.echo(

@@ -11,11 +11,10 @@ import click
 
 from quadimpact.cli.options import (
     CONTROLLER,
-    MAX_RECORD_MB,
     MODEL,
-    FiniteFloat,
     announce_compilation,
     file_argument,
+    max_record_option,
     number_option,
     out_option,
 )
@@ -189,14 +188,9 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "Output folder (created if needed). A folder holding an earlier run is replaced: its "
     "files and the pictures drawn from it go; one holding anything else is refused.",
 )
-@click.option(
-    "--max-record-mb",
-    type=FiniteFloat(min=0, min_open=True),
-    default=MAX_RECORD_MB,
-    show_default=True,
-    metavar="MB",
-    help="Largest record (time series and IMU samples: final time x output rate) the run "
-    "may allocate; a larger one is refused before it starts, with its estimate.",
+@max_record_option(
+    "Largest record (time series and IMU samples: final time x output rate) the run "
+    "may allocate; a larger one is refused before it starts, with its estimate."
 )
 @click.option(
     "--viz",

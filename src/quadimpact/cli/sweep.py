@@ -11,10 +11,9 @@ from pathlib import Path
 import click
 
 from quadimpact.cli.options import (
-    MAX_RECORD_MB,
-    FiniteFloat,
     announce_compilation,
     file_argument,
+    max_record_option,
     parallel_options,
     stoppable,
 )
@@ -76,14 +75,9 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
     is_flag=True,
     help="Allow a sweep of more than 1,000,000 runs (refused otherwise).",
 )
-@click.option(
-    "--max-record-mb",
-    type=FiniteFloat(min=0, min_open=True),
-    default=MAX_RECORD_MB,
-    show_default=True,
-    metavar="MB",
-    help="Largest record (time series and IMU samples) one run may allocate; a run above "
-    "it is refused before any starts.",
+@max_record_option(
+    "Largest record (time series and IMU samples) one run may allocate; a run above "
+    "it is refused before any starts."
 )
 @click.option("--no-plots", is_flag=True, help="Do not write plots/.")
 def sweep(
