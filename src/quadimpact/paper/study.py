@@ -164,9 +164,10 @@ class StageClock:
             done = (
                 f"{self._done_pieces} of {self._n_pieces} pieces done, " if self._n_pieces else ""
             )
+            compiling = "" if self._done_pieces else "; a first run compiles the simulator first"
             self._say(
                 f"{current[0]}: still running ({done}{time.perf_counter() - current[1]:.0f} s "
-                "so far)"
+                f"so far{compiling})"
             )
 
     def piece(self, text: str, seconds: float) -> None:
@@ -282,8 +283,7 @@ def reproduce(
         clock.start(f"the paper's runs: {len(pieces)} pieces on {min(processes, len(pieces))} "
                     "processes (Figure 4 and the example in both variants"
                     + (", the ablations" if ablation else "")
-                    + (", the crashes of Table III" if experiments else "")
-                    + "; each takes 10-30 s, and a first run compiles the simulator first)",
+                    + (", the crashes of Table III" if experiments else "") + ")",
                     n_pieces=len(pieces))  # fmt: skip
 
         def done(k: int, result: tuple[Any, float]) -> None:
