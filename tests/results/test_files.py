@@ -40,9 +40,9 @@ def make_timeseries(n: int = 50) -> pd.DataFrame:
 
 def make_episodes() -> pd.DataFrame:
     raw = np.zeros((3, L.NEP))
-    raw[0, [L.E_BUMPER, L.E_SURFACE, L.E_T_START, L.E_T_END]] = [3, 0, 0.5, 0.52]
+    raw[0, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END]] = [3, 0, 0.5, 0.52]
     raw[0, [L.E_V_I, L.E_PEAK_DELTA, L.E_PEAK_FORCE]] = [0.75, 0.0312345678901234, 50.5]
-    raw[1, [L.E_BUMPER, L.E_SURFACE, L.E_T_START, L.E_T_END, L.E_OPEN]] = [1, 1, 0.9, 1.0, 1]
+    raw[1, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END, L.E_OPEN]] = [1, 1, 0.9, 1.0, 1]
     raw[1, L.E_V_I] = np.nan
     return episodes_frame(raw, 2, ["wall", "ground"])
 
@@ -310,7 +310,10 @@ def test_check_out_dir_says_what_is_wrong_in_one_line(tmp_path: Path) -> None:
     assert folder_kind(tmp_path / "run") == ("run", ["summary.json"])
     with pytest.raises(InputError, match="holds a run .*this sweep's own folder"):
         check_out_dir(tmp_path / "run", "sweep")
-    assert check_out_dir(tmp_path, "sweep") == tmp_path  # a sweep may go among other files
+    # one rule for every kind (issue 20 item 8): no output among files that are not quadimpact's
+    for kind in ("sweep", "recovery", "report", "experiments", "run"):
+        with pytest.raises(InputError, match="holds files that are not quadimpact's"):
+            check_out_dir(tmp_path, kind)
 
 
 def test_a_one_sample_run_is_plotted_without_warnings(tmp_path: Path) -> None:
