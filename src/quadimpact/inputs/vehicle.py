@@ -263,18 +263,18 @@ class Vehicle(BaseModel):
                 "rotor_positions_m: rotor arms (horizontal distance from the CM) must lie in "
                 f"[0.005, 5] m (got {arms.min():.4g} to {arms.max():.4g} m)"
             )
-        if self.bumper_radius_m >= arms.min():
+        if self.features is None and self.bumper_radius_m >= arms.min():
             raise ValueError(
                 f"bumper_radius_m: {self.bumper_radius_m:g} m is not less than the shortest "
                 f"rotor arm ({arms.min():.3g} m): a bumper ring around a rotor would enclose "
                 "the CM and cross the other rotors (each bumper is a circle around one rotor)"
             )
-        reach = float(np.linalg.norm(np.asarray(self.rotor_positions_m, float), axis=1).max())
+        reach = self.reach_m()
         imu = float(np.linalg.norm(np.asarray(self.imu_position_m, dtype=float)))
-        if imu > reach + self.bumper_radius_m:
+        if imu > reach:
             raise ValueError(
                 f"imu_position_m: {imu:.3g} m from the CM, off the vehicle (its rotors and "
-                f"bumpers reach {reach + self.bumper_radius_m:.3g} m): the IMU must sit on it"
+                f"bumpers reach {reach:.3g} m): the IMU must sit on it"
             )
         hover_rpm = self.hover_speed_rad_s * 60.0 / (2.0 * math.pi)
         lo, hi = self.rotor_speed_range_rpm
@@ -418,6 +418,15 @@ class Vehicle(BaseModel):
     def feature_names(self) -> tuple[str, ...]:
         """Names of :meth:`contact_features`, in order (the output columns' suffixes)."""
         return tuple(f.name for f in self.contact_features())
+
+    def reach_m(self) -> float:
+        """How far the vehicle reaches from its CM, m: the longest rotor arm plus the bumper
+        radius, or the farthest of its rotors and its features' extents."""
+        arm = float(np.linalg.norm(np.asarray(self.rotor_positions_m, float), axis=1).max())
+        if self.features is None:
+            return arm + float(self.bumper_radius_m)
+        extents = [float(np.linalg.norm(f.centre_m)) + float(f.radius_m) for f in self.features]
+        return max([arm, *extents])
 
     def valid_depth_m(self) -> float:
         """Deepest penetration the contact model covers, m: the shallowest feature's limit.

@@ -105,7 +105,7 @@ class Cylinder(BaseModel):
     name: str = Field(min_length=1, description="Label of the obstacle in results.")
     point_m: Vec3 = Field(description="A point of the axis (a finite one's centre), NED, m.")
     axis: Vec3 = Field((0.0, 0.0, 1.0), description="Axis direction (normalised).")
-    radius_m: Real = Field(gt=0, le=100, description="Radius, m.")
+    radius_m: Real = Field(gt=0, le=1e4, description="Radius, m.")
     length_m: Real | None = Field(None, gt=0, description="Length, m; None: infinite.")
 
     @field_validator("axis")

@@ -155,8 +155,10 @@ class PoleStudy:
             raise InputError(f"{where}: obstacles: must list at least one [[obstacles]] table")
         out = []
         for i, item in enumerate(items):
+            name = item.get("name") if isinstance(item, dict) else None
+            label = f"obstacle {i + 1}" + (f" ({name!r})" if isinstance(name, str) else "")
             try:
-                obstacle_from(item, f"obstacle {i + 1}")
+                obstacle_from(item, label)
             except ValueError as exc:
                 raise InputError(f"{where}: obstacles: {exc}") from None
             out.append(dict(item))

@@ -84,8 +84,7 @@ def check_imu(setup: Any) -> None:
         return
     vehicle = setup.vehicle
     position = np.asarray(scfg[L.SC_POS : L.SC_POS + 3], dtype=float)
-    arms = np.linalg.norm(vehicle.rotor_positions, axis=1)
-    reach = float(arms.max()) + float(vehicle.bumper_radius_m)
+    reach = vehicle.reach_m()
     distance = float(np.linalg.norm(position))
     if distance > reach:
         shown = ", ".join(f"{c:g}" for c in position)
