@@ -306,8 +306,13 @@ class SimulationResult:
 #: The parts of ``scenario.json`` and the JSON kind each must have (absent: allowed).
 _WORLD_PARTS = {"scenario": (dict, type(None)), "resolved": (dict,), "vehicle": (dict,),
                 "surfaces": (list,)}  # fmt: skip
-#: The keys every surface record has (``simulation.packing.surface_records``).
+#: The keys every surface record has, by kind (``simulation.packing.surface_records``).
 _SURFACE_KEYS = ("name", "point_m", "normal", "is_ground", "kind")
+_SHAPE_KEYS = {
+    "plane": _SURFACE_KEYS,
+    "cylinder": ("name", "kind", "point_m", "axis", "radius_m", "length_m", "is_ground"),
+    "box": ("name", "kind", "centre_m", "half_extents_m", "axes", "is_ground"),
+}
 
 
 def _check_world(world: dict, path: Path) -> None:
@@ -320,10 +325,12 @@ def _check_world(world: dict, path: Path) -> None:
                 "is damaged or was not written by quadimpact"
             )
     for i, surface in enumerate(world.get("surfaces") or []):
-        missing = [k for k in _SURFACE_KEYS if not isinstance(surface, dict) or k not in surface]
+        kind = surface.get("kind", "plane") if isinstance(surface, dict) else "plane"
+        keys = _SHAPE_KEYS.get(kind, _SURFACE_KEYS)
+        missing = [k for k in keys if not isinstance(surface, dict) or k not in surface]
         if missing:
             raise InputError(
-                f"{path}: surfaces.{i}: must be a surface record with {', '.join(_SURFACE_KEYS)} "
+                f"{path}: surfaces.{i}: must be a surface record with {', '.join(keys)} "
                 f"(missing {', '.join(missing)}): the file is damaged or was not written by "
                 "quadimpact"
             )
