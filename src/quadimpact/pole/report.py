@@ -59,7 +59,11 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         "",
         f"{run['n_runs']} runs ({run['n_ran']} run now in {run['sweep_s']:.1f} s, "
         f"{run['backend']}; {run['n_already_done']} done before); the whole study "
-        f"{description['elapsed_s']:.1f} s.",
+        f"{description['elapsed_s']:.1f} s this time."
+        + "".join(
+            f" Earlier: {h['n_ran']} runs in {h['sweep_s']:.1f} s ({h['backend']})."
+            for h in description.get("sweeps", [])[: -1 if run["n_ran"] else None]
+        ),
         "",
         "## The two controllers",
         "",
@@ -99,10 +103,15 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         f"{fl['not_detected']} touched it without the detector firing.",
         f"- Stage reached: none {stage['0']}, stage 1 (tilting away) {stage['1']}, stage 2 "
         f"{stage['2']}, stage 3 (level, braking the descent) {stage['3']}, stage 4 "
-        f"(recovered, then fell) {stage['4']}.",
+        f"(levelled and braked, but too late: 2 m or more already lost) {stage['4']}.",
         f"- Largest tilt after the detection: {_spread(fl['max_tilt_deg'], 'deg', digits=0)};"
-        f" {fl['flipped']} turned past 90 deg (upside down).",
-        f"- {fl['impacts_after_detection']} hit the obstacle again after the detection.",
+        f" {fl['flipped']} turned past 90 deg (upside down); in the successes "
+        f"{_spread(fl['max_tilt_deg_successes'], 'deg', digits=0)}.",
+        f"- {fl['impacts_after_detection']} hit the obstacle again after the detection: "
+        f"{_spread(fl['impacts_after_detection_failures'], 'impacts', digits=0)} against "
+        f"{_spread(fl['impacts_after_detection_successes'], 'impacts', digits=0)} in the "
+        "successes.",
+        f"- Stage 4 entered, when it was: {_spread(fl['t_stage4_failures_s'], 's')}.",
         f"- The first contact's normal: its sideways part |n_Y| is "
         f"{_spread(fl['lateral_normal_failures'], '')} in the failures against "
         f"{_spread(fl['lateral_normal_successes'], '')} in the successes; the detector's "
@@ -139,9 +148,11 @@ def _explain(fl: dict[str, Any], arms: dict[str, Any]) -> str:
         )
     if fl["impacts_after_detection"] >= 0.3 * n:
         parts.append(
-            "Many hit the pole again after the detection: tilting away from an estimated "
-            "normal that is not the pole's (a glancing, off-centre contact) swings a rotor "
-            "back into it."
+            "Many hit the obstacle again and again after the detection: a pole is not a wall, "
+            "so tilting 45 deg away from the first contact's normal (the detector's estimate) "
+            "does not take the vehicle clear of it: the rotor arms swing around the pole and "
+            "the body tumbles against it while it falls, and the staged law levels the vehicle "
+            "(stage 4) only once it has slid off, metres lower."
         )
     if fl["not_detected"] >= 0.3 * n:
         parts.append(

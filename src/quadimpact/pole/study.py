@@ -323,6 +323,16 @@ def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
         "impacts_after_detection": int(
             (pd.to_numeric(fail["impacts_after_detection"], errors="coerce") > 0).sum()
         ),
+        "impacts_after_detection_failures": spread(
+            pd.to_numeric(fail["impacts_after_detection"], errors="coerce")
+        ),
+        "impacts_after_detection_successes": spread(
+            pd.to_numeric(rec[r_ok]["impacts_after_detection"], errors="coerce")
+        ),
+        "max_tilt_deg_successes": spread(
+            pd.to_numeric(rec[r_ok]["max_tilt_deg"], errors="coerce").to_numpy(dtype=float)
+        ),
+        "t_stage4_failures_s": spread(pd.to_numeric(fail["t_stage4_s"], errors="coerce")),
         "abs_pitch_deg": spread(abs_pitch),
         "abs_offset_m": spread(np.abs(offsets)),
         "max_tilt_deg": spread(tilt),
@@ -383,6 +393,7 @@ def run_pole_study(
         "study": study.options(),
         "grid": {"pitch_deg": len(study.pitches()), "lateral_offset_m": len(study.offsets())},
         "run": run,
+        "sweeps": _sweep_history(out, run),
         "elapsed_s": elapsed,
         "numbers": numbers,
     }
@@ -392,6 +403,20 @@ def run_pole_study(
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
     atomic_write(report_path, lambda tmp: tmp.write_text(md, encoding="utf-8"))
     return PoleResult(out, table, numbers, report_path, paths, info, elapsed)
+
+
+def _sweep_history(out: Path, run: dict[str, Any]) -> list[dict[str, Any]]:
+    """The invocations that ran trials of this study (``study.json``'s, then this one's)."""
+    history: list[dict[str, Any]] = []
+    path = out / STUDY_JSON
+    if run["n_already_done"] and path.is_file():
+        try:
+            history = list(json.loads(path.read_text(encoding="utf-8")).get("sweeps") or [])
+        except (OSError, ValueError):
+            history = []
+    if run["n_ran"]:
+        history.append({k: run[k] for k in ("n_ran", "sweep_s", "backend")})
+    return history
 
 
 def _jsonable(value: Any) -> Any:
