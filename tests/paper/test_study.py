@@ -17,6 +17,8 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     # in full)
     monkeypatch.setattr(study, "RECOVERY_N", 40)
     monkeypatch.setattr(study, "RECOVERY_COMPARE_N", 20)
+    # the pole at 2 x 3 points instead of 10 x 15
+    monkeypatch.setattr(study, "POLE_GRID", {"pitch_step_deg": 45.0, "offset_step_m": 0.35})
     r = reproduce(tmp_path, ablation=False, experiments=False, workers=2, progress=True)
     err = capsys.readouterr().err.splitlines()
     timed = re.compile(r"^reproduce: (.+): (\d+\.\d) s$")  # a stage's or a piece's end
@@ -41,6 +43,7 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
         "reproduce: recovery: the Figure 4 grid with the recovery controller, paper-replica",
         "reproduce: recovery: the Figure 4 grid with the recovery controller, default",
         "reproduce: recovery: the crashes without their power-off, nominal and recovery",
+        "reproduce: the pole: 6 grid points, without and with recovery",
         "reproduce: figures, tables and the report",
     ]
     assert err[err.index(stages[1]) + 1] == "sweep: 40 runs to do"  # each sweep is named
@@ -76,6 +79,8 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     # beyond the paper: recovery, its numbers those of its tables
     part = r.recovery
     assert "## Beyond the paper: recovery" in text and "(40 trials per variant)" in text
+    assert "## Beyond the paper: the pole" in text and (tmp_path / "pole" / "maps.png").is_file()
+    assert r.pole.numbers["n_points"] == 6
     for variant, numbers in part.monte_carlo.items():
         assert f"| {variant} | 40 | {rate_text(numbers['success'])} |" in text
     trials = pd.read_parquet(tmp_path / "recovery_trials.parquet")
@@ -110,7 +115,6 @@ def test_reproduce_tables_do_not_depend_on_the_processes(tmp_path, capsys):
         pd.testing.assert_frame_equal(
             pd.read_parquet(tmp_path / "two" / name), pd.read_parquet(tmp_path / "one" / name)
         )
-
 
 
 def test_a_long_stage_of_pieces_is_never_silent(capsys, monkeypatch) -> None:
