@@ -49,7 +49,14 @@ def flight_result():
 
 def test_the_world_holds_the_whole_scenario_resolved(flight_result) -> None:
     w = flight_result.world
-    assert set(w) == {"scenario", "resolved", "vehicle", "surfaces", "quadimpact_version"}
+    assert set(w) == {
+        "scenario",
+        "resolved",
+        "vehicle",
+        "surfaces",
+        "features",
+        "quadimpact_version",
+    }
     # every field of the validated scenario, and it validates back to the same scenario
     assert w["scenario"] == FLIGHT.model_dump(mode="json")
     again = scenario_from_dict(w["scenario"])

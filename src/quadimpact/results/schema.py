@@ -38,20 +38,25 @@ BUMPERS: tuple[int, ...] = (1, 2, 3, 4)
 def feature_columns(columns) -> list[tuple[str, str, str]]:
     """(feature name, deflection column, force column) of a time series, in column order.
 
-    A ring vehicle's are ``("1", "delta1_m", "force1_n")`` to ``"4"``; a
-    vehicle with named features has ``delta_<name>_m`` and ``force_<name>_n``
-    (``quadimpact.inputs.features.feature_column``).
+    A ring vehicle's are ``("1", "delta1_m", "force1_n")`` to ``"4"`` (all
+    four as soon as one numbered column is there, so that a missing bumper's
+    column is named); a vehicle with named features has ``delta_<name>_m`` and
+    ``force_<name>_n`` (``quadimpact.inputs.features.feature_column``).
     """
     import re
 
-    names = []
+    found = []
     for c in columns:
         m = re.fullmatch(r"delta(\d+)_m|delta_(\w+)_m", str(c))
         if m and str(c) != "delta_init_m":
-            name = m.group(1) or m.group(2)
-            force = f"force{name}_n" if name.isdigit() else f"force_{name}_n"
-            names.append((name, str(c), force))
-    return names
+            found.append(m.group(1) or m.group(2))
+    if any(name.isdigit() for name in found):  # the four bumpers are all there, or missed
+        numbered = sorted({int(n) for n in found if n.isdigit()} | set(BUMPERS))
+        found = [str(j) for j in numbered] + [n for n in found if not n.isdigit()]
+    return [
+        (n, f"delta{n}_m", f"force{n}_n") if n.isdigit() else (n, f"delta_{n}_m", f"force_{n}_n")
+        for n in found
+    ]
 
 
 @dataclass(frozen=True)
