@@ -112,7 +112,6 @@ def test_reproduce_tables_do_not_depend_on_the_processes(tmp_path, capsys):
         )
 
 
-
 def test_a_long_stage_of_pieces_is_never_silent(capsys, monkeypatch) -> None:
     """Issue 20 item 20: make run printed nothing for ~85 s (a compile and the first piece)."""
     import time
