@@ -429,9 +429,7 @@ class Vehicle(BaseModel):
                 known = ", ".join(type(self).model_fields)
                 close = near_miss(str(key), list(type(self).model_fields))
                 hint = f"; did you mean {close!r}?" if close else ""
-                raise InputError(
-                    f"{where}: {field}: unknown vehicle field{hint} (known: {known})"
-                )
+                raise InputError(f"{where}: {field}: unknown vehicle field{hint} (known: {known})")
         try:
             key = (id(self), json.dumps(fields, sort_keys=True, default=repr))
         except (TypeError, ValueError):

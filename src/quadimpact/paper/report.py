@@ -241,7 +241,8 @@ def _crashes_markdown(crashes: pd.DataFrame) -> list[str]:
     for r in crashes.itertuples():
         t4 = "–" if r.t_stage4_s is None or r.t_stage4_s != r.t_stage4_s else f"{r.t_stage4_s:.3f}"
         hl = (
-            "–" if r.height_loss_m is None or r.height_loss_m != r.height_loss_m
+            "–"
+            if r.height_loss_m is None or r.height_loss_m != r.height_loss_m
             else f"{r.height_loss_m:.2f}"
         )
         lines.append(
@@ -259,7 +260,7 @@ def _crashes_markdown(crashes: pd.DataFrame) -> list[str]:
 
 
 def recovery_markdown(part: Any, elapsed_s: float) -> str:
-    """"Beyond the paper: recovery" from the study's ``RecoveryPart``."""
+    """ "Beyond the paper: recovery" from the study's ``RecoveryPart``."""
     mc = part.monte_carlo
     n_mc = next(iter(mc.values()))["n"]
     n_cmp = next(iter(part.compare.values()))["n"]
@@ -296,7 +297,7 @@ def recovery_markdown(part: Any, elapsed_s: float) -> str:
         "",
         "### Nominal against recovery on the Figure 4 grid (Spiri)",
         "",
-        "The same 246 wall approaches with `controller = \"recovery\"`: the paper's "
+        'The same 246 wall approaches with `controller = "recovery"`: the paper\'s '
         "controller until the impact is detected, then the staged law (the Spiri's file has no "
         "slew limit and none is added here). *Saved*: no crash and stage 4 reached.",
         "",
@@ -355,9 +356,13 @@ def _motion_note(r: pd.Series, threshold_deg: float) -> str:
             continue
         moved.append((angle, float(sim), float(log)))
     if moved:
-        note += " In that time the log turns " + ", ".join(
-            f"{a} {lg:+.0f}°" for a, _, lg in moved
-        ) + "; ours " + ", ".join(f"{a} {sm:+.0f}°" for a, sm, _ in moved) + "."
+        note += (
+            " In that time the log turns "
+            + ", ".join(f"{a} {lg:+.0f}°" for a, _, lg in moved)
+            + "; ours "
+            + ", ".join(f"{a} {sm:+.0f}°" for a, sm, _ in moved)
+            + "."
+        )
         opposite = [a for a, sm, lg in moved if sm * lg < 0 and min(abs(sm), abs(lg)) > 5.0]
         if opposite:
             verb = "turns" if len(opposite) == 1 else "turn"

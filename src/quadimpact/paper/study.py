@@ -69,7 +69,8 @@ FIG4_GRID: dict[str, list[float]] = {
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
 VARIANTS = ("paper-replica", "default")
 SWITCHES = tuple(
-    k for k in MODEL_VARIANTS["default"]
+    k
+    for k in MODEL_VARIANTS["default"]
     if MODEL_VARIANTS["default"][k] != MODEL_VARIANTS["paper-replica"][k]
 )  # the paper replica's six differences (its other switches are the default's)
 #: Trials of the Navi's recovery Monte Carlo in each variant (reduced from the study's 10,000).
@@ -331,8 +332,9 @@ def reproduce(
     elapsed = time.perf_counter() - start
     report = out / "report.md"
     report.write_text(
-        render_report(tables, findings, ablation_df, elapsed, table3, part, clock.times,
-                      clock.pieces)  # fmt: skip
+        render_report(
+            tables, findings, ablation_df, elapsed, table3, part, clock.times, clock.pieces
+        )  # fmt: skip
     )
     return StudyResult(
         out, report, tables, findings, ablation_df, elapsed, part, clock.times, clock.pieces

@@ -83,7 +83,6 @@ MAX_TEXT_CELLS = 400
 """Type maps write each cell's text up to this many cells per panel."""
 
 
-
 def new_figure(
     width_in: float, height_in: float, margins: Mapping[str, float] | None = None
 ) -> Figure:

@@ -407,16 +407,11 @@ def check_out_dir(
         "run": "a new or empty folder, or a run folder (whose run it replaces)",
         "sweep": "a new or empty folder, or this sweep's own folder (to resume it)",
     }.get(kind, f"a new or empty folder, or a folder of {_KIND_WORDS[kind]} (to resume it)")
-    raise InputError(
-        f"{label}: holds {_KIND_WORDS[held]} ({', '.join(names)}); "
-        f"use {advice}"
-    )
+    raise InputError(f"{label}: holds {_KIND_WORDS[held]} ({', '.join(names)}); use {advice}")
 
 
 @contextlib.contextmanager
-def staged_folder(
-    path: str | os.PathLike[str], replaces: tuple[str, ...] = ()
-) -> Iterator[Path]:
+def staged_folder(path: str | os.PathLike[str], replaces: tuple[str, ...] = ()) -> Iterator[Path]:
     """Write a folder completely, then move it into place (never a half-written folder).
 
     Yields a new hidden folder beside ``path`` (``.<name>.partial-<pid>-<random>``,
@@ -493,9 +488,7 @@ def read_summary_json(path: str | os.PathLike[str]) -> dict[str, Any]:
         return json.load(fh)
 
 
-def write_episodes_csv(
-    df: pd.DataFrame | Mapping[str, Any], path: str | os.PathLike[str]
-) -> Path:
+def write_episodes_csv(df: pd.DataFrame | Mapping[str, Any], path: str | os.PathLike[str]) -> Path:
     """Write the episodes table to CSV, atomically.
 
     Columns :data:`EPISODES_LEADING_COLUMNS` come first (those present), then

@@ -331,6 +331,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         )
     return setup
 
+
 # ---------------------------------------------------------------- impact trial
 def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     """The recovery benchmark's trial (docs/RECOVERY.md 5): the wall ``X = 0``, no shooting.

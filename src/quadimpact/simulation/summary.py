@@ -235,8 +235,6 @@ def _obstacle_names(setup: RunSetup) -> list[str]:
     return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, L.SH_IS_GROUND] < 0.5]
 
 
-
-
 def describe_outcome(s: dict[str, Any]) -> str:
     """One sentence saying what the run did after the first impact."""
     if s["status"] == "failed":
