@@ -82,7 +82,8 @@ def after_recovery(rows: list[dict]) -> dict:
         "recovered": len(rec),
         "inside_envelope_to_the_end": len(kept),
         "median_final_speed_m_s": float(np.median([r["final_speed_m_s"] for r in kept]))
-        if kept else math.nan,
+        if kept
+        else math.nan,
         "outcomes": {o: sum(r["outcome"] == o for r in rec) for o in {r["outcome"] for r in rec}},
     }
 
@@ -171,12 +172,20 @@ def main() -> None:
     ap.add_argument("--envs", type=int, default=64, help="trials stepped together")
     ap.add_argument("--eval", type=int, default=500, help="held-out evaluation trials")
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--run-to-end", action="store_true",
-                    help="train without ending episodes at the recovery (end_on_recovery=False)")
-    ap.add_argument("--load", default=None,
-                    help="evaluate a saved model (ppo_recovery.zip) instead of training")
-    ap.add_argument("--threads", type=int, default=1,
-                    help="PyTorch threads (more than 1 is much slower on a busy 2-core machine)")
+    ap.add_argument(
+        "--run-to-end",
+        action="store_true",
+        help="train without ending episodes at the recovery (end_on_recovery=False)",
+    )
+    ap.add_argument(
+        "--load", default=None, help="evaluate a saved model (ppo_recovery.zip) instead of training"
+    )
+    ap.add_argument(
+        "--threads",
+        type=int,
+        default=1,
+        help="PyTorch threads (more than 1 is much slower on a busy 2-core machine)",
+    )
     args = ap.parse_args()
 
     import torch
@@ -242,14 +251,20 @@ def main() -> None:
     table = [
         summarise("PPO (learned)", evaluate_in_env(learned, trials)),
         summarise("staged controller (simulate: its own stages)", simulate_batch(trials)),
-        summarise("staged controller through the env, judged by the observer (rotors)",
-                  evaluate_in_env(staged_observed, trials, action="rotors")),
-        summarise("hover speeds, no correction (rotors)",
-                  evaluate_in_env(E.HoverPolicy, trials, action="rotors")),
-        summarise("hover thrust, zero rate references (ctbr)",
-                  evaluate_in_env(E.HoverPolicy, trials)),
-        summarise("random actions (ctbr)",
-                  evaluate_in_env(lambda v: E.RandomPolicy(v, seed=1), trials)),
+        summarise(
+            "staged controller through the env, judged by the observer (rotors)",
+            evaluate_in_env(staged_observed, trials, action="rotors"),
+        ),
+        summarise(
+            "hover speeds, no correction (rotors)",
+            evaluate_in_env(E.HoverPolicy, trials, action="rotors"),
+        ),
+        summarise(
+            "hover thrust, zero rate references (ctbr)", evaluate_in_env(E.HoverPolicy, trials)
+        ),
+        summarise(
+            "random actions (ctbr)", evaluate_in_env(lambda v: E.RandomPolicy(v, seed=1), trials)
+        ),
     ]
     eval_s = time.perf_counter() - t1
     result = {

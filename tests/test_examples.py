@@ -31,7 +31,7 @@ def test_every_example_runs(path: Path) -> None:
 
 def test_the_flight_fields_are_documented() -> None:
     text = (ROOT / "docs/STUDIES.md").read_text(encoding="utf-8")
-    section = text[text.index("## 7. Flights"):]
+    section = text[text.index("## 7. Flights") :]
     table = set(re.findall(r"^\| `\[*(\w+)\]*` \|", section, flags=re.M))
     own = set(FlightScenario.model_fields) - set(FlightScenario.__mro__[1].model_fields)
     assert own <= table | {"kind"}, own - table

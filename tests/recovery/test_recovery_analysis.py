@@ -184,7 +184,6 @@ def test_invalid_and_below_ground_trials_are_classed_and_left_out_of_the_rates()
     from quadimpact.recovery.report import excluded_text
 
     assert excluded_text(n) == (
-        "3 of 6 trials (1 invalid: started in contact, 1 invalid: bumper model exceeded, "
-        "1 failed)"
+        "3 of 6 trials (1 invalid: started in contact, 1 invalid: bumper model exceeded, 1 failed)"
     )
     assert excluded_text(analysis.summarise(_table([_row()]))) == "none (all 1 trials valid)"

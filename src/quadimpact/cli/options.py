@@ -65,6 +65,7 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
 #: ``--help`` imports nothing heavy; a test checks that the two agree).
 MAX_RECORD_MB = 1024.0
 
+
 def max_record_option(help: str) -> Decorator:
     """``--max-record-mb MB``: the largest record a run may allocate (``run``, ``sweep``)."""
     return click.option(
@@ -193,9 +194,7 @@ def result_dir_argument(command: Callable[..., Any]) -> Callable[..., Any]:
 
 def data_option(help: str) -> Decorator:
     """``--data FOLDER``: the crash set's flight data."""
-    return click.option(
-        "--data", type=click.Path(file_okay=False, path_type=Path), help=help
-    )
+    return click.option("--data", type=click.Path(file_okay=False, path_type=Path), help=help)
 
 
 def out_option(default: str, help: str) -> Decorator:

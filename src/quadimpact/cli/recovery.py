@@ -131,11 +131,13 @@ def _summary(result) -> str:
         ("trials", f"{numbers['n']} ({ran})"),
         ("success", f"{rate_text(numbers['success'])} (recovered / valid trials, 95 % Wilson)"),
         ("excluded", excluded_text(numbers)),
-        ("if detected", f"{rate_text(numbers['success_detected'])} (recovered / detected "
-                        "impacts)"),
-        ("other", f"recovered below ground level {c['recovered below ground level']} (not "
-                  f"successes), not detected {c['not detected']}, false detections "
-                  f"{c['false detection']}"),
+        ("if detected", f"{rate_text(numbers['success_detected'])} (recovered / detected impacts)"),
+        (
+            "other",
+            f"recovered below ground level {c['recovered below ground level']} (not "
+            f"successes), not detected {c['not detected']}, false detections "
+            f"{c['false detection']}",
+        ),
         ("table", str(result.out_dir / "trials.parquet")),
         ("report", str(result.report)),
         ("time", f"{result.elapsed_s:.1f} s"),

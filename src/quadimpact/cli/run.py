@@ -88,16 +88,11 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
 @_flag(
     "--speed",
     "M/S",
-    "Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. "
-    "[default: 0.75]",
+    "Speed of the centre of mass toward the wall at first contact, m/s in (0, 20]. [default: 0.75]",
 )
-@_flag(
-    "--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]"
-)
+@_flag("--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]")
 @_flag("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
-@_flag(
-    "--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]"
-)
+@_flag("--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]")
 @_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--kind",
@@ -107,19 +102,37 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "--roll, --pitch, --yaw, --speed, --start-distance, --altitude set it). A file sets "
     "its own kind. [default: wall-approach]",
 )
-@_flag("--roll", "DEG", "Initial roll, deg (ZYX): an impact trial's, or a wall approach's "
-       "attitude instead of its heading/inclination mapping (with --pitch). [default: 0]")
-@_flag("--pitch", "DEG", "Initial pitch, deg in (-90, 90) (ZYX); the inclination toward the "
-       "wall is about -pitch. [default: 0]")
-@_flag("--yaw", "DEG", "Impact trial: initial yaw, deg in [-180, 180]. [default: 0]")
-@_flag("--start-distance", "M", "Impact trial: CM distance from the wall at the start, m; "
-       "no bumper may touch the wall then. [default: 0.32]")
 @_flag(
-    "--imu", "PRESET", "IMU preset: 'ideal' or 'noisy' (docs/RECOVERY.md 1.4). [default: ideal]",
+    "--roll",
+    "DEG",
+    "Initial roll, deg (ZYX): an impact trial's, or a wall approach's "
+    "attitude instead of its heading/inclination mapping (with --pitch). [default: 0]",
+)
+@_flag(
+    "--pitch",
+    "DEG",
+    "Initial pitch, deg in (-90, 90) (ZYX); the inclination toward the "
+    "wall is about -pitch. [default: 0]",
+)
+@_flag("--yaw", "DEG", "Impact trial: initial yaw, deg in [-180, 180]. [default: 0]")
+@_flag(
+    "--start-distance",
+    "M",
+    "Impact trial: CM distance from the wall at the start, m; "
+    "no bumper may touch the wall then. [default: 0.32]",
+)
+@_flag(
+    "--imu",
+    "PRESET",
+    "IMU preset: 'ideal' or 'noisy' (docs/RECOVERY.md 1.4). [default: ideal]",
     type=click.Choice(["ideal", "noisy"]),
 )
-@_flag("--seed", "S", "Seed of the run's random draws (the IMU's noise and biases), an "
-       "integer >= 0. [default: 0]", type=click.IntRange(min=0, max=2**63 - 1))
+@_flag(
+    "--seed",
+    "S",
+    "Seed of the run's random draws (the IMU's noise and biases), an integer >= 0. [default: 0]",
+    type=click.IntRange(min=0, max=2**63 - 1),
+)
 @click.option(
     "--model",
     type=MODEL,
@@ -166,8 +179,9 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "motor lag with the vehicle's time constant. [default: ideal]",
 )
 @_flag(
-    "--friction", "MU", "Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). "
-    "[default: 0]"
+    "--friction",
+    "MU",
+    "Coulomb friction coefficient at the bumpers (>= 0; 0 = the paper). [default: 0]",
 )
 @click.option(
     "--ground",
@@ -176,12 +190,8 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "contact surface for the bumper rims only (the body passes through it: docs/MODEL.md "
     "4.9); 'none': no ground. [default: crash]",
 )
-@_flag(
-    "--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]"
-)
-@_flag(
-    "--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]"
-)
+@_flag("--output-rate", "HZ", "Sampling rate of the output time series, Hz. [default: 1000]")
+@_flag("--rtol", None, "Integrator relative tolerance, in (0, 0.1). [default: kernel default]")
 @_flag("--atol", None, "Integrator absolute tolerance, > 0. [default: kernel default]")
 @out_option(
     "results/run",
@@ -461,8 +471,10 @@ def _response_type(summary: Mapping[str, Any], scenario: Any) -> str:
     kind = getattr(scenario, "kind", None)
     if scenario is not None and not response_type_applies(kind, getattr(scenario, "ground", None)):
         words = {"impact-trial": "an impact trial", "flight": "a flight"}
-        why = words.get(kind, f"a {kind}") if kind != "wall-approach" else (
-            "no ground, so no crash rule"
+        why = (
+            words.get(kind, f"a {kind}")
+            if kind != "wall-approach"
+            else ("no ground, so no crash rule")
         )
         return f"n/a ({why}: the types A-D are defined for the wall approach with a crash rule)"
     rtype = summary.get("response_type")

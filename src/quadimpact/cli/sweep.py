@@ -185,4 +185,3 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
     if plots:
         lines.append(f"plots   {out / 'plots'} ({', '.join(p.name for p in plots)})")
     return "\n".join(lines)
-

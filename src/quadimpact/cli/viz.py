@@ -189,9 +189,7 @@ def _check_frames(times: list[float], max_frames: int) -> None:
 # ------------------------------------------------------------------ animate
 @click.command("animate")
 @result_dir_argument
-@defaulted_option(
-    "--fps", FiniteFloat(min=1, max=240), 30.0, "Frames per second of the movie."
-)
+@defaulted_option("--fps", FiniteFloat(min=1, max=240), 30.0, "Frames per second of the movie.")
 @defaulted_option(
     "--slow",
     FiniteFloat(min=0.01, max=1000),
@@ -202,7 +200,10 @@ def _check_frames(times: list[float], max_frames: int) -> None:
 @number_option("--end", "S", "Last simulated time shown, s. [default: end of the run]")
 @click.option("--gif", is_flag=True, help="Also write animation.gif (smaller, 15 fps, for slides).")
 @click.option(
-    "--size", default="1280x720", show_default=True, metavar="WxH",
+    "--size",
+    default="1280x720",
+    show_default=True,
+    metavar="WxH",
     help="Movie size in pixels (even, at least 64x64, at most 8K: 7680x4320 pixels).",
 )
 @_camera_options
@@ -375,4 +376,3 @@ def make_all(out: Path, result: Any) -> list[Path]:
         files.append(write_animation(out, scene=scene).mp4)
     files.append(write_viewer(out, scene=scene))
     return files
-

@@ -25,6 +25,7 @@ on the same records.
 from __future__ import annotations
 
 import inspect
+import itertools
 import math
 import types
 from collections.abc import Callable, Mapping
@@ -81,13 +82,23 @@ def _global_names(code: types.CodeType) -> set[str]:
     return names
 
 
+_COPIES = itertools.count(1)
+
+
 def _rebound(fn: Dispatcher, scope_changes: Mapping[str, object]) -> Dispatcher:
-    """A fresh (uncached) ``njit`` copy of ``fn`` with some module globals replaced."""
+    """A fresh (uncached) ``njit`` copy of ``fn`` with some module globals replaced.
+
+    The copy gets a name of its own (``tick__plugin3``...): Numba names the
+    compiled symbols after the function, and a copy named like the original
+    could be linked in place of the original's cached code in the same
+    process (the built-in loop would then call a plug-in).
+    """
     py = fn.py_func
     scope = dict(py.__globals__)
     scope.update(scope_changes)
-    copy = types.FunctionType(py.__code__, scope, py.__name__, py.__defaults__)
-    copy.__qualname__ = py.__qualname__
+    name = f"{py.__name__}__plugin{next(_COPIES)}"
+    copy = types.FunctionType(py.__code__, scope, name, py.__defaults__)
+    copy.__qualname__ = name
     options = {k: v for k, v in fn.targetoptions.items() if k not in ("cache", "nopython")}
     return njit(**options)(copy)
 

@@ -85,7 +85,6 @@ class Slots:
     ) -> None:
         self.n = int(n)
         self.trials = trials
-        self.par = par
         self.until_detection = until_detection
         self.ground = ground
         self.record = record
@@ -135,6 +134,21 @@ class Slots:
     def ENV(self) -> np.ndarray:  # noqa: N802
         """Each row's episode state (N, NB), layout ``core.batch.B_*``."""
         return self.E.state
+
+    @property
+    def reward(self) -> np.ndarray:
+        """The rewards of the last step (N,)."""
+        return self.E.reward
+
+    @property
+    def terminated(self) -> np.ndarray:
+        """Which rows' episodes ended in the last step by a termination (N,)."""
+        return self.E.terminated
+
+    @property
+    def truncated(self) -> np.ndarray:
+        """Which rows' episodes were cut in the last step (time limit, failure) (N,)."""
+        return self.E.truncated
 
     @property
     def par(self) -> np.ndarray:
@@ -239,9 +253,7 @@ class Slots:
         st = self.O.stats[k].copy()
         n_ep = int(st[L.ST_N_EPISODES])
         episodes = episode_columns(self.O.episodes[k], n_ep, s.shape_names, len(s.feature_names))
-        obstacles = [
-            n for i, n in enumerate(s.shape_names) if s.shapes[i, L.SH_IS_GROUND] < 0.5
-        ]
+        obstacles = [n for i, n in enumerate(s.shape_names) if s.shapes[i, L.SH_IS_GROUND] < 0.5]
         # the state at the end: the output row at the final time when the run got there
         # (as analyse reads it), else the state reached
         n_out = int(st[L.ST_N_OUT])

@@ -102,8 +102,10 @@ def _check_range(name: str, value: Any) -> None:
 def _check_choices(name: str, value: Any) -> None:
     """A non-empty string or a non-empty sequence of them."""
     items = [value] if isinstance(value, str) else value
-    if not isinstance(items, Sequence) or not items or not all(
-        isinstance(v, str) and v for v in items
+    if (
+        not isinstance(items, Sequence)
+        or not items
+        or not all(isinstance(v, str) and v for v in items)
     ):
         raise ValueError(f"{name}: must be a name or a non-empty list of names (got {value!r})")
 

@@ -251,9 +251,7 @@ def locate_contact(
                 stop = float(ts[k])
                 break
     if stop is not None:
-        f = (t >= stop - CHANGEPOINT_BEFORE_S - FIT_WINDOW_S) & (
-            t <= stop + CHANGEPOINT_AFTER_S
-        )
+        f = (t >= stop - CHANGEPOINT_BEFORE_S - FIT_WINDOW_S) & (t <= stop + CHANGEPOINT_AFTER_S)
         tf, xf = t[f], x[f]
         best: tuple[float, float, np.ndarray] | None = None
         sse0 = None

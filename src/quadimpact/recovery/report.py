@@ -93,6 +93,7 @@ def spread_table(numbers: dict[str, Any], rows: Sequence[tuple[str, str, str, in
 def _values(v: Sequence[Any]) -> str:
     if not v:
         return "–"
+
     def one(x: Any) -> str:
         if isinstance(x, (bool, np.bool_)):
             return f"`{str(bool(x)).lower()}`"
@@ -127,12 +128,18 @@ def _what_ran(d: dict[str, Any]) -> list[str]:
         ]
     lines += [
         f"- **Vehicle**: {_values(d['vehicle'])}; rotor range "
-        + (f"{d['rotor_speed_range_rpm'][0]:g}-{d['rotor_speed_range_rpm'][1]:g} RPM"
-           if d["rotor_speed_range_rpm"] else "none")
+        + (
+            f"{d['rotor_speed_range_rpm'][0]:g}-{d['rotor_speed_range_rpm'][1]:g} RPM"
+            if d["rotor_speed_range_rpm"]
+            else "none"
+        )
         + f"; rotor slew limit {d['slew_limit']}."
-        + (" The vehicle file has no slew limit; without one the spin-down would stop the "
-           "rotors within one control tick, so the study passes the Navi's."
-           if "set by the study" in d["slew_limit"] else ""),
+        + (
+            " The vehicle file has no slew limit; without one the spin-down would stop the "
+            "rotors within one control tick, so the study passes the Navi's."
+            if "set by the study" in d["slew_limit"]
+            else ""
+        ),
         f"- **Model variant**: {_values(d['model'])}; controller {_values(d['controller'])}; "
         f"pre-impact behaviour {_values(d['pre_impact'])}.",
         "- **Model switches** (as run): "
@@ -200,8 +207,11 @@ def _outcomes(n: dict[str, Any]) -> list[str]:
         f"- **Excluded** from the rates: {excluded_text(n)}.",
         f"- **Recovery rate of the detected impacts** = recovered / detected: {rate_text(sd)}.",
         f"- Not detected: {c['not detected']}; false detections: {c['false detection']}"
-        + (f" (of which {n['false_recovered']} reached stage 4 and count in the success rate)"
-           if n["false_recovered"] else "")
+        + (
+            f" (of which {n['false_recovered']} reached stage 4 and count in the success rate)"
+            if n["false_recovered"]
+            else ""
+        )
         + f"; failed runs: {c['failed']}.",
         "",
     ]
@@ -222,9 +232,12 @@ def _outcomes(n: dict[str, Any]) -> list[str]:
             f"{q['inclination_deg']['max']:.1f}° (median {q['inclination_deg']['median']:.1f}°), "
             f"speed {q['speed_m_s']['min']:.2f} to {q['speed_m_s']['max']:.2f} m/s (median "
             f"{q['speed_m_s']['median']:.2f} m/s)"
-            + (f"; initial-impact peak force median {force['median']:.2f} N (recovered "
-               f"trials: {seen['peak_force_n']['median']:.2f} N)"
-               if force and force["n"] and seen and seen["peak_force_n"]["n"] else "")
+            + (
+                f"; initial-impact peak force median {force['median']:.2f} N (recovered "
+                f"trials: {seen['peak_force_n']['median']:.2f} N)"
+                if force and force["n"] and seen and seen["peak_force_n"]["n"]
+                else ""
+            )
             + "."
         )
     if any(name in n["conditions"] for name in why):

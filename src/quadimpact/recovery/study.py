@@ -222,9 +222,7 @@ class RecoveryStudy:
 
     def sweep_spec(self) -> SweepSpec:
         """The study as a sweep: the base and one ``[[runs]]`` entry per trial."""
-        return SweepSpec(
-            base=self.base(), runs=sample_trials(self.n, self.seed), where="recovery"
-        )
+        return SweepSpec(base=self.base(), runs=sample_trials(self.n, self.seed), where="recovery")
 
     def options(self) -> dict[str, Any]:
         """The study's options as plain data (``study.json``)."""

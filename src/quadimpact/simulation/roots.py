@@ -75,8 +75,8 @@ def brentq(
             else:  # inverse quadratic extrapolation
                 d_prev = (f_prev - f_cur) / (x_prev - x_cur)
                 d_blk = (f_blk - f_cur) / (x_blk - x_cur)
-                s_try = -f_cur * (f_blk * d_blk - f_prev * d_prev) / (
-                    d_blk * d_prev * (f_blk - f_prev)
+                s_try = (
+                    -f_cur * (f_blk * d_blk - f_prev * d_prev) / (d_blk * d_prev * (f_blk - f_prev))
                 )
             if 2.0 * abs(s_try) < min(abs(s_prev), 3.0 * abs(s_bis) - delta):
                 s_prev, s_cur = s_cur, s_try  # a good short step

@@ -32,6 +32,7 @@ from quadimpact.sweep.worker import (
 Sink = Callable[[list[dict[str, Any]]], None]
 """Takes the rows of finished runs (``[]``: a clock tick, so that waiting rows get written)."""
 
+
 # --------------------------------------------------------------- backends
 def make_chunks(spec: SweepSpec, todo: Any, size: int) -> Iterator[list[Item]]:
     """Items of the missing runs, ``size`` per chunk, built lazily (flat memory)."""

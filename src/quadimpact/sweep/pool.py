@@ -325,8 +325,7 @@ class Pool:
             if head.lost:
                 if timed_out is not None:
                     reason = (
-                        f"no result within {seconds(timed_out)} s, twice "
-                        f"({self.limits.describe()})"
+                        f"no result within {seconds(timed_out)} s, twice ({self.limits.describe()})"
                     )
                 else:
                     reason = "worker process died while running it, twice (crash in native code?)"

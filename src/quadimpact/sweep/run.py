@@ -79,7 +79,7 @@ def _refuse_in_a_starting_worker() -> None:
     if getattr(multiprocessing.current_process(), "_inheriting", False):
         print(
             "quadimpact: error: a sweep worker, starting up, ran the script's top level "
-            "again: guard the code that runs the sweep with `if __name__ == \"__main__\":` "
+            'again: guard the code that runs the sweep with `if __name__ == "__main__":` '
             "(README, 'Sweeps from Python')",
             file=sys.stderr,
             flush=True,
@@ -261,8 +261,10 @@ def run_sweep(
                             chunks = make_chunks(spec, todo, chunk_size(n_left, n_workers))
                             run_pool(chunks, n_workers, sink, limits=limits, stop=stop, note=note)
                         backend = (
-                            "serial" if not n_left
-                            else f"{n_workers} processes" if not n_here
+                            "serial"
+                            if not n_left
+                            else f"{n_workers} processes"
+                            if not n_here
                             else f"{n_workers} processes, the first {n_here} runs in this one"
                         )
                 finally:

@@ -110,7 +110,6 @@ def parse_values(text: str, field: str = "") -> list[Any]:
     return values
 
 
-
 # --------------------------------------------------------------- the spec
 def plain(value: Any) -> Any:
     """NumPy values, tuples, paths... as plain Python values (JSON-able); NaN kept."""
@@ -598,5 +597,3 @@ def load_sweep_file(path: str | os.PathLike[str]) -> SweepSpec:
     elif isinstance(base, Mapping):
         data["base"] = locate_vehicle(base, path.parent)
     return SweepSpec.from_dict(data, where=str(path))
-
-

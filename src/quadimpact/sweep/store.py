@@ -42,6 +42,7 @@ FORMAT_VERSION = 1
 
 _ARROW_KINDS = ("f", "i", "b", "s", "j")
 
+
 def _is_time_measurement(key: str) -> bool:
     """Flattened summary keys that measure wall-clock time (not deterministic)."""
     return key.startswith("integrator__") and "time" in key
@@ -58,8 +59,6 @@ wall-clock timings, so that a table is the same whatever ran it. Summary keys
 outside the schema land, as JSON, in ``summary_extra`` (null when none)."""
 
 _SUMMARY_KIND = dict(SUMMARY_COLUMNS)
-
-
 
 
 # ------------------------------------------------------------ the worker
@@ -132,7 +131,6 @@ def failed_row(reason: str, skip: Iterable[str]) -> dict[str, Any]:
     if "quadimpact_version" in row:
         row["quadimpact_version"] = __version__
     return row
-
 
 
 # ---------------------------------------------------------------- storage
@@ -330,9 +328,7 @@ def _check_table(path: Path, schema: Any, n_runs: int, writer: PartWriter) -> tu
     return np.concatenate([ids for _, ids in good] or [np.zeros(0, np.int64)]), problem
 
 
-def scan_done(
-    out: Path, n_runs: int, schema: Any, warn: Callable[[str], None]
-) -> tuple[Any, int]:
+def scan_done(out: Path, n_runs: int, schema: Any, warn: Callable[[str], None]) -> tuple[Any, int]:
     """Mask of the run_ids already written (runs.parquet and parts), and the last part number.
 
     Every part and ``runs.parquet`` is checked (:func:`check_part`); a part
@@ -497,5 +493,3 @@ def folder_lock(out: Path) -> Iterator[None]:
         yield
     finally:
         os.close(fd)
-
-
