@@ -50,6 +50,7 @@ from numba import njit
 
 from .controllers.recovery import (
     R_FIRST_TICK_LEVEL,
+    STAGE_HOVER,
     R_Q_TOL,
     R_RATE_TOL,
     R_W_TOL,
@@ -57,10 +58,12 @@ from .controllers.recovery import (
     STAGE_PRE_IMPACT,
     STAGE_RECOVERED,
     STAGE_TILTED,
+    law_references,
     rate_loop,
     recovery_step,
     staged_references,
 )
+from .estimators import write_estimate
 from .layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -74,11 +77,13 @@ from .layout import (
     LS_TF,
     MEM_STAGE,
     MS_DETECTED,
+    MS_BIAS_HAT,
     MS_IMU_F,
     MS_IMU_W,
     MS_NORMAL,
     MS_T,
     MS_T_DETECT,
+    MS_W_HAT,
     MS_X,
     N_ROTORS,
     NX,
@@ -102,7 +107,6 @@ from .layout import (
 )
 from .quaternion import normalise_quaternion, rotation_matrix
 from .records import Data, Model, Output, Work, data_row, model_row, new_work, output_row
-from .sensors.measurement import measure
 from .step import finish, start, tick
 
 
@@ -276,7 +280,7 @@ def action_command(
         thrust = affine_map(a[0], 0.0, max_thrust(veh, ctrl))
         rates = (a[1] * par[EP_RATE_MAX], a[2] * par[EP_RATE_MAX + 1], a[3] * par[EP_RATE_MAX + 2])
         rate_loop(
-            thrust, rates[0], rates[1], rates[2], meas[MS_IMU_W : MS_IMU_W + 3], ctrl, veh, cmd
+            thrust, rates[0], rates[1], rates[2], meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd
         )
     else:
         lo, hi = rotor_range(ctrl, par)
@@ -294,7 +298,7 @@ def level_test(
     _, _, _, qex, qey = staged_references(
         STAGE_TILTED, False, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh
     )
-    return qex, qey, tmeas[MS_IMU_W], tmeas[MS_IMU_W + 1], x[X_VEL + 2]
+    return qex, qey, tmeas[MS_W_HAT], tmeas[MS_W_HAT + 1], x[X_VEL + 2]
 
 
 @njit(cache=True)
@@ -381,12 +385,13 @@ def tick_measurement(m: Model, d: Data, tmeas: np.ndarray) -> None:
 
     The state is renormalised on a copy, as ``step.tick`` renormalises it
     before the estimator runs (the same arithmetic, so the same bits), and the
-    estimate written by the one writer of the measurement record.
+    estimate written by the estimator stage (``estimators.write_estimate``, through
+    the one writer of the measurement record).
     """
     tmeas[:] = d.meas
     x = d.x.copy()
     normalise_quaternion(x, X_QUAT)
-    measure(d.ls[LS_T0] + int(d.ls[LS_K]) * m.opts[O_DT_CONTROL], x, tmeas)
+    write_estimate(d.ls[LS_T0] + int(d.ls[LS_K]) * m.opts[O_DT_CONTROL], x, m, d, tmeas)
 
 
 # ---------------------------------------------------------------- observation, reward
@@ -688,13 +693,13 @@ def staged_policy(
             first = before == STAGE_PRE_IMPACT
             a_ref_on = not (first and ctrl[C_PARAMS + R_FIRST_TICK_LEVEL] > 0.5)
             x = tmeas[MS_X : MS_X + NX]
-            thrust, p_des, q_des, _, _ = staged_references(
-                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh
+            thrust, p_des, q_des, r_des, _, _ = law_references(
+                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh, mem
             )
             actions[k, 0], _ = affine_inverse(thrust, 0.0, max_thrust(veh, ctrl))
             actions[k, 1] = min(max(p_des / par[EP_RATE_MAX], -1.0), 1.0)
             actions[k, 2] = min(max(q_des / par[EP_RATE_MAX + 1], -1.0), 1.0)
-            actions[k, 3] = 0.0
+            actions[k, 3] = min(max(r_des / par[EP_RATE_MAX + 2], -1.0), 1.0)
             continue
         lo, hi = rotor_range(ctrl, par)
         slew = opts[O_SLEW_MAX] * opts[O_DT_CONTROL]

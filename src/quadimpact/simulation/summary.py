@@ -26,6 +26,7 @@ from quadimpact.simulation.metrics import (
     impact_metrics,
     n_rows,
 )
+from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.recovery_metrics import (
     contact_normal,
     first_obstacle_episode,
@@ -186,8 +187,24 @@ def build_summary(
             final_state=np.asarray(final_state, dtype=float),
         )
     )
+    summary.update(_estimation(setup, scenario, st))
     summary["outcome"] = describe_outcome(summary)
     return summary
+
+
+def _estimation(setup: RunSetup, scenario: Any, st: np.ndarray) -> dict[str, Any]:
+    """The estimator, the added sensors and the estimate's errors (docs/ESTIMATION.md 4)."""
+    scfg = setup.scfg
+    out: dict[str, Any] = {
+        "estimator": setup.estimator,
+        "estimator_settings": setup.estimator_settings,
+        "sensors": getattr(scenario, "sensors", None),
+        "impact_disturbance": bool(scfg[L.SC_IMPACT_TAU] > 0.0),
+        "magnetometer": bool(scfg[L.SC_MAG] > 0.5),
+        "pose_sensor": bool(scfg[L.SC_POSE] > 0.5),
+    }
+    out.update(estimation_metrics(st))
+    return out
 
 
 def _too_deep(setup: RunSetup, episodes: Any, max_pen: float, rb: float) -> str:
