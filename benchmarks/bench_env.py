@@ -39,7 +39,8 @@ import numpy as np
 
 import quadimpact.envs as E
 from quadimpact import simulate
-from quadimpact.core.run import run_builtin
+from quadimpact.core.records import new_output
+from quadimpact.core.run import BUILTIN
 from quadimpact.simulation.setup import prepare
 
 SAME_TICKS = {
@@ -75,17 +76,12 @@ def kernel_rate(trials: list) -> dict:
     for t in trials:
         lean = d.trial(t.model_dump(include={"roll_deg", "pitch_deg", "yaw_deg", "speed_m_s",
                                              "seed"}), ground=False, record=False)  # fmt: skip
-        s = prepare(lean)
-        t_out = s.output_times()
-        out = np.zeros((t_out.shape[0], L.NOUT))
-        imu = np.zeros((0, L.NIMU))
-        ep = np.zeros((256, L.NEP))
-        st = np.zeros(L.NSTAT)
+        m = prepare(lean).model()
+        o = new_output(m, 0, 256)  # no IMU record, as the environments
         t0 = time.perf_counter()
-        run_builtin(s.x0.copy(), s.t0, s.tf, s.veh, s.surf, s.opts, s.ctrl, s.scfg, s.sched_t,
-                    s.sched_rate, s.sched_stop, s.noise, t_out, out, imu, ep, st)  # fmt: skip
+        BUILTIN.run(m, o)
         env_wall += time.perf_counter() - t0
-        env_ticks += st[L.ST_N_TICKS]
+        env_ticks += o.stats[L.ST_N_TICKS]
     return {"ticks": ticks, "ticks_per_s": ticks / wall, "lean_ticks_per_s": env_ticks / env_wall}
 
 
@@ -210,9 +206,11 @@ def main() -> None:
     actions, metrics = record_actions(trials)
     rows = {}
     rows["single env (ImpactRecoveryEnv)"] = replay_single(
-        E.ImpactRecoveryEnv(**SAME_TICKS), trials, actions, metrics)
+        E.ImpactRecoveryEnv(**SAME_TICKS), trials, actions, metrics
+    )
     rows["single env via gym.make (wrappers)"] = replay_single(
-        gym.make(E.ENV_ID, **SAME_TICKS), trials, actions, metrics)
+        gym.make(E.ENV_ID, **SAME_TICKS), trials, actions, metrics
+    )
     for n in (64, 256):
         if n <= len(trials):
             rows[f"batched env, N = {n}"] = replay_batched(n, trials, actions, metrics)

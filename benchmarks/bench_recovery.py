@@ -78,8 +78,9 @@ def study_numbers(name: str, study: Any, out: Path, workers: int) -> dict[str, A
         "success": [s.k, s.n, s.value, s.low, s.high],
         "success_detected": [sd.k, sd.n, sd.value, sd.low, sd.high],
         "classes": n["classes"],
-        "by_inclination": n["by_inclination"][["bin", "n", "recovered", "rate", "low", "high"]]
-        .to_dict("records"),
+        "by_inclination": n["by_inclination"][
+            ["bin", "n", "recovered", "rate", "low", "high"]
+        ].to_dict("records"),
         "time_to_recover_s": n["time_to_recover_s"],
         "height_loss_m": n["height_loss_m"],
         "horizontal_drift_m": n["horizontal_drift_m"],
@@ -172,8 +173,10 @@ def friction_check(n: int, workers: int) -> dict[str, Any]:
         ref, fine = V_REGS[0], V_REGS[-1]
         per = []
         print(f"\n== friction check, {model}: {n} trials x v_reg {V_REGS} ({elapsed:.0f} s)")
-        print("  v_reg     recovered  changed vs 1e-2  changed vs 1e-4  |dt4| median / p90 / "
-              "max vs 1e-2 (s)  steps median / mean")
+        print(
+            "  v_reg     recovered  changed vs 1e-2  changed vs 1e-4  |dt4| median / p90 / "
+            "max vs 1e-2 (s)  steps median / mean"
+        )
         for v in V_REGS:
             both = wide[ref] & wide[v]
             d = (t4[v] - t4[ref])[both].abs().to_numpy()
@@ -199,11 +202,21 @@ def friction_check(n: int, workers: int) -> dict[str, Any]:
                   f"{entry['changed_vs_finest']:15d}  {entry['dt4_median_s']:.4f} / "
                   f"{entry['dt4_p90_s']:.4f} / {entry['dt4_max_s']:.4f}   "
                   f"{entry['steps_median']:.0f} / {entry['steps_mean']:.0f}")  # fmt: skip
-        print("  stage-4 time changed vs 1e-2 (of the trials recovered in both): " + ", ".join(
-            f"{e['v_reg']:g}: {e['dt4_nonzero']} by a tick or more, {e['dt4_over_one_tick']} by "
-            f"more than a tick, {e['dt4_over_50ms']} by more than 50 ms" for e in per[1:]))
-        print("  stage-4 time over the recovered trials, median / p90 (s): " + ", ".join(
-            f"{e['v_reg']:g}: {e['t4_median_s']:.3f} / {e['t4_p90_s']:.3f}" for e in per))
+        print(
+            "  stage-4 time changed vs 1e-2 (of the trials recovered in both): "
+            + ", ".join(
+                f"{e['v_reg']:g}: {e['dt4_nonzero']} by a tick or more, "
+                f"{e['dt4_over_one_tick']} by more than a tick, "
+                f"{e['dt4_over_50ms']} by more than 50 ms"
+                for e in per[1:]
+            )
+        )
+        print(
+            "  stage-4 time over the recovered trials, median / p90 (s): "
+            + ", ".join(
+                f"{e['v_reg']:g}: {e['t4_median_s']:.3f} / {e['t4_p90_s']:.3f}" for e in per
+            )
+        )
         out[model] = {"elapsed_s": elapsed, "rows": per}
     return out
 
@@ -237,9 +250,11 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         out = args.out or Path(tmp)
         out.mkdir(parents=True, exist_ok=True)
-        runs = [] if args.skip_studies else [
-            (f"navi-{m}-{args.n}", RecoveryStudy(n=args.n, model=m)) for m in MODELS
-        ]
+        runs = (
+            []
+            if args.skip_studies
+            else [(f"navi-{m}-{args.n}", RecoveryStudy(n=args.n, model=m)) for m in MODELS]
+        )
         if not (args.skip_variants or args.skip_studies):
             nv = args.n_variants
             for m in MODELS:

@@ -13,7 +13,7 @@ each simulator's own vehicle and controller:
 * **quadimpact**: a :class:`~quadimpact.FlightScenario` of the Spiri with its
   ``paper`` controller at 200 Hz, no ground, no surfaces: ``simulate()`` (the
   summary and the tables) and the compiled kernel alone
-  (``core.run.execute_record`` on the prepared setup).
+  (``core.run.execute`` of the prepared setup's model).
 
 The two vehicles and controllers differ, so the ratio is one of tools, not of
 identical physics: the time each needs for 3 s of controlled flight. The best
@@ -49,19 +49,18 @@ def best(fn, repeat: int) -> float:
 
 def quadimpact_times(repeat: int) -> dict:
     from quadimpact import FlightScenario, simulate
-    from quadimpact.core.run import execute_record
+    from quadimpact.core.run import execute
     from quadimpact.simulation.setup import prepare
 
     s = FlightScenario(euler_deg=(ROLL_DEG, 0.0, 0.0), attitude_ref_deg=(0.0, 0.0, 0.0),
                        final_time_s=FLIGHT_S, ground="none")  # fmt: skip
     st = prepare(s)
-    args = (st.x0, st.t0, st.tf, st.veh, st.surf, st.opts, st.ctrl, st.output_times())
-    kw = {**st.schedule(), **st.sensors()}
+    run = st.model()
     result = simulate(s)
     assert result.summary["status"] == "completed", result.summary["status"]
     return {
         "simulate_s": best(lambda: simulate(s), repeat),
-        "kernel_s": best(lambda: execute_record(*args, **kw), repeat),
+        "kernel_s": best(lambda: execute(run, n_imu=st.n_imu), repeat),
         "final_roll_deg": float(result.timeseries["roll_deg"].iloc[-1]),
     }
 
@@ -110,9 +109,11 @@ def main(argv: list[str] | None = None) -> None:
         print(f"RotorPy Environment.run {r['run_s'] * 1e3:7.1f} ms  = "
               f"{r['run_s'] / q['simulate_s']:.0f}x quadimpact's simulate(), "
               f"{r['run_s'] / q['kernel_s']:.0f}x its kernel")  # fmt: skip
-    print(f"roll after {FLIGHT_S:g} s (from {ROLL_DEG:g} deg): "
-          f"quadimpact {q['final_roll_deg']:.3f} deg"
-          + ("" if r is None else f", RotorPy {r['final_roll_deg']:.3f} deg"))
+    print(
+        f"roll after {FLIGHT_S:g} s (from {ROLL_DEG:g} deg): "
+        f"quadimpact {q['final_roll_deg']:.3f} deg"
+        + ("" if r is None else f", RotorPy {r['final_roll_deg']:.3f} deg")
+    )
     if args.json:
         args.json.write_text(json.dumps({"quadimpact": q, "rotorpy": r}, indent=2))
 

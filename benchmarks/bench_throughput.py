@@ -7,8 +7,8 @@ process: to the compiled kernel's own time on the same runs. Measures:
 
 1. ``simulate()`` of the paper example (psi = 45 deg, iota = 15 deg,
    V_c = 0.75 m/s) in both model variants, warm, one core: its time / the
-   kernel-only time of its main run (``core.run.execute_record`` on the
-   prepared setup). The approach shooting runs are kernel time too; they are
+   kernel-only time of its main run (``core.run.execute`` of the prepared
+   setup's model). The approach shooting runs are kernel time too; they are
    reported apart (their number is what the approach needs: 2 for a start at
    t = 0, about 11 for a late start, kept so that every result stays bit for
    bit the same).
@@ -62,6 +62,8 @@ class KernelClock:
     """Sums the wall time of every compiled run (main and shooting) while active."""
 
     def __init__(self) -> None:
+        import dataclasses
+
         import quadimpact.core.run as run
         import quadimpact.simulation.approach as approach
         import quadimpact.simulation.batch as batch
@@ -69,7 +71,7 @@ class KernelClock:
         self.total = 0.0
         self._patches = []
         real_execute = run.execute
-        real_kernel = run.run_builtin
+        real_kernel = run.BUILTIN.run
 
         def timed_execute(*a, **k):
             t = time.perf_counter()
@@ -83,7 +85,8 @@ class KernelClock:
             self.total += time.perf_counter() - t
             return r
 
-        self._patches = [(approach, "execute", timed_execute), (batch, "run_builtin", timed_kernel)]
+        timed_builtin = dataclasses.replace(run.BUILTIN, run=timed_kernel)
+        self._patches = [(approach, "execute", timed_execute), (batch, "BUILTIN", timed_builtin)]
 
     def __enter__(self) -> KernelClock:
         self._saved = [(m, n, getattr(m, n)) for m, n, _ in self._patches]
@@ -98,22 +101,21 @@ class KernelClock:
 
 def bench_simulate(repeat: int) -> dict:
     from quadimpact import WallApproach, simulate
-    from quadimpact.core.run import execute_record
+    from quadimpact.core.run import execute
     from quadimpact.simulation.setup import prepare
 
     res = {}
     for model in ("paper-replica", "default"):
         s = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75, model=model)
         st = prepare(s)
-        args = (st.x0, st.t0, st.tf, st.veh, st.surf, st.opts, st.ctrl, st.output_times())
-        kw = {**st.schedule(), **st.sensors()}
+        run = st.model()
         for _ in range(5):
-            execute_record(*args, **kw)
+            execute(run, n_imu=st.n_imu)
             simulate(s)
         k, m = [], []
         for _ in range(repeat):
             t = time.perf_counter()
-            execute_record(*args, **kw)
+            execute(run, n_imu=st.n_imu)
             k.append(time.perf_counter() - t)
             t = time.perf_counter()
             simulate(s)
@@ -213,8 +215,11 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--json", type=Path)
     args = parser.parse_args(argv)
     report = {
-        "machine": {"cpus": os.cpu_count(), "python": sys.version.split()[0],
-                    "numpy": np.__version__},  # fmt: skip
+        "machine": {
+            "cpus": os.cpu_count(),
+            "python": sys.version.split()[0],
+            "numpy": np.__version__,
+        },  # fmt: skip
         "simulate": bench_simulate(20 if args.quick else 60),
         "grid": bench_grid(),
         "commands": bench_commands(),

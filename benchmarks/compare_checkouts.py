@@ -9,8 +9,8 @@ checkout's ``src`` (``PYTHONPATH``) with Numba's on-disk cache warm (a
 warm-up run first). Each round times, for the paper's example (psi = 45 deg,
 iota = 15 deg, V_c = 0.75 m/s) in both model variants:
 
-* the kernel alone (``core.run.execute`` on a prepared setup): median of
-  ``--repeat`` calls;
+* the kernel alone (``core.run.execute`` on a prepared setup, without its
+  IMU; either checkout's API): median of ``--repeat`` calls;
 * the whole ``simulate()``: median of ``--repeat // 5`` calls.
 
 The report gives, per measure, the median over rounds of each version and
@@ -42,13 +42,17 @@ res = {}
 for model in ("paper-replica", "default"):
     s = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75, model=model)
     st = prepare(s)
-    t_out = st.output_times()
-    args = (st.x0, st.t0, st.tf, st.veh, st.surf, st.opts, st.ctrl, t_out)
-    execute(*args)
+    if hasattr(st, "model"):  # the core records: execute(model), the run without its IMU
+        m = st.model(scfg=None, noise=None)
+        kernel = lambda: execute(m)
+    else:  # earlier checkouts: execute(x0, t0, tf, veh, surf, opts, ctrl, t_out)
+        args = (st.x0, st.t0, st.tf, st.veh, st.surf, st.opts, st.ctrl, st.output_times())
+        kernel = lambda: execute(*args)
+    kernel()
     simulate(s)
     ks, ss = [], []
     for _ in range(repeat):
-        t = time.perf_counter(); execute(*args); ks.append(time.perf_counter() - t)
+        t = time.perf_counter(); kernel(); ks.append(time.perf_counter() - t)
     for _ in range(max(5, repeat // 5)):
         t = time.perf_counter(); simulate(s); ss.append(time.perf_counter() - t)
     res[model] = {"kernel_ms": statistics.median(ks) * 1e3,

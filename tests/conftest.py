@@ -37,4 +37,3 @@ def tmpdir_env() -> Iterator[Path]:
     """A short private folder for a command's ``TMPDIR`` (``helpers.short_tmpdir``)."""
     with short_tmpdir() as path:
         yield path
-

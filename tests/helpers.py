@@ -22,19 +22,17 @@ SPIRI_TOML = Path(quadimpact.__file__).resolve().parent / "inputs" / "vehicles" 
 
 
 def run_packed(setup: RunSetup, **changes: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Run ``setup`` (with some packed arrays replaced) on its output grid."""
-    arrays = {k: getattr(setup, k) for k in ("x0", "veh", "surf", "opts", "ctrl")}
-    arrays.update(changes)
-    return execute(
-        arrays["x0"],
-        setup.t0,
-        setup.tf,
-        arrays["veh"],
-        arrays["surf"],
-        arrays["opts"],
-        arrays["ctrl"],
-        setup.output_times(),
+    """Run ``setup`` (with some fields of its model replaced) on its output grid.
+
+    No IMU and no power-off schedule unless ``changes`` give them; returns
+    ``(out, episodes, stats)``.
+    """
+    fields: dict[str, np.ndarray | None] = dict.fromkeys(
+        ("scfg", "noise", "sched_t", "sched_rate", "sched_stop")
     )
+    fields.update(changes)
+    rec = execute(setup.model(**fields))
+    return rec.out, rec.episodes, rec.stats
 
 
 def states(out: np.ndarray) -> np.ndarray:
@@ -107,4 +105,3 @@ def assert_all_gone(procs: list[psutil.Process], tmp: Path, within_s: float = 5.
         p.kill()
     assert not names, f"left running: {names}"
     assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
-

@@ -32,8 +32,13 @@ def test_help_and_version(tmp_path: Path) -> None:
     assert proc.returncode == 0 and "run" in proc.stdout and "NED" in proc.stdout
     proc = run_cli("run", "--help", cwd=tmp_path)
     assert proc.returncode == 0
-    for text in ("--heading, --heading-deg DEG", "--inclination, --inclination-deg DEG",
-                 "--speed, --speed-m-s M/S", "--model", "results/run"):
+    for text in (
+        "--heading, --heading-deg DEG",
+        "--inclination, --inclination-deg DEG",
+        "--speed, --speed-m-s M/S",
+        "--model",
+        "results/run",
+    ):
         assert text in proc.stdout
     proc = run_cli("--version", cwd=tmp_path)
     assert proc.returncode == 0 and proc.stdout.startswith("quadimpact ")
@@ -321,25 +326,54 @@ def test_disk_full_during_run_leaves_no_half_folder(
 @pytest.mark.parametrize(
     ("files", "args", "fragments"),
     [
-        ({"k.toml": 'kind = ["flight"]\n'}, ["run", "k.toml"],
-         ["k.toml: kind: must be one of 'wall-approach', 'flight', 'impact-trial'",
-          "(got ['flight'])"]),
-        ({}, ["sweep", "--grid", "vehicle_overrides=1", "--out", "s"],
-         ["vehicle_overrides: must be a table of vehicle field = value (got 1.0)"]),
-        ({"s.toml": "[sample]\nn = 3\nranges = [1, 2]\n"}, ["sweep", "s.toml", "--out", "s"],
-         ["s.toml: sample.ranges: must be a table of field = values (got [1, 2])"]),
-        ({"s.toml": '[sample]\nn = 3\nchoices = "abc"\n'}, ["sweep", "s.toml", "--out", "s"],
-         ["s.toml: sample.choices: must be a table of field = values (got 'abc')"]),
-        ({"s.toml": 'base = {kind = ["flight"]}\n[grid]\nspeed_m_s = [1, 2]\n'},
-         ["sweep", "s.toml", "--out", "s"], ["s.toml: base: kind: must be one of"]),
-        ({"d.toml": "a = " + "[" * 3000 + "]" * 3000 + "\n"}, ["run", "d.toml"],
-         ["d.toml: invalid TOML: nested too deeply"]),
-        ({"d.toml": "a = " + "{x = " * 600 + "1" + "}" * 600 + "\n"}, ["run", "d.toml"],
-         ["d.toml: invalid TOML: nested too deeply"]),
-        ({"d.toml": "vehicle_overrides = " + "[" * 400 + "]" * 400 + "\n"}, ["run", "d.toml"],
-         ["d.toml: tables and lists nested 17 deep; no input has more than 16 levels"]),
-        ({"b.toml": "heading_deg = " + "9" * 5000 + "\n"}, ["run", "b.toml"],
-         ["b.toml: invalid TOML: Exceeds the limit (4300 digits)"]),
+        (
+            {"k.toml": 'kind = ["flight"]\n'},
+            ["run", "k.toml"],
+            [
+                "k.toml: kind: must be one of 'wall-approach', 'flight', 'impact-trial'",
+                "(got ['flight'])",
+            ],
+        ),
+        (
+            {},
+            ["sweep", "--grid", "vehicle_overrides=1", "--out", "s"],
+            ["vehicle_overrides: must be a table of vehicle field = value (got 1.0)"],
+        ),
+        (
+            {"s.toml": "[sample]\nn = 3\nranges = [1, 2]\n"},
+            ["sweep", "s.toml", "--out", "s"],
+            ["s.toml: sample.ranges: must be a table of field = values (got [1, 2])"],
+        ),
+        (
+            {"s.toml": '[sample]\nn = 3\nchoices = "abc"\n'},
+            ["sweep", "s.toml", "--out", "s"],
+            ["s.toml: sample.choices: must be a table of field = values (got 'abc')"],
+        ),
+        (
+            {"s.toml": 'base = {kind = ["flight"]}\n[grid]\nspeed_m_s = [1, 2]\n'},
+            ["sweep", "s.toml", "--out", "s"],
+            ["s.toml: base: kind: must be one of"],
+        ),
+        (
+            {"d.toml": "a = " + "[" * 3000 + "]" * 3000 + "\n"},
+            ["run", "d.toml"],
+            ["d.toml: invalid TOML: nested too deeply"],
+        ),
+        (
+            {"d.toml": "a = " + "{x = " * 600 + "1" + "}" * 600 + "\n"},
+            ["run", "d.toml"],
+            ["d.toml: invalid TOML: nested too deeply"],
+        ),
+        (
+            {"d.toml": "vehicle_overrides = " + "[" * 400 + "]" * 400 + "\n"},
+            ["run", "d.toml"],
+            ["d.toml: tables and lists nested 17 deep; no input has more than 16 levels"],
+        ),
+        (
+            {"b.toml": "heading_deg = " + "9" * 5000 + "\n"},
+            ["run", "b.toml"],
+            ["b.toml: invalid TOML: Exceeds the limit (4300 digits)"],
+        ),
         ({}, ["run", "a" * 5000 + ".toml"], ["(5005 characters): cannot read file (File name"]),
     ],
 )
@@ -451,7 +485,6 @@ def test_no_library_warnings_leak_from_the_drawing_commands(
     assert "Warning" not in proc.stderr and "frames have been written" not in proc.stderr
 
 
-
 def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) -> None:
     """The compiled loop's cache index is looked for where Numba itself puts it."""
     from numba.core.caching import UserProvidedCacheLocator
@@ -468,7 +501,7 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
     run_py = str(Path(core.__file__).parent / "run.py")
     where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
     where.mkdir(parents=True)
-    (where / "run.run_builtin-52.py311.nbi").write_bytes(b"")
+    (where / "run.run-44.py311.nbi").write_bytes(b"")
     assert core.cache_is_warm()
     announce_compilation()
     assert capsys.readouterr().err == ""

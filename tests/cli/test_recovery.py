@@ -39,8 +39,10 @@ seed = 2
         (["--pre-impact", "nominal"], ["'--pre-impact'", "'nominal' is not one of"]),
         (["--seed", "-3"], ["'--seed'", "-3 is not in the range x>=0"]),
         (["--sweep", "missing.toml"], ["missing.toml: file not found"]),
-        (["--sweep", "trials.toml", "--n", "5"], ["--sweep: the sweep file sets the trials",
-                                                  "--n"]),
+        (
+            ["--sweep", "trials.toml", "--n", "5"],
+            ["--sweep: the sweep file sets the trials", "--n"],
+        ),
         (["--sweep", "approach.toml"], ["approach.toml: base: kind: must be 'impact-trial'"]),
     ],
 )

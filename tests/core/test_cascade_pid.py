@@ -17,10 +17,10 @@ import pytest
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import bumper_contact
+from quadimpact.core.geometry import contact_record
 from quadimpact.inputs.world import Plane
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
+from quadimpact.simulation.packing import pack_features, pack_surfaces
 
 STATE_COLS = [
     "x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3",
@@ -39,8 +39,8 @@ def impact_energy(result, episode, vehicle) -> float:
     C = np.ascontiguousarray(quat_to_matrix(x[6:10]))
     d = result.summary["wall_distance_m"]
     surf = pack_surfaces([Plane.wall(d)])
-    _, rate, rx, ry, rz, *_ = bumper_contact(
-        x, C, pack_vehicle(vehicle), int(episode["bumper"]) - 1, surf, 0
+    _, rate, rx, ry, rz, *_ = contact_record(
+        x, C, pack_features(vehicle, 0.0), surf, int(episode["bumper"]) - 1, 0
     )
     n_body = C.T @ np.array([1.0, 0.0, 0.0])  # direction of the push on the wall
     rxn = np.cross([rx, ry, rz], n_body)

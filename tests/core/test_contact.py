@@ -8,10 +8,10 @@ from scipy.integrate import solve_ivp
 
 from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import bumper_contact
+from quadimpact.core.geometry import contact_record
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
-from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
+from quadimpact.simulation.packing import pack_features, pack_surfaces
 from quadimpact.simulation.setup import prepare
 
 from helpers import run_packed
@@ -34,7 +34,7 @@ def state(pos, euler_deg, v_body=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)):
 
 def contact(x, j, surf=WALL, vehicle=SPIRI):
     C = np.ascontiguousarray(quat_to_matrix(x[6:10]))
-    return bumper_contact(x, C, pack_vehicle(vehicle), j, surf, 0)
+    return contact_record(x, C, pack_features(vehicle, 0.0), surf, j, 0)
 
 
 def brute_force_depth(x, j, p0, m, vehicle=SPIRI, n=200001):
@@ -200,7 +200,7 @@ def test_point_mass_impact_restitution_matches_one_dof(speed):
     ctrl = setup.ctrl.copy()
     ctrl[L.C_KIND] = L.CTRL_NONE
     out, ep, stats = run_packed(setup, veh=veh, ctrl=ctrl)
-    assert ep.shape[0] == 1 and int(ep[0, L.E_BUMPER]) == 3  # bumper 4, once
+    assert ep.shape[0] == 1 and int(ep[0, L.E_FEATURE]) == 3  # bumper 4, once
     assert ep[0, L.E_V_I] == pytest.approx(speed, rel=1e-9)
     q = out[-1, L.OUT_X + 6 : L.OUT_X + 10]
     v_after = quat_to_matrix(q) @ out[-1, L.OUT_X + 3 : L.OUT_X + 6]

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.geometry import pair_table
+from quadimpact.core.records import model, new_data, new_output
 from quadimpact.core.sensors.detection import detect
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
@@ -18,21 +20,26 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     scfg[L.SC_DET_THRESHOLD] = threshold
     scfg[L.SC_DET_PERSIST] = persist
     scfg[L.SC_DET_WORLD] = 1.0 if world else 0.0
-    sst = np.zeros(L.NSST)
-    meas = np.zeros(L.NMEAS)
-    meas[L.MS_T_DETECT] = np.nan
-    imu_out = np.zeros((len(samples), L.NIMU))
-    stats = np.zeros(L.NSTAT)
-    stats[L.ST_T_DETECT] = np.nan
     x = np.zeros(L.NX)
     x[L.X_QUAT : L.X_QUAT + 4] = euler_zyx_to_quat(0.0, pitch, yaw)
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
     veh = np.zeros(L.NVEH)
     veh[L.V_GRAVITY] = G
+    feat = np.zeros((0, L.NFEAT))
+    shapes = np.zeros((0, L.NSHAPE))
+    m = model(x0=x, t0=0.0, tf=1.0, veh=veh, feat=feat, shapes=shapes,
+              pairs=pair_table(feat, shapes), opts=np.zeros(L.NOPT), ctrl=np.zeros(L.NCTRL),
+              t_out=np.zeros(0), scfg=scfg)  # fmt: skip
+    d = new_data(m)
+    o = new_output(m, len(samples), 0)
+    meas, sst, stats = d.meas, d.sst, o.stats
+    meas[L.MS_T_DETECT] = np.nan
+    stats[L.ST_T_DETECT] = np.nan
     for i, f in enumerate(samples):
         meas[L.MS_IMU_F : L.MS_IMU_F + 3] = f
         sst[L.SS_N] = i + 1
-        detect(i * 0.005, x, C, veh, scfg, sst, meas, imu_out, stats)
+        detect(i * 0.005, x, C, m, d, o)
+    imu_out = o.imu
     return meas, stats, imu_out
 
 

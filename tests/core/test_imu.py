@@ -9,7 +9,7 @@ import pytest
 
 from quadimpact import FlightScenario
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute_record
+from quadimpact.core.run import execute
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 
@@ -25,11 +25,12 @@ def _scfg(rate_hz: float = 200.0, position=(0.0, 0.0, 0.0)) -> np.ndarray:
 
 def _run(setup, scfg, *, veh=None, ctrl=None, noise=None):
     n_imu = int((setup.tf - setup.t0) * scfg[L.SC_RATE]) + 2
-    return execute_record(
-        setup.x0, setup.t0, setup.tf, setup.veh if veh is None else veh, setup.surf,
-        setup.opts, setup.ctrl if ctrl is None else ctrl, setup.output_times(),
-        scfg=scfg, noise=noise, n_imu=n_imu,
+    changes = {"veh": veh, "ctrl": ctrl}
+    m = setup.model(
+        **{k: v for k, v in changes.items() if v is not None},
+        scfg=scfg, noise=noise, sched_t=None, sched_rate=None, sched_stop=None,
     )  # fmt: skip
+    return execute(m, n_imu=n_imu)
 
 
 def test_level_hover_reads_minus_g_along_body_z():
@@ -85,7 +86,8 @@ def test_wall_contact_body_x_reading_is_the_contact_force_over_mass():
     assert len(rec.episodes) >= 2  # bumpers 1 and 4 (the contact really happened)
     # the output grid (1 kHz) and the IMU samples (1 kHz) coincide
     np.testing.assert_allclose(out[:, L.OUT_T], imu[:, L.I_T], atol=1e-12)
-    force = out[:, L.OUT_FORCE : L.OUT_FORCE + 4].sum(axis=1)
+    nf = setup.feat.shape[0]
+    force = out[:, L.OUT_DELTA + nf : L.OUT_DELTA + 2 * nf].sum(axis=1)
     assert force.max() > 1.0
     quat = out[:, L.OUT_X + L.X_QUAT : L.OUT_X + L.X_QUAT + 4]
     # contact force along -X (inertial) in body axes, over the mass

@@ -35,7 +35,7 @@ def test_crash_when_the_cm_reaches_the_ground_is_located():
     _, _, st = rotors_off(falling())
     assert st[L.ST_STATUS] == L.STATUS_CRASHED
     assert st[L.ST_CRASH_T] == pytest.approx(math.sqrt(2 * 2.0 / G), abs=1e-9)
-    assert st[L.ST_CRASH_Z] == pytest.approx(0.0, abs=1e-9)
+    assert st[L.ST_CRASH_X + 2] == pytest.approx(0.0, abs=1e-9)
 
 
 def test_paper_crash_rule_tests_altitude_at_control_ticks():
@@ -48,10 +48,10 @@ def test_ground_as_contact_surface_bounces_and_records_the_crash():
     setup = falling(ground="contact", vehicle_overrides=HEAVY)
     out, ep, st = rotors_off(setup)
     assert st[L.ST_STATUS] == L.STATUS_CRASHED and st[L.ST_T_END] == 2.0  # goes on
-    assert setup.surface_names == ("ground",)
+    assert setup.shape_names == ("ground",)
     # level vehicle: the four bumpers touch the ground together, then it bounces up
     first = ep[ep[:, L.E_T_START] < ep[0, L.E_T_START] + 1e-6]
-    assert sorted(first[:, L.E_BUMPER].astype(int)) == [0, 1, 2, 3]
+    assert sorted(first[:, L.E_FEATURE].astype(int)) == [0, 1, 2, 3]
     assert st[L.ST_CRASH_T] == pytest.approx(ep[0, L.E_T_START])
     h = -states(out)[:, L.X_POS + 2]
     after = h[out[:, L.OUT_T] > ep[0, L.E_T_END] + 0.05]
@@ -115,17 +115,7 @@ def test_first_order_rotors_follow_their_time_constant():
     veh = setup.veh.copy()
     veh[L.V_GRAVITY] = 0.0
     kernel = make_kernel(_step_to_600)
-    out, _, _ = execute(
-        setup.x0,
-        setup.t0,
-        setup.tf,
-        veh,
-        setup.surf,
-        setup.opts,
-        setup.ctrl,
-        setup.output_times(),
-        kernel=kernel,
-    )
+    out = execute(setup.model(veh=veh), kernel=kernel).out
     t = out[:, L.OUT_T]
     tau = setup.vehicle.motor_time_constant_s
     expected = 600.0 - 100.0 * np.exp(-t / tau)

@@ -34,7 +34,7 @@ def test_recovered_termination_holds_the_condition_and_pays_the_bonus():
         while True:
             obs, r, term, trunc, info = env.step(pol(obs))
             total += r
-            held.append(B.recovered_condition(s.TMEAS[0], s.CTRL[0], s.VEH[0]))
+            held.append(B.recovered_condition(s.TMEAS[0], s.M.ctrl[0], s.M.veh[0]))
             stages.append(info["stage"])
             if term or trunc:
                 break
@@ -87,7 +87,7 @@ def test_the_ground_ends_the_episode_when_enabled():
     env = E.ImpactRecoveryEnv(ground=True, trials=E.TrialDistribution(altitude_m=1.0),
                               envelope=E.Envelope(180.0, 1e9, 1e9, 1e9))  # fmt: skip
     obs, _ = env.reset(seed=6)
-    assert env.run_setup.surface_names == ("wall", "ground")
+    assert env.run_setup.shape_names == ("wall", "ground")
     _, _, _, term, _, info = _until_end(env, lambda o: np.full(4, -1.0), obs)  # rotors at minimum
     assert term and info["outcome"] == "ground"
     assert info["metrics"]["min_altitude_m"] < 0.4  # a bumper reaches the ground, not the CM
@@ -97,21 +97,21 @@ def test_reward_is_the_documented_cost():
     w = E.RewardWeights(tilt=0.7, rate=0.3, vertical_speed=0.2, height_loss=0.4, effort=0.9)
     env = E.ImpactRecoveryEnv(reward=w, end_on_recovery=False)
     obs, _ = env.reset(seed=8)
-    h_ref = -env.unwrapped._slots.X[0, L.X_POS + 2]
+    h_ref = -env.unwrapped._slots.D.x[0, L.X_POS + 2]
     s = env._slots
-    veh = s.VEH[0]
+    veh = s.M.veh[0]
     hover = math.sqrt(veh[L.V_MASS] * veh[L.V_GRAVITY] / (4 * veh[L.V_KT]))
-    span = s.CTRL[0, L.C_OMEGA_MAX] - s.CTRL[0, L.C_OMEGA_MIN]
+    span = s.M.ctrl[0, L.C_OMEGA_MAX] - s.M.ctrl[0, L.C_OMEGA_MIN]
     rng = np.random.default_rng(0)
     for _ in range(30):
         obs, r, term, trunc, _ = env.step(rng.uniform(-0.2, 0.4, 4))
-        x = s.X[0]
+        x = s.D.x[0]
         q = x[L.X_QUAT : L.X_QUAT + 4] / np.linalg.norm(x[L.X_QUAT : L.X_QUAT + 4])
         c22 = 1 - 2 * (q[1] ** 2 + q[2] ** 2)
         from quadimpact.rotations import quat_to_matrix
 
         vz = (quat_to_matrix(q) @ x[L.X_VEL : L.X_VEL + 3])[2]
-        cmd = s.RIN[0, L.RIN_CMD : L.RIN_CMD + 4]
+        cmd = s.D.rin[0, L.RIN_CMD : L.RIN_CMD + 4]
         cost = (
             w.tilt * (1 - c22) / 2
             + w.rate * min(np.linalg.norm(x[L.X_OMEGA : L.X_OMEGA + 3]) / 10.0, 1.0)
@@ -128,12 +128,12 @@ def test_the_loop_limits_apply_to_the_agent():
     # rotor_floor "zero": a = -1 commands 0 rad/s; the slew limit lowers the speeds a step a tick
     env = E.ImpactRecoveryEnv(start="trial", rotor_floor="zero")
     env.reset(seed=3)
-    before = env._slots.X[0, L.X_ROTOR : L.X_ROTOR + 4].copy()
+    before = env._slots.D.x[0, L.X_ROTOR : L.X_ROTOR + 4].copy()
     env.step(np.full(4, -1.0))
     slew = env.run_setup.opts[L.O_SLEW_MAX] * 0.005
-    np.testing.assert_allclose(env._slots.X[0, L.X_ROTOR : L.X_ROTOR + 4], before - slew)
+    np.testing.assert_allclose(env._slots.D.x[0, L.X_ROTOR : L.X_ROTOR + 4], before - slew)
     env.step(np.full(4, 2.0))  # clipped to 1 (the top), slewed back up
-    np.testing.assert_allclose(env._slots.X[0, L.X_ROTOR : L.X_ROTOR + 4], before, rtol=1e-12)
+    np.testing.assert_allclose(env._slots.D.x[0, L.X_ROTOR : L.X_ROTOR + 4], before, rtol=1e-12)
 
 
 def test_info_metrics_are_those_of_the_summary():

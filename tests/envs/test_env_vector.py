@@ -108,7 +108,7 @@ def test_same_step_autoreset_and_the_sync_vector_env_agree():
             np.testing.assert_array_equal(a[4]["_final_obs"], mask)
             for k in np.flatnonzero(mask):
                 np.testing.assert_array_equal(a[4]["final_obs"][k], b[4]["final_obs"][k])
-                assert (a[4]["final_info"]["outcome"][k] == b[4]["final_info"]["outcome"][k])
+                assert a[4]["final_info"]["outcome"][k] == b[4]["final_info"]["outcome"][k]
                 n_final += 1
     assert n_final > 0  # random actions end episodes quickly (the envelope)
 

@@ -66,7 +66,7 @@ def test_scenario_rules(fields, fragment):
 
 
 def test_a_misspelled_required_key_is_named(tmp_path: Path):
-    text = (Path(__file__).resolve().parents[2] / "src/quadimpact/inputs/vehicles/spiri.toml")
+    text = Path(__file__).resolve().parents[2] / "src/quadimpact/inputs/vehicles/spiri.toml"
     bad = tmp_path / "v.toml"
     bad.write_text(text.read_text().replace("mass_kg = 0.933", "mass_kgg = 0.933"))
     with pytest.raises(InputError, match=r"mass_kg: is required \('mass_kgg' is there"):

@@ -109,4 +109,3 @@ def test_reproduce_tables_do_not_depend_on_the_processes(tmp_path, capsys):
         pd.testing.assert_frame_equal(
             pd.read_parquet(tmp_path / "two" / name), pd.read_parquet(tmp_path / "one" / name)
         )
-

@@ -34,8 +34,10 @@ def test_wilson_interval_against_scipy_and_its_symmetry() -> None:
         lo, hi = analysis.wilson_interval(k, n, z=stats.norm.ppf(0.975))
         assert (lo, hi) == pytest.approx((ci.low, ci.high), abs=1e-12)
         mlo, mhi = analysis.wilson_interval(n - k, n)
-        assert (mlo, mhi) == pytest.approx((1 - analysis.wilson_interval(k, n)[1],
-                                            1 - analysis.wilson_interval(k, n)[0]), abs=1e-12)
+        assert (mlo, mhi) == pytest.approx(
+            (1 - analysis.wilson_interval(k, n)[1], 1 - analysis.wilson_interval(k, n)[0]),
+            abs=1e-12,
+        )
     assert analysis.wilson_interval(0, 5)[0] == 0.0 and analysis.wilson_interval(5, 5)[1] == 1.0
     assert all(math.isnan(x) for x in analysis.wilson_interval(0, 0))
     with pytest.raises(ValueError):

@@ -16,8 +16,16 @@ from quadimpact.simulation import simulate
 
 
 def _sweep_row(speed, **kw):
-    row = {"speed_m_s": speed, "status": "crashed", "response_type": "D", "crash_time_s": 1.3,
-           "detected": None, "recovered": None, "t_stage4_s": None, "height_loss_m": None}
+    row = {
+        "speed_m_s": speed,
+        "status": "crashed",
+        "response_type": "D",
+        "crash_time_s": 1.3,
+        "detected": None,
+        "recovered": None,
+        "t_stage4_s": None,
+        "height_loss_m": None,
+    }
     row.update(kw)
     return row
 

@@ -155,6 +155,8 @@ def test_the_table_is_the_same_on_one_or_two_workers(tmp_path) -> None:
     one = run_study(study, tmp_path / "one", workers=1, example=False)
     two = run_study(study, tmp_path / "two", workers=2, example=False)
     assert two.run_info["backend"] == "2 processes"
-    pd.testing.assert_frame_equal(pd.read_parquet(tmp_path / "one" / "trials.parquet"),
-                                  pd.read_parquet(tmp_path / "two" / "trials.parquet"))
+    pd.testing.assert_frame_equal(
+        pd.read_parquet(tmp_path / "one" / "trials.parquet"),
+        pd.read_parquet(tmp_path / "two" / "trials.parquet"),
+    )
     assert one.table["seed"].nunique() == 16

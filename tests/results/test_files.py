@@ -40,9 +40,9 @@ def make_timeseries(n: int = 50) -> pd.DataFrame:
 
 def make_episodes() -> pd.DataFrame:
     raw = np.zeros((3, L.NEP))
-    raw[0, [L.E_BUMPER, L.E_SURFACE, L.E_T_START, L.E_T_END]] = [3, 0, 0.5, 0.52]
+    raw[0, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END]] = [3, 0, 0.5, 0.52]
     raw[0, [L.E_V_I, L.E_PEAK_DELTA, L.E_PEAK_FORCE]] = [0.75, 0.0312345678901234, 50.5]
-    raw[1, [L.E_BUMPER, L.E_SURFACE, L.E_T_START, L.E_T_END, L.E_OPEN]] = [1, 1, 0.9, 1.0, 1]
+    raw[1, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END, L.E_OPEN]] = [1, 1, 0.9, 1.0, 1]
     raw[1, L.E_V_I] = np.nan
     return episodes_frame(raw, 2, ["wall", "ground"])
 

@@ -27,10 +27,13 @@ def _flat(summary, prefix=""):
 
 SCENARIOS = {
     "wall-approach": WallApproach(heading_deg=45, inclination_deg=15, final_time_s=1.5),
-    "wall-approach, recovery": WallApproach(heading_deg=45, inclination_deg=15, final_time_s=1.5,
-                                            controller="recovery"),  # fmt: skip
-    "flight": FlightScenario(final_time_s=0.5, surfaces=(
-        {"name": "slope", "point_m": (0.3, 0, 0), "normal": (-1, 0, -0.5)},)),  # fmt: skip
+    "wall-approach, recovery": WallApproach(
+        heading_deg=45, inclination_deg=15, final_time_s=1.5, controller="recovery"
+    ),  # fmt: skip
+    "flight": FlightScenario(
+        final_time_s=0.5,
+        surfaces=({"name": "slope", "point_m": (0.3, 0, 0), "normal": (-1, 0, -0.5)},),
+    ),  # fmt: skip
     "impact-trial": ImpactTrial(roll_deg=5, pitch_deg=-30, yaw_deg=20, speed_m_s=1.5),
 }
 

@@ -20,8 +20,8 @@ def raw_episodes(*eps: dict, extra_rows: int = 2) -> np.ndarray:
     """Kernel-style episode buffer; ``bumper`` given 1-based here, stored 0-based."""
     raw = np.full((len(eps) + extra_rows, L.NEP), -999.0)  # garbage beyond n
     for i, e in enumerate(eps):
-        raw[i, L.E_BUMPER] = e["bumper"] - 1
-        raw[i, L.E_SURFACE] = SURFACES.index(e.get("surface", "wall"))
+        raw[i, L.E_FEATURE] = e["bumper"] - 1
+        raw[i, L.E_SHAPE] = SURFACES.index(e.get("surface", "wall"))
         raw[i, L.E_T_START] = e["t0"]
         raw[i, L.E_T_END] = e["t1"]
         raw[i, L.E_V_I] = e.get("v_i", 0.7)
@@ -68,12 +68,12 @@ def test_episodes_frame_empty_has_contract_columns() -> None:
 
 def test_episodes_frame_rejects_bad_indices() -> None:
     raw = raw_episodes(ep(1, 0.5, 0.6))
-    raw[0, L.E_SURFACE] = 5
+    raw[0, L.E_SHAPE] = 5
     with pytest.raises(ValueError, match="surface index"):
         episodes_frame(raw, 1, SURFACES)
     raw = raw_episodes(ep(1, 0.5, 0.6))
-    raw[0, L.E_BUMPER] = 4
-    with pytest.raises(ValueError, match="bumper index"):
+    raw[0, L.E_FEATURE] = 4  # bumper 5 of a four-bumper vehicle
+    with pytest.raises(ValueError, match="feature index"):
         episodes_frame(raw, 1, SURFACES)
     with pytest.raises(ValueError, match="row count"):
         episodes_frame(raw, 10, SURFACES)
@@ -84,7 +84,7 @@ def test_episodes_frame_rejects_bad_indices() -> None:
 
 def test_timeseries_frame_columns_and_derived_quantities() -> None:
     n = 3
-    raw = np.zeros((n + 2, L.NOUT))
+    raw = np.zeros((n + 2, L.out_width(4)))
     q = euler_zyx_to_quat(10 * D, -15 * D, 90 * D)
     for i in range(n):
         raw[i, L.OUT_T] = 0.001 * i
@@ -94,7 +94,7 @@ def test_timeseries_frame_columns_and_derived_quantities() -> None:
         raw[i, L.OUT_X + L.X_OMEGA : L.OUT_X + L.X_OMEGA + 3] = [0.1, 0.2, 0.3]
         raw[i, L.OUT_X + L.X_ROTOR : L.OUT_X + L.X_ROTOR + 4] = [600, 610, 620, 630]
         raw[i, L.OUT_DELTA : L.OUT_DELTA + 4] = [0.001, 0.002, 0.003, 0.004]
-        raw[i, L.OUT_FORCE : L.OUT_FORCE + 4] = [1.0, 2.0, 3.0, 4.0]
+        raw[i, L.OUT_DELTA + 4 : L.OUT_DELTA + 8] = [1.0, 2.0, 3.0, 4.0]
         raw[i, L.OUT_CMD : L.OUT_CMD + 4] = [700, 710, 720, 730]
     ts = timeseries_frame(raw, n)
     assert tuple(ts.columns) == TIMESERIES_COLUMNS
@@ -120,7 +120,7 @@ def test_timeseries_frame_columns_and_derived_quantities() -> None:
 
 
 def test_timeseries_frame_empty() -> None:
-    ts = timeseries_frame(np.zeros((4, L.NOUT)), 0)
+    ts = timeseries_frame(np.zeros((4, L.out_width(4))), 0)
     assert tuple(ts.columns) == TIMESERIES_COLUMNS and len(ts) == 0
 
 

@@ -10,7 +10,7 @@ import pytest
 
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute_record
+from quadimpact.core.run import execute
 from quadimpact.simulation.setup import prepare
 
 G = 9.81
@@ -31,9 +31,8 @@ def test_wall_approaches_without_the_wall_never_detect():
         off_cm = {"imu_position_m": (0.02, 0.01, -0.05)}
         setup = prepare(WallApproach(heading_deg=heading, inclination_deg=incl, speed_m_s=speed,
                                      model=model, vehicle_overrides=off_cm))  # fmt: skip
-        no_wall = np.zeros((0, L.NSURF))
-        rec = execute_record(setup.x0, setup.t0, setup.tf, setup.veh, no_wall, setup.opts,
-                             setup.ctrl, setup.output_times(), **setup.sensors())  # fmt: skip
+        no_wall = np.zeros((0, L.NSHAPE))
+        rec = execute(setup.model(shapes=no_wall), n_imu=setup.n_imu)
         assert rec.stats[L.ST_N_DETECTIONS] == 0 and math.isnan(rec.stats[L.ST_T_DETECT])
         assert rec.imu[:, L.I_HORIZONTAL].max() < 0.1 * 0.5 * G
         count += 1

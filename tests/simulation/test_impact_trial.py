@@ -33,10 +33,12 @@ def test_initial_state(roll, pitch, yaw, model):
     np.testing.assert_allclose(vel, (1.2, 0.0, 0.0), atol=1e-15)
     np.testing.assert_array_equal(x[L.X_OMEGA : L.X_OMEGA + 3], 0.0)
     # the wall X = 0, normal -X, no ground; the vehicle's slew limit; friction 0.3; 3 s
-    np.testing.assert_array_equal(setup.surf[:, L.S_P0 : L.S_NORMAL + 3], [[0, 0, 0, -1, 0, 0]])
+    wall = setup.shapes[:, L.SH_POINT : L.SH_NORMAL + 3]
+    np.testing.assert_array_equal(wall, [[0, 0, 0, -1, 0, 0]])
     assert setup.opts[L.O_CRASH_RULE] == L.CRASH_NONE
     assert setup.opts[L.O_SLEW_MAX] == pytest.approx(70_000 * math.pi / 30)
-    assert setup.opts[L.O_MU] == 0.3 and setup.tf == 3.0
+    np.testing.assert_array_equal(setup.feat[:, L.F_MU], [0.3] * len(setup.feature_names))
+    assert setup.tf == 3.0
     assert s.resolved_pre_impact() == "spin-down"
 
 
@@ -94,6 +96,7 @@ def test_recovered_and_not_detected_are_separate():
 def test_seeds_make_the_noise():
     def imu(seed):
         return simulate(ImpactTrial(speed_m_s=1.0, imu="noisy", seed=seed)).imu
+
     a, b, c = imu(1), imu(1), imu(2)
     assert a.equals(b)
     assert not np.allclose(a["fx_m_s2"], c["fx_m_s2"])

@@ -46,8 +46,9 @@ def test_from_a_tilted_hover_after_a_detection_the_stages_come_in_order(tilt, ve
                        controller="recovery", pre_impact="hold", ground="none",
                        rotor_slew_limit_rad_s2="vehicle")  # fmt: skip
     sim = Simulation(s)
-    sim._meas[L.MS_DETECTED] = 1.0  # a detector's verdict, made by hand
-    sim._meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+    meas = sim._d.meas  # the run's measurement record
+    meas[L.MS_DETECTED] = 1.0  # a detector's verdict, made by hand
+    meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
     result = sim.run()
     times, tilt_deg, _ = _check_stages(result)
     assert times[0] == 0.0  # stage 1 at the first tick

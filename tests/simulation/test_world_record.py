@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, Plane, Simulation, WallApproach, read_result, simulate
+from quadimpact.core import layout as L
 from quadimpact.inputs.controllers import RecoveryParams
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import scenario_from_dict
@@ -74,13 +75,14 @@ def test_the_world_holds_the_whole_scenario_resolved(flight_result) -> None:
 
 
 def test_the_surfaces_are_the_packed_ones_bit_for_bit(flight_result, tmp_path: Path) -> None:
-    surf = prepare(FLIGHT).surf
+    surf = prepare(FLIGHT).shapes
     records = flight_result.world["surfaces"]
     assert [(s["name"], s["is_ground"], s["kind"]) for s in records] == [
         ("slope", False, "plane"), ("side", False, "plane"), ("ground", True, "plane")
     ]  # fmt: skip
     np.testing.assert_array_equal(pack_surface_records(records), surf)
-    np.testing.assert_allclose(np.linalg.norm(surf[:, 3:6], axis=1), 1.0, rtol=1e-15)
+    normals = surf[:, L.SH_NORMAL : L.SH_NORMAL + 3]
+    np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, rtol=1e-15)
     # through the file: the same numbers (floats are written in full)
     back = read_result(flight_result.write(tmp_path / "run"))
     assert back.world == json.loads(json.dumps(flight_result.world))

@@ -624,8 +624,11 @@ def test_plots_say_what_they_show(serial_table):
     ax = fig.axes[0]
     assert ax.get_xlabel() == "inclination ι (deg)" and ax.get_ylabel() == "δ_init (mm)"
     labels = [line.get_label() for line in ax.lines]
-    assert labels == ["heading ψ = 0 deg", "heading ψ = 45 deg",
-                      "run deeper than the bumper radius (the bumper model does not hold)"]
+    assert labels == [
+        "heading ψ = 0 deg",
+        "heading ψ = 45 deg",
+        "run deeper than the bumper radius (the bumper model does not hold)",
+    ]
     assert fig.get_suptitle() == fixed
     fig = plot_type_map(table, "inclination_deg", "heading_deg", title=fixed)
     names = [t.get_text() for t in fig.legends[0].get_texts()]

@@ -20,10 +20,10 @@ import pytest
 import quadimpact.errors
 from quadimpact import WallApproach, load_vehicle, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import bumper_contact
+from quadimpact.core.geometry import contact_record
 from quadimpact.inputs.world import Plane
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
-from quadimpact.simulation.packing import pack_surfaces, pack_vehicle
+from quadimpact.simulation.packing import pack_features, pack_surfaces
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial
 
@@ -85,14 +85,14 @@ def test_drawn_circles_are_the_contact_laws_circles(fine_scene: Scene) -> None:
 def test_drawn_deepest_point_is_the_computed_contact_point(fine_scene: Scene) -> None:
     sc = fine_scene
     wall = pack_surfaces([Plane.wall(WALL_D)])
-    veh = pack_vehicle(SPIRI)
+    feat = pack_features(SPIRI, 0.0)
     t = float(sc.t[np.searchsorted(sc.t, sc.first_contact_s + 0.08)])  # a sample, in contact
     fr = sc.frame(t)
     x = np.ascontiguousarray(sc.state_at(t))
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
     computed = {}
     for j in range(4):
-        d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, veh, j, wall, 0)
+        d, _dd, rx, ry, rz, *_ = contact_record(x, C, feat, wall, j, 0)
         p_c = x[0:3] + C @ np.array([rx, ry, rz])
         computed[j + 1] = (d, p_c)
         # the deepest point of the drawn rim (brute force over its points)
@@ -465,9 +465,9 @@ def test_run_viz_draws_the_recorded_slope_and_bumpers(slope_dir: Path) -> None:
     np.testing.assert_allclose(veh["centres"], OVERRIDES["bumper_centres_m"], atol=1e-6)
     rims = np.asarray(veh["circles"]) - np.asarray(veh["centres"])[:, None, :]
     np.testing.assert_allclose(np.linalg.norm(rims, axis=2), 0.15, atol=2e-5)
-    # every drawn contact point is bumper_contact's at the sample's state, computed
+    # every drawn contact point is contact_record's at the sample's state, computed
     # here from the file's own numbers (not from what the run recorded)
-    vehicle = pack_vehicle(load_vehicle().with_overrides(**OVERRIDES))
+    feat = pack_features(load_vehicle().with_overrides(**OVERRIDES), 0.0)
     surf = pack_surfaces([SLOPE])
     ts = pd.read_parquet(slope_dir / "timeseries.parquet")
     state_cols = ["x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3",
@@ -482,7 +482,7 @@ def test_run_viz_draws_the_recorded_slope_and_bumpers(slope_dir: Path) -> None:
         x = np.ascontiguousarray(ts[state_cols].to_numpy(dtype=float)[i])
         C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
         for mark in marks:
-            d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, vehicle, mark[0] - 1, surf, 0)
+            d, _dd, rx, ry, rz, *_ = contact_record(x, C, feat, surf, mark[0] - 1, 0)
             assert d > 0
             np.testing.assert_allclose(mark[1:4], x[0:3] + C @ np.array([rx, ry, rz]), atol=1e-5)
             assert mark[10] == pytest.approx(1e3 * d, abs=1e-3)  # deflection, mm
@@ -497,7 +497,7 @@ def test_scene_of_a_flight_is_its_recorded_world(slope_dir: Path) -> None:
     vehicle = load_vehicle().with_overrides(**OVERRIDES)
     assert sc.drawing.vehicle == vehicle and sc.drawing.radius_m == 0.15
     np.testing.assert_array_equal(sc.surf, pack_surfaces([SLOPE]))  # as the kernel had it
-    veh = pack_vehicle(vehicle)
+    feat = pack_features(vehicle, 0.0)
     m = np.array(SLOPE.normal)
     touching = np.flatnonzero(sc.deltas.max(axis=1) > 1e-3)
     assert len(touching) > 2
@@ -509,7 +509,7 @@ def test_scene_of_a_flight_is_its_recorded_world(slope_dir: Path) -> None:
         assert fr.contacts
         for mark in fr.contacts:
             j = mark.bumper - 1
-            d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, veh, j, sc.surf, 0)
+            d, _dd, rx, ry, rz, *_ = contact_record(x, C, feat, sc.surf, j, 0)
             p_c = x[0:3] + C @ np.array([rx, ry, rz])
             np.testing.assert_allclose(mark.point, p_c, atol=1e-12)
             assert mark.delta_m == pytest.approx(sc.deltas[i, j], rel=1e-6)
@@ -546,8 +546,9 @@ def test_navi_is_drawn_with_its_own_bumper_centres(trial_dir: Path) -> None:
     x = np.ascontiguousarray(sc.state_at(t))
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
     for mark in fr.contacts:
-        d, _dd, rx, ry, rz, *_ = bumper_contact(x, C, pack_vehicle(navi), mark.bumper - 1,
-                                                pack_surfaces([Plane.wall(0.0)]), 0)  # fmt: skip
+        d, _dd, rx, ry, rz, *_ = contact_record(x, C, pack_features(navi, 0.0),
+                                                pack_surfaces([Plane.wall(0.0)]),
+                                                mark.bumper - 1, 0)  # fmt: skip
         np.testing.assert_allclose(mark.point, x[0:3] + C @ np.array([rx, ry, rz]), atol=1e-12)
     assert fr.contacts
 
