@@ -50,7 +50,6 @@ from numba import njit
 
 from .controllers.recovery import (
     R_FIRST_TICK_LEVEL,
-    STAGE_HOVER,
     R_Q_TOL,
     R_RATE_TOL,
     R_W_TOL,
@@ -190,8 +189,27 @@ ACT_ROTORS = 0
 ACT_CTBR = 1
 OBS_IMU = 0
 OBS_STATE = 1
+OBS_ESTIMATE = 2
 N_OBS_IMU = 24
 N_OBS_STATE = 19
+N_OBS_ESTIMATE = 30
+# the estimate mode's scales: powers of two, so that value = observation * scale exactly
+# (observations float64): the staged controller can act on its observation alone
+OBS_EST_VEL = 2.0  # m/s
+OBS_EST_POS = 8.0  # m
+OBS_EST_RATE = 8.0  # rad/s
+OBS_EST_F = 16.0  # m/s^2
+OBS_EST_BIAS = 0.125  # rad/s
+OBS_EST_ROTOR = 1024.0  # rad/s
+
+
+def n_observations(mode: int) -> int:
+    """The observation length of a mode (``OBS_*``)."""
+    if mode == OBS_STATE:
+        return N_OBS_STATE
+    if mode == OBS_ESTIMATE:
+        return N_OBS_ESTIMATE
+    return N_OBS_IMU
 
 
 # ---------------------------------------------------------------- action maps
@@ -421,6 +439,9 @@ def observe(
     since = tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0
     lo, hi = rotor_range(ctrl, par)
     h = 0.5 * (hi - lo)
+    if int(par[EP_OBSERVE]) == OBS_ESTIMATE:
+        observe_estimate(tmeas, par, obs)
+        return
     if int(par[EP_OBSERVE]) == OBS_STATE:
         obs[0] = _clip(x[X_POS] / par[EP_OBS_POS], clip)
         obs[1] = _clip((x[X_POS + 1] - env[B_Y_REF]) / par[EP_OBS_POS], clip)
@@ -450,6 +471,62 @@ def observe(
     obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
     for j in range(4):
         obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
+
+
+@njit(cache=True)
+def observe_estimate(tmeas: np.ndarray, par: np.ndarray, obs: np.ndarray) -> None:
+    """The estimate mode's observation: what an on-board controller sees (docs/LEARNING.md).
+
+    The estimator's output (attitude, body velocity, position, rates, gyro
+    bias), the IMU sample, the detector, the rotor speeds; every value divided
+    by a power of two (so exactly recoverable from the float64 observation),
+    then clipped.
+    """
+    x = tmeas[MS_X : MS_X + NX]
+    clip = par[EP_OBS_CLIP]
+    for i in range(4):
+        obs[i] = _clip(x[X_QUAT + i], clip)
+    for i in range(3):
+        obs[4 + i] = _clip(x[X_VEL + i] / OBS_EST_VEL, clip)
+        obs[7 + i] = _clip(x[X_POS + i] / OBS_EST_POS, clip)
+        obs[10 + i] = _clip(tmeas[MS_W_HAT + i] / OBS_EST_RATE, clip)
+        obs[13 + i] = _clip(tmeas[MS_IMU_F + i] / OBS_EST_F, clip)
+        obs[16 + i] = _clip(tmeas[MS_IMU_W + i] / OBS_EST_RATE, clip)
+        obs[19 + i] = _clip(tmeas[MS_BIAS_HAT + i] / OBS_EST_BIAS, clip)
+    detected = tmeas[MS_DETECTED] > 0.5
+    obs[22] = 1.0 if detected else 0.0
+    obs[23] = _clip(tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0, clip)
+    obs[24] = _clip(tmeas[MS_NORMAL], clip)
+    obs[25] = _clip(tmeas[MS_NORMAL + 1], clip)
+    for j in range(4):
+        obs[26 + j] = _clip(x[X_ROTOR + j] / OBS_EST_ROTOR, clip)
+
+
+@njit(cache=True)
+def measurement_from_estimate(obs: np.ndarray, meas: np.ndarray) -> None:
+    """The measurement record an estimate-mode observation stands for (its inverse).
+
+    Fills what the staged controller reads: the state estimate, the estimated
+    rates and bias, the IMU sample, the detector's verdict and normal.
+    """
+    meas[:] = 0.0
+    for i in range(4):
+        meas[MS_X + X_QUAT + i] = obs[i]
+    for i in range(3):
+        meas[MS_X + X_VEL + i] = obs[4 + i] * OBS_EST_VEL
+        meas[MS_X + X_POS + i] = obs[7 + i] * OBS_EST_POS
+        meas[MS_X + X_OMEGA + i] = obs[10 + i] * OBS_EST_RATE
+        meas[MS_W_HAT + i] = obs[10 + i] * OBS_EST_RATE
+        meas[MS_IMU_F + i] = obs[13 + i] * OBS_EST_F
+        meas[MS_IMU_W + i] = obs[16 + i] * OBS_EST_RATE
+        meas[MS_BIAS_HAT + i] = obs[19 + i] * OBS_EST_BIAS
+    meas[MS_DETECTED] = obs[22]
+    meas[MS_T_DETECT] = 0.0 if obs[22] > 0.5 else np.nan
+    meas[MS_T] = obs[23]
+    meas[MS_NORMAL] = obs[24]
+    meas[MS_NORMAL + 1] = obs[25]
+    for j in range(4):
+        meas[MS_X + X_ROTOR + j] = obs[26 + j] * OBS_EST_ROTOR
 
 
 @njit(cache=True)
@@ -670,12 +747,31 @@ def staged_policy(
     ``E.state[:, B_INEXACT]`` the commands inside the slew window that the
     rotor map cannot give exactly.
     """
+    staged_actions(active, E.tmeas, M, E.par, pmem, actions, stages, E.state[:, B_INEXACT])
+
+
+@njit(cache=True)
+def staged_actions(
+    active: np.ndarray,
+    TMEAS: np.ndarray,
+    M: Model,
+    par: np.ndarray,
+    pmem: np.ndarray,
+    actions: np.ndarray,
+    stages: np.ndarray,
+    inexact: np.ndarray,
+) -> None:
+    """:func:`staged_policy` on given measurement records ``TMEAS`` (N, NMEAS).
+
+    ``M`` gives each run's controller parameters, vehicle and options (the
+    policy's own configuration); ``inexact`` (N,) counts the commands the
+    rotor map cannot give exactly.
+    """
     cmd = np.zeros(N_ROTORS)
-    par = E.par
-    for k in range(E.tmeas.shape[0]):
+    for k in range(TMEAS.shape[0]):
         if not active[k]:
             continue
-        tmeas = E.tmeas[k]
+        tmeas = TMEAS[k]
         ctrl = M.ctrl[k]
         veh = M.veh[k]
         opts = M.opts[k]
@@ -708,4 +804,4 @@ def staged_policy(
             actions[k, j] = a
             prev = tmeas[MS_X + X_ROTOR + j]
             if not exact and (slew <= 0.0 or abs(cmd[j] - prev) <= slew):
-                E.state[k, B_INEXACT] += 1.0
+                inexact[k] += 1.0
