@@ -8,7 +8,7 @@ position error (``|p_hat - p|``, m), in three phases: ``pre`` (before the
 first contact with an obstacle), ``crash`` (from it to the entry into stage 4
 of the recovery controller, or to the end), ``post`` (after stage 4). This
 module turns the sums into the RMS and the maximum of each (``None`` for a
-phase without samples).
+phase without samples), and the attitude error's RMS over the whole run.
 """
 
 from __future__ import annotations
@@ -32,11 +32,14 @@ QUANTITIES: tuple[tuple[str, str], ...] = (
 #: The phases, in the loop's order.
 PHASES: tuple[str, ...] = ("pre", "crash", "post")
 
-ESTIMATION_KEYS: tuple[str, ...] = tuple(
-    f"est_{q}_{stat}_{phase}_{unit}"
-    for q, unit in QUANTITIES
-    for phase in PHASES
-    for stat in ("rms", "max")
+ESTIMATION_KEYS: tuple[str, ...] = (
+    *(
+        f"est_{q}_{stat}_{phase}_{unit}"
+        for q, unit in QUANTITIES
+        for phase in PHASES
+        for stat in ("rms", "max")
+    ),
+    "est_attitude_rms_run_deg",
 )
 """The metric keys, in summary order (``est_attitude_rms_pre_deg`` ...)."""
 
@@ -51,4 +54,8 @@ def estimation_metrics(st: np.ndarray) -> dict[str, Any]:
             ok = n > 0 and math.isfinite(float(st[j]))
             out[f"est_{q}_rms_{phase}_{unit}"] = math.sqrt(float(st[j]) / n) if ok else None
             out[f"est_{q}_max_{phase}_{unit}"] = float(st[j + 1]) if ok else None
+    j = L.ST_EST_ERR
+    sq = sum(float(st[j + 3 * p]) for p in range(L.N_PHASES))
+    n = sum(float(st[j + 3 * p + 2]) for p in range(L.N_PHASES))
+    out["est_attitude_rms_run_deg"] = math.sqrt(sq / n) if n > 0 and math.isfinite(sq) else None
     return out
