@@ -2,12 +2,15 @@
 
 At each IMU sample (gyro ``w``, specific force ``f``, period ``dt``):
 
+* the predicted attitude ``q_pred = q_hat (x) exp((w - b_hat) dt)``, at which the
+  errors below are measured (a sample consistent with the truth then corrects
+  nothing: a constant rotation is tracked exactly);
 * accelerometer error, skipped (gated) while ``||f| - g| > gate``: the cross
   product of the measured "up" direction and the estimated one,
-  ``e_a = (f / |f|) x (-C_hat^T e_Z)`` (at rest the specific force points up);
-* magnetometer error (with a magnetometer): ``h = C_hat m``, its horizontal
+  ``e_a = (f / |f|) x (-C_pred^T e_Z)`` (at rest the specific force points up);
+* magnetometer error (with a magnetometer): ``h = C_pred m``, its horizontal
   part laid on magnetic north, ``b = (|h_XY|, 0, h_Z)``, and
-  ``e_m = m x (C_hat^T b)`` (``m`` the normalised reading): it corrects the
+  ``e_m = m x (C_pred^T b)`` (``m`` the normalised reading): it corrects the
   heading and leaves the inclination of the field to the accelerometer;
 * bias (integral) update ``b_hat <- b_hat - k_I (e_a + e_m) dt``, then the
   corrected rate ``w_c = w - b_hat + k_acc e_a + k_mag e_m``;
@@ -24,8 +27,10 @@ The estimated rates given to the controllers are ``w - b_hat``. Gains
 (``ecfg``): ``k_acc`` (``EC_K_ACC``, default 0.25 1/s), ``k_mag`` (0.15 1/s),
 ``k_I`` (``EC_K_BIAS``, 0.25 1/s^2), the gate (1 m/s^2): the authors'
 simulation values. With ``k_acc = k_mag`` and no gate this is the ``ahrs``
-package's Mahony filter except for its integration (first-order,
-``q += q (x) (0, w_c) dt / 2`` then normalised, against the exponential here).
+package's Mahony filter but for two things: ``ahrs`` measures the errors at
+the prior attitude (one sample behind the measurement: a lag of ``|w| dt``
+under rotation) and integrates to first order (``q += q (x) (0, w_c) dt / 2``,
+normalised) where this filter uses the exponential.
 """
 
 import math
@@ -72,6 +77,13 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
     meas = d.meas
     g = m.veh[V_GRAVITY]
     q = est[ES_Q : ES_Q + 4]
+    w = meas[MS_IMU_W : MS_IMU_W + 3]
+    # the errors are measured at the attitude predicted for this sample (the prior
+    # advanced by the gyro minus the bias), so that a consistent sample corrects nothing
+    prior = q.copy()
+    rotate_by(
+        q, (w[0] - est[ES_BIAS]) * dt, (w[1] - est[ES_BIAS + 1]) * dt, (w[2] - est[ES_BIAS + 2]) * dt
+    )
     rotation_matrix(q, C)
     f = meas[MS_IMU_F : MS_IMU_F + 3]
     ex = 0.0
@@ -116,12 +128,12 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
     est[ES_BIAS + 2] -= k_i * (ez + mz) * dt
     ka = ecfg[EC_K_ACC]
     km = ecfg[EC_K_MAG]
-    w = meas[MS_IMU_W : MS_IMU_W + 3]
     for a in range(3):
         est[ES_W + a] = w[a] - est[ES_BIAS + a]
     wx_c = est[ES_W] + ka * ex + km * mx
     wy_c = est[ES_W + 1] + ka * ey + km * my
     wz_c = est[ES_W + 2] + ka * ez + km * mz
+    q[:] = prior
     rotate_by(q, wx_c * dt, wy_c * dt, wz_c * dt)
     rotation_matrix(q, C)
     integrate_navigation(est, C, f, g, dt)

@@ -1,10 +1,10 @@
 """The pose sensor: position (and optionally attitude) from motion capture or vision.
 
-It measures at its own rate (``scfg[SC_POSE_RATE]``, default 100 Hz), each
-measurement taken at the first IMU sample at or after its time
-``t0 + n / rate``; a latency of ``L`` IMU samples (``scfg[SC_POSE_LAG]``) means
-the measurement arriving at sample ``i`` is of the true pose at sample
-``i - L`` (a ring of the last poses is kept in ``sst``). Position noise:
+It measures at its own rate (``scfg[SC_POSE_RATE]``, default 100 Hz):
+measurement ``n`` arrives at the first IMU sample at or after
+``t0 + n / rate + L / rate_imu``, with a latency of ``L`` IMU samples
+(``scfg[SC_POSE_LAG]``), and is of the true pose ``L`` samples before it
+arrived (a ring of the last poses is kept in ``sst``). Position noise:
 white, ``scfg[SC_POSE_NOISE_P]`` per axis; attitude (when ``SC_POSE_ATT``):
 the true attitude rotated by a small rotation vector of white noise
 ``scfg[SC_POSE_NOISE_A]`` per axis (body axes). Draws: ``snoise[i, SN_POSE...]``.
@@ -31,6 +31,7 @@ from ..layout import (
     SC_POSE_NOISE_A,
     SC_POSE_NOISE_P,
     SC_POSE_RATE,
+    SC_RATE,
     SN_POSE,
     SS_N,
     SS_POSE_N,
@@ -60,7 +61,8 @@ def pose_sample(t: float, xs: np.ndarray, m: Model, d: Data, o: Output) -> None:
     for a in range(4):
         sst[ring + 3 + a] = xs[X_QUAT + a]
     lag = int(scfg[SC_POSE_LAG])
-    due = d.ls[LS_T0] + sst[SS_POSE_N] / scfg[SC_POSE_RATE]
+    # measurement n is taken at t0 + n / rate and arrives lag samples later
+    due = d.ls[LS_T0] + sst[SS_POSE_N] / scfg[SC_POSE_RATE] + lag / scfg[SC_RATE]
     if i < lag or t < due - 1e-9:
         return
     src = SS_POSE_RING + 7 * ((i - lag) % MAX_POSE_LAG)
