@@ -109,8 +109,8 @@ def test_ekf_is_consistent_on_long_noisy_hovers():
         rng = np.random.default_rng(100 + r)
         q0 = expmap(rng.normal(0.0, 0.2, 3))
         s = constant_rotation(np.zeros(3), q0, n, dt)
-        b = np.cumsum(np.vstack([rng.normal(0.0, p0_b, (1, 3)),
-                                 sw * np.sqrt(dt) * rng.standard_normal((n - 1, 3))]), 0)  # fmt: skip
+        steps = sw * np.sqrt(dt) * rng.standard_normal((n - 1, 3))
+        b = np.cumsum(np.vstack([rng.normal(0.0, p0_b, (1, 3)), steps]), 0)
         w = b + sg * rng.standard_normal((n, 3))
         f = s.f + sa * rng.standard_normal((n, 3))
         mag = _mag(q0)[0] + sm * rng.standard_normal((n, 3))
@@ -170,7 +170,9 @@ def _wobble(n, rng, f_noise=0.3, w_noise=2e-3, m_noise=5e-3):
     for i in range(1, n):
         q[i] = qmul(q[i - 1], expmap(w_true[i] * DT))
         q[i] /= np.linalg.norm(q[i])
-    f = np.array([-9.81 * quat_to_matrix(qi)[2] for qi in q]) + f_noise * rng.standard_normal((n, 3))
+    f = np.array([-9.81 * quat_to_matrix(qi)[2] for qi in q]) + f_noise * rng.standard_normal(
+        (n, 3)
+    )
     w = w_true + w_noise * rng.standard_normal((n, 3))
     return t, q, f, w, _mag(q, rng, m_noise)
 

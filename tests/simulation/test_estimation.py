@@ -122,8 +122,8 @@ def test_the_controllers_read_the_estimate():
     controller holds the estimate level, not the truth."""
     kw = {"controller": "cascade-pid", "final_time_s": 0.5, "imu": {"position": "cm"}}
     truth = simulate(FlightScenario(**kw))
-    off = simulate(FlightScenario(**kw, estimator="complementary", seed=4,
-                                  estimator_params={"initial_attitude_error_deg": 3.0}))  # fmt: skip
+    error = {"initial_attitude_error_deg": 3.0}
+    off = simulate(FlightScenario(**kw, estimator="complementary", seed=4, estimator_params=error))
     tilt = {}
     for name, r in (("truth", truth), ("off", off)):
         last = r.timeseries.iloc[-1]

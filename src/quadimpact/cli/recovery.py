@@ -99,7 +99,7 @@ def recovery(
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
     if imu is not None and sensors is not None:
-        raise InputError("--imu and --sensors: give one or the other (a sensor preset sets the IMU)")
+        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
     values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
     given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
     if sweep_file is not None:

@@ -9,8 +9,8 @@ compiled entry points of one loop (``run``, ``start``, ``advance``);
 
 :func:`make_kernel` compiles the loop again around plug-ins: a user's
 controller step (in place of the built-in dispatch), a sensor sampled with
-the IMU, an estimator updated at every IMU sample, and the rows of the contact-geometry table registered at run time
-(``core.geometry``). It uses
+the IMU, an estimator updated at every IMU sample, and the rows of the
+contact-geometry table registered at run time (``core.geometry``). It uses
 :func:`specialise`, which rebuilds every compiled core function that reaches
 a replaced global (Numba resolves globals at compile time); such a kernel is
 compiled once per process and not cached on disk.

@@ -89,7 +89,8 @@ class Slots:
         self.ground = ground
         self.record = record
         template = self._prepare(self._template_fields())
-        setups = [self._prepare({**self._template_fields(), "imu": p}) for p in trials.imu_choices()]
+        fields = self._template_fields()
+        setups = [self._prepare({**fields, "imu": p}) for p in trials.imu_choices()]
         self.n_noise = max(x.noise.shape[0] for x in setups)
         self.n_snoise = max(x.snoise.shape[0] for x in [template, *setups])
         m = template.model(

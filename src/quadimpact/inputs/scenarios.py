@@ -57,9 +57,9 @@ from quadimpact.inputs.controllers import (
     controller_names,
     validate_params,
 )
+from quadimpact.inputs.estimators import estimator_entry, estimator_names, validate_estimator_params
 from quadimpact.inputs.files import locate_vehicle, read_toml_file
 from quadimpact.inputs.model import ModelName, ModelOptions, resolve_model_options
-from quadimpact.inputs.estimators import estimator_entry, estimator_names, validate_estimator_params
 from quadimpact.inputs.sensors import (
     SENSOR_PRESETS,
     DetectionSettings,

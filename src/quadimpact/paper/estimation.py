@@ -102,7 +102,9 @@ def _q(x: dict[str, float], digits: int = 2) -> str:
 
 
 def _fmt(x: Any, digits: int = 1) -> str:
-    return "–" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{digits}f}"
+    return (
+        "–" if x is None or (isinstance(x, float) and not math.isfinite(x)) else f"{x:.{digits}f}"
+    )
 
 
 def estimators_markdown(numbers: dict[str, Any], n: int) -> list[str]:

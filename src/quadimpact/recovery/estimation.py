@@ -52,7 +52,9 @@ def estimation_numbers(table: pd.DataFrame) -> dict[str, Any]:
             out[f"{q}_{phase}"] = _q(table[f"est_{q}_rms_{phase}_{unit}"])
     hover = table["time_to_hover_s"] if "time_to_hover_s" in table else pd.Series(dtype=float)
     out["time_to_hover_s"] = _q(hover)
-    out["hover_share"] = float(np.isfinite(hover.to_numpy(dtype=float)).mean()) if len(hover) else 0.0
+    out["hover_share"] = (
+        float(np.isfinite(hover.to_numpy(dtype=float)).mean()) if len(hover) else 0.0
+    )
     return out
 
 
@@ -74,10 +76,11 @@ def estimation_lines(numbers: dict[str, Any]) -> list[str]:
     if not e:
         return []
     est = ", ".join(str(v) for v in e["estimator"]) or "ideal"
+    sensors = ", ".join(str(v) for v in e["sensors"]) or "the IMU preset"
     lines = [
         "## Estimation",
         "",
-        f"Estimator: {est}; sensors: {', '.join(str(v) for v in e['sensors']) or 'the IMU preset'}. "
+        f"Estimator: {est}; sensors: {sensors}. "
         "Each trial's error RMS in each phase, then the median / 90th percentile over "
         "the trials (docs/ESTIMATION.md 4). The ideal estimator reads the true state (its "
         "errors are zero but for the gyro bias, which it does not correct).",
@@ -92,7 +95,8 @@ def estimation_lines(numbers: dict[str, Any]) -> list[str]:
     lines += [
         "",
         f"Time to hover (detection to speed < 0.2 m/s and tilt < 5° held for 0.5 s): reached in "
-        f"{100 * e['hover_share']:.1f} % of the trials; median {_cell(th, 3).replace(' / ', ' s, p90 ')} s"
+        f"{100 * e['hover_share']:.1f} % of the trials; median {th['median']:.3f} s, "
+        f"p90 {th['p90']:.3f} s"
         if th["n"]
         else "Time to hover: no trial reached hover (speed < 0.2 m/s, tilt < 5° for 0.5 s).",
         "",

@@ -42,10 +42,10 @@ import pandas as pd
 
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
+from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
-from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS, analysis
 from quadimpact.results.files import atomic_write
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM

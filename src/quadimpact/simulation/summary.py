@@ -18,6 +18,7 @@ from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
 from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.approach import inclination_deg_of
+from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.metrics import (
     GRAZE_DELTA_M,
     attitude_excursion_deg,
@@ -26,7 +27,6 @@ from quadimpact.simulation.metrics import (
     impact_metrics,
     n_rows,
 )
-from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.recovery_metrics import (
     contact_normal,
     first_obstacle_episode,

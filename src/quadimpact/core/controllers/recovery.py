@@ -50,9 +50,10 @@ stage 4's entry (``recovered``) and everything before it are unchanged.
 At the detection tick the stage becomes 1 and the law runs at once (no test).
 Rates are the estimator's (``meas[MS_W_HAT]``: the gyro as measured with the
 ideal estimator, the gyro minus the estimated bias otherwise), attitude,
-velocity and position come from the state estimate. Every gain, threshold, ``a_mag`` and ``k_z`` is a parameter
-(layout ``R_*`` below, at ``ctrl[C_PARAMS + ...]``); the recovery replica's
-"level target at the detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
+velocity and position come from the state estimate. Every gain, threshold,
+``a_mag`` and ``k_z`` is a parameter (layout ``R_*`` below, at
+``ctrl[C_PARAMS + ...]``); the recovery replica's "level target at the
+detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
 """
 
 import math

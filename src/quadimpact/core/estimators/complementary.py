@@ -82,7 +82,10 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
     # advanced by the gyro minus the bias), so that a consistent sample corrects nothing
     prior = q.copy()
     rotate_by(
-        q, (w[0] - est[ES_BIAS]) * dt, (w[1] - est[ES_BIAS + 1]) * dt, (w[2] - est[ES_BIAS + 2]) * dt
+        q,
+        (w[0] - est[ES_BIAS]) * dt,
+        (w[1] - est[ES_BIAS + 1]) * dt,
+        (w[2] - est[ES_BIAS + 2]) * dt,
     )
     rotation_matrix(q, C)
     f = meas[MS_IMU_F : MS_IMU_F + 3]

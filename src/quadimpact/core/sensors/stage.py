@@ -3,9 +3,9 @@
 At each IMU sample: the IMU (``imu.py``), the magnetometer and the pose
 sensor when the run has them (``magnetometer.py``, ``pose.py``), the
 estimator's update (``core/estimators``), the detector with the estimated
-attitude (``detection.py``), then a plug-in sensor. The run loop takes the samples on the dense output of each step (so a
-sample at a control tick precedes that tick's new command), at the times
-``t0 + n / rate``. A plug-in sensor (``core.run.make_kernel(sensor=...)``) is
+attitude (``detection.py``), then a plug-in sensor. The run loop takes the
+samples on the dense output of each step (so a sample at a control tick
+precedes that tick's new command), at the times ``t0 + n / rate``. A plug-in sensor (``core.run.make_kernel(sensor=...)``) is
 sampled with the IMU and writes the measurement record's user block.
 """
 
