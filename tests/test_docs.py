@@ -39,3 +39,72 @@ def test_the_docs_it_points_to_exist():
             if not (ROOT / "docs" / name).is_file():
                 missing.append(f"{path.relative_to(ROOT)} -> docs/{name}")
     assert not missing, "\n".join(missing)
+
+
+# ------------------------------------------------- issue 20 item 14: flags and links
+#: Flags of other programs that the docs name (not quadimpact's).
+OTHER_PROGRAMS_FLAGS = {"--preload"}  # dask worker --preload (docs/CONTROLLERS.md)
+FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
+MD_LINK = re.compile(r"\]\(([^)\s]+)\)")
+
+
+def _doc_pages() -> list[Path]:
+    return sorted((ROOT / "docs").glob("*.md")) + [ROOT / "README.md", ROOT / "benchmarks" /
+                                                      "README.md"]  # fmt: skip
+
+
+def _script_flags() -> set[str]:
+    """The flags of the scripts in examples/ and benchmarks/ (their argparse options)."""
+    flags: set[str] = set()
+    for path in [*ROOT.glob("examples/*.py"), *ROOT.glob("benchmarks/*.py")]:
+        text = path.read_text(encoding="utf-8")
+        flags.update(re.findall(r"add_argument\(\s*\"(--[a-z][a-z0-9-]*)\"", text))
+    return flags
+
+
+def test_every_flag_the_docs_name_exists():
+    """A flag named in docs/*.md or a README is an option of a quadimpact command (or of
+    a script of examples/ or benchmarks/): docs/RECOVERY.md once named a --param that
+    did not exist."""
+    from quadimpact.cli import cli
+
+    known = {"--help", "--version", *OTHER_PROGRAMS_FLAGS, *_script_flags()}
+    for command in cli.commands.values():
+        for param in command.params:
+            known.update(o for o in (*param.opts, *param.secondary_opts) if o.startswith("--"))
+    unknown = []
+    for page in _doc_pages():
+        for n, line in enumerate(page.read_text(encoding="utf-8").splitlines()):
+            unknown += [f"{page.relative_to(ROOT)}:{n + 1}: {flag}"
+                        for flag in FLAG.findall(line) if flag not in known]  # fmt: skip
+    assert not unknown, "\n".join(unknown)
+
+
+def test_every_relative_link_resolves():
+    """Every relative link of docs/*.md and the READMEs points to a file of the repository
+    (docs/LEARNING.md once linked docs/docs/RECOVERY.md)."""
+    broken = []
+    for page in _doc_pages():
+        for n, line in enumerate(page.read_text(encoding="utf-8").splitlines()):
+            for target in MD_LINK.findall(line):
+                if re.match(r"[a-z]+:", target) or target.startswith("#"):
+                    continue  # a URL or an anchor on the same page
+                path = target.split("#")[0]
+                if path and not (page.parent / path).exists():
+                    broken.append(f"{page.relative_to(ROOT)}:{n + 1}: {target}")
+    assert not broken, "\n".join(broken)
+
+
+def test_no_tracked_symlink_points_outside_the_repository():
+    """Issue 20 item 17: the repository tracked .venv-int, a link to another checkout's venv."""
+    out = subprocess.run(["git", "ls-files", "-s"], cwd=ROOT, capture_output=True, text=True)
+    if out.returncode != 0:  # not a git checkout
+        return
+    links = [line.split("\t", 1)[1] for line in out.stdout.splitlines()
+             if line.startswith("120000 ")]  # fmt: skip
+    bad = []
+    for name in links:
+        target = (ROOT / name).resolve()
+        if not target.exists() or ROOT not in target.parents:
+            bad.append(name)
+    assert not bad, bad

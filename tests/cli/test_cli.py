@@ -496,7 +496,8 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
     assert not core.cache_is_warm()
     announce_compilation()
     assert capsys.readouterr().err == (
-        "quadimpact: compiling the simulator (first run only, about 40 s) ...\n"
+        "quadimpact: compiling the simulator (first run only: about 40 s of CPU on a 2-core "
+        "machine, more on a slower one) ...\n"
     )
     run_py = str(Path(core.__file__).parent / "run.py")
     where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)

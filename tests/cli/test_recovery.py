@@ -80,10 +80,15 @@ def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
     proc = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",
                    "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
     assert proc.returncode == 0, proc.stderr
-    assert "success   " in proc.stdout and "report    r/report.md" in proc.stdout
+    assert "success     " in proc.stdout and "report      r/report.md" in proc.stdout
     t = pd.read_parquet(tmp_path / "r" / "trials.parquet")
     k = int(t["recovered"].fillna(False).sum())
-    assert f"success   {k} / 6 = " in proc.stdout
+    assert f"success     {k} / 6 = " in proc.stdout
+    assert "excluded    none (all 6 trials valid)" in proc.stdout
+    # issue 20 item 15: the line of the detected impacts says what it is
+    d = int(t["detected"].fillna(False).sum())
+    assert f"if detected {k} / {d} = " in proc.stdout
+    assert "(recovered / detected impacts)" in proc.stdout
     again = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",
                     "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
     assert again.returncode == 0 and "all done before, nothing to run" in again.stdout

@@ -73,3 +73,52 @@ def test_a_misspelled_required_key_is_named(tmp_path: Path):
         load_vehicle(bad)
     with pytest.raises(InputError, match="mass_kgg"):
         WallApproach(vehicle=str(bad)).build_vehicle()
+
+
+# ---------------------------------------------- issue 20 item 10: accepted silently before
+@pytest.mark.parametrize(
+    ("override", "fragment"),
+    [
+        ({"bumper_radius_m": 0.4}, "not less than the shortest rotor arm (0.175 m)"),
+        ({"imu_position_m": [100.0, 0.0, 0.0]}, "imu_position_m: 100 m from the CM, off the"),
+    ],
+)
+def test_bumpers_and_imu_must_fit_the_vehicle(override, fragment):
+    with pytest.raises(InputError) as info:
+        SPIRI.with_overrides(**override)
+    assert fragment in str(info.value), str(info.value)
+
+
+def test_overlapping_bumper_rings_are_named_in_a_warning():
+    text = " ".join(SPIRI.with_overrides(bumper_radius_m=0.15).plausibility_warnings())
+    assert "bumper rings overlap: 2 x bumper_radius_m = 0.3 m is more than the 0.253 m" in text
+    assert SPIRI.plausibility_warnings() == []
+
+
+@pytest.mark.parametrize(
+    ("imu", "fragment"),
+    [
+        ({"position": [100, 0, 0]}, "imu: position: (100, 0, 0) m is 100 m from the CM, off"),
+        ({"accel_range_m_s2": 1}, "imu: accel_range_m_s2: must be at least g = 9.81"),
+        ({"accel_range_m_s2": 10}, None),
+    ],
+)
+def test_an_imu_off_the_vehicle_or_saturated_in_hover_is_refused(imu, fragment):
+    from quadimpact.simulation.setup import prepare
+
+    trial = scenario_from_dict({"kind": "impact-trial", "imu": imu})
+    if fragment is None:
+        prepare(trial)
+        return
+    with pytest.raises(InputError) as info:
+        prepare(trial)
+    assert fragment in str(info.value), str(info.value)
+
+
+def test_a_detection_threshold_beyond_the_accelerometer_range_is_refused():
+    from quadimpact.simulation.setup import prepare
+
+    trial = scenario_from_dict({"kind": "impact-trial", "imu": {"accel_range_m_s2": 10},
+                                "detection": {"threshold_g": 2.0}})  # fmt: skip
+    with pytest.raises(InputError, match="detection: threshold_g: 2 g = 19.6.* can never be read"):
+        prepare(trial)

@@ -108,8 +108,9 @@ def test_outcome_classes_and_the_two_rates() -> None:
     ]  # fmt: skip
     n = analysis.summarise(t)
     assert n["classes"]["recovered"] == 3 and n["classes"]["not recovered"] == 1
-    # success: the recovered column over all trials (the false detection that recovered counts)
-    assert (n["success"].k, n["success"].n) == (4, 8) and n["false_recovered"] == 1
+    # success: the recovered column over the valid trials (the false detection that
+    # recovered counts; the failed run is excluded)
+    assert (n["success"].k, n["success"].n) == (4, 7) and n["false_recovered"] == 1
     # recovered / detected: the detected impacts only
     assert (n["success_detected"].k, n["success_detected"].n) == (3, 4)
     assert n["time_to_recover_s"]["n"] == 3 and n["time_to_recover_s"]["median"] == 0.28
@@ -154,3 +155,36 @@ def test_sampling_is_seeded_per_trial_and_within_the_distribution() -> None:
         # uniform: the 200 draws spread over the range (each quarter holds some)
         counts = np.histogram(v, bins=4, range=(lo, hi))[0]
         assert counts.min() > 25
+
+
+def test_invalid_and_below_ground_trials_are_classed_and_left_out_of_the_rates() -> None:
+    # issue 20 item 1: none of these reads as a success, and the rates say what they left out
+    t = _table([
+        _row(), _row(),
+        _row(min_altitude_m=-3.9),  # recovered, but through where the ground would be
+        _row(bumper_model_valid=False),  # 518 mm into the wall
+        _row(status="failed", detected=None, not_detected=None, false_detection=None,
+             recovered=None, reason="InputError: impact trial: starts in contact with the "
+             "wall: bumper 1 is 209.9 mm into it at the start"),
+        _row(status="failed", detected=None, not_detected=None, false_detection=None,
+             recovered=None, reason="step size fell below the floor"),
+    ])  # fmt: skip
+    assert list(t["outcome_class"].astype(str)) == [
+        "recovered", "recovered", "recovered below ground level",
+        "invalid: bumper model exceeded", "invalid: started in contact", "failed",
+    ]  # fmt: skip
+    n = analysis.summarise(t)
+    assert n["n_valid"] == 3 and n["below_ground"] == 1
+    assert n["excluded"] == {"invalid: started in contact": 1,
+                             "invalid: bumper model exceeded": 1, "failed": 1}  # fmt: skip
+    assert (n["success"].k, n["success"].n) == (2, 3)
+    assert (n["success_detected"].k, n["success_detected"].n) == (2, 3)
+    r = analysis.rate_by(t, "speed_bin")
+    assert r["n"].sum() == 3 and r["recovered"].sum() == 2 and r["excluded"].sum() == 3
+    from quadimpact.recovery.report import excluded_text
+
+    assert excluded_text(n) == (
+        "3 of 6 trials (1 invalid: started in contact, 1 invalid: bumper model exceeded, "
+        "1 failed)"
+    )
+    assert excluded_text(analysis.summarise(_table([_row()]))) == "none (all 1 trials valid)"

@@ -310,7 +310,10 @@ def test_check_out_dir_says_what_is_wrong_in_one_line(tmp_path: Path) -> None:
     assert folder_kind(tmp_path / "run") == ("run", ["summary.json"])
     with pytest.raises(InputError, match="holds a run .*this sweep's own folder"):
         check_out_dir(tmp_path / "run", "sweep")
-    assert check_out_dir(tmp_path, "sweep") == tmp_path  # a sweep may go among other files
+    # one rule for every kind (issue 20 item 8): no output among files that are not quadimpact's
+    for kind in ("sweep", "recovery", "report", "experiments", "run"):
+        with pytest.raises(InputError, match="holds files that are not quadimpact's"):
+            check_out_dir(tmp_path, kind)
 
 
 def test_a_one_sample_run_is_plotted_without_warnings(tmp_path: Path) -> None:

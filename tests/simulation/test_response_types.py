@@ -4,11 +4,16 @@ import pandas as pd
 import pytest
 
 from quadimpact import WallApproach, simulate
-from quadimpact.simulation.metrics import GRAZE_DELTA_M, classify_response, impact_metrics
+from quadimpact.simulation.metrics import (
+    GRAZE_IMPULSE_FRACTION,
+    classify_response,
+    graze_mask,
+    impact_metrics,
+)
 
 
 def episodes(*rows):
-    """rows: (bumper, t_start, t_end, peak_delta[, surface])."""
+    """rows: (bumper, t_start, t_end, peak_delta[, surface[, peak_force]])."""
     data = []
     for r in rows:
         b, t0, t1, d = r[:4]
@@ -21,7 +26,7 @@ def episodes(*rows):
                 "v_i_m_s": 0.5,
                 "peak_delta_m": d,
                 "t_peak_s": t0,
-                "peak_force_n": 1.0,
+                "peak_force_n": r[5] if len(r) > 5 else 1.0,
                 "t_peak_force_s": t0,
                 "open": False,
             }
@@ -30,7 +35,7 @@ def episodes(*rows):
 
 
 def rtype(eps, crashed):
-    m = impact_metrics(eps, min_peak_delta_m=GRAZE_DELTA_M)
+    m = impact_metrics(eps, graze_fraction=GRAZE_IMPULSE_FRACTION)
     return classify_response(m["leading_bumpers"], m["subsequent_impacts"], crashed), m
 
 
@@ -100,13 +105,43 @@ def test_leading_hit_without_aft_follow_up_is_other():
 
 
 def test_grazes_are_not_impacts():
-    # a 0.2 mm graze of bumper 2 after the impact does not make it D
-    eps = episodes((4, 0.5, 0.7, 0.05), (2, 0.9, 0.91, 0.0002))
+    # a light touch of bumper 2 (impulse scale 0.1 N x 0.01 s, 0.5 % of the
+    # impact's 1 N x 0.2 s) after the impact does not make it D
+    eps = episodes((4, 0.5, 0.7, 0.05), (2, 0.9, 0.91, 0.0002, "wall", 0.1))
     t, m = rtype(eps, crashed=True)
     assert t == "B" and m["n_grazes"] == 1 and m["n_episodes"] == 2
     # a graze that starts first is not the initial impact
-    eps = episodes((1, 0.45, 0.46, 0.0001), (4, 0.5, 0.7, 0.05))
+    eps = episodes((1, 0.45, 0.46, 0.0001, "wall", 0.1), (4, 0.5, 0.7, 0.05))
     assert rtype(eps, crashed=True)[1]["leading_bumpers"] == [4]
+
+
+def test_a_graze_is_small_in_impulse_not_in_depth():
+    # bumpers 1000 times stiffer: every deflection under 1 mm, the same impulses;
+    # the impact stays an impact (the old 1-mm rule made both episodes grazes)
+    eps = episodes(
+        (4, 0.5, 0.5002, 0.0004, "wall", 1000.0), (2, 0.9, 0.9002, 0.0003, "wall", 600.0)
+    )
+    t, m = rtype(eps, crashed=True)
+    assert m["n_grazes"] == 0 and m["delta_init_m"] == 0.0004 and m["leading_bumpers"] == [4]
+    assert t == "Other" and m["n_subsequent_impacts"] == 1
+    # a deep but feeble contact (1 % of the impulse or less) is a graze
+    eps = episodes((4, 0.5, 0.7, 0.05, "wall", 10.0), (2, 0.9, 0.92, 0.02, "wall", 0.9))
+    assert list(graze_mask(eps, fraction=GRAZE_IMPULSE_FRACTION)) == [False, True]
+    # ground episodes are never grazes, and never the reference
+    eps = episodes((4, 0.5, 0.7, 0.05, "wall", 10.0), (1, 0.9, 1.9, 0.02, "ground", 100.0))
+    assert list(graze_mask(eps, fraction=GRAZE_IMPULSE_FRACTION)) == [False, False]
+
+
+def test_stiff_bumpers_keep_their_impact_and_warn_of_the_imu():
+    # issue 20 item 2: from k = 4e4 the 1-mm rule gave NaN delta_init and two grazes
+    for k in (4e4, 1e12):
+        s = simulate(WallApproach(vehicle_overrides={"contact_stiffness": k})).summary
+        assert s["delta_init_m"] is not None and s["delta_init_m"] < 1e-3
+        assert s["peak_force_n"] > 100 and s["n_grazes"] == 0 and s["leading_bumpers"] == [1, 4]
+        assert any("shorter than the IMU's sample period" in w for w in s["warnings"])
+    # the default bumpers: no such warning
+    s = simulate(WallApproach()).summary
+    assert not any("IMU" in w for w in s["warnings"])
 
 
 def test_ground_contacts_are_not_impacts():

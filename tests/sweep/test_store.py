@@ -115,6 +115,21 @@ def test_table_keeps_its_good_row_groups(reference, tmp_path, capsys):
     assert "(the 5 readable ones are kept)" in err
 
 
+@pytest.mark.parametrize("damage", ["empty", "truncated", "garbage"])
+def test_a_damaged_merged_table_is_replaced_on_resume(reference, tmp_path, capsys, damage):
+    """Issue 20 item 4: an emptied or truncated runs.parquet no longer blocks every rerun."""
+    out = tmp_path / "out"
+    shutil.copytree(Path(reference.attrs["sweep"]["out_dir"]), out)
+    path = out / "runs.parquet"
+    data = path.read_bytes()
+    path.write_bytes({"empty": b"", "truncated": data[: len(data) // 2],
+                      "garbage": b"PAR1" + bytes(100) + b"PAR1"}[damage])  # fmt: skip
+    err = _resume(out, capsys, reference)
+    assert f"quadimpact: warning: {path}: " in err and "its 8 missing runs will be redone" in err
+    # and the rerun after it has nothing to do
+    assert run_sweep(SPEC, out, workers=1).attrs["sweep"]["n_ran"] == 0
+
+
 def test_merge_names_an_unreadable_file(unfinished):
     """A part damaged after the check (between the resume's scan and the merge)."""
     bad = _parts(unfinished)[0]

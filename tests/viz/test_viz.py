@@ -698,3 +698,42 @@ def test_default_views_read(run_dir: Path, camera: str, paper_figure: int) -> No
                 assert abs(x) < art.half_w and abs(y) < art.half_h
                 gaps = np.hypot(labels[:, 0] - x, labels[:, 1] - y)
                 assert gaps.min() > 0.02 * 2 * art.half_h, (tau, txt.get_text())
+
+
+# ------------------------------------------------- issue 20 item 19: labels and margins
+def test_bumper_numbers_stay_off_every_ring() -> None:
+    """The numbers of a tilted vehicle were drawn on rings (its own or another's)."""
+    from quadimpact import WallApproach, simulate
+    from quadimpact.viz.render import LABEL_CLEARANCE, place_labels
+    from quadimpact.viz.snapshots import DEFAULT_SNAPSHOT_CAMERA
+
+    result = simulate(WallApproach(heading_deg=45, inclination_deg=15, model="paper-replica"))
+    scene = Scene.from_result(result)
+    cam = DEFAULT_SNAPSHOT_CAMERA
+    clearance = LABEL_CLEARANCE * cam.span_m
+    t0 = scene.first_contact_s
+    for dt in (0.0, 0.07, 0.1, 0.13, 0.215, 0.25):
+        fr = scene.frame(t0 + dt)
+        target = scene.target(t0 + dt, cam)
+        rings = np.stack([cam.project(fr.circles[j], target) for j in range(4)])
+        xy = place_labels(rings, cam.project(fr.label_points, target), clearance)
+        for j in range(4):
+            gap = np.min(np.hypot(*(rings.reshape(-1, 2) - xy[j]).T))
+            assert gap >= clearance * 0.999, (dt, j, gap)
+        pairs = [np.hypot(*(xy[a] - xy[b])) for a in range(4) for b in range(a + 1, 4)]
+        assert min(pairs) >= clearance * 0.999
+
+
+def test_the_run_figures_keep_their_axis_labels_inside() -> None:
+    """fig6.png cut its "Y (m)" label (tick labels like -0.005 took the margin)."""
+    from quadimpact import WallApproach, simulate
+    from quadimpact.results.figures import make_fig5, make_fig6
+
+    result = simulate(WallApproach(heading_deg=45, inclination_deg=15, model="paper-replica"))
+    ts = result.timeseries
+    for fig in (make_fig5(ts, "t"), make_fig6(ts, result.references, 1.5, "t")):
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        for ax in fig.axes:
+            box = ax.yaxis.label.get_window_extent(renderer)
+            assert box.x0 >= 0, (ax.get_ylabel(), box.x0)

@@ -12,6 +12,7 @@ from quadimpact.cli.options import (
     defaulted_option,
     out_option,
     parallel_options,
+    stoppable,
 )
 
 
@@ -22,8 +23,9 @@ from quadimpact.cli.options import (
 )
 @data_option(
     "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
-    "must hold the logs [default: $QUADIMPACT_DATA, else ../shared/data beside the "
-    "project; without them the comparisons with the logs are left out]."
+    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
+    "shared/data beside the checkout's folder, else /work/shared/data; without logs the "
+    "comparisons with them are left out] The folder used is printed."
 )
 @defaulted_option(
     "--samples",
@@ -56,18 +58,23 @@ def experiments(
     the first 0.3 s after impact), and where the log shows the wall contact
     the crash is run again at the log's own pre-impact estimates (speed,
     heading, roll, pitch) and over their uncertainty.
+
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
     """
-    from quadimpact.experiments.table3 import check_data_dir, run_experiments
+    from quadimpact.experiments.table3 import check_data_dir, logs_source, run_experiments
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "experiments")
     if data is not None:
         check_data_dir(data)
     announce_compilation()
-    table = run_experiments(
-        out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
-        scheduler=scheduler, progress=not no_progress,
-    )  # fmt: skip
+    with stoppable(out):
+        table = run_experiments(
+            out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,
+            scheduler=scheduler, progress=not no_progress,
+        )  # fmt: skip
     cols = ["crash", "type_paper_experiment", "type_paper_simulation", "type_ours", "type_replica",
             "attitude_rms_deg_0_3s", "type_log", "type_log_conditions", "verdict"]  # fmt: skip
     shown = table[cols].rename(
@@ -77,3 +84,4 @@ def experiments(
     )  # fmt: skip
     click.echo(shown.to_string(index=False, float_format="%.1f"))
     click.echo(f"table          {out / 'table3.csv'}")
+    click.echo(f"logs           {logs_source(data)}")

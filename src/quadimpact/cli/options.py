@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -19,6 +20,7 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     Both are checked before the command starts any work: ``--workers`` and
     ``--scheduler`` together are refused, and a scheduler address must be
     ``SCHEME://HOST:PORT``; a ``tcp://`` one must accept a connection.
+    ``--workers`` above 4 per core is capped there, with a warning.
     """
 
     @functools.wraps(command)
@@ -28,6 +30,12 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
             if kwargs.get("workers") is not None:
                 raise InputError("--workers and --scheduler: give one or the other")
             check_scheduler(scheduler)
+        if kwargs.get("workers") is not None:
+            from quadimpact.sweep.run import cap_workers
+
+            kwargs["workers"], note = cap_workers(kwargs["workers"])
+            if note:
+                click.echo(f"quadimpact: warning: {note}", err=True)
         return command(*args, **kwargs)
 
     options = [
@@ -35,8 +43,9 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
             "--workers",
             type=click.IntRange(min=1),
             metavar="N",
-            help="Local worker processes (1: in this process). [default: all cores, after "
-            "a start in this process; a sweep that takes under a second stays in it]",
+            help="Local worker processes (1: in this process; at most 4 per core, more is "
+            "capped). [default: all cores, after a start in this process; a sweep that takes "
+            "under a second stays in it]",
         ),
         click.option(
             "--scheduler",
@@ -50,6 +59,22 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     for option in reversed(options):
         wrapped = option(wrapped)
     return wrapped
+
+
+#: Default of --max-record-mb (``simulation.checks.MAX_RECORD_MB``, kept here so that
+#: ``--help`` imports nothing heavy; a test checks that the two agree).
+MAX_RECORD_MB = 1024.0
+
+def max_record_option(help: str) -> Decorator:
+    """``--max-record-mb MB``: the largest record a run may allocate (``run``, ``sweep``)."""
+    return click.option(
+        "--max-record-mb",
+        type=FiniteFloat(min=0, min_open=True),
+        default=MAX_RECORD_MB,
+        show_default=True,
+        metavar="MB",
+        help=help,
+    )
 
 
 #: What a first run takes to compile the simulator (measured on 2 cores: 40 s of CPU).
@@ -66,7 +91,8 @@ def announce_compilation() -> None:
 
     if not cache_is_warm():
         click.echo(
-            f"quadimpact: compiling the simulator (first run only, about {COMPILE_SECONDS} s) ...",
+            "quadimpact: compiling the simulator (first run only: about "
+            f"{COMPILE_SECONDS} s of CPU on a 2-core machine, more on a slower one) ...",
             err=True,
         )
 
@@ -226,3 +252,50 @@ def model_names() -> tuple[str, ...]:
 
 CONTROLLER = RegistryChoice("controller", controller_names)
 MODEL = RegistryChoice("model", model_names)
+
+
+# ---------------------------------------------------------- stopping a study
+RESUME = "run the same command again to resume"
+
+
+def stopped(exc: BaseException, out: Path | None = None) -> int:
+    """Say why a study stopped, what is saved, that a rerun resumes; return the exit status.
+
+    ``exc``: a ``SweepInterrupted`` (Ctrl-C: 130, SIGTERM: 143) or a
+    ``WorkerError`` (1). A sweep's interruption knows how many runs it saved
+    and where; any other part of a study (a crash run on a worker, the
+    report) says that the finished sweeps are kept in ``out``.
+    """
+    from quadimpact.sweep import SweepInterrupted
+    from quadimpact.sweep.interrupt import signal_name
+
+    if getattr(exc, "saved", None) is not None:
+        resume = f"{exc.saved} of {exc.n_runs} runs saved in {exc.out_dir}; {RESUME}"
+    elif out is not None:
+        resume = f"every finished sweep is saved in {out}; {RESUME}"
+    else:
+        resume = RESUME
+    if isinstance(exc, SweepInterrupted):
+        click.echo(f"quadimpact: interrupted by {signal_name(exc.signum)}: {resume}", err=True)
+        return exc.exit_code
+    click.echo(f"quadimpact: error: {getattr(exc, 'cause', exc)}; {resume}", err=True)
+    return 1
+
+
+@contextlib.contextmanager
+def stoppable(out: Path | None = None) -> Iterator[None]:
+    """Ctrl-C and SIGTERM stop a study command as they stop ``quadimpact sweep``.
+
+    The first signal stops the work at once (every finished run kept), later
+    ones are ignored until the program has ended; the command then says what
+    was saved and how to resume, and exits with 130 (Ctrl-C) or 143
+    (SIGTERM); a worker that failed the study exits with 1.
+    """
+    from quadimpact.sweep import SweepInterrupted, WorkerError
+    from quadimpact.sweep.interrupt import stop_signals
+
+    with stop_signals(restore_after_stop=False):
+        try:
+            yield
+        except (SweepInterrupted, WorkerError) as exc:
+            raise click.exceptions.Exit(stopped(exc, out)) from None

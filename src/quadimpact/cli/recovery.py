@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import out_option, parallel_options
+from quadimpact.cli.options import out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
 from quadimpact.recovery import DEFAULT_N, ESTIMATORS, IMUS, MODELS, PRE_IMPACTS, SENSORS
 
@@ -87,6 +87,10 @@ def recovery(
     trial (figure, viewer, animation) and DIR/report.md. The table is the
     same on any number of cores or a Dask cluster.
 
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
+
     \b
     Examples:
       quadimpact recovery --out results/recovery
@@ -95,6 +99,9 @@ def recovery(
       quadimpact recovery --sweep my-trials.toml --out results/mine
     """
     from quadimpact.recovery.study import RecoveryStudy, run_study
+    from quadimpact.results.files import check_out_dir
+
+    check_out_dir(out, "recovery")
 
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
@@ -114,17 +121,19 @@ def recovery(
     else:
         try:
             study = RecoveryStudy(**given)
-        except InputError as exc:
-            raise InputError(f"--{str(exc).replace('_', '-', 1)}") from None
-    result = run_study(
-        study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
-        animation=not no_animation,
-    )  # fmt: skip
+        except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
+            field, sep, rest = str(exc).partition(":")
+            raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
+    with stoppable(out):
+        result = run_study(
+            study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
+            animation=not no_animation,
+        )  # fmt: skip
     click.echo(_summary(result))
 
 
 def _summary(result) -> str:
-    from quadimpact.recovery.report import rate_text
+    from quadimpact.recovery.report import excluded_text, rate_text
 
     info, numbers = result.run_info, result.numbers
     c = numbers["classes"]
@@ -133,13 +142,17 @@ def _summary(result) -> str:
     else:
         before = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
         ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{before}"
-    return "\n".join([
-        f"trials    {numbers['n']} ({ran})",
-        f"success   {rate_text(numbers['success'])} (recovered / all trials, 95 % Wilson)",
-        f"detected  {rate_text(numbers['success_detected'])} (recovered / detected impacts)",
-        f"other     not detected {c['not detected']}, false detections {c['false detection']}, "
-        f"failed runs {c['failed']}",
-        f"table     {result.out_dir / 'trials.parquet'}",
-        f"report    {result.report}",
-        f"time      {result.elapsed_s:.1f} s",
-    ])  # fmt: skip
+    rows = [
+        ("trials", f"{numbers['n']} ({ran})"),
+        ("success", f"{rate_text(numbers['success'])} (recovered / valid trials, 95 % Wilson)"),
+        ("excluded", excluded_text(numbers)),
+        ("if detected", f"{rate_text(numbers['success_detected'])} (recovered / detected "
+                        "impacts)"),
+        ("other", f"recovered below ground level {c['recovered below ground level']} (not "
+                  f"successes), not detected {c['not detected']}, false detections "
+                  f"{c['false detection']}"),
+        ("table", str(result.out_dir / "trials.parquet")),
+        ("report", str(result.report)),
+        ("time", f"{result.elapsed_s:.1f} s"),
+    ]
+    return "\n".join(f"{label:<12}{text}" for label, text in rows)

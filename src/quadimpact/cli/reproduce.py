@@ -6,7 +6,13 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import announce_compilation, data_option, out_option, parallel_options
+from quadimpact.cli.options import (
+    announce_compilation,
+    data_option,
+    out_option,
+    parallel_options,
+    stoppable,
+)
 
 
 @click.command("reproduce")
@@ -26,8 +32,10 @@ from quadimpact.cli.options import announce_compilation, data_option, out_option
     "the crashes with the recovery controller).",
 )
 @data_option(
-    "Folder of the crash set's flight logs [default: $QUADIMPACT_DATA, else "
-    "../shared/data beside the project]; without it the comparisons are left out."
+    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
+    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
+    "shared/data beside the checkout's folder, else /work/shared/data; without logs the "
+    "comparisons with them are left out] The folder used is printed."
 )
 @parallel_options
 def reproduce(
@@ -54,8 +62,12 @@ def reproduce(
     recovery part run side by side on the local cores (--workers 1: one
     after the other here). Each stage is named on stderr when it starts and
     timed when it ends; the report ends with the time per stage.
+
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
     """
-    from quadimpact.experiments.table3 import check_data_dir
+    from quadimpact.experiments.table3 import check_data_dir, logs_source
     from quadimpact.paper.study import reproduce as run_study
     from quadimpact.results.files import check_out_dir
 
@@ -64,13 +76,16 @@ def reproduce(
         check_data_dir(data)
     announce_compilation()
 
-    result = run_study(
-        out, workers=workers, scheduler=scheduler, progress=not no_progress,
-        ablation=not no_ablation, experiments=not no_experiments, recovery=not no_recovery,
-        data_dir=data,
-    )  # fmt: skip
+    with stoppable(out):
+        result = run_study(
+            out, workers=workers, scheduler=scheduler, progress=not no_progress,
+            ablation=not no_ablation, experiments=not no_experiments, recovery=not no_recovery,
+            data_dir=data,
+        )  # fmt: skip
     f = result.findings
     click.echo(f"report         {result.report}")
+    if not no_experiments:
+        click.echo(f"logs           {logs_source(data)}")
     for variant, group in f.groupby("variant", sort=False):
         counts = group["verdict"].value_counts()
         click.echo(

@@ -14,6 +14,7 @@ from quadimpact.cli.options import (
     MODEL,
     announce_compilation,
     file_argument,
+    max_record_option,
     number_option,
     out_option,
 )
@@ -39,6 +40,12 @@ _FLAGS: dict[str, tuple[str, str]] = {
     "output_rate": ("output_rate_hz", "--output-rate"),
     "rtol": ("rtol", "--rtol"),
     "atol": ("atol", "--atol"),
+    "roll": ("roll_deg", "--roll"),
+    "pitch": ("pitch_deg", "--pitch"),
+    "yaw": ("yaw_deg", "--yaw"),
+    "start_distance": ("start_distance_m", "--start-distance"),
+    "imu": ("imu", "--imu"),
+    "seed": ("seed", "--seed"),
 }
 _WALL_ONLY = {
     "heading_deg",
@@ -56,11 +63,12 @@ _OUTPUT_FILES = (
 )
 
 
-def _flag(flag: str, metavar: str | None, help: str) -> Any:
-    """A number flag of ``run``, also under its scenario file key (``--heading-deg``)."""
+def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
+    """A flag of ``run`` (a number by default), also named by its file key (``--roll-deg``)."""
     field = next(f for f, typed in _FLAGS.values() if typed == flag)
     alias = "--" + field.replace("_", "-")
-    return number_option(flag, metavar, help, alias=None if alias == flag else alias)
+    extra = {} if type is None else {"type": type}
+    return number_option(flag, metavar, help, alias=None if alias == flag else alias, **extra)
 
 
 @click.command("run")
@@ -92,6 +100,27 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
 )
 @_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
+    "--kind",
+    type=click.Choice(["wall-approach", "impact-trial"]),
+    help="Scenario kind without a file: the paper's wall approach, or an impact trial of "
+    "the recovery benchmark (the Navi 0.32 m from the wall at 5 m, docs/RECOVERY.md 5.1; "
+    "--roll, --pitch, --yaw, --speed, --start-distance, --altitude set it). A file sets "
+    "its own kind. [default: wall-approach]",
+)
+@_flag("--roll", "DEG", "Initial roll, deg (ZYX): an impact trial's, or a wall approach's "
+       "attitude instead of its heading/inclination mapping (with --pitch). [default: 0]")
+@_flag("--pitch", "DEG", "Initial pitch, deg in (-90, 90) (ZYX); the inclination toward the "
+       "wall is about -pitch. [default: 0]")
+@_flag("--yaw", "DEG", "Impact trial: initial yaw, deg in [-180, 180]. [default: 0]")
+@_flag("--start-distance", "M", "Impact trial: CM distance from the wall at the start, m; "
+       "no bumper may touch the wall then. [default: 0.32]")
+@_flag(
+    "--imu", "PRESET", "IMU preset: 'ideal' or 'noisy' (docs/RECOVERY.md 1.4). [default: ideal]",
+    type=click.Choice(["ideal", "noisy"]),
+)
+@_flag("--seed", "S", "Seed of the run's random draws (the IMU's noise and biases), an "
+       "integer >= 0. [default: 0]", type=click.IntRange(min=0, max=2**63 - 1))
+@click.option(
     "--model",
     type=MODEL,
     help="Model variant: 'default' is physically consistent; 'paper-replica' reproduces "
@@ -107,6 +136,15 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
     "Switches: yaw_reaction, spinup_reaction, bumper1_yaw_twice, initial_rotor_speeds, "
     "attitude_mapping, crash_rule, approach_start, detection_tick_reference, "
     "contact_gate_m, pre_impact (docs/VARIANTS.md).",
+)
+@click.option(
+    "--param",
+    "params",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="Set one parameter of the controller (repeatable), as [controller_params] of a "
+    "scenario file does, e.g. --controller recovery --param k_att_1_s=25 "
+    "(docs/RECOVERY.md 3.5, docs/CONTROLLERS.md).",
 )
 @click.option(
     "--controller",
@@ -150,6 +188,10 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
     "Output folder (created if needed). A folder holding an earlier run is replaced: its "
     "files and the pictures drawn from it go; one holding anything else is refused.",
 )
+@max_record_option(
+    "Largest record (time series and IMU samples: final time x output rate) the run "
+    "may allocate; a larger one is refused before it starts, with its estimate."
+)
 @click.option(
     "--viz",
     is_flag=True,
@@ -157,7 +199,14 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
     "(as 'quadimpact snapshots', 'animate' and 'view' do).",
 )
 def run(
-    scenario: Path | None, out: Path, options: tuple[str, ...], viz: bool, **flags: Any
+    scenario: Path | None,
+    out: Path,
+    options: tuple[str, ...],
+    params: tuple[str, ...],
+    kind: str | None,
+    viz: bool,
+    max_record_mb: float,
+    **flags: Any,
 ) -> None:
     """Simulate one scenario and write its results to --out.
 
@@ -189,8 +238,10 @@ def run(
          NaN); its folder is still written, with the reason in summary.json
     """
     from quadimpact.results.files import check_out_dir
+    from quadimpact.simulation.checks import check_record_size
 
-    built = build_scenario(scenario, flags, options)
+    built = build_scenario(scenario, flags, options, params=params, kind=kind)
+    check_record_size(built, max_record_mb, "--max-record-mb")
     check_out_dir(out, "run")
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
@@ -206,7 +257,7 @@ def run(
             f"{out}: the result folder could not be written ({exc.strerror or exc}); "
             "nothing was changed there"
         ) from None
-    click.echo(format_summary(result.summary, out))
+    click.echo(format_summary(result.summary, out, built))
     if viz:
         from quadimpact.cli.viz import make_all
 
@@ -216,20 +267,45 @@ def run(
         click.get_current_context().exit(EXIT_RUN_FAILED)
 
 
-def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
-    """``NAME=VALUE`` pairs of ``--option`` to a dict (``true``/``false`` become bools)."""
+def _option_value(text: str) -> Any:
+    """A ``--option`` value as the scenario file would read it: a number, a boolean, a word.
+
+    ``0.3`` is the number 0.3 and ``true``/``false`` (any case) booleans, as in
+    a TOML file; a quoted TOML string is its content; anything else is the
+    text itself (``crash_rule=cm-ground``).
+    """
+    import tomllib
+
+    lowered = text.lower()
+    if lowered in ("true", "false"):
+        return lowered == "true"
+    try:
+        value = tomllib.loads(f"v = {text}")["v"]
+    except (tomllib.TOMLDecodeError, KeyError):
+        return text
+    if isinstance(value, float) and not math.isfinite(value):
+        return text  # nan, inf: refused by the field's own check, with the text shown
+    return value if isinstance(value, (int, float, str, bool)) else text
+
+
+def _parse_options(options: tuple[str, ...], flag: str = "--option") -> dict[str, Any]:
+    """``NAME=VALUE`` pairs of ``--option`` (``--param``) to a dict (values read as in a file)."""
     parsed: dict[str, Any] = {}
     for item in options:
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
-            raise InputError(f"--option: must be NAME=VALUE (got {item!r})")
-        text = value.strip()
-        parsed[name.strip()] = {"true": True, "false": False}.get(text.lower(), text)
+            raise InputError(f"{flag}: must be NAME=VALUE (got {item!r})")
+        parsed[name.strip()] = _option_value(value.strip())
     return parsed
 
 
 def build_scenario(
-    scenario_path: Path | None, flags: Mapping[str, Any], options: tuple[str, ...] = ()
+    scenario_path: Path | None,
+    flags: Mapping[str, Any],
+    options: tuple[str, ...] = (),
+    *,
+    params: tuple[str, ...] = (),
+    kind: str | None = None,
 ) -> Any:
     """Build the scenario of a ``run``: the file's values, then the flags on top.
 
@@ -241,6 +317,10 @@ def build_scenario(
         Click parameter name -> value (``None``: not given).
     options : tuple of str
         ``NAME=VALUE`` model switches from ``--option``.
+    params : tuple of str, keyword
+        ``NAME=VALUE`` controller parameters from ``--param``.
+    kind : str, keyword
+        ``--kind``: the scenario kind without a file (a file's own kind must match).
 
     Returns
     -------
@@ -261,17 +341,34 @@ def build_scenario(
     data: dict[str, Any] = {}
     if scenario_path is not None:
         data = load_scenario_file(scenario_path).model_dump()
+        if kind is not None and data.get("kind", "wall-approach") != kind:
+            raise InputError(
+                f"--kind {kind}: {scenario_path} has kind = {data.get('kind')!r} (a file sets "
+                "its own kind; leave --kind out)"
+            )
+    elif kind is not None:
+        data = {"kind": kind}
     kind = data.get("kind", "wall-approach")
     cls = _KINDS[kind]
 
     given = {_FLAGS[key][0]: value for key, value in flags.items() if value is not None}
     rename = {field: flag for field, flag in _FLAGS.values()}
     for field in given:
-        if field in _WALL_ONLY and field not in cls.model_fields:
-            raise InputError(
-                f"{rename[field]}: applies to wall-approach scenarios only "
-                f"({scenario_path} has kind = {kind!r})"
-            )
+        if field not in cls.model_fields:
+            named = {"wall-approach": "a wall approach", "impact-trial": "an impact trial"}
+            where = (
+                f"{scenario_path} has kind = {kind!r}" if scenario_path
+                else named.get(kind, f"a {kind}")
+            )  # fmt: skip
+            if field in _WALL_ONLY:
+                rule = "applies to wall-approach scenarios only"
+            else:
+                rule = "applies to impact trials only (--kind impact-trial, or a file's kind)"
+            raise InputError(f"{rename[field]}: {rule} ({where})")
+    parsed_params: dict[str, Any] = {}
+    if params:
+        parsed_params = _parse_options(params, "--param")
+        data["controller_params"] = {**(data.get("controller_params") or {}), **parsed_params}
     if options:
         parsed = _parse_options(options)
         try:
@@ -284,6 +381,10 @@ def build_scenario(
         return cls.model_validate(data)
     except ValidationError as exc:
         loc = exc.errors()[0].get("loc", ())
+        text = str(input_error_from_validation(exc, "", model=cls))
+        name = text.removeprefix("controller_params.").partition(":")[0]
+        if params and text.startswith("controller_params.") and name in parsed_params:
+            raise InputError("--param: " + text.removeprefix("controller_params.")) from None
         if not loc and given:  # a cross-field rule (e.g. impact before final time)
             message = str(input_error_from_validation(exc))
             field = message.partition(":")[0]
@@ -341,10 +442,36 @@ def _recovery_lines(summary: Mapping[str, Any]) -> list[str]:
     recovered = "stage 4 not reached" if t4 is None else f"stage 4 at {_fmt(t4, unit='s')}"
     if t4 is not None and summary.get("time_to_recover_s") is not None:
         recovered += f" ({_fmt(summary['time_to_recover_s'], unit='s')} after the detection)"
+    low = summary.get("min_altitude_m")
+    if t4 is not None and low is not None and low < 0:
+        recovered += (
+            f", but below ground level on the way (lowest altitude {_fmt(low, unit='m', digits=3)}"
+            "; without a ground in the run it flew through where the ground would be: not a "
+            "success in the recovery study)"
+        )
+    if summary.get("bumper_model_valid") is False:
+        recovered += " (invalid: a bumper went deeper than its radius, beyond the bumper model)"
     return [f"detection      {detected}", f"recovered      {recovered}"]
 
 
-def format_summary(summary: Mapping[str, Any], out: Path) -> str:
+def _response_type(summary: Mapping[str, Any], scenario: Any) -> str:
+    """The response type with its meaning, or why there is none (docs/STUDIES.md 3)."""
+    from quadimpact.simulation.metrics import RESPONSE_TYPE_MEANINGS, response_type_applies
+
+    kind = getattr(scenario, "kind", None)
+    if scenario is not None and not response_type_applies(kind, getattr(scenario, "ground", None)):
+        words = {"impact-trial": "an impact trial", "flight": "a flight"}
+        why = words.get(kind, f"a {kind}") if kind != "wall-approach" else (
+            "no ground, so no crash rule"
+        )
+        return f"n/a ({why}: the types A-D are defined for the wall approach with a crash rule)"
+    rtype = summary.get("response_type")
+    if not rtype:
+        return "n/a"
+    return f"{rtype} ({RESPONSE_TYPE_MEANINGS.get(str(rtype), '')})"
+
+
+def format_summary(summary: Mapping[str, Any], out: Path, scenario: Any = None) -> str:
     """The short human summary printed after a run.
 
     Parameters
@@ -353,6 +480,9 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         The run's summary (the content of summary.json).
     out : pathlib.Path
         The output folder.
+    scenario : WallApproach or FlightScenario or ImpactTrial, optional
+        The run's scenario: a response type is printed only where it is
+        defined (a wall approach with a crash rule), with its meaning.
 
     Returns
     -------
@@ -370,7 +500,7 @@ def format_summary(summary: Mapping[str, Any], out: Path) -> str:
         f"delta_init     {_fmt(summary.get('delta_init_m'), 1000.0, 'mm')}",
         f"peak force     {_fmt(summary.get('peak_force_n'), unit='N')}",
         f"leading bumper {leading if leading is not None else 'n/a'}",
-        f"response type  {summary.get('response_type') or 'n/a'}",
+        f"response type  {_response_type(summary, scenario)}",
         f"episodes       {_fmt(summary.get('n_episodes'))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]

@@ -10,7 +10,13 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import announce_compilation, file_argument, parallel_options
+from quadimpact.cli.options import (
+    announce_compilation,
+    file_argument,
+    max_record_option,
+    parallel_options,
+    stoppable,
+)
 from quadimpact.errors import InputError
 
 __all__ = ["sweep"]
@@ -69,6 +75,10 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
     is_flag=True,
     help="Allow a sweep of more than 1,000,000 runs (refused otherwise).",
 )
+@max_record_option(
+    "Largest record (time series and IMU samples) one run may allocate; a run above "
+    "it is refused before any starts."
+)
 @click.option("--no-plots", is_flag=True, help="Do not write plots/.")
 def sweep(
     sweep_file: Path | None,
@@ -79,6 +89,7 @@ def sweep(
     no_progress: bool,
     timeout: float | None,
     allow_large: bool,
+    max_record_mb: float,
     no_plots: bool,
 ) -> None:
     """Run a sweep: one base scenario over a grid, a list or a random sample.
@@ -107,14 +118,8 @@ def sweep(
           --grid speed_m_s=0.5,0.75,1.0 --grid model=paper-replica --out fig4
       quadimpact sweep study.toml --grid restitution=0.2:0.8:0.1 --out restitution
     """
-    from quadimpact.sweep import (
-        SweepInterrupted,
-        SweepSpec,
-        WorkerError,
-        load_sweep_file,
-        run_sweep,
-    )
-    from quadimpact.sweep.interrupt import stop_signals
+    from quadimpact.results.files import check_out_dir
+    from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
 
     extra = _parse_grid(grid)
     if sweep_file is not None:
@@ -127,22 +132,21 @@ def sweep(
         spec = SweepSpec(grid=extra, where="sweep")
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
+    check_out_dir(out, "sweep")
     announce_compilation()
     # once stopped by a signal, every later one is ignored until the program has ended
-    with stop_signals(restore_after_stop=False):
-        try:
-            info = run_sweep(
-                spec,
-                out,
-                workers=workers,
-                scheduler=scheduler,
-                progress=not no_progress,
-                load=False,
-                timeout=timeout,
-                allow_large=allow_large,
-            )
-        except (SweepInterrupted, WorkerError) as exc:
-            raise click.exceptions.Exit(_stopped(exc)) from None
+    with stoppable():
+        info = run_sweep(
+            spec,
+            out,
+            workers=workers,
+            scheduler=scheduler,
+            progress=not no_progress,
+            load=False,
+            timeout=timeout,
+            allow_large=allow_large,
+            max_record_mb=max_record_mb,
+        )
     plots: list[Path] = []
     if not no_plots:
         from quadimpact.sweep.plots import auto_plots
@@ -152,21 +156,6 @@ def sweep(
         except Exception as exc:  # plots never lose the table
             click.echo(f"quadimpact: warning: plots not written: {exc}", err=True)
     click.echo(_report(out, plots, info))
-
-
-def _stopped(exc: Exception) -> int:
-    """Say why the sweep stopped, what is saved, that a rerun resumes; the exit status."""
-    from quadimpact.sweep import SweepInterrupted
-    from quadimpact.sweep.interrupt import signal_name
-
-    resume = "run the same command again to resume"
-    if hasattr(exc, "saved"):
-        resume = f"{exc.saved} of {exc.n_runs} runs saved in {exc.out_dir}; {resume}"
-    if isinstance(exc, SweepInterrupted):
-        click.echo(f"quadimpact: interrupted by {signal_name(exc.signum)}: {resume}", err=True)
-        return exc.exit_code
-    click.echo(f"quadimpact: error: {getattr(exc, 'cause', exc)}; {resume}", err=True)
-    return 1
 
 
 def _report(out: Path, plots: list[Path], info: dict) -> str:

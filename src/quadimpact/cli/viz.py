@@ -10,6 +10,7 @@ folder written by ``quadimpact run`` and writes into it:
 
 from __future__ import annotations
 
+import errno
 import functools
 from collections.abc import Callable
 from pathlib import Path
@@ -87,7 +88,7 @@ def _camera(
 
 def _scene(result_dir: Path, vehicle: str | None) -> Any:
     """The scene of a result folder, with input errors as one line."""
-    from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET
+    from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET, check_writable
     from quadimpact.results.result import read_result
     from quadimpact.viz.scene import Scene
 
@@ -102,21 +103,34 @@ def _scene(result_dir: Path, vehicle: str | None) -> Any:
 
         veh = load_vehicle(vehicle)
     result = read_result(result_dir)  # a file that cannot be read: one line naming it
+    check_writable(result_dir, f"{result_dir}: the pictures cannot be written there")
     try:
         return Scene.from_result(result, vehicle=veh)
     except InputError as exc:
         raise InputError(f"{exc} (pass --vehicle with the run's vehicle file)") from None
     except ValueError as exc:
         raise InputError(f"{result_dir}: {exc}") from None
+    except (KeyError, TypeError, AttributeError, IndexError) as exc:  # a hand-edited record
+        raise InputError(
+            f"{result_dir / 'scenario.json'}: damaged or not written by quadimpact "
+            f"({type(exc).__name__}: {exc})"
+        ) from None
 
 
 def _value_errors(func: Callable[..., Any]) -> Callable[..., Any]:
+    """A ValueError, or a folder that refuses the files, as an input error (exit 2)."""
+
     @functools.wraps(func)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
         try:
             return func(*args, **kwargs)
         except ValueError as exc:
             raise InputError(str(exc)) from None
+        except OSError as exc:
+            if exc.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
+                raise
+            where = exc.filename or kwargs.get("result_dir") or "the result folder"
+            raise InputError(f"{where}: cannot be written ({exc.strerror or exc})") from None
 
     return wrapper
 
@@ -134,6 +148,12 @@ def _parse_times(text: str) -> list[float]:
     return times
 
 
+#: The largest movie frame, pixels (8K UHD): a frame is drawn whole in memory (4 bytes a pixel).
+MAX_FRAME_PIXELS = 7680 * 4320
+#: The most frames of a snapshot strip without --max-frames (one row of panels).
+MAX_SNAPSHOT_FRAMES = 24
+
+
 def _parse_size(text: str) -> tuple[int, int]:
     w, sep, h = text.lower().partition("x")
     try:
@@ -142,7 +162,28 @@ def _parse_size(text: str) -> tuple[int, int]:
         size = (0, 0)
     if not sep or size[0] < 64 or size[1] < 64 or size[0] % 2 or size[1] % 2:
         raise InputError(f"--size: WIDTHxHEIGHT in pixels, even, at least 64 (got {text!r})")
+    pixels = size[0] * size[1]
+    if pixels > MAX_FRAME_PIXELS:
+        raise InputError(
+            f"--size {text}: a frame of {pixels / 1e6:,.0f} Mpx ({4 * pixels / 2**30:,.1f} GiB "
+            f"to draw) is larger than 8K (7680x4320, {MAX_FRAME_PIXELS / 1e6:.1f} Mpx), the "
+            "largest movie size quadimpact draws"
+        )
     return size
+
+
+def _check_frames(times: list[float], max_frames: int) -> None:
+    """Refuse a snapshot strip of more than ``max_frames`` frames, with its picture size."""
+    from quadimpact.viz.snapshots import SNAPSHOT_DPI
+
+    if len(times) <= max_frames:
+        return
+    width = round(2.3 * SNAPSHOT_DPI * len(times))
+    raise InputError(
+        f"--times: {len(times)} frames would make a {width:,} pixel wide strip (one row of "
+        f"panels, each drawn in 3D), more than the {max_frames} frames allowed; give fewer "
+        "times, or --max-frames N to allow more (for a movie: quadimpact animate)"
+    )
 
 
 # ------------------------------------------------------------------ animate
@@ -161,7 +202,8 @@ def _parse_size(text: str) -> tuple[int, int]:
 @number_option("--end", "S", "Last simulated time shown, s. [default: end of the run]")
 @click.option("--gif", is_flag=True, help="Also write animation.gif (smaller, 15 fps, for slides).")
 @click.option(
-    "--size", default="1280x720", show_default=True, metavar="WxH", help="Movie size in pixels."
+    "--size", default="1280x720", show_default=True, metavar="WxH",
+    help="Movie size in pixels (even, at least 64x64, at most 8K: 7680x4320 pixels).",
 )
 @_camera_options
 @_value_errors
@@ -238,10 +280,23 @@ def _need_ffmpeg() -> None:
     type=click.Choice(["7", "8"]),
     help="Use the times of the paper's Figure 7 (0,0.13,0.2,0.265,0.33,0.365) or 8.",
 )
+@click.option(
+    "--max-frames",
+    type=click.IntRange(min=1),
+    default=MAX_SNAPSHOT_FRAMES,
+    show_default=True,
+    metavar="N",
+    help="Most frames --times may give (the strip is one row of 3D panels).",
+)
 @_camera_options
 @_value_errors
 def snapshots(
-    result_dir: Path, times: str | None, paper_figure: str | None, vehicle: str | None, **cam: Any
+    result_dir: Path,
+    times: str | None,
+    paper_figure: str | None,
+    max_frames: int,
+    vehicle: str | None,
+    **cam: Any,
 ) -> None:
     """Write RESULT_DIR/snapshots.png and .pdf: 3D frames at times after impact.
 
@@ -253,6 +308,8 @@ def snapshots(
     if times is not None and paper_figure is not None:
         raise InputError("--times and --paper-figure: give one of them, not both")
     parsed = None if times is None else _parse_times(times)
+    if parsed is not None:
+        _check_frames(parsed, max_frames)
     camera = _camera(DEFAULT_SNAPSHOT_CAMERA, **cam)
     scene = _scene(result_dir, vehicle)
     png, pdf, warnings = write_snapshots(

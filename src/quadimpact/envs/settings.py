@@ -29,6 +29,7 @@ __all__ = [
     "Envelope",
     "RewardWeights",
     "TrialDistribution",
+    "coerce",
     "pack_parameters",
 ]
 
@@ -54,6 +55,84 @@ def _choice(rng: np.random.Generator, options: str | Sequence[str]) -> str:
     if isinstance(options, str):
         return options
     return str(options[k % len(options)])
+
+
+def _number(name: str, value: Any, *, low: float | None = None, low_open: bool = False) -> float:
+    """A finite real number (not a bool), optionally above ``low``; else ``ValueError``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise ValueError(f"{name}: must be a number (got {value!r})")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name}: must be a finite number (got {value!r})")
+    if low is not None and (x < low or (low_open and x == low)):
+        raise ValueError(f"{name}: must be {'>' if low_open else '>='} {low:g} (got {value!r})")
+    return x
+
+
+def _flag(name: str, value: Any) -> bool:
+    """A boolean option: True or False (NumPy's too), nothing else."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name}: must be True or False (got {value!r})")
+    return bool(value)
+
+
+def _check_range(name: str, value: Any) -> None:
+    """A fixed value or ``(lo, hi)`` with ``lo <= hi``, finite; valid for ImpactTrial's field."""
+    if isinstance(value, (str, bytes)) or not (
+        isinstance(value, (int, float, np.number)) or isinstance(value, Sequence)
+    ):
+        raise ValueError(f"{name}: must be a number or (low, high) (got {value!r})")
+    ends = [value] if not isinstance(value, Sequence) else list(value)
+    if isinstance(value, Sequence) and len(ends) != 2:
+        raise ValueError(f"{name}: must be a number or (low, high) (got {value!r})")
+    numbers = [_number(name, v) for v in ends]
+    if numbers[0] > numbers[-1]:
+        raise ValueError(f"{name}: (low, high) needs low <= high (got {value!r})")
+    field_name = "friction_coefficient" if name == "friction" else name
+    for x in numbers:  # each end a valid trial value: checked now, not when drawn
+        try:
+            ImpactTrial.model_validate({field_name: x})
+        except Exception as exc:  # pydantic's ValidationError: the field's own rule
+            from quadimpact.errors import input_error_from_validation
+
+            rule = str(input_error_from_validation(exc)).partition(": ")[2] or str(exc)
+            raise ValueError(f"{name}: {rule}") from None
+
+
+def _check_choices(name: str, value: Any) -> None:
+    """A non-empty string or a non-empty sequence of them."""
+    items = [value] if isinstance(value, str) else value
+    if not isinstance(items, Sequence) or not items or not all(
+        isinstance(v, str) and v for v in items
+    ):
+        raise ValueError(f"{name}: must be a name or a non-empty list of names (got {value!r})")
+
+
+def coerce(cls: type, value: Any, name: str) -> Any:
+    """``value`` as a ``cls`` (a settings dataclass): itself, or a mapping of its fields.
+
+    Raises
+    ------
+    TypeError
+        Anything else, or a mapping with a key that is not a field.
+    """
+    if value is None:
+        return cls()
+    if isinstance(value, cls):
+        return value
+    if isinstance(value, Mapping):
+        known = [f for f in cls.__dataclass_fields__ if not f.startswith("_")]
+        unknown = [k for k in value if k not in known]
+        if unknown:
+            raise TypeError(
+                f"{name}: unknown field(s) {', '.join(map(repr, unknown))} of {cls.__name__} "
+                f"(fields: {', '.join(known)})"
+            )
+        return cls(**value)
+    raise TypeError(
+        f"{name}: must be a {cls.__name__} or a mapping of its fields (got "
+        f"{type(value).__name__} {value!r})"
+    )
 
 
 @dataclass(frozen=True)
@@ -120,6 +199,18 @@ class TrialDistribution:
     estimator_params: Mapping[str, Any] = field(default_factory=dict)
     sensors: str | None = None
     overrides: Mapping[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        for name in ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "friction"):
+            _check_range(name, getattr(self, name))
+        for name in ("vehicle", "model", "imu"):
+            _check_choices(name, getattr(self, name))
+        _number("start_distance_m", self.start_distance_m, low=0.0, low_open=True)
+        _number("altitude_m", self.altitude_m, low=0.0, low_open=True)
+        _number("final_time_s", self.final_time_s, low=0.0, low_open=True)
+        for name in ("controller_params", "overrides"):
+            if not isinstance(getattr(self, name), Mapping):
+                raise TypeError(f"{name}: must be a mapping (got {getattr(self, name)!r})")
 
     def imu_choices(self) -> list[Any]:
         """The IMU settings a trial can have (presets, or the override's table)."""
@@ -207,6 +298,14 @@ class RewardWeights:
     vertical_speed_scale_m_s: float = 1.0
     height_scale_m: float = 1.0
 
+    def __post_init__(self) -> None:
+        for name in ("tilt", "rate", "vertical_speed", "height_loss", "effort",
+                     "recovery_bonus", "failure_penalty"):  # fmt: skip
+            _number(name, getattr(self, name), low=0.0)
+        for name in ("rate_scale_rad_s", "vertical_speed_scale_m_s", "height_scale_m"):
+            _number(name, getattr(self, name), low=0.0, low_open=True)
+        _flag("failure_remaining", self.failure_remaining)
+
 
 @dataclass(frozen=True)
 class Envelope:
@@ -229,6 +328,12 @@ class Envelope:
     max_distance_m: float = 10.0
     max_rate_rad_s: float = 40.0
 
+    def __post_init__(self) -> None:
+        for name in ("max_tilt_deg", "max_drop_m", "max_distance_m", "max_rate_rad_s"):
+            _number(name, getattr(self, name), low=0.0, low_open=True)
+        if self.max_tilt_deg > 180.0:
+            raise ValueError(f"max_tilt_deg: must be <= 180 (got {self.max_tilt_deg!r})")
+
 
 def pack_parameters(
     *,
@@ -249,8 +354,9 @@ def pack_parameters(
         raise ValueError(f"observe: one of {OBSERVATION_MODES} (got {observe!r})")
     if rotor_floor not in ("vehicle", "zero"):
         raise ValueError(f"rotor_floor: 'vehicle' or 'zero' (got {rotor_floor!r})")
-    if not hold_s > 0.0:
-        raise ValueError(f"hold_s: > 0 s (got {hold_s!r})")
+    _number("hold_s", hold_s, low=0.0, low_open=True)
+    end_on_recovery = _flag("end_on_recovery", end_on_recovery)
+    ground = _flag("ground", ground)
     par = np.zeros(B.NPAR)
     par[B.EP_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
     par[B.EP_OBSERVE] = {"state": B.OBS_STATE, "estimate": B.OBS_ESTIMATE}.get(observe, B.OBS_IMU)

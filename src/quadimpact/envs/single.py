@@ -19,6 +19,7 @@ from quadimpact.envs.settings import (
     Envelope,
     RewardWeights,
     TrialDistribution,
+    coerce,
     pack_parameters,
 )
 from quadimpact.inputs.scenarios import ImpactTrial
@@ -27,6 +28,35 @@ from quadimpact.results.result import SimulationResult
 __all__ = ["ImpactRecoveryEnv", "configure", "observation_dtype", "spaces_for"]
 
 StartMode = Literal["detection", "trial"]
+
+
+def check_options(options: Any, known: tuple[str, ...]) -> None:
+    """Refuse ``reset`` options that are not a mapping or have a key ``reset`` does not use."""
+    if options is None:
+        return
+    if not isinstance(options, Mapping):
+        raise TypeError(f"options: must be a mapping (got {type(options).__name__})")
+    unknown = [k for k in options if k not in known]
+    if unknown:
+        raise ValueError(
+            f"options: unknown key(s) {', '.join(map(repr, unknown))} (known: "
+            f"{', '.join(map(repr, known))})"
+        )
+
+
+def check_actions(action: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """The action as float64 of exactly ``shape``, finite; else ``ValueError`` (no broadcast)."""
+    if action is None:
+        raise ValueError(f"action: must be an array of shape {shape} (got None)")
+    try:
+        a = np.asarray(action, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ValueError(f"action: must be an array of numbers of shape {shape}") from None
+    if a.shape != shape:
+        raise ValueError(f"action: must have shape {shape} (got {a.shape})")
+    if not np.all(np.isfinite(a)):
+        raise ValueError("action: must be finite (got NaN or infinity)")
+    return a
 
 
 def spaces_for(action: str, observe: str) -> tuple[gym.spaces.Box, gym.spaces.Box]:
@@ -73,20 +103,27 @@ def configure(
     """
     if start not in ("detection", "trial"):
         raise ValueError(f"start: 'detection' or 'trial' (got {start!r})")
-    env.trials = trials or TrialDistribution()
+    if isinstance(max_redraws, bool) or not isinstance(max_redraws, (int, np.integer)):
+        raise TypeError(f"max_redraws: must be an integer >= 0 (got {max_redraws!r})")
+    if max_redraws < 0:
+        raise ValueError(f"max_redraws: must be an integer >= 0 (got {max_redraws!r})")
+    if not isinstance(record, (bool, np.bool_)):
+        raise TypeError(f"record: must be True or False (got {record!r})")
+    env.trials = coerce(TrialDistribution, trials, "trials")
     env.start_mode = start
     env.action_mode = action
     env.observe_mode = observe
-    env.reward_weights = reward or RewardWeights()
-    env.envelope = envelope or Envelope()
+    env.reward_weights = coerce(RewardWeights, reward, "reward")
+    env.envelope = coerce(Envelope, envelope, "envelope")
     env.max_redraws = int(max_redraws)
     par = pack_parameters(
         action=action, observe=observe, rotor_floor=rotor_floor, reward=env.reward_weights,
         envelope=env.envelope, hold_s=hold_s, end_on_recovery=end_on_recovery, ground=ground,
     )  # fmt: skip
     env._slots = Slots(
-        n, env.trials, par, until_detection=start == "detection", ground=ground, record=record
-    )
+        n, env.trials, par, until_detection=start == "detection", ground=bool(ground),
+        record=bool(record),
+    )  # fmt: skip
 
 
 class ImpactRecoveryEnv(gym.Env):
@@ -149,6 +186,7 @@ class ImpactRecoveryEnv(gym.Env):
         settings) to run instead of a draw.
         """
         super().reset(seed=seed)
+        check_options(options, ("trial",))
         trial = (options or {}).get("trial")
         self._slots.reset(0, self.np_random, trial, self.max_redraws)
         info = {
@@ -164,7 +202,7 @@ class ImpactRecoveryEnv(gym.Env):
         s = self._slots
         if not s.active()[0]:
             raise RuntimeError("step: the episode has ended; call reset()")
-        self._act[0] = action
+        self._act[0] = check_actions(action, (4,))
         s.step(self._act)
         info: dict[str, Any] = {"t": float(s.D.ls[0, L.LS_T]), "stage": int(s.ENV[0, B.B_STAGE])}
         terminated = bool(s.terminated[0])

@@ -21,7 +21,7 @@ from gymnasium.vector.utils import batch_space
 
 from quadimpact.core import batch as B
 from quadimpact.core import layout as L
-from quadimpact.envs.single import configure, spaces_for
+from quadimpact.envs.single import check_actions, check_options, configure, spaces_for
 
 __all__ = ["BatchedImpactRecoveryEnv"]
 
@@ -53,6 +53,10 @@ class BatchedImpactRecoveryEnv(VectorEnv):
         autoreset_mode: AutoresetMode | str = AutoresetMode.NEXT_STEP,
         **options: Any,
     ) -> None:
+        if isinstance(num_envs, bool) or not isinstance(num_envs, (int, np.integer)):
+            raise TypeError(f"num_envs: must be an integer >= 1 (got {num_envs!r})")
+        if num_envs < 1:
+            raise ValueError(f"num_envs: must be an integer >= 1 (got {num_envs!r})")
         self.num_envs = int(num_envs)
         self.autoreset_mode = AutoresetMode(autoreset_mode)
         self.metadata = {"autoreset_mode": self.autoreset_mode, "render_modes": []}
@@ -91,12 +95,21 @@ class BatchedImpactRecoveryEnv(VectorEnv):
             seeds = list(seed)
             if len(seeds) != n:
                 raise ValueError(f"seed: one per sub-environment ({n}), got {len(seeds)}")
+        check_options(options, ("reset_mask", "trials"))
         options = dict(options or {})
         mask = options.pop("reset_mask", None)
         mask = np.ones(n, dtype=np.bool_) if mask is None else np.asarray(mask, dtype=np.bool_)
         if mask.shape != (n,):
             raise ValueError(f"reset_mask: a boolean array of shape ({n},)")
-        trials = options.pop("trials", None) or [None] * n
+        trials = options.pop("trials", None)
+        if trials is None:
+            trials = [None] * n
+        elif isinstance(trials, (str, Mapping)) or not isinstance(trials, Sequence):
+            raise TypeError(f"trials: a list of one trial (or None) per sub-environment ({n})")
+        elif len(trials) != n:
+            raise ValueError(
+                f"trials: one trial (or None) per sub-environment ({n}), got {len(trials)}"
+            )
         infos: dict[str, Any] = {}
         for k in np.flatnonzero(mask):
             if seeds[k] is not None:
@@ -119,7 +132,7 @@ class BatchedImpactRecoveryEnv(VectorEnv):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """One control period of every sub-environment."""
         s = self._slots
-        self._actions[:] = actions
+        self._actions[:] = check_actions(actions, (self.num_envs, 4))
         next_step = self.autoreset_mode == AutoresetMode.NEXT_STEP
         resetting = self._autoreset.copy() if next_step else None
         if resetting is not None:

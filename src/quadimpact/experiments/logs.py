@@ -34,35 +34,55 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-__all__ = ["DATA_ENV_VAR", "FlightLog", "PreImpact", "data_dir", "rpm_to_rad_s"]
+__all__ = [
+    "DATA_ENV_VAR",
+    "DATA_SEARCH",
+    "FlightLog",
+    "PreImpact",
+    "data_dir",
+    "find_data_dir",
+    "rpm_to_rad_s",
+]
 
 # --------------------------------------------------------------------------- data
 #: Environment variable naming the data folder (holding ``spiri-crash-set-1/``).
 DATA_ENV_VAR = "QUADIMPACT_DATA"
 
 
-def data_dir() -> Path | None:
-    """The shared data folder, or None when it is absent.
+#: Where the flight logs are looked for without --data, in order (docs/EXPERIMENTS.md).
+DATA_SEARCH = (
+    f"${DATA_ENV_VAR} when set (then only it), else the folder shared/data beside the "
+    "checkout's folder, else /work/shared/data (the project's workspace)"
+)
 
-    ``$QUADIMPACT_DATA`` when set (and then only it); otherwise
-    ``../shared/data`` beside the project (the checkout's parent folder), then
-    ``/work/shared/data``. A folder counts only if it holds
-    ``spiri-crash-set-1/``.
+
+def find_data_dir() -> tuple[Path | None, str]:
+    """The data folder and how it was found (``$QUADIMPACT_DATA``, beside the checkout...).
+
+    In the order of :data:`DATA_SEARCH`; a folder counts only if it holds
+    ``spiri-crash-set-1/``. Returns ``(None, why)`` when there is none.
     """
-    candidates: list[Path] = []
+    candidates: list[tuple[Path, str]] = []
     env = os.environ.get(DATA_ENV_VAR)
     if env:
         p = Path(env).resolve()
-        return p if (p / "spiri-crash-set-1").is_dir() else None
+        if (p / "spiri-crash-set-1").is_dir():
+            return p, f"${DATA_ENV_VAR}"
+        return None, f"${DATA_ENV_VAR}={env} holds no spiri-crash-set-1/"
     here = Path(__file__).resolve()
     if len(here.parents) > 3:  # .../<checkout>/src/quadimpact/experiments/logs.py
-        candidates.append(here.parents[3] / ".." / "shared" / "data")
-    candidates.append(Path("/work/shared/data"))
-    for c in candidates:
+        candidates.append((here.parents[3] / ".." / "shared" / "data", "beside the checkout"))
+    candidates.append((Path("/work/shared/data"), "the workspace's data folder"))
+    for c, how in candidates:
         c = c.resolve()
         if (c / "spiri-crash-set-1").is_dir():
-            return c
-    return None
+            return c, how
+    return None, f"none found ({DATA_SEARCH})"
+
+
+def data_dir() -> Path | None:
+    """The shared data folder, or None when it is absent (:func:`find_data_dir`)."""
+    return find_data_dir()[0]
 
 
 def rpm_to_rad_s(rpm: Any) -> Any:

@@ -225,6 +225,22 @@ def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | Non
     )
 
 
+def logs_source(data: str | Path | None) -> str:
+    """One line saying which folder the flight logs are read from, and how it was found.
+
+    ``data``: the folder given (``--data``), or None for the default search
+    (:func:`quadimpact.experiments.logs.find_data_dir`).
+    """
+    from quadimpact.experiments.logs import find_data_dir
+
+    if data is not None:
+        return f"flight logs read from {Path(data).resolve()} (--data)"
+    found, how = find_data_dir()
+    if found is None:
+        return f"no flight logs: {how}; the comparisons with the logs are left out"
+    return f"flight logs read from {found} (found: {how})"
+
+
 def read_log(crash: Crash, data: str | Path | None = None) -> SpiriMatLog | None:
     """The crash's flight log, None where the data folder or the file is absent."""
     root = Path(data) if data is not None else data_dir()

@@ -293,6 +293,12 @@ def register_controller(
         raise ValueError(f"controller {name!r} is already registered (replace=True to replace)")
     if step is None and kind is None:
         raise ValueError(f"controller {name!r}: give its compiled step (or a built-in kind)")
+    if step is not None and not _is_compiled(step):
+        raise TypeError(
+            f"controller {name!r}: step must be compiled with numba.njit (got "
+            f"{type(step).__name__} {getattr(step, '__name__', step)!r}): the loop that calls "
+            "it is compiled, and a plain Python function would fail only when a run starts"
+        )
     entry = ControllerEntry(
         name=name,
         kind=L.CTRL_USER if kind is None else int(kind),
@@ -303,6 +309,15 @@ def register_controller(
     )
     _REGISTRY[name] = entry
     return entry
+
+
+def _is_compiled(step: Any) -> bool:
+    """Whether ``step`` is a Numba dispatcher (``njit``), which a compiled loop can call."""
+    try:
+        from numba.core.dispatcher import Dispatcher
+    except ImportError:  # pragma: no cover (numba is a dependency)
+        return callable(step)
+    return isinstance(step, Dispatcher)
 
 
 def unregister_controller(name: str) -> None:

@@ -215,6 +215,19 @@ class Vehicle(BaseModel):
                 "rotor_positions_m: rotor arms (horizontal distance from the CM) must lie in "
                 f"[0.005, 5] m (got {arms.min():.4g} to {arms.max():.4g} m)"
             )
+        if self.bumper_radius_m >= arms.min():
+            raise ValueError(
+                f"bumper_radius_m: {self.bumper_radius_m:g} m is not less than the shortest "
+                f"rotor arm ({arms.min():.3g} m): a bumper ring around a rotor would enclose "
+                "the CM and cross the other rotors (each bumper is a circle around one rotor)"
+            )
+        reach = float(np.linalg.norm(np.asarray(self.rotor_positions_m, float), axis=1).max())
+        imu = float(np.linalg.norm(np.asarray(self.imu_position_m, dtype=float)))
+        if imu > reach + self.bumper_radius_m:
+            raise ValueError(
+                f"imu_position_m: {imu:.3g} m from the CM, off the vehicle (its rotors and "
+                f"bumpers reach {reach + self.bumper_radius_m:.3g} m): the IMU must sit on it"
+            )
         hover_rpm = self.hover_speed_rad_s * 60.0 / (2.0 * math.pi)
         lo, hi = self.rotor_speed_range_rpm
         if not lo <= hover_rpm <= hi:
@@ -254,10 +267,18 @@ class Vehicle(BaseModel):
     def _plausibility_warnings(self) -> list[str]:
         out = []
         arms = np.linalg.norm(self.rotor_positions[:, :2], axis=1)
-        if not 0.3 * arms.mean() <= self.bumper_radius_m <= 3.0 * arms.mean():
+        if self.bumper_radius_m < 0.3 * arms.mean():
             out.append(
                 f"bumper_radius_m {self.bumper_radius_m:g} m is unusual for rotor arms of "
                 f"{arms.mean():.3g} m (a bumper circle around each rotor)"
+            )
+        r = self.rotor_positions[:, :2]
+        gaps = [float(np.linalg.norm(r[i] - r[j])) for i in range(4) for j in range(i + 1, 4)]
+        if 2.0 * self.bumper_radius_m > min(gaps):
+            out.append(
+                f"bumper rings overlap: 2 x bumper_radius_m = {2 * self.bumper_radius_m:.3g} m "
+                f"is more than the {min(gaps):.3g} m between the nearest rotor hubs (each ring "
+                "is still treated as a separate bumper)"
             )
         hi = self.rotor_speed_range_rpm[1] * 2.0 * math.pi / 60.0
         ratio = (hi / self.hover_speed_rad_s) ** 2

@@ -143,7 +143,10 @@ def render_report(
                   f"![Snapshots after impact (the paper's Figure 8 times), {v}]"
                   f"(example-{v}/snapshots.png)", ""]  # fmt: skip
     if table3 is not None:
-        lines += ["## Table III: the seven real crashes", "", table3_markdown(table3), ""]
+        logs = table3.attrs.get("logs")
+        lines += ["## Table III: the seven real crashes", ""]
+        lines += [f"The {logs} (docs/EXPERIMENTS.md).", ""] if logs else []
+        lines += [table3_markdown(table3), ""]
     if recovery is not None:
         lines += [recovery_markdown(recovery, elapsed_s), ""]
     if stage_times:
@@ -169,7 +172,7 @@ def _quantile_pair(q: dict[str, float], digits: int = 2) -> str:
 
 def _monte_carlo_table(numbers: dict[str, dict], first: str) -> list[str]:
     lines = [
-        f"| {first} | trials | success (recovered / all) | recovered / detected "
+        f"| {first} | trials | success (recovered / valid trials) | recovered / detected "
         "| not detected | false detections | time to recover, median / p90 (s) "
         "| height loss, median / p90 (m) | drift, median / p90 (m) "
         "| detection latency, median (s) |",

@@ -35,6 +35,7 @@ figures (:mod:`~quadimpact.paper.estimation`). It writes ``recovery/<study>/``
 from __future__ import annotations
 
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -128,35 +129,72 @@ class StageClock:
     which overlap).
     """
 
+    #: Seconds without a line after which a running stage says it is still running.
+    HEARTBEAT_S = 15.0
+
     def __init__(self, progress: bool) -> None:
         self.progress = progress
         self.times: list[tuple[str, float]] = []
         self.pieces: list[tuple[str, float]] = []
         self._current: tuple[str, float] | None = None
+        self._n_pieces = 0
+        self._done_pieces = 0
+        self._last_line = time.perf_counter()
+        self._beat: threading.Event | None = None
 
-    def start(self, text: str) -> None:
-        """End the running stage (if any) and start the one named ``text``."""
+    def _say(self, line: str) -> None:
+        self._last_line = time.perf_counter()
+        if self.progress:
+            print(f"reproduce: {line}", file=sys.stderr, flush=True)
+
+    def start(self, text: str, n_pieces: int = 0) -> None:
+        """End the running stage (if any) and start the one named ``text``.
+
+        ``n_pieces``: the pieces it runs on worker processes; while none has
+        ended for :attr:`HEARTBEAT_S`, a line says the stage is still running
+        (how many pieces are done, the time so far), so that a long stage (a
+        first run also compiles the simulator) is never silent.
+        """
         self.stop()
         self._current = (text, time.perf_counter())
-        if self.progress:
-            print(f"reproduce: {text}", file=sys.stderr, flush=True)
+        self._n_pieces, self._done_pieces = n_pieces, 0
+        self._say(text)
+        if self.progress and n_pieces:  # (other stages show their sweeps' progress bars)
+            self._beat = threading.Event()
+            threading.Thread(target=self._heartbeat, args=(self._beat,), daemon=True).start()
+
+    def _heartbeat(self, stop: threading.Event) -> None:
+        while not stop.wait(1.0):
+            current = self._current
+            if current is None or time.perf_counter() - self._last_line < self.HEARTBEAT_S:
+                continue
+            done = (
+                f"{self._done_pieces} of {self._n_pieces} pieces done, " if self._n_pieces else ""
+            )
+            compiling = "" if self._done_pieces else "; a first run compiles the simulator first"
+            self._say(
+                f"{current[0]}: still running ({done}{time.perf_counter() - current[1]:.0f} s "
+                f"so far{compiling})"
+            )
 
     def piece(self, text: str, seconds: float) -> None:
         """A piece of the running stage finished (on a worker process) in ``seconds``."""
         self.pieces.append((text, seconds))
-        if self.progress:
-            print(f"reproduce: {text}: {seconds:.1f} s", file=sys.stderr, flush=True)
+        self._done_pieces += 1
+        self._say(f"{text}: {seconds:.1f} s")
 
     def stop(self) -> None:
         """End the running stage (if any) and record its time."""
+        if self._beat is not None:
+            self._beat.set()
+            self._beat = None
         if self._current is None:
             return
         text, t0 = self._current
         self._current = None
         seconds = time.perf_counter() - t0
         self.times.append((text, seconds))
-        if self.progress:
-            print(f"reproduce: {text}: {seconds:.1f} s", file=sys.stderr, flush=True)
+        self._say(f"{text}: {seconds:.1f} s")
 
 
 def _ablation_name(switch: str) -> str:
@@ -208,6 +246,7 @@ def reproduce(
         SENSITIVITY_RUNS,
         TABLE3,
         check_data_dir,
+        logs_source,
         prepare_experiments,
         write_table3,
     )
@@ -251,7 +290,8 @@ def reproduce(
         clock.start(f"the paper's runs: {len(pieces)} pieces on {min(processes, len(pieces))} "
                     "processes (Figure 4 and the example in both variants"
                     + (", the ablations" if ablation else "")
-                    + (", the crashes of Table III" if experiments else "") + ")")  # fmt: skip
+                    + (", the crashes of Table III" if experiments else "") + ")",
+                    n_pieces=len(pieces))  # fmt: skip
 
         def done(k: int, result: tuple[Any, float]) -> None:
             clock.piece(pieces[order[k]][0], result[1])
@@ -280,6 +320,8 @@ def reproduce(
     ablation_df = pd.DataFrame(ablation_rows)
     findings = findings_frame(found)
     table3 = write_table3(crash_rows, exp_out) if experiments else None
+    if table3 is not None:
+        table3.attrs["logs"] = logs_source(data_dir)  # said in the report's Table III
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
 

@@ -3,20 +3,37 @@
 Outcome classes partition the trials (:data:`OUTCOME_CLASSES`, checked in
 this order):
 
+* ``invalid: started in contact``: the trial could not run because its
+  vehicle starts already touching the wall (``simulation/checks.py``: an
+  input error for a single run, a failed row with that reason in a sweep);
 * ``failed``: the run failed numerically (``status = "failed"``);
+* ``invalid: bumper model exceeded``: a bumper went deeper than its radius
+  (``bumper_model_valid = False``): the body itself would be in the wall,
+  beyond what the contact model covers, so the outcome means nothing;
 * ``false detection``: the detector fired before any contact;
 * ``not detected``: there was a contact and the detector never fired (a
   failure of the detector, not of the recovery);
 * ``no contact``: no contact and no detection;
-* ``recovered``: the impact was detected and stage 4 was reached;
+* ``recovered below ground level``: the impact was detected and stage 4 was
+  reached, but the vehicle's altitude went below 0 on the way
+  (``min_altitude_m < 0``): the start altitude is measured from a ground at
+  0 that the trial does not model (``ground = "none"``), so it flew through
+  where the ground would be: not a success;
+* ``recovered``: the impact was detected and stage 4 was reached, never
+  below altitude 0;
 * ``not recovered``: the impact was detected and stage 4 was not reached (a
   failed recovery).
 
-Two success rates, each with its 95 % Wilson score interval
-(:func:`wilson_interval`): the **success rate** is ``recovered`` (stage 4
-reached, the table's column) over all trials; the **recovery rate of the
-detected impacts** is the ``recovered`` class over the trials whose impact
-was detected (classes ``recovered`` and ``not recovered``).
+The first three are **excluded** (:data:`EXCLUDED_CLASSES`): they say nothing
+of the recovery, so the rates are over the **valid** trials (all the others)
+and the report and the command's summary line say how many were excluded and
+why. Two success rates, each with its 95 % Wilson score interval
+(:func:`wilson_interval`): the **success rate** is the valid trials that
+reached stage 4 (the table's ``recovered`` column: a false detection that
+reached stage 4 counts) and never went below altitude 0, over the valid
+trials; the **recovery rate of the detected impacts** is the ``recovered``
+class over the trials whose impact was detected (classes ``recovered``,
+``recovered below ground level`` and ``not recovered``).
 
 Bins: the inclination toward the wall, ``inclination_deg = -pitch_deg``, in
 10-deg bins centred on multiples of 10 deg (edges at ..., -15, -5, 5, 15, ...;
@@ -38,6 +55,8 @@ import pandas as pd
 from quadimpact.recovery.estimation import estimation_numbers
 
 __all__ = [
+    "BELOW_GROUND",
+    "EXCLUDED_CLASSES",
     "INCLINATION_BIN",
     "OUTCOME_CLASSES",
     "SPEED_BIN",
@@ -53,7 +72,9 @@ __all__ = [
     "quantiles",
     "rate",
     "rate_by",
+    "success_mask",
     "summarise",
+    "valid_mask",
     "wilson_interval",
 ]
 
@@ -63,14 +84,21 @@ Z_95 = 1.96
 INCLINATION_BIN = (10.0, 5.0)
 #: (width, offset) of the speed bins, m/s.
 SPEED_BIN = (0.25, 0.0)
+#: The class of a trial that recovered but went below altitude 0 (not a success).
+BELOW_GROUND = "recovered below ground level"
 OUTCOME_CLASSES = (
     "recovered",
+    BELOW_GROUND,
     "not recovered",
     "not detected",
     "false detection",
     "no contact",
+    "invalid: bumper model exceeded",
+    "invalid: started in contact",
     "failed",
 )
+#: Classes left out of the rates (they say nothing of the recovery).
+EXCLUDED_CLASSES = ("invalid: started in contact", "invalid: bumper model exceeded", "failed")
 #: Tilt beyond which a vehicle has turned over (its up axis points down), deg.
 FLIP_DEG = 90.0
 #: The trial conditions, for the example trial (nearest the medians of these).
@@ -170,19 +198,51 @@ def _flag(table: pd.DataFrame, column: str) -> np.ndarray:
 
 def outcome_class(table: pd.DataFrame) -> pd.Series:
     """Each trial's class (:data:`OUTCOME_CLASSES`, see the module docstring)."""
+    from quadimpact.simulation.checks import STARTED_IN_CONTACT
+
     failed = (table["status"] == "failed").to_numpy()
+    reason = (
+        table["reason"].fillna("").astype(str) if "reason" in table
+        else pd.Series("", index=table.index)
+    )  # fmt: skip
+    in_contact = failed & reason.str.contains(STARTED_IN_CONTACT, regex=False).to_numpy()
+    too_deep = (
+        (table["bumper_model_valid"] == False).fillna(False).to_numpy(dtype=bool)  # noqa: E712
+        if "bumper_model_valid" in table
+        else np.zeros(len(table), dtype=bool)
+    )
     false = _flag(table, "false_detection")
     missed = _flag(table, "not_detected")
     detected = _flag(table, "detected")
     recovered = _flag(table, "recovered")
+    below = _below_ground(table)
     classes = np.select(
-        [failed, false, missed, ~detected, recovered],
-        ["failed", "false detection", "not detected", "no contact", "recovered"],
+        [in_contact, failed, too_deep, false, missed, ~detected, recovered & below, recovered],
+        ["invalid: started in contact", "failed", "invalid: bumper model exceeded",
+         "false detection", "not detected", "no contact", BELOW_GROUND, "recovered"],
         default="not recovered",
-    )
+    )  # fmt: skip
     return pd.Series(
         pd.Categorical(classes, categories=OUTCOME_CLASSES), index=table.index, name="outcome"
     )
+
+
+def _below_ground(table: pd.DataFrame) -> np.ndarray:
+    """Trials whose altitude went below 0 (the level the start altitude is measured from)."""
+    if "min_altitude_m" not in table:
+        return np.zeros(len(table), dtype=bool)
+    return (table["min_altitude_m"].astype(float) < 0.0).fillna(False).to_numpy(dtype=bool)
+
+
+def valid_mask(table: pd.DataFrame) -> np.ndarray:
+    """The trials the rates count: not of an :data:`EXCLUDED_CLASSES` class."""
+    return ~table["outcome_class"].astype(str).isin(EXCLUDED_CLASSES).to_numpy()
+
+
+def success_mask(table: pd.DataFrame) -> np.ndarray:
+    """The successes: valid, stage 4 reached (``recovered``), never below altitude 0."""
+    cls = table["outcome_class"].astype(str).to_numpy()
+    return _flag(table, "recovered") & valid_mask(table) & (cls != BELOW_GROUND)
 
 
 def add_derived(table: pd.DataFrame) -> pd.DataFrame:
@@ -197,27 +257,31 @@ def add_derived(table: pd.DataFrame) -> pd.DataFrame:
 
 # ----------------------------------------------------------------- numbers
 def _success(table: pd.DataFrame) -> np.ndarray:
-    return _flag(table, "recovered")
+    return success_mask(table)
 
 
 def rate_by(table: pd.DataFrame, column: str) -> pd.DataFrame:
-    """Success rate (``recovered`` / trials) per bin of ``column``, with Wilson intervals.
+    """Success rate (successes / valid trials) per bin of ``column``, with Wilson intervals.
 
     Returns
     -------
     pandas.DataFrame
         One row per category of ``column`` (empty bins included):
-        ``bin``, ``n``, ``recovered``, ``rate``, ``low``, ``high``,
-        ``not_detected``, ``false_detection``.
+        ``bin``, ``n`` (valid trials), ``recovered`` (successes), ``rate``,
+        ``low``, ``high``, ``not_detected``, ``false_detection``, ``excluded``
+        (trials of the bin left out of ``n``).
     """
     success = pd.Series(_success(table), index=table.index)
+    valid = pd.Series(valid_mask(table), index=table.index)
     rows = []
     for label, group in table.groupby(column, observed=False, sort=True):
-        r = rate(int(success[group.index].sum()), len(group))
+        n_valid = int(valid[group.index].sum())
+        r = rate(int(success[group.index].sum()), n_valid)
         rows.append({
             "bin": str(label), "n": r.n, "recovered": r.k, "rate": r.value, "low": r.low,
             "high": r.high, "not_detected": int(_flag(group, "not_detected").sum()),
             "false_detection": int(_flag(group, "false_detection").sum()),
+            "excluded": len(group) - n_valid,
         })  # fmt: skip
     return pd.DataFrame(rows)
 
@@ -299,7 +363,8 @@ def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
         out[key] = {name: quantiles(values(g)) for name, g in (("failed", failed),
                                                              ("recovered", recovered))}  # fmt: skip
     cells = (
-        table.assign(success=_success(table))
+        table[valid_mask(table)]
+        .assign(success=_success(table[valid_mask(table)]))
         .groupby(["inclination_bin", "speed_bin"], observed=True)["success"]
         .agg(["sum", "count"])
         .reset_index()
@@ -342,9 +407,11 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
     Returns
     -------
     dict
-        ``n``; ``classes`` (class -> count); ``success`` (:class:`Rate`,
-        ``recovered`` over all trials); ``success_detected`` (the
-        ``recovered`` class over the detected impacts); ``false_recovered``
+        ``n``; ``classes`` (class -> count); ``n_valid`` (trials not
+        excluded) and ``excluded`` (excluded class -> count); ``success``
+        (:class:`Rate`, :func:`success_mask` over the valid trials);
+        ``success_detected`` (the ``recovered`` class over the detected
+        impacts); ``below_ground`` (recovered below ground level); ``false_recovered``
         (false detections that reached stage 4); ``by_inclination`` and
         ``by_speed`` (:func:`rate_by`); ``time_to_recover_s``,
         ``height_loss_m``, ``horizontal_drift_m``, ``stage1_duration_s`` ..
@@ -356,13 +423,17 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
     cls = table["outcome_class"].astype(str)
     counts = {c: int((cls == c).sum()) for c in OUTCOME_CLASSES}
     n = len(table)
-    detected = counts["recovered"] + counts["not recovered"]
+    detected = counts["recovered"] + counts[BELOW_GROUND] + counts["not recovered"]
     good = table[cls == "recovered"]
-    seen = table[cls.isin(["recovered", "not recovered"])]
+    seen = table[cls.isin(["recovered", BELOW_GROUND, "not recovered"])]
+    n_valid = int(valid_mask(table).sum())
     return {
         "n": n,
         "classes": counts,
-        "success": rate(int(_success(table).sum()), n),
+        "n_valid": n_valid,
+        "excluded": {c: counts[c] for c in EXCLUDED_CLASSES},
+        "below_ground": counts[BELOW_GROUND],
+        "success": rate(int(_success(table).sum()), n_valid),
         "success_detected": rate(counts["recovered"], detected),
         "false_recovered": int((_success(table) & (cls == "false detection").to_numpy()).sum()),
         "by_inclination": rate_by(table, "inclination_bin"),

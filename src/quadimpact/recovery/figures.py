@@ -54,9 +54,9 @@ DISTRIBUTIONS = (
 
 def success_map_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     """Success rate (colour) over inclination bin (x) and speed bin (y), counts in the cells."""
-    ok = table["recovered"].fillna(False).astype(bool)
+    valid = table[analysis.valid_mask(table)]  # the excluded trials are not in the rates
     cells = (
-        table.assign(success=ok)
+        valid.assign(success=analysis.success_mask(valid))
         .groupby(["speed_bin", "inclination_bin"], observed=False)["success"]
         .agg(["sum", "count"])
     )
@@ -79,7 +79,7 @@ def success_map_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     ax.set_yticks(range(len(ys)), ys, fontsize=8)
     ax.set_xlabel("inclination toward the wall, -pitch (deg)")
     ax.set_ylabel("speed toward the wall (m/s)")
-    fig.colorbar(mesh, ax=ax, label="success rate (recovered / trials)")
+    fig.colorbar(mesh, ax=ax, label="success rate (recovered / valid trials)")
     ax.set_title(title or "Success rate; cells: recovered / trials")
     return fig
 
@@ -95,7 +95,9 @@ def _rate_points(ax: Any, x: np.ndarray, rates: pd.DataFrame, **style: Any) -> N
 
 def _rate_panel(ax: Any, rates: pd.DataFrame, xlabel: str) -> None:
     x = np.arange(len(rates))
-    _rate_points(ax, x, rates, color="tab:blue", label="recovered / trials, 95 % Wilson interval")
+    _rate_points(
+        ax, x, rates, color="tab:blue", label="recovered / valid trials, 95 % Wilson interval"
+    )
     for xi, r in zip(x, rates.itertuples(), strict=True):
         if r.n:
             ax.annotate(f"n={r.n}", (xi, 1.08), ha="center", fontsize=7, color="0.35")

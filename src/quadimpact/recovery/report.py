@@ -20,6 +20,7 @@ from quadimpact.recovery.estimation import estimation_lines
 
 __all__ = [
     "bin_table",
+    "excluded_text",
     "percent",
     "rate_text",
     "render_report",
@@ -48,6 +49,15 @@ def rate_text(r: Rate) -> str:
     return f"{r.k} / {r.n} = {percent(r.value)} [{percent(r.low)}, {percent(r.high)}]"
 
 
+def excluded_text(numbers: dict[str, Any]) -> str:
+    """How many trials the rates leave out, and why (``none`` when none)."""
+    parts = [f"{k} {c}" for c, k in numbers["excluded"].items() if k]
+    if not parts:
+        return f"none (all {numbers['n']} trials valid)"
+    total = numbers["n"] - numbers["n_valid"]
+    return f"{total} of {numbers['n']} trials ({', '.join(parts)})"
+
+
 def _num(x: float, digits: int = 3) -> str:
     return "–" if x is None or not math.isfinite(x) else f"{x:.{digits}f}"
 
@@ -55,14 +65,15 @@ def _num(x: float, digits: int = 3) -> str:
 def bin_table(rates: pd.DataFrame, what: str) -> str:
     """A :func:`~quadimpact.recovery.analysis.rate_by` table as Markdown."""
     lines = [
-        f"| {what} | trials | recovered | success rate | 95 % interval | not detected "
-        "| false detections |",
-        "|---|---|---|---|---|---|---|",
+        f"| {what} | valid trials | recovered | success rate | 95 % interval | not detected "
+        "| false detections | excluded |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for r in rates.itertuples():
         lines.append(
             f"| {r.bin} | {r.n} | {r.recovered} | {percent(r.rate)} "
-            f"| [{percent(r.low)}, {percent(r.high)}] | {r.not_detected} | {r.false_detection} |"
+            f"| [{percent(r.low)}, {percent(r.high)}] | {r.not_detected} | {r.false_detection} "
+            f"| {getattr(r, 'excluded', 0)} |"
         )
     return "\n".join(lines)
 
@@ -172,14 +183,22 @@ def _outcomes(n: dict[str, Any]) -> list[str]:
     s, sd = n["success"], n["success_detected"]
     lines += [
         "",
-        "Classes: *recovered*: impact detected, stage 4 reached; *not recovered*: impact "
+        "Classes: *recovered*: impact detected, stage 4 reached; *recovered below ground "
+        "level*: the same, but the altitude went below 0 on the way (the start altitude is "
+        "measured from a ground at 0 that the trial does not model: with it the vehicle would "
+        "have hit the ground), not a success; *not recovered*: impact "
         "detected, stage 4 not reached (a failed recovery); *not detected*: a contact the "
         "detector never saw (a failure of the detector, not of the recovery); *false "
-        "detection*: the detector fired before any contact; *no contact*: neither; *failed*: "
-        "the run failed numerically.",
+        "detection*: the detector fired before any contact; *no contact*: neither; "
+        "*invalid: bumper model exceeded*: a bumper went deeper than its radius, beyond what "
+        "the contact model covers; *invalid: started in contact*: the vehicle started "
+        "touching the wall (the trial is not an impact); *failed*: the run failed "
+        "numerically. The last three are excluded from the rates.",
         "",
-        f"- **Success rate** = recovered / all trials: **{rate_text(s)}** (95 % Wilson "
-        "interval). A not-detected trial counts as not recovered here.",
+        f"- **Success rate** = recovered / valid trials: **{rate_text(s)}** (95 % Wilson "
+        "interval). A not-detected trial counts as not recovered here; so does a trial "
+        f"recovered below ground level ({n['below_ground']}).",
+        f"- **Excluded** from the rates: {excluded_text(n)}.",
         f"- **Recovery rate of the detected impacts** = recovered / detected: {rate_text(sd)}.",
         f"- Not detected: {c['not detected']}; false detections: {c['false detection']}"
         + (f" (of which {n['false_recovered']} reached stage 4 and count in the success rate)"
@@ -291,7 +310,8 @@ def render_report(
         "## Success by inclination and by speed",
         "",
         "Inclination toward the wall = -pitch, in 10° bins; speed toward the wall in "
-        "0.25 m/s bins; success = recovered / trials of the bin, with its 95 % Wilson interval.",
+        "0.25 m/s bins; success = recovered / valid trials of the bin, with its 95 % Wilson "
+        "interval.",
         "",
     ]
     for name, alt in (("success_by_bin.png", "Success rate by bin"),

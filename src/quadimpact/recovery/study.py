@@ -47,7 +47,7 @@ from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS, analysis
-from quadimpact.results.files import atomic_write
+from quadimpact.results.files import atomic_write, check_out_dir
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 
@@ -390,7 +390,7 @@ def run_trials(
         The sweep, the trials table (:func:`trial_table`) and
         :func:`quadimpact.sweep.run_sweep`'s run information.
     """
-    out = Path(out_dir)
+    out = check_out_dir(Path(out_dir), "recovery", where="")
     if isinstance(study, SweepSpec):
         spec = study
         _check_trial_base(spec, spec.where)

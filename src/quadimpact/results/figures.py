@@ -109,13 +109,30 @@ def save_figure(fig: Figure, path: str | os.PathLike[str]) -> Path:
     return atomic_write(path, lambda tmp: fig.savefig(tmp, format="png", dpi=FIG_DPI))
 
 
+#: Left margin of the per-run figures, in: a y label and six-character tick labels.
+LEFT_MARGIN_IN = 1.0
+
+
+def compact_ticks(ax: Any) -> None:
+    """Y tick labels of at most about six characters: powers of ten beyond 1e-3..1e4 go
+    to the axis' offset text (``1e-3`` above it) instead of widening every label."""
+    try:
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-3, 4), useOffset=False)
+    except AttributeError:  # a non-scalar formatter (none here): leave it
+        pass
+
+
 def _fig_margins(
     width_in: float, height_in: float, title: str | None, hspace: float = 0.2, wspace: float = 0.2
 ) -> dict[str, float]:
-    """Fixed margins of a per-run figure, in inches turned into figure fractions."""
+    """Fixed margins of a per-run figure, in inches turned into figure fractions.
+
+    The left margin holds a y label and tick labels of up to six characters
+    (``-0.005``, ``1000``: :func:`compact_ticks` keeps them that short).
+    """
     top_in = 0.55 if title else 0.25
     return {
-        "left": 0.8 / width_in,
+        "left": LEFT_MARGIN_IN / width_in,
         "right": 1.0 - 0.2 / width_in,
         "bottom": 0.55 / height_in,
         "top": 1.0 - top_in / height_in,
@@ -174,6 +191,7 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     ax.set_xlabel("Time (s)")
     ax.set_ylabel("Bumper deflection (mm)")
     ax.grid(True, alpha=0.4)
+    compact_ticks(ax)
     ax.legend(loc="best")
     set_time_limits(ax, t)
     if title:
@@ -255,6 +273,7 @@ def make_fig6(
 
     for ax in axes.flat:
         ax.grid(True, alpha=0.4)
+        compact_ticks(ax)
         if len(ax.get_legend_handles_labels()[0]) > 1:
             ax.legend(loc="best", fontsize="small")
     for ax in axes[-1, :]:
@@ -347,6 +366,7 @@ def make_imu(
         mark_stages(ax, summary)
         ax.legend(loc="upper right", fontsize="small", ncols=2)
         ax.grid(True, alpha=0.4)
+        compact_ticks(ax)
         first = ax
     else:
         first = axes[0]
@@ -372,6 +392,7 @@ def make_imu(
     ax_w.legend(loc="upper right", fontsize="small", ncols=3)
     for ax in (ax_f, ax_w):
         ax.grid(True, alpha=0.4)
+        compact_ticks(ax)
     set_time_limits(first, t)
     if title:
         fig.suptitle(title)

@@ -67,6 +67,7 @@ __all__ = [
     "RUN_FILES",
     "atomic_write",
     "check_out_dir",
+    "check_writable",
     "column_unit",
     "folder_kind",
     "staged_folder",
@@ -104,14 +105,18 @@ DERIVED_FILES: tuple[str, ...] = (
 )  # fmt: skip
 #: What each kind of output folder holds (any one of these names marks it), in the
 #: order they are recognised.
+#: A study stopped early holds only the folders it had begun (``sweep/`` of a recovery
+#: study, ``sweeps/`` of a report, ``sensitivity/`` of the experiments): they mark it too.
 FOLDER_MARKERS: dict[str, tuple[str, ...]] = {
     "sweep": ("sweep.json", "runs.parquet", "parts"),
-    "report": ("report.md", "findings.parquet"),
-    "experiments": ("table3.csv", "table3.parquet"),
+    "recovery": ("study.json", "trials.parquet", "sweep"),
+    "report": ("report.md", "findings.parquet", "sweeps", "experiments", "recovery"),
+    "experiments": ("table3.csv", "table3.parquet", "sensitivity", "sensitivity-log"),
     "run": (SUMMARY_JSON, TIMESERIES_PARQUET),
 }
 _KIND_WORDS = {
     "sweep": "a sweep",
+    "recovery": "a recovery study",
     "report": "a study report",
     "experiments": "the crash experiments",
     "run": "a run",
@@ -308,6 +313,28 @@ def folder_kind(path: str | os.PathLike[str]) -> tuple[str | None, list[str]]:
     return "other", [n for n in names if n not in RUN_FILES and n not in DERIVED_FILES][:3]
 
 
+def check_writable(folder: str | os.PathLike[str], label: str) -> None:
+    """Refuse a folder in which nothing can be written, by writing (and removing) a probe.
+
+    Permission bits alone do not tell (root passes ``os.access`` everywhere,
+    even in ``/proc`` or on a read-only file system).
+
+    Raises
+    ------
+    InputError
+        ``<label> (<reason>)``.
+    """
+    import tempfile
+
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".quadimpact-probe-", dir=os.fspath(folder))
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        raise InputError(f"{label} ({reason})") from None
+    os.close(fd)
+    os.unlink(probe)
+
+
 def check_out_dir(
     path: str | os.PathLike[str],
     kind: str,
@@ -322,12 +349,12 @@ def check_out_dir(
     path : path-like
         The output folder (created later, if absent).
     kind : str
-        ``"run"``, ``"sweep"``, ``"report"`` or ``"experiments"``.
+        ``"run"``, ``"sweep"``, ``"recovery"``, ``"report"`` or ``"experiments"``.
     where : str, keyword
         How the folder was given, for the message (``"--out"``).
     refuse_other : bool, keyword
-        Refuse a folder that holds files of no kind (default: only for a run,
-        whose files would be mixed with them).
+        Refuse a folder that holds files of no kind (default: yes, for every
+        kind: quadimpact's files would be mixed with them).
 
     Returns
     -------
@@ -366,18 +393,20 @@ def check_out_dir(
         for part in d.relative_to(ancestor).parts if ancestor != d else ():
             if len(os.fsencode(part)) > 255:
                 raise InputError(f"{label}: a folder name is longer than 255 bytes")
+        check_writable(ancestor, f"{label}: cannot be created in {_short(ancestor)}")
         return d
     if not os.access(d, os.W_OK | os.X_OK):
         raise InputError(f"{label}: no write permission in the folder")
+    check_writable(d, f"{label}: cannot be written")
     held, names = folder_kind(d)
     if refuse_other is None:
-        refuse_other = kind == "run"
+        refuse_other = True
     if held is None or held == kind or (held == "other" and not refuse_other):
         return d
     advice = {
         "run": "a new or empty folder, or a run folder (whose run it replaces)",
         "sweep": "a new or empty folder, or this sweep's own folder (to resume it)",
-    }.get(kind, "a new or empty folder")
+    }.get(kind, f"a new or empty folder, or a folder of {_KIND_WORDS[kind]} (to resume it)")
     raise InputError(
         f"{label}: holds {_KIND_WORDS[held]} ({', '.join(names)}); "
         f"use {advice}"

@@ -314,6 +314,32 @@ class SimulationResult:
             self.summary.pop("plot_errors", None)
 
 
+#: The parts of ``scenario.json`` and the JSON kind each must have (absent: allowed).
+_WORLD_PARTS = {"scenario": (dict, type(None)), "resolved": (dict,), "vehicle": (dict,),
+                "surfaces": (list,)}  # fmt: skip
+#: The keys every surface record has (``simulation.packing.surface_records``).
+_SURFACE_KEYS = ("name", "point_m", "normal", "is_ground", "kind")
+
+
+def _check_world(world: dict, path: Path) -> None:
+    """Refuse a ``scenario.json`` whose parts are not what quadimpact writes (one line)."""
+    for key, kinds in _WORLD_PARTS.items():
+        if key in world and not isinstance(world[key], kinds):
+            want = "a JSON object" if dict in kinds else "a JSON array"
+            raise InputError(
+                f"{path}: {key}: must be {want} (got a JSON {_json_kind(world[key])}): the file "
+                "is damaged or was not written by quadimpact"
+            )
+    for i, surface in enumerate(world.get("surfaces") or []):
+        missing = [k for k in _SURFACE_KEYS if not isinstance(surface, dict) or k not in surface]
+        if missing:
+            raise InputError(
+                f"{path}: surfaces.{i}: must be a surface record with {', '.join(_SURFACE_KEYS)} "
+                f"(missing {', '.join(missing)}): the file is damaged or was not written by "
+                "quadimpact"
+            )
+
+
 def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     """Load a result folder written by :meth:`SimulationResult.write`.
 
@@ -359,6 +385,7 @@ def read_result(directory: str | os.PathLike[str]) -> SimulationResult:
     world = _read(world_path, files.read_summary_json) if world_path.is_file() else {}
     if not isinstance(world, dict):
         raise InputError(f"{world_path}: must be a JSON object (got a JSON {_json_kind(world)})")
+    _check_world(world, world_path)
     references = dict(summary.get("references") or {})
     stats = dict(summary.get("integrator") or summary.pop("stats", None) or {})
     return SimulationResult(

@@ -96,7 +96,7 @@ SUMMARY_KEYS: tuple[Key, ...] = (
     _k("aft_bumpers", "j", "", "the other bumpers"),
     _k("response_type", "s", "", "A, B, C, D or Other (docs/STUDIES.md 3)"),
     _k("n_episodes", "i", "1", "contact episodes with obstacles"),
-    _k("n_grazes", "i", "1", "episodes shallower than the graze threshold (1 mm)"),
+    _k("n_grazes", "i", "1", "grazes: obstacle episodes of under 1 % of the largest impulse"),
     _k("n_subsequent_impacts", "i", "1", "impacts after the initial one"),
     _k("n_subsequent_episodes", "i", "1", "episodes in those impacts"),
     _k("subsequent_impacts", "j", "", "bumpers of each subsequent impact"),

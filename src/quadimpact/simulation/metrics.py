@@ -27,12 +27,17 @@ from quadimpact.rotations import (
 )
 
 __all__ = [
-    "GRAZE_DELTA_M",
+    "GRAZE_IMPULSE_FRACTION",
     "RESPONSE_TYPES",
     "attitude_excursion_deg",
     "classify_response",
+    "RESPONSE_TYPE_MEANINGS",
+    "graze_mask",
     "group_impacts",
     "impact_metrics",
+    "impulse_scale",
+    "response_type_applies",
+    "short_impacts",
 ]
 
 
@@ -128,10 +133,82 @@ def group_impacts(episodes: Table) -> list[list[int]]:
     return groups
 
 
+def impulse_scale(episodes: Table) -> np.ndarray:
+    """Each episode's impulse scale, N s: peak normal force times duration.
+
+    An upper bound of the episode's normal impulse (the integral of the
+    force over the episode, since the force never exceeds its peak), from the
+    episode record alone (docs/STUDIES.md 2.2).
+    """
+    if n_rows(episodes) == 0:
+        return np.zeros(0)
+    duration = column(episodes, "t_end_s") - column(episodes, "t_start_s")
+    return column(episodes, "peak_force_n") * np.maximum(duration, 0.0)
+
+
+def graze_mask(
+    episodes: Table,
+    exclude_surfaces: Sequence[str] = ("ground",),
+    fraction: float = 0.0,
+) -> np.ndarray:
+    """Which episodes are grazes (docs/STUDIES.md 2.2).
+
+    An episode on an obstacle (a surface not in ``exclude_surfaces``) is a
+    graze when its impulse scale (:func:`impulse_scale`) is below
+    ``fraction`` times the largest impulse scale among the run's obstacle
+    episodes (the impact's): its velocity change is small relative to the
+    impact's, whatever the bumpers' stiffness. Episodes on excluded surfaces
+    are never grazes (they are left out of the impacts anyway). ``fraction``
+    0 (the default): no grazes.
+    """
+    n = n_rows(episodes)
+    grazes = np.zeros(n, dtype=bool)
+    if n == 0 or fraction <= 0.0:
+        return grazes
+    obstacle = np.ones(n, dtype=bool)
+    if len(exclude_surfaces):
+        surface = column(episodes, "surface", dtype=object).astype(str)
+        obstacle = ~np.isin(surface, [str(s) for s in exclude_surfaces])
+    if not obstacle.any():
+        return grazes
+    scale = impulse_scale(episodes)
+    grazes[obstacle] = scale[obstacle] < fraction * float(np.max(scale[obstacle]))
+    return grazes
+
+
+def short_impacts(
+    episodes: Table,
+    period_s: float,
+    exclude_surfaces: Sequence[str] = ("ground",),
+    graze_fraction: float = 0.0,
+) -> tuple[int, float]:
+    """The impacts (grazes and excluded surfaces left out) lasting less than ``period_s``.
+
+    Returns
+    -------
+    (int, float)
+        Their number and the shortest impact's duration, s (NaN when none).
+    """
+    n = n_rows(episodes)
+    if n == 0 or not period_s > 0.0:
+        return 0, math.nan
+    keep = ~graze_mask(episodes, exclude_surfaces, graze_fraction)
+    if len(exclude_surfaces):
+        surface = column(episodes, "surface", dtype=object).astype(str)
+        keep &= ~np.isin(surface, [str(s) for s in exclude_surfaces])
+    eps = select(episodes, keep, _EPISODE_NEEDED)
+    durations = [
+        float(np.max(eps["t_end_s"][g]) - np.min(eps["t_start_s"][g]))
+        for g in (group_impacts(eps) if keep.any() else [])
+    ]
+    short = [d for d in durations if d < period_s]
+    return len(short), (min(short) if short else math.nan)
+
+
 def impact_metrics(
     episodes: Table,
     exclude_surfaces: Sequence[str] = ("ground",),
-    min_peak_delta_m: float = 0.0,
+    graze_fraction: float = 0.0,
 ) -> dict[str, Any]:
     """Initial-impact metrics and counts of subsequent impacts (docs/STUDIES.md section 2).
 
@@ -143,9 +220,10 @@ def impact_metrics(
     exclude_surfaces : sequence of str
         Surfaces whose episodes are ignored (by default the ground, when it is
         a contact surface: touching down is not an impact with the obstacle).
-    min_peak_delta_m : float
-        Episodes whose peak deflection is below this (m) are grazes: left out
-        of the impacts and their counts (``GRAZE_DELTA_M`` in the summary).
+    graze_fraction : float
+        Episodes whose impulse scale is below this fraction of the run's
+        largest are grazes (:func:`graze_mask`): left out of the impacts and
+        their counts (``GRAZE_IMPULSE_FRACTION`` in the summary; 0: none).
 
     Returns
     -------
@@ -171,8 +249,8 @@ def impact_metrics(
         surface = column(episodes, "surface", dtype=object).astype(str)
         keep = ~np.isin(surface, [str(s) for s in exclude_surfaces])
     n_all = int(keep.sum())
-    if n_all and min_peak_delta_m > 0.0:
-        keep &= column(episodes, "peak_delta_m") >= min_peak_delta_m
+    if n_all and graze_fraction > 0.0:
+        keep &= ~graze_mask(episodes, exclude_surfaces, graze_fraction)
     eps = select(episodes, keep, _EPISODE_NEEDED) if n else dict.fromkeys(_EPISODE_NEEDED, [])
     groups = group_impacts(eps)
     out: dict[str, Any] = {
@@ -275,11 +353,36 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
 
 
 # ------------------------------------------------------------ response types
-#: Contacts shallower than this (m) are grazes, not impacts: they do not start,
-#: join or count as impacts for the metrics and the response type.
-GRAZE_DELTA_M = 1e-3
+#: An obstacle episode whose impulse scale (peak force x duration, an upper bound
+#: of its impulse) is below this fraction of the run's largest is a graze, not an
+#: impact: it does not start, join or count as an impact for the metrics and the
+#: response type (docs/STUDIES.md 2.2). A fraction, not a depth: the same
+#: contacts are grazes whatever the bumpers' stiffness.
+GRAZE_IMPULSE_FRACTION = 0.01
 
 RESPONSE_TYPES: tuple[str, ...] = ("A", "B", "C", "D", "Other")
+
+#: What each response type says, in a few words (docs/STUDIES.md 3).
+RESPONSE_TYPE_MEANINGS: dict[str, str] = {
+    "A": "no crash before the end of the run; says nothing of the attitude or speed then",
+    "B": "crashed with no impact after the initial one",
+    "C": "another impact on the leading bumper(s), then the D pattern, then a crash",
+    "D": "flipped toward the wall, hit it with the aft bumper(s), then crashed",
+    "Other": "crashed, in none of the patterns B-D",
+}
+
+
+def response_type_applies(kind: str | None, ground: str | None) -> bool:
+    """Whether the paper's response types (docs/STUDIES.md 3) are defined for a run.
+
+    Only for the paper's wall approach (``kind = "wall-approach"``) with a
+    crash rule, i.e. a ground that can end the run (``ground`` not
+    ``"none"``): the types sort what follows an approach's first impact by
+    how it ends in a crash. An impact trial or a flight also gets a
+    ``response_type`` in its summary (the same rules), but it is not printed
+    as one.
+    """
+    return kind in (None, "wall-approach") and ground != "none"
 
 
 def classify_response(

@@ -21,9 +21,10 @@ from quadimpact.core.geometry import contact_record
 from quadimpact.linalg import dot, norm
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.metrics import (
-    GRAZE_DELTA_M,
+    GRAZE_IMPULSE_FRACTION,
     Table,
     column,
+    graze_mask,
     group_impacts,
     n_rows,
     select,
@@ -185,7 +186,8 @@ def recovery_metrics(
     if n_rows(episodes):
         surface = column(episodes, "surface", dtype=object).astype(str)
         keep = np.isin(surface, list(obstacle_names))
-        keep &= column(episodes, "peak_delta_m") >= GRAZE_DELTA_M
+        others = sorted(set(surface.tolist()) - set(obstacle_names))
+        keep &= ~graze_mask(episodes, others, GRAZE_IMPULSE_FRACTION)
         eps = select(episodes, keep, ("bumper", "t_start_s", "t_end_s"))
         starts = eps["t_start_s"]
         out["impacts_after_detection"] = int(

@@ -26,6 +26,7 @@ from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
+from quadimpact.simulation.checks import check_prepared, check_scenario_type
 from quadimpact.simulation.estimation import pack_estimation
 from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
@@ -378,9 +379,13 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
 
 
 def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
-    """Validated scenario -> packed run."""
+    """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``)."""
+    check_scenario_type(scenario)
     if isinstance(scenario, WallApproach):
-        return prepare_wall_approach(scenario)
-    if isinstance(scenario, ImpactTrial):
-        return prepare_impact_trial(scenario)
-    return prepare_flight(scenario)
+        setup = prepare_wall_approach(scenario)
+    elif isinstance(scenario, ImpactTrial):
+        setup = prepare_impact_trial(scenario)
+    else:
+        setup = prepare_flight(scenario)
+    check_prepared(scenario, setup)
+    return setup

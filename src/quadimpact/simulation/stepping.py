@@ -30,6 +30,7 @@ from quadimpact.core import step as core_step
 from quadimpact.core.records import new_data, new_output, raw_record
 from quadimpact.core.run import BUILTIN, Kernel
 from quadimpact.results.result import SimulationResult
+from quadimpact.simulation.checks import whole_ticks
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
 
@@ -78,6 +79,7 @@ class Simulation:
             Rotor speed commands (rad/s) to apply at each of these ticks instead
             of the controller's (the loop's generic limits still apply).
         """
+        n_ticks = whole_ticks(n_ticks)
         advance = self._kernel.advance
         if command is None:
             return int(advance(int(n_ticks), self._m, self._d, self._o))

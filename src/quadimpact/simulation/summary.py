@@ -20,12 +20,13 @@ from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.approach import inclination_deg_of
 from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.metrics import (
-    GRAZE_DELTA_M,
+    GRAZE_IMPULSE_FRACTION,
     attitude_excursion_deg,
     classify_response,
     column,
     impact_metrics,
     n_rows,
+    short_impacts,
 )
 from quadimpact.simulation.recovery_metrics import (
     contact_normal,
@@ -66,7 +67,7 @@ def build_summary(
     status = STATUS_NAMES[status_code]
     warnings = list(setup.warnings)
     reason = L.REASON_TEXT[int(st[L.ST_REASON])]
-    metrics = impact_metrics(episodes, min_peak_delta_m=GRAZE_DELTA_M)
+    metrics = impact_metrics(episodes, graze_fraction=GRAZE_IMPULSE_FRACTION)
     rb = setup.vehicle.bumper_radius_m
 
     onset_t = float(st[L.ST_ONSET_T])
@@ -94,6 +95,9 @@ def build_summary(
             f"{int(st[L.ST_MISSED_ONSETS])} contact(s) found already penetrating "
             "(onset not located; v_i taken at first sight)"
         )
+    short = _short_contact_warning(setup, episodes)
+    if short:
+        warnings.append(short)
     if st[L.ST_EPISODES_DROPPED] > 0:
         warnings.append(
             f"{int(st[L.ST_EPISODES_DROPPED])} episodes beyond the buffer were not recorded"
@@ -221,6 +225,25 @@ def _too_deep(setup: RunSetup, episodes: Any, max_pen: float, rb: float) -> str:
     return (
         f"penetration {max_pen * 1e3:.1f} mm exceeds the bumper radius {rb * 1e3:.0f} mm: "
         "the body itself would be in the surface, beyond what the bumper model covers"
+    )
+
+
+def _short_contact_warning(setup: RunSetup, episodes: Any) -> str:
+    """A warning when an impact is shorter than the IMU's sample period ('' otherwise).
+
+    Such an impact can fall between two IMU samples: the IMU (and the
+    detection) may not see it at all (docs/STUDIES.md 2.2).
+    """
+    rate = float(setup.scfg[L.SC_RATE])
+    if not rate > 0.0:
+        return ""
+    count, shortest = short_impacts(episodes, 1.0 / rate, graze_fraction=GRAZE_IMPULSE_FRACTION)
+    if not count:
+        return ""
+    return (
+        f"{count} impact(s) shorter than the IMU's sample period {1e3 / rate:.3g} ms "
+        f"({rate:g} Hz; shortest {shortest:.3g} s): the IMU may take no sample during "
+        "it and the detection may miss it (stiff bumpers make contacts short)"
     )
 
 

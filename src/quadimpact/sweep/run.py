@@ -87,12 +87,35 @@ def _refuse_in_a_starting_worker() -> None:
         raise SystemExit(1)
 
 
+#: Most local worker processes per core: more only share the same cores and the memory.
+MAX_WORKERS_PER_CORE = 4
+
+
+def cap_workers(workers: int) -> tuple[int, str]:
+    """``workers`` capped at :data:`MAX_WORKERS_PER_CORE` per core, and a note if it was.
+
+    Each worker process holds its own compiled kernel and buffers (about 150
+    MB); a thousand of them on two cores gain nothing and take the memory.
+    """
+    cores = default_workers()
+    cap = MAX_WORKERS_PER_CORE * cores
+    if workers <= cap:
+        return workers, ""
+    return cap, (
+        f"--workers {workers}: capped at {cap} ({MAX_WORKERS_PER_CORE} per core on the {cores} "
+        "core(s) this process may use; more processes only share the same cores and memory)"
+    )
+
+
 def _resolve_workers(workers: int | None) -> int:
     if workers is None:
         return default_workers()
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InputError(f"--workers: must be an integer >= 1 (got {format_value(workers)})")
-    return workers
+    capped, note = cap_workers(workers)
+    if note:
+        _note(note)
+    return capped
 
 
 def _note(message: str, bar: Progress | None = None) -> None:
@@ -113,6 +136,7 @@ def run_sweep(
     load: bool = True,
     timeout: float | None = None,
     allow_large: bool = False,
+    max_record_mb: float | None = None,
 ) -> Any:
     """Run a sweep into ``out_dir`` (resuming whatever is already there) and return its table.
 
@@ -149,6 +173,10 @@ def run_sweep(
         applied to runs in this process (``workers=1``).
     allow_large : bool, keyword
         Allow more than :data:`LARGE_SWEEP_RUNS` runs.
+    max_record_mb : float, keyword
+        Largest raw record one run may allocate, MB (default
+        ``simulation.checks.MAX_RECORD_MB``): a run above it is refused before
+        any starts.
 
     Returns
     -------
@@ -190,7 +218,7 @@ def run_sweep(
                 start_server(pool_context())  # it loads the kernel while the runs are checked
             if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
                 _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
-            spec.validate()
+            spec.validate(max_record_mb=max_record_mb)
             schema = schema_of(spec)
             client, threads = (
                 stack.enter_context(dask_session(scheduler)) if scheduler is not None else (None, 0)

@@ -464,13 +464,18 @@ class SweepSpec:
         """Row values of the input columns for one run's inputs."""
         return {k: _column_value(inputs.get(k), kind) for k, kind in self.columns.items()}
 
-    def validate(self, check: Callable[[int], None] | None = None) -> None:
+    def validate(
+        self, check: Callable[[int], None] | None = None, *, max_record_mb: float | None = None
+    ) -> None:
         """Build and validate every run's scenario and vehicle (raises the first problem).
 
         Parameters
         ----------
         check : callable, optional
             Called with each run_id after it validated (progress hooks).
+        max_record_mb : float, optional
+            Largest raw record of a run, MB (``simulation.checks.check_record_size``;
+            default its ``MAX_RECORD_MB``).
 
         Raises
         ------
@@ -479,7 +484,9 @@ class SweepSpec:
         """
         from quadimpact.inputs.scenarios import scenario_from_dict
         from quadimpact.inputs.vehicle import load_vehicle
+        from quadimpact.simulation.checks import MAX_RECORD_MB, check_record_size
 
+        limit = MAX_RECORD_MB if max_record_mb is None else float(max_record_mb)
         base = scenario_from_dict(self.base, where=f"{self.where}: base")
         base.build_vehicle(where=f"{self.where}: base")
         vehicles: dict[str, Any] = {}
@@ -488,6 +495,7 @@ class SweepSpec:
             inputs = self.inputs(run_id)
             try:
                 scenario = scenario_from_dict(self.scenario_dict(run_id, inputs), where="")
+                check_record_size(scenario, limit, "--max-record-mb")
                 key = canonical([scenario.vehicle, plain(scenario.vehicle_overrides)])
                 if key not in checked:
                     if scenario.vehicle not in vehicles:

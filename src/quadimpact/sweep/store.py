@@ -294,18 +294,25 @@ def _check_table(path: Path, schema: Any, n_runs: int, writer: PartWriter) -> tu
     """run_ids of ``runs.parquet`` that pass the checks, and what failed ('' if nothing).
 
     Checked row group by row group (flat memory); if one fails, the good ones
-    are written as new parts and ``runs.parquet`` is removed.
+    are written as new parts and ``runs.parquet`` is removed. A file that
+    cannot be opened at all (empty, truncated, not Parquet) or has another
+    schema is removed too: its runs are redone, and the merge rebuilds it.
     """
     import numpy as np
     import pyarrow.parquet as pq
 
     try:
         file = pq.ParquetFile(path, page_checksum_verification=True)
-        _check_schema(file.schema_arrow, schema)
-    except BadFile as exc:
-        return np.zeros(0, dtype=np.int64), str(exc)
-    except Exception as exc:
+    except Exception as exc:  # empty, truncated, not Parquet: nothing of it can be kept
+        path.unlink()
         return np.zeros(0, dtype=np.int64), one_line(f"{type(exc).__name__}: {exc}")
+    try:
+        _check_schema(file.schema_arrow, schema)
+    except Exception as exc:
+        file.close()
+        path.unlink()  # a table of another schema cannot be merged: its runs are redone
+        detail = str(exc) if isinstance(exc, BadFile) else f"{type(exc).__name__}: {exc}"
+        return np.zeros(0, dtype=np.int64), one_line(detail)
     good, problem = [], ""
     with file:
         for i in range(file.num_row_groups):

@@ -10,6 +10,7 @@ direction; altitude is up.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,8 @@ FORCE_COLOR = "#7b2cbf"
 BODY_COLOR = "#222222"
 AXIS_COLORS = ("#444444", "#444444", "#444444")
 MAX_CONTACTS = 8  # drawn at once (4 bumpers x 2 surfaces)
+#: Least distance of a bumper number from any bumper ring on the picture, in picture heights.
+LABEL_CLEARANCE = 0.045
 WALL_WIDTH_M = 1.0  # walls: a panel this wide, from the view centre away from the camera
 
 
@@ -295,7 +298,10 @@ class SceneArtists:
 
         depth = cam.depth(fr.circles.mean(axis=1), target)
         order = np.argsort(-depth)  # far first
-        label_xy = self._inside(P(fr.label_points))
+        rings = np.stack([P(fr.circles[j]) for j in range(4)])
+        label_xy = self._inside(
+            place_labels(rings, P(fr.label_points), LABEL_CLEARANCE * 2 * self.half_h)
+        )
         for rank, j in enumerate(order):
             self.circles[j].set_data(*P(fr.circles[j]).T)
             self.circles[j].set_zorder(5 + 0.1 * rank)
@@ -369,3 +375,63 @@ class SceneArtists:
         arts += [*self.circles, *self.labels, *self.points, *self.deflections, *self.arrows]
         arts += [*self.force_texts, *self.compass]
         return sorted(arts, key=lambda a: a.get_zorder())
+
+
+def place_labels(rings: np.ndarray, default: np.ndarray, clearance: float) -> np.ndarray:
+    """Where the four bumper numbers go on the picture: off every ring, each by its own.
+
+    Parameters
+    ----------
+    rings : numpy.ndarray, shape (4, N, 2)
+        The bumper rings as drawn (picture coordinates).
+    default : numpy.ndarray, shape (4, 2)
+        The 3D placement's points (1.3 bumper radii out from each centre),
+        projected: where a number goes when it is clear there.
+    clearance : float
+        The least distance of a number from any ring point and from the other
+        numbers (picture units).
+
+    Returns
+    -------
+    numpy.ndarray, shape (4, 2)
+        For each bumper: its default point if that is clear of every ring;
+        otherwise, among points just outside its own ring in directions
+        around the one from the vehicle's centre through the ring's, the first
+        clear one (or the one farthest from the rings and numbers).
+    """
+    rings = np.asarray(rings, dtype=float)
+    centres = rings.mean(axis=1)
+    middle = centres.mean(axis=0)
+    every = rings.reshape(-1, 2)
+    out = np.array(default, dtype=float)
+    placed: list[np.ndarray] = []
+    for j in range(rings.shape[0]):
+
+        def room(p: np.ndarray) -> float:
+            d = float(np.min(np.hypot(*(every - p).T)))
+            if placed:
+                d = min(d, float(np.min(np.hypot(*(np.array(placed) - p).T))))
+            return d
+
+        if room(out[j]) >= clearance:
+            placed.append(out[j])
+            continue
+        away = centres[j] - middle
+        if np.hypot(*away) < 1e-12:
+            away = out[j] - centres[j]
+        base = math.atan2(away[1], away[0]) if np.hypot(*away) > 1e-12 else 0.0
+        best, best_room = out[j], room(out[j])
+        for step in (0, 1, -1, 2, -2, 3, -3, 4, -4, 5, -5, 6):
+            angle = base + step * math.pi / 6
+            d = np.array([math.cos(angle), math.sin(angle)])
+            reach = float(np.max((rings[j] - centres[j]) @ d))
+            p = centres[j] + (reach + clearance) * d
+            r = room(p)
+            if r >= clearance:
+                best, best_room = p, r
+                break
+            if r > best_room:
+                best, best_room = p, r
+        out[j] = best
+        placed.append(best)
+    return out

@@ -692,19 +692,24 @@ class Scene:
 
     def describe(self) -> str:
         """One line naming the run (kind, heading, inclination, speed, model, outcome type)."""
+        from quadimpact.simulation.metrics import response_type_applies
+
         s = self.summary
         parts = []
-        kind = (_world_part(self.world, "scenario") or {}).get("kind")
+        scenario = _world_part(self.world, "scenario") or {}
+        kind = scenario.get("kind")
         if kind in ("flight", "impact-trial"):
             parts.append(str(kind).replace("-", " "))
         if s.get("heading_deg") is not None:
             parts.append(f"heading {s['heading_deg']:g}°")
         if s.get("inclination_deg") is not None:
             parts.append(f"inclination {s['inclination_deg']:g}°")
+        if kind == "impact-trial" and scenario.get("speed_m_s") is not None:
+            parts.append(f"initial speed {float(scenario['speed_m_s']):.2f} m/s")
         if s.get("impact_speed_m_s") is not None:
-            parts.append(f"{s['impact_speed_m_s']:.2f} m/s")
+            parts.append(f"impact speed {s['impact_speed_m_s']:.2f} m/s")
         if s.get("model"):
             parts.append(str(s["model"]))
-        if s.get("response_type"):
+        if s.get("response_type") and response_type_applies(kind, scenario.get("ground")):
             parts.append(f"type {s['response_type']}")
         return ", ".join(parts) or "quadimpact run"
