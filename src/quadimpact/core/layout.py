@@ -452,6 +452,7 @@ ES_N = _est.slot("ES_N")  # samples processed
 ES_GATED = _est.slot("ES_GATED")  # 1: the accelerometer correction was gated at the latest sample
 N_EKF = 12  # error state: attitude (3), gyro bias (3), velocity (3), position (3)
 ES_P = _est.slot("ES_P", N_EKF * N_EKF)  # EKF error covariance, row-major
+ES_SCRATCH = _est.slot("ES_SCRATCH", 4)  # a quaternion's worth of scratch (EKF prediction)
 N_USER_EST = 32
 ES_USER = _est.slot("ES_USER", N_USER_EST)  # a plug-in estimator's own state
 NEST = _est.end("NEST")

@@ -50,6 +50,7 @@ from ..layout import (
     MS_BIAS_HAT,
     MS_IMU_W,
     MS_W_HAT,
+    MS_X,
     NX,
     SC_BIAS,
     X_OMEGA,
@@ -57,10 +58,9 @@ from ..layout import (
     X_QUAT,
     X_VEL,
 )
-from ..quaternion import rotation_matrix
 from ..records import Data, Model, Output, Work
 from ..sensors.measurement import measure
-from ..sensors.rotvec import rotate_by
+from ..sensors.rotvec import dcm, rotate_by
 from .complementary import complementary_sample
 from .ekf import ekf_init, ekf_sample
 from .errors import record_estimate
@@ -110,7 +110,7 @@ def init_estimate(m: Model, d: Data) -> None:
     for a in range(4):
         est[ES_Q + a] = x[X_QUAT + a] / n
     C = np.empty((3, 3))
-    rotation_matrix(est[ES_Q : ES_Q + 4], C)
+    dcm(est[ES_Q : ES_Q + 4], C)
     e = m.ecfg
     for r in range(3):
         est[ES_VEL + r] = (
@@ -149,7 +149,7 @@ def estimate_sample(
     else:
         plugin_estimator(t, dt, d.meas, m.ecfg, est)
     if kind != EST_IDEAL:
-        rotation_matrix(est[ES_Q : ES_Q + 4], w.C_hat)
+        dcm(est[ES_Q : ES_Q + 4], w.C_hat)
     est[ES_T] = t
     est[ES_N] += 1.0
     record_estimate(t, xs, C, m, d, o)
@@ -186,18 +186,23 @@ def write_estimate(t: float, x: np.ndarray, m: Model, d: Data, meas: np.ndarray)
             meas[MS_BIAS_HAT + a] = 0.0
         return
     est = d.est
-    xh = x.copy()
-    C = np.empty((3, 3))
-    rotation_matrix(est[ES_Q : ES_Q + 4], C)
+    measure(t, x, meas)  # the true rotor speeds; the rest is replaced by the estimate
+    xh = meas[MS_X : MS_X + NX]
+    q0, q1, q2, q3 = est[ES_Q], est[ES_Q + 1], est[ES_Q + 2], est[ES_Q + 3]
+    n2 = q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3
+    vx, vy, vz = est[ES_VEL], est[ES_VEL + 1], est[ES_VEL + 2]
+    # C^T v with C the rotation of q (normalised)
+    xh[X_VEL] = ((1.0 - 2.0 * (q2 * q2 + q3 * q3) / n2) * vx + 2.0 * (q1 * q2 + q0 * q3) / n2 * vy
+                 + 2.0 * (q1 * q3 - q0 * q2) / n2 * vz)  # fmt: skip
+    xh[X_VEL + 1] = (2.0 * (q1 * q2 - q0 * q3) / n2 * vx + (1.0 - 2.0 * (q1 * q1 + q3 * q3) / n2)
+                     * vy + 2.0 * (q2 * q3 + q0 * q1) / n2 * vz)  # fmt: skip
+    xh[X_VEL + 2] = (2.0 * (q1 * q3 + q0 * q2) / n2 * vx + 2.0 * (q2 * q3 - q0 * q1) / n2 * vy
+                     + (1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2) * vz)  # fmt: skip
     for a in range(4):
         xh[X_QUAT + a] = est[ES_Q + a]
     for a in range(3):
         xh[X_POS + a] = est[ES_POS + a]
-        xh[X_VEL + a] = (
-            C[0, a] * est[ES_VEL] + C[1, a] * est[ES_VEL + 1] + C[2, a] * est[ES_VEL + 2]
-        )
         xh[X_OMEGA + a] = est[ES_W + a]
-    measure(t, xh[:NX], meas)
     for a in range(3):
         meas[MS_W_HAT + a] = est[ES_W + a]
         meas[MS_BIAS_HAT + a] = est[ES_BIAS + a]

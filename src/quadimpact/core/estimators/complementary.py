@@ -60,9 +60,8 @@ from ..layout import (
     SC_POSE_ATT,
     V_GRAVITY,
 )
-from ..quaternion import rotation_matrix
 from ..records import Data, Model
-from ..sensors.rotvec import error_vector, rotate_by
+from ..sensors.rotvec import dcm, error_vector, rotate_by
 from .navigation import integrate_navigation
 
 
@@ -80,14 +79,14 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
     w = meas[MS_IMU_W : MS_IMU_W + 3]
     # the errors are measured at the attitude predicted for this sample (the prior
     # advanced by the gyro minus the bias), so that a consistent sample corrects nothing
-    prior = q.copy()
+    p0, p1, p2, p3 = q[0], q[1], q[2], q[3]
     rotate_by(
         q,
         (w[0] - est[ES_BIAS]) * dt,
         (w[1] - est[ES_BIAS + 1]) * dt,
         (w[2] - est[ES_BIAS + 2]) * dt,
     )
-    rotation_matrix(q, C)
+    dcm(q, C)
     f = meas[MS_IMU_F : MS_IMU_F + 3]
     ex = 0.0
     ey = 0.0
@@ -136,9 +135,9 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
     wx_c = est[ES_W] + ka * ex + km * mx
     wy_c = est[ES_W + 1] + ka * ey + km * my
     wz_c = est[ES_W + 2] + ka * ez + km * mz
-    q[:] = prior
+    q[0], q[1], q[2], q[3] = p0, p1, p2, p3
     rotate_by(q, wx_c * dt, wy_c * dt, wz_c * dt)
-    rotation_matrix(q, C)
+    dcm(q, C)
     integrate_navigation(est, C, f, g, dt)
     if meas[MS_POSE_T] == t:
         kp = ecfg[EC_K_POS]
@@ -150,4 +149,4 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
         if m.scfg[SC_POSE_ATT] > 0.5:
             px, py, pz = error_vector(q, meas[MS_POSE + 3 : MS_POSE + 7])
             rotate_by(q, kp * px, kp * py, kp * pz)
-            rotation_matrix(q, C)
+            dcm(q, C)

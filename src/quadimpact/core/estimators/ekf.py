@@ -60,6 +60,7 @@ from ..layout import (
     ES_P,
     ES_POS,
     ES_Q,
+    ES_SCRATCH,
     ES_VEL,
     ES_W,
     GATE_DEWEIGHT,
@@ -74,9 +75,8 @@ from ..layout import (
     SC_POSE_ATT,
     V_GRAVITY,
 )
-from ..quaternion import rotation_matrix
 from ..records import Data, Model
-from ..sensors.rotvec import error_vector, rotate_by
+from ..sensors.rotvec import dcm, error_vector, rotate_by
 from .navigation import integrate_navigation
 
 
@@ -99,7 +99,7 @@ def ekf_init(m: Model, d: Data) -> None:
 
 @njit(cache=True)
 def covariance(est: np.ndarray, n: int) -> np.ndarray:
-    """A copy of the covariance's first ``n`` rows and columns."""
+    """A copy of the covariance's first ``n`` rows and columns (for tests and analysis)."""
     P = np.empty((n, n))
     for i in range(n):
         for j in range(n):
@@ -108,151 +108,106 @@ def covariance(est: np.ndarray, n: int) -> np.ndarray:
 
 
 @njit(cache=True)
-def _store(est: np.ndarray, P: np.ndarray) -> None:
-    n = P.shape[0]
-    for i in range(n):
-        for j in range(n):
-            est[ES_P + i * N_EKF + j] = 0.5 * (P[i, j] + P[j, i])
-
-
-@njit(cache=True)
-def _skew(H: np.ndarray, col: int, s: float, u0: float, u1: float, u2: float) -> None:
-    """``H[:, col:col+3] = s [u x]``."""
-    H[0, col] = 0.0
-    H[0, col + 1] = -s * u2
-    H[0, col + 2] = s * u1
-    H[1, col] = s * u2
-    H[1, col + 1] = 0.0
-    H[1, col + 2] = -s * u0
-    H[2, col] = -s * u1
-    H[2, col + 1] = s * u0
-    H[2, col + 2] = 0.0
-
-
-@njit(cache=True)
-def _mm(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """``A B`` in a fixed order of operations (no BLAS: the same bits on every CPU)."""
-    n, k = A.shape
-    m = B.shape[1]
-    out = np.zeros((n, m))
+def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool) -> None:
+    """``W[o, :n, :m] = W[a, :n, :k] W[b, :k, :m]`` (``W[b]^T`` when ``bt``), in a fixed
+    order of operations (no BLAS: the same bits on every CPU)."""
     for i in range(n):
         for j in range(m):
             s = 0.0
             for r in range(k):
-                s += A[i, r] * B[r, j]
-            out[i, j] = s
-    return out
+                s += W[a, i, r] * (W[b, j, r] if bt else W[b, r, j])
+            W[o, i, j] = s
 
 
 @njit(cache=True)
-def _mmt(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """``A B^T`` in a fixed order of operations."""
-    n, k = A.shape
-    m = B.shape[0]
-    out = np.zeros((n, m))
-    for i in range(n):
-        for j in range(m):
-            s = 0.0
-            for r in range(k):
-                s += A[i, r] * B[j, r]
-            out[i, j] = s
-    return out
-
-
-@njit(cache=True)
-def _inverse3(S: np.ndarray) -> np.ndarray:
-    """The inverse of a 3 x 3 matrix (adjugate over determinant)."""
-    a, b, c = S[0, 0], S[0, 1], S[0, 2]
-    d, e, f = S[1, 0], S[1, 1], S[1, 2]
-    g, h, i = S[2, 0], S[2, 1], S[2, 2]
-    A = e * i - f * h
-    B = -(d * i - f * g)
-    Cc = d * h - e * g
-    det = a * A + b * B + c * Cc
-    out = np.empty((3, 3))
-    out[0, 0] = A / det
-    out[1, 0] = B / det
-    out[2, 0] = Cc / det
-    out[0, 1] = -(b * i - c * h) / det
-    out[1, 1] = (a * i - c * g) / det
-    out[2, 1] = -(a * h - b * g) / det
-    out[0, 2] = (b * f - c * e) / det
-    out[1, 2] = -(a * f - c * d) / det
-    out[2, 2] = (a * e - b * d) / det
-    return out
-
-
-@njit(cache=True)
-def kalman_update(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: float) -> None:
-    """One 3-row update of ``P`` (in place) with innovation ``y`` and noise variance ``r``;
-    the correction injected into the nominal state ``est``."""
-    n = P.shape[0]
-    PHt = _mmt(P, H)
-    S = _mm(H, PHt)
+def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: float) -> None:
+    """One 3-row update (Joseph form) of the covariance ``W[0]`` (``n`` states) with the
+    rows ``W[4, :3]`` of ``H``, innovation ``y`` and noise variance ``r``; the correction
+    injected into the nominal state ``est``. ``W[1..3]``, ``W[5]``: scratch."""
+    P, T2, T3, K = W[0], W[2], W[3], W[5]
+    _mul(W, 0, 4, 1, n, n, 3, True)  # P H^T (n x 3)
+    _mul(W, 4, 1, 2, 3, n, 3, False)  # S = H P H^T (3 x 3)
     for k in range(3):
-        S[k, k] += r
-    K = _mm(PHt, _inverse3(S))
-    dx = np.zeros(n)
-    for i in range(n):
-        dx[i] = K[i, 0] * y[0] + K[i, 1] * y[1] + K[i, 2] * y[2]
-    IKH = np.eye(n) - _mm(K, H)
-    Pn = _mmt(_mm(IKH, P), IKH)
-    KKt = _mmt(K, K)
-    for i in range(n):
-        for j in range(n):
-            P[i, j] = Pn[i, j] + r * KKt[i, j]
+        T2[k, k] += r
+    a, b, c = T2[0, 0], T2[0, 1], T2[0, 2]
+    d, e, f = T2[1, 0], T2[1, 1], T2[1, 2]
+    g, h, i = T2[2, 0], T2[2, 1], T2[2, 2]
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    T3[0, 0] = (e * i - f * h) / det
+    T3[0, 1] = -(b * i - c * h) / det
+    T3[0, 2] = (b * f - c * e) / det
+    T3[1, 0] = -(d * i - f * g) / det
+    T3[1, 1] = (a * i - c * g) / det
+    T3[1, 2] = -(a * f - c * d) / det
+    T3[2, 0] = (d * h - e * g) / det
+    T3[2, 1] = -(a * h - b * g) / det
+    T3[2, 2] = (a * e - b * d) / det
+    _mul(W, 1, 3, 5, n, 3, 3, False)  # K = P H^T S^-1 (n x 3)
+    dx = K[:, 3]  # the correction, in K's fourth column
+    dx[:] = 0.0
+    for j in range(n):
+        dx[j] = K[j, 0] * y[0] + K[j, 1] * y[1] + K[j, 2] * y[2]
+    _mul(W, 5, 4, 3, n, 3, n, False)  # K H
+    for j in range(n):
+        for k in range(n):
+            T3[j, k] = (1.0 if j == k else 0.0) - T3[j, k]  # I - K H
+    _mul(W, 3, 0, 1, n, n, n, False)
+    _mul(W, 1, 3, 2, n, n, n, True)  # (I - K H) P (I - K H)^T
+    for j in range(n):
+        for k in range(n):
+            P[j, k] = T2[j, k] + r * (K[j, 0] * K[k, 0] + K[j, 1] * K[k, 1] + K[j, 2] * K[k, 2])
     rotate_by(est[ES_Q : ES_Q + 4], dx[0], dx[1], dx[2])
-    for a in range(3):
-        est[ES_BIAS + a] += dx[3 + a]
-    if n == N_EKF:
-        for a in range(3):
-            est[ES_VEL + a] += dx[6 + a]
-            est[ES_POS + a] += dx[9 + a]
+    for a3 in range(3):
+        est[ES_BIAS + a3] += dx[3 + a3]
+        est[ES_VEL + a3] += dx[6 + a3]
+        est[ES_POS + a3] += dx[9 + a3]
 
 
 @njit(cache=True)
-def ekf_predict(est: np.ndarray, P: np.ndarray, ecfg: np.ndarray, w: np.ndarray,
+def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.ndarray,
                 f: np.ndarray, dt: float, C: np.ndarray) -> None:  # fmt: skip
-    """The prediction over ``dt`` (s): attitude and covariance (``C``: the rotation before)."""
-    n = P.shape[0]
+    """The prediction over ``dt`` (s): the attitude and the covariance ``W[0]``.
+
+    ``C``: the estimate's rotation before; ``W[1..3]``: scratch.
+    """
+    P, T1, Phi = W[0], W[1], W[3]
     wx = w[0] - est[ES_BIAS]
     wy = w[1] - est[ES_BIAS + 1]
     wz = w[2] - est[ES_BIAS + 2]
-    Phi = np.eye(n)
-    # R(w dt)^T: the rotation of the rotation vector -w dt
-    R = np.empty((3, 3))
-    q = np.array([1.0, 0.0, 0.0, 0.0])
+    for i in range(n):
+        for j in range(n):
+            Phi[i, j] = 1.0 if i == j else 0.0
+    # R(w dt)^T: the rotation of the rotation vector -w dt (into T1's corner)
+    q = est[ES_SCRATCH : ES_SCRATCH + 4]
+    q[0] = 1.0
+    q[1] = 0.0
+    q[2] = 0.0
+    q[3] = 0.0
     rotate_by(q, -wx * dt, -wy * dt, -wz * dt)
-    rotation_matrix(q, R)
+    dcm(q, T1)
     for i in range(3):
         for j in range(3):
-            Phi[i, j] = R[i, j]
+            Phi[i, j] = T1[i, j]
         Phi[i, 3 + i] = -dt
     if n == N_EKF:
         # -C [f x] dt
-        Fx = np.zeros((3, 3))
-        Fx[0, 1] = -f[2]
-        Fx[0, 2] = f[1]
-        Fx[1, 0] = f[2]
-        Fx[1, 2] = -f[0]
-        Fx[2, 0] = -f[1]
-        Fx[2, 1] = f[0]
-        CF = _mm(C, Fx)
         for i in range(3):
-            for j in range(3):
-                Phi[6 + i, j] = -CF[i, j] * dt
+            c0, c1, c2 = C[i, 0], C[i, 1], C[i, 2]
+            Phi[6 + i, 0] = -(c1 * f[2] - c2 * f[1]) * dt
+            Phi[6 + i, 1] = -(c2 * f[0] - c0 * f[2]) * dt
+            Phi[6 + i, 2] = -(c0 * f[1] - c1 * f[0]) * dt
             Phi[9 + i, 6 + i] = dt
-    Pn = _mmt(_mm(Phi, P), Phi)
+    _mul(W, 3, 0, 1, n, n, n, False)
+    _mul(W, 1, 3, 0, n, n, n, True)
     sg = ecfg[EC_SIG_GYRO] * dt
     sb = ecfg[EC_SIG_WALK]
     for k in range(3):
-        Pn[k, k] += sg * sg
-        Pn[3 + k, 3 + k] += sb * sb * dt
+        P[k, k] += sg * sg
+        P[3 + k, 3 + k] += sb * sb * dt
     if n == N_EKF:
         sa = ecfg[EC_SIG_ACC] * dt
         for k in range(3):
-            Pn[6 + k, 6 + k] += sa * sa
-    P[:, :] = Pn
+            P[6 + k, 6 + k] += sa * sa
     rotate_by(est[ES_Q : ES_Q + 4], wx * dt, wy * dt, wz * dt)
 
 
@@ -267,17 +222,23 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     meas = d.meas
     g = m.veh[V_GRAVITY]
     n = ekf_dimension(ecfg)
-    P = covariance(est, n)
+    # the covariance, scratch, H (rows 0-2; the innovation in row 3), K (columns 0-2; the
+    # correction in column 3)
+    W = np.zeros((6, N_EKF, N_EKF))
+    P = W[0]
+    for i in range(n):
+        for j in range(n):
+            P[i, j] = est[ES_P + i * N_EKF + j]
     f = meas[MS_IMU_F : MS_IMU_F + 3]
     w = meas[MS_IMU_W : MS_IMU_W + 3]
     q = est[ES_Q : ES_Q + 4]
-    rotation_matrix(q, C)
+    dcm(q, C)
     if dt > 0.0:
-        ekf_predict(est, P, ecfg, w, f, dt, C)
-        rotation_matrix(q, C)
+        ekf_predict(est, W, n, ecfg, w, f, dt, C)
+        dcm(q, C)
         integrate_navigation(est, C, f, g, dt)
-    H = np.zeros((3, n))
-    y = np.empty(3)
+    H = W[4]
+    y = H[3, :3]  # the innovation, in H's fourth row
     # accelerometer: gravity
     fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
     excess = abs(fn - g)
@@ -289,40 +250,58 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
         r *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
     est[ES_GATED] = 0.0 if excess <= gate else 1.0
     if use:
-        u0 = C[2, 0]
-        u1 = C[2, 1]
-        u2 = C[2, 2]
         for k in range(3):
-            y[k] = f[k] + g * (C[2, k])
-        _skew(H, 0, -g, u0, u1, u2)
-        kalman_update(est, P, H, y, r)
-        rotation_matrix(q, C)
-    # magnetometer
+            y[k] = f[k] + g * C[2, k]
+        # H_theta = -g [u x], u = C^T e_Z
+        _skew(H, -g, C[2, 0], C[2, 1], C[2, 2])
+        kalman_update(est, W, n, y, r)
+        dcm(q, C)
+    # magnetometer: H_theta = [u_m x], u_m = C^T m_I
     if meas[MS_MAG_T] == t:
         mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
-        u = np.empty(3)
-        for k in range(3):
-            u[k] = C[0, k] * mi[0] + C[1, k] * mi[1] + C[2, k] * mi[2]
-            y[k] = meas[MS_MAG + k] - u[k]
-        H[:, :] = 0.0
-        _skew(H, 0, 1.0, u[0], u[1], u[2])
-        kalman_update(est, P, H, y, ecfg[EC_SIG_MAG] ** 2)
-        rotation_matrix(q, C)
-    # pose sensor
+        u0 = C[0, 0] * mi[0] + C[1, 0] * mi[1] + C[2, 0] * mi[2]
+        u1 = C[0, 1] * mi[0] + C[1, 1] * mi[1] + C[2, 1] * mi[2]
+        u2 = C[0, 2] * mi[0] + C[1, 2] * mi[1] + C[2, 2] * mi[2]
+        y[0] = meas[MS_MAG] - u0
+        y[1] = meas[MS_MAG + 1] - u1
+        y[2] = meas[MS_MAG + 2] - u2
+        _skew(H, 1.0, u0, u1, u2)
+        kalman_update(est, W, n, y, ecfg[EC_SIG_MAG] ** 2)
+        dcm(q, C)
+    # pose sensor: position (H_p = I), attitude (H_theta = I)
     if meas[MS_POSE_T] == t:
         if n == N_EKF:
-            H[:, :] = 0.0
+            _unit(H, 9)
             for k in range(3):
-                H[k, 9 + k] = 1.0
                 y[k] = meas[MS_POSE + k] - est[ES_POS + k]
-            kalman_update(est, P, H, y, ecfg[EC_SIG_POS] ** 2)
+            kalman_update(est, W, n, y, ecfg[EC_SIG_POS] ** 2)
         if m.scfg[SC_POSE_ATT] > 0.5:
-            H[:, :] = 0.0
-            for k in range(3):
-                H[k, k] = 1.0
+            _unit(H, 0)
             y[0], y[1], y[2] = error_vector(q, meas[MS_POSE + 3 : MS_POSE + 7])
-            kalman_update(est, P, H, y, ecfg[EC_SIG_ATT] ** 2)
-        rotation_matrix(q, C)
-    _store(est, P)
+            kalman_update(est, W, n, y, ecfg[EC_SIG_ATT] ** 2)
+        dcm(q, C)
+    for i in range(n):
+        for j in range(n):
+            est[ES_P + i * N_EKF + j] = 0.5 * (P[i, j] + P[j, i])
     for a in range(3):
         est[ES_W + a] = w[a] - est[ES_BIAS + a]
+
+
+@njit(cache=True)
+def _skew(H: np.ndarray, s: float, u0: float, u1: float, u2: float) -> None:
+    """``H[:3, :] = [s [u x], 0]``: a measurement of the attitude error alone."""
+    H[:3, :] = 0.0
+    H[0, 1] = -s * u2
+    H[0, 2] = s * u1
+    H[1, 0] = s * u2
+    H[1, 2] = -s * u0
+    H[2, 0] = -s * u1
+    H[2, 1] = s * u0
+
+
+@njit(cache=True)
+def _unit(H: np.ndarray, col: int) -> None:
+    """``H[:3, :]`` selecting the three states from ``col``."""
+    H[:3, :] = 0.0
+    for k in range(3):
+        H[k, col + k] = 1.0

@@ -72,12 +72,10 @@ def record_estimate(t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data, 
     ev = 0.0
     eb = 0.0
     ep = 0.0
-    bias = np.empty(3)
     for r in range(3):
         v = C[r, 0] * xs[X_VEL] + C[r, 1] * xs[X_VEL + 1] + C[r, 2] * xs[X_VEL + 2]
         ev += (est[ES_VEL + r] - v) ** 2
-        bias[r] = m.scfg[SC_BIAS + 3 + r] + d.sst[SS_WALK + r]
-        eb += (est[ES_BIAS + r] - bias[r]) ** 2
+        eb += (est[ES_BIAS + r] - (m.scfg[SC_BIAS + 3 + r] + d.sst[SS_WALK + r])) ** 2
         ep += (est[ES_POS + r] - xs[X_POS + r]) ** 2
     errors = (e_att, math.sqrt(ev), math.sqrt(eb), math.sqrt(ep))
     stats = o.stats
@@ -98,4 +96,4 @@ def record_estimate(t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data, 
         row[I_BIAS_HAT + a] = est[ES_BIAS + a]
         row[I_VEL_HAT + a] = est[ES_VEL + a]
         row[I_POS_HAT + a] = est[ES_POS + a]
-        row[I_BIAS_TRUE + a] = bias[a]
+        row[I_BIAS_TRUE + a] = m.scfg[SC_BIAS + 3 + a] + d.sst[SS_WALK + a]

@@ -73,10 +73,10 @@ def pose_sample(t: float, xs: np.ndarray, m: Model, d: Data, o: Output) -> None:
         if noisy:
             v += scfg[SC_POSE_NOISE_P] * m.snoise[i, SN_POSE + a]
         meas[MS_POSE + a] = v
-    q = sst[src + 3 : src + 7].copy()
-    n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    q = meas[MS_POSE + 3 : MS_POSE + 7]
+    n = math.sqrt(sst[src + 3] ** 2 + sst[src + 4] ** 2 + sst[src + 5] ** 2 + sst[src + 6] ** 2)
     for a in range(4):
-        q[a] /= n
+        q[a] = sst[src + 3 + a] / n
     if scfg[SC_POSE_ATT] > 0.5 and noisy:
         s = scfg[SC_POSE_NOISE_A]
         rotate_by(
@@ -85,8 +85,6 @@ def pose_sample(t: float, xs: np.ndarray, m: Model, d: Data, o: Output) -> None:
             s * m.snoise[i, SN_POSE + 4],
             s * m.snoise[i, SN_POSE + 5],
         )
-    for a in range(4):
-        meas[MS_POSE + 3 + a] = q[a]
     meas[MS_POSE_T] = t
     sst[SS_POSE_N] += 1.0
     if row:

@@ -10,6 +10,19 @@ import math
 import numpy as np
 from numba import njit
 
+from ..quaternion import rotation_matrix
+
+
+@njit(cache=True)
+def dcm(q: np.ndarray, C: np.ndarray) -> None:
+    """Fill ``C`` (3x3) with the body-to-inertial rotation of ``q`` (normalised here).
+
+    ``quaternion.rotation_matrix`` as a called function: it is inlined wherever it
+    is used, and the estimators use it often (one compiled copy keeps the loop's
+    compile time down).
+    """
+    rotation_matrix(q, C)
+
 
 @njit(cache=True)
 def rotate_by(q: np.ndarray, px: float, py: float, pz: float) -> None:
