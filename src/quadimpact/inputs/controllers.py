@@ -137,9 +137,9 @@ class RecoveryParams(BaseModel):
         None, gt=0, description="Stage 5 acceleration limit (each of |a_XY|, |a_Z|); None: g/2."
     )
     hover_k_yaw_1_s: Real = Field(2.0, ge=0, description="Stage 5 yaw gain, 1/s.")
-    hover_hold: Literal["entry", "stop"] = Field(
-        "entry",
-        description="Stage 5 holds the position estimate at stage 4's entry, or where it stops.",
+    hover_hold: Literal["stop", "entry"] = Field(
+        "stop",
+        description="Stage 5 holds where the vehicle stops, or the position at stage 4's entry.",
     )
     hover_set_point_m: Vec3 | None = Field(
         None, description="Stage 5 position set-point (inertial NED, m); None: hover_hold's."

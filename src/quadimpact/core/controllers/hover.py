@@ -1,8 +1,10 @@
 """Stage 5 of the staged recovery law: return to hover and hold the position.
 
 After stage 4 (recovered: level, not descending) the ``recovery`` controller
-holds a position set-point ``p_set`` (the position estimate at which stage 4
-was entered, or a given one) and the yaw ``psi_set`` it had there. Its outer
+holds a position set-point ``p_set`` (by default where the vehicle stops: it
+brakes, holding wherever it is, until its speed estimate falls below 0.2 m/s;
+or the position estimate at which stage 4 was entered, or a given one) and
+the yaw ``psi_set`` it had on entering stage 4. Its outer
 loop is a cascade on the estimate, position to velocity to acceleration,
 with limits (so a fast vehicle brakes at the limit and comes back at a
 bounded speed, without the overshoot of a saturated PD)::

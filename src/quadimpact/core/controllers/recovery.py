@@ -43,8 +43,9 @@ stage meaning             a_ref       k_z   leaves when
 ====  ==================  ==========  ====  =====================================
 
 With stage 5 on (``R_HOVER``, the default) stage 4 lasts one tick: at the next
-tick the law holds the position estimate and the yaw at which stage 4 was
-entered (or a given set-point), so a recovered vehicle no longer drifts away;
+tick the law brakes and holds a position estimate (where it stops, by
+default; ``R_HOVER_MODE``) and the yaw at which stage 4 was entered, so a
+recovered vehicle no longer drifts away;
 stage 4's entry (``recovered``) and everything before it are unchanged.
 
 At the detection tick the stage becomes 1 and the law runs at once (no test).
