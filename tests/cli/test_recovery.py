@@ -44,6 +44,9 @@ seed = 2
             ["--sweep: the sweep file sets the trials", "--n"],
         ),
         (["--sweep", "approach.toml"], ["approach.toml: base: kind: must be 'impact-trial'"]),
+        (["--estimator", "kalman"], ["--estimator: must be one of 'ideal', 'complementary'"]),
+        (["--sensors", "all"], ["'--sensors'", "'all' is not one of 'ideal', 'noisy'"]),
+        (["--imu", "noisy", "--sensors", "impact"], ["--imu and --sensors: give one"]),
     ],
 )
 def test_bad_arguments_exit_2_with_one_line(tmp_path: Path, args, fragments) -> None:
@@ -91,3 +94,17 @@ def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
     assert again.returncode == 0 and "all done before, nothing to run" in again.stdout
     other = run_cli("recovery", "--n", "7", "--out", "r", "--workers", "1", cwd=tmp_path)
     assert_input_error(other, "holds a different sweep")
+
+
+@pytest.mark.slow  # the study's example with its viewer
+def test_the_recovery_command_takes_an_estimator_and_sensors(tmp_path: Path) -> None:
+    proc = run_cli("recovery", "--n", "4", "--estimator", "complementary", "--sensors", "impact",
+                   "--out", "r", "--workers", "1", "--no-animation", "--no-progress",
+                   cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    t = pd.read_parquet(tmp_path / "r" / "trials.parquet")
+    assert (t["estimator"] == "complementary").all() and (t["sensors"] == "impact").all()
+    assert t["impact_disturbance"].all() and t["est_attitude_rms_crash_deg"].notna().all()
+    report = (tmp_path / "r" / "report.md").read_text()
+    assert "## Estimation" in report and "Estimator: complementary; sensors: impact" in report
+    assert (tmp_path / "r" / "example" / "estimate.png").is_file()

@@ -95,7 +95,8 @@ def test_the_factories_allocate_the_declared_sizes():
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (L.NRIN,), (L.NMEM,), (L.NMEAS,), (L.NSST,)
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (L.NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
+        (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)
     assert o.out.shape == (n_out, L.out_width(m_feat)) == (n_out, L.NOUT + 2 * m_feat)

@@ -60,7 +60,7 @@ def test_impact_trial_stepping_and_partial_results():
     assert partial.summary["t_final_s"] == pytest.approx(0.05)
     sim.advance(-1)
     _compare(whole.summary, sim.result().summary)
-    assert whole.summary["recovered"] and sim.stage == 4
+    assert whole.summary["recovered"] and sim.stage == 5  # stage 5 (hover) follows stage 4
 
 
 def test_external_command_drives_the_rotors():

@@ -8,11 +8,11 @@ import click
 
 from quadimpact.cli.options import out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
-from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS
+from quadimpact.recovery import DEFAULT_N, ESTIMATORS, IMUS, MODELS, PRE_IMPACTS, SENSORS
 
 __all__ = ["recovery"]
 
-_STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact")
+_STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimator", "sensors")
 
 
 @click.command("recovery")
@@ -43,6 +43,16 @@ _STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact")
     "[default: spin-down]",
 )  # fmt: skip
 @click.option(
+    "--estimator", metavar="|".join(ESTIMATORS),
+    help="State estimator the controller and the detector read (docs/ESTIMATION.md); a "
+    "registered one is accepted too. [default: ideal]",
+)  # fmt: skip
+@click.option(
+    "--sensors", type=click.Choice(SENSORS),
+    help="A preset of sensors (replaces --imu): impact = the noisy IMU with the impact "
+    "disturbance and a gyro bias walk; indoor = impact + magnetometer + pose sensor.",
+)  # fmt: skip
+@click.option(
     "--sweep", "sweep_file", type=click.Path(dir_okay=False, path_type=Path),
     metavar="SWEEP.toml",
     help="Run this sweep file (its base an impact trial) instead of the authors' distribution.",
@@ -57,6 +67,8 @@ def recovery(
     model: str | None,
     imu: str | None,
     pre_impact: str | None,
+    estimator: str | None,
+    sensors: str | None,
     sweep_file: Path | None,
     no_animation: bool,
     workers: int | None,
@@ -83,6 +95,7 @@ def recovery(
     Examples:
       quadimpact recovery --out results/recovery
       quadimpact recovery --vehicle spiri --n 2000 --imu noisy --out results/spiri-noisy
+      quadimpact recovery --estimator ekf --sensors impact --out results/ekf-impact
       quadimpact recovery --sweep my-trials.toml --out results/mine
     """
     from quadimpact.recovery.study import RecoveryStudy, run_study
@@ -92,8 +105,10 @@ def recovery(
 
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
-    given = {k: v for k, v in zip(_STUDY_OPTIONS, (vehicle, n, seed, model, imu, pre_impact),
-                                  strict=True) if v is not None}  # fmt: skip
+    if imu is not None and sensors is not None:
+        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
+    values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
+    given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
     if sweep_file is not None:
         if given:
             flag = "--" + next(iter(given)).replace("_", "-")

@@ -57,10 +57,12 @@ from .controllers.recovery import (
     STAGE_PRE_IMPACT,
     STAGE_RECOVERED,
     STAGE_TILTED,
+    law_references,
     rate_loop,
     recovery_step,
     staged_references,
 )
+from .estimators import write_estimate
 from .layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -73,12 +75,14 @@ from .layout import (
     LS_T0,
     LS_TF,
     MEM_STAGE,
+    MS_BIAS_HAT,
     MS_DETECTED,
     MS_IMU_F,
     MS_IMU_W,
     MS_NORMAL,
     MS_T,
     MS_T_DETECT,
+    MS_W_HAT,
     MS_X,
     N_ROTORS,
     NX,
@@ -102,7 +106,6 @@ from .layout import (
 )
 from .quaternion import normalise_quaternion, rotation_matrix
 from .records import Data, Model, Output, Work, data_row, model_row, new_work, output_row
-from .sensors.measurement import measure
 from .step import finish, start, tick
 
 
@@ -186,8 +189,27 @@ ACT_ROTORS = 0
 ACT_CTBR = 1
 OBS_IMU = 0
 OBS_STATE = 1
+OBS_ESTIMATE = 2
 N_OBS_IMU = 24
 N_OBS_STATE = 19
+N_OBS_ESTIMATE = 30
+# the estimate mode's scales: powers of two, so that value = observation * scale exactly
+# (observations float64): the staged controller can act on its observation alone
+OBS_EST_VEL = 2.0  # m/s
+OBS_EST_POS = 8.0  # m
+OBS_EST_RATE = 8.0  # rad/s
+OBS_EST_F = 16.0  # m/s^2
+OBS_EST_BIAS = 0.125  # rad/s
+OBS_EST_ROTOR = 1024.0  # rad/s
+
+
+def n_observations(mode: int) -> int:
+    """The observation length of a mode (``OBS_*``)."""
+    if mode == OBS_STATE:
+        return N_OBS_STATE
+    if mode == OBS_ESTIMATE:
+        return N_OBS_ESTIMATE
+    return N_OBS_IMU
 
 
 # ---------------------------------------------------------------- action maps
@@ -276,7 +298,7 @@ def action_command(
         thrust = affine_map(a[0], 0.0, max_thrust(veh, ctrl))
         rates = (a[1] * par[EP_RATE_MAX], a[2] * par[EP_RATE_MAX + 1], a[3] * par[EP_RATE_MAX + 2])
         rate_loop(
-            thrust, rates[0], rates[1], rates[2], meas[MS_IMU_W : MS_IMU_W + 3], ctrl, veh, cmd
+            thrust, rates[0], rates[1], rates[2], meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd
         )
     else:
         lo, hi = rotor_range(ctrl, par)
@@ -294,7 +316,7 @@ def level_test(
     _, _, _, qex, qey = staged_references(
         STAGE_TILTED, False, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh
     )
-    return qex, qey, tmeas[MS_IMU_W], tmeas[MS_IMU_W + 1], x[X_VEL + 2]
+    return qex, qey, tmeas[MS_W_HAT], tmeas[MS_W_HAT + 1], x[X_VEL + 2]
 
 
 @njit(cache=True)
@@ -381,12 +403,13 @@ def tick_measurement(m: Model, d: Data, tmeas: np.ndarray) -> None:
 
     The state is renormalised on a copy, as ``step.tick`` renormalises it
     before the estimator runs (the same arithmetic, so the same bits), and the
-    estimate written by the one writer of the measurement record.
+    estimate written by the estimator stage (``estimators.write_estimate``, through
+    the one writer of the measurement record).
     """
     tmeas[:] = d.meas
     x = d.x.copy()
     normalise_quaternion(x, X_QUAT)
-    measure(d.ls[LS_T0] + int(d.ls[LS_K]) * m.opts[O_DT_CONTROL], x, tmeas)
+    write_estimate(d.ls[LS_T0] + int(d.ls[LS_K]) * m.opts[O_DT_CONTROL], x, m, d, tmeas)
 
 
 # ---------------------------------------------------------------- observation, reward
@@ -416,6 +439,9 @@ def observe(
     since = tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0
     lo, hi = rotor_range(ctrl, par)
     h = 0.5 * (hi - lo)
+    if int(par[EP_OBSERVE]) == OBS_ESTIMATE:
+        observe_estimate(tmeas, par, obs)
+        return
     if int(par[EP_OBSERVE]) == OBS_STATE:
         obs[0] = _clip(x[X_POS] / par[EP_OBS_POS], clip)
         obs[1] = _clip((x[X_POS + 1] - env[B_Y_REF]) / par[EP_OBS_POS], clip)
@@ -445,6 +471,62 @@ def observe(
     obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
     for j in range(N_ROTORS):
         obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
+
+
+@njit(cache=True)
+def observe_estimate(tmeas: np.ndarray, par: np.ndarray, obs: np.ndarray) -> None:
+    """The estimate mode's observation: what an on-board controller sees (docs/LEARNING.md).
+
+    The estimator's output (attitude, body velocity, position, rates, gyro
+    bias), the IMU sample, the detector, the rotor speeds; every value divided
+    by a power of two (so exactly recoverable from the float64 observation),
+    then clipped.
+    """
+    x = tmeas[MS_X : MS_X + NX]
+    clip = par[EP_OBS_CLIP]
+    for i in range(4):
+        obs[i] = _clip(x[X_QUAT + i], clip)
+    for i in range(3):
+        obs[4 + i] = _clip(x[X_VEL + i] / OBS_EST_VEL, clip)
+        obs[7 + i] = _clip(x[X_POS + i] / OBS_EST_POS, clip)
+        obs[10 + i] = _clip(tmeas[MS_W_HAT + i] / OBS_EST_RATE, clip)
+        obs[13 + i] = _clip(tmeas[MS_IMU_F + i] / OBS_EST_F, clip)
+        obs[16 + i] = _clip(tmeas[MS_IMU_W + i] / OBS_EST_RATE, clip)
+        obs[19 + i] = _clip(tmeas[MS_BIAS_HAT + i] / OBS_EST_BIAS, clip)
+    detected = tmeas[MS_DETECTED] > 0.5
+    obs[22] = 1.0 if detected else 0.0
+    obs[23] = _clip(tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0, clip)
+    obs[24] = _clip(tmeas[MS_NORMAL], clip)
+    obs[25] = _clip(tmeas[MS_NORMAL + 1], clip)
+    for j in range(4):
+        obs[26 + j] = _clip(x[X_ROTOR + j] / OBS_EST_ROTOR, clip)
+
+
+@njit(cache=True)
+def measurement_from_estimate(obs: np.ndarray, meas: np.ndarray) -> None:
+    """The measurement record an estimate-mode observation stands for (its inverse).
+
+    Fills what the staged controller reads: the state estimate, the estimated
+    rates and bias, the IMU sample, the detector's verdict and normal.
+    """
+    meas[:] = 0.0
+    for i in range(4):
+        meas[MS_X + X_QUAT + i] = obs[i]
+    for i in range(3):
+        meas[MS_X + X_VEL + i] = obs[4 + i] * OBS_EST_VEL
+        meas[MS_X + X_POS + i] = obs[7 + i] * OBS_EST_POS
+        meas[MS_X + X_OMEGA + i] = obs[10 + i] * OBS_EST_RATE
+        meas[MS_W_HAT + i] = obs[10 + i] * OBS_EST_RATE
+        meas[MS_IMU_F + i] = obs[13 + i] * OBS_EST_F
+        meas[MS_IMU_W + i] = obs[16 + i] * OBS_EST_RATE
+        meas[MS_BIAS_HAT + i] = obs[19 + i] * OBS_EST_BIAS
+    meas[MS_DETECTED] = obs[22]
+    meas[MS_T_DETECT] = 0.0 if obs[22] > 0.5 else np.nan
+    meas[MS_T] = obs[23]
+    meas[MS_NORMAL] = obs[24]
+    meas[MS_NORMAL + 1] = obs[25]
+    for j in range(4):
+        meas[MS_X + X_ROTOR + j] = obs[26 + j] * OBS_EST_ROTOR
 
 
 @njit(cache=True)
@@ -665,12 +747,31 @@ def staged_policy(
     ``E.state[:, B_INEXACT]`` the commands inside the slew window that the
     rotor map cannot give exactly.
     """
+    staged_actions(active, E.tmeas, M, E.par, pmem, actions, stages, E.state[:, B_INEXACT])
+
+
+@njit(cache=True)
+def staged_actions(
+    active: np.ndarray,
+    TMEAS: np.ndarray,
+    M: Model,
+    par: np.ndarray,
+    pmem: np.ndarray,
+    actions: np.ndarray,
+    stages: np.ndarray,
+    inexact: np.ndarray,
+) -> None:
+    """:func:`staged_policy` on given measurement records ``TMEAS`` (N, NMEAS).
+
+    ``M`` gives each run's controller parameters, vehicle and options (the
+    policy's own configuration); ``inexact`` (N,) counts the commands the
+    rotor map cannot give exactly.
+    """
     cmd = np.zeros(N_ROTORS)
-    par = E.par
-    for k in range(E.tmeas.shape[0]):
+    for k in range(TMEAS.shape[0]):
         if not active[k]:
             continue
-        tmeas = E.tmeas[k]
+        tmeas = TMEAS[k]
         ctrl = M.ctrl[k]
         veh = M.veh[k]
         opts = M.opts[k]
@@ -688,13 +789,13 @@ def staged_policy(
             first = before == STAGE_PRE_IMPACT
             a_ref_on = not (first and ctrl[C_PARAMS + R_FIRST_TICK_LEVEL] > 0.5)
             x = tmeas[MS_X : MS_X + NX]
-            thrust, p_des, q_des, _, _ = staged_references(
-                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh
+            thrust, p_des, q_des, r_des, _, _ = law_references(
+                stage, a_ref_on, x, tmeas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh, mem
             )
             actions[k, 0], _ = affine_inverse(thrust, 0.0, max_thrust(veh, ctrl))
             actions[k, 1] = min(max(p_des / par[EP_RATE_MAX], -1.0), 1.0)
             actions[k, 2] = min(max(q_des / par[EP_RATE_MAX + 1], -1.0), 1.0)
-            actions[k, 3] = 0.0
+            actions[k, 3] = min(max(r_des / par[EP_RATE_MAX + 2], -1.0), 1.0)
             continue
         lo, hi = rotor_range(ctrl, par)
         slew = opts[O_SLEW_MAX] * opts[O_DT_CONTROL]
@@ -703,4 +804,4 @@ def staged_policy(
             actions[k, j] = a
             prev = tmeas[MS_X + X_ROTOR + j]
             if not exact and (slew <= 0.0 or abs(cmd[j] - prev) <= slew):
-                E.state[k, B_INEXACT] += 1.0
+                inexact[k] += 1.0

@@ -109,6 +109,15 @@ class ControllerKind(IntEnum):
     USER = 99  # a plug-in compiled into its own loop (core/run.py, make_kernel)
 
 
+class EstimatorKind(IntEnum):
+    """Built-in estimators (``ecfg[EC_KIND]``; core/estimators/)."""
+
+    IDEAL = 0  # the true state (and the gyro as measured): every result as before estimators
+    COMPLEMENTARY = 1  # Mahony-type nonlinear complementary filter
+    EKF = 2  # multiplicative (error-state) extended Kalman filter
+    USER = 99  # a plug-in compiled into its own loop (core/run.py, make_kernel)
+
+
 class RotorMode(IntEnum):
     IDEAL = 0
     FIRST_ORDER = 1
@@ -150,6 +159,10 @@ CTRL_PAPER = int(ControllerKind.PAPER)
 CTRL_CASCADE_PID = int(ControllerKind.CASCADE_PID)
 CTRL_RECOVERY = int(ControllerKind.RECOVERY)
 CTRL_USER = int(ControllerKind.USER)
+EST_IDEAL = int(EstimatorKind.IDEAL)
+EST_COMPLEMENTARY = int(EstimatorKind.COMPLEMENTARY)
+EST_EKF = int(EstimatorKind.EKF)
+EST_USER = int(EstimatorKind.USER)
 ROTOR_IDEAL = int(RotorMode.IDEAL)
 ROTOR_FIRST_ORDER = int(RotorMode.FIRST_ORDER)
 CRASH_CM_GROUND = int(CrashRule.CM_GROUND)
@@ -292,8 +305,63 @@ SC_FILTER_PARAM = _scfg.slot("SC_FILTER_PARAM")  # first-order: tau, s; moving a
 SC_DET_THRESHOLD = _scfg.slot("SC_DET_THRESHOLD")  # m/s^2, detecting specific force (<= 0: off)
 SC_DET_WORLD = _scfg.slot("SC_DET_WORLD")  # 1: world-horizontal |(C f)_XY|, else body |(f_x, f_y)|
 SC_DET_PERSIST = _scfg.slot("SC_DET_PERSIST")  # consecutive samples at or above the threshold
+# the IMU's impact disturbance: from each contact onset t_c, extra white noise of std
+# a0 exp(-(t - t_c)/tau) (accelerometer) and g0 exp(-(t - t_c)/tau) (gyro); off when tau <= 0
+SC_IMPACT_F = _scfg.slot("SC_IMPACT_F")  # a0, m/s^2
+SC_IMPACT_W = _scfg.slot("SC_IMPACT_W")  # g0, rad/s
+SC_IMPACT_TAU = _scfg.slot("SC_IMPACT_TAU")  # tau, s (<= 0: off)
+SC_BIAS_WALK = _scfg.slot("SC_BIAS_WALK")  # gyro bias random walk, rad/s/sqrt(s) (0: off)
+SC_MAG = _scfg.slot("SC_MAG")  # 1: a magnetometer, sampled with the IMU
+SC_MAG_FIELD = _scfg.slot("SC_MAG_FIELD", 3)  # unit Earth field m_I, inertial NED
+SC_MAG_NOISE = _scfg.slot("SC_MAG_NOISE")  # magnetometer white-noise std per axis (unit field)
+SC_POSE = _scfg.slot("SC_POSE")  # 1: a pose sensor (motion capture, vision)
+SC_POSE_RATE = _scfg.slot("SC_POSE_RATE")  # Hz (taken at the first IMU sample at or after its time)
+SC_POSE_NOISE_P = _scfg.slot("SC_POSE_NOISE_P")  # position white-noise std per axis, m
+SC_POSE_ATT = _scfg.slot("SC_POSE_ATT")  # 1: it measures the attitude too
+SC_POSE_NOISE_A = _scfg.slot("SC_POSE_NOISE_A")  # attitude noise std per axis (rot. vector), rad
+SC_POSE_LAG = _scfg.slot("SC_POSE_LAG")  # latency, IMU samples (< MAX_POSE_LAG)
 NSCFG = _scfg.end("NSCFG")
+MAX_POSE_LAG = 64  # IMU samples
 MAX_AVERAGE_WINDOW = 64  # samples
+
+# ---- the added sensors' standard normal draws snoise (n_imu, NSN): row i for IMU sample i
+_sn = Block("snoise", "SN_")
+SN_IMPACT = _sn.slot("SN_IMPACT", 6)  # impact disturbance (f_x, f_y, f_z, w_x, w_y, w_z)
+SN_WALK = _sn.slot("SN_WALK", 3)  # gyro bias random-walk increments
+SN_MAG = _sn.slot("SN_MAG", 3)  # magnetometer noise
+SN_POSE = _sn.slot("SN_POSE", 6)  # pose sensor: position (3), attitude rotation vector (3)
+NSN = _sn.end("NSN")
+
+# ---- estimator ecfg (NECFG): kind, the initial estimate's error, gains and noises
+# (core/estimators/); EC_USER is a plug-in estimator's own parameter block
+_ecfg = Block("ecfg", "EC_")
+EC_KIND = _ecfg.slot("EC_KIND")  # EST_*
+EC_INIT_ATT = _ecfg.slot("EC_INIT_ATT", 3)  # initial attitude error, rotation vector (body), rad
+EC_INIT_VEL = _ecfg.slot("EC_INIT_VEL", 3)  # initial velocity error, inertial, m/s
+EC_INIT_POS = _ecfg.slot("EC_INIT_POS", 3)  # initial position error, inertial, m
+EC_INIT_BIAS = _ecfg.slot("EC_INIT_BIAS", 3)  # initial gyro bias error, rad/s
+EC_K_ACC = _ecfg.slot("EC_K_ACC")  # complementary: accelerometer gain k_P, 1/s
+EC_K_MAG = _ecfg.slot("EC_K_MAG")  # complementary: magnetometer gain, 1/s
+EC_K_BIAS = _ecfg.slot("EC_K_BIAS")  # complementary: bias (integral) gain k_I, 1/s^2
+EC_K_POS = _ecfg.slot("EC_K_POS")  # complementary: pose position gain, per sample (0-1)
+EC_K_VEL = _ecfg.slot("EC_K_VEL")  # complementary: pose velocity gain, 1/s per sample
+EC_GATE = _ecfg.slot("EC_GATE")  # m/s^2: accelerometer correction gated while ||f| - g| > this
+EC_GATE_MODE = _ecfg.slot("EC_GATE_MODE")  # GATE_SKIP or GATE_DEWEIGHT (EKF)
+EC_DEWEIGHT = _ecfg.slot("EC_DEWEIGHT")  # EKF de-weighting: R times this (excess / gate)^2
+EC_SIG_GYRO = _ecfg.slot("EC_SIG_GYRO")  # EKF: gyro white noise per sample, rad/s
+EC_SIG_WALK = _ecfg.slot("EC_SIG_WALK")  # EKF: gyro bias random walk, rad/s/sqrt(s)
+EC_SIG_ACC = _ecfg.slot("EC_SIG_ACC")  # EKF: accelerometer white noise per sample, m/s^2
+EC_SIG_GRAV = _ecfg.slot("EC_SIG_GRAV")  # EKF: std of the gravity measurement, m/s^2
+EC_SIG_MAG = _ecfg.slot("EC_SIG_MAG")  # EKF: magnetometer noise (unit field)
+EC_SIG_POS = _ecfg.slot("EC_SIG_POS")  # EKF: pose position noise, m
+EC_SIG_ATT = _ecfg.slot("EC_SIG_ATT")  # EKF: pose attitude noise, rad
+EC_P0 = _ecfg.slot("EC_P0", 4)  # EKF initial std: attitude rad, bias rad/s, velocity m/s, pos m
+EC_NAV = _ecfg.slot("EC_NAV")  # EKF: 1: velocity and position are filter states (pose sensor)
+N_USER_ECFG = 16
+EC_USER = _ecfg.slot("EC_USER", N_USER_ECFG)  # a plug-in estimator's parameters
+NECFG = _ecfg.end("NECFG")
+GATE_SKIP = 0
+GATE_DEWEIGHT = 1
 
 # ---- the span of the run: span (NSPAN)
 _span = Block("span", "SPAN_")
@@ -357,6 +425,12 @@ MS_IMU_W = _ms.slot("MS_IMU_W", 3)  # measured angular velocity, body FRD, rad/s
 MS_DETECTED = _ms.slot("MS_DETECTED")  # 1 once an impact has been detected
 MS_T_DETECT = _ms.slot("MS_T_DETECT")  # s, time of the detecting sample (NaN: none)
 MS_NORMAL = _ms.slot("MS_NORMAL", 3)  # wall-normal estimate at detection, inertial, unit
+MS_W_HAT = _ms.slot("MS_W_HAT", 3)  # estimated body rates (ideal: the gyro as measured), rad/s
+MS_BIAS_HAT = _ms.slot("MS_BIAS_HAT", 3)  # estimated gyro bias, rad/s
+MS_MAG = _ms.slot("MS_MAG", 3)  # latest magnetometer sample, body FRD (unit field)
+MS_MAG_T = _ms.slot("MS_MAG_T")  # s, its time (NaN: none)
+MS_POSE = _ms.slot("MS_POSE", 7)  # latest pose measurement: position (inertial, m), quaternion
+MS_POSE_T = _ms.slot("MS_POSE_T")  # s, the IMU sample at which it arrived (NaN: none)
 N_USER_MEAS = 8
 MS_USER = _ms.slot("MS_USER", N_USER_MEAS)  # a plug-in sensor's readings (core/run.py, make_kernel)
 NMEAS = _ms.end("NMEAS")
@@ -368,7 +442,28 @@ SS_NEXT_T = _sst.slot("SS_NEXT_T")  # s, time of the next sample
 SS_COUNT = _sst.slot("SS_COUNT")  # consecutive samples at or above the detection threshold
 SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
 SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
+SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
+SS_POSE_NEXT_T = _sst.slot("SS_POSE_NEXT_T")  # s, time of the next pose measurement
+SS_POSE_N = _sst.slot("SS_POSE_N")  # pose measurements taken
+SS_POSE_RING = _sst.slot("SS_POSE_RING", 7 * MAX_POSE_LAG)  # true poses of the last samples
 NSST = _sst.end("NSST")
+
+# ---- estimator state est (NEST): the estimate after the latest IMU sample
+_est = Block("est", "ES_")
+ES_Q = _est.slot("ES_Q", 4)  # attitude estimate, body -> inertial, scalar first
+ES_BIAS = _est.slot("ES_BIAS", 3)  # gyro bias estimate, rad/s
+ES_VEL = _est.slot("ES_VEL", 3)  # CM velocity estimate, inertial, m/s
+ES_POS = _est.slot("ES_POS", 3)  # CM position estimate, inertial, m
+ES_W = _est.slot("ES_W", 3)  # estimated body rates (gyro minus bias) at the latest sample, rad/s
+ES_T = _est.slot("ES_T")  # s, time of the latest sample processed (NaN: none)
+ES_N = _est.slot("ES_N")  # samples processed
+ES_GATED = _est.slot("ES_GATED")  # 1: the accelerometer correction was gated at the latest sample
+N_EKF = 12  # error state: attitude (3), gyro bias (3), velocity (3), position (3)
+ES_P = _est.slot("ES_P", N_EKF * N_EKF)  # EKF error covariance, row-major
+ES_SCRATCH = _est.slot("ES_SCRATCH", 4)  # a quaternion's worth of scratch (EKF prediction)
+N_USER_EST = 32
+ES_USER = _est.slot("ES_USER", N_USER_EST)  # a plug-in estimator's own state
+NEST = _est.end("NEST")
 
 # ==========================================================================
 # Output: what a run returns
@@ -382,6 +477,14 @@ I_W = _imu.slot("I_W", 3)  # measured angular velocity, body FRD, rad/s
 I_F_TRUE = _imu.slot("I_F_TRUE", 3)  # true specific force at the IMU position, m/s^2
 I_W_TRUE = _imu.slot("I_W_TRUE", 3)  # true angular velocity, rad/s
 I_HORIZONTAL = _imu.slot("I_HORIZONTAL")  # the detector's horizontal measure, m/s^2
+I_MAG = _imu.slot("I_MAG", 3)  # magnetometer sample, body FRD, unit field (NaN: none)
+I_POSE = _imu.slot("I_POSE", 7)  # pose measurement arrived here: position, quaternion (NaN: none)
+I_Q_HAT = _imu.slot("I_Q_HAT", 4)  # attitude estimate after this sample
+I_BIAS_HAT = _imu.slot("I_BIAS_HAT", 3)  # gyro bias estimate, rad/s
+I_VEL_HAT = _imu.slot("I_VEL_HAT", 3)  # velocity estimate, inertial, m/s
+I_POS_HAT = _imu.slot("I_POS_HAT", 3)  # position estimate, inertial, m
+I_BIAS_TRUE = _imu.slot("I_BIAS_TRUE", 3)  # the gyro's true bias (constant + walk), rad/s
+I_ERR = _imu.slot("I_ERR", 4)  # errors: attitude deg, velocity m/s, bias rad/s, position m
 NIMU = _imu.end("NIMU")
 
 # ---- time series out (n_out, NOUT + 2 n_features): the fixed columns, then
@@ -444,4 +547,11 @@ ST_STAGE_X = _st.slot("ST_STAGE_X", 3 * N_STAGES)  # CM position there, inertial
 ST_MIN_ALT = _st.slot("ST_MIN_ALT")  # m, lowest CM altitude (step ends and events)
 ST_MIN_TILT_COS = _st.slot("ST_MIN_TILT_COS")  # after detection: lowest cos(tilt) (1: none)
 ST_MAX_RATE = _st.slot("ST_MAX_RATE")  # after detection: largest |omega|, rad/s (0: none)
+ST_IMPACT_V = _st.slot("ST_IMPACT_V")  # sum over onsets of exp(-2 (ST_IMPACT_T - t_c) / tau)
+ST_IMPACT_T = _st.slot("ST_IMPACT_T")  # s, the latest contact onset (NaN: none)
+N_EST_ERR = 4  # estimation errors: attitude (deg), velocity (m/s), gyro bias (rad/s), position (m)
+N_PHASES = 3  # before the first contact, the crash (to stage 4), after stage 4
+ST_EST_ERR = _st.slot("ST_EST_ERR", 3 * N_EST_ERR * N_PHASES)  # (sum of squares, max, samples)
+ST_HOVER_RUN_T = _st.slot("ST_HOVER_RUN_T")  # s, first tick of the hover condition's run (NaN)
+ST_T_HOVER = _st.slot("ST_T_HOVER")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
 NSTAT = _st.end("NSTAT")

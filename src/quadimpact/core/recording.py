@@ -56,6 +56,7 @@ from .layout import (
 )
 from .quaternion import rotation_matrix
 from .records import Data, Model, Output, Work
+from .sensors.disturbance import impact_onset
 
 
 @njit(cache=True)
@@ -120,6 +121,7 @@ def open_episode(c: int, t: float, gd: float, m: Model, d: Data, o: Output, w: W
     episodes = o.episodes
     cs[c, CS_ACTIVE] = 1.0
     cs[c, CS_LAMBDA] = pair_damping(m, c, gd, m.opts[O_V_MIN])
+    impact_onset(t, m.scfg, stats)  # the IMU's impact disturbance (off unless configured)
     n_ep = int(stats[ST_N_EPISODES])
     if n_ep < episodes.shape[0]:
         rotation_matrix(d.x[X_QUAT : X_QUAT + 4], w.C)

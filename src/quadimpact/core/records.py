@@ -7,10 +7,11 @@ spirit of MuJoCo MJX's ``Model``/``Data``:
 * :class:`Model`: what the run *is*, never written by the loop: the initial
   state and time span, the vehicle, its contact features, the world's
   shapes, the contact-pair table, options, controller, sensors, the IMU's
-  noise draws, the power-off schedule and the output times;
+  noise draws, the power-off schedule, the output times, the estimator's
+  settings and the added sensors' noise draws;
 * :class:`Data`: what the loop carries from one control tick to the next
   (state, loop scalars, contact pairs, rotor inputs, controller memory,
-  measurement record, sensor state);
+  estimator state, measurement record, sensor state);
 * :class:`Output`: what a run returns (time series, IMU samples, contact
   episodes, statistics; counters are live, so a run stopped after any tick
   can be read);
@@ -41,7 +42,9 @@ from .layout import (
     MAX_AVERAGE_WINDOW,
     N_ROTORS,
     NCS,
+    NECFG,
     NEP,
+    NEST,
     NIMU,
     NLS,
     NMEAS,
@@ -49,6 +52,7 @@ from .layout import (
     NOUT,
     NRIN,
     NSCFG,
+    NSN,
     NSPAN,
     NSST,
     NSTAT,
@@ -96,6 +100,8 @@ class Model(NamedTuple):
     sched_rate: np.ndarray  # (K, N_ROTORS) power-off rates, rad/s^2
     sched_stop: np.ndarray  # (N_ROTORS,) 1: motor stalls at the trigger
     t_out: np.ndarray  # (n_out,) output times, s
+    ecfg: np.ndarray  # (NECFG,) estimator: kind, initial error, gains, noises
+    snoise: np.ndarray  # (n_snoise, NSN) standard normal draws of the added sensors
 
 
 class Data(NamedTuple):
@@ -106,6 +112,7 @@ class Data(NamedTuple):
     cs: np.ndarray  # (n_pairs, NCS) contact pairs: in an episode, damping, episode row
     rin: np.ndarray  # (NRIN,) rotor inputs of the interval
     mem: np.ndarray  # (NMEM,) controller memory
+    est: np.ndarray  # (NEST,) estimator state
     meas: np.ndarray  # (NMEAS,) measurement record
     sst: np.ndarray  # (NSST,) sensor state
 
@@ -136,6 +143,7 @@ class Work(NamedTuple):
     g_b: np.ndarray  # (n_pairs,) gaps at the step's end
     gd_b: np.ndarray  # (n_pairs,) rates there
     ev_sig: np.ndarray  # (n_pairs,) located event of each pair, fraction of the step
+    C_hat: np.ndarray  # (3, 3) the estimated rotation at an IMU sample
 
 
 # ---------------------------------------------------------------- factories
@@ -148,6 +156,7 @@ def new_data(m: Model) -> Data:
         np.zeros((m.pairs.shape[0], NCS)),
         np.zeros(NRIN),
         np.zeros(NMEM),
+        np.zeros(NEST),
         np.zeros(NMEAS),
         np.zeros(NSST),
     )
@@ -182,6 +191,7 @@ def new_work(n_pairs: int) -> Work:
         np.zeros(n_pairs),
         np.zeros(n_pairs),
         np.zeros(n_pairs),
+        np.zeros((3, 3)),
     )
 
 
@@ -209,8 +219,10 @@ def model(
     sched_t: np.ndarray | None = None,
     sched_rate: np.ndarray | None = None,
     sched_stop: np.ndarray | None = None,
+    ecfg: np.ndarray | None = None,
+    snoise: np.ndarray | None = None,
 ) -> Model:
-    """A :class:`Model` of contiguous arrays (absent sensors and schedule: none).
+    """A :class:`Model` of contiguous arrays (absent sensors, schedule, estimator: none, ideal).
 
     ``pairs`` is the contact-pair table of ``feat`` and ``shapes``
     (``core.geometry.pair_table``); ``t0``, ``tf`` in s.
@@ -233,6 +245,8 @@ def model(
         sched_rate=_f64(sched_rate, (0, N_ROTORS)),
         sched_stop=_f64(sched_stop, (N_ROTORS,)),
         t_out=_f64(t_out, (0,)),
+        ecfg=_f64(ecfg, (NECFG,)),
+        snoise=_f64(snoise, (0, NSN)),
     )
 
 
@@ -255,13 +269,15 @@ def model_row(M: Model, k: int) -> Model:
         M.sched_rate[k],
         M.sched_stop[k],
         M.t_out[k],
+        M.ecfg[k],
+        M.snoise[k],
     )
 
 
 @njit(cache=True)
 def data_row(D: Data, k: int) -> Data:
     """Run ``k`` of loop states stacked along a first axis."""
-    return Data(D.x[k], D.ls[k], D.cs[k], D.rin[k], D.mem[k], D.meas[k], D.sst[k])
+    return Data(D.x[k], D.ls[k], D.cs[k], D.rin[k], D.mem[k], D.est[k], D.meas[k], D.sst[k])
 
 
 @njit(cache=True)

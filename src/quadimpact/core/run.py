@@ -9,8 +9,8 @@ compiled entry points of one loop (``run``, ``start``, ``advance``);
 
 :func:`make_kernel` compiles the loop again around plug-ins: a user's
 controller step (in place of the built-in dispatch), a sensor sampled with
-the IMU, and the rows of the contact-geometry table registered at run time
-(``core.geometry``). It uses
+the IMU, an estimator updated at every IMU sample, and the rows of the
+contact-geometry table registered at run time (``core.geometry``). It uses
 :func:`specialise`, which rebuilds every compiled core function that reaches
 a replaced global (Numba resolves globals at compile time); such a kernel is
 compiled once per process and not cached on disk.
@@ -192,7 +192,11 @@ def _distance_dispatch(entries: Mapping[int, Callable]) -> Callable:
 
 
 def make_kernel(
-    step: Callable | None = None, *, geometry: bool = False, sensor: Callable | None = None
+    step: Callable | None = None,
+    *,
+    geometry: bool = False,
+    sensor: Callable | None = None,
+    estimator: Callable | None = None,
 ) -> Kernel:
     """Compile the run loop around plug-ins.
 
@@ -212,6 +216,10 @@ def make_kernel(
         rotation; it writes its readings into the measurement record's user
         block ``d.meas[MS_USER : MS_USER + N_USER_MEAS]``, which a controller
         reads (``core/sensors/stage.py``).
+    estimator : numba.njit function, optional
+        An estimator ``estimator(t, dt, meas, ecfg, est)`` updated at every IMU
+        sample, bound in place of ``core.estimators.plugin_estimator``; it runs
+        when ``ecfg[EC_KIND]`` is ``EST_USER`` (docs/ESTIMATION.md).
 
     Returns
     -------
@@ -227,6 +235,15 @@ def make_kernel(
         if not hasattr(sensor, "py_func"):
             raise TypeError("sensor: must be a numba.njit function")
         replacements["plugin_sensor"] = sensor
+    if estimator is not None:
+        if not hasattr(estimator, "py_func"):
+            raise TypeError("estimator: must be a numba.njit function")
+        n_params = len(inspect.signature(estimator.py_func).parameters)
+        if n_params != 5:
+            raise TypeError(
+                f"estimator: expected estimator(t, dt, meas, ecfg, est); got {n_params} parameters"
+            )
+        replacements["plugin_estimator"] = estimator
     if geometry:
         contact_fns = {g.id: g.fn for g in _geometry.plugin_geometries()}
         replacements["plugin_contact"] = _contact_dispatch(contact_fns)

@@ -7,7 +7,8 @@ Per control tick ``t_k = t0 + k dt`` (``dt = opts[O_DT_CONTROL]``, 5 ms),
    rule); the quaternion renormalised;
 2. estimation: the state estimate into the measurement record
    (``estimators``; the IMU samples up to and including ``t_k`` are already in
-   it, taken by the sensor stage ``sensors/stage.py`` during the last interval);
+   it, taken and filtered by the sensor stage ``sensors/stage.py`` during the
+   last interval); the time-to-hover test on the true state (``hover.py``);
 3. the controller (``controllers/``), or an external command set in
    ``ls[LS_EXT_CMD]`` (from Python, a learning agent...); its stage is recorded;
 4. actuators: limits, slew, the rotor inputs of the interval (``actuators.py``);
@@ -31,7 +32,8 @@ from numba import njit
 
 from .actuators import apply_command
 from .controllers import builtin_step
-from .estimators import at_tick
+from .estimators import at_tick, init_estimate
+from .hover import track_hover
 from .interval import FAILED, RUNNING, contact_values, integrate_interval
 from .layout import (
     CRASH_PAPER_TICKS,
@@ -55,6 +57,8 @@ from .layout import (
     LS_TF,
     MEM_STAGE,
     MS_IMU_T,
+    MS_MAG_T,
+    MS_POSE_T,
     MS_T_DETECT,
     N_ROTORS,
     N_STAGES,
@@ -73,6 +77,8 @@ from .layout import (
     SPAN_TF,
     SS_NEXT_T,
     ST_CRASH_T,
+    ST_HOVER_RUN_T,
+    ST_IMPACT_T,
     ST_MAX_DELTA,
     ST_MIN_ALT,
     ST_MIN_TILT_COS,
@@ -86,6 +92,7 @@ from .layout import (
     ST_STATUS,
     ST_T_DETECT,
     ST_T_END,
+    ST_T_HOVER,
     STATUS_COMPLETED,
     STATUS_CRASHED,
     STATUS_FAILED,
@@ -113,6 +120,8 @@ def start(m: Model, d: Data, o: Output) -> None:
     stats = o.stats
     stats[:] = 0.0
     for i in (ST_CRASH_T, ST_ONSET_T, ST_POWER_OFF_T, ST_T_DETECT):
+        stats[i] = np.nan
+    for i in (ST_IMPACT_T, ST_HOVER_RUN_T, ST_T_HOVER):
         stats[i] = np.nan
     stats[ST_STAGE_T : ST_STAGE_T + N_STAGES] = np.nan
     stats[ST_T_END] = t0
@@ -142,6 +151,9 @@ def start(m: Model, d: Data, o: Output) -> None:
     d.meas[:] = 0.0
     d.meas[MS_IMU_T] = np.nan
     d.meas[MS_T_DETECT] = np.nan
+    d.meas[MS_MAG_T] = np.nan
+    d.meas[MS_POSE_T] = np.nan
+    init_estimate(m, d)
     at_tick(t0, m, d)
     d.sst[:] = 0.0
     d.sst[SS_NEXT_T] = t0 if m.scfg[SC_RATE] > 0.0 else math.inf
@@ -208,6 +220,7 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
         ls[LS_DONE] = 1.0
         return
     at_tick(t_k, m, d)
+    track_hover(t_k, d.x, o.stats)
     _command(t_k, m, d, o, w)
     apply_command(w.cmd, d.x, d.rin, m.opts, dt_c, ls[LS_PO_ACTIVE] > 0.5)
     contact_values(d.x, m, d, w, w.g_a, w.gd_a)

@@ -89,21 +89,24 @@ class Slots:
         self.ground = ground
         self.record = record
         template = self._prepare(self._template_fields())
-        self.n_noise = max(
-            self._prepare({**self._template_fields(), "imu": p}).noise.shape[0]
-            for p in trials.imu_choices()
+        fields = self._template_fields()
+        setups = [self._prepare({**fields, "imu": p}) for p in trials.imu_choices()]
+        self.n_noise = max(x.noise.shape[0] for x in setups)
+        self.n_snoise = max(x.snoise.shape[0] for x in [template, *setups])
+        m = template.model(
+            noise=np.zeros((self.n_noise, 6)), snoise=np.zeros((self.n_snoise, L.NSN))
         )
-        m = template.model(noise=np.zeros((self.n_noise, 6)))
         self.M = stacked(m, n)
         self.D = stacked(new_data(m), n)
         self.O = stacked(new_output(m, int(template.n_imu) if record else 0, max_episodes), n)
-        n_obs = B.N_OBS_STATE if par[B.EP_OBSERVE] == B.OBS_STATE else B.N_OBS_IMU
+        n_obs = B.n_observations(int(par[B.EP_OBSERVE]))
+        obs_dtype = np.float64 if par[B.EP_OBSERVE] == B.OBS_ESTIMATE else np.float32
         self.E = B.Env(
             state=np.zeros((n, B.NB)),
             par=par,
             tmeas=np.zeros((n, L.NMEAS)),
             reported=np.full(n, -1.0),
-            obs=np.zeros((n, n_obs), dtype=np.float32),
+            obs=np.zeros((n, n_obs), dtype=obs_dtype),
             reward=np.zeros(n),
             terminated=np.zeros(n, dtype=np.bool_),
             truncated=np.zeros(n, dtype=np.bool_),
@@ -117,7 +120,7 @@ class Slots:
     # ------------------------------------------------------------ views
     @property
     def obs(self) -> np.ndarray:
-        """The observations (N, n_obs), float32."""
+        """The observations (N, n_obs), float32 (float64 in the ``estimate`` mode)."""
         return self.E.obs
 
     @property
@@ -189,13 +192,15 @@ class Slots:
                 f"of the environment's trials ({self.M.shapes.shape[1]} surfaces, "
                 f"{self.trials.final_time_s:g} s)"
             )
-        if s.noise.shape[0] > self.n_noise:
-            raise ValueError("trial: a noisy IMU in an environment made for ideal IMUs")
+        if s.noise.shape[0] > self.n_noise or s.snoise.shape[0] > self.n_snoise:
+            raise ValueError("trial: a noisy sensor in an environment made for ideal ones")
         if s.kernel is not None or s.controller != "recovery":
             raise ValueError("trial: the environment's trials run the 'recovery' controller")
         noise = np.zeros((self.n_noise, 6))
         noise[: s.noise.shape[0]] = s.noise
-        set_row(self.M, k, m._replace(noise=noise))
+        snoise = np.zeros((self.n_snoise, L.NSN))
+        snoise[: s.snoise.shape[0]] = s.snoise
+        set_row(self.M, k, m._replace(noise=noise, snoise=snoise))
         self.setups[k] = s
         self.scenarios[k] = scenario
         self.trial_fields[k] = fields

@@ -4,9 +4,11 @@ Each is called with the observation (single env: (n_obs,); batched env:
 (N, n_obs)) and returns the action(s) of the environment it was made for.
 
 * :class:`RecoveryPolicy`: the ``recovery`` controller's staged law
-  (docs/RECOVERY.md 3) run on the environment's measurement record with its
-  own memory; it reports its stages through the environment's hook, so the
-  episode metrics are the controller's own.
+  (docs/RECOVERY.md 3) with its own memory; in the ``estimate`` observation
+  mode it acts on its observation alone (what an on-board controller sees),
+  in the others on the environment's tick measurement; it reports its stages
+  through the environment's hook, so the episode metrics are the
+  controller's own.
 * :class:`RandomPolicy`: uniform actions (the floor).
 * :class:`HoverPolicy`: the level-hover rotor speeds (or the hover thrust and
   zero rate references), no correction.
@@ -69,15 +71,36 @@ class RecoveryPolicy:
         self._seen = s.episode_id.copy() - 1
         self._actions = np.zeros((s.n, 4))
         self._stages = np.zeros(s.n)
+        self._meas = np.zeros((s.n, L.NMEAS))
+        self.inexact = np.zeros(s.n)
+        """Estimate mode: commands the rotor map could not give exactly, per row (this episode)."""
+        self.from_observation = bool(s.par[B.EP_OBSERVE] == B.OBS_ESTIMATE)
+        """True in the ``estimate`` mode: the policy reads nothing but its observation."""
 
     def __call__(self, observation: np.ndarray | None = None) -> np.ndarray:
-        """The action(s) for the next step (the observation itself is not needed)."""
+        """The action(s) for the next step.
+
+        In the ``estimate`` mode from ``observation`` alone (its values are the
+        estimator's output, recovered exactly: ``core.batch.measurement_from_estimate``);
+        the controller's gains, the vehicle's constants and the rotor map are
+        the policy's own configuration. Otherwise the observation is not needed.
+        """
         s = self._base._slots
         fresh = s.episode_id != self._seen
         self._mem[fresh] = 0.0
+        self.inexact[fresh] = 0.0
         self._seen[:] = s.episode_id
         active = s.active()
-        B.staged_policy(active, s.M, s.E, self._mem, self._actions, self._stages)
+        if self.from_observation:
+            if observation is None:
+                raise ValueError("RecoveryPolicy: the estimate mode needs the observation")
+            obs = np.asarray(observation, dtype=np.float64).reshape(s.n, -1)
+            for k in range(s.n):
+                B.measurement_from_estimate(obs[k], self._meas[k])
+            B.staged_actions(active, self._meas, s.M, s.par, self._mem, self._actions,
+                             self._stages, self.inexact)  # fmt: skip
+        else:
+            B.staged_policy(active, s.M, s.E, self._mem, self._actions, self._stages)
         if _batched(self._base):
             self._base.report_stages(np.where(active, self._stages, -1.0))
         elif active[0]:

@@ -34,7 +34,7 @@ __all__ = [
 ]
 
 ACTION_MODES = ("rotors", "ctbr")
-OBSERVATION_MODES = ("imu", "state")
+OBSERVATION_MODES = ("imu", "state", "estimate")
 CTBR_RATE_MAX_RAD_S = (32.0, 32.0, 8.0)  # powers of two: the scaling of a rate action is exact
 
 Range = float | tuple[float, float]
@@ -168,7 +168,17 @@ class TrialDistribution:
     controller_params : mapping
         The ``recovery`` controller's parameters (docs/RECOVERY.md 3.5): its
         stage tolerances are the observer's, its ``k_rate_1_s`` the ctbr rate
-        loop's.
+        loop's. Stage 5 (``hover``) is off unless set here: an episode ends
+        at the confirmed recovery (stage 4), which stage 5's braking would delay.
+    estimator : str
+        The trials' state estimator (``"ideal"``, ``"complementary"``, ``"ekf"``
+        or a registered one; docs/ESTIMATION.md); what the ``estimate``
+        observation shows.
+    estimator_params : mapping
+        Its parameters.
+    sensors : str or None
+        A preset of sensors (``"ideal"``, ``"noisy"``, ``"impact"``, ``"indoor"``);
+        it replaces the IMU preset choice.
     overrides : mapping
         Any other :class:`~quadimpact.inputs.scenarios.ImpactTrial` field
         (e.g. ``{"detection": {"threshold_g": 1.0}}``, ``{"imu": {"position": "cm"}}``
@@ -187,6 +197,9 @@ class TrialDistribution:
     altitude_m: float = 5.0
     final_time_s: float = 3.0
     controller_params: Mapping[str, Any] = field(default_factory=dict)
+    estimator: str = "ideal"
+    estimator_params: Mapping[str, Any] = field(default_factory=dict)
+    sensors: str | None = None
     overrides: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
@@ -235,10 +248,17 @@ class TrialDistribution:
             "start_distance_m": self.start_distance_m,
             "altitude_m": self.altitude_m,
             "final_time_s": self.final_time_s,
-            "controller_params": dict(self.controller_params),
+            "controller_params": {"hover": False, **dict(self.controller_params)},
             **dict(self.overrides),
             **dict(fields),
         }
+        if self.estimator != "ideal" or self.estimator_params:
+            values.setdefault("estimator", self.estimator)
+            values.setdefault("estimator_params", dict(self.estimator_params))
+        if self.sensors is not None:
+            values.setdefault("sensors", self.sensors)
+            if "imu" not in self.overrides:  # the preset's IMU, not the drawn preset name
+                values.pop("imu", None)
         values.setdefault("ground", "contact" if ground else "none")
         if not record:
             values["output_rate_hz"] = 1.0 / float(values["final_time_s"])
@@ -320,7 +340,7 @@ class Envelope:
 def pack_parameters(
     *,
     action: Literal["rotors", "ctbr"],
-    observe: Literal["imu", "state"],
+    observe: Literal["imu", "state", "estimate"],
     rotor_floor: Literal["vehicle", "zero"],
     reward: RewardWeights,
     envelope: Envelope,
@@ -341,7 +361,7 @@ def pack_parameters(
     ground = _flag("ground", ground)
     par = np.zeros(B.NPAR)
     par[B.EP_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
-    par[B.EP_OBSERVE] = B.OBS_STATE if observe == "state" else B.OBS_IMU
+    par[B.EP_OBSERVE] = {"state": B.OBS_STATE, "estimate": B.OBS_ESTIMATE}.get(observe, B.OBS_IMU)
     par[B.EP_ZERO_LOW] = 1.0 if rotor_floor == "zero" else 0.0
     par[B.EP_RATE_MAX : B.EP_RATE_MAX + 3] = CTBR_RATE_MAX_RAD_S
     par[B.EP_W_TILT] = reward.tilt

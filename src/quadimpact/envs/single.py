@@ -25,7 +25,7 @@ from quadimpact.envs.settings import (
 from quadimpact.inputs.scenarios import ImpactTrial
 from quadimpact.results.result import SimulationResult
 
-__all__ = ["ImpactRecoveryEnv", "configure", "spaces_for"]
+__all__ = ["ImpactRecoveryEnv", "configure", "observation_dtype", "spaces_for"]
 
 StartMode = Literal["detection", "trial"]
 
@@ -64,12 +64,20 @@ def spaces_for(action: str, observe: str) -> tuple[gym.spaces.Box, gym.spaces.Bo
 
     Actions are float64, so that a policy can give the command it means to the
     last bit (:class:`~quadimpact.envs.policies.RecoveryPolicy`); observations
-    float32.
+    float32, but float64 in the ``estimate`` mode (whose values a policy
+    recovers exactly: the staged controller acts on that observation alone).
     """
-    n_obs = B.N_OBS_STATE if observe == "state" else B.N_OBS_IMU
+    mode = {"state": B.OBS_STATE, "estimate": B.OBS_ESTIMATE}.get(observe, B.OBS_IMU)
     act = gym.spaces.Box(-1.0, 1.0, shape=(4,), dtype=np.float64)
-    obs = gym.spaces.Box(-10.0, 10.0, shape=(n_obs,), dtype=np.float32)
+    obs = gym.spaces.Box(
+        -10.0, 10.0, shape=(B.n_observations(mode),), dtype=observation_dtype(observe)
+    )
     return act, obs
+
+
+def observation_dtype(observe: str) -> type:
+    """float64 for the ``estimate`` observation, float32 for the others."""
+    return np.float64 if observe == "estimate" else np.float32
 
 
 def configure(
@@ -79,7 +87,7 @@ def configure(
     trials: TrialDistribution | None = None,
     start: StartMode = "detection",
     action: Literal["rotors", "ctbr"] = "rotors",
-    observe: Literal["imu", "state"] = "imu",
+    observe: Literal["imu", "state", "estimate"] = "imu",
     reward: RewardWeights | None = None,
     envelope: Envelope | None = None,
     hold_s: float = 0.2,
@@ -137,9 +145,10 @@ class ImpactRecoveryEnv(gym.Env):
     action : {"rotors", "ctbr"}
         Four rotor speeds, or collective thrust and body rates through the
         staged controller's rate loop.
-    observe : {"imu", "state"}
-        On-board measurements (IMU, detector, ideal attitude estimate), or the
-        full state.
+    observe : {"imu", "state", "estimate"}
+        On-board measurements (IMU, detector, the attitude estimate), the full
+        state, or the estimator's output with the IMU and the detector (what an
+        on-board controller sees; float64; docs/LEARNING.md).
     reward : RewardWeights, optional
     envelope : Envelope, optional
     hold_s : float

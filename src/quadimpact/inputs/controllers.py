@@ -23,10 +23,10 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import BaseModel, Field, StrictBool, ValidationError
 
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import common as PID
@@ -127,6 +127,23 @@ class RecoveryParams(BaseModel):
     )
     rate_tol_rad_s: Real = Field(0.5, gt=0, description="|p|, |q| below this end stages 1-2.")
     w_tol_m_s: Real = Field(0.3, description="Body z velocity below this ends stage 3, m/s.")
+    hover: StrictBool = Field(
+        True, description="Stage 5 after stage 4: return to hover, hold position and yaw."
+    )
+    hover_kp_1_s: Real = Field(1.5, ge=0, description="Stage 5 position -> velocity, 1/s.")
+    hover_kv_1_s: Real = Field(4.0, ge=0, description="Stage 5 velocity -> acceleration, 1/s.")
+    hover_v_max_m_s: Real = Field(1.0, gt=0, description="Stage 5 speed limit (XY, Z), m/s.")
+    hover_a_max_m_s2: Real | None = Field(
+        None, gt=0, description="Stage 5 acceleration limit (each of |a_XY|, |a_Z|); None: g/2."
+    )
+    hover_k_yaw_1_s: Real = Field(2.0, ge=0, description="Stage 5 yaw gain, 1/s.")
+    hover_hold: Literal["stop", "entry"] = Field(
+        "stop",
+        description="Stage 5 holds where the vehicle stops, or the position at stage 4's entry.",
+    )
+    hover_set_point_m: Vec3 | None = Field(
+        None, description="Stage 5 position set-point (inertial NED, m); None: hover_hold's."
+    )
 
 
 # ------------------------------------------------------------------ registry
@@ -220,6 +237,19 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block[REC.R_W_TOL] = p.w_tol_m_s
     level = ctx.options.detection_tick_reference == "level"
     block[REC.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
+    block[REC.R_HOVER] = 1.0 if p.hover else 0.0
+    a_max = 0.5 * ctx.vehicle.gravity_m_s2 if p.hover_a_max_m_s2 is None else p.hover_a_max_m_s2
+    block[REC.R_HOVER_GAINS : REC.R_HOVER_GAINS + 5] = (
+        p.hover_kp_1_s,
+        p.hover_kv_1_s,
+        p.hover_v_max_m_s,
+        a_max,
+        p.hover_k_yaw_1_s,
+    )
+    block[REC.R_HOVER_MODE] = REC.HOLD_STOP if p.hover_hold == "stop" else REC.HOLD_ENTRY
+    if p.hover_set_point_m is not None:
+        block[REC.R_HOVER_MODE] = REC.HOLD_GIVEN
+        block[REC.R_HOVER_SET : REC.R_HOVER_SET + 3] = p.hover_set_point_m
     return block
 
 

@@ -64,9 +64,16 @@ from quadimpact.inputs.controllers import (
     controller_names,
     validate_params,
 )
+from quadimpact.inputs.estimators import estimator_entry, estimator_names, validate_estimator_params
 from quadimpact.inputs.files import locate_vehicle, read_toml_file
 from quadimpact.inputs.model import ModelName, ModelOptions, resolve_model_options
-from quadimpact.inputs.sensors import DetectionSettings, ImuSettings
+from quadimpact.inputs.sensors import (
+    SENSOR_PRESETS,
+    DetectionSettings,
+    ImuSettings,
+    Magnetometer,
+    PoseSensor,
+)
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec2, Vec3, Vec4
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import Obstacles, Plane
@@ -207,6 +214,20 @@ class RunSettings(BaseModel):
     obstacles : tuple of Plane, Cylinder, Box
         The world's obstacles (docs/OBSTACLES.md), names unique; the wall
         approach and the impact trial keep their wall plane when empty.
+    magnetometer : Magnetometer or None
+        A magnetometer sampled with the IMU (docs/ESTIMATION.md); ``None``: none.
+    pose_sensor : PoseSensor or None
+        A pose sensor (motion capture, vision); ``None``: none.
+    sensors : {"ideal", "noisy", "impact", "indoor"} or None
+        A preset of sensors (:data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`):
+        it sets ``imu``, ``magnetometer`` and ``pose_sensor`` where the scenario
+        does not set them itself.
+    estimator : str
+        A registered state estimator (``quadimpact.inputs.estimators``):
+        ``"ideal"`` (the true state; the default), ``"complementary"``,
+        ``"ekf"``, or one registered by the user.
+    estimator_params : dict
+        The estimator's own parameters (validated by its registry entry).
     """
 
     model_config = MODEL_CONFIG
@@ -302,6 +323,47 @@ class RunSettings(BaseModel):
                 "name the obstacle otherwise, or use ground = 'none'"
             )
         return self
+
+    magnetometer: Magnetometer | None = Field(None, description="A magnetometer (None: none).")
+    pose_sensor: PoseSensor | None = Field(None, description="A pose sensor (None: none).")
+    sensors: Literal["ideal", "noisy", "impact", "indoor"] | None = Field(
+        None, description="A preset of sensors (imu, magnetometer, pose_sensor not set)."
+    )
+    estimator: str = Field(
+        "ideal", description="State estimator: 'ideal', 'complementary', 'ekf' or a registered one."
+    )
+    estimator_params: dict[str, Any] = Field(
+        default_factory=dict, description="The estimator's own parameters."
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _sensor_preset(cls, value: Any) -> Any:
+        # the preset fills the sensor fields the scenario does not set itself
+        if isinstance(value, Mapping) and isinstance(value.get("sensors"), str):
+            preset = SENSOR_PRESETS.get(value["sensors"])
+            if preset is not None:
+                value = {**{k: v for k, v in preset.items() if k not in value}, **value}
+        return value
+
+    @field_validator("estimator")
+    @classmethod
+    def _registered_estimator(cls, value: str) -> str:
+        if value not in estimator_names():
+            try:
+                estimator_entry(value)
+            except InputError as exc:
+                raise ValueError(str(exc).removeprefix("estimator: ")) from None
+        return value
+
+    @model_validator(mode="after")
+    def _estimator_params(self) -> RunSettings:
+        validate_estimator_params(self.estimator, self.estimator_params)
+        return self
+
+    def resolved_estimator_params(self) -> BaseModel:
+        """The estimator's parameters, validated, with its defaults filled in."""
+        return validate_estimator_params(self.estimator, self.estimator_params)
 
     @field_validator("seed", mode="before")
     @classmethod

@@ -17,6 +17,18 @@ In a scenario file::
     threshold_g = 0.5
     frame = "body"             # or "world"
     persistence = 1
+
+    [magnetometer]             # optional sensors (docs/ESTIMATION.md): absent by default
+    dip_deg = 60
+    [pose_sensor]
+    rate_hz = 100
+
+    sensors = "indoor"         # or a preset of sensors: "ideal", "noisy", "impact", "indoor"
+
+The IMU's impact disturbance (``[imu.impact_disturbance]``, or
+``impact_disturbance = true`` for the authors' values) and its gyro bias random
+walk (``gyro_bias_walk_rad_s_sqrt_s``) are IMU options; the ``"impact"`` IMU
+preset has both (with the ``"noisy"`` preset's noise).
 """
 
 from __future__ import annotations
@@ -28,9 +40,66 @@ from pydantic import BaseModel, Field, StrictBool, field_validator, model_valida
 
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3
 
-__all__ = ["IMU_PRESETS", "DetectionSettings", "ImuSettings", "ResolvedImu"]
+__all__ = [
+    "IMU_PRESETS",
+    "SENSOR_PRESETS",
+    "DetectionSettings",
+    "ImpactDisturbance",
+    "ImuSettings",
+    "Magnetometer",
+    "PoseSensor",
+    "ResolvedImu",
+]
 
 G0 = 9.80665  # standard gravity, m/s^2 (sensor ranges are quoted in g)
+
+
+class ImpactDisturbance(BaseModel):
+    """The IMU's impact disturbance: noise that rings after each contact onset.
+
+    From each contact onset ``t_c``, extra white noise of standard deviation
+    ``accel_m_s2 exp(-(t - t_c)/time_constant_s)`` on each accelerometer axis
+    and ``gyro_rad_s exp(-(t - t_c)/time_constant_s)`` on each gyro axis, added
+    to the nominal noise (before saturation). Defaults: the authors' values.
+    """
+
+    model_config = MODEL_CONFIG
+
+    accel_m_s2: Real = Field(14.0, ge=0, description="Accelerometer amplitude a0, m/s^2.")
+    gyro_rad_s: Real = Field(0.1, ge=0, description="Gyro amplitude g0, rad/s.")
+    time_constant_s: Real = Field(0.4, gt=0, description="Decay time constant tau, s.")
+
+
+class Magnetometer(BaseModel):
+    """A magnetometer sampled with the IMU: the unit Earth field in body axes, with noise.
+
+    The field ``m_I`` points to magnetic north (+X) and dips ``dip_deg`` below
+    the horizon (down positive, NED). Without a magnetometer yaw is
+    unobservable and an estimator's heading drifts with the gyro bias.
+    """
+
+    model_config = MODEL_CONFIG
+
+    dip_deg: Real = Field(60.0, ge=-90, le=90, description="Dip of the field, deg (down +).")
+    noise: Real = Field(7e-3, ge=0, description="White-noise std per axis, unit field.")
+
+
+class PoseSensor(BaseModel):
+    """A pose sensor (motion capture or vision): position, and optionally attitude.
+
+    Measures at ``rate_hz`` (taken at the first IMU sample at or after each of
+    its times), with white noise, delivered ``latency_s`` later (rounded to
+    whole IMU samples, at most 63).
+    """
+
+    model_config = MODEL_CONFIG
+
+    rate_hz: Real = Field(100.0, gt=0, le=100000, description="Measurement rate, Hz.")
+    position_noise_m: Real = Field(1e-3, ge=0, description="Position noise std per axis, m.")
+    attitude: StrictBool = Field(True, description="Measure the attitude too.")
+    attitude_noise_deg: Real = Field(0.5, ge=0, description="Attitude noise std per axis, deg.")
+    latency_s: Real = Field(0.0, ge=0, le=1, description="Latency, s.")
+
 
 IMU_PRESETS: dict[str, dict[str, float | None]] = {
     "ideal": {
@@ -53,7 +122,26 @@ IMU_PRESETS: dict[str, dict[str, float | None]] = {
         "gyro_range_rad_s": math.radians(2000.0),
     },
 }
+# the noisy IMU through impacts: its structure rings after each contact (the
+# authors' disturbance) and its gyro bias wanders (1e-4 rad/s/sqrt(s))
+IMU_PRESETS["impact"] = dict(IMU_PRESETS["noisy"])
 """The IMU presets; a field set in ``[imu]`` overrides its preset's value."""
+IMU_EXTRAS: dict[str, dict[str, Any]] = {
+    "ideal": {"impact_disturbance": None, "gyro_bias_walk_rad_s_sqrt_s": 0.0},
+    "noisy": {"impact_disturbance": None, "gyro_bias_walk_rad_s_sqrt_s": 0.0},
+    "impact": {"impact_disturbance": {}, "gyro_bias_walk_rad_s_sqrt_s": 1e-4},
+}
+"""Each IMU preset's impact disturbance (None: off; a table: its settings) and bias walk."""
+
+SENSOR_PRESETS: dict[str, dict[str, Any]] = {
+    "ideal": {"imu": "ideal"},
+    "noisy": {"imu": "noisy"},
+    "impact": {"imu": "impact"},
+    "indoor": {"imu": "impact", "magnetometer": {}, "pose_sensor": {}},
+}
+"""Realistic combinations of sensors (a scenario's ``sensors``): the IMU preset and the
+optional sensors (``{}``: present with their defaults). Fields a scenario sets itself
+(``imu``, ``magnetometer``, ``pose_sensor``) win over its preset's."""
 
 
 class ResolvedImu(BaseModel):
@@ -72,6 +160,8 @@ class ResolvedImu(BaseModel):
     filter: str
     filter_time_constant_s: float | None
     filter_window: int | None
+    impact_disturbance: ImpactDisturbance | None = None
+    gyro_bias_walk_rad_s_sqrt_s: float = 0.0
 
     @property
     def has_noise(self) -> bool:
@@ -92,8 +182,10 @@ class ImuSettings(BaseModel):
 
     Attributes
     ----------
-    preset : {"ideal", "noisy"}
+    preset : {"ideal", "noisy", "impact"}
         Starting values (:data:`IMU_PRESETS`); the fields below override them.
+        ``"impact"``: the noisy IMU with the impact disturbance and a gyro
+        bias random walk of 1e-4 rad/s/sqrt(s).
     rate_hz : float or None
         Sample rate, Hz; ``None``: every control tick (200 Hz). Higher rates
         sample between the ticks from the integrator's dense output.
@@ -112,11 +204,17 @@ class ImuSettings(BaseModel):
         First-order filter time constant, s.
     filter_window : int or None
         Moving-average window, samples (1-64).
+    impact_disturbance : ImpactDisturbance or bool or None
+        Extra noise after each contact onset (:class:`ImpactDisturbance`);
+        ``True``: with the authors' values; ``False``: none; ``None``: the preset's.
+    gyro_bias_walk_rad_s_sqrt_s : float or None
+        Standard deviation of the gyro bias random walk, rad/s per sqrt(s)
+        (e.g. 1e-4); ``None``: the preset's (0 but for ``"impact"``).
     """
 
     model_config = MODEL_CONFIG
 
-    preset: Literal["ideal", "noisy"] = Field("ideal", description="Starting values.")
+    preset: Literal["ideal", "noisy", "impact"] = Field("ideal", description="Starting values.")
     rate_hz: Real | None = Field(
         None, gt=0, le=100000, description="Sample rate, Hz; None: every control tick."
     )
@@ -137,6 +235,12 @@ class ImuSettings(BaseModel):
     )
     filter_window: int | None = Field(
         None, ge=1, le=64, description="Moving-average window, samples."
+    )
+    impact_disturbance: ImpactDisturbance | StrictBool | None = Field(
+        None, description="Noise after each contact onset: a table, true (defaults), false."
+    )
+    gyro_bias_walk_rad_s_sqrt_s: Real | None = Field(
+        None, ge=0, description="Gyro bias random walk, rad/s/sqrt(s)."
     )
 
     @model_validator(mode="before")
@@ -172,12 +276,27 @@ class ImuSettings(BaseModel):
             position = (0.0, 0.0, 0.0)
         else:
             position = tuple(float(c) for c in self.position)
+        extras = IMU_EXTRAS[self.preset]
+        disturbance = extras["impact_disturbance"]
+        if self.impact_disturbance is not None:
+            disturbance = self.impact_disturbance
+        if disturbance is True:
+            disturbance = ImpactDisturbance()
+        elif disturbance is False:
+            disturbance = None
+        elif isinstance(disturbance, dict):
+            disturbance = ImpactDisturbance(**disturbance)
+        walk = self.gyro_bias_walk_rad_s_sqrt_s
         return ResolvedImu(
             rate_hz=float(self.rate_hz) if self.rate_hz is not None else float(control_rate_hz),
             position_m=position,
             filter=self.filter,
             filter_time_constant_s=self.filter_time_constant_s,
             filter_window=self.filter_window,
+            impact_disturbance=disturbance,
+            gyro_bias_walk_rad_s_sqrt_s=float(
+                extras["gyro_bias_walk_rad_s_sqrt_s"] if walk is None else walk
+            ),
             **values,
         )
 

@@ -338,6 +338,11 @@ def recovery_markdown(part: Any, elapsed_s: float) -> str:
         "",
         *_crashes_markdown(part.crashes),
     ]
+    if getattr(part, "estimators", None):
+        from quadimpact.paper.estimation import estimators_markdown
+
+        n_est = next(iter(part.estimators.values()))["n"]
+        lines += ["", *estimators_markdown(part.estimators, n_est)]
     return "\n".join(lines)
 
 

@@ -24,13 +24,16 @@ the Navi's first :data:`RECOVERY_COMPARE_N` trials (ideal IMU, default);
 the Figure 4 grid with the recovery controller (pre-impact nominal, the
 ``paper`` controller) against the nominal runs, in both paper variants; and
 the seven Table III crashes without the motor power-off, nominal against
-recovery. It writes ``recovery/<study>/`` (the trials, resumable),
-``recovery_trials.parquet``, ``recovery_fig4.parquet``,
-``recovery_crashes.parquet`` and ``recovery_by_inclination.png``. It also
-adds "Beyond the paper: the pole" (:func:`pole_part`, docs/OBSTACLES.md 3):
-the authors' pole study on a coarser grid (:data:`POLE_GRID`: pitch 0 to
--45 deg every 5 deg by offsets -0.35 to 0.35 m every 0.05 m, 150 points,
-both controllers), into ``pole/`` (its trials, maps and report).
+recovery; and the estimators (``ideal``, ``complementary``, ``ekf``) on the
+same first trials under the IMU's impact disturbance, beside the authors'
+figures (:mod:`~quadimpact.paper.estimation`). It writes ``recovery/<study>/``
+(the trials, resumable), ``recovery_trials.parquet``, ``recovery_fig4.parquet``,
+``recovery_crashes.parquet``, ``recovery_by_inclination.png`` and
+``recovery_estimators_error.png``. It also adds "Beyond the paper: the pole"
+(:func:`pole_part`, docs/OBSTACLES.md 3): the authors' pole study on a coarser
+grid (:data:`POLE_GRID`: pitch 0 to -45 deg every 5 deg by offsets -0.35 to
+0.35 m every 0.05 m, 150 points, both controllers), into ``pole/`` (its
+trials, maps and report).
 """
 
 from __future__ import annotations
@@ -47,6 +50,7 @@ from matplotlib.figure import Figure
 
 from quadimpact.inputs.model import MODEL_VARIANTS
 from quadimpact.inputs.scenarios import WallApproach
+from quadimpact.paper.estimation import COMPARE_N, compare_estimators
 from quadimpact.paper.findings import Finding, evaluate, fig4_curves, findings_frame
 from quadimpact.paper.report import render_report, type_label
 from quadimpact.recovery import analysis as recovery_analysis
@@ -108,7 +112,9 @@ class RecoveryPart:
     trials; ``compare``: label -> numbers of :data:`RECOVERY_COMPARE_N` trials
     (the Navi's first, ideal IMU; the noisy IMU; the Spiri), default model;
     ``grid``: paper variant -> ``saved_by_type`` of the Figure 4 grid;
-    ``crashes``: ``crashes_without_power_off``; ``elapsed_s``: its wall time.
+    ``crashes``: ``crashes_without_power_off``; ``elapsed_s``: its wall time;
+    ``estimators``: estimator -> numbers of the estimators' comparison
+    (:mod:`~quadimpact.paper.estimation`).
     """
 
     monte_carlo: dict[str, dict]
@@ -116,6 +122,7 @@ class RecoveryPart:
     grid: dict[str, pd.DataFrame]
     crashes: pd.DataFrame
     elapsed_s: float
+    estimators: dict[str, dict] = field(default_factory=dict)
 
 
 class StageClock:
@@ -423,6 +430,9 @@ def recovery_part(
         runs.append(both.assign(variant=variant))
     clock.start("recovery: the crashes without their power-off, nominal and recovery")
     crashes = crashes_without_power_off(VARIANTS)
+    clock.start(f"recovery: {COMPARE_N:,} trials with each estimator, impact sensors")
+    estimators, estimator_trials, _ = compare_estimators(out, par)
+    trials.update({k: t for k, t in estimator_trials.groupby("study")})
 
     pd.concat([t.assign(study=k) for k, t in trials.items()]).to_parquet(
         out / "recovery_trials.parquet", index=False
@@ -434,7 +444,9 @@ def recovery_part(
                               "Navi: success rate by inclination bin, both variants"),
         out / "recovery_by_inclination.png",
     )  # fmt: skip
-    return RecoveryPart(monte_carlo, compare, grid, crashes, time.perf_counter() - start)
+    return RecoveryPart(
+        monte_carlo, compare, grid, crashes, time.perf_counter() - start, estimators
+    )
 
 
 # ------------------------------------------------------------------ tables

@@ -17,7 +17,7 @@ writes ``trials.parquet``, the figures and ``report.md``.
   motor power-off).
 """
 
-__all__ = ["DEFAULT_N", "IMUS", "MODELS", "PRE_IMPACTS"]
+__all__ = ["DEFAULT_N", "ESTIMATORS", "IMUS", "MODELS", "PRE_IMPACTS", "SENSORS"]
 
 # The study's choices, here so that the command line needs nothing heavy.
 #: Trials of a study by default.
@@ -25,6 +25,10 @@ DEFAULT_N = 10_000
 #: Model variants of the study (docs/VARIANTS.md).
 MODELS = ("default", "recovery-replica")
 #: IMU presets (``quadimpact.inputs.sensors.IMU_PRESETS``).
-IMUS = ("ideal", "noisy")
+IMUS = ("ideal", "noisy", "impact")
+#: Presets of sensors (``quadimpact.inputs.sensors.SENSOR_PRESETS``).
+SENSORS = ("ideal", "noisy", "impact", "indoor")
+#: Built-in state estimators (``quadimpact.inputs.estimators``; a registered one is accepted too).
+ESTIMATORS = ("ideal", "complementary", "ekf")
 #: Pre-impact behaviours of the recovery controller in the study.
 PRE_IMPACTS = ("spin-down", "hold")

@@ -52,6 +52,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from quadimpact.recovery.estimation import estimation_numbers
+
 __all__ = [
     "BELOW_GROUND",
     "EXCLUDED_CLASSES",
@@ -447,6 +449,7 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
         "normal_error_deg": quantiles(seen["normal_error_deg"]),
         "failures": failure_analysis(table),
         "conditions": class_conditions(table, OUTCOME_CLASSES),
+        "estimation": estimation_numbers(table),
     }
 
 

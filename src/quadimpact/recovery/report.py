@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.recovery.analysis import FLIP_DEG, OUTCOME_CLASSES, Rate
+from quadimpact.recovery.estimation import estimation_lines
 
 __all__ = [
     "bin_table",
@@ -351,6 +352,7 @@ def render_report(
         )),
         "",
         *_failures(numbers),
+        *estimation_lines(numbers),
     ]  # fmt: skip
     ex = d.get("example")
     if ex is not None:

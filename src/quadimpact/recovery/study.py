@@ -42,10 +42,11 @@ import pandas as pd
 
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
+from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
-from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, analysis
+from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS, analysis
 from quadimpact.results.files import atomic_write, check_out_dir
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
@@ -155,12 +156,20 @@ class RecoveryStudy:
         The study's seed, >= 0 (trial inputs and IMU seeds, :func:`sample_trials`).
     model : {"default", "recovery-replica"}
         Model variant (docs/VARIANTS.md).
-    imu : {"ideal", "noisy"}
+    imu : {"ideal", "noisy", "impact"}
         IMU preset (docs/RECOVERY.md 1.4).
     pre_impact : {"spin-down", "hold"}
         The recovery controller's behaviour before the detection. The recovery
         replica forces spin-down through its ``pre_impact`` switch; with
         ``"hold"`` that switch is set to ``"scenario"``.
+    estimator : str
+        The state estimator the controller and the detector read
+        (docs/ESTIMATION.md): ``"ideal"`` (the default), ``"complementary"``,
+        ``"ekf"`` or a registered one.
+    sensors : {"ideal", "noisy", "impact", "indoor"} or None
+        A preset of sensors; it replaces ``imu`` (``None``: ``imu`` alone).
+        The same seed gives the same trials (conditions and IMU seeds) with
+        any estimator and sensors, so studies compare row by row.
 
     Notes
     -----
@@ -176,6 +185,8 @@ class RecoveryStudy:
     model: str = "default"
     imu: str = "ideal"
     pre_impact: str = "spin-down"
+    estimator: str = "ideal"
+    sensors: str | None = None
     _vehicle_ref: str = field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
@@ -184,6 +195,9 @@ class RecoveryStudy:
         _check_choice("model", self.model, MODELS)
         _check_choice("imu", self.imu, IMUS)
         _check_choice("pre_impact", self.pre_impact, PRE_IMPACTS)
+        if self.sensors is not None:
+            _check_choice("sensors", self.sensors, SENSORS)
+        estimator_entry(self.estimator)
         if not isinstance(self.vehicle, str) or not self.vehicle:
             raise InputError(f"vehicle: must be a vehicle name or file (got {self.vehicle!r})")
         _vehicle(self.vehicle)
@@ -211,6 +225,11 @@ class RecoveryStudy:
             "imu": self.imu,
             "pre_impact": self.pre_impact,
         }
+        if self.estimator != "ideal":
+            base["estimator"] = self.estimator
+        if self.sensors is not None:
+            base["sensors"] = self.sensors
+            del base["imu"]
         if resolve_model_options(self.model).pre_impact == "spin-down" and (
             self.pre_impact != "spin-down"
         ):
@@ -317,6 +336,11 @@ def describe(spec: SweepSpec, study: RecoveryStudy | None, table: pd.DataFrame) 
         "detection_threshold_m_s2": values("detection_threshold_m_s2"),
         "detection": first.detection.model_dump(),
         "imu": {"preset": first.imu.preset, **imu.model_dump()},
+        "estimator": first.estimator,
+        "estimator_params": first.resolved_estimator_params().model_dump(mode="json"),
+        "sensors": first.sensors,
+        "magnetometer": first.magnetometer.model_dump() if first.magnetometer else None,
+        "pose_sensor": first.pose_sensor.model_dump() if first.pose_sensor else None,
         "friction_coefficient": float(first.friction_coefficient),
         "slew_limit": slew_text,
         "rotor_speed_range_rpm": list(vehicle.rotor_speed_range_rpm)

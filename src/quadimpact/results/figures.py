@@ -315,7 +315,7 @@ def plot_fig6(
     return save_figure(make_fig6(ts, refs, wall_x_m=wall_x_m, title=title), path)
 
 
-STAGE_COLORS = {1: "tab:red", 2: "tab:orange", 3: "tab:olive", 4: "tab:green"}
+STAGE_COLORS = {1: "tab:red", 2: "tab:orange", 3: "tab:olive", 4: "tab:green", 5: "tab:cyan"}
 #: The recovery controller's stages (docs/RECOVERY.md 3.4), as drawn in the
 #: figures, the movie's clock and the viewer.
 STAGE_NAMES = {
@@ -324,6 +324,7 @@ STAGE_NAMES = {
     2: "tilted away",
     3: "level",
     4: "recovered",
+    5: "hover",
 }
 
 

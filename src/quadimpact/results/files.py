@@ -101,7 +101,7 @@ IMU_PARQUET = "imu.parquet"
 #: Every file of a run folder that :meth:`SimulationResult.write` writes (data, then figures).
 RUN_FILES: tuple[str, ...] = (
     SUMMARY_JSON, SCENARIO_JSON, EPISODES_CSV, TIMESERIES_PARQUET, IMU_PARQUET,
-    "fig5.png", "fig6.png", "imu.png",
+    "fig5.png", "fig6.png", "imu.png", "estimate.png",
 )  # fmt: skip
 #: Files drawn from a run folder afterwards (``quadimpact snapshots``, ``animate``,
 #: ``view``, the crash experiments' comparison with the log): a new run written into

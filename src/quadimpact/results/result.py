@@ -32,6 +32,7 @@ READ_COLUMNS: tuple[str, ...] = (
 FIG5_PNG = "fig5.png"
 FIG6_PNG = "fig6.png"
 IMU_PNG = "imu.png"
+ESTIMATE_PNG = "estimate.png"
 
 
 class SimulationResult:
@@ -220,7 +221,8 @@ class SimulationResult:
         counters ``integrator`` unless it already has those keys),
         ``scenario.json`` (the world record, when there is one),
         ``episodes.csv``, ``timeseries.parquet``, ``imu.parquet`` (when there
-        are IMU samples), ``fig5.png``, ``fig6.png``, ``imu.png``. A figure
+        are IMU samples), ``fig5.png``, ``fig6.png``, ``imu.png``, and
+        ``estimate.png`` with an estimator other than ``ideal``. A figure
         that fails is not written; the failure is printed as a one-line
         warning on stderr and listed under ``plot_errors`` in ``summary.json``
         (and in ``self.summary``).
@@ -286,6 +288,15 @@ class SimulationResult:
                     lambda p: plots.plot_imu(imu, timeseries, p, summary=self.summary, title=title),
                 ),
             )
+            if self.summary.get("estimator") not in (None, "ideal") and "q0_hat" in imu:
+                from quadimpact.results.estimate_figures import plot_estimate
+
+                jobs += (
+                    (
+                        ESTIMATE_PNG,
+                        lambda p: plot_estimate(imu, timeseries, p, self.summary, title=title),
+                    ),
+                )
         errors: list[str] = []
         for name, job in jobs:
             try:

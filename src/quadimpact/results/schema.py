@@ -86,6 +86,20 @@ _MODEL_OPTIONS = (
     _k("model_options__pre_impact", "s", "", "recovery pre-impact rule of the model"),
 )
 
+_ERR_UNITS = {"deg": "deg", "m_s": "m/s", "rad_s": "rad/s", "m": "m"}
+_PHASE_TEXT = {
+    "pre": "before the first contact",
+    "crash": "from the first contact to stage 4 (or the end)",
+    "post": "after stage 4",
+}
+_ESTIMATION = tuple(
+    _k(f"est_{q}_{stat}_{phase}_{unit}", "f", _ERR_UNITS[unit],
+       f"estimation: {q} error, {'RMS' if stat == 'rms' else 'maximum'}, {_PHASE_TEXT[phase]}")
+    for q, unit in (("attitude", "deg"), ("velocity", "m_s"), ("bias", "rad_s"), ("position", "m"))
+    for phase in ("pre", "crash", "post")
+    for stat in ("rms", "max")
+)  # fmt: skip
+
 SUMMARY_KEYS: tuple[Key, ...] = (
     _k("status", "s", "", "completed, crashed or failed"),
     _k("reason", "s", "", "why a run failed (empty otherwise)"),
@@ -153,6 +167,8 @@ SUMMARY_KEYS: tuple[Key, ...] = (
     _k("t_stage4_s", "f", "s", "recovery: tick of entry into stage 4 (recovered)"),
     _k("recovered", "b", "", "stage 4 reached before the final time"),
     _k("time_to_recover_s", "f", "s", "detection to stage 4"),
+    _k("t_stage5_s", "f", "s", "recovery: tick of entry into stage 5 (hover, position hold)"),
+    _k("time_to_hover_s", "f", "s", "detection to speed < 0.2 m/s and tilt < 5 deg for 0.5 s"),
     _k("height_loss_stage2_m", "f", "m", "altitude at detection minus at stage 2 entry"),
     _k("height_loss_stage3_m", "f", "m", "altitude at detection minus at stage 3 entry"),
     _k("height_loss_m", "f", "m", "altitude at detection minus at stage 4 entry"),
@@ -167,6 +183,14 @@ SUMMARY_KEYS: tuple[Key, ...] = (
     _k("final_altitude_m", "f", "m", "CM altitude at the end of the run"),
     _k("first_contact_bumper", "i", "1", "feature (bumper) of the first obstacle contact"),
     _k("first_contact_normal", "j", "1", "its contact normal there, inertial NED, unit"),
+    _k("estimator", "s", "", "state estimator"),
+    _k("estimator_settings", "s", "", "the estimator's parameters, name=value, ..."),
+    _k("sensors", "s", "", "preset of sensors (null: none given)"),
+    _k("impact_disturbance", "b", "", "the IMU's impact disturbance is on"),
+    _k("magnetometer", "b", "", "the run has a magnetometer"),
+    _k("pose_sensor", "b", "", "the run has a pose sensor"),
+    *_ESTIMATION,
+    _k("est_attitude_rms_run_deg", "f", "deg", "estimation: attitude error, RMS over the run"),
     _k("outcome", "s", "", "one sentence on what the run did"),
     _k("integrator__steps", "i", "1", "accepted steps"),
     _k("integrator__rejected_steps", "i", "1", "rejected steps"),
@@ -231,8 +255,10 @@ TIMESERIES_COLUMNS: tuple[str, ...] = (
 )
 
 #: Columns of the IMU table (imu.parquet), in order (docs/RESULTS.md): the
-#: measured specific force (body FRD) and angular rate, the true ones, and the
-#: detector's horizontal measure.
+#: measured specific force (body FRD) and angular rate, the true ones, the
+#: detector's horizontal measure, the magnetometer and the pose sensor (NaN
+#: where absent), the estimate after the sample, the gyro's true bias and the
+#: estimate's errors.
 IMU_COLUMNS: tuple[str, ...] = (
     "t_s",
     "fx_m_s2",
@@ -248,4 +274,34 @@ IMU_COLUMNS: tuple[str, ...] = (
     "q_true_rad_s",
     "r_true_rad_s",
     "f_horizontal_m_s2",
+    "mx",
+    "my",
+    "mz",
+    "pose_x_m",
+    "pose_y_m",
+    "pose_z_m",
+    "pose_q0",
+    "pose_q1",
+    "pose_q2",
+    "pose_q3",
+    "q0_hat",
+    "q1_hat",
+    "q2_hat",
+    "q3_hat",
+    "bias_p_hat_rad_s",
+    "bias_q_hat_rad_s",
+    "bias_r_hat_rad_s",
+    "vx_hat_m_s",
+    "vy_hat_m_s",
+    "vz_hat_m_s",
+    "x_hat_m",
+    "y_hat_m",
+    "z_hat_m",
+    "bias_p_true_rad_s",
+    "bias_q_true_rad_s",
+    "bias_r_true_rad_s",
+    "attitude_error_deg",
+    "velocity_error_m_s",
+    "bias_error_rad_s",
+    "position_error_m",
 )

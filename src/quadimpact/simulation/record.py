@@ -230,6 +230,10 @@ def imu_columns(raw: np.ndarray) -> dict[str, np.ndarray]:
         L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
         L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
         L.I_HORIZONTAL,
+        *range(L.I_MAG, L.I_MAG + 3), *range(L.I_POSE, L.I_POSE + 7),
+        *range(L.I_Q_HAT, L.I_Q_HAT + 4), *range(L.I_BIAS_HAT, L.I_BIAS_HAT + 3),
+        *range(L.I_VEL_HAT, L.I_VEL_HAT + 3), *range(L.I_POS_HAT, L.I_POS_HAT + 3),
+        *range(L.I_BIAS_TRUE, L.I_BIAS_TRUE + 3), *range(L.I_ERR, L.I_ERR + 4),
     )  # fmt: skip
     return {name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources, strict=True)}
 
@@ -243,7 +247,9 @@ def imu_frame(raw: np.ndarray) -> pd.DataFrame:
         Columns :data:`~quadimpact.results.files.IMU_COLUMNS`: time (s); measured
         specific force ``fx/fy/fz_m_s2`` (body FRD, m/s^2) and angular rate
         ``p/q/r_rad_s``; the true values (``*_true_*``); the detector's horizontal
-        measure ``f_horizontal_m_s2``.
+        measure ``f_horizontal_m_s2``; the magnetometer and the pose sensor (NaN
+        where absent); the estimate after the sample (``*_hat*``), the gyro's true
+        bias and the estimate's errors (docs/RESULTS.md).
     """
     import pandas as pd
 

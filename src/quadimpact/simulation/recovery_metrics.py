@@ -48,6 +48,8 @@ RECOVERY_KEYS: tuple[str, ...] = (
     "t_stage4_s",
     "recovered",
     "time_to_recover_s",
+    "t_stage5_s",
+    "time_to_hover_s",
     "height_loss_stage2_m",
     "height_loss_stage3_m",
     "height_loss_m",
@@ -144,7 +146,7 @@ def recovery_metrics(
     v = final_state[L.X_VEL : L.X_VEL + 3]
     out["final_speed_m_s"] = _finite(norm(v))
     stage_t = [float(st[L.ST_STAGE_T + k]) for k in range(L.N_STAGES)]
-    for k in (1, 2, 3, 4):
+    for k in (1, 2, 3, 4, 5):
         out[f"t_stage{k}_s"] = _finite(stage_t[k])
     out["recovered"] = bool(math.isfinite(stage_t[RECOVERED_STAGE]))
     out["impacts_after_detection"] = 0
@@ -175,6 +177,9 @@ def recovery_metrics(
         out[f"horizontal_drift{suffix}_m"] = float(drift)
     if out["recovered"]:
         out["time_to_recover_s"] = stage_t[RECOVERED_STAGE] - t_detect
+    t_hover = float(st[L.ST_T_HOVER])
+    if math.isfinite(t_hover):
+        out["time_to_hover_s"] = t_hover - t_detect
     out["max_tilt_deg"] = math.degrees(math.acos(float(np.clip(st[L.ST_MIN_TILT_COS], -1, 1))))
     out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
     # impacts (grazes excluded, obstacles only) that start after the detection

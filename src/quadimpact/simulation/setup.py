@@ -28,6 +28,7 @@ from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_prepared, check_scenario_type
+from quadimpact.simulation.estimation import pack_estimation
 from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
     RPM,
@@ -76,6 +77,10 @@ class RunSetup:
     scfg: np.ndarray = field(default_factory=lambda: np.zeros(L.NSCFG))
     noise: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
     n_imu: int = 0
+    ecfg: np.ndarray = field(default_factory=lambda: np.zeros(L.NECFG))
+    snoise: np.ndarray = field(default_factory=lambda: np.zeros((0, L.NSN)))
+    estimator: str = "ideal"
+    estimator_settings: str = ""
     controller: str = "paper"
     kernel: Kernel | None = None
     resolved: dict[str, Any] = field(default_factory=dict)
@@ -105,6 +110,8 @@ class RunSetup:
             "sched_t": self.sched_t,
             "sched_rate": self.sched_rate,
             "sched_stop": self.sched_stop,
+            "ecfg": self.ecfg,
+            "snoise": self.snoise,
         }
         fields.update(changes)
         if "t_out" not in fields:
@@ -196,13 +203,17 @@ def _ground(s: RunSettings) -> list[Plane]:
     return []
 
 
-def _kernel(entry) -> Kernel | None:
-    """The compiled loop of a plug-in controller (once per process); None for built-ins."""
-    if entry.step is None:
+def _kernel(entry, estimator=None) -> Kernel | None:
+    """The compiled loop of a plug-in controller or estimator (once per process and pair).
+
+    None for built-ins.
+    """
+    if entry.step is None and estimator is None:
         return None
-    if "kernel" not in entry.kernel_cache:
-        entry.kernel_cache["kernel"] = make_kernel(entry.step)
-    return entry.kernel_cache["kernel"]
+    key = "kernel" if estimator is None else ("kernel", id(estimator))
+    if key not in entry.kernel_cache:
+        entry.kernel_cache[key] = make_kernel(entry.step, estimator=estimator)
+    return entry.kernel_cache[key]
 
 
 def _setup(
@@ -225,6 +236,7 @@ def _setup(
     )
     imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
     scfg, noise, n_imu = pack_sensors(imu, s.detection, v, s.seed, duration_s)
+    est = pack_estimation(s, imu, scfg, n_imu, v)
     params = s.resolved_controller_params()
     resolved = {
         "model": s.model,
@@ -235,6 +247,7 @@ def _setup(
         "nominal_controller": s.nominal_controller,
         "imu": imu.model_dump(mode="json"),
         "rotor_slew_limit_rad_s2": _slew_limit_rad_s2(s, v),
+        **(est.resolved or {}),
     }
     setup = RunSetup(
         tf=float(s.final_time_s),
@@ -252,8 +265,12 @@ def _setup(
         scfg=scfg,
         noise=noise,
         n_imu=n_imu,
+        ecfg=est.ecfg,
+        snoise=est.snoise,
+        estimator=est.name,
+        estimator_settings=est.settings,
         controller=s.controller,
-        kernel=_kernel(entry),
+        kernel=_kernel(entry, est.step),
         resolved=resolved,
         **fields,
         **_schedule(s),

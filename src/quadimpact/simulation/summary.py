@@ -18,6 +18,7 @@ from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
 from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.approach import inclination_deg_of
+from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
     attitude_excursion_deg,
@@ -199,9 +200,25 @@ def build_summary(
     if first_normal is not None:
         summary["first_contact_bumper"] = int(first_normal[0])
         summary["first_contact_normal"] = [float(c) for c in first_normal[1]]
+    summary.update(_estimation(setup, scenario, st))
     rings = setup.vehicle.features is None
     summary["outcome"] = describe_outcome(summary, None if rings else setup.feature_names)
     return summary
+
+
+def _estimation(setup: RunSetup, scenario: Any, st: np.ndarray) -> dict[str, Any]:
+    """The estimator, the added sensors and the estimate's errors (docs/ESTIMATION.md 4)."""
+    scfg = setup.scfg
+    out: dict[str, Any] = {
+        "estimator": setup.estimator,
+        "estimator_settings": setup.estimator_settings,
+        "sensors": getattr(scenario, "sensors", None),
+        "impact_disturbance": bool(scfg[L.SC_IMPACT_TAU] > 0.0),
+        "magnetometer": bool(scfg[L.SC_MAG] > 0.5),
+        "pose_sensor": bool(scfg[L.SC_POSE] > 0.5),
+    }
+    out.update(estimation_metrics(st))
+    return out
 
 
 def _too_deep(setup: RunSetup, episodes: Any, max_pen: float, rb: float) -> str:

@@ -627,6 +627,7 @@ class Scene:
         surfaces: list[Plane] | None = None,
         n_points: int = 72,
         world: Mapping[str, Any] | None = None,
+        imu: pd.DataFrame | None = None,
     ) -> None:
         if len(timeseries) == 0:
             raise ValueError("the run has no samples to draw")
@@ -676,11 +677,26 @@ class Scene:
         self.anchor = self.state_at(
             self.t[0] if self.first_contact_s is None else self.first_contact_s
         )[0:3].copy()
+        self.q_hat = self.attitude_error_deg = None
+        if imu is not None and "q0_hat" in imu and summary.get("estimator") not in (None, "ideal"):
+            self._estimate(imu)
+
+    def _estimate(self, imu: pd.DataFrame) -> None:
+        """The estimator's attitude at each sample of the run (the last IMU sample's, held)."""
+        t_imu = imu["t_s"].to_numpy(dtype=float)
+        if len(t_imu) == 0:
+            return
+        k = np.clip(np.searchsorted(t_imu, self.t + 1e-12, side="right") - 1, 0, len(t_imu) - 1)
+        q = np.stack([imu[f"q{j}_hat"].to_numpy(dtype=float) for j in range(4)], 1)
+        self.q_hat = q[k]
+        self.attitude_error_deg = imu["attitude_error_deg"].to_numpy(dtype=float)[k]
 
     @classmethod
     def from_result(cls, result: Any, vehicle: Vehicle | None = None, **kw: Any) -> Scene:
         """Scene of a :class:`~quadimpact.results.result.SimulationResult` (its world record)."""
         kw.setdefault("world", getattr(result, "world", None))
+        if result.summary.get("estimator") not in (None, "ideal"):
+            kw.setdefault("imu", result.imu)
         return cls(result.timeseries, result.summary, result.episodes, vehicle=vehicle, **kw)
 
     @classmethod

@@ -186,7 +186,13 @@ def viewer_data(
             "alt": _r(scene.altitude[idx], 4),
             "contacts": contacts,
             "stage": None if stages is None else stages.tolist(),
+            # the estimator's attitude (null with the ideal estimator) and its error, deg
+            "quat_hat": None if scene.q_hat is None else _r(scene.q_hat[idx], 6),
+            "att_err": None
+            if scene.attitude_error_deg is None
+            else _r(scene.attitude_error_deg[idx], 3),
         },
+        "estimator": s.get("estimator"),
     }
 
 

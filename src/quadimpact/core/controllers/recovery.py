@@ -37,14 +37,24 @@ stage meaning             a_ref       k_z   leaves when
 1     impact detected     a_mag n     0     |q_e,x|, |q_e,y| < q_tol and |p|, |q| < rate_tol
 2     tilted away         0           0     the same test (now toward level)
 3     level               0           10    body z velocity w < w_tol
-4     recovered           0           10    stays
+4     recovered           0           10    stays (or 5 at the next tick)
+5     hover (optional)    position    --    stays (``hover.py``: holds the position
+                          hold                    estimate and yaw of the stage 4 entry)
 ====  ==================  ==========  ====  =====================================
 
+With stage 5 on (``R_HOVER``, the default) stage 4 lasts one tick: at the next
+tick the law brakes and holds a position estimate (where it stops, by
+default; ``R_HOVER_MODE``) and the yaw at which stage 4 was entered, so a
+recovered vehicle no longer drifts away;
+stage 4's entry (``recovered``) and everything before it are unchanged.
+
 At the detection tick the stage becomes 1 and the law runs at once (no test).
-Rates come from the gyro (``meas[MS_IMU_W]``), attitude and velocity from the
-state estimate. Every gain, threshold, ``a_mag`` and ``k_z`` is a parameter
-(layout ``R_*`` below, at ``ctrl[C_PARAMS + ...]``); the recovery replica's
-"level target at the detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
+Rates are the estimator's (``meas[MS_W_HAT]``: the gyro as measured with the
+ideal estimator, the gyro minus the estimated bias otherwise), attitude,
+velocity and position come from the state estimate. Every gain, threshold,
+``a_mag`` and ``k_z`` is a parameter (layout ``R_*`` below, at
+``ctrl[C_PARAMS + ...]``); the recovery replica's "level target at the
+detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
 """
 
 import math
@@ -59,14 +69,15 @@ from ..layout import (
     CTRL_CASCADE_PID,
     MEM_STAGE,
     MS_DETECTED,
-    MS_IMU_W,
     MS_NORMAL,
+    MS_W_HAT,
     MS_X,
     N_ROTORS,
     NPARAM,
     NX,
     V_GRAVITY,
     V_MASS,
+    X_POS,
     X_QUAT,
     X_ROTOR,
     X_VEL,
@@ -75,6 +86,7 @@ from ..layout import (
 from ..quaternion import rotation_matrix
 from .cascade_pid import cascade_pid_step
 from .common import N_PID_MEM, N_PID_PARAMS, allocate, linearised_torques
+from .hover import hover_acceleration, yaw_of
 from .paper import paper_step
 
 # ---- parameters, at ctrl[C_PARAMS + ...] (the PID block of common.py comes first)
@@ -89,7 +101,17 @@ R_Q_TOL = _params.slot("R_Q_TOL")  # tilt-error tolerance of the stage 1 and 2 t
 R_RATE_TOL = _params.slot("R_RATE_TOL")  # rad/s, |p|, |q| tolerance of the stage 1 and 2 tests
 R_W_TOL = _params.slot("R_W_TOL")  # m/s, body z velocity below which stage 3 ends
 R_FIRST_TICK_LEVEL = _params.slot("R_FIRST_TICK_LEVEL")  # 1: a_ref = 0 at detection (replica)
+R_HOVER = _params.slot("R_HOVER")  # 1: stage 5 (hold position and yaw) after stage 4
+R_HOVER_GAINS = _params.slot("R_HOVER_GAINS", 5)  # K_p 1/s, K_v 1/s, v_max m/s, a_max m/s^2,
+# K_psi 1/s (controllers/hover.py)
+R_HOVER_MODE = _params.slot("R_HOVER_MODE")  # HOLD_* below: which position stage 5 holds
+R_HOVER_SET = _params.slot("R_HOVER_SET", 3)  # m, the given set-point, inertial NED
 N_RECOVERY_PARAMS = _params.end("N_RECOVERY_PARAMS")
+
+HOLD_ENTRY = 0  # the position estimate at stage 4's entry
+HOLD_STOP = 1  # brake first; hold the position estimate where the speed fell below 0.2 m/s
+HOLD_GIVEN = 2  # R_HOVER_SET
+HOLD_CAPTURE_M_S = 0.2
 
 PRE_NOMINAL = 0
 PRE_HOLD = 1
@@ -100,6 +122,9 @@ PRE_IMMEDIATE = 3
 _mem = Block("mem", "RM_", start=N_PID_MEM, capacity=MEM_STAGE)
 RM_QE_X = _mem.slot("RM_QE_X")  # previous tick's tilt error quaternion, x and y
 RM_QE_Y = _mem.slot("RM_QE_Y")
+RM_HOLD = _mem.slot("RM_HOLD", 3)  # m, stage 5's position set-point, inertial NED
+RM_HOLD_PSI = _mem.slot("RM_HOLD_PSI")  # rad, stage 5's yaw set-point
+RM_HOLD_SET = _mem.slot("RM_HOLD_SET")  # 1 once the position set-point is set (HOLD_STOP)
 N_RECOVERY_MEM = _mem.end("N_RECOVERY_MEM")
 
 STAGE_PRE_IMPACT = 0
@@ -107,6 +132,7 @@ STAGE_DETECTED = 1
 STAGE_TILTED = 2
 STAGE_LEVEL = 3
 STAGE_RECOVERED = 4
+STAGE_HOVER = 5
 
 
 @njit(cache=True)
@@ -120,12 +146,13 @@ def next_stage(
     q_tol: float,
     rate_tol: float,
     w_tol: float,
+    hover: bool = False,
 ) -> int:
     """The stage machine: the stage after this tick's test (at most one step up).
 
     ``qe_x``, ``qe_y``: the previous tick's tilt error quaternion (body x, y);
     ``p``, ``q``: body rates now (rad/s); ``w``: body z velocity now (m/s, down
-    positive).
+    positive); ``hover``: stage 5 follows stage 4 at the next tick.
     """
     if stage == STAGE_DETECTED or stage == STAGE_TILTED:
         if abs(qe_x) < q_tol and abs(qe_y) < q_tol and abs(p) < rate_tol and abs(q) < rate_tol:
@@ -135,6 +162,8 @@ def next_stage(
         if w < w_tol:
             return STAGE_RECOVERED
         return stage
+    if stage == STAGE_RECOVERED and hover:
+        return STAGE_HOVER
     return stage
 
 
@@ -159,10 +188,7 @@ def staged_references(
     C = np.empty((3, 3))
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
     g = veh[V_GRAVITY]
-    # up axis u = -C e_z and the inertial vertical velocity V_Z = (C v)_Z
-    ux = -C[0, 2]
-    uy = -C[1, 2]
-    uz = -C[2, 2]
+    # the inertial vertical velocity V_Z = (C v)_Z
     vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
     k_z = ctrl[p0 + R_K_Z + stage - 1]
     ax = 0.0
@@ -176,6 +202,22 @@ def staged_references(
     fx = ax
     fy = ay
     fz = -g + az - k_z * vz
+    return thrust_and_tilt(fx, fy, fz, C, ctrl, veh)
+
+
+@njit(cache=True)
+def thrust_and_tilt(
+    fx: float, fy: float, fz: float, C: np.ndarray, ctrl: np.ndarray, veh: np.ndarray
+) -> tuple[float, float, float, float, float]:
+    """Thrust (N), rate references (rad/s) and tilt error toward ``f_des = (fx, fy, fz)``.
+
+    ``f_des``: the desired thrust per unit mass, inertial (m/s^2); ``C``: the
+    estimated attitude. Returns ``(thrust, p_des, q_des, qe_x, qe_y)``.
+    """
+    p0 = C_PARAMS
+    ux = -C[0, 2]
+    uy = -C[1, 2]
+    uz = -C[2, 2]
     thrust = veh[V_MASS] * (fx * ux + fy * uy + fz * uz)
     if thrust < 0.0:
         thrust = 0.0
@@ -199,6 +241,61 @@ def staged_references(
 
 
 @njit(cache=True)
+def law_references(
+    stage: int,
+    a_ref_on: bool,
+    x: np.ndarray,
+    normal: np.ndarray,
+    ctrl: np.ndarray,
+    veh: np.ndarray,
+    mem: np.ndarray,
+) -> tuple[float, float, float, float, float, float]:
+    """The outer loop in ``stage`` (1-5): ``(thrust, p_des, q_des, r_des, qe_x, qe_y)``.
+
+    Stages 1-4: :func:`staged_references` with ``r_des = 0``; stage 5: the
+    position hold of ``hover.py`` toward the set-points in ``mem``.
+    """
+    if stage == STAGE_HOVER:
+        p0 = C_PARAMS
+        C = np.empty((3, 3))
+        rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
+        if mem[RM_HOLD_SET] < 0.5:
+            # HOLD_STOP: brake (hold wherever the vehicle is) until slow, then keep that point
+            v2 = x[X_VEL] ** 2 + x[X_VEL + 1] ** 2 + x[X_VEL + 2] ** 2
+            for i in range(3):
+                mem[RM_HOLD + i] = x[X_POS + i]
+            if v2 < HOLD_CAPTURE_M_S**2:
+                mem[RM_HOLD_SET] = 1.0
+        fx, fy, fz, r_des = hover_acceleration(
+            x,
+            C,
+            mem[RM_HOLD : RM_HOLD + 3],
+            mem[RM_HOLD_PSI],
+            ctrl[p0 + R_HOVER_GAINS : p0 + R_HOVER_GAINS + 5],
+            veh[V_GRAVITY],
+        )
+        thrust, p_des, q_des, qex, qey = thrust_and_tilt(fx, fy, fz, C, ctrl, veh)
+        return thrust, p_des, q_des, r_des, qex, qey
+    thrust, p_des, q_des, qex, qey = staged_references(stage, a_ref_on, x, normal, ctrl, veh)
+    return thrust, p_des, q_des, 0.0, qex, qey
+
+
+@njit(cache=True)
+def hold_set_point(x: np.ndarray, ctrl: np.ndarray, mem: np.ndarray) -> None:
+    """Stage 5's set-points into ``mem`` at stage 4's entry: the yaw of ``x`` and, by the
+    mode, the position estimate of ``x``, the given point, or (``HOLD_STOP``) none yet."""
+    p0 = C_PARAMS
+    mode = int(ctrl[p0 + R_HOVER_MODE])
+    for i in range(3):
+        if mode == HOLD_GIVEN:
+            mem[RM_HOLD + i] = ctrl[p0 + R_HOVER_SET + i]
+        else:
+            mem[RM_HOLD + i] = x[X_POS + i]
+    mem[RM_HOLD_SET] = 0.0 if mode == HOLD_STOP else 1.0
+    mem[RM_HOLD_PSI] = yaw_of(x[X_QUAT : X_QUAT + 4])
+
+
+@njit(cache=True)
 def rate_loop(
     thrust: float,
     p_des: float,
@@ -214,7 +311,7 @@ def rate_loop(
     ``nu = K_rate (omega_des - omega)``, feedback-linearised torques, the
     allocation (negative squares to zero) and the vehicle's rotor range
     (``ctrl[C_OMEGA_MIN]``, ``ctrl[C_OMEGA_MAX]``); writes rad/s into ``cmd``.
-    ``omega``: measured body rates (rad/s).
+    ``omega``: estimated body rates (rad/s).
     """
     p0 = C_PARAMS
     nu_p = ctrl[p0 + R_K_RATE] * (p_des - omega[0])
@@ -289,28 +386,26 @@ def recovery_step(
     else:
         first_tick = False
         w_body = x[X_VEL + 2]
+        before = stage
         stage = next_stage(
             stage,
             mem[RM_QE_X],
             mem[RM_QE_Y],
-            meas[MS_IMU_W],
-            meas[MS_IMU_W + 1],
+            meas[MS_W_HAT],
+            meas[MS_W_HAT + 1],
             w_body,
             ctrl[p0 + R_Q_TOL],
             ctrl[p0 + R_RATE_TOL],
             ctrl[p0 + R_W_TOL],
+            ctrl[p0 + R_HOVER] > 0.5,
         )
+        if stage == STAGE_RECOVERED and before != STAGE_RECOVERED:
+            hold_set_point(x, ctrl, mem)
     a_ref_on = not (first_tick and ctrl[p0 + R_FIRST_TICK_LEVEL] > 0.5)
-    qex, qey = staged_law(
-        stage,
-        a_ref_on,
-        x,
-        meas[MS_IMU_W : MS_IMU_W + 3],
-        meas[MS_NORMAL : MS_NORMAL + 3],
-        ctrl,
-        veh,
-        cmd,
+    thrust, p_des, q_des, r_des, qex, qey = law_references(
+        stage, a_ref_on, x, meas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh, mem
     )
+    rate_loop(thrust, p_des, q_des, r_des, meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd)
     mem[RM_QE_X] = qex
     mem[RM_QE_Y] = qey
     mem[MEM_STAGE] = stage

@@ -2,21 +2,210 @@
 
 The controllers and the impact detector's wall-normal estimate read only
 what this stage gives them: the state estimate in the measurement record
-(``meas[MS_X:MS_X+NX]``, written by ``sensors.measurement.measure``) and the
-attitude at each IMU sample.
+(``meas[MS_X:MS_X+NX]``, the estimated rates ``meas[MS_W_HAT]`` and bias
+``meas[MS_BIAS_HAT]``, written by :func:`write_estimate` through
+``sensors.measurement.measure``) and the attitude at each IMU sample
+(:func:`attitude_at_sample`).
 
-Only the ``ideal`` estimator exists today: it reads the true state (so the
-controllers see the truth, and every result is what it was before the seam).
-An estimator that filters the IMU (complementary, EKF) is a module here with
-its own state, selected by an option, and branches in :func:`at_tick` and
-:func:`attitude_at_sample`.
+The estimator is chosen by ``ecfg[EC_KIND]`` (``EST_*``):
+
+* ``ideal``: the true state (attitude, velocity, position), with the gyro as
+  measured for the rates (no bias correction): every result is what it was
+  before estimators existed, bit for bit;
+* ``complementary`` (``complementary.py``): a Mahony-type filter on the attitude;
+* ``ekf`` (``ekf.py``): a multiplicative error-state Kalman filter;
+* a plug-in (``EST_USER``): a compiled step bound in place of
+  :func:`plugin_estimator` by ``core.run.make_kernel(estimator=...)``.
+
+The stage runs at each IMU sample, after the IMU, the magnetometer and the
+pose sensor have written their readings into the measurement record and
+before the detector (:func:`estimate_sample`); at each control tick
+:func:`at_tick` writes the latest estimate for the controller. The initial
+estimate is the true initial state plus the seeded error of ``ecfg``,
+and the gyro's bias (:func:`init_estimate`). Rotor speeds in the state estimate are the true
+ones (the motor controllers measure them).
 """
+
+import math
 
 import numpy as np
 from numba import njit
 
-from ..records import Data, Model
+from ..layout import (
+    EC_INIT_ATT,
+    EC_INIT_BIAS,
+    EC_INIT_POS,
+    EC_INIT_VEL,
+    EC_KIND,
+    ES_BIAS,
+    ES_N,
+    ES_POS,
+    ES_Q,
+    ES_T,
+    ES_VEL,
+    ES_W,
+    EST_COMPLEMENTARY,
+    EST_EKF,
+    EST_IDEAL,
+    MS_BIAS_HAT,
+    MS_IMU_W,
+    MS_W_HAT,
+    MS_X,
+    NX,
+    SC_BIAS,
+    X_OMEGA,
+    X_POS,
+    X_QUAT,
+    X_VEL,
+)
+from ..records import Data, Model, Output, Work
 from ..sensors.measurement import measure
+from ..sensors.rotvec import dcm, rotate_by
+from .complementary import complementary_sample
+from .ekf import ekf_init, ekf_sample
+from .errors import record_estimate
+
+
+@njit(cache=True, inline="always")
+def plugin_estimator(t: float, dt: float, meas: np.ndarray, ecfg: np.ndarray, est: np.ndarray):
+    """A plug-in estimator's step (rebound by ``core.run.make_kernel``); none here.
+
+    At each IMU sample ``t`` (s), ``dt`` (s) after the previous one (0 at the
+    first), it reads the measurement record ``meas`` (``MS_IMU_F``,
+    ``MS_IMU_W``; ``MS_MAG`` when ``meas[MS_MAG_T] == t``; ``MS_POSE`` when
+    ``meas[MS_POSE_T] == t``) and its parameters ``ecfg[EC_USER...]``, and
+    updates its state ``est``: the estimate in ``ES_Q``, ``ES_BIAS``,
+    ``ES_VEL``, ``ES_POS``, ``ES_W`` (the initial estimate is there at the
+    first call), its own state in ``ES_USER``.
+    """
+    return
+
+
+@njit(cache=True)
+def _truth(xs: np.ndarray, C: np.ndarray, d: Data) -> None:
+    """The ideal estimator's estimate: the true state (no gyro bias estimate)."""
+    est = d.est
+    for a in range(4):
+        est[ES_Q + a] = xs[X_QUAT + a]
+    for r in range(3):
+        est[ES_VEL + r] = C[r, 0] * xs[X_VEL] + C[r, 1] * xs[X_VEL + 1] + C[r, 2] * xs[X_VEL + 2]
+        est[ES_POS + r] = xs[X_POS + r]
+        est[ES_BIAS + r] = 0.0
+        est[ES_W + r] = d.meas[MS_IMU_W + r]
+
+
+@njit(cache=True)
+def init_estimate(m: Model, d: Data) -> None:
+    """The initial estimate from the initial state ``d.x``: the truth plus ``ecfg``'s error.
+
+    The truth includes the gyro's bias (the vehicle has flown before the run, so
+    a filter's bias estimate has converged): a filter starts from the IMU's
+    drawn bias plus ``ecfg[EC_INIT_BIAS]``; the ideal estimator does not
+    correct the gyro at all.
+    """
+    est = d.est
+    est[:] = 0.0
+    x = d.x
+    n = math.sqrt(x[X_QUAT] ** 2 + x[X_QUAT + 1] ** 2 + x[X_QUAT + 2] ** 2 + x[X_QUAT + 3] ** 2)
+    for a in range(4):
+        est[ES_Q + a] = x[X_QUAT + a] / n
+    C = np.empty((3, 3))
+    dcm(est[ES_Q : ES_Q + 4], C)
+    e = m.ecfg
+    for r in range(3):
+        est[ES_VEL + r] = (
+            C[r, 0] * x[X_VEL] + C[r, 1] * x[X_VEL + 1] + C[r, 2] * x[X_VEL + 2]
+        ) + e[EC_INIT_VEL + r]
+        est[ES_POS + r] = x[X_POS + r] + e[EC_INIT_POS + r]
+        est[ES_W + r] = x[X_OMEGA + r]
+    rotate_by(est[ES_Q : ES_Q + 4], e[EC_INIT_ATT], e[EC_INIT_ATT + 1], e[EC_INIT_ATT + 2])
+    if int(e[EC_KIND]) != EST_IDEAL:
+        for r in range(3):
+            est[ES_BIAS + r] = m.scfg[SC_BIAS + 3 + r] + e[EC_INIT_BIAS + r]
+    est[ES_T] = np.nan
+    if int(e[EC_KIND]) == EST_EKF:
+        ekf_init(m, d)
+
+
+@njit(cache=True)
+def estimate_sample(
+    t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data, o: Output, w: Work
+) -> None:
+    """The estimator's update with the sample at ``t`` (s); then the estimate's errors.
+
+    ``xs``, ``C``: the true state there and its rotation (read only by the
+    ideal estimator and by the error record). Leaves the estimate's rotation
+    in ``w.C_hat``.
+    """
+    est = d.est
+    kind = int(m.ecfg[EC_KIND])
+    dt = t - est[ES_T] if est[ES_N] > 0.0 else 0.0
+    if kind == EST_IDEAL:
+        _truth(xs, C, d)
+    elif kind == EST_COMPLEMENTARY:
+        complementary_sample(t, dt, m, d, w.C_hat)
+    elif kind == EST_EKF:
+        ekf_sample(t, dt, m, d, w.C_hat)
+    else:
+        plugin_estimator(t, dt, d.meas, m.ecfg, est)
+    if kind != EST_IDEAL:
+        dcm(est[ES_Q : ES_Q + 4], w.C_hat)
+    est[ES_T] = t
+    est[ES_N] += 1.0
+    record_estimate(t, xs, C, m, d, o)
+
+
+@njit(cache=True, inline="always")
+def attitude_at_sample(
+    t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data, w: Work
+) -> np.ndarray:
+    """The estimated body-to-inertial rotation at the IMU sample ``t`` (s), 3x3.
+
+    ``xs`` is the true state there and ``C`` its rotation: the ideal
+    estimator's answer. Others: the estimate after the sample
+    (:func:`estimate_sample` left it in ``w.C_hat``).
+    """
+    if int(m.ecfg[EC_KIND]) == EST_IDEAL:
+        return C
+    return w.C_hat
+
+
+@njit(cache=True)
+def write_estimate(t: float, x: np.ndarray, m: Model, d: Data, meas: np.ndarray) -> None:
+    """The estimate of the tick ``t`` (s) into the measurement record ``meas``.
+
+    ``x``: the true state (quaternion renormalised), which the ideal estimator
+    writes as it is; with it the estimated rates are the gyro as measured.
+    Others write their estimate (velocity in body axes of the estimated
+    attitude; the true rotor speeds).
+    """
+    if int(m.ecfg[EC_KIND]) == EST_IDEAL:
+        measure(t, x, meas)
+        for a in range(3):
+            meas[MS_W_HAT + a] = meas[MS_IMU_W + a]
+            meas[MS_BIAS_HAT + a] = 0.0
+        return
+    est = d.est
+    measure(t, x, meas)  # the true rotor speeds; the rest is replaced by the estimate
+    xh = meas[MS_X : MS_X + NX]
+    q0, q1, q2, q3 = est[ES_Q], est[ES_Q + 1], est[ES_Q + 2], est[ES_Q + 3]
+    n2 = q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3
+    vx, vy, vz = est[ES_VEL], est[ES_VEL + 1], est[ES_VEL + 2]
+    # C^T v with C the rotation of q (normalised)
+    xh[X_VEL] = ((1.0 - 2.0 * (q2 * q2 + q3 * q3) / n2) * vx + 2.0 * (q1 * q2 + q0 * q3) / n2 * vy
+                 + 2.0 * (q1 * q3 - q0 * q2) / n2 * vz)  # fmt: skip
+    xh[X_VEL + 1] = (2.0 * (q1 * q2 - q0 * q3) / n2 * vx + (1.0 - 2.0 * (q1 * q1 + q3 * q3) / n2)
+                     * vy + 2.0 * (q2 * q3 + q0 * q1) / n2 * vz)  # fmt: skip
+    xh[X_VEL + 2] = (2.0 * (q1 * q3 + q0 * q2) / n2 * vx + 2.0 * (q2 * q3 - q0 * q1) / n2 * vy
+                     + (1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2) * vz)  # fmt: skip
+    for a in range(4):
+        xh[X_QUAT + a] = est[ES_Q + a]
+    for a in range(3):
+        xh[X_POS + a] = est[ES_POS + a]
+        xh[X_OMEGA + a] = est[ES_W + a]
+    for a in range(3):
+        meas[MS_W_HAT + a] = est[ES_W + a]
+        meas[MS_BIAS_HAT + a] = est[ES_BIAS + a]
 
 
 @njit(cache=True, inline="always")
@@ -25,13 +214,4 @@ def at_tick(t: float, m: Model, d: Data) -> None:
 
     Ideal: the true state ``d.x`` (its quaternion already renormalised by the tick).
     """
-    measure(t, d.x, d.meas)
-
-
-@njit(cache=True, inline="always")
-def attitude_at_sample(t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data) -> np.ndarray:
-    """The estimated body-to-inertial rotation at the IMU sample ``t`` (s), 3x3.
-
-    ``xs`` is the true state there and ``C`` its rotation. Ideal: ``C`` itself.
-    """
-    return C
+    write_estimate(t, d.x, m, d, d.meas)

@@ -23,6 +23,13 @@ caller from the run's seed) -> saturation at the sensor's range -> low-pass
 (first-order, ``y += (1 - exp(-dt/tau)) (u - y)``, or a moving average of
 the last N samples). Saturation comes before the filter, as in a sensor whose
 analogue range clips before its digital filter.
+
+Two options add to the chain, each off unless configured: the impact
+disturbance (``disturbance.py``: extra white noise after each contact onset,
+decaying with a time constant, drawn from ``snoise[i, SN_IMPACT...]``) is
+added to the true value, and the gyro bias random walk (``SS_WALK``, its
+increments ``sigma sqrt(1/rate) snoise[i, SN_WALK...]``) to the gyro's
+constant bias. With both off the chain is the same arithmetic as without them.
 """
 
 import math
@@ -43,23 +50,31 @@ from ..layout import (
     MS_IMU_T,
     MS_IMU_W,
     SC_BIAS,
+    SC_BIAS_WALK,
     SC_FILTER,
     SC_FILTER_PARAM,
+    SC_IMPACT_F,
+    SC_IMPACT_TAU,
+    SC_IMPACT_W,
     SC_NOISE_F,
     SC_NOISE_W,
     SC_POS,
     SC_RANGE_F,
     SC_RANGE_W,
     SC_RATE,
+    SN_IMPACT,
+    SN_WALK,
     SS_FILT,
     SS_N,
     SS_RING,
+    SS_WALK,
     ST_N_IMU,
     V_GRAVITY,
     X_OMEGA,
     X_VEL,
 )
 from ..records import Data, Model, Output
+from .disturbance import impact_factor
 
 
 @njit(cache=True)
@@ -145,11 +160,28 @@ def imu_sample(
     if kind == FILTER_FIRST_ORDER and scfg[SC_FILTER_PARAM] > 0.0:
         alpha = 1.0 - math.exp(-dt / scfg[SC_FILTER_PARAM])
     row = i < imu_out.shape[0]
+    snoise = m.snoise
+    has_extra = i < snoise.shape[0]
+    factor = 0.0
+    if scfg[SC_IMPACT_TAU] > 0.0 and has_extra:
+        factor = impact_factor(t, scfg[SC_IMPACT_TAU], o.stats)
+    walk = scfg[SC_BIAS_WALK] > 0.0 and has_extra
+    if walk and i > 0:
+        step = scfg[SC_BIAS_WALK] * math.sqrt(dt)
+        for a in range(3):
+            sst[SS_WALK + a] += step * snoise[i, SN_WALK + a]
     for a in range(6):
         sigma = scfg[SC_NOISE_F] if a < 3 else scfg[SC_NOISE_W]
         rng = scfg[SC_RANGE_F] if a < 3 else scfg[SC_RANGE_W]
         z = noise[i, a] if has_noise else 0.0
-        y = _measure_axis(true[a], scfg[SC_BIAS + a], sigma, z, rng)
+        value = true[a]
+        if factor > 0.0:
+            amplitude = scfg[SC_IMPACT_F] if a < 3 else scfg[SC_IMPACT_W]
+            value += amplitude * factor * snoise[i, SN_IMPACT + a]
+        bias = scfg[SC_BIAS + a]
+        if walk and a >= 3:
+            bias += sst[SS_WALK + a - 3]
+        y = _measure_axis(value, bias, sigma, z, rng)
         if kind == FILTER_FIRST_ORDER:
             if i == 0:
                 sst[SS_FILT + a] = y

@@ -1,20 +1,26 @@
-"""The sensor stage of the loop: one IMU sample, the estimator's attitude there, detection.
+"""The sensor stage of the loop: one IMU sample, the estimator's update there, detection.
 
-The run loop takes the samples on the dense output of each step (so a
-sample at a control tick precedes that tick's new command), at the times
-``t0 + n / rate``. A plug-in sensor (``core.run.make_kernel(sensor=...)``) is
-sampled with the IMU and writes the measurement record's user block.
+At each IMU sample: the IMU (``imu.py``), the magnetometer and the pose
+sensor when the run has them (``magnetometer.py``, ``pose.py``), the
+estimator's update (``core/estimators``), the detector with the estimated
+attitude (``detection.py``), then a plug-in sensor. The run loop takes the
+samples on the dense output of each step (so a sample at a control tick
+precedes that tick's new command), at the times ``t0 + n / rate``. A plug-in
+sensor (``core.run.make_kernel(sensor=...)``) is sampled with the IMU and
+writes the measurement record's user block.
 """
 
 import numpy as np
 from numba import njit
 
 from ..dynamics import state_derivative
-from ..estimators import attitude_at_sample
+from ..estimators import attitude_at_sample, estimate_sample
 from ..layout import LS_T0, SC_RATE, SS_N, SS_NEXT_T
 from ..records import Data, Model, Output, Work
 from .detection import detect
 from .imu import imu_sample
+from .magnetometer import magnetometer_sample
+from .pose import pose_sample
 
 
 @njit(cache=True, inline="always")
@@ -39,7 +45,10 @@ def take_sample(
     ``w.C`` must hold the rotation of ``xs``. Schedules the next sample.
     """
     imu_sample(t, xs, xd, w.C, m, d, o)
-    detect(t, xs, attitude_at_sample(t, xs, w.C, m, d), m, d, o)
+    magnetometer_sample(t, w.C, m, d, o)
+    pose_sample(t, xs, m, d, o)
+    estimate_sample(t, xs, w.C, m, d, o, w)
+    detect(t, xs, attitude_at_sample(t, xs, w.C, m, d, w), m, d, o)
     plugin_sensor(t, xs, xd, w.C, m, d)
     d.sst[SS_NEXT_T] = d.ls[LS_T0] + d.sst[SS_N] / m.scfg[SC_RATE]
 

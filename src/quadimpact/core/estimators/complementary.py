@@ -1,0 +1,152 @@
+"""A nonlinear complementary filter (Mahony-type): the attitude from the gyro, corrected.
+
+At each IMU sample (gyro ``w``, specific force ``f``, period ``dt``):
+
+* the predicted attitude ``q_pred = q_hat (x) exp((w - b_hat) dt)``, at which the
+  errors below are measured (a sample consistent with the truth then corrects
+  nothing: a constant rotation is tracked exactly);
+* accelerometer error, skipped (gated) while ``||f| - g| > gate``: the cross
+  product of the measured "up" direction and the estimated one,
+  ``e_a = (f / |f|) x (-C_pred^T e_Z)`` (at rest the specific force points up);
+* magnetometer error (with a magnetometer): ``h = C_pred m``, its horizontal
+  part laid on magnetic north, ``b = (|h_XY|, 0, h_Z)``, and
+  ``e_m = m x (C_pred^T b)`` (``m`` the normalised reading): it corrects the
+  heading and leaves the inclination of the field to the accelerometer;
+* bias (integral) update ``b_hat <- b_hat - k_I (e_a + e_m) dt``, then the
+  corrected rate ``w_c = w - b_hat + k_acc e_a + k_mag e_m``;
+* attitude ``q_hat <- q_hat (x) exp(w_c dt)`` (the exact exponential of a rate
+  held over the period);
+* velocity and position by integrating the accelerometer
+  (``navigation.py``); with a pose sensor, a complementary correction toward
+  each measurement ``p_m``: ``p_hat += k_pos (p_m - p_hat)``,
+  ``v_hat += k_vel (p_m - p_hat)``, and with its attitude
+  ``q_hat <- q_hat (x) exp(k_pos phi)`` (``phi`` the rotation from the
+  estimate to the measured attitude).
+
+The estimated rates given to the controllers are ``w - b_hat``. Gains
+(``ecfg``): ``k_acc`` (``EC_K_ACC``, default 0.25 1/s), ``k_mag`` (0.15 1/s),
+``k_I`` (``EC_K_BIAS``, 0.25 1/s^2), the gate (1 m/s^2): the authors'
+simulation values. With ``k_acc = k_mag`` and no gate this is the ``ahrs``
+package's Mahony filter but for two things: ``ahrs`` measures the errors at
+the prior attitude (one sample behind the measurement: a lag of ``|w| dt``
+under rotation) and integrates to first order (``q += q (x) (0, w_c) dt / 2``,
+normalised) where this filter uses the exponential.
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    EC_GATE,
+    EC_K_ACC,
+    EC_K_BIAS,
+    EC_K_MAG,
+    EC_K_POS,
+    EC_K_VEL,
+    ES_BIAS,
+    ES_GATED,
+    ES_POS,
+    ES_Q,
+    ES_VEL,
+    ES_W,
+    MS_IMU_F,
+    MS_IMU_W,
+    MS_MAG,
+    MS_MAG_T,
+    MS_POSE,
+    MS_POSE_T,
+    SC_POSE_ATT,
+    V_GRAVITY,
+)
+from ..records import Data, Model
+from ..sensors.rotvec import dcm, error_vector, rotate_by
+from .navigation import integrate_navigation
+
+
+@njit(cache=True)
+def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
+    """Update the estimate ``d.est`` with the sample at ``t`` (s), ``dt`` (s) after the last.
+
+    ``C``: scratch 3x3 (the estimate's rotation on return).
+    """
+    ecfg = m.ecfg
+    est = d.est
+    meas = d.meas
+    g = m.veh[V_GRAVITY]
+    q = est[ES_Q : ES_Q + 4]
+    w = meas[MS_IMU_W : MS_IMU_W + 3]
+    # the errors are measured at the attitude predicted for this sample (the prior
+    # advanced by the gyro minus the bias), so that a consistent sample corrects nothing
+    p0, p1, p2, p3 = q[0], q[1], q[2], q[3]
+    rotate_by(
+        q,
+        (w[0] - est[ES_BIAS]) * dt,
+        (w[1] - est[ES_BIAS + 1]) * dt,
+        (w[2] - est[ES_BIAS + 2]) * dt,
+    )
+    dcm(q, C)
+    f = meas[MS_IMU_F : MS_IMU_F + 3]
+    ex = 0.0
+    ey = 0.0
+    ez = 0.0
+    mx = 0.0
+    my = 0.0
+    mz = 0.0
+    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+    est[ES_GATED] = 1.0
+    if fn > 0.0 and abs(fn - g) <= ecfg[EC_GATE]:
+        est[ES_GATED] = 0.0
+        ax = f[0] / fn
+        ay = f[1] / fn
+        az = f[2] / fn
+        vx = -C[2, 0]
+        vy = -C[2, 1]
+        vz = -C[2, 2]
+        ex = ay * vz - az * vy
+        ey = az * vx - ax * vz
+        ez = ax * vy - ay * vx
+    if meas[MS_MAG_T] == t:
+        mm = meas[MS_MAG : MS_MAG + 3]
+        nn = math.sqrt(mm[0] * mm[0] + mm[1] * mm[1] + mm[2] * mm[2])
+        if nn > 0.0:
+            ux = mm[0] / nn
+            uy = mm[1] / nn
+            uz = mm[2] / nn
+            hx = C[0, 0] * ux + C[0, 1] * uy + C[0, 2] * uz
+            hy = C[1, 0] * ux + C[1, 1] * uy + C[1, 2] * uz
+            hz = C[2, 0] * ux + C[2, 1] * uy + C[2, 2] * uz
+            bx = math.sqrt(hx * hx + hy * hy)
+            wx = C[0, 0] * bx + C[2, 0] * hz
+            wy = C[0, 1] * bx + C[2, 1] * hz
+            wz = C[0, 2] * bx + C[2, 2] * hz
+            mx = uy * wz - uz * wy
+            my = uz * wx - ux * wz
+            mz = ux * wy - uy * wx
+    k_i = ecfg[EC_K_BIAS]
+    est[ES_BIAS] -= k_i * (ex + mx) * dt
+    est[ES_BIAS + 1] -= k_i * (ey + my) * dt
+    est[ES_BIAS + 2] -= k_i * (ez + mz) * dt
+    ka = ecfg[EC_K_ACC]
+    km = ecfg[EC_K_MAG]
+    for a in range(3):
+        est[ES_W + a] = w[a] - est[ES_BIAS + a]
+    wx_c = est[ES_W] + ka * ex + km * mx
+    wy_c = est[ES_W + 1] + ka * ey + km * my
+    wz_c = est[ES_W + 2] + ka * ez + km * mz
+    q[0], q[1], q[2], q[3] = p0, p1, p2, p3
+    rotate_by(q, wx_c * dt, wy_c * dt, wz_c * dt)
+    dcm(q, C)
+    integrate_navigation(est, C, f, g, dt)
+    if meas[MS_POSE_T] == t:
+        kp = ecfg[EC_K_POS]
+        kv = ecfg[EC_K_VEL]
+        for a in range(3):
+            e = meas[MS_POSE + a] - est[ES_POS + a]
+            est[ES_POS + a] += kp * e
+            est[ES_VEL + a] += kv * e
+        if m.scfg[SC_POSE_ATT] > 0.5:
+            px, py, pz = error_vector(q, meas[MS_POSE + 3 : MS_POSE + 7])
+            rotate_by(q, kp * px, kp * py, kp * pz)
+            dcm(q, C)

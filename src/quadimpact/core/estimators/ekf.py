@@ -1,0 +1,307 @@
+"""A multiplicative (error-state) extended Kalman filter.
+
+Nominal state: the attitude ``q_hat`` (body to inertial), the gyro bias
+``b_hat`` and, integrated from the accelerometer, the velocity ``v_hat`` and
+position ``p_hat`` (inertial). Error state: ``dtheta`` (rotation vector, body
+axes, ``q = q_hat (x) exp(dtheta)``), ``db = b - b_hat``, and, when the run has
+a pose sensor (``EC_NAV``), ``dv``, ``dp``: 6 or 12 states, covariance ``P``
+(``est[ES_P]``, 12 x 12 row-major, the first ``n`` rows and columns used).
+
+Prediction at each IMU sample (gyro ``w``, specific force ``f``, ``dt`` since
+the last sample), ``w_hat = w - b_hat``::
+
+    q_hat <- q_hat (x) exp(w_hat dt)
+    Phi   = [[R(w_hat dt)^T, -I dt, 0, 0],
+             [0,              I,    0, 0],
+             [-C_hat [f x] dt, 0,   I, 0],
+             [0,              0,  I dt, I]]
+    P     <- Phi P Phi^T + diag(s_g^2 dt^2 I, s_b^2 dt I, s_a^2 dt^2 I, 0)
+
+(``s_g``: the gyro's white noise per sample, rad/s; ``s_b``: its bias random
+walk, rad/s/sqrt(s); ``s_a``: the accelerometer's noise per sample, m/s^2),
+then velocity and position by ``navigation.py``.
+
+Updates, each a 3-row Kalman update in Joseph form followed by the injection
+``q_hat <- q_hat (x) exp(dtheta)``, ``b_hat += db``, ``v_hat += dv``, ``p_hat += dp``:
+
+* accelerometer as a measurement of gravity, ``f = -g C^T e_Z``:
+  ``H_theta = -g [u x]`` with ``u = C_hat^T e_Z``, noise ``s_grav`` (m/s^2);
+  while ``||f| - g| > gate`` it is skipped (``GATE_SKIP``) or its noise
+  variance multiplied by ``k (||f| - g| / gate)^2`` (``GATE_DEWEIGHT``);
+* magnetometer, ``m = C^T m_I``: ``H_theta = [u_m x]``, ``u_m = C_hat^T m_I``;
+* pose position, ``p_m = p``: ``H_p = I``; pose attitude, the rotation vector
+  from the estimate to the measured attitude: ``H_theta = I``.
+
+The reset's second-order term (``P <- G P G^T``, ``G = I - [dtheta/2 x]``) is
+neglected. All noise figures are parameters (``ecfg``); by default they are
+the sensors' own (with floors, so an ideal IMU does not make ``P`` singular).
+"""
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..layout import (
+    EC_DEWEIGHT,
+    EC_GATE,
+    EC_GATE_MODE,
+    EC_NAV,
+    EC_P0,
+    EC_SIG_ACC,
+    EC_SIG_ATT,
+    EC_SIG_GRAV,
+    EC_SIG_GYRO,
+    EC_SIG_MAG,
+    EC_SIG_POS,
+    EC_SIG_WALK,
+    ES_BIAS,
+    ES_GATED,
+    ES_P,
+    ES_POS,
+    ES_Q,
+    ES_SCRATCH,
+    ES_VEL,
+    ES_W,
+    GATE_DEWEIGHT,
+    MS_IMU_F,
+    MS_IMU_W,
+    MS_MAG,
+    MS_MAG_T,
+    MS_POSE,
+    MS_POSE_T,
+    N_EKF,
+    SC_MAG_FIELD,
+    SC_POSE_ATT,
+    V_GRAVITY,
+)
+from ..records import Data, Model
+from ..sensors.rotvec import dcm, error_vector, rotate_by
+from .navigation import integrate_navigation
+
+
+@njit(cache=True)
+def ekf_dimension(ecfg: np.ndarray) -> int:
+    """Error-state dimension: 12 with the navigation states (a pose sensor), else 6."""
+    return N_EKF if ecfg[EC_NAV] > 0.5 else 6
+
+
+@njit(cache=True)
+def ekf_init(m: Model, d: Data) -> None:
+    """The initial covariance: ``diag(s_att^2, s_bias^2, s_vel^2, s_pos^2)`` (``EC_P0``)."""
+    est = d.est
+    for k in range(N_EKF * N_EKF):
+        est[ES_P + k] = 0.0
+    for k in range(N_EKF):
+        s = m.ecfg[EC_P0 + k // 3]
+        est[ES_P + k * N_EKF + k] = s * s
+
+
+@njit(cache=True)
+def covariance(est: np.ndarray, n: int) -> np.ndarray:
+    """A copy of the covariance's first ``n`` rows and columns (for tests and analysis)."""
+    P = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            P[i, j] = est[ES_P + i * N_EKF + j]
+    return P
+
+
+@njit(cache=True)
+def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool) -> None:
+    """``W[o, :n, :m] = W[a, :n, :k] W[b, :k, :m]`` (``W[b]^T`` when ``bt``), in a fixed
+    order of operations (no BLAS: the same bits on every CPU)."""
+    for i in range(n):
+        for j in range(m):
+            s = 0.0
+            for r in range(k):
+                s += W[a, i, r] * (W[b, j, r] if bt else W[b, r, j])
+            W[o, i, j] = s
+
+
+@njit(cache=True)
+def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: float) -> None:
+    """One 3-row update (Joseph form) of the covariance ``W[0]`` (``n`` states) with the
+    rows ``W[4, :3]`` of ``H``, innovation ``y`` and noise variance ``r``; the correction
+    injected into the nominal state ``est``. ``W[1..3]``, ``W[5]``: scratch."""
+    P, T2, T3, K = W[0], W[2], W[3], W[5]
+    _mul(W, 0, 4, 1, n, n, 3, True)  # P H^T (n x 3)
+    _mul(W, 4, 1, 2, 3, n, 3, False)  # S = H P H^T (3 x 3)
+    for k in range(3):
+        T2[k, k] += r
+    a, b, c = T2[0, 0], T2[0, 1], T2[0, 2]
+    d, e, f = T2[1, 0], T2[1, 1], T2[1, 2]
+    g, h, i = T2[2, 0], T2[2, 1], T2[2, 2]
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    T3[0, 0] = (e * i - f * h) / det
+    T3[0, 1] = -(b * i - c * h) / det
+    T3[0, 2] = (b * f - c * e) / det
+    T3[1, 0] = -(d * i - f * g) / det
+    T3[1, 1] = (a * i - c * g) / det
+    T3[1, 2] = -(a * f - c * d) / det
+    T3[2, 0] = (d * h - e * g) / det
+    T3[2, 1] = -(a * h - b * g) / det
+    T3[2, 2] = (a * e - b * d) / det
+    _mul(W, 1, 3, 5, n, 3, 3, False)  # K = P H^T S^-1 (n x 3)
+    dx = K[:, 3]  # the correction, in K's fourth column
+    dx[:] = 0.0
+    for j in range(n):
+        dx[j] = K[j, 0] * y[0] + K[j, 1] * y[1] + K[j, 2] * y[2]
+    _mul(W, 5, 4, 3, n, 3, n, False)  # K H
+    for j in range(n):
+        for k in range(n):
+            T3[j, k] = (1.0 if j == k else 0.0) - T3[j, k]  # I - K H
+    _mul(W, 3, 0, 1, n, n, n, False)
+    _mul(W, 1, 3, 2, n, n, n, True)  # (I - K H) P (I - K H)^T
+    for j in range(n):
+        for k in range(n):
+            P[j, k] = T2[j, k] + r * (K[j, 0] * K[k, 0] + K[j, 1] * K[k, 1] + K[j, 2] * K[k, 2])
+    rotate_by(est[ES_Q : ES_Q + 4], dx[0], dx[1], dx[2])
+    for a3 in range(3):
+        est[ES_BIAS + a3] += dx[3 + a3]
+        est[ES_VEL + a3] += dx[6 + a3]
+        est[ES_POS + a3] += dx[9 + a3]
+
+
+@njit(cache=True)
+def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.ndarray,
+                f: np.ndarray, dt: float, C: np.ndarray) -> None:  # fmt: skip
+    """The prediction over ``dt`` (s): the attitude and the covariance ``W[0]``.
+
+    ``C``: the estimate's rotation before; ``W[1..3]``: scratch.
+    """
+    P, T1, Phi = W[0], W[1], W[3]
+    wx = w[0] - est[ES_BIAS]
+    wy = w[1] - est[ES_BIAS + 1]
+    wz = w[2] - est[ES_BIAS + 2]
+    for i in range(n):
+        for j in range(n):
+            Phi[i, j] = 1.0 if i == j else 0.0
+    # R(w dt)^T: the rotation of the rotation vector -w dt (into T1's corner)
+    q = est[ES_SCRATCH : ES_SCRATCH + 4]
+    q[0] = 1.0
+    q[1] = 0.0
+    q[2] = 0.0
+    q[3] = 0.0
+    rotate_by(q, -wx * dt, -wy * dt, -wz * dt)
+    dcm(q, T1)
+    for i in range(3):
+        for j in range(3):
+            Phi[i, j] = T1[i, j]
+        Phi[i, 3 + i] = -dt
+    if n == N_EKF:
+        # -C [f x] dt
+        for i in range(3):
+            c0, c1, c2 = C[i, 0], C[i, 1], C[i, 2]
+            Phi[6 + i, 0] = -(c1 * f[2] - c2 * f[1]) * dt
+            Phi[6 + i, 1] = -(c2 * f[0] - c0 * f[2]) * dt
+            Phi[6 + i, 2] = -(c0 * f[1] - c1 * f[0]) * dt
+            Phi[9 + i, 6 + i] = dt
+    _mul(W, 3, 0, 1, n, n, n, False)
+    _mul(W, 1, 3, 0, n, n, n, True)
+    sg = ecfg[EC_SIG_GYRO] * dt
+    sb = ecfg[EC_SIG_WALK]
+    for k in range(3):
+        P[k, k] += sg * sg
+        P[3 + k, 3 + k] += sb * sb * dt
+    if n == N_EKF:
+        sa = ecfg[EC_SIG_ACC] * dt
+        for k in range(3):
+            P[6 + k, 6 + k] += sa * sa
+    rotate_by(est[ES_Q : ES_Q + 4], wx * dt, wy * dt, wz * dt)
+
+
+@njit(cache=True)
+def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
+    """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
+
+    ``C``: scratch 3x3 (the estimate's rotation on return).
+    """
+    ecfg = m.ecfg
+    est = d.est
+    meas = d.meas
+    g = m.veh[V_GRAVITY]
+    n = ekf_dimension(ecfg)
+    # the covariance, scratch, H (rows 0-2; the innovation in row 3), K (columns 0-2; the
+    # correction in column 3)
+    W = np.zeros((6, N_EKF, N_EKF))
+    P = W[0]
+    for i in range(n):
+        for j in range(n):
+            P[i, j] = est[ES_P + i * N_EKF + j]
+    f = meas[MS_IMU_F : MS_IMU_F + 3]
+    w = meas[MS_IMU_W : MS_IMU_W + 3]
+    q = est[ES_Q : ES_Q + 4]
+    dcm(q, C)
+    if dt > 0.0:
+        ekf_predict(est, W, n, ecfg, w, f, dt, C)
+        dcm(q, C)
+        integrate_navigation(est, C, f, g, dt)
+    H = W[4]
+    y = H[3, :3]  # the innovation, in H's fourth row
+    # accelerometer: gravity
+    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+    excess = abs(fn - g)
+    gate = ecfg[EC_GATE]
+    r = ecfg[EC_SIG_GRAV] ** 2
+    use = excess <= gate
+    if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
+        use = True
+        r *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
+    est[ES_GATED] = 0.0 if excess <= gate else 1.0
+    if use:
+        for k in range(3):
+            y[k] = f[k] + g * C[2, k]
+        # H_theta = -g [u x], u = C^T e_Z
+        _skew(H, -g, C[2, 0], C[2, 1], C[2, 2])
+        kalman_update(est, W, n, y, r)
+        dcm(q, C)
+    # magnetometer: H_theta = [u_m x], u_m = C^T m_I
+    if meas[MS_MAG_T] == t:
+        mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
+        u0 = C[0, 0] * mi[0] + C[1, 0] * mi[1] + C[2, 0] * mi[2]
+        u1 = C[0, 1] * mi[0] + C[1, 1] * mi[1] + C[2, 1] * mi[2]
+        u2 = C[0, 2] * mi[0] + C[1, 2] * mi[1] + C[2, 2] * mi[2]
+        y[0] = meas[MS_MAG] - u0
+        y[1] = meas[MS_MAG + 1] - u1
+        y[2] = meas[MS_MAG + 2] - u2
+        _skew(H, 1.0, u0, u1, u2)
+        kalman_update(est, W, n, y, ecfg[EC_SIG_MAG] ** 2)
+        dcm(q, C)
+    # pose sensor: position (H_p = I), attitude (H_theta = I)
+    if meas[MS_POSE_T] == t:
+        if n == N_EKF:
+            _unit(H, 9)
+            for k in range(3):
+                y[k] = meas[MS_POSE + k] - est[ES_POS + k]
+            kalman_update(est, W, n, y, ecfg[EC_SIG_POS] ** 2)
+        if m.scfg[SC_POSE_ATT] > 0.5:
+            _unit(H, 0)
+            y[0], y[1], y[2] = error_vector(q, meas[MS_POSE + 3 : MS_POSE + 7])
+            kalman_update(est, W, n, y, ecfg[EC_SIG_ATT] ** 2)
+        dcm(q, C)
+    for i in range(n):
+        for j in range(n):
+            est[ES_P + i * N_EKF + j] = 0.5 * (P[i, j] + P[j, i])
+    for a in range(3):
+        est[ES_W + a] = w[a] - est[ES_BIAS + a]
+
+
+@njit(cache=True)
+def _skew(H: np.ndarray, s: float, u0: float, u1: float, u2: float) -> None:
+    """``H[:3, :] = [s [u x], 0]``: a measurement of the attitude error alone."""
+    H[:3, :] = 0.0
+    H[0, 1] = -s * u2
+    H[0, 2] = s * u1
+    H[1, 0] = s * u2
+    H[1, 2] = -s * u0
+    H[2, 0] = -s * u1
+    H[2, 1] = s * u0
+
+
+@njit(cache=True)
+def _unit(H: np.ndarray, col: int) -> None:
+    """``H[:3, :]`` selecting the three states from ``col``."""
+    H[:3, :] = 0.0
+    for k in range(3):
+        H[k, col + k] = 1.0

@@ -1,0 +1,364 @@
+"""The estimator registry: every state estimator a scenario can name, and its parameters.
+
+An estimator is a stage of the compiled loop between the sensors and the
+controller (docs/ESTIMATION.md): it predicts at each IMU sample and corrects
+when a measurement arrives; the controllers and the detector's wall-normal
+estimate read only its estimate. A scenario names one (``estimator = "ekf"``)
+and may set its parameters (``[estimator_params]``). Built in:
+
+* ``ideal`` (the default): the true state, the gyro as measured for the rates;
+  every result as before estimators, bit for bit;
+* ``complementary``: a Mahony-type nonlinear complementary filter
+  (:class:`ComplementaryParams`);
+* ``ekf``: a multiplicative error-state extended Kalman filter
+  (:class:`EkfParams`).
+
+A user's compiled estimator plugs in like a controller:
+``register_estimator(name, step=..., params=..., pack=...)`` (the step's
+interface in ``quadimpact.core.estimators.plugin_estimator``); the run loop is
+then compiled around it (``core.run.make_kernel(estimator=...)``) once per
+process.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, Field, ValidationError
+
+from quadimpact.core import layout as L
+from quadimpact.errors import InputError, input_error_from_validation, near_miss
+from quadimpact.inputs.types import MODEL_CONFIG, Real
+
+__all__ = [
+    "ComplementaryParams",
+    "EkfParams",
+    "EstimatorContext",
+    "EstimatorEntry",
+    "EstimatorParams",
+    "estimator_entry",
+    "estimator_names",
+    "register_estimator",
+    "settings_text",
+    "unregister_estimator",
+    "validate_estimator_params",
+]
+
+# floors of the EKF's noise figures, so that an ideal sensor (noise 0) does not make
+# its covariance singular
+GYRO_NOISE_FLOOR = 1e-4  # rad/s
+WALK_FLOOR = 1e-6  # rad/s/sqrt(s)
+ACCEL_NOISE_FLOOR = 1e-2  # m/s^2
+GRAVITY_NOISE_FLOOR = 0.1  # m/s^2
+MAG_NOISE_FLOOR = 1e-3  # unit field
+POSITION_NOISE_FLOOR = 1e-4  # m
+ATTITUDE_NOISE_FLOOR_DEG = 0.01
+BIAS_STD_FLOOR = 1e-3  # rad/s
+INITIAL_ATTITUDE_STD_DEG = 0.5
+
+
+class EstimatorParams(BaseModel):
+    """What every built-in filter shares: the initial estimate's seeded error.
+
+    The initial estimate is the true initial state, gyro bias included (the
+    vehicle has flown before: a filter's bias estimate has converged), plus
+    an error drawn once per run from the run's seed: a rotation vector of
+    standard deviation ``initial_attitude_error_deg`` per axis, and velocity,
+    position and gyro-bias errors of the given standard deviations per axis
+    (0: exact).
+    """
+
+    model_config = MODEL_CONFIG
+
+    initial_attitude_error_deg: Real = Field(0.0, ge=0, description="Std per axis, deg.")
+    initial_velocity_error_m_s: Real = Field(0.0, ge=0, description="Std per axis, m/s.")
+    initial_position_error_m: Real = Field(0.0, ge=0, description="Std per axis, m.")
+    initial_bias_error_rad_s: Real = Field(0.0, ge=0, description="Std per axis, rad/s.")
+
+
+class ComplementaryParams(EstimatorParams):
+    """Gains of the complementary filter (the authors' simulation values by default)."""
+
+    k_acc_1_s: Real = Field(0.25, ge=0, description="Accelerometer gain k_P, 1/s.")
+    k_mag_1_s: Real = Field(0.15, ge=0, description="Magnetometer gain, 1/s.")
+    k_bias_1_s2: Real = Field(0.25, ge=0, description="Bias (integral) gain k_I, 1/s^2.")
+    gate_m_s2: Real = Field(1.0, ge=0, description="Skip the accelerometer while ||f|-g| > this.")
+    k_pose_position: Real = Field(
+        0.1, ge=0, le=1, description="Pose: position (and attitude) gain per measurement."
+    )
+    k_pose_velocity_1_s: Real = Field(
+        0.5, ge=0, description="Pose: velocity gain per measurement, 1/s."
+    )
+
+
+class EkfParams(EstimatorParams):
+    """Noise figures, gate and initial covariance of the EKF.
+
+    A noise left ``None`` is the sensor's own setting (with a small floor, so
+    that an ideal sensor does not make the covariance singular). The
+    accelerometer measures gravity only when the vehicle does not accelerate:
+    a quadrotor's specific force points along its thrust axis, so a tilted
+    vehicle whose thrust is near ``m g`` passes the gate with an error of
+    ``2 g sin(tilt/2)``; ``maneuver_accel_m_s2`` stands for it in the gravity
+    measurement's noise.
+    """
+
+    gyro_noise_rad_s: Real | None = Field(None, ge=0, description="Gyro noise per sample.")
+    gyro_bias_walk_rad_s_sqrt_s: Real | None = Field(
+        None, ge=0, description="Gyro bias random walk, rad/s/sqrt(s)."
+    )
+    accel_noise_m_s2: Real | None = Field(None, ge=0, description="Accel. noise per sample.")
+    gravity_noise_m_s2: Real | None = Field(
+        None,
+        gt=0,
+        description="Std of the accelerometer as a gravity measurement, m/s^2; None: "
+        "sqrt(accel_noise^2 + maneuver_accel^2).",
+    )
+    maneuver_accel_m_s2: Real = Field(
+        4.0,
+        ge=0,
+        description="The vehicle's own acceleration the gate lets through, m/s^2 (a tilt of "
+        "about 25 deg at hover thrust).",
+    )
+    magnetometer_noise: Real | None = Field(None, gt=0, description="Unit field.")
+    pose_position_noise_m: Real | None = Field(None, gt=0, description="m.")
+    pose_attitude_noise_deg: Real | None = Field(None, gt=0, description="deg.")
+    gate_m_s2: Real = Field(0.5, ge=0, description="Gate on ||f| - g|, m/s^2 (authors: 0.5).")
+    gate: Literal["skip", "deweight"] = Field(
+        "skip", description="Beyond the gate: skip the update, or de-weight it."
+    )
+    deweight: Real = Field(
+        1.0, gt=0, description="De-weighting: variance times this (||f|-g| / gate)^2."
+    )
+    initial_attitude_std_deg: Real | None = Field(
+        None, gt=0, description="Initial std, deg; None: the initial error's std, at least 0.5."
+    )
+    initial_bias_std_rad_s: Real | None = Field(
+        None, gt=0, description="Initial bias std, rad/s; None: the initial error's, >= 1e-3."
+    )
+    initial_velocity_std_m_s: Real | None = Field(
+        None, gt=0, description="m/s (with a pose sensor); None: the initial error's, >= 0.01."
+    )
+    initial_position_std_m: Real | None = Field(
+        None, gt=0, description="m (with a pose sensor); None: the initial error's, >= 0.01."
+    )
+
+
+class _NoParams(BaseModel):
+    model_config = MODEL_CONFIG
+
+
+@dataclass(frozen=True)
+class EstimatorContext:
+    """What a packer may need besides its parameters: the run's sensors.
+
+    ``imu``: :class:`~quadimpact.inputs.sensors.ResolvedImu`; ``magnetometer``
+    and ``pose_sensor``: their settings or ``None``; ``vehicle``.
+    """
+
+    imu: Any
+    magnetometer: Any = None
+    pose_sensor: Any = None
+    vehicle: Any = None
+
+
+@dataclass(frozen=True)
+class EstimatorEntry:
+    """One registered estimator.
+
+    Attributes
+    ----------
+    name : str
+        As written in scenario files and on the command line.
+    kind : int
+        ``ecfg[EC_KIND]``: a built-in ``EST_*`` id, or ``EST_USER`` for a plug-in.
+    params : type of pydantic.BaseModel
+        Its parameters (``[estimator_params]``), with defaults.
+    pack : callable
+        ``pack(params, context) -> ndarray (NECFG,)``: its settings (the kind and
+        the initial error are filled in by the caller).
+    step : callable or None
+        The compiled step of a plug-in (``None`` for built-ins).
+    description : str
+        One line for help texts.
+    """
+
+    name: str
+    kind: int
+    params: type[BaseModel]
+    pack: Callable[[BaseModel, EstimatorContext], np.ndarray]
+    step: Callable | None = None
+    description: str = ""
+    kernel_cache: dict = field(default_factory=dict, compare=False, repr=False)
+
+
+def _empty(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    return np.zeros(L.NECFG)
+
+
+def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: ComplementaryParams = params  # type: ignore[assignment]
+    e = np.zeros(L.NECFG)
+    e[L.EC_K_ACC] = p.k_acc_1_s
+    e[L.EC_K_MAG] = p.k_mag_1_s
+    e[L.EC_K_BIAS] = p.k_bias_1_s2
+    e[L.EC_GATE] = p.gate_m_s2
+    e[L.EC_K_POS] = p.k_pose_position
+    e[L.EC_K_VEL] = p.k_pose_velocity_1_s
+    return e
+
+
+def _or(value: float | None, default: float, floor: float) -> float:
+    return float(value) if value is not None else max(float(default), floor)
+
+
+def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: EkfParams = params  # type: ignore[assignment]
+    imu = ctx.imu
+    mag = ctx.magnetometer
+    pose = ctx.pose_sensor
+    e = np.zeros(L.NECFG)
+    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
+    e[L.EC_SIG_WALK] = _or(
+        p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
+    )
+    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
+    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
+    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
+    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
+    e[L.EC_SIG_POS] = _or(
+        p.pose_position_noise_m, pose.position_noise_m if pose else 0.0, POSITION_NOISE_FLOOR
+    )
+    att = p.pose_attitude_noise_deg
+    e[L.EC_SIG_ATT] = math.radians(
+        _or(att, pose.attitude_noise_deg if pose else 0.0, ATTITUDE_NOISE_FLOOR_DEG)
+    )
+    e[L.EC_GATE] = p.gate_m_s2
+    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
+    e[L.EC_DEWEIGHT] = p.deweight
+    e[L.EC_P0] = math.radians(
+        _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
+    )
+    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
+    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
+    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
+    e[L.EC_NAV] = 1.0 if pose is not None else 0.0
+    return e
+
+
+_REGISTRY: dict[str, EstimatorEntry] = {}
+BUILTIN = ("ideal", "complementary", "ekf")
+
+
+def register_estimator(
+    name: str,
+    step: Callable | None = None,
+    *,
+    params: type[BaseModel] | None = None,
+    pack: Callable[[BaseModel, EstimatorContext], np.ndarray] | None = None,
+    kind: int | None = None,
+    description: str = "",
+    replace: bool = False,
+) -> EstimatorEntry:
+    """Make an estimator selectable by ``name`` in scenarios, sweeps and the CLI.
+
+    Parameters
+    ----------
+    name : str
+        Its name (letters, digits, ``-`` and ``_``).
+    step : callable, optional
+        A Numba ``njit`` step ``step(t, dt, meas, ecfg, est)`` (a plug-in,
+        ``quadimpact.core.estimators.plugin_estimator``); omit for a built-in
+        (then give ``kind``).
+    params : pydantic model class, optional
+        Its parameters with defaults (default: none).
+    pack : callable, optional
+        ``pack(params, context) -> ndarray (NECFG,)``; a plug-in's own
+        parameters go to ``ecfg[EC_USER : EC_USER + N_USER_ECFG]`` (default: zeros).
+    kind : int, optional
+        A built-in ``EST_*`` id of the cached kernel.
+    description : str, optional
+        One line for help texts.
+    replace : bool, optional
+        Replace an entry of the same name instead of refusing.
+    """
+    if not name or not all(c.isalnum() or c in "-_" for c in name):
+        raise ValueError(f"estimator name {name!r}: letters, digits, '-' and '_' only")
+    if name in _REGISTRY and not replace:
+        raise ValueError(f"estimator {name!r} is already registered (replace=True to replace)")
+    if step is None and kind is None:
+        raise ValueError(f"estimator {name!r}: give its compiled step (or a built-in kind)")
+    entry = EstimatorEntry(
+        name=name,
+        kind=L.EST_USER if kind is None else int(kind),
+        params=params or _NoParams,
+        pack=pack or _empty,
+        step=step,
+        description=description,
+    )
+    _REGISTRY[name] = entry
+    return entry
+
+
+def unregister_estimator(name: str) -> None:
+    """Remove a registered estimator (built-ins cannot be removed)."""
+    if name in BUILTIN:
+        raise ValueError(f"estimator {name!r} is built in")
+    _REGISTRY.pop(name, None)
+
+
+def estimator_names() -> tuple[str, ...]:
+    """Names of every registered estimator, built-ins first."""
+    return tuple(_REGISTRY)
+
+
+def estimator_entry(name: str) -> EstimatorEntry:
+    """The registry entry of ``name`` (``InputError`` for an unknown one)."""
+    try:
+        return _REGISTRY[name]
+    except (KeyError, TypeError):
+        known = ", ".join(repr(n) for n in _REGISTRY)
+        close = near_miss(str(name), list(_REGISTRY))
+        hint = f"; did you mean {close!r}?" if close else ""
+        raise InputError(f"estimator: must be one of {known} (got {name!r}){hint}") from None
+
+
+def validate_estimator_params(name: str, values: Mapping[str, Any] | BaseModel | None):
+    """The validated parameters of estimator ``name`` (defaults for what is not given)."""
+    entry = estimator_entry(name)
+    if isinstance(values, entry.params):
+        return values
+    try:
+        return entry.params.model_validate(dict(values or {}))
+    except ValidationError as exc:
+        raise input_error_from_validation(
+            exc, prefix=("estimator_params",), model=entry.params
+        ) from None
+
+
+def settings_text(params: BaseModel) -> str:
+    """The parameters as one line ``name=value, ...`` (the summary's ``estimator_settings``)."""
+    return ", ".join(f"{k}={v}" for k, v in params.model_dump(mode="json").items())
+
+
+register_estimator(
+    "ideal", kind=L.EST_IDEAL, description="the true state (the default; results as before)"
+)
+register_estimator(
+    "complementary",
+    kind=L.EST_COMPLEMENTARY,
+    params=ComplementaryParams,
+    pack=_pack_complementary,
+    description="Mahony-type complementary filter with the accelerometer gate",
+)
+register_estimator(
+    "ekf",
+    kind=L.EST_EKF,
+    params=EkfParams,
+    pack=_pack_ekf,
+    description="multiplicative error-state EKF: attitude, gyro bias (+ velocity, position)",
+)

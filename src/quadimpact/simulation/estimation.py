@@ -1,0 +1,136 @@
+"""The run's added sensors and its estimator as the compiled core's arrays.
+
+:func:`pack_estimation` fills the added sensors' slots of ``scfg`` (the IMU's
+impact disturbance and gyro bias random walk, the magnetometer, the pose
+sensor: layout ``SC_*``), draws their noise (``snoise``, layout ``SN_*``) and
+packs the estimator (``ecfg``, layout ``EC_*``) with its seeded initial error.
+
+Random draws never touch the IMU's own (``packing.pack_sensors``: NumPy's
+PCG64 seeded with the run's seed): the added sensors draw from the stream
+``SeedSequence(seed, spawn_key=(SENSOR_STREAM,))``, one row of ``NSN``
+standard normal numbers per IMU sample, only when one of them needs noise;
+the initial estimate's error from ``SeedSequence(seed, spawn_key=(INIT_STREAM,))``
+(twelve numbers: attitude, velocity, position, gyro bias), only when it is
+asked for.
+So a run's table is the same on one core or a cluster, and adding a sensor
+does not change the IMU's noise.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from quadimpact.core import layout as L
+from quadimpact.inputs.estimators import (
+    EstimatorContext,
+    EstimatorParams,
+    estimator_entry,
+    settings_text,
+)
+from quadimpact.inputs.sensors import ResolvedImu
+
+__all__ = ["Estimation", "pack_estimation"]
+
+SENSOR_STREAM = 1
+INIT_STREAM = 2
+
+
+@dataclass
+class Estimation:
+    """The packed estimator and added sensors of a run (and what the summary reports)."""
+
+    ecfg: np.ndarray
+    snoise: np.ndarray
+    name: str
+    settings: str
+    step: Any = None  # a plug-in estimator's compiled step
+    resolved: dict[str, Any] | None = None
+
+
+def _stream(seed: int, key: int) -> np.random.Generator:
+    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(key,))))
+
+
+def pack_estimation(
+    s: Any, imu: ResolvedImu, scfg: np.ndarray, n_imu: int, vehicle: Any
+) -> Estimation:
+    """Fill ``scfg``'s added-sensor slots (in place); the estimator and the added draws.
+
+    ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU;
+    ``n_imu``: the IMU samples the run takes at most.
+    """
+    rate = float(imu.rate_hz)
+    dist = imu.impact_disturbance
+    if dist is not None:
+        scfg[L.SC_IMPACT_F] = dist.accel_m_s2
+        scfg[L.SC_IMPACT_W] = dist.gyro_rad_s
+        scfg[L.SC_IMPACT_TAU] = dist.time_constant_s
+    scfg[L.SC_BIAS_WALK] = imu.gyro_bias_walk_rad_s_sqrt_s
+    mag = s.magnetometer
+    if mag is not None:
+        dip = math.radians(mag.dip_deg)
+        scfg[L.SC_MAG] = 1.0
+        scfg[L.SC_MAG_FIELD : L.SC_MAG_FIELD + 3] = (math.cos(dip), 0.0, math.sin(dip))
+        scfg[L.SC_MAG_NOISE] = mag.noise
+    pose = s.pose_sensor
+    if pose is not None:
+        scfg[L.SC_POSE] = 1.0
+        scfg[L.SC_POSE_RATE] = pose.rate_hz
+        scfg[L.SC_POSE_NOISE_P] = pose.position_noise_m
+        scfg[L.SC_POSE_ATT] = 1.0 if pose.attitude else 0.0
+        scfg[L.SC_POSE_NOISE_A] = math.radians(pose.attitude_noise_deg)
+        scfg[L.SC_POSE_LAG] = min(round(pose.latency_s * rate), L.MAX_POSE_LAG - 1)
+    noisy = (
+        (dist is not None and (dist.accel_m_s2 > 0.0 or dist.gyro_rad_s > 0.0))
+        or imu.gyro_bias_walk_rad_s_sqrt_s > 0.0
+        or (mag is not None and mag.noise > 0.0)
+        or (
+            pose is not None
+            and (pose.position_noise_m > 0.0 or (pose.attitude and pose.attitude_noise_deg > 0.0))
+        )
+    )
+    snoise = np.zeros((0, L.NSN))
+    if noisy:
+        snoise = _stream(s.seed, SENSOR_STREAM).standard_normal((n_imu, L.NSN))
+
+    entry = estimator_entry(s.estimator)
+    params = s.resolved_estimator_params()
+    context = EstimatorContext(imu=imu, magnetometer=mag, pose_sensor=pose, vehicle=vehicle)
+    ecfg = np.array(entry.pack(params, context), dtype=float)
+    if ecfg.shape != (L.NECFG,):
+        raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
+    ecfg[L.EC_KIND] = entry.kind
+    if isinstance(params, EstimatorParams) and entry.kind != L.EST_IDEAL:
+        std = np.repeat(
+            [
+                math.radians(params.initial_attitude_error_deg),
+                params.initial_velocity_error_m_s,
+                params.initial_position_error_m,
+                params.initial_bias_error_rad_s,
+            ],
+            3,
+        )
+        if np.any(std > 0.0):
+            draws = _stream(s.seed, INIT_STREAM).standard_normal(12) * std
+            ecfg[L.EC_INIT_ATT : L.EC_INIT_ATT + 3] = draws[0:3]
+            ecfg[L.EC_INIT_VEL : L.EC_INIT_VEL + 3] = draws[3:6]
+            ecfg[L.EC_INIT_POS : L.EC_INIT_POS + 3] = draws[6:9]
+            ecfg[L.EC_INIT_BIAS : L.EC_INIT_BIAS + 3] = draws[9:12]
+    return Estimation(
+        ecfg=ecfg,
+        snoise=snoise,
+        name=entry.name,
+        settings=settings_text(params),
+        step=entry.step,
+        resolved={
+            "estimator": entry.name,
+            "estimator_params": params.model_dump(mode="json"),
+            "magnetometer": mag.model_dump(mode="json") if mag is not None else None,
+            "pose_sensor": pose.model_dump(mode="json") if pose is not None else None,
+            "sensors": s.sensors,
+        },
+    )

@@ -1,0 +1,61 @@
+"""Estimation metrics of a run (docs/ESTIMATION.md 4): the estimate's errors by phase.
+
+The loop accumulates, at every IMU sample, each error of the estimate
+against the truth (``core/estimators/errors.py``): the attitude error (the
+angle of ``q_hat (x) q^-1``, deg), the velocity error (``|v_hat - v|``, m/s,
+inertial CM velocity), the gyro-bias error (``|b_hat - b|``, rad/s) and the
+position error (``|p_hat - p|``, m), in three phases: ``pre`` (before the
+first contact with an obstacle), ``crash`` (from it to the entry into stage 4
+of the recovery controller, or to the end), ``post`` (after stage 4). This
+module turns the sums into the RMS and the maximum of each (``None`` for a
+phase without samples), and the attitude error's RMS over the whole run.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from quadimpact.core import layout as L
+
+__all__ = ["ESTIMATION_KEYS", "PHASES", "QUANTITIES", "estimation_metrics"]
+
+#: (name in the keys, unit suffix) of the four errors, in the loop's order.
+QUANTITIES: tuple[tuple[str, str], ...] = (
+    ("attitude", "deg"),
+    ("velocity", "m_s"),
+    ("bias", "rad_s"),
+    ("position", "m"),
+)
+#: The phases, in the loop's order.
+PHASES: tuple[str, ...] = ("pre", "crash", "post")
+
+ESTIMATION_KEYS: tuple[str, ...] = (
+    *(
+        f"est_{q}_{stat}_{phase}_{unit}"
+        for q, unit in QUANTITIES
+        for phase in PHASES
+        for stat in ("rms", "max")
+    ),
+    "est_attitude_rms_run_deg",
+)
+"""The metric keys, in summary order (``est_attitude_rms_pre_deg`` ...)."""
+
+
+def estimation_metrics(st: np.ndarray) -> dict[str, Any]:
+    """RMS and maximum of each error in each phase, from the kernel's stats (``ST_EST_ERR``)."""
+    out: dict[str, Any] = {}
+    for k, (q, unit) in enumerate(QUANTITIES):
+        for p, phase in enumerate(PHASES):
+            j = L.ST_EST_ERR + 3 * (L.N_PHASES * k + p)
+            n = float(st[j + 2])
+            ok = n > 0 and math.isfinite(float(st[j]))
+            out[f"est_{q}_rms_{phase}_{unit}"] = math.sqrt(float(st[j]) / n) if ok else None
+            out[f"est_{q}_max_{phase}_{unit}"] = float(st[j + 1]) if ok else None
+    j = L.ST_EST_ERR
+    sq = sum(float(st[j + 3 * p]) for p in range(L.N_PHASES))
+    n = sum(float(st[j + 3 * p + 2]) for p in range(L.N_PHASES))
+    out["est_attitude_rms_run_deg"] = math.sqrt(sq / n) if n > 0 and math.isfinite(sq) else None
+    return out
