@@ -29,6 +29,9 @@ _FLAGS: dict[str, tuple[str, str]] = {
     "impact_time": ("impact_time_s", "--impact-time"),
     "wall_distance": ("wall_distance_m", "--wall-distance"),
     "altitude": ("altitude_m", "--altitude"),
+    "start_altitude": ("start_altitude_m", "--start-altitude"),
+    "roll": ("roll_deg", "--roll"),
+    "pitch": ("pitch_deg", "--pitch"),
     "final_time": ("final_time_s", "--final-time"),
     "model": ("model", "--model"),
     "controller": ("controller", "--controller"),
@@ -47,6 +50,9 @@ _WALL_ONLY = {
     "impact_time_s",
     "wall_distance_m",
     "altitude_m",
+    "start_altitude_m",
+    "roll_deg",
+    "pitch_deg",
 }
 #: Exit status of a run whose status is "failed" (numerical failure; see ``run --help``).
 EXIT_RUN_FAILED = 3
@@ -90,6 +96,23 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
 @_flag(
     "--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]"
 )
+@_flag(
+    "--start-altitude",
+    "M",
+    "Initial altitude when it differs from the set-point, m (>= 0): the controller climbs "
+    "(or descends) toward --altitude on the way to the wall, as in the authors' crash runs. "
+    "[default: the set-point]",
+)
+@_flag(
+    "--roll",
+    "DEG",
+    "With --pitch: an explicit attitude held on the approach (ZYX roll and pitch, yaw = "
+    "--heading) instead of --inclination; the thrust may then push across the wall, so the "
+    "vehicle drifts sideways (an impact trial: its initial roll). [default: from the "
+    "inclination]",
+)
+@_flag("--pitch", "DEG", "With --roll: the explicit pitch, deg (ZYX). [default: from the "
+       "inclination]")
 @_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--model",
@@ -103,10 +126,11 @@ def _flag(flag: str, metavar: str | None, help: str) -> Any:
     "options",
     multiple=True,
     metavar="NAME=VALUE",
-    help="Change one switch of the model variant (repeatable), e.g. crash_rule=cm-ground. "
-    "Switches: yaw_reaction, spinup_reaction, bumper1_yaw_twice, initial_rotor_speeds, "
-    "attitude_mapping, crash_rule, approach_start, detection_tick_reference, "
-    "contact_gate_m, pre_impact (docs/VARIANTS.md).",
+    help="Change one switch of the model variant (repeatable), e.g. crash_rule=cm-ground, "
+    "cut_step_motors=[2] or bumper_force_scale=1,2,1,1. Switches: yaw_reaction, spinup_reaction, "
+    "bumper1_yaw_twice, initial_rotor_speeds, attitude_mapping, crash_rule, approach_start, "
+    "detection_tick_reference, contact_gate_m, pre_impact, cut_step_motors, "
+    "bumper_force_scale (docs/VARIANTS.md).",
 )
 @click.option(
     "--controller",
@@ -216,15 +240,30 @@ def run(
         click.get_current_context().exit(EXIT_RUN_FAILED)
 
 
+def _option_value(text: str) -> Any:
+    """An ``--option`` value: ``true``/``false``, a number, a list (``[2]``, ``1,2,1,1``), or
+    the text itself."""
+    import json
+
+    low = text.lower()
+    if low in ("true", "false"):
+        return low == "true"
+    candidate = f"[{text}]" if "," in text and not text.startswith("[") else text
+    try:
+        value = json.loads(candidate)
+    except ValueError:
+        return text
+    return value if isinstance(value, (int, float, list)) else text
+
+
 def _parse_options(options: tuple[str, ...]) -> dict[str, Any]:
-    """``NAME=VALUE`` pairs of ``--option`` to a dict (``true``/``false`` become bools)."""
+    """``NAME=VALUE`` pairs of ``--option`` to a dict (:func:`_option_value`)."""
     parsed: dict[str, Any] = {}
     for item in options:
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             raise InputError(f"--option: must be NAME=VALUE (got {item!r})")
-        text = value.strip()
-        parsed[name.strip()] = {"true": True, "false": False}.get(text.lower(), text)
+        parsed[name.strip()] = _option_value(value.strip())
     return parsed
 
 

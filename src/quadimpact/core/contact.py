@@ -11,7 +11,9 @@ this module turns those records into forces:
 * optional regularised Coulomb friction ``-mu F_n v_t / sqrt(|v_t|^2 + v_reg^2)``
   opposing the contact point's sliding velocity ``v_t``;
 * the wrench of all active bumper-surface pairs about the CM (body axes), with
-  the paper replica's error of counting bumper 1's yaw moment twice as a switch;
+  the paper replica's error of counting bumper 1's yaw moment twice as a switch,
+  and a per-bumper factor on the normal force (``O_BUMPER_FORCE_SCALE``: the
+  authors' hand modification of one crash run, bumper 2's force doubled);
 * the contact *gap* that the event locator watches: ``delta`` itself, or, with
   the recovery replica's broad-phase gate, ``min(delta, gate - d_CM)`` so that
   the force switches on only once the CM is within ``gate`` of the surface.
@@ -28,6 +30,7 @@ from .geometry import bumper_contact, surface_distance
 from .layout import (
     CS_ACTIVE,
     CS_LAMBDA,
+    O_BUMPER_FORCE_SCALE,
     O_CONTACT_GATE,
     O_DOUBLE_BUMPER1_YAW,
     O_MU,
@@ -55,6 +58,16 @@ def normal_force(veh: np.ndarray, delta: float, delta_dot: float, lam: float) ->
     dn = delta ** veh[V_N]
     f = veh[V_K] * dn + lam * dn * delta_dot
     return f if f > 0.0 else 0.0
+
+
+@njit(cache=True)
+def bumper_force(
+    veh: np.ndarray, opts: np.ndarray, j: int, delta: float, delta_dot: float, lam: float
+) -> float:
+    """Normal force (N) of bumper ``j``: :func:`normal_force` times the bumper's factor
+    ``opts[O_BUMPER_FORCE_SCALE + j]`` (``<= 0``: 1, the law unchanged)."""
+    s = opts[O_BUMPER_FORCE_SCALE + j]
+    return normal_force(veh, delta, delta_dot, lam) * (s if s > 0.0 else 1.0)
 
 
 @njit(cache=True)
@@ -127,7 +140,7 @@ def contact_wrench(
             continue
         j = c % 4
         d, dd, rx, ry, rz, vcx, vcy, vcz, nx, ny, nz = bumper_contact(x, C, veh, j, surf, c // 4)
-        fn = normal_force(veh, d, dd, cs[c, CS_LAMBDA])
+        fn = bumper_force(veh, opts, j, d, dd, cs[c, CS_LAMBDA])
         if fn <= 0.0:
             continue
         gx = fn * nx

@@ -77,10 +77,13 @@ O_POWER_OFF_T = 17  # s, power-off trigger time (< 0: at the first contact; inf:
 O_STOP_ON_CRASH = 18  # 1: end the run at the crash
 O_SPINUP_PAPER = 19  # 1: spin-up reaction -Jr sum_j Omega_dot_j (no spin sign; paper replica)
 O_CONTACT_GATE = 20  # m; > 0: contact forces act only while the CM is within this of the plane
-NOPT = 21
+O_CUT_STEP_MOTORS = 21  # bit j-1 set: a power-off schedule cuts motor j at the first tick after
+#                         its trigger, as a one-tick command step (actuators.cut_step)
+O_BUMPER_FORCE_SCALE = 22  # 4: per-bumper factor on the contact force (<= 0: 1, unscaled)
+NOPT = 26
 
 CRASH_CM_GROUND = 0  # event: CM altitude crosses O_CRASH_ALTITUDE (default 0)
-CRASH_PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at control ticks only
+CRASH_PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at the control ticks after the start
 CRASH_NONE = 2  # no crash plane (ground may be a contact surface)
 
 ROTOR_IDEAL = 0

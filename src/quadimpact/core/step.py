@@ -40,8 +40,8 @@ import math
 import numpy as np
 from numba import njit
 
-from .actuators import apply_command, apply_segment, next_boundary, segment_at
-from .contact import contact_gap, damping_coefficient, normal_force
+from .actuators import apply_command, apply_segment, cut_step, next_boundary, segment_at
+from .contact import bumper_force, contact_gap, damping_coefficient
 from .controllers import builtin_step
 from .dynamics import state_derivative
 from .events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
@@ -182,6 +182,7 @@ def _write_sample(
     rin: np.ndarray,
     stage: float,
     out: np.ndarray,
+    opts: np.ndarray,
 ) -> None:
     """One output row: time, state, per-bumper deflection and force, command, stage."""
     out[row, OUT_T] = t
@@ -199,7 +200,7 @@ def _write_sample(
         if d > out[row, OUT_DELTA + j]:
             out[row, OUT_DELTA + j] = d
         if cs[c, CS_ACTIVE] > 0.5:
-            out[row, OUT_FORCE + j] += normal_force(veh, d, dd, cs[c, CS_LAMBDA])
+            out[row, OUT_FORCE + j] += bumper_force(veh, opts, j, d, dd, cs[c, CS_LAMBDA])
 
 
 @njit(cache=True)
@@ -230,6 +231,7 @@ def _observe(
     veh: np.ndarray,
     surf: np.ndarray,
     lam: float,
+    opts: np.ndarray,
 ) -> float:
     """Track episode ``e``'s peaks with pair ``c`` at ``t_old + sigma h`` (dense output).
 
@@ -238,7 +240,7 @@ def _observe(
     dense_eval(x_old, Q, h, sigma, xs)
     rotation_matrix(xs[X_QUAT : X_QUAT + 4], C)
     d, dd = bumper_depth(xs, C, veh, c % 4, surf, c // 4)
-    _track_peak(episodes, e, t_old + sigma * h, d, normal_force(veh, d, dd, lam))
+    _track_peak(episodes, e, t_old + sigma * h, d, bumper_force(veh, opts, c % 4, d, dd, lam))
     return dd
 
 
@@ -342,7 +344,7 @@ def start(
     C = np.zeros((3, 3))
     i_out = 0
     while i_out < t_out.shape[0] and t_out[i_out] <= t0:
-        _write_sample(i_out, t_out[i_out], x, C, veh, surf, cs, rin, 0.0, out)
+        _write_sample(i_out, t_out[i_out], x, C, veh, surf, cs, rin, 0.0, out, opts)
         i_out += 1
     stats[ST_N_OUT] = i_out
     if sst[SS_NEXT_T] <= t0:
@@ -480,7 +482,7 @@ def tick(
     t_next = min(t0 + (k + 1) * dt_c, tf)
     t = t_k
     normalise_quaternion(x, X_QUAT)
-    if crash_rule == CRASH_PAPER_TICKS and -x[X_POS + 2] <= crash_level:
+    if crash_rule == CRASH_PAPER_TICKS and k > 0 and -x[X_POS + 2] <= crash_level:
         _record_crash(t, x, stats)
         ls[LS_DONE] = 1.0
         return
@@ -501,6 +503,7 @@ def tick(
         for i in range(3):
             stats[ST_STAGE_X + 3 * si + i] = x[X_POS + i]
     apply_command(cmd, x, rin, opts, dt_c, po_active)
+    cut_step(x, rin, opts, t0, k, dt_c, po_active, po_t)
     _contact_values(x, C, veh, surf, opts, g_a, gd_a)
     fsal = False
     # ---- integrate [t_k, t_next], cut at schedule boundaries ----
@@ -519,7 +522,7 @@ def tick(
                     if sched_stop[j] > 0.5:
                         x[X_ROTOR + j] = 0.0
             po_seg = segment_at(t + tiny, po_t, sched_t)
-            apply_segment(x, sched_rate, po_seg, rin)
+            apply_segment(x, sched_rate, po_seg, rin, opts)
             t_sched = next_boundary(t, x, po_t, sched_t, po_seg, rin)
             fsal = False
         t_stop = min(t_next, t_sched)
@@ -617,7 +620,8 @@ def tick(
             while i_out < n_out_max and t_out[i_out] <= t_b:
                 sm = (t_out[i_out] - t) / h_try
                 dense_eval(x, Q, h_try, sm, xs)
-                _write_sample(i_out, t_out[i_out], xs, C, veh, surf, cs, rin, ls[LS_STAGE], out)
+                _write_sample(i_out, t_out[i_out], xs, C, veh, surf, cs, rin, ls[LS_STAGE], out,
+                              opts)  # fmt: skip
                 i_out += 1
             while sst[SS_NEXT_T] <= t_b:
                 ts = sst[SS_NEXT_T]
@@ -637,13 +641,14 @@ def tick(
                 if cs[c, CS_ACTIVE] < 0.5 or e < 0:
                     continue
                 lam = cs[c, CS_LAMBDA]
-                rate_end = _observe(episodes, e, c, sig_min, t, h_try, x, Q, xs, C, veh, surf, lam)
+                rate_end = _observe(episodes, e, c, sig_min, t, h_try, x, Q, xs, C, veh, surf, lam,
+                                    opts)  # fmt: skip
                 # the force peaks before the deflection: look half-way too
-                _observe(episodes, e, c, 0.5 * sig_min, t, h_try, x, Q, xs, C, veh, surf, lam)
+                _observe(episodes, e, c, 0.5 * sig_min, t, h_try, x, Q, xs, C, veh, surf, lam, opts)
                 if gd_a[c] > 0.0 and rate_end <= 0.0 and sig_min > 0.0:
                     sp = locate(EV_RATE, c, x, Q, h_try, gd_a[c], rate_end, sig_min, ev_tol,
                                 xs, C, veh, surf, opts, 0.0)  # fmt: skip
-                    _observe(episodes, e, c, sp, t, h_try, x, Q, xs, C, veh, surf, lam)
+                    _observe(episodes, e, c, sp, t, h_try, x, Q, xs, C, veh, surf, lam, opts)
             if sig_crash <= sig_min:
                 _record_crash(t_b, x_b, stats)
                 if stop_on_crash:

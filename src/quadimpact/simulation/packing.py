@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.actuators import MOTOR_OFF
 from quadimpact.inputs.controllers import ControllerEntry, PackContext
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
@@ -235,6 +236,33 @@ def pack_options(
     opts[L.O_EVENT_TOL] = EVENT_TOL_S
     opts[L.O_POWER_OFF_T] = np.inf
     return opts
+
+
+def pack_crash_run_options(
+    opts: np.ndarray, cut_step_motors: Sequence[int], bumper_force_scale: Sequence[float]
+) -> None:
+    """The switches of the authors' crash runs into ``opts`` (docs/VARIANTS.md 2).
+
+    ``O_CUT_STEP_MOTORS``: the motors (1-4) cut at the first tick after a
+    power-off trigger, as bits (motor ``j``: bit ``j - 1``);
+    ``O_BUMPER_FORCE_SCALE``: the factor on each bumper's contact force.
+    """
+    opts[L.O_CUT_STEP_MOTORS] = float(sum(1 << (m - 1) for m in set(cut_step_motors)))
+    opts[L.O_BUMPER_FORCE_SCALE : L.O_BUMPER_FORCE_SCALE + 4] = bumper_force_scale
+
+
+def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -> np.ndarray:
+    """A power-off schedule's rates as the kernel takes them, rad/s^2.
+
+    With ``zero_rate = "off"`` a rate of exactly 0 (or -0) is the motor
+    switched off over the segment (``core.actuators.MOTOR_OFF``: its speed 0
+    from the segment's start); with ``"hold"`` it keeps its speed.
+    """
+    rpm = np.asarray(rates_rpm_per_s, dtype=float).reshape(-1, 4)
+    rates = rpm * RPM
+    if zero_rate == "off":
+        rates[rpm == 0.0] = MOTOR_OFF
+    return rates
 
 
 def pack_sensors(

@@ -29,10 +29,12 @@ from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
     RPM,
     pack_controller,
+    pack_crash_run_options,
     pack_options,
     pack_sensors,
     pack_surfaces,
     pack_vehicle,
+    schedule_rates,
     trim_rotor_speeds,
 )
 
@@ -122,6 +124,8 @@ def _packed_options(
         crash_rule, level, stop = L.CRASH_NONE, 0.0, False
     elif o.crash_rule == "paper-ticks":
         crash_rule, level, stop = L.CRASH_PAPER_TICKS, PAPER_CRASH_ALTITUDE_M, True
+    elif o.crash_rule == "ground-ticks":
+        crash_rule, level, stop = L.CRASH_PAPER_TICKS, 0.0, True
     else:
         crash_rule, level, stop = L.CRASH_CM_GROUND, 0.0, True
     limits = None
@@ -144,6 +148,7 @@ def _packed_options(
         atol=s.atol,
         duration_s=duration_s,
     )
+    pack_crash_run_options(opts, o.cut_step_motors, o.bumper_force_scale)
     if s.power_off is not None:
         trigger = s.power_off.trigger
         opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
@@ -159,7 +164,7 @@ def _schedule(s: RunSettings) -> dict[str, np.ndarray]:
         stop[m - 1] = 1.0
     return {
         "sched_t": np.asarray(s.power_off.segment_start_s, dtype=float),
-        "sched_rate": np.asarray(s.power_off.rates_rpm_per_s, dtype=float) * RPM,
+        "sched_rate": schedule_rates(s.power_off.rates_rpm_per_s, s.power_off.zero_rate),
         "sched_stop": stop,
     }
 
