@@ -273,6 +273,10 @@ def reproduce(
     ablation_df = pd.DataFrame(ablation_rows)
     findings = findings_frame(found)
     table3 = write_table3(crash_rows, exp_out) if experiments else None
+    table3_extras = [
+        pd.read_parquet(exp_out / f"{name}.parquet") if experiments else None
+        for name in ("table3_runs", "table3_switches")
+    ]
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
 
@@ -290,7 +294,7 @@ def reproduce(
     report = out / "report.md"
     report.write_text(
         render_report(tables, findings, ablation_df, elapsed, table3, part, clock.times,
-                      clock.pieces)  # fmt: skip
+                      clock.pieces, *table3_extras)  # fmt: skip
     )
     return StudyResult(
         out, report, tables, findings, ablation_df, elapsed, part, clock.times, clock.pieces
