@@ -459,11 +459,13 @@ HELD_STALL_RPM_PER_S = 100.0
 def _zero_rate_held(scenario: Any) -> Any:
     """The scenario with its schedule read the earlier way: a zero rate holds the motor's
     speed, and a motor whose rates never exceed ``HELD_STALL_RPM_PER_S`` stops at the
-    trigger (``stopped_motors``)."""
+    trigger (``stopped_motors``), unless the run cuts it at the next tick
+    (``cut_step_motors``: the cut is the switch's, not the reading's)."""
     po = scenario.power_off
     rates = po.rates_rpm_per_s
+    cut = scenario.resolved_model_options().cut_step_motors
     quiet = [all(abs(r[j]) <= HELD_STALL_RPM_PER_S for r in rates) for j in range(4)]
-    stalled = tuple(j + 1 for j in range(4) if quiet[j])
+    stalled = tuple(j + 1 for j in range(4) if quiet[j] and j + 1 not in cut)
     held = po.model_copy(update={"zero_rate": "hold", "stopped_motors": stalled})
     return scenario.model_copy(update={"power_off": held})
 
