@@ -36,6 +36,8 @@ HEADING_UNCERTAINTY_DEG = 6.4  # Table III: psi +- 6.4 deg
 SPEED_UNCERTAINTY_M_S = 0.01  # Table III: V_c +- 0.01 m/s
 #: The two sets of pre-impact conditions of a crash.
 CONDITIONS = ("nominal", "matched")
+#: The model variants of the crash runs (the replica with its crash-run switches).
+VARIANTS = ("default", "paper-replica")
 #: First contact of the matched approach, s ("about 0.5 s" after the start).
 MATCHED_CONTACT_TIME_S = 0.5
 #: The rotor thrust coefficient of the authors' crash runs, N/rpm^2 (Table I: 7.015e-8).

@@ -9,12 +9,72 @@ Pure functions of the tables of :mod:`quadimpact.experiments.table3`
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 import pandas as pd
 
 from quadimpact.inputs.vehicle import load_vehicle
 from quadimpact.rotations import wrap_angle_deg
 
-__all__ = ["table3_markdown"]
+__all__ = [
+    "CHAINING_NOTE_MS",
+    "MOTION_RMS_DEG",
+    "TYPE_SHARE_PARTLY",
+    "VERDICT_RULE",
+    "crash_verdict",
+    "table3_markdown",
+]
+
+#: A type hinging on a chaining margin smaller than this (ms) is noted in the report.
+CHAINING_NOTE_MS = 5.0
+#: A run matches the crash in motion when its attitude error against the log over
+#: the first 0.3 s (RMS of the rotation angle) is at most this, deg.
+MOTION_RMS_DEG = 20.0
+#: A different type at the nominal conditions is ``partly`` when the experiment's
+#: type occurs in at least this share of the runs over the stated uncertainty.
+TYPE_SHARE_PARTLY = 0.2
+#: The rule of :func:`crash_verdict`, as the report states it.
+VERDICT_RULE = (
+    f"agrees: ours (default) has the experiment's type and its attitude error against the "
+    f"log over the first 0.3 s is at most {MOTION_RMS_DEG:g}° RMS (or there is no log); "
+    f"partly: the same type with a larger attitude error (the type matches, the motion "
+    f"does not), or another type at the nominal conditions while the experiment's occurs in "
+    f"at least {TYPE_SHARE_PARTLY:.0%} of the runs over the stated uncertainty; disagrees: "
+    "otherwise"
+)
+
+def crash_verdict(row: Any) -> tuple[str, str]:
+    """Our nominal run against the experiment, for one row of Table III (:data:`VERDICT_RULE`).
+
+    Parameters
+    ----------
+    row : mapping
+        A row of the table (``type_ours``, ``type_paper_experiment``,
+        ``attitude_rms_deg_0_3s``, ``share_<type>``).
+
+    Returns
+    -------
+    (str, str)
+        The verdict and its reason, with the measure and the threshold.
+    """
+    ours, exp = row["type_ours"], row["type_paper_experiment"]
+    rms = float(row["attitude_rms_deg_0_3s"])
+    if ours == exp:
+        if math.isnan(rms):
+            return "agrees", f"type {ours} (no log to compare the motion with)"
+        if rms <= MOTION_RMS_DEG:
+            return "agrees", f"type {ours}; attitude RMS {rms:.1f}° ≤ {MOTION_RMS_DEG:g}°"
+        return "partly", (
+            f"type {ours}, but not the motion: attitude RMS {rms:.1f}° > {MOTION_RMS_DEG:g}°"
+        )
+    share = float(row.get(f"share_{exp}", math.nan))
+    if math.isnan(share):
+        return "disagrees", f"type {ours}, not {exp} (no runs over the uncertainty)"
+    seen = f"type {ours}, not {exp}; {exp} in {share:.0%} of the runs over the uncertainty"
+    if share >= TYPE_SHARE_PARTLY:
+        return "partly", f"{seen} (≥ {TYPE_SHARE_PARTLY:.0%})"
+    return "disagrees", f"{seen} (< {TYPE_SHARE_PARTLY:.0%})"
 
 
 def _percent(x: float) -> str:
@@ -110,8 +170,6 @@ def table3_markdown(
 
 def _nominal_markdown(table: pd.DataFrame) -> str:
     """The nominal runs against the experiments (verdicts) and the runs at the logs' estimates."""
-    from quadimpact.experiments.table3 import MOTION_RMS_DEG, VERDICT_RULE, crash_verdict
-
     rb_mm = 1e3 * load_vehicle("spiri").bumper_radius_m
     has_log = "type_log_conditions" in table.columns
     head = (
@@ -254,8 +312,7 @@ def _bumpers(text: str) -> str:
 
 def conditions_markdown(table: pd.DataFrame, runs: pd.DataFrame) -> str:
     """Nominal and matched conditions side by side, per variant: conditions, types, runs, notes."""
-    from quadimpact.experiments.crashes import AUTHORS_THRUST_COEFFICIENT_N_PER_RPM2
-    from quadimpact.experiments.table3 import CHAINING_NOTE_MS, VARIANTS
+    from quadimpact.experiments.crashes import AUTHORS_THRUST_COEFFICIENT_N_PER_RPM2, VARIANTS
 
     keys = [(c, m) for c in ("nominal", "matched") for m in VARIANTS]
     count = {k: int(runs[(runs.conditions == k[0]) & (runs.model == k[1])]["matches"].sum())

@@ -51,11 +51,20 @@ from quadimpact.experiments.crashes import (
     REPLICA_CRASH_SWITCHES,
     SPEED_UNCERTAINTY_M_S,
     TABLE3,
+    VARIANTS,
     Crash,
     scenario_file,
     scenario_path,
 )
 from quadimpact.experiments.logs import PreImpact, data_dir
+from quadimpact.experiments.report import (  # noqa: F401 (the verdict rule, here as before)
+    CHAINING_NOTE_MS,
+    MOTION_RMS_DEG,
+    TYPE_SHARE_PARTLY,
+    VERDICT_RULE,
+    crash_verdict,
+    table3_markdown,
+)
 from quadimpact.experiments.spiri_mat import SpiriMatLog
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.simulation import simulate
@@ -127,8 +136,6 @@ MATCHED_COLUMNS = (
 EXTRA_COLUMNS = (
     "max_penetration_mm", *LOG_COLUMNS, *MOTION_COLUMNS, *VERDICT_COLUMNS, *MATCHED_COLUMNS,
 )
-#: The model variants of the crash runs (the replica with its crash-run switches).
-VARIANTS = ("default", "paper-replica")
 #: ``table3_runs.csv``: one row per crash, conditions and variant. The conditions
 #: as run (heading as flown, rear first; roll and pitch only where explicit;
 #: start altitude and set-point), the type and the experiment's, the bumpers of
@@ -164,23 +171,6 @@ SWITCH_COLUMNS = (
     "first_peak_mm", "crash_time_s", "crash_after_contact_s",
     "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
 )  # fmt: skip
-#: A type hinging on a chaining margin smaller than this (ms) is noted in the report.
-CHAINING_NOTE_MS = 5.0
-#: A run matches the crash in motion when its attitude error against the log over
-#: the first 0.3 s (RMS of the rotation angle) is at most this, deg.
-MOTION_RMS_DEG = 20.0
-#: A different type at the nominal conditions is ``partly`` when the experiment's
-#: type occurs in at least this share of the runs over the stated uncertainty.
-TYPE_SHARE_PARTLY = 0.2
-#: The rule of :func:`crash_verdict`, as the report states it.
-VERDICT_RULE = (
-    f"agrees: ours (default) has the experiment's type and its attitude error against the "
-    f"log over the first 0.3 s is at most {MOTION_RMS_DEG:g}° RMS (or there is no log); "
-    f"partly: the same type with a larger attitude error (the type matches, the motion "
-    f"does not), or another type at the nominal conditions while the experiment's occurs in "
-    f"at least {TYPE_SHARE_PARTLY:.0%} of the runs over the stated uncertainty; disagrees: "
-    "otherwise"
-)
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
@@ -207,39 +197,6 @@ def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
     """Share of each response type among a sweep's runs, as ``{prefix + type: share}``."""
     counts = sweep["response_type"].value_counts()
     return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
-
-
-def crash_verdict(row: Any) -> tuple[str, str]:
-    """Our nominal run against the experiment, for one row of Table III (:data:`VERDICT_RULE`).
-
-    Parameters
-    ----------
-    row : mapping
-        A row of the table (``type_ours``, ``type_paper_experiment``,
-        ``attitude_rms_deg_0_3s``, ``share_<type>``).
-
-    Returns
-    -------
-    (str, str)
-        The verdict and its reason, with the measure and the threshold.
-    """
-    ours, exp = row["type_ours"], row["type_paper_experiment"]
-    rms = float(row["attitude_rms_deg_0_3s"])
-    if ours == exp:
-        if math.isnan(rms):
-            return "agrees", f"type {ours} (no log to compare the motion with)"
-        if rms <= MOTION_RMS_DEG:
-            return "agrees", f"type {ours}; attitude RMS {rms:.1f}° ≤ {MOTION_RMS_DEG:g}°"
-        return "partly", (
-            f"type {ours}, but not the motion: attitude RMS {rms:.1f}° > {MOTION_RMS_DEG:g}°"
-        )
-    share = float(row.get(f"share_{exp}", math.nan))
-    if math.isnan(share):
-        return "disagrees", f"type {ours}, not {exp} (no runs over the uncertainty)"
-    seen = f"type {ours}, not {exp}; {exp} in {share:.0%} of the runs over the uncertainty"
-    if share >= TYPE_SHARE_PARTLY:
-        return "partly", f"{seen} (≥ {TYPE_SHARE_PARTLY:.0%})"
-    return "disagrees", f"{seen} (< {TYPE_SHARE_PARTLY:.0%})"
 
 
 def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | None:
@@ -494,7 +451,6 @@ def switch_records(
     the matched ones are the ``"as run"`` rows.
     """
     from quadimpact.experiments.compare import compare
-    from quadimpact.experiments.logs_compare import attitude_rms, position_rms_mm
 
     rows = []
     for model in VARIANTS:
@@ -505,11 +461,9 @@ def switch_records(
             c = None if log is None else compare(r, log, classify_log=False)
             todo.append((change, r, c))
         for change, r, c in todo:
-            rec = run_record(crash, "matched", model, r, c)
-            rows.append({"change": change, **{k: rec[k] for k in SWITCH_COLUMNS if k in rec}})
-            rows[-1]["attitude_rms_deg_0_3s"] = attitude_rms(c)
-            rows[-1]["position_rms_mm_0_3s"] = position_rms_mm(c)
-    return [{k: row.get(k) for k in SWITCH_COLUMNS} for row in rows]
+            record = {**run_record(crash, "matched", model, r, c), "change": change}
+            rows.append({k: record[k] for k in SWITCH_COLUMNS})
+    return rows
 
 
 def crash_task(
@@ -689,8 +643,6 @@ def write_table3(rows: list[dict[str, Any]], out: Path) -> pd.DataFrame:
     Parquet) and the report ``table3.md``. Returns the per-crash table, with
     the other two as ``table.attrs["runs"]`` and ``table.attrs["switches"]``.
     """
-    from quadimpact.experiments.report import table3_markdown
-
     runs = pd.DataFrame([r for row in rows for r in row.get("runs", [])], columns=RUN_COLUMNS)
     switches = pd.DataFrame([r for row in rows for r in row.get("switches", [])],
                             columns=SWITCH_COLUMNS)  # fmt: skip
