@@ -316,6 +316,10 @@ def reproduce(
     table3 = write_table3(crash_rows, exp_out) if experiments else None
     if table3 is not None:
         table3.attrs["logs"] = logs_source(data_dir)  # said in the report's Table III
+    table3_extras = [
+        pd.read_parquet(exp_out / f"{name}.parquet") if experiments else None
+        for name in ("table3_runs", "table3_switches")
+    ]
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
 
@@ -333,7 +337,15 @@ def reproduce(
     report = out / "report.md"
     report.write_text(
         render_report(
-            tables, findings, ablation_df, elapsed, table3, part, clock.times, clock.pieces
+            tables,
+            findings,
+            ablation_df,
+            elapsed,
+            table3,
+            part,
+            clock.times,
+            clock.pieces,
+            *table3_extras,
         )  # fmt: skip
     )
     return StudyResult(
