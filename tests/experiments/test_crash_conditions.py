@@ -8,6 +8,7 @@ from quadimpact import FlightScenario, simulate
 from quadimpact.experiments.crashes import (
     AUTHORS_THRUST_COEFFICIENT_N_PER_RPM2,
     HAND_MODIFICATION,
+    MATCHED_APPROACH_OPTIONS,
     MATCHED_CONTACT_TIME_S,
     REPLICA_CRASH_SWITCHES,
     TABLE3,
@@ -20,24 +21,35 @@ from quadimpact.simulation.packing import RPM, pack_vehicle
 KEYS = ("crash_rule", "cut_step_motors", "bumper_force_scale")
 
 
-@pytest.mark.parametrize("number", [3, 5])
-def test_matched_approach_arrives_climbing_and_drifting_at_the_matched_speed(number):
-    """At the first contact: the matched speed toward the wall, time and attitude, from the
-    start altitude; the climb and drift are those of the same flight without the wall."""
+@pytest.mark.parametrize(("number", "model"), [(3, "default"), (5, "default"),
+                                               (5, "paper-replica")])  # fmt: skip
+def test_matched_approach_arrives_climbing_and_drifting_at_the_matched_speed(number, model):
+    """The authors' approach in every variant: a start at t = 0 at the start altitude with
+    the rotors at level hover; at the first contact, 0.5 s later, the matched speed toward
+    the wall and attitude, climbing and drifting as the same flight without the wall does."""
     crash = TABLE3[number - 1]
     m = crash.matched
-    r = simulate(crash.scenario("default", "matched"))
+    scenario = crash.scenario(model, "matched")
+    r = simulate(scenario)
     s, ts = r.summary, r.timeseries
     t_c = s["first_contact_s"]
+    assert ts["t_s"].iloc[0] == 0.0 and ts["vz_m_s"].iloc[0] == pytest.approx(0.0, abs=1e-12)
+    v = scenario.build_vehicle()  # as flown: the replica's thrust coefficient included
+    hover = np.sqrt(v.mass_kg * v.gravity_m_s2 / (4.0 * v.thrust_coefficient))
+    for j in range(1, 5):
+        assert ts[f"omega{j}_rad_s"].iloc[0] == pytest.approx(hover, rel=1e-12)
     assert t_c == pytest.approx(MATCHED_CONTACT_TIME_S, abs=1e-9)
     assert s["impact_speed_m_s"] == pytest.approx(m.speed_m_s, abs=1e-6)  # the wall's normal: X
     assert ts["altitude_m"].iloc[0] == pytest.approx(m.altitude_at_start_m, abs=1e-12)
     t = ts["t_s"].to_numpy()
     at = {c: float(np.interp(t_c, t, ts[c].to_numpy())) for c in ts.columns}
     assert at["vx_m_s"] == pytest.approx(m.speed_m_s, abs=1e-6)
-    for got, want in ((at["roll_deg"], m.roll_deg), (at["pitch_deg"], m.pitch_deg),
-                      (at["yaw_deg"], m.heading_deg)):  # fmt: skip
-        assert got == pytest.approx(want, abs=0.5)
+    # the attitude held; the replica's spin-up reaction (no spin sign) turns the collective
+    # step of the first tick into a yaw kick: its heading at the contact is 1.4 deg off here
+    yaw_tolerance = 0.05 if model == "default" else 2.0
+    for got, want, tol in ((at["roll_deg"], m.roll_deg, 0.1), (at["pitch_deg"], m.pitch_deg, 0.1),
+                           (at["yaw_deg"], m.heading_deg, yaw_tolerance)):  # fmt: skip
+        assert got == pytest.approx(want, abs=tol)
     climb, drift = -at["vz_m_s"], at["vy_m_s"]
     assert 0.2 < climb < 0.7 and m.altitude_at_start_m < at["altitude_m"] < m.altitude_setpoint_m
     # the drift: the held thrust's sideways share (inertial Y of -z_B), from rest sideways
@@ -53,6 +65,8 @@ def test_matched_approach_arrives_climbing_and_drifting_at_the_matched_speed(num
         euler_deg=(m.roll_deg, m.pitch_deg, m.heading_deg),
         rotor_speeds_rad_s=tuple(x0[f"omega{j}_rad_s"] for j in range(1, 5)),
         altitude_ref_m=m.altitude_setpoint_m, final_time_s=t_c + 0.01, ground="none",
+        model=model, model_options=scenario.model_options,
+        vehicle_overrides=scenario.vehicle_overrides,
     )).timeseries  # fmt: skip
     for col in ("altitude_m", "vz_m_s", "vy_m_s", "y_m"):
         got = np.interp(t_c, free["t_s"].to_numpy(), free[col].to_numpy())
@@ -94,8 +108,9 @@ def test_each_replica_switch_changes_exactly_what_it_names():
     full = crash.scenario("paper-replica", "matched").resolved_model_options()
     assert (full.crash_rule, full.cut_step_motors) == ("ground-ticks", (2,))
     assert crash.scenario("default", "matched").resolved_model_options() == (
-        resolve_model_options("default")
-    )
+        resolve_model_options("default", MATCHED_APPROACH_OPTIONS)
+    )  # the default variant: the authors' approach (conditions), no crash-run switch
+    assert crash.scenario("default").resolved_model_options() == resolve_model_options("default")
     # the packed vehicles differ in the thrust coefficient alone
     kt = crash.scenario("paper-replica", "matched", ["thrust_coefficient"]).build_vehicle()
     a, b = pack_vehicle(base.build_vehicle()), pack_vehicle(kt)

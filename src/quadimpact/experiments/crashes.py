@@ -7,10 +7,12 @@ Each crash can be run at two sets of pre-impact conditions:
   held from the start: the shipped scenario files ``crashes/crash_N.toml``;
 * ``"matched"``: the conditions the authors matched in their own simulations
   of these crashes (the crash set's description file): the measured roll,
-  pitch and heading held by the controller, a start at a lower altitude with
-  the controller climbing toward the set-point, first contact 0.5 s later at
-  the matched speed. The vehicle reaches the wall climbing (and drifting
-  sideways, its thrust tilted partly across the wall) as theirs did.
+  pitch and heading held by the controller, a start at t = 0 at a lower
+  altitude with the rotors at level hover and the controller climbing toward
+  the set-point, first contact 0.5 s later at the matched speed. The vehicle
+  reaches the wall climbing (and drifting sideways, its thrust tilted partly
+  across the wall) as theirs did. The approach is the same in both variants
+  (:data:`MATCHED_APPROACH_OPTIONS`): conditions, not model.
 
 Both carry the measured motor schedule from the first contact (a zero rate:
 the motor switched off). In the ``paper-replica`` variant a crash also runs
@@ -40,6 +42,14 @@ CONDITIONS = ("nominal", "matched")
 VARIANTS = ("default", "paper-replica")
 #: First contact of the matched approach, s ("about 0.5 s" after the start).
 MATCHED_CONTACT_TIME_S = 0.5
+#: The matched approach's start, in every variant (the authors' approach): at t = 0,
+#: moving away from the wall at first if the tilt needs it (crash 1: the default
+#: variant's late start would begin 0.1 s later, at rest), with the rotors at level
+#: hover (the first control tick commands them at once).
+MATCHED_APPROACH_OPTIONS: dict[str, str] = {
+    "approach_start": "paper",
+    "initial_rotor_speeds": "level-hover",
+}
 #: The rotor thrust coefficient of the authors' crash runs, N/rpm^2 (Table I: 7.015e-8).
 AUTHORS_THRUST_COEFFICIENT_N_PER_RPM2 = 8.7e-8
 #: The switches of the authors' crash runs, on in the replica's crash runs:
@@ -148,6 +158,8 @@ class Crash:
         if switches is None:
             switches = REPLICA_CRASH_SWITCHES if model == "paper-replica" else ()
         update.update(crash_run_changes(self.number, base, switches))
+        if conditions == "matched":
+            update["model_options"] = {**MATCHED_APPROACH_OPTIONS, **update["model_options"]}
         return WallApproach.model_validate({**base.model_dump(exclude_unset=True), **update})
 
 
