@@ -10,6 +10,7 @@ from quadimpact.experiments.logs import data_dir
 from quadimpact.experiments.table3 import (
     EXTRA_COLUMNS,
     RUN_COLUMNS,
+    SWITCH_CHANGES,
     SWITCH_COLUMNS,
     TABLE3_COLUMNS,
     run_experiments,
@@ -36,9 +37,11 @@ def test_experiments_table3(tmp_path):
     assert set(runs["type"]) <= set(RESPONSE_TYPES)
     switches = pd.read_csv(tmp_path / "table3_switches.csv")
     assert list(switches.columns) == list(SWITCH_COLUMNS)
-    # per crash: as run and zero rate held in both variants, three switches off in the
-    # replica; crash 1 also with the hand modification
-    assert len(switches) == 7 * (2 + 2 + 3) + 1
+    # per crash: as run, zero rate held and the other heading in both variants, the late
+    # start and two replica switches on in the default, three switches off in the replica;
+    # crash 1 also with the hand modification
+    assert len(switches) == 7 * (3 + 3 + 3 + 3) + 1
+    assert set(switches["change"]) == {"as run", *SWITCH_CHANGES}
     t = table.set_index("crash")
     by = runs.set_index(["crash", "conditions", "model"])
     for c in TABLE3:
@@ -54,6 +57,11 @@ def test_experiments_table3(tmp_path):
                 assert r["crash_after_contact_s"] == pytest.approx(
                     s["crash_time_s"] - s["first_contact_s"]
                 )
+                if conditions == "matched":  # the authors' approach: from t = 0, tilted
+                    assert r["contact_after_start_s"] == pytest.approx(0.5, abs=1e-9)
+                    assert r["contact_inclination_deg"] == pytest.approx(
+                        c.matched.inclination_deg, abs=0.5
+                    )
         # the table's types are the runs'
         assert t.loc[c.number, "type_ours"] == by.loc[(c.number, "nominal", "default"), "type"]
         assert (

@@ -432,14 +432,14 @@ def _chaining_note(r: pd.Series) -> str:
 
 def switches_markdown(switches: pd.DataFrame) -> str:
     """The matched runs with one change each: what each switch of the crash runs does."""
+    from quadimpact.experiments.table3 import SWITCH_CHANGES
+
+    made = set(switches.change)
     lines = [
-        "What each change does, at the matched conditions: the schedules read the earlier "
-        "way (a zero rate holding the motor's speed; only a motor whose rates never exceed "
-        "100 rpm/s stopped, at the contact), in both variants; the "
-        "replica with each switch of the authors' crash runs off in turn; crash 1 with the "
-        "authors' hand modification (bumper 2's force doubled, motor 2 cut though its log "
-        "shows it running; undocumented by them, off by default). Differences are against "
-        "the run as made (*as run*).",
+        "What each change does, at the matched conditions (each against the run as made, "
+        "*as run*; the variants it is run in after the semicolon):",
+        "",
+        *(f"- *{name}*: {what}." for name, what in SWITCH_CHANGES.items() if name in made),
         "",
     ]
     summary = []

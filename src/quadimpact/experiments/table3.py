@@ -147,7 +147,8 @@ EXTRA_COLUMNS = (
 #: episode's peak deflection (its bumper: 2, the leading one), the crash time
 #: (from the start and after the first contact), the deepest deflection, the
 #: state at the first contact (altitude, climb rate, sideways drift = inertial
-#: V_Y, roll, pitch, yaw), the errors against the log over the first 0.3 s
+#: V_Y, roll, pitch, yaw, the inclination toward the wall, the time since the
+#: start), the errors against the log over the first 0.3 s
 #: (attitude: RMS rotation angle; position: RMS of the X, Y, altitude
 #: displacements since the impact), and the chaining decision closest to going
 #: the other way (:func:`~quadimpact.simulation.metrics.closest_chaining`: its
@@ -161,20 +162,41 @@ RUN_COLUMNS = (
     "leading_bumpers", "subsequent_impacts", "delta_init_mm", "first_bumper", "first_peak_mm",
     "crash_time_s", "crash_after_contact_s", "max_penetration_mm",
     "contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s",
-    "contact_roll_deg", "contact_pitch_deg", "contact_yaw_deg",
+    "contact_roll_deg", "contact_pitch_deg", "contact_yaw_deg", "contact_inclination_deg",
+    "contact_after_start_s",
     "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
     "chaining_margin_ms", "chaining_bumper", "type_chaining_flipped",
 )  # fmt: skip
-#: ``table3_switches.csv``: the matched conditions with one change each. ``change``:
-#: ``"as run"`` (the run of ``table3_runs.csv``), ``"zero rate held"`` (a zero
-#: scheduled rate read as the motor keeping its speed, the old reading),
-#: ``"without <switch>"`` (the replica with one crash-run switch off) and
-#: ``"with i03_hand_modification"`` (crash 1, replica).
+#: ``table3_switches.csv``: the matched conditions with one change each
+#: (:data:`SWITCH_CHANGES`; ``"as run"``: the run of ``table3_runs.csv``), with
+#: the state at the first contact as in ``table3_runs.csv``.
 SWITCH_COLUMNS = (
     "crash", "model", "change", "type", "type_experiment", "matches", "delta_init_mm",
     "first_peak_mm", "crash_time_s", "crash_after_contact_s",
-    "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
+    "contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s", "contact_inclination_deg",
+    "contact_after_start_s", "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
 )  # fmt: skip
+#: The changes of the switch runs (matched conditions), each against the run as
+#: made: what it tests, and the variant it is run in (docs/EXPERIMENTS.md,
+#: "What each candidate changes").
+SWITCH_CHANGES: dict[str, str] = {
+    "zero rate held": "a zero scheduled rate read the earlier way, the motor keeping its speed "
+    "(only a motor whose rates never exceed 100 rpm/s stopped, at the contact); both variants",
+    "late start": "the default variant's own start rule for the approach (a late start at "
+    "rest where the tilt needs v0 < 0, trimmed rotors) instead of the authors' start at "
+    "t = 0; default",
+    "heading 180 - yaw": "the heading from the other sense of the data's yaw (180° - yaw "
+    "instead of yaw - 180°); both variants",
+    "with motor2_cut_step": "the replica's one-tick cut of motor 2 (held to the first tick "
+    "after the contact, then braked in one step with its spin-up kick); default",
+    "with thrust_coefficient": "the authors' thrust coefficient 8.7e-8 N/rpm²; default",
+    "without ground_tick_crash": "the replica's own crash rule (h <= -0.3 m at the ticks); replica",
+    "without thrust_coefficient": "Table I's thrust coefficient everywhere; replica",
+    "without motor2_cut_step": "motor 2 off from the contact by the schedule alone (no hold "
+    "to the tick, no kick); replica",
+    "with i03_hand_modification": "crash 1: bumper 2's contact force doubled and motor 2 cut "
+    "though its log shows it running (the authors' undocumented modification); replica",
+}
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
@@ -363,9 +385,13 @@ def _log_row(
 
 
 def _contact_state(result: Any) -> dict[str, float]:
-    """Altitude, climb rate, sideways drift and attitude at the run's first contact."""
+    """Altitude, climb rate, sideways drift, attitude, inclination toward the wall and the time
+    since the start, at the run's first contact (interpolated in the time series)."""
+    from quadimpact.rotations import inclination_deg, quat_to_matrix
+
     keys = ("contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s",
-            "contact_roll_deg", "contact_pitch_deg", "contact_yaw_deg")  # fmt: skip
+            "contact_roll_deg", "contact_pitch_deg", "contact_yaw_deg",
+            "contact_inclination_deg", "contact_after_start_s")  # fmt: skip
     t_c = result.summary.get("first_contact_s")
     if t_c is None:
         return dict.fromkeys(keys, math.nan)
@@ -374,6 +400,9 @@ def _contact_state(result: Any) -> dict[str, float]:
     cols = ("altitude_m", "vz_m_s", "vy_m_s", "roll_deg", "pitch_deg", "yaw_deg")
     values = [float(np.interp(t_c, t, ts[c].to_numpy())) for c in cols]
     values[1] = -values[1]  # climb: -V_Z (NED)
+    q = np.array([np.interp(t_c, t, ts[c].to_numpy()) for c in ("q0", "q1", "q2", "q3")])
+    values.append(float(inclination_deg(quat_to_matrix(q / np.linalg.norm(q)))))
+    values.append(float(t_c - t[0]))
     return dict(zip(keys, values, strict=True))
 
 
@@ -448,10 +477,30 @@ def _zero_rate_held(scenario: Any) -> Any:
 
 
 def _switch_changes(crash: Crash, model: str) -> list[tuple[str, Any]]:
-    """The switch runs of a crash in a variant (matched conditions): (change, scenario)."""
+    """The switch runs of a crash in a variant (matched conditions): (change, scenario).
+
+    The changes are those of :data:`SWITCH_CHANGES` that apply to the variant.
+    """
+    from quadimpact.experiments.crashes import MATCHED_APPROACH_OPTIONS
+
     base = crash.scenario(model, "matched")
+    options = base.model_options.model_dump(exclude_none=True)
+
+    def changed(**fields: Any) -> Any:  # validated again
+        return type(base).model_validate({**base.model_dump(exclude_unset=True), **fields})
+
+    mirrored = changed(heading_deg=180.0 - crash.matched.yaw_from_wall_normal_deg)
     changes: list[tuple[str, Any]] = [("zero rate held", _zero_rate_held(base))]
-    if model == "paper-replica":
+    if model == "default":
+        own = {k: v for k, v in options.items() if k not in MATCHED_APPROACH_OPTIONS}
+        changes += [
+            ("late start", changed(model_options=own)),
+            ("heading 180 - yaw", mirrored),
+            ("with motor2_cut_step", crash.scenario(model, "matched", ["motor2_cut_step"])),
+            ("with thrust_coefficient", crash.scenario(model, "matched", ["thrust_coefficient"])),
+        ]
+    else:
+        changes.append(("heading 180 - yaw", mirrored))
         for switch in REPLICA_CRASH_SWITCHES:
             others = [k for k in REPLICA_CRASH_SWITCHES if k != switch]
             changes.append((f"without {switch}", crash.scenario(model, "matched", others)))
@@ -459,6 +508,7 @@ def _switch_changes(crash: Crash, model: str) -> list[tuple[str, Any]]:
             with_hand = [*REPLICA_CRASH_SWITCHES, HAND_MODIFICATION]
             changes.append((f"with {HAND_MODIFICATION}",
                             crash.scenario(model, "matched", with_hand)))  # fmt: skip
+    assert all(name in SWITCH_CHANGES for name, _ in changes)
     return changes
 
 
