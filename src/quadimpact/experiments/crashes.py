@@ -67,6 +67,28 @@ REPLICA_CRASH_SWITCHES: dict[str, str] = {
 #: running, an undocumented hand modification.
 HAND_MODIFICATION = "i03_hand_modification"
 
+#: The changes of the switch runs (matched conditions), each against the run as
+#: made: what it tests, and the variant it is run in (docs/EXPERIMENTS.md,
+#: "What each change does"; the runs: ``experiments.table3``).
+SWITCH_CHANGES: dict[str, str] = {
+    "zero rate held": "a zero scheduled rate read the earlier way, the motor keeping its speed "
+    "(only a motor whose rates never exceed 100 rpm/s stopped, at the contact); both variants",
+    "late start": "the default variant's own start rule for the approach (a late start at "
+    "rest where the tilt needs v0 < 0, trimmed rotors) instead of the authors' start at "
+    "t = 0; default",
+    "heading 180 - yaw": "the heading from the other sense of the data's yaw (180° - yaw "
+    "instead of yaw - 180°); both variants",
+    "with motor2_cut_step": "the replica's one-tick cut of motor 2 (held to the first tick "
+    "after the contact, then braked in one step with its spin-up kick); default",
+    "with thrust_coefficient": "the authors' thrust coefficient 8.7e-8 N/rpm²; default",
+    "without ground_tick_crash": "the replica's own crash rule (h <= -0.3 m at the ticks); replica",
+    "without thrust_coefficient": "Table I's thrust coefficient everywhere; replica",
+    "without motor2_cut_step": "motor 2 off from the contact by the schedule alone (no hold "
+    "to the tick, no kick); replica",
+    "with i03_hand_modification": "crash 1: bumper 2's contact force doubled and motor 2 cut "
+    "though its log shows it running (the authors' undocumented modification); replica",
+}
+
 
 @dataclass(frozen=True)
 class Matched:

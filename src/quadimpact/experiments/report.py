@@ -432,7 +432,7 @@ def _chaining_note(r: pd.Series) -> str:
 
 def switches_markdown(switches: pd.DataFrame) -> str:
     """The matched runs with one change each: what each switch of the crash runs does."""
-    from quadimpact.experiments.table3 import SWITCH_CHANGES
+    from quadimpact.experiments.crashes import SWITCH_CHANGES
 
     made = set(switches.change)
     lines = [

@@ -50,6 +50,7 @@ from quadimpact.experiments.crashes import (
     HEADING_UNCERTAINTY_DEG,
     REPLICA_CRASH_SWITCHES,
     SPEED_UNCERTAINTY_M_S,
+    SWITCH_CHANGES,
     TABLE3,
     VARIANTS,
     Crash,
@@ -176,27 +177,6 @@ SWITCH_COLUMNS = (
     "contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s", "contact_inclination_deg",
     "contact_after_start_s", "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
 )  # fmt: skip
-#: The changes of the switch runs (matched conditions), each against the run as
-#: made: what it tests, and the variant it is run in (docs/EXPERIMENTS.md,
-#: "What each candidate changes").
-SWITCH_CHANGES: dict[str, str] = {
-    "zero rate held": "a zero scheduled rate read the earlier way, the motor keeping its speed "
-    "(only a motor whose rates never exceed 100 rpm/s stopped, at the contact); both variants",
-    "late start": "the default variant's own start rule for the approach (a late start at "
-    "rest where the tilt needs v0 < 0, trimmed rotors) instead of the authors' start at "
-    "t = 0; default",
-    "heading 180 - yaw": "the heading from the other sense of the data's yaw (180° - yaw "
-    "instead of yaw - 180°); both variants",
-    "with motor2_cut_step": "the replica's one-tick cut of motor 2 (held to the first tick "
-    "after the contact, then braked in one step with its spin-up kick); default",
-    "with thrust_coefficient": "the authors' thrust coefficient 8.7e-8 N/rpm²; default",
-    "without ground_tick_crash": "the replica's own crash rule (h <= -0.3 m at the ticks); replica",
-    "without thrust_coefficient": "Table I's thrust coefficient everywhere; replica",
-    "without motor2_cut_step": "motor 2 off from the contact by the schedule alone (no hold "
-    "to the tick, no kick); replica",
-    "with i03_hand_modification": "crash 1: bumper 2's contact force doubled and motor 2 cut "
-    "though its log shows it running (the authors' undocumented modification); replica",
-}
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
