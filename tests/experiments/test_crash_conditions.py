@@ -233,3 +233,35 @@ def test_matched_approach_may_start_on_the_ground():
         assert r.timeseries["altitude_m"].iloc[0] == 0.0
         assert r.summary["first_contact_s"] == pytest.approx(0.5, abs=1e-9)
         assert r.summary["crash_time_s"] > 0.6
+
+
+def test_offs_within_segment_move_only_the_switch_offs_after_the_contact():
+    """Crash 5: motor 2 off from the contact, motor 3 from 82 ms, motor 4 from 197 ms,
+    motor 1 from 374 ms; fraction 0 is the schedule itself, 1 keeps each motor running to
+    its segment's end (the log's next sample) and nothing else changes."""
+    from quadimpact.experiments.table3 import HELD_RATE_RPM_PER_S, offs_within_segment
+
+    scenario = TABLE3[4].scenario("default", "matched")
+    po = scenario.power_off
+    assert offs_within_segment(po, 0.0) == po
+    late = offs_within_segment(po, 1.0)
+    # the ends are the next segments' starts (the last segment's: 0.1 s after its start)
+    assert late.segment_start_s[:-1] == po.segment_start_s
+    assert late.segment_start_s[-1] == pytest.approx(po.segment_start_s[-1] + 0.1)
+    assert late.rates_rpm_per_s[-1] == po.rates_rpm_per_s[-1]
+    for k, (was, now) in enumerate(zip(po.rates_rpm_per_s, late.rates_rpm_per_s, strict=False)):
+        for j in range(4):
+            first_off = k > 0 and was[j] == 0.0 and po.rates_rpm_per_s[k - 1][j] != 0.0
+            assert now[j] == (HELD_RATE_RPM_PER_S if first_off else was[j]), (k, j)
+    assert [r[2] for r in late.rates_rpm_per_s[:3]] == [-16292.6, HELD_RATE_RPM_PER_S, 0.0]
+    assert late.rates_rpm_per_s[0][1] == 0.0  # motor 2: off from the contact, kept
+    half = offs_within_segment(po, 0.5)
+    mid = 0.5 * (po.segment_start_s[1] + po.segment_start_s[2])
+    assert mid in half.segment_start_s and len(half.segment_start_s) > len(po.segment_start_s)
+    # simulated: motor 3 runs at 0.15 s after the contact with the late offs only
+    speeds = []
+    for schedule in (po, late):
+        r = simulate(scenario.model_copy(update={"power_off": schedule}))
+        ts = r.timeseries
+        speeds.append(np.interp(r.summary["first_contact_s"] + 0.15, ts["t_s"], ts["omega3_rad_s"]))
+    assert speeds[0] == 0.0 and speeds[1] > 300.0

@@ -37,10 +37,10 @@ def test_experiments_table3(tmp_path):
     assert set(runs["type"]) <= set(RESPONSE_TYPES)
     switches = pd.read_csv(tmp_path / "table3_switches.csv")
     assert list(switches.columns) == list(SWITCH_COLUMNS)
-    # per crash: as run, zero rate held and the other heading in both variants, the late
-    # start and two replica switches on in the default, three switches off in the replica;
-    # crash 1 also with the hand modification
-    assert len(switches) == 7 * (3 + 3 + 3 + 3) + 1
+    # per crash: as run, zero rate held, the offs at the segments' ends and the other
+    # heading in both variants, the late start and two replica switches on in the default,
+    # three switches off in the replica; crash 1 also with the hand modification
+    assert len(switches) == 7 * (4 + 3 + 4 + 3) + 1
     assert set(switches["change"]) == {"as run", *SWITCH_CHANGES}
     t = table.set_index("crash")
     by = runs.set_index(["crash", "conditions", "model"])

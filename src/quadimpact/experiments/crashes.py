@@ -73,6 +73,9 @@ HAND_MODIFICATION = "i03_hand_modification"
 SWITCH_CHANGES: dict[str, str] = {
     "zero rate held": "a zero scheduled rate read the earlier way, the motor keeping its speed "
     "(only a motor whose rates never exceed 100 rpm/s stopped, at the contact); both variants",
+    "offs at the segment's end": "each motor the schedule switches off after the contact "
+    "kept at its speed to the end of that segment (the log's next sample, which reads it off) "
+    "instead of off from its start: the latest switch-off the log allows; both variants",
     "late start": "the default variant's own start rule for the approach (a late start at "
     "rest where the tilt needs v0 < 0, trimmed rotors) instead of the authors' start at "
     "t = 0; default",

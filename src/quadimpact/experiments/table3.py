@@ -456,6 +456,49 @@ def _zero_rate_held(scenario: Any) -> Any:
     return scenario.model_copy(update={"power_off": held})
 
 
+#: A held rate in :func:`offs_within_segment`: not exactly 0, so not a switch-off.
+HELD_RATE_RPM_PER_S = 1e-12
+
+
+def offs_within_segment(power_off: Any, fraction: float) -> Any:
+    """The schedule with each switch-off after the contact moved inside its segment.
+
+    A motor's first zero rate in a segment ``k > 0`` switches it off from the
+    segment's start (the authors' reading). The segment runs from one of the
+    log's motor samples, the motor still running, to the next, which reads it
+    off, so the log puts the switch-off anywhere in it. Here the motor keeps
+    its speed over ``fraction`` of that segment (the last segment: of 0.1 s)
+    and is off after it: 0 is the schedule as given, 1 the latest switch-off
+    the log allows. Zero rates from the first segment (off from the contact)
+    and the other rates are kept; the segments are split where needed.
+    """
+    starts, rates = list(power_off.segment_start_s), power_off.rates_rpm_per_s
+    n = len(starts)
+    off: dict[tuple[int, int], float] = {}  # (motor, its first zero segment) -> switch-off
+    for j in range(4):
+        for k in range(1, n):
+            if rates[k][j] == 0.0 and rates[k - 1][j] != 0.0:
+                end = starts[k + 1] if k + 1 < n else starts[k] + 0.1
+                off[(j, k)] = starts[k] + fraction * (end - starts[k])
+    cuts = sorted(set(starts) | set(off.values()))
+    new = []
+    for t in cuts:
+        k = max(i for i in range(n) if starts[i] <= t)
+        row = []
+        for j in range(4):
+            r = rates[k][j]
+            first = k
+            while r == 0.0 and first > 0 and rates[first - 1][j] == 0.0:
+                first -= 1
+            if r == 0.0 and t < off.get((j, first), -math.inf):
+                r = HELD_RATE_RPM_PER_S
+            row.append(r)
+        new.append(tuple(row))
+    return power_off.model_copy(
+        update={"segment_start_s": tuple(cuts), "rates_rpm_per_s": tuple(new)}
+    )
+
+
 def _switch_changes(crash: Crash, model: str) -> list[tuple[str, Any]]:
     """The switch runs of a crash in a variant (matched conditions): (change, scenario).
 
@@ -470,7 +513,11 @@ def _switch_changes(crash: Crash, model: str) -> list[tuple[str, Any]]:
         return type(base).model_validate({**base.model_dump(exclude_unset=True), **fields})
 
     mirrored = changed(heading_deg=180.0 - crash.matched.yaw_from_wall_normal_deg)
-    changes: list[tuple[str, Any]] = [("zero rate held", _zero_rate_held(base))]
+    late = base.model_copy(update={"power_off": offs_within_segment(base.power_off, 1.0)})
+    changes: list[tuple[str, Any]] = [
+        ("zero rate held", _zero_rate_held(base)),
+        ("offs at the segment's end", late),
+    ]
     if model == "default":
         own = {k: v for k, v in options.items() if k not in MATCHED_APPROACH_OPTIONS}
         changes += [
