@@ -10,6 +10,13 @@ switches) it runs the matched scenario as made, then one change at a time:
   cut as made);
 * ``schedule +/-S ms``: the power-off schedule started S ms after (before)
   the first contact (a fixed trigger time instead of the contact);
+* ``offs at F of the segment``: every motor the schedule switches off after
+  the contact (its first zero rate, in segment k > 0) held at its speed over
+  the fraction F of that segment and off after it, instead of off from the
+  segment's start (F = 0, the authors' reading). A segment runs from one of
+  the log's motor samples, the motor still running, to the next, which reads
+  it off: the log puts the switch-off anywhere in the segment, F = 1 being
+  the latest (``experiments.table3.offs_within_segment``);
 * ``roll/pitch/heading +/-D deg``, ``speed +/-0.1 m/s``: the matched
   conditions moved (the heading as ``yaw_from_wall_normal_deg``).
 
@@ -29,6 +36,7 @@ import pandas as pd
 
 from quadimpact import simulate
 from quadimpact.experiments.crashes import MATCHED_CONTACT_TIME_S, TABLE3, Crash
+from quadimpact.experiments.table3 import offs_within_segment
 from quadimpact.simulation.metrics import closest_chaining
 
 VARIANTS = ("default", "paper-replica")
@@ -53,6 +61,9 @@ def changes(crash: Crash, model: str) -> list[tuple[str, object]]:
     for ms in (-10, 5, 10, 20):
         later = {**po.model_dump(), "trigger": MATCHED_CONTACT_TIME_S + ms / 1e3}
         out.append((f"schedule {ms:+d} ms", _changed(base, power_off=later)))
+    for fraction in (0.5, 0.75, 1.0):
+        moved = offs_within_segment(po, fraction).model_dump()
+        out.append((f"offs at {fraction:g} of the segment", _changed(base, power_off=moved)))
     m = crash.matched
     for name, field, delta in (("roll", "roll_deg", 2.0), ("pitch", "pitch_deg", 2.0),
                                ("heading", "yaw_from_wall_normal_deg", 3.0)):  # fmt: skip
