@@ -8,6 +8,8 @@ from pathlib import Path
 
 import pytest
 
+from quadimpact.errors import InputError
+
 from helpers import SPIRI_TOML, run_cli
 
 SUMMARY_KEYS = (
@@ -133,6 +135,26 @@ def test_flags_override_file_values(tmp_path: Path) -> None:
     options = scenario.resolved_model_options()
     assert options.crash_rule == "cm-ground" and options.bumper1_yaw_twice is False
     assert options.yaw_reaction == "paper"
+
+
+def test_authors_approach_from_flags_and_list_valued_switches(tmp_path: Path) -> None:
+    """--start-altitude, --roll, --pitch: the authors' approach of a crash run; --option takes
+    numbers and lists ([2], 1,2,1,1) for the crash-run switches."""
+    from quadimpact.cli import build_scenario
+
+    flags = {"heading": -163.0, "speed": 2.0283, "roll": -2.7, "pitch": 9.4,
+             "start_altitude": 0.6, "altitude": 1.02}  # fmt: skip
+    options = ("crash_rule=ground-ticks", "cut_step_motors=[2]", "bumper_force_scale=1,2,1,1",
+               "contact_gate_m=0.3")  # fmt: skip
+    scenario = build_scenario(None, flags, options)
+    assert (scenario.roll_deg, scenario.pitch_deg, scenario.start_altitude_m) == (-2.7, 9.4, 0.6)
+    resolved = scenario.resolved_model_options()
+    assert resolved.cut_step_motors == (2,) and resolved.bumper_force_scale == (1, 2, 1, 1)
+    assert resolved.crash_rule == "ground-ticks" and resolved.contact_gate_m == 0.3
+    path = tmp_path / "flight.toml"
+    path.write_text('kind = "flight"\n')
+    with pytest.raises(InputError, match="--start-altitude: applies to wall-approach"):
+        build_scenario(path, {"start_altitude": 0.5})
 
 
 def test_valid_run_writes_all_outputs(tmp_path: Path) -> None:

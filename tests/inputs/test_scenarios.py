@@ -26,6 +26,8 @@ DEFAULT_SWITCHES = {
     "detection_tick_reference": "tilt-away",
     "contact_gate_m": 0.0,
     "pre_impact": "scenario",
+    "cut_step_motors": (),
+    "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
 }
 REPLICA_SWITCHES = {
     "yaw_reaction": "paper",
@@ -38,6 +40,8 @@ REPLICA_SWITCHES = {
     "detection_tick_reference": "tilt-away",
     "contact_gate_m": 0.0,
     "pre_impact": "scenario",
+    "cut_step_motors": (),
+    "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
 }
 # the recovery replica: the paper replica's drag sense, the rest its own (docs/VARIANTS.md 5)
 RECOVERY_REPLICA_SWITCHES = {

@@ -30,6 +30,7 @@ _FLAGS: dict[str, tuple[str, str]] = {
     "impact_time": ("impact_time_s", "--impact-time"),
     "wall_distance": ("wall_distance_m", "--wall-distance"),
     "altitude": ("altitude_m", "--altitude"),
+    "start_altitude": ("start_altitude_m", "--start-altitude"),
     "final_time": ("final_time_s", "--final-time"),
     "model": ("model", "--model"),
     "controller": ("controller", "--controller"),
@@ -54,6 +55,7 @@ _WALL_ONLY = {
     "impact_time_s",
     "wall_distance_m",
     "altitude_m",
+    "start_altitude_m",
 }
 #: Exit status of a run whose status is "failed" (numerical failure; see ``run --help``).
 EXIT_RUN_FAILED = 3
@@ -93,6 +95,13 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
 @_flag("--impact-time", "S", "Time of the first contact, s (> 0, < final time). [default: 0.5]")
 @_flag("--wall-distance", "M", "Wall position along inertial X (NED), m. [default: 1.5]")
 @_flag("--altitude", "M", "Altitude set-point and initial altitude, m (> 0). [default: 2]")
+@_flag(
+    "--start-altitude",
+    "M",
+    "Wall approach: initial altitude when it differs from the set-point, m (>= 0): the "
+    "controller climbs (or descends) toward --altitude on the way to the wall, as in the "
+    "authors' crash runs (with --roll, --pitch and --impact-time). [default: the set-point]",
+)
 @_flag("--final-time", "S", "End of the simulation, s in (0, 600]. [default: 3]")
 @click.option(
     "--kind",
@@ -145,10 +154,11 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "options",
     multiple=True,
     metavar="NAME=VALUE",
-    help="Change one switch of the model variant (repeatable), e.g. crash_rule=cm-ground. "
-    "Switches: yaw_reaction, spinup_reaction, bumper1_yaw_twice, initial_rotor_speeds, "
-    "attitude_mapping, crash_rule, approach_start, detection_tick_reference, "
-    "contact_gate_m, pre_impact (docs/VARIANTS.md).",
+    help="Change one switch of the model variant (repeatable), e.g. crash_rule=cm-ground, "
+    "cut_step_motors=[2] or bumper_force_scale=1,2,1,1. Switches: yaw_reaction, spinup_reaction, "
+    "bumper1_yaw_twice, initial_rotor_speeds, attitude_mapping, crash_rule, approach_start, "
+    "detection_tick_reference, contact_gate_m, pre_impact, cut_step_motors, "
+    "bumper_force_scale (docs/VARIANTS.md).",
 )
 @click.option(
     "--param",
@@ -278,21 +288,26 @@ def run(
 
 
 def _option_value(text: str) -> Any:
-    """A ``--option`` value as the scenario file would read it: a number, a boolean, a word.
+    """A ``--option`` value as the scenario file would read it: a number, a boolean, a word, a list.
 
     ``0.3`` is the number 0.3 and ``true``/``false`` (any case) booleans, as in
-    a TOML file; a quoted TOML string is its content; anything else is the
-    text itself (``crash_rule=cm-ground``).
+    a TOML file; a quoted TOML string is its content; a list of numbers is
+    written as in TOML (``[2]``, ``[1, 2, 1, 1]``) or bare with commas
+    (``1,2,1,1``); anything else is the text itself (``crash_rule=cm-ground``).
     """
     import tomllib
 
     lowered = text.lower()
     if lowered in ("true", "false"):
         return lowered == "true"
+    toml = f"[{text}]" if "," in text and not text.startswith("[") else text
     try:
-        value = tomllib.loads(f"v = {text}")["v"]
+        value = tomllib.loads(f"v = {toml}")["v"]
     except (tomllib.TOMLDecodeError, KeyError):
         return text
+    if isinstance(value, list):
+        numbers = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in value)
+        return value if numbers and all(math.isfinite(v) for v in value) else text
     if isinstance(value, float) and not math.isfinite(value):
         return text  # nan, inf: refused by the field's own check, with the text shown
     return value if isinstance(value, (int, float, str, bool)) else text

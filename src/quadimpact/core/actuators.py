@@ -16,8 +16,17 @@ a prescribed piecewise-linear schedule, whatever the controller commands:
 over segment ``k``, ``[t_p + start_k, t_p + start_{k+1})``, motor ``j``
 changes at ``rate[k, j]`` (rad/s^2), and never goes below zero (a motor that
 reaches zero stays there until a later segment's rate is positive).
-Motors marked as stalling stop at the trigger (their speed jumps to zero; the
-spin-down torque of that jump is not modelled).
+A rate of :data:`MOTOR_OFF` (the packing's value for a scheduled rate of
+exactly 0: the crash data's powered-off motor) stops the motor at the
+segment's start: its speed jumps to zero and stays there until a later
+segment's rate is positive. Motors marked as stalling stop at the trigger.
+The reaction torque of these jumps is not modelled, with one exception: the
+motors of the option ``O_CUT_STEP_MOTORS`` (the authors' crash runs: motor 2)
+keep their speed from the trigger to the first control tick after it and are
+cut there as a one-tick command step, ``Omega_dot = -Omega / dt`` over that
+tick's interval in the spin-up reaction (:func:`cut_step`, a stage of the tick
+after the actuators); they stay off for the rest of the run, whatever the
+schedule says.
 
 The rotor speeds are states whose derivative is the current rate, so the
 integrator reproduces the schedule exactly (a linear function); the run loop
@@ -31,7 +40,13 @@ import numpy as np
 from numba import njit
 
 from .layout import (
+    LS_K,
+    LS_PO_ACTIVE,
+    LS_PO_T,
+    LS_T0,
     N_ROTORS,
+    O_CUT_STEP_MOTORS,
+    O_DT_CONTROL,
     O_OMEGA_MAX,
     O_OMEGA_MIN,
     O_SLEW_MAX,
@@ -43,18 +58,29 @@ from .layout import (
     V_TAU_M,
     X_ROTOR,
 )
+from .records import Data, Model
 
 ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
+MOTOR_OFF = -math.inf  # a schedule rate: the motor is off (speed 0 from the segment's start)
 
 
 @njit(cache=True)
-def apply_segment(x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray) -> None:
-    """Rotor inputs for segment ``seg``: prescribed rates, floored at zero speed."""
+def apply_segment(
+    x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray, cut: int
+) -> None:
+    """Rotor inputs for segment ``seg``: prescribed rates, floored at zero speed.
+
+    A rate of :data:`MOTOR_OFF` stops the motor. The motors of the bit mask
+    ``cut`` (``opts[O_CUT_STEP_MOTORS]``) are left alone: :func:`cut_step`
+    drives them.
+    """
     rin[RIN_FIRST_ORDER] = 0.0
     for j in range(N_ROTORS):
-        if x[X_ROTOR + j] <= ZERO_SPEED:
-            x[X_ROTOR + j] = 0.0
+        if (cut >> j) & 1:
+            continue
         r = sched_rate[seg, j]
+        if x[X_ROTOR + j] <= ZERO_SPEED or r == MOTOR_OFF:
+            x[X_ROTOR + j] = 0.0
         if x[X_ROTOR + j] <= 0.0 and r < 0.0:
             r = 0.0
         rin[RIN_RATE + j] = r
@@ -72,6 +98,34 @@ def next_boundary(
         if r < 0.0 and x[X_ROTOR + j] > 0.0:
             t_b = min(t_b, t + x[X_ROTOR + j] / -r)
     return t_b
+
+
+@njit(cache=True)
+def cut_step(m: Model, d: Data) -> None:
+    """The authors' motor cut at the tick ``d.ls[LS_K]``, once the power-off schedule is on.
+
+    Each motor of ``opts[O_CUT_STEP_MOTORS]`` (bit ``j``: motor ``j + 1``)
+    keeps its speed from the trigger to the first control tick after it and
+    is commanded there from that speed to 0 in one step: over that tick's
+    interval the spin-up reaction sees the finite difference ``-Omega / dt``
+    (as an ideal rotor's command step), from the next tick on nothing; its
+    speed is 0 from the cut on. Nothing happens without such motors or before
+    the trigger.
+    """
+    cut = int(m.opts[O_CUT_STEP_MOTORS])
+    ls = d.ls
+    if cut == 0 or ls[LS_PO_ACTIVE] < 0.5:
+        return
+    dt = m.opts[O_DT_CONTROL]
+    k = int(ls[LS_K])
+    first = ls[LS_PO_T] >= ls[LS_T0] + (k - 1) * dt  # the trigger fell in the last interval
+    x = d.x
+    rin = d.rin
+    for j in range(N_ROTORS):
+        if (cut >> j) & 1:
+            rin[RIN_FF + j] = -x[X_ROTOR + j] / dt if first else 0.0
+            rin[RIN_RATE + j] = 0.0
+            x[X_ROTOR + j] = 0.0
 
 
 @njit(cache=True)

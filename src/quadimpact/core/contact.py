@@ -14,7 +14,9 @@ record; this module turns records into forces and never reads a shape:
   opposing the contact point's sliding velocity ``v_t``;
 * the wrench of all active pairs about the CM (body axes), with the paper
   replica's error of counting the first feature's (bumper 1's) yaw moment
-  twice as a switch;
+  twice as a switch, and a per-feature factor on the normal force
+  (``F_FORCE_SCALE``, 1 by default: the authors' hand modification of one
+  crash run doubled bumper 2's force);
 * the contact *gap* that the event locator watches: ``delta`` itself, or, with
   the recovery replica's broad-phase gate, ``min(delta, gate - d_CM)`` so that
   the force switches on only once the CM is within ``gate`` of the shape.
@@ -32,6 +34,7 @@ from .layout import (
     CS_ACTIVE,
     CS_LAMBDA,
     F_E,
+    F_FORCE_SCALE,
     F_K,
     F_MU,
     F_N,
@@ -67,9 +70,16 @@ def normal_force(k: float, n: float, delta: float, delta_dot: float, lam: float)
 
 @njit(cache=True, inline="always")
 def pair_normal_force(m: Model, c: int, delta: float, delta_dot: float, lam: float) -> float:
-    """:func:`normal_force` of pair ``c`` with its feature's parameters."""
+    """:func:`normal_force` of pair ``c`` with its feature's parameters.
+
+    Times the feature's factor ``F_FORCE_SCALE`` (1, or 0 in a row written
+    without it: the law itself; the authors' hand modification of one crash
+    run doubled bumper 2's force).
+    """
     f = m.pairs[c, PR_FEATURE]
-    return normal_force(m.feat[f, F_K], m.feat[f, F_N], delta, delta_dot, lam)
+    fn = normal_force(m.feat[f, F_K], m.feat[f, F_N], delta, delta_dot, lam)
+    scale = m.feat[f, F_FORCE_SCALE]
+    return fn * scale if scale > 0.0 else fn
 
 
 @njit(cache=True)

@@ -40,6 +40,7 @@ from .layout import (
     O_ATOL,
     O_CRASH_ALTITUDE,
     O_CRASH_RULE,
+    O_CUT_STEP_MOTORS,
     O_DT_CONTROL,
     O_EVENT_TOL,
     O_H_MAX,
@@ -113,7 +114,7 @@ def _schedule_boundary(t: float, tiny: float, m: Model, d: Data, o: Output) -> N
                 x[X_ROTOR + j] = 0.0
     seg = segment_at(t + tiny, ls[LS_PO_T], m.sched_t)
     ls[LS_PO_SEG] = seg
-    apply_segment(x, m.sched_rate, seg, d.rin)
+    apply_segment(x, m.sched_rate, seg, d.rin, int(m.opts[O_CUT_STEP_MOTORS]))
     ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin)
 
 

@@ -125,7 +125,7 @@ class RotorMode(IntEnum):
 
 class CrashRule(IntEnum):
     CM_GROUND = 0  # event: the CM altitude crosses O_CRASH_ALTITUDE (default 0)
-    PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at the control ticks only
+    PAPER_TICKS = 1  # h <= O_CRASH_ALTITUDE tested at the control ticks after the start
     NONE = 2  # no crash plane (the ground may be a contact shape)
 
 
@@ -226,6 +226,7 @@ F_K = _feat.slot("F_K")  # contact stiffness, N/m^n
 F_N = _feat.slot("F_N")  # contact exponent
 F_E = _feat.slot("F_E")  # coefficient of restitution
 F_MU = _feat.slot("F_MU")  # friction coefficient (0: frictionless)
+F_FORCE_SCALE = _feat.slot("F_FORCE_SCALE")  # factor on the normal force (<= 0 or 1: none)
 NFEAT = _feat.end("NFEAT")
 
 # ---- world shapes shapes (n_shapes, NSHAPE), inertial frame; each kind
@@ -272,6 +273,8 @@ O_POWER_OFF_T = _opt.slot("O_POWER_OFF_T")  # s, power-off trigger (< 0: first c
 O_STOP_ON_CRASH = _opt.slot("O_STOP_ON_CRASH")  # 1: end the run at the crash
 O_SPINUP_PAPER = _opt.slot("O_SPINUP_PAPER")  # 1: spin-up reaction -Jr sum Omega_dot (replica)
 O_CONTACT_GATE = _opt.slot("O_CONTACT_GATE")  # m; > 0: forces only while the CM is this close
+O_CUT_STEP_MOTORS = _opt.slot("O_CUT_STEP_MOTORS")  # bit j: motor j+1 cut at the first tick
+#   after the power-off trigger as a one-tick command step (actuators.cut_step)
 NOPT = _opt.end("NOPT")
 
 # ---- controller ctrl (NCTRL): a common head, then NPARAM slots that each

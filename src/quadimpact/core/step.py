@@ -3,15 +3,16 @@
 Per control tick ``t_k = t0 + k dt`` (``dt = opts[O_DT_CONTROL]``, 5 ms),
 :func:`tick` chains the stages, each a small function:
 
-1. the end of the run and the crash test at the tick (the paper replica's
-   rule); the quaternion renormalised;
+1. the end of the run and the crash test at the tick (the replica's rules,
+   from the first tick after the start); the quaternion renormalised;
 2. estimation: the state estimate into the measurement record
    (``estimators``; the IMU samples up to and including ``t_k`` are already in
    it, taken and filtered by the sensor stage ``sensors/stage.py`` during the
    last interval); the time-to-hover test on the true state (``hover.py``);
 3. the controller (``controllers/``), or an external command set in
    ``ls[LS_EXT_CMD]`` (from Python, a learning agent...); its stage is recorded;
-4. actuators: limits, slew, the rotor inputs of the interval (``actuators.py``);
+4. actuators: limits, slew, the rotor inputs of the interval, then the
+   one-tick motor cut of the authors' crash runs (``actuators.py``);
 5. integration to ``t_{k+1}`` with located events, output rows, IMU samples
    and episode peaks (``interval.py``).
 
@@ -30,7 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .actuators import apply_command
+from .actuators import apply_command, cut_step
 from .controllers import builtin_step
 from .estimators import at_tick, init_estimate
 from .hover import track_hover
@@ -169,8 +170,12 @@ def start(m: Model, d: Data, o: Output) -> None:
 
 @njit(cache=True)
 def _crash_at_tick(t: float, m: Model, d: Data, o: Output) -> bool:
-    """The paper replica's crash rule: ``h <= level`` tested at the control ticks only."""
-    if int(m.opts[O_CRASH_RULE]) != CRASH_PAPER_TICKS:
+    """The replica's crash rules: ``h <= level`` tested at the control ticks after the start.
+
+    The start tick is not tested: a run may start on the ground (the authors'
+    crash run of I-11 starts at altitude 0).
+    """
+    if int(m.opts[O_CRASH_RULE]) != CRASH_PAPER_TICKS or d.ls[LS_K] < 0.5:
         return False
     if not -d.x[X_POS + 2] <= m.opts[O_CRASH_ALTITUDE]:
         return False
@@ -223,6 +228,7 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
     track_hover(t_k, d.x, o.stats)
     _command(t_k, m, d, o, w)
     apply_command(w.cmd, d.x, d.rin, m.opts, dt_c, ls[LS_PO_ACTIVE] > 0.5)
+    cut_step(m, d)
     contact_values(d.x, m, d, w, w.g_a, w.gd_a)
     result = integrate_interval(t_k, t_next, m, d, o, w)
     if result == FAILED:

@@ -15,19 +15,25 @@ COMPARE_CSV = "compare.csv"
 
 
 def compare_crash(
-    crash: Crash, result: SimulationResult, log: FlightLog | None, folder: Path
+    crash: Crash,
+    result: SimulationResult,
+    log: FlightLog | None,
+    folder: Path,
+    title: str = "simulation",
+    classify_log: bool = True,
 ) -> Comparison | None:
     """The run against its log (None without the log); table and plot written into ``folder``.
 
     The scenarios fly rear first as the real vehicle did, so the log is read
-    in its own frame.
+    in its own frame. ``title`` names the run in the plot's title;
+    ``classify_log``: also classify the log's own response type.
     """
     if log is None:
         return None
-    comparison = compare(result, log)
+    comparison = compare(result, log, classify_log=classify_log)
     folder.mkdir(parents=True, exist_ok=True)
     comparison.table().to_csv(folder / COMPARE_CSV, index=False)
-    comparison.plot(folder / COMPARE_PNG, title=f"Crash {crash.number}: simulation vs log")
+    comparison.plot(folder / COMPARE_PNG, title=f"Crash {crash.number}: {title} vs log")
     return comparison
 
 
@@ -38,6 +44,12 @@ def attitude_rms(comparison: Comparison | None) -> float:
     attitude (free of the Euler angles' singularity near 90 deg of pitch).
     """
     return math.nan if comparison is None else comparison.error("attitude", 0.3, "rotation")
+
+
+def position_rms_mm(comparison: Comparison | None) -> float:
+    """RMS position error (mm) over the first 0.3 s after impact (X, Y and altitude
+    displacements since the impact together), NaN without the log."""
+    return math.nan if comparison is None else 1e3 * comparison.error("position", 0.3)
 
 
 def attitude_rms_for_crash(

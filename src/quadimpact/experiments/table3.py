@@ -1,48 +1,75 @@
-"""Table III: the seven real crashes, simulated, with their uncertainty and their logs.
+"""Table III: the seven real crashes, simulated at two sets of conditions, with their logs.
 
-``run_experiments(out_dir)`` simulates each crash of ``crashes.TABLE3`` at its
-nominal conditions in both model variants, runs a sensitivity sweep over the
-stated uncertainty (heading +- 6.4 deg, speed +- 0.01 m/s, inclination +- its
-own, uniform, seeded) giving the share of each response type, and compares
-each run with its flight log where the log is available.
+``run_experiments(out_dir)`` simulates each crash of ``crashes.TABLE3`` at
+Table III's nominal conditions and at the conditions the authors matched in
+their own simulations (``crashes.CONDITIONS``: their approach, climbing and
+drifting into the wall), in the default model and in the paper replica with
+the switches of the authors' crash runs (``crashes.REPLICA_CRASH_SWITCHES``),
+and compares each run with its flight log where the log is available
+(attitude and position over the first 0.3 s after the impact). For the
+matched conditions it also runs the replica with each of its crash-run
+switches off in turn, crash I-03's hand modification on, and both variants
+with a zero scheduled rate read the old way (the motor held, not switched
+off): what each changes. A sensitivity sweep over Table III's stated
+uncertainty (heading +- 6.4 deg, speed +- 0.01 m/s, inclination +- its own,
+uniform, seeded) gives the share of each response type at the nominal
+conditions.
 
 Where the log shows the wall contact, the crash is also simulated at the
 log's own pre-impact estimates (heading, speed at the contact, roll and pitch
 from the motion capture, :meth:`FlightLog.pre_impact`): once at the estimates
 and over their uncertainty (uniform within ``LOG_RANGE_SIGMAS`` standard
-uncertainties). Table III's conditions and the logs' disagree beyond the
-stated uncertainty (docs/EXPERIMENTS.md), and these runs show what that
-changes. The log's own response type (classified from its motion) is given
-too.
+uncertainties). The log's own response type (classified from its motion) is
+given too.
 
-It writes ``table3.csv`` (the stable interface: ``TABLE3_COLUMNS``, then
-``EXTRA_COLUMNS``), ``table3.parquet``, one folder per crash (the nominal runs'
-files and the comparison plots) and the sensitivity sweeps (resumable).
+It writes ``table3.csv`` (one row per crash; the stable interface:
+``TABLE3_COLUMNS``, then ``EXTRA_COLUMNS``), ``table3_runs.csv`` (one row per
+crash, conditions and variant: ``RUN_COLUMNS``), ``table3_switches.csv`` (the
+switch runs: ``SWITCH_COLUMNS``), each also as Parquet, ``table3.md`` (the
+report: :func:`quadimpact.experiments.report.table3_markdown`), one folder
+per crash (``crash_N/<conditions>-<model>/``: each run's files and its
+comparison with the log; ``crash_N/log-conditions/``) and the sensitivity
+sweeps (resumable).
 """
 
 from __future__ import annotations
 
+import json
 import math
 import sys
 import time
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from quadimpact.experiments.crashes import (
+    CONDITIONS,
+    HAND_MODIFICATION,
     HEADING_UNCERTAINTY_DEG,
+    REPLICA_CRASH_SWITCHES,
     SPEED_UNCERTAINTY_M_S,
+    SWITCH_CHANGES,
     TABLE3,
+    VARIANTS,
     Crash,
     scenario_file,
     scenario_path,
 )
 from quadimpact.experiments.logs import PreImpact, data_dir
+from quadimpact.experiments.report import (  # noqa: F401 (the verdict rule, here as before)
+    CHAINING_NOTE_MS,
+    MOTION_RMS_DEG,
+    TYPE_SHARE_PARTLY,
+    VERDICT_RULE,
+    crash_verdict,
+    table3_markdown,
+)
 from quadimpact.experiments.spiri_mat import SpiriMatLog
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.simulation import simulate
-from quadimpact.simulation.metrics import RESPONSE_TYPES
+from quadimpact.simulation.metrics import RESPONSE_TYPES, closest_chaining
 from quadimpact.sweep import SweepSpec, run_sweep
 
 SENSITIVITY_RUNS = 300  # per crash
@@ -88,26 +115,68 @@ MOTION_COLUMNS = tuple(
 )
 #: The row's verdict (``agrees``, ``partly``, ``disagrees``: :func:`crash_verdict`) and why.
 VERDICT_COLUMNS = ("verdict", "verdict_reason")
+#: The authors' matched conditions of the crash (``crashes.Matched``: heading as
+#: flown, rear first), our types there (default; replica with the crash-run
+#: switches) and the default run's attitude error against the log.
+MATCHED_COLUMNS = (
+    "matched_heading_deg",
+    "matched_speed_m_s",
+    "matched_roll_deg",
+    "matched_pitch_deg",
+    "matched_inclination_deg",
+    "matched_start_altitude_m",
+    "matched_altitude_setpoint_m",
+    "type_matched_ours",
+    "type_matched_replica",
+    "attitude_rms_matched_deg_0_3s",
+)
 #: Columns of ``table3.csv`` after ``TABLE3_COLUMNS``: the deepest bumper
 #: deflection of our nominal run (default model, mm; beyond the bumper radius,
-#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``, ``MOTION_COLUMNS``
-#: and ``VERDICT_COLUMNS``.
-EXTRA_COLUMNS = ("max_penetration_mm", *LOG_COLUMNS, *MOTION_COLUMNS, *VERDICT_COLUMNS)
-#: A run matches the crash in motion when its attitude error against the log over
-#: the first 0.3 s (RMS of the rotation angle) is at most this, deg.
-MOTION_RMS_DEG = 20.0
-#: A different type at the nominal conditions is ``partly`` when the experiment's
-#: type occurs in at least this share of the runs over the stated uncertainty.
-TYPE_SHARE_PARTLY = 0.2
-#: The rule of :func:`crash_verdict`, as the report states it.
-VERDICT_RULE = (
-    f"agrees: ours (default) has the experiment's type and its attitude error against the "
-    f"log over the first 0.3 s is at most {MOTION_RMS_DEG:g}° RMS (or there is no log); "
-    f"partly: the same type with a larger attitude error (the type matches, the motion "
-    f"does not), or another type at the nominal conditions while the experiment's occurs in "
-    f"at least {TYPE_SHARE_PARTLY:.0%} of the runs over the stated uncertainty; disagrees: "
-    "otherwise"
+#: 110 mm, the model no longer holds), then ``LOG_COLUMNS``, ``MOTION_COLUMNS``,
+#: ``VERDICT_COLUMNS`` and ``MATCHED_COLUMNS``.
+EXTRA_COLUMNS = (
+    "max_penetration_mm",
+    *LOG_COLUMNS,
+    *MOTION_COLUMNS,
+    *VERDICT_COLUMNS,
+    *MATCHED_COLUMNS,
 )
+#: ``table3_runs.csv``: one row per crash, conditions and variant. The conditions
+#: as run (heading as flown, rear first; roll and pitch only where explicit;
+#: start altitude and set-point), the type and the experiment's, the bumpers of
+#: the initial impact and of each later one (JSON), delta_init and the first
+#: episode's peak deflection (its bumper: 2, the leading one), the crash time
+#: (from the start and after the first contact), the deepest deflection, the
+#: state at the first contact (altitude, climb rate, sideways drift = inertial
+#: V_Y, roll, pitch, yaw, the inclination toward the wall, the time since the
+#: start), the errors against the log over the first 0.3 s
+#: (attitude: RMS rotation angle; position: RMS of the X, Y, altitude
+#: displacements since the impact), and the chaining decision closest to going
+#: the other way (:func:`~quadimpact.simulation.metrics.closest_chaining`: its
+#: margin in ms, negative an overlap, its bumper, and the type had it gone the
+#: other way).
+RUN_COLUMNS = (
+    "crash", "conditions", "model",
+    "heading_deg", "speed_m_s", "inclination_deg", "roll_deg", "pitch_deg",
+    "start_altitude_m", "altitude_setpoint_m",
+    "type", "type_experiment", "matches",
+    "leading_bumpers", "subsequent_impacts", "delta_init_mm", "first_bumper", "first_peak_mm",
+    "crash_time_s", "crash_after_contact_s", "max_penetration_mm",
+    "contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s",
+    "contact_roll_deg", "contact_pitch_deg", "contact_yaw_deg", "contact_inclination_deg",
+    "contact_after_start_s",
+    "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
+    "chaining_margin_ms", "chaining_bumper", "type_chaining_flipped",
+)  # fmt: skip
+#: ``table3_switches.csv``: the matched conditions with one change each
+#: (:data:`SWITCH_CHANGES`; ``"as run"``: the run of ``table3_runs.csv``), with
+#: the state at the first contact as in ``table3_runs.csv``.
+SWITCH_COLUMNS = (
+    "crash", "model", "change", "type", "type_experiment", "matches", "delta_init_mm",
+    "first_peak_mm", "crash_time_s", "crash_after_contact_s",
+    "contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s", "contact_inclination_deg",
+    "contact_after_start_s", "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
+)  # fmt: skip
 _LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
@@ -134,39 +203,6 @@ def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
     """Share of each response type among a sweep's runs, as ``{prefix + type: share}``."""
     counts = sweep["response_type"].value_counts()
     return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
-
-
-def crash_verdict(row: Any) -> tuple[str, str]:
-    """Our nominal run against the experiment, for one row of Table III (:data:`VERDICT_RULE`).
-
-    Parameters
-    ----------
-    row : mapping
-        A row of the table (``type_ours``, ``type_paper_experiment``,
-        ``attitude_rms_deg_0_3s``, ``share_<type>``).
-
-    Returns
-    -------
-    (str, str)
-        The verdict and its reason, with the measure and the threshold.
-    """
-    ours, exp = row["type_ours"], row["type_paper_experiment"]
-    rms = float(row["attitude_rms_deg_0_3s"])
-    if ours == exp:
-        if math.isnan(rms):
-            return "agrees", f"type {ours} (no log to compare the motion with)"
-        if rms <= MOTION_RMS_DEG:
-            return "agrees", f"type {ours}; attitude RMS {rms:.1f}° ≤ {MOTION_RMS_DEG:g}°"
-        return "partly", (
-            f"type {ours}, but not the motion: attitude RMS {rms:.1f}° > {MOTION_RMS_DEG:g}°"
-        )
-    share = float(row.get(f"share_{exp}", math.nan))
-    if math.isnan(share):
-        return "disagrees", f"type {ours}, not {exp} (no runs over the uncertainty)"
-    seen = f"type {ours}, not {exp}; {exp} in {share:.0%} of the runs over the uncertainty"
-    if share >= TYPE_SHARE_PARTLY:
-        return "partly", f"{seen} (≥ {TYPE_SHARE_PARTLY:.0%})"
-    return "disagrees", f"{seen} (< {TYPE_SHARE_PARTLY:.0%})"
 
 
 def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | None:
@@ -328,6 +364,205 @@ def _log_row(
     return row
 
 
+def _contact_state(result: Any) -> dict[str, float]:
+    """Altitude, climb rate, sideways drift, attitude, inclination toward the wall and the time
+    since the start, at the run's first contact (interpolated in the time series)."""
+    from quadimpact.rotations import inclination_deg, quat_to_matrix
+
+    keys = ("contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s",
+            "contact_roll_deg", "contact_pitch_deg", "contact_yaw_deg",
+            "contact_inclination_deg", "contact_after_start_s")  # fmt: skip
+    t_c = result.summary.get("first_contact_s")
+    if t_c is None:
+        return dict.fromkeys(keys, math.nan)
+    ts = result.timeseries
+    t = ts["t_s"].to_numpy()
+    cols = ("altitude_m", "vz_m_s", "vy_m_s", "roll_deg", "pitch_deg", "yaw_deg")
+    values = [float(np.interp(t_c, t, ts[c].to_numpy())) for c in cols]
+    values[1] = -values[1]  # climb: -V_Z (NED)
+    q = np.array([np.interp(t_c, t, ts[c].to_numpy()) for c in ("q0", "q1", "q2", "q3")])
+    values.append(float(inclination_deg(quat_to_matrix(q / np.linalg.norm(q)))))
+    values.append(float(t_c - t[0]))
+    return dict(zip(keys, values, strict=True))
+
+
+def run_record(
+    crash: Crash, conditions: str, model: str, result: Any, comparison: Any
+) -> dict[str, Any]:
+    """One row of ``table3_runs.csv`` (:data:`RUN_COLUMNS`) from a crash's run."""
+    from quadimpact.experiments.logs_compare import attitude_rms, position_rms_mm
+
+    s = result.summary
+    scenario = result.scenario
+    episodes = result.episodes
+    crash_t = s["crash_time_s"]
+    contact = s["first_contact_s"]
+    first = episodes.sort_values(["t_start_s", "bumper"]).iloc[0] if len(episodes) else None
+    chain = closest_chaining(episodes, crash_t is not None)
+    return {
+        "crash": crash.number,
+        "conditions": conditions,
+        "model": model,
+        "heading_deg": scenario.heading_deg,
+        "speed_m_s": scenario.speed_m_s,
+        "inclination_deg": scenario.inclination_deg,
+        "roll_deg": scenario.roll_deg,
+        "pitch_deg": scenario.pitch_deg,
+        "start_altitude_m": scenario.start_altitude_m
+        if scenario.start_altitude_m is not None
+        else scenario.altitude_m,
+        "altitude_setpoint_m": scenario.altitude_m,
+        "type": s["response_type"],
+        "type_experiment": crash.type_experiment,
+        "matches": s["response_type"] == crash.type_experiment,
+        "leading_bumpers": json.dumps(s["leading_bumpers"]),
+        "subsequent_impacts": json.dumps(s["subsequent_impacts"]),
+        "delta_init_mm": _mm(s["delta_init_m"]),
+        "first_bumper": None if first is None else int(first["bumper"]),
+        "first_peak_mm": math.nan if first is None else 1e3 * float(first["peak_delta_m"]),
+        "crash_time_s": math.nan if crash_t is None else crash_t,
+        "crash_after_contact_s": math.nan if crash_t is None or contact is None
+        else crash_t - contact,
+        "max_penetration_mm": _mm(s["max_penetration_m"]),
+        **_contact_state(result),
+        "attitude_rms_deg_0_3s": attitude_rms(comparison),
+        "position_rms_mm_0_3s": position_rms_mm(comparison),
+        "chaining_margin_ms": math.nan if chain is None else 1e3 * chain["margin_s"],
+        "chaining_bumper": None if chain is None else chain["bumper"],
+        "type_chaining_flipped": None if chain is None else chain["type_flipped"],
+    }  # fmt: skip
+
+
+def _mm(x: float | None) -> float:
+    return math.nan if x is None else 1e3 * x
+
+
+#: The earlier reading of the schedules: a motor whose rates never exceed this
+#: (rpm/s) stalled at the impact; any other zero rate held the motor's speed.
+HELD_STALL_RPM_PER_S = 100.0
+
+
+def _zero_rate_held(scenario: Any) -> Any:
+    """The scenario with its schedule read the earlier way: a zero rate holds the motor's
+    speed, and a motor whose rates never exceed ``HELD_STALL_RPM_PER_S`` stops at the
+    trigger (``stopped_motors``), unless the run cuts it at the next tick
+    (``cut_step_motors``: the cut is the switch's, not the reading's)."""
+    po = scenario.power_off
+    rates = po.rates_rpm_per_s
+    cut = scenario.resolved_model_options().cut_step_motors
+    quiet = [all(abs(r[j]) <= HELD_STALL_RPM_PER_S for r in rates) for j in range(4)]
+    stalled = tuple(j + 1 for j in range(4) if quiet[j] and j + 1 not in cut)
+    held = po.model_copy(update={"zero_rate": "hold", "stopped_motors": stalled})
+    return scenario.model_copy(update={"power_off": held})
+
+
+#: A held rate in :func:`offs_within_segment`: not exactly 0, so not a switch-off.
+HELD_RATE_RPM_PER_S = 1e-12
+
+
+def offs_within_segment(power_off: Any, fraction: float) -> Any:
+    """The schedule with each switch-off after the contact moved inside its segment.
+
+    A motor's first zero rate in a segment ``k > 0`` switches it off from the
+    segment's start (the authors' reading). The segment runs from one of the
+    log's motor samples, the motor still running, to the next, which reads it
+    off, so the log puts the switch-off anywhere in it. Here the motor keeps
+    its speed over ``fraction`` of that segment (the last segment: of 0.1 s)
+    and is off after it: 0 is the schedule as given, 1 the latest switch-off
+    the log allows. Zero rates from the first segment (off from the contact)
+    and the other rates are kept; the segments are split where needed.
+    """
+    starts, rates = list(power_off.segment_start_s), power_off.rates_rpm_per_s
+    n = len(starts)
+    off: dict[tuple[int, int], float] = {}  # (motor, its first zero segment) -> switch-off
+    for j in range(4):
+        for k in range(1, n):
+            if rates[k][j] == 0.0 and rates[k - 1][j] != 0.0:
+                end = starts[k + 1] if k + 1 < n else starts[k] + 0.1
+                off[(j, k)] = starts[k] + fraction * (end - starts[k])
+    cuts = sorted(set(starts) | set(off.values()))
+    new = []
+    for t in cuts:
+        k = max(i for i in range(n) if starts[i] <= t)
+        row = []
+        for j in range(4):
+            r = rates[k][j]
+            first = k
+            while r == 0.0 and first > 0 and rates[first - 1][j] == 0.0:
+                first -= 1
+            if r == 0.0 and t < off.get((j, first), -math.inf):
+                r = HELD_RATE_RPM_PER_S
+            row.append(r)
+        new.append(tuple(row))
+    return power_off.model_copy(
+        update={"segment_start_s": tuple(cuts), "rates_rpm_per_s": tuple(new)}
+    )
+
+
+def _switch_changes(crash: Crash, model: str) -> list[tuple[str, Any]]:
+    """The switch runs of a crash in a variant (matched conditions): (change, scenario).
+
+    The changes are those of :data:`SWITCH_CHANGES` that apply to the variant.
+    """
+    from quadimpact.experiments.crashes import MATCHED_APPROACH_OPTIONS
+
+    base = crash.scenario(model, "matched")
+    options = base.model_options.model_dump(exclude_none=True)
+
+    def changed(**fields: Any) -> Any:  # validated again
+        return type(base).model_validate({**base.model_dump(exclude_unset=True), **fields})
+
+    mirrored = changed(heading_deg=180.0 - crash.matched.yaw_from_wall_normal_deg)
+    late = base.model_copy(update={"power_off": offs_within_segment(base.power_off, 1.0)})
+    changes: list[tuple[str, Any]] = [
+        ("zero rate held", _zero_rate_held(base)),
+        ("offs at the segment's end", late),
+    ]
+    if model == "default":
+        own = {k: v for k, v in options.items() if k not in MATCHED_APPROACH_OPTIONS}
+        changes += [
+            ("late start", changed(model_options=own)),
+            ("heading 180 - yaw", mirrored),
+            ("with motor2_cut_step", crash.scenario(model, "matched", ["motor2_cut_step"])),
+            ("with thrust_coefficient", crash.scenario(model, "matched", ["thrust_coefficient"])),
+        ]
+    else:
+        changes.append(("heading 180 - yaw", mirrored))
+        for switch in REPLICA_CRASH_SWITCHES:
+            others = [k for k in REPLICA_CRASH_SWITCHES if k != switch]
+            changes.append((f"without {switch}", crash.scenario(model, "matched", others)))
+        if crash.number == 1:
+            with_hand = [*REPLICA_CRASH_SWITCHES, HAND_MODIFICATION]
+            changes.append((f"with {HAND_MODIFICATION}",
+                            crash.scenario(model, "matched", with_hand)))  # fmt: skip
+    assert all(name in SWITCH_CHANGES for name, _ in changes)
+    return changes
+
+
+def switch_records(
+    crash: Crash, log: SpiriMatLog | None, runs: dict[tuple[str, str], Any]
+) -> list[dict[str, Any]]:
+    """The rows of ``table3_switches.csv`` (:data:`SWITCH_COLUMNS`) of one crash.
+
+    ``runs``: the crash's runs by (conditions, model), with their comparisons:
+    the matched ones are the ``"as run"`` rows.
+    """
+    from quadimpact.experiments.compare import compare
+
+    rows = []
+    for model in VARIANTS:
+        result, comparison = runs[("matched", model)]
+        todo: list[tuple[str, Any, Any]] = [("as run", result, comparison)]
+        for change, scenario in _switch_changes(crash, model):
+            r = simulate(scenario)
+            c = None if log is None else compare(r, log, classify_log=False)
+            todo.append((change, r, c))
+        for change, r, c in todo:
+            record = {**run_record(crash, "matched", model, r, c), "change": change}
+            rows.append({k: record[k] for k in SWITCH_COLUMNS})
+    return rows
+
+
 def crash_task(
     crash: Crash,
     log: SpiriMatLog | None,
@@ -340,20 +575,32 @@ def crash_task(
 
     The piece of work a study hands to a process
     (:func:`quadimpact.sweep.tasks.run_tasks`); ``sweep_options`` go to its
-    sweeps (default: in this process, no progress).
+    sweeps (default: in this process, no progress). The row also carries the
+    crash's rows of ``table3_runs.csv`` and ``table3_switches.csv`` (keys
+    ``"runs"`` and ``"switches"``), which :func:`write_table3` takes out.
     """
     from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
 
     sweep_options = sweep_options or {"workers": 1, "scheduler": None, "progress": False}
     start = time.perf_counter()
     folder = out / f"crash_{crash.number}"
-    types: dict[str, str | None] = {}
-    results = {}
-    for model, key in (("default", "type_ours"), ("paper-replica", "type_replica")):
-        r = simulate(crash.scenario(model))
-        r.write(folder / model)
-        results[model] = r
-        types[key] = r.summary["response_type"]
+    runs: dict[tuple[str, str], Any] = {}
+    records = []
+    for conditions in CONDITIONS:
+        for model in VARIANTS:
+            r = simulate(crash.scenario(model, conditions))
+            name = f"{conditions}-{model}"
+            r.write(folder / name)
+            c = compare_crash(
+                crash,
+                r,
+                log,
+                folder / name,
+                title=f"{conditions} conditions, {model}",
+                classify_log=False,
+            )
+            runs[(conditions, model)] = (r, c)
+            records.append(run_record(crash, conditions, model, r, c))  # fmt: skip
     shares: dict[str, float] = {f"share_{t}": math.nan for t in RESPONSE_TYPES}
     if samples > 0:
         sweep = run_sweep(
@@ -362,12 +609,13 @@ def crash_task(
             **sweep_options,
         )
         shares = _shares(sweep, "share_")
-    comparison = compare_crash(crash, results["default"], log, folder)
+    nominal, comparison = runs[("nominal", "default")]
     motion = {c: math.nan for c in MOTION_COLUMNS}
     if comparison is not None:
         for angle, (sim, logged) in comparison.departures(0.3).items():
             motion[f"sim_{angle}_change_deg_0_3s"] = sim
             motion[f"log_{angle}_change_deg_0_3s"] = logged
+    m = crash.matched
     row = {
         "crash": crash.number,
         "heading_deg": crash.heading_deg,
@@ -375,14 +623,27 @@ def crash_task(
         "inclination_deg": crash.inclination_deg,
         "type_paper_experiment": crash.type_experiment,
         "type_paper_simulation": crash.type_paper_simulation,
-        **types,
+        "type_ours": nominal.summary["response_type"],
+        "type_replica": runs[("nominal", "paper-replica")][0].summary["response_type"],
         **shares,
         "attitude_rms_deg_0_3s": attitude_rms(comparison),
-        "max_penetration_mm": 1e3 * results["default"].summary["max_penetration_m"],
+        "max_penetration_mm": 1e3 * nominal.summary["max_penetration_m"],
         **_log_row(crash, log, folder, out, log_samples, sweep_options),
         **motion,
+        "matched_heading_deg": m.heading_deg,
+        "matched_speed_m_s": m.speed_m_s,
+        "matched_roll_deg": m.roll_deg,
+        "matched_pitch_deg": m.pitch_deg,
+        "matched_inclination_deg": m.inclination_deg,
+        "matched_start_altitude_m": m.altitude_at_start_m,
+        "matched_altitude_setpoint_m": m.altitude_setpoint_m,
+        "type_matched_ours": runs[("matched", "default")][0].summary["response_type"],
+        "type_matched_replica": runs[("matched", "paper-replica")][0].summary["response_type"],
+        "attitude_rms_matched_deg_0_3s": attitude_rms(runs[("matched", "default")][1]),
     }
     row["verdict"], row["verdict_reason"] = crash_verdict(row)
+    row["runs"] = records
+    row["switches"] = switch_records(crash, log, runs)
     return row, time.perf_counter() - start
 
 
@@ -478,9 +739,24 @@ def prepare_experiments(
 
 
 def write_table3(rows: list[dict[str, Any]], out: Path) -> pd.DataFrame:
-    """Table III from the crashes' rows (in crash order), written to ``out``
-    (``table3.csv``, ``table3.parquet``)."""
+    """Table III from the crashes' rows (in crash order), written to ``out``.
+
+    ``table3.csv`` and ``.parquet`` (one row per crash), the runs and switch
+    runs the rows carry (``table3_runs``, ``table3_switches``, CSV and
+    Parquet) and the report ``table3.md``. Returns the per-crash table, with
+    the other two as ``table.attrs["runs"]`` and ``table.attrs["switches"]``.
+    """
+    runs = pd.DataFrame([r for row in rows for r in row.get("runs", [])], columns=RUN_COLUMNS)
+    switches = pd.DataFrame([r for row in rows for r in row.get("switches", [])],
+                            columns=SWITCH_COLUMNS)  # fmt: skip
     table = pd.DataFrame(rows, columns=[*TABLE3_COLUMNS, *EXTRA_COLUMNS])
     table.to_csv(out / "table3.csv", index=False)
     table.to_parquet(out / "table3.parquet")
+    for name, frame in (("table3_runs", runs), ("table3_switches", switches)):
+        frame.to_csv(out / f"{name}.csv", index=False)
+        frame.to_parquet(out / f"{name}.parquet")
+    table.attrs["runs"] = runs
+    table.attrs["switches"] = switches
+    (out / "table3.md").write_text("# Table III: the seven real crashes\n\n"
+                                    + table3_markdown(table, runs, switches) + "\n")  # fmt: skip
     return table

@@ -6,10 +6,10 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, Literal
 
-from pydantic import BaseModel, Field, StrictBool, ValidationError
+from pydantic import BaseModel, Field, StrictBool, ValidationError, field_validator
 
 from quadimpact.errors import InputError, input_error_from_validation
-from quadimpact.inputs.types import MODEL_CONFIG, Real
+from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec4
 
 __all__ = ["MODEL_VARIANTS", "ModelName", "ModelOptions", "resolve_model_options"]
 
@@ -54,11 +54,13 @@ class ModelOptions(BaseModel):
         roll 0 and pitch ``-inclination``; for heading +-45 deg
         ``roll = pitch = -(incl - 0.0042477) / 1.3836686`` (rad); other
         headings as ``"exact"``.
-    crash_rule : {"cm-ground", "paper-ticks"} or None
+    crash_rule : {"cm-ground", "paper-ticks", "ground-ticks"} or None
         ``"cm-ground"`` (default): crash when the CM reaches altitude 0,
         located exactly as an integrator event. ``"paper-ticks"`` (replica):
         crash when the altitude is at or below -0.3 m, tested at the control
-        ticks only.
+        ticks after the start. ``"ground-ticks"`` (the authors' crash runs of
+        Table III): at or below altitude 0, tested at the control ticks after
+        the start.
     approach_start : {"late-start", "paper"} or None
         ``"late-start"`` (default): when the vehicle would have to start
         moving away from the wall (needed initial speed < 0), it starts at rest
@@ -81,6 +83,19 @@ class ModelOptions(BaseModel):
         ``"scenario"`` (default): the ``recovery`` controller's pre-impact
         behaviour is the scenario's ``pre_impact``. ``"spin-down"`` (recovery
         replica): always spin-down, as in the authors' Monte Carlo code.
+    cut_step_motors : tuple of int or None
+        Motors (1-4) that a power-off schedule cuts at the first control tick
+        after its trigger, as a one-tick command step: the motor keeps its
+        speed from the trigger to that tick, is then at 0 and stays off, and
+        the spin-up reaction sees ``-Omega / dt`` over that tick's interval (a
+        yaw kick of about 2.6 N m for 5 ms at hover speed). ``()`` (every
+        variant): none, the schedule alone drives the motors. The authors'
+        crash runs of Table III: ``(2,)`` (docs/EXPERIMENTS.md).
+    bumper_force_scale : 4 floats or None
+        Factor on each bumper's contact force (bumpers 1-4), ``> 0``.
+        ``(1, 1, 1, 1)`` (every variant): the contact law. The authors' run
+        of crash I-03 (Table III row 1) had ``(1, 2, 1, 1)``, an undocumented
+        hand modification (docs/EXPERIMENTS.md).
     """
 
     model_config = MODEL_CONFIG
@@ -97,8 +112,10 @@ class ModelOptions(BaseModel):
     attitude_mapping: Literal["exact", "paper-fit"] | None = Field(
         None, description="Heading/inclination -> roll/pitch: exact, or the authors' fit."
     )
-    crash_rule: Literal["cm-ground", "paper-ticks"] | None = Field(
-        None, description="Crash: CM at h = 0 (event), or h <= -0.3 m at control ticks."
+    crash_rule: Literal["cm-ground", "paper-ticks", "ground-ticks"] | None = Field(
+        None,
+        description="Crash: CM at h = 0 (event), h <= -0.3 m at control ticks, or h <= 0 "
+        "at control ticks.",
     )
     approach_start: Literal["late-start", "paper"] | None = Field(
         None,
@@ -117,6 +134,30 @@ class ModelOptions(BaseModel):
     pre_impact: Literal["scenario", "spin-down"] | None = Field(
         None, description="Recovery pre-impact behaviour: the scenario's, or spin-down."
     )
+    cut_step_motors: tuple[int, ...] | None = Field(
+        None,
+        description="Motors (1-4) a power-off schedule cuts at the first tick after its "
+        "trigger as a one-tick command step.",
+    )
+    bumper_force_scale: Vec4 | None = Field(
+        None, description="Factor (> 0) on the contact force of bumpers 1-4."
+    )
+
+    @field_validator("cut_step_motors")
+    @classmethod
+    def _motor_numbers(cls, value: tuple[int, ...] | None) -> tuple[int, ...] | None:
+        if value is not None and (
+            any(m not in (1, 2, 3, 4) for m in value) or len(set(value)) != len(value)
+        ):
+            raise ValueError("distinct motor numbers 1-4")
+        return value
+
+    @field_validator("bumper_force_scale")
+    @classmethod
+    def _positive_scales(cls, value: tuple[float, ...] | None) -> tuple[float, ...] | None:
+        if value is not None and not min(value) > 0:
+            raise ValueError("every factor must be > 0")
+        return value
 
 
 MODEL_VARIANTS: dict[str, dict[str, Any]] = {
@@ -131,6 +172,8 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "tilt-away",
         "contact_gate_m": 0.0,
         "pre_impact": "scenario",
+        "cut_step_motors": (),
+        "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
     "paper-replica": {
         "yaw_reaction": "paper",
@@ -143,6 +186,8 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "tilt-away",
         "contact_gate_m": 0.0,
         "pre_impact": "scenario",
+        "cut_step_motors": (),
+        "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
     "recovery-replica": {
         "yaw_reaction": "paper",
@@ -155,6 +200,8 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "level",
         "contact_gate_m": 0.30,
         "pre_impact": "spin-down",
+        "cut_step_motors": (),
+        "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
 }
 """Every switch of :class:`ModelOptions` for each named model variant."""

@@ -97,7 +97,10 @@ class PowerOff(BaseModel):
     Over segment k, from ``trigger + segment_start_s[k]`` to the next start,
     motor j changes at ``rates_rpm_per_s[k][j]`` (rpm/s, motors 1-4) and never
     goes below zero, whatever the controller commands (the paper's
-    experiments: the motors' safety power-off after impact).
+    experiments: the motors' safety power-off after impact). A rate of
+    exactly 0 (or -0) is the motor switched off over that segment: its speed is
+    0 from the segment's start (the crash data's convention: the log reads its
+    powered-off marker next), unless ``zero_rate = "hold"``.
 
     Attributes
     ----------
@@ -110,7 +113,11 @@ class PowerOff(BaseModel):
         Per segment, the rate of change of motors 1-4, rpm/s.
     stopped_motors : tuple of int
         Motors (1-4) that stall at the trigger: their speed drops to zero at
-        once (the logs show them stopped with no measurable ramp).
+        once (as a zero rate in the first segment does).
+    zero_rate : {"off", "hold"}
+        What a rate of exactly 0 means: ``"off"`` (default), the motor is
+        switched off (speed 0 from the segment's start); ``"hold"``, it keeps
+        its speed over the segment.
     """
 
     model_config = MODEL_CONFIG
@@ -126,6 +133,9 @@ class PowerOff(BaseModel):
     )
     stopped_motors: tuple[int, ...] = Field(
         (), description="Motors (1-4) that stall at the trigger: speed 0 at once."
+    )
+    zero_rate: Literal["off", "hold"] = Field(
+        "off", description="A rate of exactly 0: the motor switched off ('off'), or held."
     )
 
     @model_validator(mode="after")
@@ -525,7 +535,12 @@ class WallApproach(RunSettings):
         may then leave the X-Z plane (the experiments' measured attitudes).
         ``inclination_deg`` is ignored and reported as reached.
     start_altitude_m : float or None
-        Initial altitude, m, when it differs from the set-point.
+        Initial altitude, m, when it differs from the set-point (>= 0; 0: the
+        CM on the ground plane, which the crash rules test only after the
+        start). With it, an explicit attitude and ``impact_time_s`` this is
+        the authors' approach of their crash runs: the controller holds the
+        attitude and climbs toward the set-point, so the vehicle reaches the
+        wall climbing and drifting sideways, at ``speed_m_s`` toward it.
     """
 
     kind: Literal["wall-approach"] = Field("wall-approach", description="Scenario kind tag.")
@@ -550,7 +565,7 @@ class WallApproach(RunSettings):
         None, ge=-60, le=60, description="Explicit pitch (with roll_deg), deg."
     )
     start_altitude_m: Real | None = Field(
-        None, gt=0, description="Initial altitude if not the set-point, m."
+        None, ge=0, description="Initial altitude if not the set-point, m (>= 0)."
     )
 
     @model_validator(mode="after")

@@ -11,9 +11,8 @@ from typing import Any
 import pandas as pd
 
 from quadimpact import __version__
-from quadimpact.inputs.vehicle import load_vehicle
+from quadimpact.experiments.report import table3_markdown
 from quadimpact.recovery.report import percent, rate_text
-from quadimpact.rotations import wrap_angle_deg
 from quadimpact.simulation.metrics import RESPONSE_TYPES
 
 __all__ = [
@@ -67,6 +66,8 @@ def render_report(
     stage_times: list[tuple[str, float]] | None = None,
     piece_times: list[tuple[str, float]] | None = None,
     pole: Any = None,
+    table3_runs: pd.DataFrame | None = None,
+    table3_switches: pd.DataFrame | None = None,
 ) -> str:
     """The Markdown report: findings, ablation, figures, Table II, Table III, recovery.
 
@@ -75,6 +76,8 @@ def render_report(
     ``RecoveryPart`` (:func:`recovery_markdown`), or None; ``stage_times``,
     (stage, wall time in s) in order, ends the report with the time per stage,
     and ``piece_times`` with those of the pieces that ran on worker processes.
+    ``table3_runs`` and ``table3_switches``: the crashes' runs at both sets of
+    conditions and their switch runs (:func:`table3_markdown`).
     """
     variants = list(dict.fromkeys(findings["variant"]))
     switches = list(dict.fromkeys(ablation["switch"])) if not ablation.empty else []
@@ -147,7 +150,7 @@ def render_report(
         logs = table3.attrs.get("logs")
         lines += ["## Table III: the seven real crashes", ""]
         lines += [f"The {logs} (docs/EXPERIMENTS.md).", ""] if logs else []
-        lines += [table3_markdown(table3), ""]
+        lines += [table3_markdown(table3, table3_runs, table3_switches), ""]
     if recovery is not None:
         lines += [recovery_markdown(recovery, elapsed_s), ""]
     if pole is not None:
@@ -343,196 +346,4 @@ def recovery_markdown(part: Any, elapsed_s: float) -> str:
 
         n_est = next(iter(part.estimators.values()))["n"]
         lines += ["", *estimators_markdown(part.estimators, n_est)]
-    return "\n".join(lines)
-
-
-def _percent(x: float) -> str:
-    """A share as a whole percentage; never 0 % or 100 % unless exact."""
-    if 0 < x < 0.005:
-        return "<1%"
-    if 0.995 <= x < 1:
-        return ">99%"
-    return f"{x:.0%}"
-
-
-def _share_text(r: pd.Series, prefix: str) -> str:
-    cols = [c for c in r.index if c.startswith(prefix)]
-    return ", ".join(
-        f"{c.removeprefix(prefix)} {_percent(r[c])}" for c in cols if r[c] == r[c] and r[c] > 0
-    )
-
-
-def _deg(x: float | None, fmt: str = ".1f") -> str:
-    return "–" if x is None or x != x else format(x, fmt)
-
-
-def _depth(x: float, rb_mm: float) -> str:
-    return "–" if x != x else f"{x:.0f}" + (" †" if x > rb_mm else "")
-
-
-def _front_first(heading_deg: float) -> float:
-    """A rear-first heading (log frame, scenario files) as Table III gives it, in (-180, 180]."""
-    return float(wrap_angle_deg(heading_deg + 180.0))
-
-
-def _motion_note(r: pd.Series, threshold_deg: float) -> str:
-    """Why a row of the same type as the experiment is not the same motion, from the data."""
-    note = (
-        f"- Crash {r['crash']}: the type is the experiment's ({r['type_ours']}), the motion is "
-        f"not: the attitude differs from the log's by {r['attitude_rms_deg_0_3s']:.1f}° RMS over "
-        f"the first 0.3 s after the impact (a match needs at most {threshold_deg:g}°)."
-    )
-    moved = []
-    for angle in ("roll", "pitch", "yaw"):
-        sim, log = r.get(f"sim_{angle}_change_deg_0_3s"), r.get(f"log_{angle}_change_deg_0_3s")
-        if sim is None or log is None or sim != sim or log != log:
-            continue
-        moved.append((angle, float(sim), float(log)))
-    if moved:
-        note += (
-            " In that time the log turns "
-            + ", ".join(f"{a} {lg:+.0f}°" for a, _, lg in moved)
-            + "; ours "
-            + ", ".join(f"{a} {sm:+.0f}°" for a, sm, _ in moved)
-            + "."
-        )
-        opposite = [a for a, sm, lg in moved if sm * lg < 0 and min(abs(sm), abs(lg)) > 5.0]
-        if opposite:
-            verb = "turns" if len(opposite) == 1 else "turn"
-            note += f" Ours {verb} the other way in {' and '.join(opposite)}."
-        if any(max(abs(sm), abs(lg)) > 180.0 for a, sm, lg in moved if a != "pitch"):
-            note += (
-                " Roll and yaw change by more than half a turn: the pitch nears 90°, where "
-                "they are ill-defined (the Euler angles' singularity); the RMS above is of the "
-                "rotation angle, which is not."
-            )
-    no_contact = isinstance(r.get("type_log"), str) and r.get("log_speed_m_s") != r.get(
-        "log_speed_m_s"
-    )
-    if no_contact:
-        note += (
-            " The log does not show the wall contact (the motion capture misses it), so its "
-            "impact time is the on-board estimate and the two may not be aligned on the same "
-            "event; the log's own type is unknown."
-        )
-    return note
-
-
-def table3_markdown(table: pd.DataFrame) -> str:
-    """Table III, ours beside the paper's, and each differing row explained by the data."""
-    from quadimpact.experiments.table3 import MOTION_RMS_DEG, VERDICT_RULE, crash_verdict
-
-    rb_mm = 1e3 * load_vehicle("spiri").bumper_radius_m
-    has_log = "type_log_conditions" in table.columns
-    head = (
-        "| crash | ψ (°) | V_c (m/s) | ι (°) | experiment | paper's simulation | ours (default) "
-        "| replica | over the uncertainty (default) | attitude RMS 0-0.3 s (°) |"
-    )
-    lines = [head, "|---" * 10 + "|"]
-    if has_log:
-        lines = [head + " deepest δ (mm) |", "|---" * 11 + "|"]
-    lines = [lines[0] + " ours vs the experiment |", lines[1] + "---|"]
-    notes, motion_notes = [], []
-    for _, r in table.iterrows():
-        verdict, reason = (
-            (r["verdict"], r["verdict_reason"])
-            if isinstance(r.get("verdict"), str)
-            else crash_verdict(r)
-        )
-        dist = _share_text(r, "share_")
-        rms = (
-            "no log"
-            if r["attitude_rms_deg_0_3s"] != r["attitude_rms_deg_0_3s"]
-            else (f"{r['attitude_rms_deg_0_3s']:.1f}")
-        )
-        lines.append(
-            f"| {r['crash']} | {r['heading_deg']:g} | {r['speed_m_s']:g} "
-            f"| {r['inclination_deg']:g} "
-            f"| {r['type_paper_experiment']} | {r['type_paper_simulation']} | {r['type_ours']} "
-            f"| {r['type_replica']} | {dist or 'not run'} | {rms} |"
-            + (f" {_depth(r['max_penetration_mm'], rb_mm)} |" if has_log else "")
-            + f" **{verdict}**: {reason} |"
-        )
-        if r["type_ours"] == r["type_paper_experiment"] and verdict != "agrees":
-            motion_notes.append(_motion_note(r, MOTION_RMS_DEG))
-        if r["type_ours"] != r["type_paper_experiment"]:
-            key = f"share_{r['type_paper_experiment']}"
-            seen = r[key] if key in r and r[key] == r[key] else float("nan")
-            deep = (
-                f"; the bumpers deflect {r['max_penetration_mm']:.0f} mm, beyond their radius"
-                if has_log and r["max_penetration_mm"] > rb_mm
-                else ""
-            )
-            note = (
-                f"- Crash {r['crash']}: the experiment was type {r['type_paper_experiment']}, ours "
-                f"at the nominal conditions is {r['type_ours']} (the replica: "
-                f"{r['type_replica']}{deep}). Over the stated uncertainty type "
-                f"{r['type_paper_experiment']} occurs in {seen:.0%} of the runs ({dist})."
-            )
-            if has_log and isinstance(r["type_log_conditions"], str):
-                note += (
-                    f" The log puts the impact at V_c {r['log_speed_m_s']:.2f} m/s, ι "
-                    f"{r['log_inclination_deg']:.1f}° (roll {r['log_roll_deg']:.1f}°, pitch "
-                    f"{r['log_pitch_deg']:.1f}°); there ours is "
-                    f"{r['type_log_conditions']} ({_share_text(r, 'log_share_')} over the "
-                    "log's uncertainty)"
-                )
-                depth = r["log_max_penetration_mm"]
-                note += (
-                    f", but the bumpers deflect {depth:.0f} mm there, beyond their radius "
-                    "(the model's answer, not a prediction)."
-                    if depth > rb_mm
-                    else "."
-                )
-            notes.append(note)
-    lines += ["", f"Verdict of each row: {VERDICT_RULE}."]
-    if motion_notes:
-        lines += ["", "Rows where our type is the experiment's but the motion is not:", "",
-                  *motion_notes]  # fmt: skip
-    if notes:
-        lines += ["", "Rows where our type differs from the experiment's:", "", *notes]
-    if has_log:
-        seen = table[table["type_log_conditions"].apply(lambda v: isinstance(v, str))]
-        dv = seen["log_speed_m_s"] - seen["speed_m_s"]
-        di = seen["log_inclination_deg"] - seen["inclination_deg"]
-        spread = (
-            f" Against Table III the logs' speeds differ by {dv.min():+.2f} to {dv.max():+.2f} "
-            f"m/s (stated ±0.01) and their inclinations by {di.min():+.1f} to {di.max():+.1f}°."
-            if len(seen)
-            else ""
-        )
-        lines += [
-            "",
-            "At the logs' own pre-impact estimates (motion capture at the observed contact; "
-            "docs/EXPERIMENTS.md explains why they differ from Table III). ψ is given as in "
-            "Table III above: the heading of the equivalent front-first approach (the "
-            "flights went into the wall rear first, at ψ − 180° in the log frame and in the "
-            f"scenario files).{spread}",
-            "",
-            "| crash | ψ (°) | V_c (m/s) | ι (°) | roll / pitch (°) | log's own type "
-            "| ours at the log's estimates | over their uncertainty (±2σ) "
-            "| attitude RMS 0-0.3 s (°) | deepest δ (mm) |",
-            "|---" * 10 + "|",
-        ]
-        for _, r in table.iterrows():
-            if not isinstance(r["type_log_conditions"], str):
-                why = "no log" if not isinstance(r["type_log"], str) else "contact not observed"
-                lines.append(f"| {r['crash']} | {why} | | | | {r['type_log'] or '–'} | | | | |")
-                continue
-            lines.append(
-                f"| {r['crash']} | {_deg(_front_first(r['log_heading_deg']))} "
-                f"| {r['log_speed_m_s']:.2f} "
-                f"| {_deg(r['log_inclination_deg'])} "
-                f"| {_deg(r['log_roll_deg'])} / {_deg(r['log_pitch_deg'])} | {r['type_log']} "
-                f"| {r['type_log_conditions']} | {_share_text(r, 'log_share_') or 'not run'} "
-                f"| {_deg(r['attitude_rms_log_conditions_deg_0_3s'])} "
-                f"| {_depth(r['log_max_penetration_mm'], rb_mm)} |"
-            )
-        lines += [
-            "",
-            f"† deeper than the bumper radius ({rb_mm:.0f} mm): the bumper model no longer "
-            "holds (the body itself would reach the wall), so these runs' types are the "
-            "model's, not a prediction (docs/MODEL_NOTES.md). The paper's bumper law is the "
-            "same, with the same limit.",
-        ]
     return "\n".join(lines)

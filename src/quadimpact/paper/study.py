@@ -328,6 +328,10 @@ def reproduce(
     table3 = write_table3(crash_rows, exp_out) if experiments else None
     if table3 is not None:
         table3.attrs["logs"] = logs_source(data_dir)  # said in the report's Table III
+    table3_extras = [
+        pd.read_parquet(exp_out / f"{name}.parquet") if experiments else None
+        for name in ("table3_runs", "table3_switches")
+    ]
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
     pole = pole_part(out, workers, scheduler, progress, clock) if recovery else None
@@ -355,6 +359,8 @@ def reproduce(
             clock.times,
             clock.pieces,
             pole=pole,
+            table3_runs=table3_extras[0],
+            table3_switches=table3_extras[1],
         )  # fmt: skip
     )
     return StudyResult(

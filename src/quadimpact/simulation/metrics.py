@@ -31,6 +31,7 @@ __all__ = [
     "RESPONSE_TYPES",
     "attitude_excursion_deg",
     "classify_response",
+    "closest_chaining",
     "RESPONSE_TYPE_MEANINGS",
     "graze_mask",
     "group_impacts",
@@ -433,3 +434,72 @@ def classify_response(
         k = next(i for i, b in enumerate(later) if b in leading)
         return "C" if any(b not in leading for b in later[k + 1 :]) else "Other"
     return "D" if len(later) >= 2 else "Other"
+
+
+def closest_chaining(episodes: Table, crashed: bool) -> dict[str, Any] | None:
+    """The chaining decision of the impact grouping that came closest to going the other way.
+
+    Impacts are chained episodes (:func:`group_impacts`): an episode that
+    starts before its group has ended joins it. For every episode after the
+    first (obstacles only, grazes left out, as in the summary), its start
+    minus the end of the group before it so far is its *margin*: negative,
+    it joined that group by that overlap; positive, it started a new impact
+    after that gap. The response type can hinge on a margin of a few
+    milliseconds (an aft bumper touching just before the leading one leaves
+    the wall makes one impact of two, and a D a B).
+
+    Parameters
+    ----------
+    episodes : table
+        The run's episodes (``bumper``, ``surface``, ``t_start_s``,
+        ``t_end_s``, ``peak_delta_m``, ``peak_force_n``).
+    crashed : bool
+        Whether the run crashed.
+
+    Returns
+    -------
+    dict or None
+        ``margin_s`` (the smallest in size), ``bumper`` (that episode's),
+        ``joined`` (its margin <= 0), ``type`` (the response type as grouped)
+        and ``type_flipped`` (the type with that one episode on the other side
+        of the group's end); None with fewer than two episodes.
+    """
+    n = n_rows(episodes)
+    if n < 2:
+        return None
+    surface = column(episodes, "surface", dtype=object).astype(str)
+    keep = (surface != "ground") & ~graze_mask(episodes, ("ground",), GRAZE_IMPULSE_FRACTION)
+    eps = select(episodes, keep, _EPISODE_NEEDED)
+    order = np.lexsort((np.asarray(eps["bumper"], float), eps["t_start_s"]))
+    if len(order) < 2:
+        return None
+    best: tuple[float, int, float] | None = None  # (margin, episode, group end)
+    group_end = -math.inf
+    for k, pos in enumerate(order):
+        i = int(pos)
+        start, end = float(eps["t_start_s"][i]), float(eps["t_end_s"][i])
+        if k > 0:
+            margin = start - group_end
+            if best is None or abs(margin) < abs(best[0]):
+                best = (margin, i, group_end)
+            group_end = max(group_end, end) if margin <= 0.0 else max(end, start)
+        else:
+            group_end = max(end, start)
+
+    def response(table: dict[str, np.ndarray]) -> str:
+        m = impact_metrics(table, exclude_surfaces=())
+        return classify_response(m["leading_bumpers"], m["subsequent_impacts"], crashed)
+
+    assert best is not None
+    margin, i, end_before = best
+    flipped = {k: np.array(v, dtype=float if k != "surface" else object) for k, v in eps.items()}
+    # across the group's end: just after it (a new impact), or at it (chained: closed intervals)
+    flipped["t_start_s"][i] = np.nextafter(end_before, math.inf) if margin <= 0.0 else end_before
+    flipped["t_end_s"][i] = max(flipped["t_end_s"][i], flipped["t_start_s"][i])
+    return {
+        "margin_s": float(margin),
+        "bumper": int(eps["bumper"][i]),
+        "joined": bool(margin <= 0.0),
+        "type": response(eps),
+        "type_flipped": response(flipped),
+    }

@@ -11,6 +11,8 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.actuators import MOTOR_OFF
+from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import ControllerEntry, PackContext
 from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
@@ -77,13 +79,25 @@ FEATURE_KINDS: dict[str, int] = {
 }
 
 
-def pack_features(v: Vehicle, friction_coefficient: float) -> np.ndarray:
+def pack_features(
+    v: Vehicle, friction_coefficient: float, force_scale: Sequence[float] | None = None
+) -> np.ndarray:
     """The vehicle's contact features as an (n, NFEAT) array (body frame, SI).
 
     ``friction_coefficient``: the scenario's, for the features that set none.
+    ``force_scale``: a factor on each feature's normal force, in the
+    vehicle's feature order (the model switch ``bumper_force_scale``: bumpers
+    1-4 of a four-ring vehicle); None or all ones: the contact law itself.
     """
     feat = _memo("feat", v, lambda: _pack_features(v.contact_features()))
     feat[np.isnan(feat[:, L.F_MU]), L.F_MU] = friction_coefficient
+    if force_scale is not None and any(f != 1.0 for f in force_scale):
+        if len(force_scale) != feat.shape[0]:
+            raise InputError(
+                f"bumper_force_scale: {len(force_scale)} factors for the {feat.shape[0]} contact "
+                "features of this vehicle"
+            )
+        feat[:, L.F_FORCE_SCALE] = force_scale
     return feat
 
 
@@ -98,6 +112,7 @@ def _pack_features(features: Sequence[ContactFeature]) -> np.ndarray:
         feat[i, L.F_N] = f.exponent
         feat[i, L.F_E] = f.restitution
         feat[i, L.F_MU] = np.nan if f.friction_coefficient is None else f.friction_coefficient
+        feat[i, L.F_FORCE_SCALE] = 1.0
     return feat
 
 
@@ -330,8 +345,14 @@ def pack_options(
     rtol: float | None,
     atol: float | None,
     duration_s: float,
+    cut_step_motors: Sequence[int] = (),
 ) -> np.ndarray:
-    """Model switches and integrator settings as the ``O_*`` vector."""
+    """Model switches and integrator settings as the ``O_*`` vector.
+
+    ``cut_step_motors``: the motors (1-4) a power-off schedule cuts at the
+    first control tick after its trigger (``O_CUT_STEP_MOTORS``, motor ``j``
+    as bit ``j - 1``; docs/VARIANTS.md).
+    """
     opts = np.zeros(L.NOPT)
     opts[L.O_YAW_REACTION_PAPER] = float(yaw_paper)
     opts[L.O_SPINUP_PAPER] = float(spinup_paper)
@@ -353,7 +374,22 @@ def pack_options(
     opts[L.O_MAX_STEPS] = max(100_000, MAX_STEPS_PER_S * duration_s)
     opts[L.O_EVENT_TOL] = EVENT_TOL_S
     opts[L.O_POWER_OFF_T] = np.inf
+    opts[L.O_CUT_STEP_MOTORS] = float(sum(1 << (m - 1) for m in set(cut_step_motors)))
     return opts
+
+
+def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -> np.ndarray:
+    """A power-off schedule's rates as the kernel takes them, rad/s^2.
+
+    With ``zero_rate = "off"`` a rate of exactly 0 (or -0) is the motor
+    switched off over the segment (``core.actuators.MOTOR_OFF``: its speed 0
+    from the segment's start); with ``"hold"`` it keeps its speed.
+    """
+    rpm = np.asarray(rates_rpm_per_s, dtype=float).reshape(-1, 4)
+    rates = rpm * RPM
+    if zero_rate == "off":
+        rates[rpm == 0.0] = MOTOR_OFF
+    return rates
 
 
 def pack_sensors(

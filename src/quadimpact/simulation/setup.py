@@ -38,6 +38,7 @@ from quadimpact.simulation.packing import (
     pack_sensors,
     pack_surfaces,
     pack_vehicle,
+    schedule_rates,
     trim_rotor_speeds,
 )
 
@@ -156,6 +157,8 @@ def _packed_options(
         crash_rule, level, stop = L.CRASH_NONE, 0.0, False
     elif o.crash_rule == "paper-ticks":
         crash_rule, level, stop = L.CRASH_PAPER_TICKS, PAPER_CRASH_ALTITUDE_M, True
+    elif o.crash_rule == "ground-ticks":
+        crash_rule, level, stop = L.CRASH_PAPER_TICKS, 0.0, True
     else:
         crash_rule, level, stop = L.CRASH_CM_GROUND, 0.0, True
     limits = None
@@ -176,6 +179,7 @@ def _packed_options(
         rtol=s.rtol,
         atol=s.atol,
         duration_s=duration_s,
+        cut_step_motors=o.cut_step_motors,
     )
     if s.power_off is not None:
         trigger = s.power_off.trigger
@@ -192,7 +196,7 @@ def _schedule(s: RunSettings) -> dict[str, np.ndarray]:
         stop[m - 1] = 1.0
     return {
         "sched_t": np.asarray(s.power_off.segment_start_s, dtype=float),
-        "sched_rate": np.asarray(s.power_off.rates_rpm_per_s, dtype=float) * RPM,
+        "sched_rate": schedule_rates(s.power_off.rates_rpm_per_s, s.power_off.zero_rate),
         "sched_stop": stop,
     }
 
@@ -252,7 +256,7 @@ def _setup(
     setup = RunSetup(
         tf=float(s.final_time_s),
         veh=pack_vehicle(v),
-        feat=pack_features(v, s.friction_coefficient),
+        feat=pack_features(v, s.friction_coefficient, o.bumper_force_scale),
         shapes=pack_surfaces(surfaces),
         opts=_packed_options(s, o, v, duration_s),
         ctrl=pack_controller(entry, params, context, refs, yaw_paper),
