@@ -38,6 +38,7 @@ from geometry_reference import (
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
 from quadimpact.core.geometry.ring import ring_deepest
+from quadimpact.core.geometry.ring_box import ring_box_exact
 
 SHAPES = ("plane", "box", "cylinder", "infinite cylinder")
 
@@ -240,6 +241,52 @@ def test_rings_around_a_bar_take_the_branch_and_bound_and_stay_exact():
         ring = random_ring(rng, spread=0.02)
         _, g, *_ = ring_deepest(ring, row[None, :], 0)
         assert g == pytest.approx(ring_brute_force(ring, row)[0], abs=1e-12)
+
+
+def _ring_at_a_corner(rng, row, off):
+    """A circle centred near a corner of the box ``row`` (within ``off``), any orientation."""
+    axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
+    signs = rng.choice([-1.0, 1.0], 3)
+    corner = row[L.SH_POINT : L.SH_POINT + 3] + axes.T @ (signs * row[L.SH_HALF : L.SH_HALF + 3])
+    ring = random_ring(rng, spread=off)
+    return (*(np.array(ring[:3]) + corner), *ring[3:])
+
+
+@pytest.mark.parametrize("off", (0.02, 0.1))
+def test_a_box_corner_in_the_rings_disk_is_solved_exactly(off):
+    """A corner or an edge through the ring's disk (no one-point certificate): the closed form
+    (``ring_box.ring_box_exact``), inside and outside the box, equals brute force to rounding."""
+    rng = np.random.default_rng({0.02: 61, 0.1: 62}[off])
+    inside = outside = 0
+    for _ in range(30):
+        row = box_row(rng.uniform(-0.1, 0.1, 3), rng.uniform(0.05, 0.3, 3), rotation(rng))
+        ring = _ring_at_a_corner(rng, row, off)
+        ok, b, g, *_ = ring_box_exact(ring, row[None, :], 0)
+        best, _ = ring_brute_force(ring, row)
+        assert ok
+        assert g == pytest.approx(best, abs=1e-13)
+        assert float(depth(circle(ring, [b])[0], row)) == pytest.approx(g, abs=1e-13)
+        assert ring_deepest(ring, row[None, :], 0)[1] == pytest.approx(best, abs=1e-12)
+        inside += g > 0.0
+        outside += g <= 0.0
+    assert inside >= 5 and outside >= 5
+
+
+def test_the_corner_depth_is_continuous_along_a_path():
+    """A ring sliding across a box's corner: the depth moves by no more than the path (the
+    depth is 1-Lipschitz) between close poses, whichever method certified each."""
+    rng = np.random.default_rng(63)
+    row = box_row(np.zeros(3), np.array([0.2, 0.2, 0.2]), rotation(rng))
+    start = np.array(_ring_at_a_corner(rng, row, 0.05))
+    step = rng.standard_normal(3)
+    step *= 2e-5 / np.linalg.norm(step)
+    previous = None
+    for k in range(-2000, 2000):
+        ring = (*(start[:3] + k * step), *start[3:])
+        g = ring_deepest(ring, row[None, :], 0)[1]
+        if previous is not None:
+            assert abs(g - previous) <= 2e-5 + 1e-12
+        previous = g
 
 
 # ------------------------------------------------------------------ python-fcl

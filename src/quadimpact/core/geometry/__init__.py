@@ -29,7 +29,9 @@ ring      cylinder  ``ring.ring_solid``           certified search over the circ
                                                   rarely a branch and bound)
 sphere    cylinder  ``cylinder.sphere_cylinder``  closed form (exact)
 point     cylinder  ``cylinder.point_cylinder``   closed form (exact)
-ring      box       ``ring.ring_solid``           certified search (as for the cylinder)
+ring      box       ``ring.ring_solid``           certified search (as for the cylinder;
+                                                  where it cannot certify, the exact
+                                                  solution of ``ring_box.py``)
 sphere    box       ``box.sphere_box``            closed form (exact)
 point     box       ``box.point_box``             closed form (exact)
 ========  ========  ============================  ======================================

@@ -33,7 +33,10 @@ The search (:func:`ring_deepest`):
    signs, the crease between them is solved for (regula falsi on the
    difference of the two pieces) and certified with the convex combination
    of their normals whose slope along the ring is zero;
-2. if that does not certify within :data:`MAX_LOCAL` evaluations (a ring
+2. if that does not certify within :data:`MAX_LOCAL` evaluations: against a
+   box (a corner or an edge of the box through the ring's disk), the exact
+   solution from the box's pieces (``ring_box.ring_box_exact``: closed-form
+   candidates, evaluated with the box's depth); against a cylinder (a ring
    around a pole or a bar, a maximum on the far side), a branch and bound
    over arcs of the circle: every arc's bound is the largest value of the
    lower of its two end cuts (closed form: the ends, the cuts' peaks and
@@ -41,15 +44,17 @@ The search (:func:`ring_deepest`):
    than :data:`TOL` are halved, until none is left (at most
    :data:`MAX_EVALS` evaluations).
 
-Both return a point whose depth is within :data:`TOL` of the maximum over
-the circle, so the depth is continuous in time up to that tolerance (a jump
-of the arg-max between two equally deep points changes the point, not the
-depth). On a crease of the solid (two faces, or a side and a cap, equally
-near) the contact normal is the blend of the two that certifies the maximum
-(:func:`_crease_normal`; not of unit length there: the depth's gradient), so
-that the force does not flip between two faces from one evaluation to the
-next and stays conservative. Cost: a typical evaluation is 3 to 6 point depths (one sine and
-cosine each); the branch and bound, rare, about 100 to 300.
+Each returns a point whose depth is within :data:`TOL` of the maximum over
+the circle (the exact box solution: to rounding), so the depth is continuous
+in time up to that tolerance (a jump of the arg-max between two equally deep
+points changes the point, not the depth). On a crease of the solid (two
+faces, or a side and a cap, equally near) the contact normal is the blend of
+the two that certifies the maximum (:func:`_crease_normal`; not of unit
+length there: the depth's gradient), so that the force does not flip between
+two faces from one evaluation to the next and stays conservative. Cost: a
+typical evaluation is 3 to 6 point depths (one sine and cosine each); the
+exact box solution, rare, a few microseconds; the branch and bound, rare and
+for cylinders only, about 100 to 300 point depths.
 """
 
 import math
@@ -72,6 +77,7 @@ from .box import box_depth, box_piece
 from .cylinder import cylinder_depth, cylinder_piece
 from .plane import plane_depth, plane_distance
 from .record import ContactRecord, material_record
+from .ring_box import ring_box_exact
 
 TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum
 CREASE_TOL = 1e-9  # m: two faces this close in depth at the deepest point: a crease
@@ -417,6 +423,13 @@ def _search(ring: Ring, shapes: np.ndarray, s: int):
         fp_prev = fp
         k_prev = k
         b = b + step
+    if int(shapes[s, SH_KIND]) == SHAPE_BOX:
+        # the exact solution (ring_box.py); never below a point already seen
+        ok, bx_, gx, kx, ky, kz = ring_box_exact(ring, shapes, s)
+        if ok and gx >= best[1]:
+            return bx_, gx, kx, ky, kz
+        if ok and gx >= best[1] - TOL:
+            return best
     return _branch_and_bound(ring, shapes, s, best)
 
 
