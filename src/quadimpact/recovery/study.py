@@ -46,6 +46,7 @@ from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, analysis
+from quadimpact.results.costs import cost_ratio
 from quadimpact.results.files import atomic_write, check_out_dir
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
@@ -423,6 +424,7 @@ def run_study(
     description["run"] = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
     description["run"]["sweep_s"] = float(info["elapsed_s"])
     description["sweeps"] = _sweep_history(out, description["run"])
+    description["cost"] = cost_ratio(table)
     numbers = analysis.summarise(table)
     warnings: list[str] = []
 
