@@ -60,7 +60,7 @@ FIG4 = ["--grid", "heading_deg=0,45", "--grid", "inclination_deg=-20:20:1",
 # Every snippet runs in a fresh interpreter of one checkout (after this prelude) and
 # prints one JSON line.
 _PRELUDE = r"""
-import json, os, resource, sys, time
+import json, os, resource, statistics, sys, time
 def children_cpu():
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime

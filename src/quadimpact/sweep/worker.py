@@ -13,12 +13,14 @@ from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 from quadimpact.results.costs import COST_KEYS, cpu_time
+from quadimpact.sweep.items import RunInputs, scenario_of
 from quadimpact.sweep.store import failed_row, flatten_summary
 
 TOTAL_COST = COST_KEYS[1]
 
-Item = tuple[int, dict[str, Any], dict[str, Any]]
-"""A run to do: (run_id, scenario mapping, input column values)."""
+Item = tuple[int, "RunInputs | dict[str, Any]", dict[str, Any]]
+"""A run to do: (run_id, its swept values and sweep base or its scenario mapping,
+input column values); see :mod:`quadimpact.sweep.items`."""
 
 
 class RunCost(NamedTuple):
@@ -42,7 +44,6 @@ def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
     (the summary of ``simulate``, bit for bit, without its tables).
     """
     global _RUNNER
-    from quadimpact.inputs.scenarios import scenario_from_dict
     from quadimpact.simulation.batch import BatchRunner
 
     if _RUNNER is None:
@@ -54,7 +55,7 @@ def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
     cpu_start = cpu_time()
     kernel_s, steps = 0.0, 0
     try:
-        scenario = scenario_from_dict(scenario_data, where=f"run {run_id}")
+        scenario = scenario_of(scenario_data, where=f"run {run_id}")
         summary = _RUNNER.summary(scenario)
         counters = summary.get("integrator") or {}
         kernel_s = float(counters.get("wall_time_s") or 0.0)
