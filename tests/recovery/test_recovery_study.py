@@ -162,3 +162,19 @@ def test_the_table_is_the_same_on_one_or_two_workers(tmp_path) -> None:
         pd.read_parquet(tmp_path / "two" / "trials.parquet"),
     )
     assert one.table["seed"].nunique() == 16
+
+
+@pytest.mark.slow
+def test_the_example_runs_beside_the_trials_on_a_pool(tmp_path, study_dir) -> None:
+    """On worker processes the example trial (chosen from the inputs) is written beside them."""
+    out, serial = study_dir
+    r = run_study(RecoveryStudy(n=N, seed=5), tmp_path, workers=2, animation=False)
+    assert r.description["example"] == serial.description["example"]
+    drop = ("cost", "integrator")
+    ex = {k: v for k, v in json.loads((tmp_path / "example/summary.json").read_text()).items()
+          if k not in drop}  # fmt: skip
+    ex_serial = {k: v for k, v in json.loads((out / "example/summary.json").read_text()).items()
+                 if k not in drop}  # fmt: skip
+    assert ex == ex_serial
+    assert sorted(p.name for p in r.figures) == sorted(p.name for p in serial.figures)
+    assert not list(tmp_path.glob(".example.partial-*"))
