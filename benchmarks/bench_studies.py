@@ -68,7 +68,10 @@ def stop_server():
     import multiprocessing.forkserver as fs
     server = getattr(fs, "_forkserver", None)
     if server is not None and getattr(server, "_forkserver_pid", None):
-        server._stop()  # reaped: its workers' CPU time counts in RUSAGE_CHILDREN
+        try:
+            server._stop()  # reaped: its workers' CPU time counts in RUSAGE_CHILDREN
+        except OSError:  # its socket already removed by the sweep's clean-up
+            pass
 """
 
 TRIALS = r"""
@@ -176,11 +179,12 @@ print(json.dumps(res))
 """
 
 COMMAND = r"""
-import atexit
-atexit.register(stop_server)  # registered first: runs last, after the command's own clean-up
-sys.argv = ["quadimpact", *sys.argv[1:]]
-from quadimpact.cli import main
-main()
+if __name__ == "__main__":  # the pool's workers import this script: no command there
+    import atexit
+    atexit.register(stop_server)  # registered first: runs last, after the command's clean-up
+    sys.argv = ["quadimpact", *sys.argv[1:]]
+    from quadimpact.cli import main
+    main()
 """
 
 
