@@ -486,7 +486,11 @@ class SweepSpec:
         from quadimpact.inputs.derive import ScenarioFactory, same_scenario
         from quadimpact.inputs.scenarios import scenario_from_dict
         from quadimpact.inputs.vehicle import load_vehicle
-        from quadimpact.simulation.checks import MAX_RECORD_MB, check_record_size
+        from quadimpact.simulation.checks import (
+            MAX_RECORD_MB,
+            check_record_size,
+            vehicle_feature_count,
+        )
 
         limit = MAX_RECORD_MB if max_record_mb is None else float(max_record_mb)
         base = scenario_from_dict(self.base, where=f"{self.where}: base")
@@ -496,6 +500,7 @@ class SweepSpec:
         swept = [k for k in self.columns if k not in self._vehicle_fields]
         vehicles: dict[str, Any] = {}
         checked: set[str] = set()
+        n_features: dict[str, int] = {}  # per vehicle and overrides (built once, not per run)
         self._derive = False
         for run_id in range(self.n_runs):
             inputs = self.inputs(run_id)
@@ -503,8 +508,13 @@ class SweepSpec:
                 scenario = scenario_from_dict(self.scenario_dict(run_id, inputs), where="")
                 if derive:  # the workers may copy this run from the base: is it the same?
                     derive = same_scenario(factory.scenario(inputs), scenario, swept)
-                check_record_size(scenario, limit, "--max-record-mb")
                 key = canonical([scenario.vehicle, plain(scenario.vehicle_overrides)])
+                count = n_features.get(key)
+                if count is None:
+                    count = vehicle_feature_count(scenario)
+                    if len(n_features) < 100_000:
+                        n_features[key] = count
+                check_record_size(scenario, limit, "--max-record-mb", n_features=count)
                 if key not in checked:
                     if scenario.vehicle not in vehicles:
                         vehicles[scenario.vehicle] = load_vehicle(scenario.vehicle)
