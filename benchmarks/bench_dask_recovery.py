@@ -154,7 +154,10 @@ def main(argv: list[str] | None = None) -> None:
             "kernel_cpu_s_per_trial": float(table["cost__kernel_cpu_s"].mean()),
             "total_cpu_s_per_trial": float(table["cost__total_cpu_s"].mean()),
         }  # fmt: skip
-        assert info["n_already_done"] >= done_before > 0, "the resumed pass redid finished trials"
+        assert info["n_already_done"] >= done_before > 0, (
+            f"the resumed pass found {info['n_already_done']} trials done, {done_before} kept; "
+            f"child: {stdout[-2000:]} {stderr[-2000:]}"
+        )
         assert len(table) == args.n and table["run_id"].tolist() == list(range(args.n))
         s = sampler.samples
         picks = [s[min(len(s) - 1, int(k * len(s) / 10))] for k in range(11)] if s else []
