@@ -43,7 +43,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import resource
 import statistics
 import subprocess
@@ -230,16 +229,10 @@ def _command(checkout: Path, *args: str) -> dict[str, float]:
 
 
 def machine() -> dict[str, Any]:
-    model = ""
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                model = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    return {"cpus": os.cpu_count(), "cpu_model": model, "python": platform.python_version(),
-            "load_average": os.getloadavg()}  # fmt: skip
+    """The machine (``bench_sweep.machine_info``) and its load average at the start."""
+    from bench_sweep import machine_info  # this folder is on the path of a script run
+
+    return {**machine_info(), "load_average": os.getloadavg()}
 
 
 def one_round(name: str, checkout: Path, args: argparse.Namespace, kernels: dict) -> dict:
