@@ -110,9 +110,13 @@ def main(argv: list[str] | None = None) -> None:
 
     report: dict = {"n": args.n, "workers": args.workers, "cpu_count": os.cpu_count(),
                     "load_average_start": os.getloadavg()}  # fmt: skip
-    with tempfile.TemporaryDirectory() as tmp, LocalCluster(
-        n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster, Client(cluster) as client:
+    with (
+        tempfile.TemporaryDirectory() as tmp,
+        LocalCluster(
+            n_workers=args.workers, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         out = Path(tmp) / "study"
         parts = out / SWEEP_DIR / "parts"
         worker_pids = list(client.run(os.getpid).values())
