@@ -269,7 +269,7 @@ def action_command(
     ``meas``: the tick's measurement record (the gyro for the ctbr rate loop).
     """
     a = np.empty(4)
-    for j in range(4):
+    for j in range(N_ROTORS):
         v = action[j]
         a[j] = -1.0 if not v >= -1.0 else (1.0 if v > 1.0 else v)  # NaN -> -1
     if int(par[EP_ACTION]) == ACT_CTBR:
@@ -280,7 +280,7 @@ def action_command(
         )
     else:
         lo, hi = rotor_range(ctrl, par)
-        for j in range(4):
+        for j in range(N_ROTORS):
             cmd[j] = affine_map(a[j], lo, hi)
 
 
@@ -427,7 +427,7 @@ def observe(
             obs[6 + i] = _clip(sign * x[X_QUAT + i], clip)
         for i in range(3):
             obs[10 + i] = _clip(x[X_OMEGA + i] / par[EP_OBS_W], clip)
-        for j in range(4):
+        for j in range(N_ROTORS):
             obs[13 + j] = _clip((x[X_ROTOR + j] - lo) / h - 1.0, clip)
         obs[17] = _clip(since / par[EP_OBS_T], clip)
         obs[18] = 1.0 if detected else 0.0
@@ -443,7 +443,7 @@ def observe(
     obs[17] = 1.0 if detected else 0.0
     obs[18] = _clip(tmeas[MS_NORMAL], clip)
     obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
-    for j in range(4):
+    for j in range(N_ROTORS):
         obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
 
 
@@ -472,7 +472,7 @@ def cost_rate(
     hover = math.sqrt(veh[V_MASS] * veh[V_GRAVITY] / (4.0 * veh[V_KT]))
     span = ctrl[C_OMEGA_MAX] - ctrl[C_OMEGA_MIN]
     effort = 0.0
-    for j in range(4):
+    for j in range(N_ROTORS):
         d = (rin[RIN_CMD + j] - hover) / span
         effort += 0.25 * d * d
     effort = min(effort, 1.0)

@@ -29,7 +29,7 @@ step=...)``), and runs in a loop compiled around it (``core.run.make_kernel``).
 import numpy as np
 from numba import njit
 
-from ..layout import C_KIND, CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, MS_X, X_ROTOR
+from ..layout import C_KIND, CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, MS_X, N_ROTORS, X_ROTOR
 from .cascade_pid import cascade_pid_step
 from .paper import paper_step
 from .recovery import recovery_step
@@ -46,7 +46,7 @@ def hold_step(
     cmd: np.ndarray,
 ) -> None:
     """No controller: the rotors keep their current speeds."""
-    for j in range(4):
+    for j in range(N_ROTORS):
         cmd[j] = meas[MS_X + X_ROTOR + j]
 
 

@@ -22,6 +22,7 @@ from ..layout import (
     C_PSI_REF,
     C_THETA_REF,
     MS_X,
+    N_ROTORS,
     NX,
     V_GRAVITY,
     V_MASS,
@@ -144,7 +145,7 @@ def cascade_pid_step(
     saturated = allocate(ctrl, thrust, tx, ty, tz, cmd)
     lo = ctrl[C_OMEGA_MIN]
     hi = ctrl[C_OMEGA_MAX]
-    for j in range(4):
+    for j in range(N_ROTORS):
         if cmd[j] < lo:
             cmd[j] = lo
             saturated = True

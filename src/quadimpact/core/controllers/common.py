@@ -8,7 +8,18 @@ import math
 import numpy as np
 from numba import njit
 
-from ..layout import C_ALLOC_INV, MEM_STAGE, NPARAM, V_INERTIA, X_OMEGA, X_POS, X_QUAT, X_VEL, Block
+from ..layout import (
+    C_ALLOC_INV,
+    MEM_STAGE,
+    N_ROTORS,
+    NPARAM,
+    V_INERTIA,
+    X_OMEGA,
+    X_POS,
+    X_QUAT,
+    X_VEL,
+    Block,
+)
 from ..quaternion import euler_zyx
 
 
@@ -38,11 +49,11 @@ def allocate(
     ``cmd``. Returns True if any square was clipped.
     """
     clipped = False
-    for j in range(4):
-        a = ctrl[C_ALLOC_INV + 4 * j]
-        b = ctrl[C_ALLOC_INV + 4 * j + 1]
-        c = ctrl[C_ALLOC_INV + 4 * j + 2]
-        d = ctrl[C_ALLOC_INV + 4 * j + 3]
+    for j in range(N_ROTORS):
+        a = ctrl[C_ALLOC_INV + N_ROTORS * j]
+        b = ctrl[C_ALLOC_INV + N_ROTORS * j + 1]
+        c = ctrl[C_ALLOC_INV + N_ROTORS * j + 2]
+        d = ctrl[C_ALLOC_INV + N_ROTORS * j + 3]
         w2 = a * thrust + b * tx + c * ty + d * tz
         if w2 < 0.0:
             w2 = 0.0

@@ -62,6 +62,7 @@ from ..layout import (
     MS_IMU_W,
     MS_NORMAL,
     MS_X,
+    N_ROTORS,
     NPARAM,
     NX,
     V_GRAVITY,
@@ -223,7 +224,7 @@ def rate_loop(
     allocate(ctrl, thrust, tx, ty, tz, cmd)
     lo = ctrl[C_OMEGA_MIN]
     hi = ctrl[C_OMEGA_MAX]
-    for j in range(4):
+    for j in range(N_ROTORS):
         if cmd[j] < lo:
             cmd[j] = lo
         elif cmd[j] > hi:
@@ -277,10 +278,10 @@ def recovery_step(
                 else:
                     paper_step(t, meas, ctrl, mem, veh, dt, cmd)
             elif pre == PRE_HOLD:
-                for j in range(4):
+                for j in range(N_ROTORS):
                     cmd[j] = x[X_ROTOR + j]
             else:
-                for j in range(4):
+                for j in range(N_ROTORS):
                     cmd[j] = 0.0
             return
         stage = STAGE_DETECTED
