@@ -105,3 +105,16 @@ def assert_all_gone(procs: list[psutil.Process], tmp: Path, within_s: float = 5.
         p.kill()
     assert not names, f"left running: {names}"
     assert not list(tmp.glob("pymp-*")), list(tmp.iterdir())
+
+
+def assert_same_table(a, b) -> None:
+    """Two sweep tables (pandas) equal bit for bit, but for what their runs cost.
+
+    The cost columns (``quadimpact.sweep.COST_COLUMNS``: CPU time where each run
+    ran) are the only ones that differ between two runs of the same sweep.
+    """
+    import pandas as pd
+
+    from quadimpact.sweep import without_costs
+
+    pd.testing.assert_frame_equal(without_costs(a), without_costs(b))

@@ -43,7 +43,8 @@ def test_the_docs_it_points_to_exist():
 
 # ------------------------------------------------- issue 20 item 14: flags and links
 #: Flags of other programs that the docs name (not quadimpact's).
-OTHER_PROGRAMS_FLAGS = {"--preload", "--check"}  # dask worker --preload; ruff format --check
+OTHER_PROGRAMS_FLAGS = {"--preload", "--check", "--port", "--nworkers", "--nthreads"}
+# dask worker --preload --nworkers --nthreads; dask scheduler --port; ruff format --check
 FLAG = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]*")
 MD_LINK = re.compile(r"\]\(([^)\s]+)\)")
 

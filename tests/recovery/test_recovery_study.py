@@ -17,6 +17,8 @@ from quadimpact.recovery.study import RecoveryStudy, run_study, sample_trials
 from quadimpact.simulation.packing import RPM
 from quadimpact.sweep import SUMMARY_COLUMNS, SweepSpec
 
+from helpers import assert_same_table
+
 N = 30
 METRICS = (
     "recovered", "not_detected", "false_detection", "t_detect_s", "detection_latency_s",
@@ -93,7 +95,7 @@ def test_rerunning_resumes_and_gives_the_same_table(study_dir) -> None:
     pq.write_table(pq.read_table(runs).slice(0, 10), runs)
     resumed = run_study(RecoveryStudy(n=N, seed=5), out, workers=1, example=False)
     assert resumed.run_info["n_already_done"] == 10 and resumed.run_info["n_ran"] == N - 10
-    pd.testing.assert_frame_equal(pd.read_parquet(out / "trials.parquet"), before)
+    assert_same_table(pd.read_parquet(out / "trials.parquet"), before)
     with pytest.raises(InputError, match="holds a different sweep"):
         run_study(RecoveryStudy(n=N, seed=6), out, workers=1, example=False)
 
@@ -155,8 +157,24 @@ def test_the_table_is_the_same_on_one_or_two_workers(tmp_path) -> None:
     one = run_study(study, tmp_path / "one", workers=1, example=False)
     two = run_study(study, tmp_path / "two", workers=2, example=False)
     assert two.run_info["backend"] == "2 processes"
-    pd.testing.assert_frame_equal(
+    assert_same_table(
         pd.read_parquet(tmp_path / "one" / "trials.parquet"),
         pd.read_parquet(tmp_path / "two" / "trials.parquet"),
     )
     assert one.table["seed"].nunique() == 16
+
+
+@pytest.mark.slow
+def test_the_example_runs_beside_the_trials_on_a_pool(tmp_path, study_dir) -> None:
+    """On worker processes the example trial (chosen from the inputs) is written beside them."""
+    out, serial = study_dir
+    r = run_study(RecoveryStudy(n=N, seed=5), tmp_path, workers=2, animation=False)
+    assert r.description["example"] == serial.description["example"]
+    drop = ("cost", "integrator")
+    ex = {k: v for k, v in json.loads((tmp_path / "example/summary.json").read_text()).items()
+          if k not in drop}  # fmt: skip
+    ex_serial = {k: v for k, v in json.loads((out / "example/summary.json").read_text()).items()
+                 if k not in drop}  # fmt: skip
+    assert ex == ex_serial
+    assert sorted(p.name for p in r.figures) == sorted(p.name for p in serial.figures)
+    assert not list(tmp_path.glob(".example.partial-*"))

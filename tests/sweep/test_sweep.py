@@ -15,7 +15,6 @@ import sys
 import time
 from pathlib import Path
 
-import pandas as pd
 import pytest
 
 import quadimpact
@@ -29,6 +28,8 @@ from quadimpact.sweep import (
     read_runs,
     run_sweep,
 )
+
+from helpers import assert_same_table
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 BASE = {"model": "paper-replica", "final_time_s": 1.0}
@@ -276,7 +277,7 @@ def test_serial_table(serial_table):
 def test_parallel_table_is_identical(serial_table, tmp_path):
     table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "p", workers=2)
     assert table.attrs["sweep"]["backend"] == "2 processes"
-    pd.testing.assert_frame_equal(table, serial_table)
+    assert_same_table(table, serial_table)
 
 
 def _children() -> set[int]:
@@ -291,7 +292,7 @@ def test_default_small_sweep_runs_in_process(serial_table, tmp_path):
     table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "s")
     assert table.attrs["sweep"]["backend"] == "serial"
     assert not _children() - before
-    pd.testing.assert_frame_equal(table, serial_table)
+    assert_same_table(table, serial_table)
 
 
 def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
@@ -313,7 +314,7 @@ def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
     # the pool, unless the other cores were measured busy
     handed_over = re.fullmatch(r"\d processes, the first [12] runs in this one", backend)
     assert backend == "serial" or handed_over, backend
-    pd.testing.assert_frame_equal(table, reference)
+    assert_same_table(table, reference)
 
 
 @pytest.mark.parametrize(
@@ -415,7 +416,7 @@ def dask_cluster(tmp_path_factory):
 def test_dask_table_is_identical(serial_table, dask_cluster, tmp_path):
     table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "d", scheduler=dask_cluster)
     assert table.attrs["sweep"]["backend"].startswith("dask")
-    pd.testing.assert_frame_equal(table, serial_table)
+    assert_same_table(table, serial_table)
 
 
 def test_bad_scheduler(tmp_path):
@@ -468,7 +469,7 @@ def test_exception_in_a_run_is_a_failed_row(monkeypatch, serial_table, tmp_path)
     assert list(bad["reason"]) == ["RuntimeError: approach shooting run failed: test"] * 2
     assert bad["delta_init_m"].isna().all() and bad["n_episodes"].isna().all()
     good = table[table["inclination_deg"] == -5.0]
-    pd.testing.assert_frame_equal(good, serial_table[serial_table["inclination_deg"] == -5.0])
+    assert_same_table(good, serial_table[serial_table["inclination_deg"] == -5.0])
     assert (table.dtypes == serial_table.dtypes).all()
 
 
@@ -537,7 +538,7 @@ def test_rerun_and_other_sweep_in_the_folder(serial_table, tmp_path):
     run_sweep(spec, out, workers=1)
     again = run_sweep(spec, out, workers=1)
     assert again.attrs["sweep"]["n_ran"] == 0
-    pd.testing.assert_frame_equal(again, serial_table)
+    assert_same_table(again, serial_table)
     # an interrupted sweep: drop two rows, the rerun does only those
     full = read_runs(out)
     import pyarrow as pa
@@ -547,7 +548,7 @@ def test_rerun_and_other_sweep_in_the_folder(serial_table, tmp_path):
     pq.write_table(table.filter(pa.array([True, False, True, False])), out / "runs.parquet")
     resumed = run_sweep(spec, out, workers=1)
     assert resumed.attrs["sweep"]["n_ran"] == 2
-    pd.testing.assert_frame_equal(resumed, full)
+    assert_same_table(resumed, full)
     with pytest.raises(InputError, match="holds a different sweep.*grid"):
         run_sweep(SweepSpec(base=BASE, grid={"heading_deg": [0]}), out, workers=1)
 

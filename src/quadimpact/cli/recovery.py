@@ -134,6 +134,7 @@ def recovery(
 
 def _summary(result) -> str:
     from quadimpact.recovery.report import excluded_text, rate_text
+    from quadimpact.results.costs import cost_text
 
     info, numbers = result.run_info, result.numbers
     c = numbers["classes"]
@@ -153,6 +154,7 @@ def _summary(result) -> str:
             f"successes), not detected {c['not detected']}, false detections "
             f"{c['false detection']}",
         ),
+        ("cost", cost_text(result.description["cost"])),
         ("table", str(result.out_dir / "trials.parquet")),
         ("report", str(result.report)),
         ("time", f"{result.elapsed_s:.1f} s"),

@@ -161,8 +161,11 @@ def sweep(
 def _report(out: Path, plots: list[Path], info: dict) -> str:
     import pyarrow.parquet as pq
 
+    from quadimpact.results.costs import COST_KEYS, cost_ratio, cost_text
+
     path = out / "runs.parquet"
-    t = pq.read_table(path, columns=["status", "response_type", "bumper_model_valid"]).to_pandas()
+    columns = ["status", "response_type", "bumper_model_valid", *COST_KEYS]
+    t = pq.read_table(path, columns=columns).to_pandas()
     n = len(t)
     status = t["status"].value_counts()
     types = t["response_type"].value_counts()
@@ -180,6 +183,7 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
         f"{int(t['bumper_model_valid'].eq(False).sum())} deeper than the bumper radius; {ran})",
         f"status  {status_text}",
         f"types   {type_text}",
+        f"cost    {cost_text(cost_ratio(t))}",
         f"table   {path}",
     ]
     if plots:

@@ -13,6 +13,7 @@ import pandas as pd
 from quadimpact import __version__
 from quadimpact.experiments.report import table3_markdown
 from quadimpact.recovery.report import percent, rate_text
+from quadimpact.results.costs import cost_ratio, cost_text
 from quadimpact.simulation.metrics import RESPONSE_TYPES
 
 __all__ = [
@@ -160,6 +161,12 @@ def render_report(
                   "| stage | time (s) |", "|---|---|"]  # fmt: skip
         lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in stage_times]
         lines += [f"| whole study | {elapsed_s:.1f} |", ""]
+        costs = [("the Figure 4 sweeps and the ablations", cost_ratio(pd.concat(tables.values())))]
+        if recovery is not None and getattr(recovery, "cost", None):
+            costs.append(("the recovery trials and grids", recovery.cost))
+        lines += ["CPU time of the runs (the thread that ran each), whole and in the compiled "
+                  "loop (the physics):", "",
+                  *(f"- {what}: {cost_text(c)}." for what, c in costs), ""]  # fmt: skip
     if piece_times:
         lines += ["The pieces that ran on worker processes, each with its own wall time "
                   "(they ran side by side, so these overlap):", "",

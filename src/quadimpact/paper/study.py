@@ -63,6 +63,7 @@ from quadimpact.recovery.baselines import (
 from quadimpact.recovery.figures import compare_by_bin_figure
 from quadimpact.recovery.study import RecoveryStudy, run_trials
 from quadimpact.results import figures
+from quadimpact.results.costs import cost_ratio
 from quadimpact.simulation import simulate
 from quadimpact.sweep import SweepSpec, run_sweep
 from quadimpact.sweep.run import warm_pool
@@ -123,6 +124,8 @@ class RecoveryPart:
     crashes: pd.DataFrame
     elapsed_s: float
     estimators: dict[str, dict] = field(default_factory=dict)
+    cost: dict[str, float] | None = None
+    """``results.costs.cost_ratio`` of its trials and its Figure 4 grids."""
 
 
 class StageClock:
@@ -424,13 +427,14 @@ def recovery_part(
         **{k: recovery_analysis.summarise(trials[k]) for k in ("navi, noisy IMU", "spiri")},
     }
 
-    grid, runs = {}, []
+    grid, runs, grids = {}, [], []
     for variant in VARIANTS:
         clock.start(f"recovery: the Figure 4 grid with the recovery controller, {variant}")
         table = run_sweep(
             SweepSpec(base=recovery_base({"model": variant}), grid=FIG4_GRID),
             out / "sweeps" / f"recovery-{variant}", **par,
         )  # fmt: skip
+        grids.append(table)
         both = grid_comparison(tables[variant], table, list(FIG4_GRID))
         grid[variant] = saved_by_type(both)
         runs.append(both.assign(variant=variant))
@@ -450,8 +454,9 @@ def recovery_part(
                               "Navi: success rate by inclination bin, both variants"),
         out / "recovery_by_inclination.png",
     )  # fmt: skip
+    cost = cost_ratio(pd.concat([*trials.values(), *grids], ignore_index=True))
     return RecoveryPart(
-        monte_carlo, compare, grid, crashes, time.perf_counter() - start, estimators
+        monte_carlo, compare, grid, crashes, time.perf_counter() - start, estimators, cost
     )
 
 

@@ -17,6 +17,7 @@ import pandas as pd
 
 from quadimpact.recovery.analysis import FLIP_DEG, OUTCOME_CLASSES, Rate
 from quadimpact.recovery.estimation import estimation_lines
+from quadimpact.results.costs import cost_text
 
 __all__ = [
     "bin_table",
@@ -176,9 +177,21 @@ def _what_ran(d: dict[str, Any]) -> list[str]:
     lines += [
         f"- **quadimpact** {d['quadimpact_version']}. **Wall time**: {ran}; the whole command "
         f"{d['elapsed_s']:.1f} s (tables, figures and the example included).",
-        "",
     ]
-    return lines
+    if d.get("cost"):
+        lines.append(f"- **Cost**: {cost_sentence(d['cost'])}")
+    return [*lines, ""]
+
+
+def cost_sentence(cost: dict[str, Any]) -> str:
+    """What the trials cost, as a sentence (``results.costs.cost_ratio`` of the table)."""
+    if not cost.get("runs"):
+        return "no trial's cost measured."
+    return (
+        f"the trials took {cost_text(cost)} (CPU time of the thread that ran each trial: "
+        "the compiled loop is the physics; the rest prepares each trial and computes its "
+        "metrics and row)."
+    )
 
 
 def _outcomes(n: dict[str, Any]) -> list[str]:

@@ -5,7 +5,9 @@
   ``timeseries.parquet`` (their columns and units), the atomic file writer and
   the JSON converter used everywhere;
 * :mod:`~quadimpact.results.figures`: Figures 5 and 6, the type map, the shared
-  figure helpers.
+  figure helpers;
+* :mod:`~quadimpact.results.costs`: what a run cost (CPU time in the compiled
+  loop and in the whole run: the summary's ``cost``) and the ratio studies print.
 
 Results do not depend on the simulator: ``quadimpact.simulation`` builds them.
 """

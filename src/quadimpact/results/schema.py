@@ -200,6 +200,8 @@ SUMMARY_KEYS: tuple[Key, ...] = (
     _k("integrator__control_ticks", "i", "1", "controller updates"),
     _k("integrator__output_rows", "i", "1", "time-series rows"),
     _k("integrator__wall_time_s", "f", "s", "wall-clock time of the kernel (not in sweeps)"),
+    _k("cost__kernel_cpu_s", "f", "s", "CPU time in the compiled loop (shooting runs included)"),
+    _k("cost__total_cpu_s", "f", "s", "CPU time of the whole run, scenario to summary or row"),
 )
 """Every summary key, flattened, in order."""
 

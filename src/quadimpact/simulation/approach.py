@@ -22,6 +22,7 @@ from quadimpact.core.geometry import contact_record
 from quadimpact.core.records import Model
 from quadimpact.core.run import Kernel, execute
 from quadimpact.linalg import matvec, matvec_t
+from quadimpact.results.costs import CpuClock
 from quadimpact.rotations import inclination_deg, quat_to_matrix
 from quadimpact.simulation.roots import brentq
 
@@ -98,6 +99,7 @@ def _free_flight_end(
     t_end: float,
     free_opts: np.ndarray,
     kernel: Kernel | None = None,
+    clock: CpuClock | None = None,
 ) -> np.ndarray:
     """State at ``t_end`` of the run ``run`` from ``(t0, x0)`` with no shapes, no IMU, no crash."""
     span = np.zeros(L.NSPAN)
@@ -113,7 +115,11 @@ def _free_flight_end(
         noise=np.zeros((0, 6)),
         t_out=np.array([t_end]),
     )
-    rec = execute(m, max_episodes=1, kernel=kernel)
+    if clock is None:
+        rec = execute(m, max_episodes=1, kernel=kernel)
+    else:
+        with clock:
+            rec = execute(m, max_episodes=1, kernel=kernel)
     if rec.stats[L.ST_STATUS] == L.STATUS_FAILED or rec.out.shape[0] != 1:
         raise RuntimeError(
             "approach shooting run failed: " + L.REASON_TEXT[int(rec.stats[L.ST_REASON])]
@@ -147,6 +153,7 @@ def solve_approach(
     speed_m_s: float,
     late_start: bool,
     kernel: Kernel | None = None,
+    clock: CpuClock | None = None,
 ) -> tuple[np.ndarray, float, dict[str, Any]]:
     """Initial state and time that bring the first contact at ``T_c`` with ``V_X = V_c``.
 
@@ -170,6 +177,8 @@ def solve_approach(
         beyond the wall.
     kernel : Kernel, optional
         The run loop of a plug-in controller (default: the built-in kernel).
+    clock : CpuClock, optional
+        Adds up the CPU time of the shooting runs (the summary's ``cost``).
 
     Returns
     -------
@@ -187,7 +196,7 @@ def solve_approach(
     def shoot(t0: float, v0: float, x_start: float) -> tuple[np.ndarray, np.ndarray]:
         pos = start + np.array([x_start, 0.0, 0.0])
         x0 = initial_state(pos, np.array([v0, 0.0, 0.0]), q, np.zeros(3), rotors)
-        return x0, _free_flight_end(run, x0, t0, tc, free_opts, kernel)
+        return x0, _free_flight_end(run, x0, t0, tc, free_opts, kernel, clock)
 
     def solve_from(t0: float, v0: float) -> tuple[float, float, float, np.ndarray]:
         """Correct v0 (unless at rest) and X0 until the residuals vanish."""

@@ -25,12 +25,23 @@ _DEG = 180.0 / math.pi
 _RAD = math.pi / 180.0
 
 
+_TWO_PI = 2.0 * math.pi
+
+
 @njit(cache=True)
 def _wrap_pi(a: float) -> float:
-    """``a`` wrapped to (-pi, pi], as ``rotations.wrap_angle_rad``."""
-    w = (a + math.pi) % (2.0 * math.pi) - math.pi
+    """``a`` wrapped to (-pi, pi], as ``rotations.wrap_angle_rad``.
+
+    ``(a + pi) % 2 pi - pi``; the modulo of a number already in [0, 2 pi) is
+    the number itself, so it is taken only outside (the same bits, without
+    the division in the common case).
+    """
+    x = a + math.pi
+    if not (0.0 <= x < _TWO_PI):
+        x = x % _TWO_PI
+    w = x - math.pi
     if w <= -math.pi:
-        w += 2.0 * math.pi
+        w += _TWO_PI
     return w
 
 
@@ -51,7 +62,7 @@ def excursion_from_quaternions(
     d_roll = 0.0
     d_pitch = 0.0
     d_yaw = 0.0
-    tilt = 0.0
+    c_min = 1.0  # the largest tilt is acos of the smallest cosine (acos decreases)
     for i in range(quat.shape[0]):
         n = math.sqrt(
             quat[i, 0] * quat[i, 0]
@@ -87,6 +98,5 @@ def excursion_from_quaternions(
         d_pitch = max(d_pitch, abs(pitch - pitch_ref))
         d_yaw = max(d_yaw, abs(_wrap_pi(yaw - yaw_ref)))
         c = c02 * z_ref[0] + c12 * z_ref[1] + c22 * z_ref[2]
-        c = min(1.0, max(-1.0, c))
-        tilt = max(tilt, math.acos(c))
-    return d_roll * _DEG, d_pitch * _DEG, d_yaw * _DEG, tilt * _DEG
+        c_min = min(c_min, max(-1.0, c))
+    return d_roll * _DEG, d_pitch * _DEG, d_yaw * _DEG, math.acos(c_min) * _DEG

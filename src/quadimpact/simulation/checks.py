@@ -162,13 +162,24 @@ def _feature_label(name: str) -> str:
 MAX_RECORD_MB = 1024.0
 
 
-def record_size_bytes(scenario: Any) -> int:
+def vehicle_feature_count(scenario: Any) -> int:
+    """The contact features of a scenario's vehicle (4, the rings, if it cannot be built:
+    an invalid vehicle is refused, by name, when the run is prepared)."""
+    try:
+        return len(scenario.build_vehicle().contact_features())
+    except Exception:
+        return 4
+
+
+def record_size_bytes(scenario: Any, n_features: int | None = None) -> int:
     """The memory of a run's raw record, bytes, from its scenario alone (before any work).
 
     ``final time x output rate`` rows of the time series (``core/layout.py``'s
     ``out_width`` columns of 8 bytes: the fixed ones and two per contact
     feature of the vehicle) and ``final time x IMU rate`` IMU samples
     (``NIMU`` columns); the tables built from them take about as much again.
+    ``n_features``: :func:`vehicle_feature_count` of the scenario, when the
+    caller knows it (a sweep, once per vehicle).
     """
     from quadimpact.simulation.packing import CONTROL_RATE_HZ
 
@@ -176,14 +187,14 @@ def record_size_bytes(scenario: Any) -> int:
     rows = math.ceil(max(duration, 0.0) * float(scenario.output_rate_hz)) + 2
     imu_rate = getattr(getattr(scenario, "imu", None), "rate_hz", None) or CONTROL_RATE_HZ
     samples = math.ceil(max(duration, 0.0) * float(imu_rate)) + 1
-    try:
-        n_features = len(scenario.build_vehicle().contact_features())
-    except Exception:  # an invalid vehicle is refused, by name, when the run is prepared
-        n_features = 4
+    if n_features is None:
+        n_features = vehicle_feature_count(scenario)
     return 8 * (rows * L.out_width(n_features) + samples * L.NIMU)
 
 
-def check_record_size(scenario: Any, limit_mb: float = MAX_RECORD_MB, flag: str = "") -> None:
+def check_record_size(
+    scenario: Any, limit_mb: float = MAX_RECORD_MB, flag: str = "", n_features: int | None = None
+) -> None:
     """Refuse a run whose raw record would exceed ``limit_mb`` (:func:`record_size_bytes`).
 
     Raises
@@ -191,7 +202,7 @@ def check_record_size(scenario: Any, limit_mb: float = MAX_RECORD_MB, flag: str 
     InputError
         With the estimate, what makes it (duration, rates) and how to raise the limit.
     """
-    size = record_size_bytes(scenario)
+    size = record_size_bytes(scenario, n_features)
     if size <= limit_mb * 1e6:
         return
     duration = float(scenario.final_time_s) - float(getattr(scenario, "start_time_s", 0.0) or 0.0)

@@ -25,6 +25,7 @@ from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
+from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_prepared, check_scenario_type
@@ -88,6 +89,10 @@ class RunSetup:
     """What the scenario's settings resolved to, as plain data (``scenario.json``'s
     ``resolved``): the model variant and every switch, the controller and its
     parameters with defaults, the pre-impact behaviour, the IMU and the slew limit."""
+    prepare_cpu_s: float = 0.0
+    """CPU time of :func:`prepare` (this thread), s; the summary's ``cost`` adds it in."""
+    kernel_cpu_s: float = 0.0
+    """Of which in the compiled loop (the approach's shooting runs), s."""
 
     def model(self, **changes: Any) -> Model:
         """The run as the compiled core's :class:`~quadimpact.core.records.Model`.
@@ -335,6 +340,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
     duration = float(s.final_time_s)
     setup = _setup(s, v, o, refs, surfaces, duration, x0=np.zeros(L.NX), t0=0.0, wall=wall)
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
+    clock = CpuClock()
     setup.x0, setup.t0, setup.approach = solve_approach(
         run=setup.model(),
         free_opts=_packed_options(s, o, v, float(s.impact_time_s), free=True),
@@ -346,7 +352,9 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
         speed_m_s=s.speed_m_s,
         late_start=o.approach_start == "late-start",
         kernel=setup.kernel,
+        clock=clock,
     )
+    setup.kernel_cpu_s = clock.total
     if setup.approach["late_start"]:
         setup.warnings.append(
             f"the approach needs v0 < 0: the vehicle starts at rest at t0 = {setup.t0:.6f} s"
@@ -450,6 +458,7 @@ def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
 
 def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
     """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``)."""
+    started = cpu_time()
     check_scenario_type(scenario)
     if isinstance(scenario, WallApproach):
         setup = prepare_wall_approach(scenario)
@@ -458,4 +467,5 @@ def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
     else:
         setup = prepare_flight(scenario)
     check_prepared(scenario, setup)
+    setup.prepare_cpu_s = cpu_time() - started
     return setup

@@ -15,6 +15,7 @@ from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.run import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
+from quadimpact.results.costs import cpu_time
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.packing import feature_records, surface_records
 from quadimpact.simulation.record import (
@@ -28,7 +29,7 @@ from quadimpact.simulation.record import (
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.summary import build_summary
 
-__all__ = ["analyse", "run_setup", "simulate", "world_record"]
+__all__ = ["analyse", "run_cost", "run_setup", "simulate", "world_record"]
 
 
 def simulate(
@@ -67,11 +68,29 @@ def run_setup(
     kernel: Kernel | None = None,
 ) -> SimulationResult:
     """Run a prepared setup through the compiled loop and analyse the record."""
+    started = cpu_time()
     m = setup.model()
     wall_start = time.perf_counter()
+    cpu_start = cpu_time()
     rec = execute(m, n_imu=setup.n_imu, max_episodes=max_episodes, kernel=kernel or setup.kernel)
+    kernel_cpu_s = cpu_time() - cpu_start
     wall_s = time.perf_counter() - wall_start
-    return analyse(setup, scenario, rec, wall_s)
+    return analyse(setup, scenario, rec, wall_s, kernel_cpu_s=kernel_cpu_s, since=started)
+
+
+def run_cost(
+    setup: RunSetup, kernel_cpu_s: float | None, since: float | None
+) -> dict[str, float | None]:
+    """The summary's ``cost``: CPU time in the compiled loops and in the whole run, s.
+
+    ``kernel_cpu_s`` (the main run's) adds the approach's shooting runs;
+    ``since`` (:func:`~quadimpact.results.costs.cpu_time` when the run
+    started after :func:`prepare`) makes the total, :func:`prepare` included.
+    Null where not measured.
+    """
+    kernel = None if kernel_cpu_s is None else setup.kernel_cpu_s + kernel_cpu_s
+    total = None if since is None else setup.prepare_cpu_s + (cpu_time() - since)
+    return {"kernel_cpu_s": kernel, "total_cpu_s": total}
 
 
 def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
@@ -106,12 +125,23 @@ def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
     }
 
 
-def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan")):
+def analyse(
+    setup: RunSetup,
+    scenario: Any,
+    rec: Any,
+    wall_s: float = float("nan"),
+    *,
+    kernel_cpu_s: float | None = None,
+    since: float | None = None,
+):
     """Summary, tables and world record of a raw record (``core.run.RawRecord``) of ``setup``.
 
     The summary is computed from the raw arrays (no DataFrame); the result's
     ``timeseries``, ``episodes`` and ``imu`` tables and its ``world`` record
-    are built when first read.
+    are built when first read. ``kernel_cpu_s``: the CPU time of the run's
+    compiled loop; ``since``: :func:`~quadimpact.results.costs.cpu_time`
+    when the run started after :func:`prepare` (both for the summary's
+    ``cost``; null when not given).
     """
     out, ep, st = rec.out, rec.episodes, rec.stats
     x0 = L.OUT_X + L.X_QUAT
@@ -129,6 +159,7 @@ def analyse(setup: RunSetup, scenario: Any, rec: Any, wall_s: float = float("nan
         "wall_time_s": wall_s,
     }
     summary["integrator"] = stats
+    summary["cost"] = run_cost(setup, kernel_cpu_s, since)
     names = setup.shape_names
     features = setup.feature_names
     imu = rec.imu

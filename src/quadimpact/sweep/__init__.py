@@ -37,8 +37,10 @@ Output folder ``DIR``:
   summary (``docs/RESULTS.md``) flattened: nested tables joined with ``__``
   (``approach__start_time_s``), lists as JSON strings (``leading_bumpers``,
   ``warnings``, ``subsequent_impacts``, ``crash_position_m``); the kernel's
-  wall-clock time is left out so that the table is the same, bit for bit,
-  however and wherever the sweep ran. The column set and types are fixed
+  wall-clock time is left out, and the table is the same, bit for bit,
+  however and wherever the sweep ran, except the two columns of what each run
+  cost (:data:`COST_COLUMNS`, CPU time; :func:`without_costs` drops them).
+  The column set and types are fixed
   (:data:`SUMMARY_COLUMNS`); a run that failed (numerically, or by raising
   while being prepared) is a row with ``status = "failed"`` and its
   ``reason``.
@@ -68,10 +70,17 @@ from quadimpact.sweep.interrupt import SweepInterrupted
 from quadimpact.sweep.pool import WorkerError
 from quadimpact.sweep.run import LARGE_SWEEP_RUNS, run_sweep
 from quadimpact.sweep.spec import SweepSpec, load_sweep_file, parse_values
-from quadimpact.sweep.store import SUMMARY_COLUMNS, flatten_summary, read_runs
+from quadimpact.sweep.store import (
+    COST_COLUMNS,
+    SUMMARY_COLUMNS,
+    flatten_summary,
+    read_runs,
+    without_costs,
+)
 from quadimpact.sweep.worker import run_chunk
 
 __all__ = [
+    "COST_COLUMNS",
     "LARGE_SWEEP_RUNS",
     "SweepInterrupted",
     "SweepSpec",
@@ -83,4 +92,5 @@ __all__ = [
     "run_chunk",
     "run_sweep",
     "flatten_summary",
+    "without_costs",
 ]

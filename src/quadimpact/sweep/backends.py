@@ -18,6 +18,7 @@ from typing import Any
 
 from quadimpact.errors import InputError, format_value, one_line
 from quadimpact.sweep.interrupt import StopFlag
+from quadimpact.sweep.items import RunInputs
 from quadimpact.sweep.limits import QUEUED_CHUNKS, RunLimits, seconds
 from quadimpact.sweep.spec import SweepSpec
 from quadimpact.sweep.worker import (
@@ -35,12 +36,17 @@ Sink = Callable[[list[dict[str, Any]]], None]
 
 # --------------------------------------------------------------- backends
 def make_chunks(spec: SweepSpec, todo: Any, size: int) -> Iterator[list[Item]]:
-    """Items of the missing runs, ``size`` per chunk, built lazily (flat memory)."""
+    """Items of the missing runs, ``size`` per chunk, built lazily (flat memory).
+
+    Each item carries the run's swept values and the sweep's shared base
+    (``sweep.items``), not its scenario mapping.
+    """
+    base = spec.sweep_base()
     chunk: list[Item] = []
     for run_id in todo:
         run_id = int(run_id)
         inputs = spec.inputs(run_id)
-        chunk.append((run_id, spec.scenario_dict(run_id, inputs), spec.input_columns(inputs)))
+        chunk.append((run_id, RunInputs(base, inputs), spec.input_columns(inputs)))
         if len(chunk) == size:
             yield chunk
             chunk = []

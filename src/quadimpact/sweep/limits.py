@@ -59,8 +59,11 @@ def check_timeout(timeout: Any) -> float | None:
     return float(timeout)
 
 
-def final_time_s(scenario: Mapping[str, Any]) -> float:
-    """A run's final time: its scenario's ``final_time_s`` or the scenarios' default."""
+def final_time_s(scenario: Mapping[str, Any] | Any) -> float:
+    """A run's final time: its scenario's ``final_time_s`` or the scenarios' default.
+
+    ``scenario``: a scenario mapping or an item's ``RunInputs``.
+    """
     from quadimpact.inputs.scenarios import RunSettings
 
     value = scenario.get("final_time_s")

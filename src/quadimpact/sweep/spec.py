@@ -16,6 +16,7 @@ from typing import Any
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.files import apply_overrides, locate_vehicle, read_toml_file
 from quadimpact.results.files import to_jsonable
+from quadimpact.sweep.items import SweepBase
 
 MAX_RUNS = 10_000_000
 """Largest number of runs in one sweep."""
@@ -302,6 +303,7 @@ class SweepSpec:
             raise InputError(f"{where}: {n} runs, more than {MAX_RUNS}")
         self.n_runs = n
         self._drawn: dict[str, list[Any]] | None = None
+        self._derive = False  # set by validate(): runs copied from the validated base
 
     # ------------------------------------------------------------ reading
     def _read_base(self, base: Any) -> dict[str, Any]:
@@ -481,21 +483,38 @@ class SweepSpec:
         InputError
             ``<where>: run <i> (<swept values>): <field>: <rule> (got <value>)``.
         """
+        from quadimpact.inputs.derive import ScenarioFactory, same_scenario
         from quadimpact.inputs.scenarios import scenario_from_dict
         from quadimpact.inputs.vehicle import load_vehicle
-        from quadimpact.simulation.checks import MAX_RECORD_MB, check_record_size
+        from quadimpact.simulation.checks import (
+            MAX_RECORD_MB,
+            check_record_size,
+            vehicle_feature_count,
+        )
 
         limit = MAX_RECORD_MB if max_record_mb is None else float(max_record_mb)
         base = scenario_from_dict(self.base, where=f"{self.where}: base")
         base.build_vehicle(where=f"{self.where}: base")
+        factory = ScenarioFactory(self.base, self._vehicle_fields)
+        derive = factory.derives(self.columns)
+        swept = [k for k in self.columns if k not in self._vehicle_fields]
         vehicles: dict[str, Any] = {}
         checked: set[str] = set()
+        n_features: dict[str, int] = {}  # per vehicle and overrides (built once, not per run)
+        self._derive = False
         for run_id in range(self.n_runs):
             inputs = self.inputs(run_id)
             try:
                 scenario = scenario_from_dict(self.scenario_dict(run_id, inputs), where="")
-                check_record_size(scenario, limit, "--max-record-mb")
+                if derive:  # the workers may copy this run from the base: is it the same?
+                    derive = same_scenario(factory.scenario(inputs), scenario, swept)
                 key = canonical([scenario.vehicle, plain(scenario.vehicle_overrides)])
+                count = n_features.get(key)
+                if count is None:
+                    count = vehicle_feature_count(scenario)
+                    if len(n_features) < 100_000:
+                        n_features[key] = count
+                check_record_size(scenario, limit, "--max-record-mb", n_features=count)
                 if key not in checked:
                     if scenario.vehicle not in vehicles:
                         vehicles[scenario.vehicle] = load_vehicle(scenario.vehicle)
@@ -511,6 +530,17 @@ class SweepSpec:
                 ) from None
             if check is not None:
                 check(run_id)
+        self._derive = derive
+
+    def sweep_base(self) -> SweepBase:
+        """What every run shares, for the workers (``sweep.items``).
+
+        Its runs are copied from the validated base in the workers only after
+        :meth:`validate` found every copy equal to the validated run.
+        """
+        return SweepBase(
+            self.base, tuple(self._vehicle_fields), canonical(self.base), bool(self._derive)
+        )
 
     # ---------------------------------------------------------- (de)serial
     def to_dict(self) -> dict[str, Any]:

@@ -60,6 +60,19 @@ outside the schema land, as JSON, in ``summary_extra`` (null when none)."""
 
 _SUMMARY_KIND = dict(SUMMARY_COLUMNS)
 
+COST_COLUMNS: tuple[str, ...] = tuple(k for k, _ in SUMMARY_COLUMNS if k.startswith("cost__"))
+"""The columns that measure what a run cost (CPU time where it ran): the only ones
+that differ between two runs of the same sweep (docs/RESULTS.md)."""
+
+
+def without_costs(table: Any) -> Any:
+    """A sweep table (pandas or Arrow) without :data:`COST_COLUMNS`: what is the same bit
+    for bit however and wherever the sweep ran."""
+    names = [c for c in COST_COLUMNS if c in getattr(table, "column_names", table.columns)]
+    if hasattr(table, "drop_columns"):  # a pyarrow.Table
+        return table.drop_columns(names)
+    return table.drop(columns=names)
+
 
 # ------------------------------------------------------------ the worker
 def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dict[str, Any]:

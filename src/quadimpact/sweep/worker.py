@@ -12,10 +12,15 @@ import time
 from collections.abc import Sequence
 from typing import Any, NamedTuple
 
+from quadimpact.results.costs import COST_KEYS, cpu_time
+from quadimpact.sweep.items import RunInputs, scenario_of
 from quadimpact.sweep.store import failed_row, flatten_summary
 
-Item = tuple[int, dict[str, Any], dict[str, Any]]
-"""A run to do: (run_id, scenario mapping, input column values)."""
+TOTAL_COST = COST_KEYS[1]
+
+Item = tuple[int, "RunInputs | dict[str, Any]", dict[str, Any]]
+"""A run to do: (run_id, its swept values and sweep base or its scenario mapping,
+input column values); see :mod:`quadimpact.sweep.items`."""
 
 
 class RunCost(NamedTuple):
@@ -39,7 +44,6 @@ def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
     (the summary of ``simulate``, bit for bit, without its tables).
     """
     global _RUNNER
-    from quadimpact.inputs.scenarios import scenario_from_dict
     from quadimpact.simulation.batch import BatchRunner
 
     if _RUNNER is None:
@@ -48,14 +52,17 @@ def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
     run_id, scenario_data, inputs = item
     head = {"run_id": int(run_id), **inputs}
     start = time.perf_counter()
+    cpu_start = cpu_time()
     kernel_s, steps = 0.0, 0
     try:
-        scenario = scenario_from_dict(scenario_data, where=f"run {run_id}")
+        scenario = scenario_of(scenario_data, where=f"run {run_id}")
         summary = _RUNNER.summary(scenario)
         counters = summary.get("integrator") or {}
         kernel_s = float(counters.get("wall_time_s") or 0.0)
         steps = int(counters.get("steps") or 0) + int(counters.get("rejected_steps") or 0)
         row = flatten_summary(summary, skip=inputs)
+        if TOTAL_COST in row:  # the whole run: its scenario and its row included
+            row[TOTAL_COST] = cpu_time() - cpu_start
     except Exception as exc:  # a failed run is a row; the sweep goes on
         row = failed_row(f"{type(exc).__name__}: {exc}", inputs)
     return {**head, **row}, RunCost(time.perf_counter() - start, kernel_s, steps)
