@@ -160,9 +160,14 @@ def _secular_root(l1, l2, c1, c2, lo, hi, increasing, mu):
 
 
 @njit(cache=True, inline="always")
-def _root_candidates(cand, n, mu, l1, l2, c1, c2, v1x, v1y, v2x, v2y, hard) -> int:
+def _root_candidates(cand, n, mu, eig, hard) -> int:
     """The circle's point of the stationary condition at ``mu``: the component with the
-    larger ``|lam - mu|`` directly, the other from ``|z| = 1`` (both signs if ``hard``)."""
+    larger ``|lam - mu|`` directly, the other from ``|z| = 1`` (both signs if ``hard``).
+
+    ``eig = (l1, l2, c1, c2, v1x, v1y, v2x, v2y)``: the eigenvalues, the gradient's
+    components along the eigenvectors and the eigenvectors.
+    """
+    l1, l2, c1, c2, v1x, v1y, v2x, v2y = eig
     d1 = l1 - mu
     d2 = l2 - mu
     if abs(d2) >= abs(d1):
@@ -227,16 +232,17 @@ def _edge_candidates(cand, n, a0, a1, a2, b0, b1, b2) -> int:
         mu = lo
     else:
         mu = _secular_root(l1, l2, c1, c2, lo, hi, True, l1 - abs(c1))
-    n = _root_candidates(cand, n, mu, l1, l2, c1, c2, v1x, v1y, v2x, v2y, hard)
+    eig = (l1, l2, c1, c2, v1x, v1y, v2x, v2y)
+    n = _root_candidates(cand, n, mu, eig, hard)
     # the roots between the eigenvalues: psi is convex there, least at mu_m
     if l2 > l1 and c1 != 0.0 and c2 != 0.0:
         rho = (abs(c2) / abs(c1)) ** (2.0 / 3.0)
         mm = (l2 + rho * l1) / (1.0 + rho)
         if l1 < mm < l2 and _psi(mm, l1, l2, c1, c2) < 0.0:
             mu = _secular_root(l1, l2, c1, c2, l1, mm, False, l1 + abs(c1))
-            n = _root_candidates(cand, n, mu, l1, l2, c1, c2, v1x, v1y, v2x, v2y, hard)
+            n = _root_candidates(cand, n, mu, eig, hard)
             mu = _secular_root(l1, l2, c1, c2, mm, l2, True, l2 - abs(c2))
-            n = _root_candidates(cand, n, mu, l1, l2, c1, c2, v1x, v1y, v2x, v2y, hard)
+            n = _root_candidates(cand, n, mu, eig, hard)
     return n
 
 
