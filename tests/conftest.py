@@ -23,6 +23,20 @@ DATA_MISSING = (
 )
 
 
+def pytest_sessionstart(session: pytest.Session) -> None:
+    """Compile the simulator once, in this process, before any test.
+
+    On a fresh checkout Numba's cache is cold: the first test to simulate would
+    compile the loop (about 2 min of CPU on 2 cores), and a command-line test
+    doing it in a subprocess would run past its time limit. Compiled here, the
+    on-disk cache serves every later process.
+    """
+    from quadimpact import ImpactTrial, WallApproach, simulate
+
+    simulate(WallApproach(final_time_s=0.05))
+    simulate(ImpactTrial(final_time_s=0.05))
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     if data_dir() is not None:
         return

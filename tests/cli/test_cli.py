@@ -518,7 +518,7 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
     assert not core.cache_is_warm()
     announce_compilation()
     assert capsys.readouterr().err == (
-        "quadimpact: compiling the simulator (first run only: about 40 s of CPU on a 2-core "
+        "quadimpact: compiling the simulator (first run only: about 120 s of CPU on a 2-core "
         "machine, more on a slower one) ...\n"
     )
     run_py = str(Path(core.__file__).parent / "run.py")

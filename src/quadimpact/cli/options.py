@@ -78,8 +78,9 @@ def max_record_option(help: str) -> Decorator:
     )
 
 
-#: What a first run takes to compile the simulator (measured on 2 cores: 40 s of CPU).
-COMPILE_SECONDS = 40
+#: What a first run takes to compile the simulator (measured on 2 cores with the
+#: estimators, obstacle shapes and features in the loop: about 120 s of CPU).
+COMPILE_SECONDS = 120
 
 
 def announce_compilation() -> None:
