@@ -1,6 +1,8 @@
 # quadimpact: one-command entry points.
 #   make run    set up .venv (once) and reproduce the paper's study (report in results/paper)
-#   make test   set up .venv (once), install headless Chromium if missing (root only), run the tests
+#   make test   set up .venv (once), install headless Chromium if missing (root only), run the
+#               tests but those marked slow (what CI runs)
+#   make test-all  every test, the slow ones (compiling plug-in kernels, whole studies) included
 #   make lint   ruff check and ruff format --check
 #   make bench  timing benchmark of the compiled core
 
@@ -11,7 +13,7 @@ STAMP  := $(VENV)/.quadimpact-installed
 
 OUT := results/paper
 
-.PHONY: setup run test lint bench clean browser
+.PHONY: setup run test test-all lint bench clean browser
 
 setup: $(STAMP)
 
@@ -42,6 +44,9 @@ browser:
 	fi
 
 test: $(STAMP) browser
+	$(BIN)/python -m pytest -m "not slow"
+
+test-all: $(STAMP) browser
 	$(BIN)/python -m pytest
 
 lint: $(STAMP)
