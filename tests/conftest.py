@@ -33,7 +33,7 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     """
     from quadimpact import ImpactTrial, WallApproach, simulate
 
-    simulate(WallApproach(final_time_s=0.05))
+    simulate(WallApproach(final_time_s=0.6))
     simulate(ImpactTrial(final_time_s=0.05))
 
 
