@@ -18,17 +18,63 @@ MAX_PARAMETERS = 10
 MAX_TICK_LINES = 80
 
 
+DECORATORS = {"njit", "compiled", "allocating"}  # core/compiled.py
+REFCOUNTED_MODULES = {"records.py", "batch.py", "run.py"}  # allocate records; plain njit
+
+
+def _decorator(fn: ast.FunctionDef) -> ast.expr | None:
+    for dec in fn.decorator_list:
+        target = dec.func if isinstance(dec, ast.Call) else dec
+        if isinstance(target, ast.Name) and target.id in DECORATORS:
+            return dec
+    return None
+
+
 def _compiled_functions() -> list[tuple[Path, ast.FunctionDef]]:
     found = []
     for path in sorted(CORE.rglob("*.py")):
         for node in ast.walk(ast.parse(path.read_text())):
-            if not isinstance(node, ast.FunctionDef):
-                continue
-            for dec in node.decorator_list:
-                target = dec.func if isinstance(dec, ast.Call) else dec
-                if isinstance(target, ast.Name) and target.id == "njit":
-                    found.append((path, node))
+            if isinstance(node, ast.FunctionDef) and _decorator(node) is not None:
+                found.append((path, node))
     return found
+
+
+def _name(dec: ast.expr) -> str:
+    return (dec.func if isinstance(dec, ast.Call) else dec).id
+
+
+def _inlined(dec: ast.expr) -> bool:
+    return isinstance(dec, ast.Call) and any(k.arg == "inline" for k in dec.keywords)
+
+
+def test_every_loop_function_says_whether_it_counts_references():
+    """``compiled`` (no reference counting) or ``allocating``; never inherited (core/compiled.py).
+
+    A plain ``njit`` function compiled from inside the loop would inherit the
+    loop's setting, so its code would depend on which caller compiled it first.
+    Functions inlined into their callers take the caller's setting.
+    """
+    loose = [
+        f"{path.relative_to(CORE)}:{fn.name}"
+        for path, fn in _compiled_functions()
+        if path.name not in REFCOUNTED_MODULES
+        and _name(_decorator(fn)) == "njit"
+        and not _inlined(_decorator(fn))
+    ]
+    assert not loose, loose
+
+
+def test_no_function_compiled_without_reference_counting_returns_an_array():
+    """Nothing would own a returned array: such functions must be ``allocating``."""
+    arrays = ("np.ndarray", "Model", "Data", "Output", "Work")
+    returning = [
+        f"{path.relative_to(CORE)}:{fn.name}"
+        for path, fn in _compiled_functions()
+        if _name(_decorator(fn)) == "compiled"
+        and fn.returns is not None
+        and any(a in ast.unparse(fn.returns) for a in arrays)
+    ]
+    assert not returning, returning
 
 
 def test_no_compiled_function_takes_more_than_ten_parameters():

@@ -37,8 +37,12 @@ NEAR_M = 0.0525  # the controller's threshold on the sensor's reading
 
 @njit
 def ball_sphere(x, C, feat, f, shapes, s):  # pragma: no cover - compiled
-    """Contact record of a ball feature against a sphere obstacle (closed form)."""
-    cb = feat[f, L.F_CENTRE : L.F_CENTRE + 3]
+    """Contact record of a ball feature against a sphere obstacle (closed form).
+
+    Copies the centre (an allocation, as every plug-in here makes one: the loop
+    is compiled without reference counting, its plug-ins with it).
+    """
+    cb = feat[f, L.F_CENTRE : L.F_CENTRE + 3].copy()
     ox = C[0, 0] * cb[0] + C[0, 1] * cb[1] + C[0, 2] * cb[2]
     oy = C[1, 0] * cb[0] + C[1, 1] * cb[1] + C[1, 2] * cb[2]
     oz = C[2, 0] * cb[0] + C[2, 1] * cb[1] + C[2, 2] * cb[2]
@@ -64,8 +68,9 @@ def sphere_distance(px, py, pz, shapes, s):  # pragma: no cover - compiled
 def proximity(t, x, xdot, C, m, d):  # pragma: no cover - compiled
     """The gap between the ball (feature 0) and the nearest sphere, into the user block."""
     gap = np.inf
+    p = x[L.X_POS : L.X_POS + 3].copy()
     for s in range(m.shapes.shape[0]):
-        g = sphere_distance(x[L.X_POS], x[L.X_POS + 1], x[L.X_POS + 2], m.shapes, s)
+        g = sphere_distance(p[0], p[1], p[2], m.shapes, s)
         gap = min(gap, g - m.feat[0, L.F_RADIUS])
     d.meas[L.MS_USER] = gap
     d.meas[L.MS_USER + 1] = t
@@ -74,8 +79,9 @@ def proximity(t, x, xdot, C, m, d):  # pragma: no cover - compiled
 @njit
 def brace(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compiled
     """No thrust; stage 1 once the proximity sensor reads less than NEAR_M."""
+    off = np.zeros(4)
     for j in range(4):
-        cmd[j] = 0.0
+        cmd[j] = off[j]
     if mem[L.MEM_STAGE] < 1.0 and meas[L.MS_USER] < NEAR_M:
         mem[L.MEM_STAGE] = 1.0
 

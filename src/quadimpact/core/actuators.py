@@ -37,8 +37,8 @@ zero, which ``next_boundary`` gives in closed form.
 import math
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .layout import (
     LS_K,
     LS_PO_ACTIVE,
@@ -64,7 +64,7 @@ ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
 MOTOR_OFF = -math.inf  # a schedule rate: the motor is off (speed 0 from the segment's start)
 
 
-@njit(cache=True)
+@compiled
 def apply_segment(
     x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray, cut: int
 ) -> None:
@@ -87,7 +87,7 @@ def apply_segment(
         rin[RIN_FF + j] = r
 
 
-@njit(cache=True)
+@compiled
 def next_boundary(
     t: float, x: np.ndarray, t_p: float, sched_t: np.ndarray, seg: int, rin: np.ndarray
 ) -> float:
@@ -100,7 +100,7 @@ def next_boundary(
     return t_b
 
 
-@njit(cache=True)
+@compiled
 def cut_step(m: Model, d: Data) -> None:
     """The authors' motor cut at the tick ``d.ls[LS_K]``, once the power-off schedule is on.
 
@@ -128,7 +128,7 @@ def cut_step(m: Model, d: Data) -> None:
             x[X_ROTOR + j] = 0.0
 
 
-@njit(cache=True)
+@compiled
 def segment_at(t: float, t_p: float, sched_t: np.ndarray) -> int:
     """Index of the segment in force at time ``t`` (0 before the second start)."""
     seg = 0
@@ -137,7 +137,7 @@ def segment_at(t: float, t_p: float, sched_t: np.ndarray) -> int:
     return seg
 
 
-@njit(cache=True)
+@compiled
 def apply_command(
     cmd: np.ndarray,
     x: np.ndarray,
@@ -179,7 +179,7 @@ def apply_command(
         rin[RIN_PREV_CMD + j] = w
 
 
-@njit(cache=True)
+@compiled
 def rotor_rates(x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray) -> None:
     """Rotor accelerations (rad/s^2) of the current rotor mode, into ``omega_dot``."""
     if rin[RIN_FIRST_ORDER] > 0.5:

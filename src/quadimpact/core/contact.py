@@ -29,6 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .compiled import compiled
 from .geometry import pair_contact, shape_distance
 from .layout import (
     CS_ACTIVE,
@@ -48,7 +49,7 @@ from .layout import (
 from .records import Model
 
 
-@njit(cache=True)
+@compiled
 def damping_coefficient(k: float, e: float, v_i: float, v_min: float) -> float:
     """Herbert-McWhannell damping ``lambda`` (N s/m^(n+1)) for onset rate ``v_i`` (m/s).
 
@@ -58,7 +59,7 @@ def damping_coefficient(k: float, e: float, v_i: float, v_min: float) -> float:
     return 6.0 * (1.0 - e) * k / (((2.0 * e - 1.0) ** 2 + 3.0) * v)
 
 
-@njit(cache=True)
+@compiled
 def normal_force(k: float, n: float, delta: float, delta_dot: float, lam: float) -> float:
     """Hunt-Crossley normal force (N): ``max(0, k d^n + lambda d^n d_dot)``, zero for d <= 0."""
     if delta <= 0.0:
@@ -82,14 +83,14 @@ def pair_normal_force(m: Model, c: int, delta: float, delta_dot: float, lam: flo
     return fn * scale if scale > 0.0 else fn
 
 
-@njit(cache=True)
+@compiled
 def pair_damping(m: Model, c: int, v_i: float, v_min: float) -> float:
     """:func:`damping_coefficient` of pair ``c`` with its feature's parameters."""
     f = m.pairs[c, PR_FEATURE]
     return damping_coefficient(m.feat[f, F_K], m.feat[f, F_E], v_i, v_min)
 
 
-@njit(cache=True)
+@compiled
 def friction_force(
     fn: float,
     mu: float,
@@ -130,7 +131,7 @@ def contact_gap(x: np.ndarray, delta: float, m: Model, c: int) -> float:
     return min(delta, gate - d)
 
 
-@njit(cache=True)
+@compiled(inline="always")
 def contact_wrench(
     x: np.ndarray, C: np.ndarray, m: Model, cs: np.ndarray
 ) -> tuple[float, float, float, float, float, float]:

@@ -6,9 +6,9 @@ functions without touching the others.
 """
 
 import numpy as np
-from numba import njit
 
 from .actuators import rotor_rates
+from .compiled import compiled
 from .contact import contact_wrench
 from .layout import (
     N_ROTORS,
@@ -27,7 +27,7 @@ from .rigid_body import rigid_body_derivative
 from .rotors import rotor_wrench
 
 
-@njit(cache=True)
+@compiled(inline="always")
 def state_derivative(x: np.ndarray, xdot: np.ndarray, m: Model, d: Data, w: Work) -> None:
     """Full state derivative ``xdot = f(x)`` (the system is autonomous).
 

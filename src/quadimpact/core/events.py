@@ -15,8 +15,8 @@ regula falsi, bracketing all along, to ``opts[O_EVENT_TOL]`` in time.
 """
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .contact import contact_gap
 from .geometry import pair_depth
 from .integrator import dense_eval
@@ -31,7 +31,7 @@ NO_EVENT = 2.0  # "no event in this step" (fractions of a step are in [0, 1])
 NEAR_GRAZE_SAMPLES = 3  # interior dense-output checks of near-grazing contacts
 
 
-@njit(cache=True)
+@compiled
 def event_value(kind: int, c: int, level: float, xs: np.ndarray, C: np.ndarray, m: Model) -> float:
     """Value of event function ``kind`` for pair ``c`` (or level ``level``) at state ``xs``.
 
@@ -46,7 +46,7 @@ def event_value(kind: int, c: int, level: float, xs: np.ndarray, C: np.ndarray, 
     return dd
 
 
-@njit(cache=True)
+@compiled
 def locate(
     kind: int,
     c: int,
@@ -96,7 +96,7 @@ def locate(
     return sb
 
 
-@njit(cache=True)
+@compiled
 def contact_event(c: int, m: Model, d: Data, w: Work, h: float) -> float:
     """Fraction of the step at which pair ``c`` begins or ends (``NO_EVENT``: neither).
 

@@ -12,8 +12,8 @@ first run that lasted long enough (``ST_T_HOVER``).
 import math
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .layout import ST_HOVER_RUN_T, ST_T_DETECT, ST_T_HOVER, X_QUAT, X_VEL
 
 HOVER_SPEED_M_S = 0.2
@@ -22,7 +22,7 @@ HOVER_HOLD_S = 0.5
 _COS_TILT = math.cos(math.radians(HOVER_TILT_DEG))
 
 
-@njit(cache=True)
+@compiled
 def track_hover(t: float, x: np.ndarray, stats: np.ndarray) -> None:
     """The hover condition at the tick ``t`` (s) of the true state ``x`` (after a detection)."""
     if np.isnan(stats[ST_T_DETECT]) or not np.isnan(stats[ST_T_HOVER]):

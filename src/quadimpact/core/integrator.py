@@ -8,7 +8,8 @@ the run loop; nothing here knows about quadrotors.
 """
 
 import numpy as np
-from numba import njit
+
+from .compiled import compiled
 
 # Butcher tableau
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0
@@ -72,7 +73,7 @@ FAC_MAX = 10.0
 ORDER_EXP = 1.0 / 5.0
 
 
-@njit(cache=True)
+@compiled
 def stage_state(x: np.ndarray, K: np.ndarray, h: float, stage: int, out: np.ndarray) -> None:
     """State at which stage ``stage`` (1..6) is evaluated; ``K[0..stage-1]`` known."""
     n = x.shape[0]
@@ -92,7 +93,7 @@ def stage_state(x: np.ndarray, K: np.ndarray, h: float, stage: int, out: np.ndar
         out[i] = x[i] + h * acc
 
 
-@njit(cache=True)
+@compiled
 def error_norm(
     x: np.ndarray, x_new: np.ndarray, K: np.ndarray, h: float, rtol: float, atol: float
 ) -> float:
@@ -109,7 +110,7 @@ def error_norm(
     return err
 
 
-@njit(cache=True)
+@compiled
 def step_factor(err: float, accepted_before: bool) -> float:
     """Step-size multiplier after a trial with scaled error ``err``."""
     if err == 0.0:
@@ -122,7 +123,7 @@ def step_factor(err: float, accepted_before: bool) -> float:
     return max(FAC_MIN, min(FAC_MAX, fac))
 
 
-@njit(cache=True)
+@compiled
 def dense_coefficients(K: np.ndarray, Q: np.ndarray) -> None:
     """``Q = K^T P`` (n x 4), the dense-output polynomial coefficients of the last step."""
     for i in range(K.shape[1]):
@@ -138,7 +139,7 @@ def dense_coefficients(K: np.ndarray, Q: np.ndarray) -> None:
         Q[i, 3] = P03 * k0 + P23 * k2 + P33 * k3 + P43 * k4 + P53 * k5 + P63 * k6
 
 
-@njit(cache=True)
+@compiled
 def dense_eval(x_old: np.ndarray, Q: np.ndarray, h: float, sigma: float, out: np.ndarray) -> None:
     """Interpolated state at ``t_old + sigma h`` (0 <= sigma <= 1), into ``out``."""
     s1 = sigma
@@ -147,3 +148,19 @@ def dense_eval(x_old: np.ndarray, Q: np.ndarray, h: float, sigma: float, out: np
     s4 = s3 * sigma
     for i in range(x_old.shape[0]):
         out[i] = x_old[i] + h * (Q[i, 0] * s1 + Q[i, 1] * s2 + Q[i, 2] * s3 + Q[i, 3] * s4)
+
+
+@compiled
+def copy_into(dst: np.ndarray, src: np.ndarray) -> None:
+    """``dst[:] = src`` element by element (no temporary: the arrays never overlap here)."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@compiled
+def all_finite(x: np.ndarray) -> bool:
+    """Every component of ``x`` finite (no temporary array)."""
+    for i in range(x.shape[0]):
+        if not np.isfinite(x[i]):
+            return False
+    return True

@@ -16,14 +16,22 @@ events, so a trial step never integrates a force switched on mid-step.
 """
 
 import numpy as np
-from numba import njit
 
 from .actuators import apply_segment, next_boundary, segment_at
+from .compiled import compiled
 from .contact import contact_gap
 from .dynamics import state_derivative
 from .events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
 from .geometry import pair_depth
-from .integrator import dense_coefficients, dense_eval, error_norm, stage_state, step_factor
+from .integrator import (
+    all_finite,
+    copy_into,
+    dense_coefficients,
+    dense_eval,
+    error_norm,
+    stage_state,
+    step_factor,
+)
 from .layout import (
     CRASH_CM_GROUND,
     CS_ACTIVE,
@@ -90,7 +98,7 @@ ENDED = 1  # it ended (a crash with stop-on-crash),
 FAILED = 2  # or failed (status and reason in stats)
 
 
-@njit(cache=True)
+@compiled
 def contact_values(x: np.ndarray, m: Model, d: Data, w: Work, g: np.ndarray, gd: np.ndarray):
     """Gap ``g`` and penetration rate ``gd`` of every pair at ``x`` (``w.C``: its rotation)."""
     rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
@@ -100,7 +108,7 @@ def contact_values(x: np.ndarray, m: Model, d: Data, w: Work, g: np.ndarray, gd:
         gd[c] = dd
 
 
-@njit(cache=True)
+@compiled
 def _schedule_boundary(t: float, tiny: float, m: Model, d: Data, o: Output) -> None:
     """The rotor inputs change at ``t``: power-off trigger, next segment, a motor stopping."""
     ls = d.ls
@@ -118,7 +126,7 @@ def _schedule_boundary(t: float, tiny: float, m: Model, d: Data, o: Output) -> N
     ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin)
 
 
-@njit(cache=True)
+@compiled
 def _pending_onsets(d: Data, o: Output, w: Work) -> bool:
     """Mark pairs already penetrating without a located onset (``w.ev_sig = 0``); any?"""
     pending = False
@@ -133,7 +141,7 @@ def _pending_onsets(d: Data, o: Output, w: Work) -> bool:
     return pending
 
 
-@njit(cache=True)
+@compiled
 def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
     """A Dormand-Prince step of ``h`` (s) from ``d.x``: stages in ``w.K``, its end in ``w.x_new``.
 
@@ -142,17 +150,16 @@ def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
     """
     x = d.x
     K = w.K
-    if not fsal:
-        state_derivative(x, K[0], m, d, w)
-    for st in range(1, 6):
-        stage_state(x, K, h, st, w.xs)
-        state_derivative(w.xs, K[st], m, d, w)
-    stage_state(x, K, h, 6, w.x_new)
-    state_derivative(w.x_new, K[6], m, d, w)
+    for st in range(1 if fsal else 0, 7):
+        # stage 0 at x (unless FSAL), 1-5 at w.xs, the last at the step's end w.x_new
+        xs = x if st == 0 else (w.x_new if st == 6 else w.xs)
+        if st > 0:
+            stage_state(x, K, h, st, xs)
+        state_derivative(xs, K[st], m, d, w)
     return error_norm(x, w.x_new, K, h, m.opts[O_RTOL], m.opts[O_ATOL])
 
 
-@njit(cache=True)
+@compiled
 def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     """Earliest event of the accepted step of ``h`` (s), and the crash's (fractions; NO_EVENT)."""
     contact_values(w.x_new, m, d, w, w.g_b, w.gd_b)
@@ -174,7 +181,7 @@ def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     return sig_min, sig_crash
 
 
-@njit(cache=True)
+@compiled
 def _dense_samples(
     m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, fsal: bool, i_out: int
 ) -> int:
@@ -197,7 +204,7 @@ def _dense_samples(
     return i_out
 
 
-@njit(cache=True)
+@compiled
 def _track_peaks(m: Model, d: Data, o: Output, w: Work, t: float, h: float, sig: float) -> None:
     """Peaks of the active contacts over the step of ``h`` (s) from ``t`` up to fraction ``sig``."""
     for c in range(d.cs.shape[0]):
@@ -212,7 +219,7 @@ def _track_peaks(m: Model, d: Data, o: Output, w: Work, t: float, h: float, sig:
             observe_peak(m, d, o, w, e, c, sp, t, h)
 
 
-@njit(cache=True)
+@compiled
 def _process_events(
     t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
 ) -> tuple[bool, bool]:
@@ -247,14 +254,14 @@ def _process_events(
     return any_event, ended
 
 
-@njit(cache=True)
+@compiled
 def _fail(stats: np.ndarray, reason: int) -> int:
     stats[ST_STATUS] = STATUS_FAILED
     stats[ST_REASON] = reason
     return FAILED
 
 
-@njit(cache=True)
+@compiled
 def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w: Work) -> int:
     """Integrate from the tick ``t`` to ``t_next`` (s); ``RUNNING``, ``ENDED`` or ``FAILED``.
 
@@ -293,7 +300,7 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
         tol_sig = 0.0
         if pending:
             sig_min = 0.0
-            w.x_b[:] = d.x
+            copy_into(w.x_b, d.x)
             t_b = t
             h_new = h
         else:
@@ -321,8 +328,8 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
             else:
                 sig_min = 1.0
                 t_b = t + h_try
-                w.x_b[:] = w.x_new
-                w.K[0, :] = w.K[6, :]
+                copy_into(w.x_b, w.x_new)
+                copy_into(w.K[0], w.K[6])
                 fsal = True
             if t_stop - t_b < tiny:
                 t_b = t_stop
@@ -334,8 +341,8 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
                     result = ENDED
         # ---- advance to t_b and process the events located there ----
         t = t_b
-        d.x[:] = w.x_b
-        if not np.isfinite(d.x).all():
+        copy_into(d.x, w.x_b)
+        if not all_finite(d.x):
             result = _fail(stats, REASON_NOT_FINITE)
             break
         track_extremes(d.x, d.meas[MS_DETECTED] > 0.5, stats)

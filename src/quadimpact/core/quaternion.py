@@ -10,6 +10,8 @@ import math
 import numpy as np
 from numba import njit
 
+from .compiled import compiled
+
 
 @njit(cache=True, inline="always")
 def rotation_matrix(q: np.ndarray, C: np.ndarray) -> None:
@@ -30,7 +32,7 @@ def rotation_matrix(q: np.ndarray, C: np.ndarray) -> None:
     C[2, 2] = 1.0 - 2.0 * (q1 * q1 + q2 * q2)
 
 
-@njit(cache=True)
+@compiled
 def euler_zyx(q: np.ndarray) -> tuple[float, float, float]:
     """Roll, pitch, yaw (rad) of the attitude ``q`` (ZYX; pitch in [-pi/2, pi/2])."""
     n = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
@@ -46,7 +48,7 @@ def euler_zyx(q: np.ndarray) -> tuple[float, float, float]:
     return roll, pitch, yaw
 
 
-@njit(cache=True)
+@compiled
 def wrap_pi(a: float) -> float:
     """Wrap an angle (rad) to (-pi, pi]."""
     w = a - 2.0 * math.pi * math.floor((a + math.pi) / (2.0 * math.pi))
@@ -55,7 +57,7 @@ def wrap_pi(a: float) -> float:
     return w
 
 
-@njit(cache=True)
+@compiled
 def normalise_quaternion(x: np.ndarray, offset: int) -> None:
     """Scale ``x[offset:offset+4]`` to unit norm in place."""
     n = math.sqrt(x[offset] ** 2 + x[offset + 1] ** 2 + x[offset + 2] ** 2 + x[offset + 3] ** 2)

@@ -10,8 +10,8 @@ active pairs, N).
 import math
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .contact import pair_damping, pair_normal_force
 from .geometry import pair_depth
 from .integrator import dense_eval
@@ -59,7 +59,7 @@ from .records import Data, Model, Output, Work
 from .sensors.disturbance import impact_onset
 
 
-@njit(cache=True)
+@compiled
 def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
     """Output row ``row`` at time ``t`` (s) of the state ``xs``: state, command, stage, contacts."""
     out = o.out
@@ -83,7 +83,7 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
             out[row, OUT_DELTA + nf + f] += pair_normal_force(m, c, dp, dd, d.cs[c, CS_LAMBDA])
 
 
-@njit(cache=True)
+@compiled
 def track_peak(o: Output, e: int, t: float, delta: float, force: float) -> None:
     """Update episode ``e``'s peak deflection (m) and peak force (N) with a new observation."""
     if e < 0:
@@ -97,7 +97,7 @@ def track_peak(o: Output, e: int, t: float, delta: float, force: float) -> None:
         ep[e, E_T_PEAK_FORCE] = t
 
 
-@njit(cache=True)
+@compiled
 def observe_peak(
     m: Model, d: Data, o: Output, w: Work, e: int, c: int, sigma: float, t: float, h: float
 ) -> float:
@@ -113,7 +113,7 @@ def observe_peak(
     return dd
 
 
-@njit(cache=True)
+@compiled
 def open_episode(c: int, t: float, gd: float, m: Model, d: Data, o: Output, w: Work) -> None:
     """Onset of pair ``c`` at ``t`` (s), state ``d.x``, rate ``gd`` (m/s): damping, episode."""
     cs = d.cs
@@ -144,7 +144,7 @@ def open_episode(c: int, t: float, gd: float, m: Model, d: Data, o: Output, w: W
         stats[ST_EPISODES_DROPPED] += 1.0
 
 
-@njit(cache=True)
+@compiled
 def close_episode(c: int, t: float, d: Data, o: Output) -> None:
     """End of pair ``c``'s contact at ``t`` (s)."""
     cs = d.cs
@@ -157,7 +157,7 @@ def close_episode(c: int, t: float, d: Data, o: Output) -> None:
     cs[c, CS_EPISODE] = -1.0
 
 
-@njit(cache=True)
+@compiled
 def track_extremes(x: np.ndarray, detected: bool, stats: np.ndarray) -> None:
     """Lowest altitude; after detection the largest tilt and rate (exact at step ends)."""
     alt = -x[X_POS + 2]
@@ -175,7 +175,7 @@ def track_extremes(x: np.ndarray, detected: bool, stats: np.ndarray) -> None:
             stats[ST_MAX_RATE] = w
 
 
-@njit(cache=True)
+@compiled
 def record_crash(t: float, x: np.ndarray, stats: np.ndarray) -> None:
     """The crash at ``t`` (s) with the CM at ``x``'s position."""
     stats[ST_CRASH_T] = t

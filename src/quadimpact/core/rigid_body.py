@@ -5,12 +5,12 @@
 """
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .layout import V_INERTIA, V_INERTIA_INV, V_MASS, X_OMEGA, X_POS, X_QUAT, X_VEL
 
 
-@njit(cache=True)
+@compiled
 def rigid_body_derivative(
     x: np.ndarray,
     xdot: np.ndarray,

@@ -14,12 +14,12 @@ spin-up term without the spin sign, ``-Jr sum_j Omega_dot_j``
 """
 
 import numpy as np
-from numba import njit
 
+from .compiled import compiled
 from .layout import N_ROTORS, V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
 
 
-@njit(cache=True)
+@compiled
 def rotor_wrench(
     x: np.ndarray, omega_dot: np.ndarray, veh: np.ndarray, drag_paper: bool, spinup_paper: bool
 ) -> tuple[float, float, float, float]:

@@ -135,6 +135,17 @@ def specialise(
     return result
 
 
+def _refcounted(fn: Dispatcher) -> Dispatcher:
+    """A copy of a user's ``njit`` function compiled with reference counting.
+
+    The loop is compiled without it (``core/compiled.py``), and a function
+    compiled from inside it inherits that; a user's function may allocate
+    arrays, so it is compiled with reference counting of its own.
+    """
+    options = {k: v for k, v in fn.targetoptions.items() if k not in ("cache", "nopython", "_nrt")}
+    return njit(_nrt=True, **options)(fn.py_func)
+
+
 def _adapt_legacy(step: Callable) -> Callable:
     """Wrap a controller of the earlier interface ``step(x, ctrl, mem, veh, dt, cmd)``.
 
@@ -142,7 +153,7 @@ def _adapt_legacy(step: Callable) -> Callable:
     """
     legacy = step
 
-    @njit
+    @njit(_nrt=True)
     def adapted(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compiled
         legacy(meas[MS_X : MS_X + NX], ctrl, mem, veh, dt, cmd)
 
@@ -160,7 +171,7 @@ def _checked_step(step: Callable) -> Callable:
             "controller step: expected step(t, meas, ctrl, mem, veh, dt, cmd) "
             f"(or the older step(x, ctrl, mem, veh, dt, cmd)); got {n_params} parameters"
         )
-    return step
+    return _refcounted(step)
 
 
 def _generated(source: str, scope: dict[str, object]) -> Callable:
@@ -174,7 +185,7 @@ def _contact_dispatch(entries: Mapping[int, Callable]) -> Callable:
     lines = ["def dispatch(g, x, C, feat, f, shapes, s):"]
     scope: dict[str, object] = {"no_contact": no_contact}
     for i, (gid, fn) in enumerate(sorted(entries.items())):
-        scope[f"fn{i}"] = fn
+        scope[f"fn{i}"] = _refcounted(fn)
         lines += [f"    if g == {int(gid)}:", f"        return fn{i}(x, C, feat, f, shapes, s)"]
     lines.append("    return no_contact()")
     return _generated("\n".join(lines), scope)
@@ -185,7 +196,7 @@ def _distance_dispatch(entries: Mapping[int, Callable]) -> Callable:
     lines = ["def dispatch(px, py, pz, shapes, s):", "    kind = int(shapes[s, SH_KIND])"]
     scope: dict[str, object] = {"SH_KIND": SH_KIND, "inf": math.inf}
     for i, (kind, fn) in enumerate(sorted(entries.items())):
-        scope[f"fn{i}"] = fn
+        scope[f"fn{i}"] = _refcounted(fn)
         lines += [f"    if kind == {int(kind)}:", f"        return fn{i}(px, py, pz, shapes, s)"]
     lines.append("    return inf")
     return _generated("\n".join(lines), scope)
@@ -234,7 +245,7 @@ def make_kernel(
     if sensor is not None:
         if not hasattr(sensor, "py_func"):
             raise TypeError("sensor: must be a numba.njit function")
-        replacements["plugin_sensor"] = sensor
+        replacements["plugin_sensor"] = _refcounted(sensor)
     if estimator is not None:
         if not hasattr(estimator, "py_func"):
             raise TypeError("estimator: must be a numba.njit function")
@@ -243,7 +254,7 @@ def make_kernel(
             raise TypeError(
                 f"estimator: expected estimator(t, dt, meas, ecfg, est); got {n_params} parameters"
             )
-        replacements["plugin_estimator"] = estimator
+        replacements["plugin_estimator"] = _refcounted(estimator)
     if geometry:
         contact_fns = {g.id: g.fn for g in _geometry.plugin_geometries()}
         replacements["plugin_contact"] = _contact_dispatch(contact_fns)

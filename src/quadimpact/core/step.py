@@ -29,9 +29,9 @@ once, bit for bit.
 import math
 
 import numpy as np
-from numba import njit
 
 from .actuators import apply_command, cut_step
+from .compiled import allocating, compiled
 from .controllers import builtin_step
 from .estimators import at_tick, init_estimate
 from .hover import track_hover
@@ -109,7 +109,7 @@ from .sensors.stage import sample_at
 controller_step = builtin_step  # rebound by run.make_kernel for plug-in controllers
 
 
-@njit(cache=True)
+@allocating
 def start(m: Model, d: Data, o: Output) -> None:
     """Initialise ``d`` and ``o`` for the run ``m`` from ``(t0, x0)``.
 
@@ -168,7 +168,7 @@ def start(m: Model, d: Data, o: Output) -> None:
         sample_at(t0, x, m, d, o, w)
 
 
-@njit(cache=True)
+@compiled
 def _crash_at_tick(t: float, m: Model, d: Data, o: Output) -> bool:
     """The replica's crash rules: ``h <= level`` tested at the control ticks after the start.
 
@@ -183,7 +183,7 @@ def _crash_at_tick(t: float, m: Model, d: Data, o: Output) -> bool:
     return True
 
 
-@njit(cache=True)
+@compiled
 def _command(t: float, m: Model, d: Data, o: Output, w: Work) -> None:
     """The tick's rotor command into ``w.cmd``: the controller's, or the external one.
 
@@ -207,7 +207,7 @@ def _command(t: float, m: Model, d: Data, o: Output, w: Work) -> None:
             stats[ST_STAGE_X + 3 * si + i] = d.x[X_POS + i]
 
 
-@njit(cache=True)
+@compiled
 def tick(m: Model, d: Data, o: Output, w: Work) -> None:
     """One control tick and the interval after it (``w``: work space)."""
     ls = d.ls
@@ -239,7 +239,7 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
         ls[LS_DONE] = 1.0
 
 
-@njit(cache=True)
+@compiled
 def finish(d: Data, o: Output) -> None:
     """Close the episodes still open at the time reached; deepest penetration of the run.
 
@@ -262,7 +262,7 @@ def finish(d: Data, o: Output) -> None:
         stats[ST_STATUS] = STATUS_COMPLETED
 
 
-@njit(cache=True)
+@allocating
 def advance(n_ticks: int, m: Model, d: Data, o: Output) -> int:
     """Run up to ``n_ticks`` control ticks (``n_ticks < 0``: to the end); return the ticks run.
 

@@ -27,15 +27,15 @@ step=...)``), and runs in a loop compiled around it (``core.run.make_kernel``).
 """
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import C_KIND, CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, MS_X, N_ROTORS, X_ROTOR
 from .cascade_pid import cascade_pid_step
 from .paper import paper_step
 from .recovery import recovery_step
 
 
-@njit(cache=True)
+@compiled
 def hold_step(
     t: float,
     meas: np.ndarray,
@@ -50,7 +50,7 @@ def hold_step(
         cmd[j] = meas[MS_X + X_ROTOR + j]
 
 
-@njit(cache=True)
+@compiled
 def builtin_step(
     t: float,
     meas: np.ndarray,

@@ -11,8 +11,8 @@ analysis are in docs/CONTROLLERS.md.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     C_H_REF,
     C_OMEGA_MAX,
@@ -59,7 +59,7 @@ from .common import (
 FADE_POWER = 4.0  # thrust fade beyond the tilt floor (tilt_compensation)
 
 
-@njit(cache=True)
+@compiled
 def _pid(
     e: float,
     slot_e: int,
@@ -85,7 +85,7 @@ def _pid(
     return out
 
 
-@njit(cache=True)
+@compiled
 def tilt_compensation(c: float, floor: float) -> float:
     """Collective-thrust factor for ``c = cos(phi) cos(theta)``.
 
@@ -106,7 +106,7 @@ def tilt_compensation(c: float, floor: float) -> float:
     return (c / floor) ** FADE_POWER / floor
 
 
-@njit(cache=True)
+@compiled
 def cascade_pid_step(
     t: float,
     meas: np.ndarray,

@@ -6,8 +6,8 @@ Frames: inertial NED, body FRD; angles in rad; rotor speeds in rad/s.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import allocating, compiled
 from ..layout import (
     C_ALLOC_INV,
     MEM_STAGE,
@@ -23,7 +23,7 @@ from ..layout import (
 from ..quaternion import euler_zyx
 
 
-@njit(cache=True)
+@compiled
 def attitude_altitude(x: np.ndarray) -> tuple[float, float, float, float, float]:
     """Roll, pitch, yaw (rad, ZYX), altitude ``h = -Z`` (m) and climb rate ``h_dot`` (m/s)."""
     roll, pitch, yaw = euler_zyx(x[X_QUAT : X_QUAT + 4])
@@ -39,7 +39,7 @@ def attitude_altitude(x: np.ndarray) -> tuple[float, float, float, float, float]
     return roll, pitch, yaw, -x[X_POS + 2], -zdot
 
 
-@njit(cache=True)
+@compiled
 def allocate(
     ctrl: np.ndarray, thrust: float, tx: float, ty: float, tz: float, cmd: np.ndarray
 ) -> bool:
@@ -62,7 +62,7 @@ def allocate(
     return clipped
 
 
-@njit(cache=True)
+@compiled
 def linearised_torques(
     omega: np.ndarray, veh: np.ndarray, a_p: float, a_q: float, a_r: float
 ) -> tuple[float, float, float]:
@@ -82,7 +82,7 @@ def linearised_torques(
     return tx, ty, tz
 
 
-@njit(cache=True)
+@allocating
 def body_rates(x: np.ndarray) -> np.ndarray:
     """The body angular velocity slice ``(p, q, r)`` of a state (a view)."""
     return x[X_OMEGA : X_OMEGA + 3]

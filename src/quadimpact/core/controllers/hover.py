@@ -24,19 +24,19 @@ most about 27 deg), ``K_psi = 2 1/s``.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import X_POS, X_QUAT, X_VEL
 from ..quaternion import wrap_pi
 
 
-@njit(cache=True)
+@compiled
 def yaw_of(q: np.ndarray) -> float:
     """ZYX yaw (rad) of the scalar-first quaternion ``q`` (body to inertial)."""
     return math.atan2(2.0 * (q[0] * q[3] + q[1] * q[2]), 1.0 - 2.0 * (q[2] * q[2] + q[3] * q[3]))
 
 
-@njit(cache=True)
+@compiled
 def _limit(x: float, y: float, z: float, lim: float) -> tuple[float, float, float]:
     """``(x, y)`` scaled to a norm of at most ``lim``, ``z`` clipped to ``+-lim``."""
     h = math.sqrt(x * x + y * y)
@@ -46,7 +46,7 @@ def _limit(x: float, y: float, z: float, lim: float) -> tuple[float, float, floa
     return x, y, min(max(z, -lim), lim)
 
 
-@njit(cache=True)
+@compiled
 def hover_acceleration(
     x: np.ndarray,
     C: np.ndarray,

@@ -15,8 +15,8 @@ of ``common.py``.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     C_H_REF,
     C_PARAMS,
@@ -50,7 +50,7 @@ from .common import (
 )
 
 
-@njit(cache=True)
+@compiled
 def paper_step(
     t: float,
     meas: np.ndarray,

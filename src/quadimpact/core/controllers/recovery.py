@@ -60,8 +60,8 @@ detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import allocating, compiled
 from ..layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -135,7 +135,7 @@ STAGE_RECOVERED = 4
 STAGE_HOVER = 5
 
 
-@njit(cache=True)
+@compiled
 def next_stage(
     stage: int,
     qe_x: float,
@@ -167,7 +167,7 @@ def next_stage(
     return stage
 
 
-@njit(cache=True)
+@allocating
 def staged_references(
     stage: int,
     a_ref_on: bool,
@@ -205,7 +205,7 @@ def staged_references(
     return thrust_and_tilt(fx, fy, fz, C, ctrl, veh)
 
 
-@njit(cache=True)
+@compiled
 def thrust_and_tilt(
     fx: float, fy: float, fz: float, C: np.ndarray, ctrl: np.ndarray, veh: np.ndarray
 ) -> tuple[float, float, float, float, float]:
@@ -240,7 +240,7 @@ def thrust_and_tilt(
     return thrust, k_att * qex, k_att * qey, qex, qey
 
 
-@njit(cache=True)
+@allocating
 def law_references(
     stage: int,
     a_ref_on: bool,
@@ -280,7 +280,7 @@ def law_references(
     return thrust, p_des, q_des, 0.0, qex, qey
 
 
-@njit(cache=True)
+@compiled
 def hold_set_point(x: np.ndarray, ctrl: np.ndarray, mem: np.ndarray) -> None:
     """Stage 5's set-points into ``mem`` at stage 4's entry: the yaw of ``x`` and, by the
     mode, the position estimate of ``x``, the given point, or (``HOLD_STOP``) none yet."""
@@ -295,7 +295,7 @@ def hold_set_point(x: np.ndarray, ctrl: np.ndarray, mem: np.ndarray) -> None:
     mem[RM_HOLD_PSI] = yaw_of(x[X_QUAT : X_QUAT + 4])
 
 
-@njit(cache=True)
+@compiled
 def rate_loop(
     thrust: float,
     p_des: float,
@@ -328,7 +328,7 @@ def rate_loop(
             cmd[j] = hi
 
 
-@njit(cache=True)
+@compiled
 def staged_law(
     stage: int,
     a_ref_on: bool,
@@ -352,7 +352,7 @@ def staged_law(
     return qex, qey
 
 
-@njit(cache=True)
+@compiled
 def recovery_step(
     t: float,
     meas: np.ndarray,

@@ -31,6 +31,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import allocating, compiled
 from ..layout import (
     EC_INIT_ATT,
     EC_INIT_BIAS,
@@ -81,7 +82,7 @@ def plugin_estimator(t: float, dt: float, meas: np.ndarray, ecfg: np.ndarray, es
     return
 
 
-@njit(cache=True)
+@compiled
 def _truth(xs: np.ndarray, C: np.ndarray, d: Data) -> None:
     """The ideal estimator's estimate: the true state (no gyro bias estimate)."""
     est = d.est
@@ -94,7 +95,7 @@ def _truth(xs: np.ndarray, C: np.ndarray, d: Data) -> None:
         est[ES_W + r] = d.meas[MS_IMU_W + r]
 
 
-@njit(cache=True)
+@allocating
 def init_estimate(m: Model, d: Data) -> None:
     """The initial estimate from the initial state ``d.x``: the truth plus ``ecfg``'s error.
 
@@ -127,7 +128,7 @@ def init_estimate(m: Model, d: Data) -> None:
         ekf_init(m, d)
 
 
-@njit(cache=True)
+@compiled
 def estimate_sample(
     t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data, o: Output, w: Work
 ) -> None:
@@ -170,7 +171,7 @@ def attitude_at_sample(
     return w.C_hat
 
 
-@njit(cache=True)
+@compiled
 def write_estimate(t: float, x: np.ndarray, m: Model, d: Data, meas: np.ndarray) -> None:
     """The estimate of the tick ``t`` (s) into the measurement record ``meas``.
 

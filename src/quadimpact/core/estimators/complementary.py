@@ -36,8 +36,8 @@ normalised) where this filter uses the exponential.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     EC_GATE,
     EC_K_ACC,
@@ -65,7 +65,7 @@ from ..sensors.rotvec import dcm, error_vector, rotate_by
 from .navigation import integrate_navigation
 
 
-@njit(cache=True)
+@compiled
 def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     """Update the estimate ``d.est`` with the sample at ``t`` (s), ``dt`` (s) after the last.
 

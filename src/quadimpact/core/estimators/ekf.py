@@ -40,8 +40,8 @@ the sensors' own (with floors, so an ideal IMU does not make ``P`` singular).
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import allocating, compiled
 from ..layout import (
     EC_DEWEIGHT,
     EC_GATE,
@@ -80,13 +80,13 @@ from ..sensors.rotvec import dcm, error_vector, rotate_by
 from .navigation import integrate_navigation
 
 
-@njit(cache=True)
+@compiled
 def ekf_dimension(ecfg: np.ndarray) -> int:
     """Error-state dimension: 12 with the navigation states (a pose sensor), else 6."""
     return N_EKF if ecfg[EC_NAV] > 0.5 else 6
 
 
-@njit(cache=True)
+@compiled
 def ekf_init(m: Model, d: Data) -> None:
     """The initial covariance: ``diag(s_att^2, s_bias^2, s_vel^2, s_pos^2)`` (``EC_P0``)."""
     est = d.est
@@ -97,7 +97,7 @@ def ekf_init(m: Model, d: Data) -> None:
         est[ES_P + k * N_EKF + k] = s * s
 
 
-@njit(cache=True)
+@allocating
 def covariance(est: np.ndarray, n: int) -> np.ndarray:
     """A copy of the covariance's first ``n`` rows and columns (for tests and analysis)."""
     P = np.empty((n, n))
@@ -107,7 +107,7 @@ def covariance(est: np.ndarray, n: int) -> np.ndarray:
     return P
 
 
-@njit(cache=True)
+@compiled
 def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool) -> None:
     """``W[o, :n, :m] = W[a, :n, :k] W[b, :k, :m]`` (``W[b]^T`` when ``bt``), in a fixed
     order of operations (no BLAS: the same bits on every CPU)."""
@@ -119,7 +119,7 @@ def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool
             W[o, i, j] = s
 
 
-@njit(cache=True)
+@compiled
 def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: float) -> None:
     """One 3-row update (Joseph form) of the covariance ``W[0]`` (``n`` states) with the
     rows ``W[4, :3]`` of ``H``, innovation ``y`` and noise variance ``r``; the correction
@@ -163,7 +163,7 @@ def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: floa
         est[ES_POS + a3] += dx[9 + a3]
 
 
-@njit(cache=True)
+@compiled
 def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.ndarray,
                 f: np.ndarray, dt: float, C: np.ndarray) -> None:  # fmt: skip
     """The prediction over ``dt`` (s): the attitude and the covariance ``W[0]``.
@@ -211,7 +211,7 @@ def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.
     rotate_by(est[ES_Q : ES_Q + 4], wx * dt, wy * dt, wz * dt)
 
 
-@njit(cache=True)
+@allocating
 def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
 
@@ -287,7 +287,7 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
         est[ES_W + a] = w[a] - est[ES_BIAS + a]
 
 
-@njit(cache=True)
+@compiled
 def _skew(H: np.ndarray, s: float, u0: float, u1: float, u2: float) -> None:
     """``H[:3, :] = [s [u x], 0]``: a measurement of the attitude error alone."""
     H[:3, :] = 0.0
@@ -299,7 +299,7 @@ def _skew(H: np.ndarray, s: float, u0: float, u1: float, u2: float) -> None:
     H[2, 1] = s * u0
 
 
-@njit(cache=True)
+@compiled
 def _unit(H: np.ndarray, col: int) -> None:
     """``H[:3, :]`` selecting the three states from ``col``."""
     H[:3, :] = 0.0

@@ -20,8 +20,8 @@ belongs to the phase before.)
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     ES_BIAS,
     ES_POS,
@@ -51,7 +51,7 @@ from ..sensors.rotvec import error_angle
 STAGE_RECOVERED = 4  # controllers/recovery.py's
 
 
-@njit(cache=True)
+@compiled
 def phase_at(t: float, stats: np.ndarray) -> int:
     """The phase (0 before contact, 1 the crash, 2 after stage 4) of a sample at ``t`` (s)."""
     onset = stats[ST_ONSET_T]
@@ -63,7 +63,7 @@ def phase_at(t: float, stats: np.ndarray) -> int:
     return 1
 
 
-@njit(cache=True)
+@compiled
 def record_estimate(t: float, xs: np.ndarray, C: np.ndarray, m: Model, d: Data, o: Output) -> None:
     """Errors of the estimate ``d.est`` against the true state ``xs`` (rotation ``C``) at ``t``."""
     est = d.est

@@ -13,12 +13,12 @@ position estimate quadratically.
 """
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import ES_POS, ES_VEL
 
 
-@njit(cache=True)
+@compiled
 def integrate_navigation(
     est: np.ndarray, C: np.ndarray, f: np.ndarray, g: float, dt: float
 ) -> None:

@@ -56,6 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     F_KIND,
     FEAT_POINT,
@@ -150,7 +151,7 @@ def plugin_contact(
     return no_contact()
 
 
-@njit(cache=True, inline="always")
+@compiled
 def pair_contact(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
 ) -> ContactRecord:
@@ -180,7 +181,7 @@ def pair_contact(
     return plugin_contact(g, x, C, feat, f, shapes, s)
 
 
-@njit(cache=True, inline="always")
+@compiled
 def pair_depth(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
 ) -> tuple[float, float]:
@@ -195,7 +196,7 @@ def plugin_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int)
     return math.inf
 
 
-@njit(cache=True, inline="always")
+@compiled
 def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) -> float:
     """Signed distance (m) of the inertial point ``p`` from shape ``s``, positive outside."""
     kind = int(shapes[s, SH_KIND])
@@ -208,7 +209,7 @@ def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) 
     return plugin_distance(px, py, pz, shapes, s)
 
 
-@njit(cache=True)
+@compiled
 def _contact_record(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
 ) -> ContactRecord:

@@ -62,6 +62,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import allocating, compiled
 from ..layout import (
     F_CENTRE,
     F_NORMAL,
@@ -161,7 +162,7 @@ def _min_cuts(c1, a1, b1, c2, a2, b2, t):
     return min(c1 + a1 * math.cos(t) + b1 * math.sin(t), c2 + a2 * math.cos(t) + b2 * math.sin(t))
 
 
-@njit(cache=True)
+@allocating
 def _arc_bound(lo: float, hi: float, cuts: tuple) -> float:
     """Largest value on ``[lo, hi]`` of the lower of two cuts (closed form)."""
     c1, a1, b1, c2, a2, b2 = cuts
@@ -192,7 +193,7 @@ def _arc_bound(lo: float, hi: float, cuts: tuple) -> float:
     return best
 
 
-@njit(cache=True)
+@compiled
 def _crease(ring: Ring, b1: float, k1: int, b2: float, k2: int, shapes: np.ndarray, s: int):
     """The crease between pieces ``k1`` (active at ``b1``) and ``k2`` (at ``b2``), certified.
 
@@ -249,7 +250,7 @@ def _crease(ring: Ring, b1: float, k1: int, b2: float, k2: int, shapes: np.ndarr
     return _excess(ring, b, xx, xy, xz) <= TOL, b, g, mx, my, mz
 
 
-@njit(cache=True)
+@allocating
 def _branch_and_bound(ring: Ring, shapes: np.ndarray, s: int, best: tuple):
     """The global search over arcs (see the module docstring), from the best point so far."""
     b_best, g_best, bmx, bmy, bmz = best
@@ -316,7 +317,7 @@ def _branch_and_bound(ring: Ring, shapes: np.ndarray, s: int, best: tuple):
     return b_best, g_best, bmx, bmy, bmz
 
 
-@njit(cache=True)
+@compiled
 def ring_deepest(ring: Ring, shapes: np.ndarray, s: int):
     """The deepest point of the circle ``ring`` in the convex shape ``s``, certified.
 
@@ -330,7 +331,7 @@ def ring_deepest(ring: Ring, shapes: np.ndarray, s: int):
     return _crease_normal(ring, b, g, mx, my, mz, shapes, s)
 
 
-@njit(cache=True)
+@compiled
 def _crease_normal(
     ring: Ring, b: float, g: float, mx: float, my: float, mz: float, shapes: np.ndarray, s: int
 ):
@@ -387,7 +388,7 @@ def _crease_normal(
     )
 
 
-@njit(cache=True)
+@compiled
 def _search(ring: Ring, shapes: np.ndarray, s: int):
     """The certified deepest point: local secant search, then branch and bound if needed."""
     cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
@@ -476,7 +477,7 @@ def ring_frame(x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int) -> Ring:
     )
 
 
-@njit(cache=True)
+@compiled
 def ring_solid(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> ContactRecord:

@@ -52,6 +52,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ..compiled import allocating, compiled
 from ..layout import SH_HALF, SH_POINT, SH_ROT
 from .box import box_depth
 
@@ -130,7 +131,7 @@ def _inv_norm(mu: float, l1: float, l2: float, c1: float, c2: float):
     return w, -0.5 * w * ds / s
 
 
-@njit(cache=True)
+@compiled
 def _secular_root(l1, l2, c1, c2, lo, hi, increasing, mu):
     """The root of ``|z(mu)| = 1`` on ``[lo, hi]`` (``|z|`` monotone there), from ``mu``.
 
@@ -191,7 +192,7 @@ def _root_candidates(cand, n, mu, eig, hard) -> int:
     return n
 
 
-@njit(cache=True)
+@compiled
 def _edge_candidates(cand, n, a0, a1, a2, b0, b1, b2) -> int:
     """The minima of ``(a0 + a1 z1 + a2 z2)^2 + (b0 + b1 z1 + b2 z2)^2`` on ``|z| = 1``.
 
@@ -246,7 +247,7 @@ def _edge_candidates(cand, n, a0, a1, a2, b0, b1, b2) -> int:
     return n
 
 
-@njit(cache=True)
+@allocating
 def ring_box_exact(ring, shapes: np.ndarray, s: int):
     """The deepest point of the circle ``ring`` in box ``s``: exact (see the module docstring).
 

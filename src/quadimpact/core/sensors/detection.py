@@ -26,8 +26,8 @@ contact-free flight is measured.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     I_HORIZONTAL,
     MS_DETECTED,
@@ -48,7 +48,7 @@ from ..layout import (
 from ..records import Data, Model, Output
 
 
-@njit(cache=True)
+@compiled
 def detect(t: float, x: np.ndarray, C_hat: np.ndarray, m: Model, d: Data, o: Output) -> None:
     """Apply the detection rule to the sample just taken at time ``t`` (s).
 

@@ -19,12 +19,12 @@ deviations ``a0 f``, ``g0 f`` with ``f = sqrt(V) exp(-(t - T)/tau)``
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import SC_IMPACT_TAU, ST_IMPACT_T, ST_IMPACT_V
 
 
-@njit(cache=True)
+@compiled
 def impact_onset(t: float, scfg: np.ndarray, stats: np.ndarray) -> None:
     """A contact onset at ``t`` (s): fold it into the disturbance's variance sum."""
     tau = scfg[SC_IMPACT_TAU]
@@ -38,7 +38,7 @@ def impact_onset(t: float, scfg: np.ndarray, stats: np.ndarray) -> None:
     stats[ST_IMPACT_T] = t
 
 
-@njit(cache=True)
+@compiled
 def impact_factor(t: float, tau: float, stats: np.ndarray) -> float:
     """The disturbance's standard deviation at ``t`` (s) per unit amplitude (0: none yet)."""
     last = stats[ST_IMPACT_T]

@@ -35,8 +35,8 @@ constant bias. With both off the chain is the same arithmetic as without them.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     FILTER_FIRST_ORDER,
     FILTER_MOVING_AVERAGE,
@@ -77,7 +77,7 @@ from ..records import Data, Model, Output
 from .disturbance import impact_factor
 
 
-@njit(cache=True)
+@compiled
 def specific_force(
     x: np.ndarray, xdot: np.ndarray, C: np.ndarray, veh: np.ndarray, rx: float, ry: float, rz: float
 ) -> tuple[float, float, float]:
@@ -115,7 +115,7 @@ def specific_force(
     return ax - g * C[2, 0], ay - g * C[2, 1], az - g * C[2, 2]
 
 
-@njit(cache=True)
+@compiled
 def _measure_axis(value: float, bias: float, sigma: float, z: float, rng: float) -> float:
     """Bias, noise and saturation of one axis."""
     y = value + bias + sigma * z
@@ -127,7 +127,7 @@ def _measure_axis(value: float, bias: float, sigma: float, z: float, rng: float)
     return y
 
 
-@njit(cache=True)
+@compiled
 def imu_sample(
     t: float, x: np.ndarray, xdot: np.ndarray, C: np.ndarray, m: Model, d: Data, o: Output
 ) -> None:

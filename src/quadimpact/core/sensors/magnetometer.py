@@ -11,13 +11,13 @@ estimator's heading drifts with the gyro bias.
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import I_MAG, MS_MAG, MS_MAG_T, SC_MAG, SC_MAG_FIELD, SC_MAG_NOISE, SN_MAG, SS_N
 from ..records import Data, Model, Output
 
 
-@njit(cache=True)
+@compiled
 def magnetometer_sample(t: float, C: np.ndarray, m: Model, d: Data, o: Output) -> None:
     """The magnetometer's sample with IMU sample ``d.sst[SS_N] - 1`` at ``t`` (s).
 

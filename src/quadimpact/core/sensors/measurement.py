@@ -7,12 +7,12 @@ the IMU and the detector write their own fields (``MS_IMU_*``,
 """
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import MS_T, MS_X, NX
 
 
-@njit(cache=True)
+@compiled
 def measure(t: float, x_hat: np.ndarray, meas: np.ndarray) -> None:
     """Write the state estimate ``x_hat`` (layout ``X_*``) of the tick ``t`` (s) into ``meas``."""
     for i in range(NX):

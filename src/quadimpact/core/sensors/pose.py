@@ -17,8 +17,8 @@ A measurement is written into the measurement record (``MS_POSE``,
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..layout import (
     I_POSE,
     LS_T0,
@@ -43,7 +43,7 @@ from ..records import Data, Model, Output
 from .rotvec import rotate_by
 
 
-@njit(cache=True)
+@compiled
 def pose_sample(t: float, xs: np.ndarray, m: Model, d: Data, o: Output) -> None:
     """The pose sensor at IMU sample ``d.sst[SS_N] - 1`` (time ``t``, s; true state ``xs``)."""
     scfg = m.scfg

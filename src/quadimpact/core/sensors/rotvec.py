@@ -8,12 +8,12 @@ rotation vector ``phi`` (rad) in body axes rotates ``q`` into
 import math
 
 import numpy as np
-from numba import njit
 
+from ..compiled import compiled
 from ..quaternion import rotation_matrix
 
 
-@njit(cache=True)
+@compiled
 def dcm(q: np.ndarray, C: np.ndarray) -> None:
     """Fill ``C`` (3x3) with the body-to-inertial rotation of ``q`` (normalised here).
 
@@ -24,7 +24,7 @@ def dcm(q: np.ndarray, C: np.ndarray) -> None:
     rotation_matrix(q, C)
 
 
-@njit(cache=True)
+@compiled
 def rotate_by(q: np.ndarray, px: float, py: float, pz: float) -> None:
     """``q <- q (x) exp(phi)`` in place (``phi`` in body axes, rad), normalised."""
     a = math.sqrt(px * px + py * py + pz * pz)
@@ -48,7 +48,7 @@ def rotate_by(q: np.ndarray, px: float, py: float, pz: float) -> None:
     q[3] = r3 / n
 
 
-@njit(cache=True)
+@compiled
 def error_vector(q_hat: np.ndarray, q: np.ndarray) -> tuple[float, float, float]:
     """The rotation vector ``phi`` (rad, body axes of ``q_hat``) with ``q = q_hat (x) exp(phi)``.
 
@@ -67,7 +67,7 @@ def error_vector(q_hat: np.ndarray, q: np.ndarray) -> tuple[float, float, float]
     return angle * x / v, angle * y / v, angle * z / v
 
 
-@njit(cache=True)
+@compiled
 def error_angle(q_hat: np.ndarray, q: np.ndarray) -> float:
     """The angle (rad) of ``q_hat (x) q^-1``: how far the estimate is from the truth."""
     n1 = math.sqrt(q_hat[0] ** 2 + q_hat[1] ** 2 + q_hat[2] ** 2 + q_hat[3] ** 2)

@@ -13,6 +13,7 @@ writes the measurement record's user block.
 import numpy as np
 from numba import njit
 
+from ..compiled import compiled
 from ..dynamics import state_derivative
 from ..estimators import attitude_at_sample, estimate_sample
 from ..layout import LS_T0, SC_RATE, SS_N, SS_NEXT_T
@@ -36,7 +37,7 @@ def plugin_sensor(
     return
 
 
-@njit(cache=True)
+@compiled
 def take_sample(
     t: float, xs: np.ndarray, xd: np.ndarray, m: Model, d: Data, o: Output, w: Work
 ) -> None:
@@ -53,7 +54,7 @@ def take_sample(
     d.sst[SS_NEXT_T] = d.ls[LS_T0] + d.sst[SS_N] / m.scfg[SC_RATE]
 
 
-@njit(cache=True)
+@compiled
 def sample_at(t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
     """:func:`take_sample` at a state ``xs`` whose derivative is not known (interval inputs)."""
     state_derivative(xs, w.xd, m, d, w)
