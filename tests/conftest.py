@@ -8,6 +8,8 @@ e.g. ``pytest -m "not slow and not data"``.
 
 from __future__ import annotations
 
+import signal
+import warnings
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -44,6 +46,27 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     for item in items:
         if item.get_closest_marker("data") is not None:
             item.add_marker(skip)
+
+
+@pytest.fixture(autouse=True)
+def stop_signal_handlers_restored(request: pytest.FixtureRequest) -> Iterator[None]:
+    """Each test leaves SIGINT and SIGTERM handled as it found them.
+
+    A sweep handles these signals only where Python's defaults are in place
+    (``sweep/interrupt.py``); a handler left behind by one test (a library's,
+    or ``SIG_IGN``) would make a later stop-signal test's sweep ignore its
+    signal and run on. A test that leaves one behind is named in a warning.
+    """
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    yield
+    for signum, handler in before.items():
+        now = signal.getsignal(signum)
+        if now is not handler:
+            signal.signal(signum, handler)
+            warnings.warn(
+                f"{request.node.nodeid} left the {signal.Signals(signum).name} handler {now!r}",
+                stacklevel=1,
+            )
 
 
 @pytest.fixture
