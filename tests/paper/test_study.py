@@ -19,6 +19,7 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     # in full)
     monkeypatch.setattr(study, "RECOVERY_N", 40)
     monkeypatch.setattr(study, "RECOVERY_COMPARE_N", 20)
+    monkeypatch.setattr(study, "COMPARE_N", 20)  # the estimators' comparison, not 1,000
     # the pole at 2 x 3 points instead of 10 x 15
     monkeypatch.setattr(study, "POLE_GRID", {"pitch_step_deg": 45.0, "offset_step_m": 0.35})
     r = reproduce(tmp_path, ablation=False, experiments=False, workers=2, progress=True)
@@ -45,6 +46,7 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
         "reproduce: recovery: the Figure 4 grid with the recovery controller, paper-replica",
         "reproduce: recovery: the Figure 4 grid with the recovery controller, default",
         "reproduce: recovery: the crashes without their power-off, nominal and recovery",
+        "reproduce: recovery: 20 trials with each estimator, impact sensors",
         "reproduce: the pole: 6 grid points, without and with recovery",
         "reproduce: figures, tables and the report",
     ]
@@ -88,8 +90,10 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
     trials = pd.read_parquet(tmp_path / "recovery_trials.parquet")
     navi = trials[trials["study"] == "navi, default"]
     assert len(navi) == 40 and part.monte_carlo["default"]["success"].k == navi["recovered"].sum()
+    estimators = {"estimator ideal", "estimator complementary", "estimator ekf"}
     assert set(trials["study"]) == {"navi, default", "navi, recovery-replica", "navi, noisy IMU",
-                                    "spiri"}  # fmt: skip
+                                    "spiri"} | estimators  # fmt: skip
+    assert (trials[trials["study"].isin(estimators)].groupby("study").size() == 20).all()
     fig4 = pd.read_parquet(tmp_path / "recovery_fig4.parquet")
     assert len(fig4) == 2 * 246 and set(fig4["variant"]) == {"paper-replica", "default"}
     for variant, grid in part.grid.items():

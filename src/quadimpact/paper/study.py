@@ -441,7 +441,7 @@ def recovery_part(
     clock.start("recovery: the crashes without their power-off, nominal and recovery")
     crashes = crashes_without_power_off(VARIANTS)
     clock.start(f"recovery: {COMPARE_N:,} trials with each estimator, impact sensors")
-    estimators, estimator_trials, _ = compare_estimators(out, par)
+    estimators, estimator_trials, _ = compare_estimators(out, par, COMPARE_N)
     trials.update({k: t for k, t in estimator_trials.groupby("study")})
 
     pd.concat([t.assign(study=k) for k, t in trials.items()]).to_parquet(
