@@ -151,7 +151,8 @@ def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
     x = d.x
     K = w.K
     for st in range(1 if fsal else 0, 7):
-        # stage 0 at x (unless FSAL), 1-5 at w.xs, the last at the step's end w.x_new
+        # stage 0 at x (unless FSAL), 1-5 at w.xs, the last at the step's end w.x_new;
+        # one call site, so the inlined right-hand side is compiled once
         xs = x if st == 0 else (w.x_new if st == 6 else w.xs)
         if st > 0:
             stage_state(x, K, h, st, xs)
