@@ -13,15 +13,18 @@ So the functions of the loop are compiled without reference counting
 and views of them, and calls other functions; it must not allocate an array
 (the compiler rejects it: "NRT required but not enabled") nor return or store
 one (nothing would own it). The few core functions that allocate or return
-arrays (the records' factories, the entry points that allocate the loop's
-work space, some estimator and controller helpers) use :func:`allocating`.
+arrays (the entry points that allocate the tick's work space, some estimator
+and controller helpers, the ring-solid search's stacks) use
+:func:`allocating`; ``records.py``, ``batch.py`` and ``run.py``, which build
+and hand out records, keep Numba's default (reference counted).
 
 A function compiled with neither inherits the setting of the function it is
 first compiled from, which would make its behaviour depend on the order of
-compilation; so every compiled function of ``quadimpact.core`` uses one of the
-two (``tests/core/test_compiled.py``). A user's plug-in (controller, sensor,
-estimator, geometry) is compiled with reference counting of its own by
-``core.run.make_kernel``, so it may allocate.
+compilation; so every other compiled function of ``quadimpact.core`` uses one
+of the two (helpers inlined into their callers excepted), and none marked
+``compiled`` returns an array (``tests/core/test_core_shape.py``). A user's
+plug-in (controller, sensor, estimator, geometry) is compiled with reference
+counting of its own by ``core.run.make_kernel``, so it may allocate.
 """
 
 from __future__ import annotations
