@@ -64,6 +64,34 @@ def test_every_loop_function_says_whether_it_counts_references():
     assert not loose, loose
 
 
+def _returns_arrays(fn: ast.FunctionDef) -> bool:
+    arrays = ("np.ndarray", "Model", "Data", "Output", "Work", "Env")
+    return fn.returns is not None and any(a in ast.unparse(fn.returns) for a in arrays)
+
+
+def test_no_function_compiled_without_reference_counting_takes_an_array_returned_to_it():
+    """A returned array is a new reference: a ``compiled`` caller would never release it.
+
+    (A leak: the array, or the one it views, would never be freed.)
+    """
+    returning = {
+        fn.name
+        for _, fn in _compiled_functions()
+        if _returns_arrays(fn) and not _inlined(_decorator(fn))  # inlined: no reference made
+    }
+    assert {"new_work", "data_row"} <= returning  # the check sees the records' factories
+    calling = [
+        f"{path.relative_to(CORE)}:{fn.name} calls {call.func.id}"
+        for path, fn in _compiled_functions()
+        if _name(_decorator(fn)) == "compiled"
+        for call in ast.walk(fn)
+        if isinstance(call, ast.Call)
+        and isinstance(call.func, ast.Name)
+        and call.func.id in returning
+    ]
+    assert not calling, calling
+
+
 def test_no_function_compiled_without_reference_counting_returns_an_array():
     """Nothing would own a returned array: such functions must be ``allocating``."""
     arrays = ("np.ndarray", "Model", "Data", "Output", "Work")
