@@ -46,8 +46,8 @@ import math
 from typing import NamedTuple
 
 import numpy as np
-from numba import njit
 
+from .compiled import allocating, compiled
 from .controllers.recovery import (
     R_FIRST_TICK_LEVEL,
     R_Q_TOL,
@@ -63,6 +63,7 @@ from .controllers.recovery import (
     staged_references,
 )
 from .estimators import write_estimate
+from .integrator import all_finite, copy_into
 from .layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -213,7 +214,7 @@ def n_observations(mode: int) -> int:
 
 
 # ---------------------------------------------------------------- action maps
-@njit(cache=True)
+@compiled
 def affine_map(a: float, lo: float, hi: float) -> float:
     """``lo + (a + 1) (hi - lo)/2`` for ``a`` in [-1, 1], rounded as finely as floats allow.
 
@@ -233,7 +234,7 @@ def affine_map(a: float, lo: float, hi: float) -> float:
     return (lo + h) + a * h
 
 
-@njit(cache=True)
+@compiled
 def affine_inverse(w: float, lo: float, hi: float) -> tuple[float, bool]:
     """The ``a`` in [-1, 1] whose :func:`affine_map` is ``w``; False if none (the nearest then).
 
@@ -263,21 +264,21 @@ def affine_inverse(w: float, lo: float, hi: float) -> tuple[float, bool]:
     return best, False
 
 
-@njit(cache=True)
+@compiled
 def rotor_range(ctrl: np.ndarray, par: np.ndarray) -> tuple[float, float]:
     """The rotor-speed range (rad/s) that rotor actions map onto."""
     lo = 0.0 if par[EP_ZERO_LOW] > 0.5 else ctrl[C_OMEGA_MIN]
     return lo, ctrl[C_OMEGA_MAX]
 
 
-@njit(cache=True)
+@compiled
 def max_thrust(veh: np.ndarray, ctrl: np.ndarray) -> float:
     """``4 kt hi^2`` (N): all rotors at the top of the range."""
     hi = ctrl[C_OMEGA_MAX]
     return 4.0 * veh[V_KT] * hi * hi
 
 
-@njit(cache=True)
+@allocating
 def action_command(
     action: np.ndarray,
     meas: np.ndarray,
@@ -307,7 +308,7 @@ def action_command(
 
 
 # ---------------------------------------------------------------- observer
-@njit(cache=True)
+@compiled
 def level_test(
     tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray
 ) -> tuple[float, float, float, float, float]:
@@ -319,7 +320,7 @@ def level_test(
     return qex, qey, tmeas[MS_W_HAT], tmeas[MS_W_HAT + 1], x[X_VEL + 2]
 
 
-@njit(cache=True)
+@compiled
 def takeover_stage(stage: int, tmeas: np.ndarray) -> int:
     """The observer's stage at a tick before its stage 2: 1 once the detector has fired."""
     if stage == STAGE_PRE_IMPACT and tmeas[MS_DETECTED] > 0.5:
@@ -327,7 +328,7 @@ def takeover_stage(stage: int, tmeas: np.ndarray) -> int:
     return stage
 
 
-@njit(cache=True)
+@compiled
 def level_and_recovered(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> tuple[bool, bool]:
     """The level test of the tick, and the recovered condition (level and ``w < w_tol``)."""
     qex, qey, p, q, w = level_test(tmeas, ctrl, veh)
@@ -338,13 +339,13 @@ def level_and_recovered(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) ->
     return level, level and w < ctrl[p0 + R_W_TOL]
 
 
-@njit(cache=True)
+@compiled
 def recovered_condition(tmeas: np.ndarray, ctrl: np.ndarray, veh: np.ndarray) -> bool:
     """Level, slow (|p|, |q|) and body z velocity below ``w_tol``, all at this tick."""
     return level_and_recovered(tmeas, ctrl, veh)[1]
 
 
-@njit(cache=True)
+@compiled
 def _enter(stats: np.ndarray, stage: int, t: float, p: np.ndarray) -> None:
     """Write a stage entry (tick, CM position) into a run's stage record."""
     stats[ST_STAGE_T + stage] = t
@@ -352,7 +353,7 @@ def _enter(stats: np.ndarray, stage: int, t: float, p: np.ndarray) -> None:
         stats[ST_STAGE_X + 3 * stage + i] = p[i]
 
 
-@njit(cache=True)
+@compiled
 def _track_windows(
     env: np.ndarray, tmeas: np.ndarray, x: np.ndarray, ctrl: np.ndarray, veh: np.ndarray
 ) -> None:
@@ -366,7 +367,7 @@ def _track_windows(
     _count(env, rec, B_HOLD, B_HOLD_T, B_HOLD_P, tmeas[MS_T], x)
 
 
-@njit(cache=True)
+@compiled
 def _count(
     env: np.ndarray, ok: bool, n_slot: int, t_slot: int, p_slot: int, t: float, x: np.ndarray
 ) -> None:
@@ -381,7 +382,7 @@ def _count(
     env[n_slot] += 1.0
 
 
-@njit(cache=True)
+@compiled
 def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np.ndarray) -> None:
     """The observer's stages 2-4, entered at the start of their completed windows."""
     window = par[EP_HOLD_TICKS]
@@ -397,7 +398,7 @@ def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np
     mem[MEM_STAGE] = stage
 
 
-@njit(cache=True)
+@allocating
 def tick_measurement(m: Model, d: Data, tmeas: np.ndarray) -> None:
     """What a controller sees at the next tick: ``d.meas`` with the estimate of that tick.
 
@@ -413,14 +414,14 @@ def tick_measurement(m: Model, d: Data, tmeas: np.ndarray) -> None:
 
 
 # ---------------------------------------------------------------- observation, reward
-@njit(cache=True)
+@compiled
 def _clip(v: float, c: float) -> float:
     if not v == v:  # NaN (a failed run)
         return 0.0
     return min(max(v, -c), c)
 
 
-@njit(cache=True)
+@allocating
 def observe(
     tmeas: np.ndarray,
     rin: np.ndarray,
@@ -473,7 +474,7 @@ def observe(
         obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
 
 
-@njit(cache=True)
+@compiled
 def observe_estimate(tmeas: np.ndarray, par: np.ndarray, obs: np.ndarray) -> None:
     """The estimate mode's observation: what an on-board controller sees (docs/LEARNING.md).
 
@@ -502,7 +503,7 @@ def observe_estimate(tmeas: np.ndarray, par: np.ndarray, obs: np.ndarray) -> Non
         obs[26 + j] = _clip(x[X_ROTOR + j] / OBS_EST_ROTOR, clip)
 
 
-@njit(cache=True)
+@compiled
 def measurement_from_estimate(obs: np.ndarray, meas: np.ndarray) -> None:
     """The measurement record an estimate-mode observation stands for (its inverse).
 
@@ -529,7 +530,7 @@ def measurement_from_estimate(obs: np.ndarray, meas: np.ndarray) -> None:
         meas[MS_X + X_ROTOR + j] = obs[26 + j] * OBS_EST_ROTOR
 
 
-@njit(cache=True)
+@allocating
 def cost_rate(
     x: np.ndarray,
     rin: np.ndarray,
@@ -568,13 +569,13 @@ def cost_rate(
     return total if total == total else max_cost_rate(par)
 
 
-@njit(cache=True)
+@compiled
 def max_cost_rate(par: np.ndarray) -> float:
     """The largest cost per second (every term at 1)."""
     return par[EP_W_TILT] + par[EP_W_RATE] + par[EP_W_VZ] + par[EP_W_HEIGHT] + par[EP_W_EFFORT]
 
 
-@njit(cache=True)
+@compiled
 def envelope_outcome(x: np.ndarray, env: np.ndarray, par: np.ndarray) -> int:
     """``OC_*`` of the first envelope limit the state breaks (``OC_RUNNING``: none)."""
     q1 = x[X_QUAT + 1]
@@ -593,7 +594,7 @@ def envelope_outcome(x: np.ndarray, env: np.ndarray, par: np.ndarray) -> int:
 
 
 # ---------------------------------------------------------------- reset and step
-@njit(cache=True)
+@compiled
 def _begin_episode(k: int, m: Model, d: Data, E: Env) -> None:
     env = E.state[k]
     env[:] = 0.0
@@ -605,7 +606,7 @@ def _begin_episode(k: int, m: Model, d: Data, E: Env) -> None:
     observe(E.tmeas[k], d.rin, m.ctrl, E.par, env, E.obs[k])
 
 
-@njit(cache=True)
+@compiled
 def _tick(m: Model, d: Data, o: Output, w: Work) -> None:
     """``step.advance(1, ...)`` of one run with preallocated work space."""
     tick(m, d, o, w)
@@ -613,7 +614,7 @@ def _tick(m: Model, d: Data, o: Output, w: Work) -> None:
         finish(d, o)
 
 
-@njit(cache=True)
+@allocating
 def reset_slot(k: int, until_detection: bool, M: Model, D: Data, O: Output, E: Env) -> bool:
     """Start run ``k`` of the stacked records from its model and begin its episode.
 
@@ -641,7 +642,7 @@ def reset_slot(k: int, until_detection: bool, M: Model, D: Data, O: Output, E: E
     return True
 
 
-@njit(cache=True)
+@compiled
 def _outcome(m: Model, d: Data, o: Output, env: np.ndarray, par: np.ndarray, finite: bool) -> int:
     """``OC_*`` of a run after its tick: recovered and held, the ground, the envelope, its end."""
     stage = int(env[B_STAGE])
@@ -663,7 +664,7 @@ def _outcome(m: Model, d: Data, o: Output, env: np.ndarray, par: np.ndarray, fin
     return outcome
 
 
-@njit(cache=True)
+@compiled
 def _step_one(k: int, actions: np.ndarray, m: Model, d: Data, o: Output, E: Env, w: Work) -> None:
     """One control tick of run ``k`` under its action; its reward, termination, observation."""
     veh = m.veh
@@ -680,7 +681,7 @@ def _step_one(k: int, actions: np.ndarray, m: Model, d: Data, o: Output, E: Env,
         env[B_STAGE] = takeover_stage(int(env[B_STAGE]), tmeas)
     d.mem[MEM_STAGE] = env[B_STAGE]
     d.ls[LS_EXT] = 1.0
-    d.ls[LS_EXT_CMD : LS_EXT_CMD + N_ROTORS] = w.cmd
+    copy_into(d.ls[LS_EXT_CMD : LS_EXT_CMD + N_ROTORS], w.cmd)
     t_before = d.ls[LS_T]
     _tick(m, d, o, w)
     d.ls[LS_EXT] = 0.0
@@ -688,7 +689,7 @@ def _step_one(k: int, actions: np.ndarray, m: Model, d: Data, o: Output, E: Env,
     env[B_STEPS] += 1.0
     r = -(d.ls[LS_T] - t_before) * cost_rate(d.x, d.rin, veh, ctrl, par, env[B_H_REF])
     # termination: recovered and held, the ground, the envelope; truncation: the run's end
-    finite = np.isfinite(d.x).all()
+    finite = all_finite(d.x)
     if finite:
         _track_windows(env, tmeas, d.x, ctrl, veh)
         if env[B_POLICY] < 0.5:
@@ -712,7 +713,7 @@ def _step_one(k: int, actions: np.ndarray, m: Model, d: Data, o: Output, E: Env,
         finish(d, o)
 
 
-@njit(cache=True)
+@allocating
 def step_batch(actions: np.ndarray, M: Model, D: Data, O: Output, E: Env) -> None:
     """One control tick of every active run under the actions ``actions`` (N, 4).
 
@@ -729,7 +730,7 @@ def step_batch(actions: np.ndarray, M: Model, D: Data, O: Output, E: Env) -> Non
 
 
 # ---------------------------------------------------------------- the built-in law as a policy
-@njit(cache=True)
+@compiled
 def staged_policy(
     active: np.ndarray,
     M: Model,
@@ -750,7 +751,7 @@ def staged_policy(
     staged_actions(active, E.tmeas, M, E.par, pmem, actions, stages, E.state[:, B_INEXACT])
 
 
-@njit(cache=True)
+@allocating
 def staged_actions(
     active: np.ndarray,
     TMEAS: np.ndarray,
