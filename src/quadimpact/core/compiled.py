@@ -15,8 +15,8 @@ and views of them, and calls other functions; it must not allocate an array
 one (nothing would own it). The few core functions that allocate or return
 arrays (the entry points that allocate the tick's work space, some estimator
 and controller helpers, the ring-solid search's stacks) use
-:func:`allocating`; ``records.py``, ``batch.py`` and ``run.py``, which build
-and hand out records, keep Numba's default (reference counted).
+:func:`allocating`; ``records.py`` and ``run.py``, which build and hand out
+records, keep Numba's default (reference counted).
 
 A function compiled with neither inherits the setting of the function it is
 first compiled from, which would make its behaviour depend on the order of
