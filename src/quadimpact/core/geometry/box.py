@@ -31,8 +31,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ..layout import F_CENTRE, F_RADIUS, SH_HALF, SH_POINT, SH_ROT, X_POS
-from .record import ContactRecord, material_record
+from ..layout import F_RADIUS, SH_HALF, SH_POINT, SH_ROT, X_POS
+from .record import ContactRecord, feature_offset, material_record
 
 OUTSIDE = -1  # the piece id of a point outside (the depth is smooth there)
 
@@ -115,12 +115,7 @@ def point_box(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> ContactRecord:
     """Point feature ``f`` (position ``F_CENTRE``, body) against box ``s``: exact."""
-    cb0 = feat[f, F_CENTRE]
-    cb1 = feat[f, F_CENTRE + 1]
-    cb2 = feat[f, F_CENTRE + 2]
-    dx = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    dy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    dz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    dx, dy, dz = feature_offset(C, feat, f)
     g, mx, my, mz, _ = box_depth(x[X_POS] + dx, x[X_POS + 1] + dy, x[X_POS + 2] + dz, shapes, s)
     return material_record(x, C, g, dx, dy, dz, mx, my, mz)
 
@@ -134,12 +129,7 @@ def sphere_box(
     The sphere's deepest point is ``centre - R m`` with ``m`` the box's normal
     at the centre, and its depth ``R + depth(centre)``.
     """
-    cb0 = feat[f, F_CENTRE]
-    cb1 = feat[f, F_CENTRE + 1]
-    cb2 = feat[f, F_CENTRE + 2]
-    ox = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    oy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    oz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    ox, oy, oz = feature_offset(C, feat, f)
     g, mx, my, mz, _ = box_depth(x[X_POS] + ox, x[X_POS + 1] + oy, x[X_POS + 2] + oz, shapes, s)
     r = feat[f, F_RADIUS]
     return material_record(x, C, g + r, ox - r * mx, oy - r * my, oz - r * mz, mx, my, mz)

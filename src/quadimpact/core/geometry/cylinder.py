@@ -34,8 +34,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ..layout import F_CENTRE, F_RADIUS, SH_LENGTH, SH_NORMAL, SH_POINT, SH_RADIUS, X_POS
-from .record import ContactRecord, material_record
+from ..layout import F_RADIUS, SH_LENGTH, SH_NORMAL, SH_POINT, SH_RADIUS, X_POS
+from .record import ContactRecord, feature_offset, material_record
 
 OUTSIDE = -1  # the piece id of a point outside (the depth is smooth there)
 AXIS_EPS = 1e-300  # rho below this: the point is on the axis
@@ -139,12 +139,7 @@ def point_cylinder(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> ContactRecord:
     """Point feature ``f`` (position ``F_CENTRE``, body) against cylinder ``s``: exact."""
-    cb0 = feat[f, F_CENTRE]
-    cb1 = feat[f, F_CENTRE + 1]
-    cb2 = feat[f, F_CENTRE + 2]
-    dx = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    dy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    dz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    dx, dy, dz = feature_offset(C, feat, f)
     g, mx, my, mz, _ = cylinder_depth(
         x[X_POS] + dx, x[X_POS + 1] + dy, x[X_POS + 2] + dz, shapes, s
     )
@@ -156,12 +151,7 @@ def sphere_cylinder(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> ContactRecord:
     """Sphere feature ``f`` (centre ``F_CENTRE``, radius ``F_RADIUS``) against cylinder ``s``."""
-    cb0 = feat[f, F_CENTRE]
-    cb1 = feat[f, F_CENTRE + 1]
-    cb2 = feat[f, F_CENTRE + 2]
-    ox = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    oy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    oz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    ox, oy, oz = feature_offset(C, feat, f)
     g, mx, my, mz, _ = cylinder_depth(
         x[X_POS] + ox, x[X_POS + 1] + oy, x[X_POS + 2] + oz, shapes, s
     )

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from ..layout import F_CENTRE, F_NORMAL, F_RADIUS, SH_NORMAL, SH_POINT, X_POS
-from .record import ContactRecord, material_record
+from .record import ContactRecord, feature_offset, material_record
 
 PARALLEL_EPS = 1e-12  # |w| below this: the circle is parallel to the plane
 
@@ -121,12 +121,7 @@ def point_plane(
     x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> ContactRecord:
     """Point feature ``f`` (position ``F_CENTRE``, body) against plane ``s``: exact."""
-    cb0 = feat[f, F_CENTRE]
-    cb1 = feat[f, F_CENTRE + 1]
-    cb2 = feat[f, F_CENTRE + 2]
-    dx = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    dy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    dz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    dx, dy, dz = feature_offset(C, feat, f)
     g = -plane_distance(x[X_POS] + dx, x[X_POS + 1] + dy, x[X_POS + 2] + dz, shapes, s)
     mx = shapes[s, SH_NORMAL]
     my = shapes[s, SH_NORMAL + 1]
@@ -142,12 +137,7 @@ def sphere_plane(
 
     The deepest point is ``centre - R m``; its depth ``R - distance(centre)``.
     """
-    cb0 = feat[f, F_CENTRE]
-    cb1 = feat[f, F_CENTRE + 1]
-    cb2 = feat[f, F_CENTRE + 2]
-    ox = C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
-    oy = C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
-    oz = C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    ox, oy, oz = feature_offset(C, feat, f)
     r = feat[f, F_RADIUS]
     g = r - plane_distance(x[X_POS] + ox, x[X_POS + 1] + oy, x[X_POS + 2] + oz, shapes, s)
     mx = shapes[s, SH_NORMAL]

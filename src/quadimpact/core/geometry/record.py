@@ -24,12 +24,25 @@ shape or a feature's geometry itself.
 import numpy as np
 from numba import njit
 
-from ..layout import X_OMEGA, X_VEL
+from ..layout import F_CENTRE, X_OMEGA, X_VEL
 
 ContactRecord = tuple[float, float, float, float, float, float, float, float, float, float, float]
 """(delta, delta_dot, rcx, rcy, rcz, vcx, vcy, vcz, nx, ny, nz)."""
 
 NO_CONTACT_DEPTH = -1e300  # m: the depth of a pair whose geometry is unknown (never touches)
+
+
+@njit(cache=True, inline="always")
+def feature_offset(C: np.ndarray, feat: np.ndarray, f: int) -> tuple[float, float, float]:
+    """Feature ``f``'s centre ``F_CENTRE`` (body) from the CM in inertial axes, ``C c_b``, m."""
+    cb0 = feat[f, F_CENTRE]
+    cb1 = feat[f, F_CENTRE + 1]
+    cb2 = feat[f, F_CENTRE + 2]
+    return (
+        C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2,
+        C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2,
+        C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2,
+    )
 
 
 @njit(cache=True, inline="always")
