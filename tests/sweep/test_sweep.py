@@ -289,10 +289,36 @@ def _children() -> set[int]:
 def test_default_small_sweep_runs_in_process(serial_table, tmp_path):
     """By default, runs that would take under a second here start no process at all."""
     before = _children()
-    table = run_sweep(SweepSpec(base=BASE, grid=SMALL_GRID), tmp_path / "s")
+    placed: list[int] = []
+    out = tmp_path / "s"
+    table = run_sweep(
+        SweepSpec(base=BASE, grid=SMALL_GRID), out, on_placed=lambda: placed.append(_rows(out))
+    )
     assert table.attrs["sweep"]["backend"] == "serial"
     assert not _children() - before
     assert_same_table(table, serial_table)
+    # told once that the runs stay here, before the last of them was written
+    assert len(placed) == 1 and placed[0] < len(table)
+
+
+def _rows(out: Path) -> int:
+    """Rows written to a sweep folder's parts so far."""
+    import pyarrow.parquet as pq
+
+    return sum(pq.read_metadata(p).num_rows for p in (out / "parts").glob("part-*.parquet"))
+
+
+def test_on_placed_is_called_once_whatever_the_backend(serial_table, tmp_path):
+    """Given workers, in this process or a pool: one call, before any run was written; in a
+    folder with nothing left to run: one call too."""
+    spec = SweepSpec(base=BASE, grid=SMALL_GRID)
+    for workers, out in ((1, tmp_path / "one"), (2, tmp_path / "two")):
+        placed: list[int] = []
+        run_sweep(spec, out, workers=workers, on_placed=lambda o=out, p=placed: p.append(_rows(o)))
+        assert placed == [0]
+    placed = []
+    info = run_sweep(spec, tmp_path / "two", load=False, on_placed=lambda: placed.append(0))
+    assert info["n_ran"] == 0 and placed == [0]
 
 
 def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
@@ -309,7 +335,9 @@ def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
         time.sleep(0.05)
     monkeypatch.setattr(run_module, "FINISH_HERE_S", 0.0)  # never "too little left"
     monkeypatch.setattr(run_module, "MEASURE_S", 0.0)  # decide after the first run
-    table = run_sweep(spec, tmp_path / "d")
+    placed: list[str] = []
+    table = run_sweep(spec, tmp_path / "d", on_placed=lambda: placed.append("placed"))
+    assert placed == ["placed"]
     backend = table.attrs["sweep"]["backend"]
     # the pool, unless the other cores were measured busy
     handed_over = re.fullmatch(r"\d processes, the first [12] runs in this one", backend)

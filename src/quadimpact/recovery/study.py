@@ -33,6 +33,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -378,10 +379,12 @@ def run_trials(
     workers: int | None = None,
     scheduler: Any = None,
     progress: bool = False,
+    on_placed: Callable[[], None] | None = None,
 ) -> tuple[SweepSpec, pd.DataFrame, dict[str, Any]]:
     """Run the trials into ``out_dir/sweep`` and write ``out_dir/trials.parquet``.
 
     The part of :func:`run_study` without figures, report and example.
+    ``on_placed``: as :func:`quadimpact.sweep.run_sweep`'s.
 
     Returns
     -------
@@ -397,7 +400,7 @@ def run_trials(
         spec = study.sweep_spec()
     info = run_sweep(
         spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
-        load=False,
+        load=False, on_placed=on_placed,
     )  # fmt: skip
     table = trial_table(read_runs(out / SWEEP_DIR), spec)
     atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
@@ -442,16 +445,23 @@ def run_study(
     out = Path(out_dir)
     spec = study if isinstance(study, SweepSpec) else study.sweep_spec()
     # the example trial depends on the trials' inputs only: it runs beside the trials
-    # when they run on other processes (a pool or Dask), else after them, here
-    early = (
-        _EarlyExample.start(spec, out, animation)
-        if example and _beside(workers, scheduler)
-        else None
-    )
+    # when they run on other processes (a pool or Dask), else after them, here. It
+    # starts once the sweep has placed its runs (the default sweep measures the idle
+    # cores first, which the example would take)
+    early: _EarlyExample | None = None
+
+    def start_example() -> None:
+        nonlocal early
+        early = _EarlyExample.start(spec, out, animation)
+
+    beside = example and _beside(workers, scheduler)
+    if beside:
+        _EarlyExample.check(spec, out)  # a folder or base it cannot use: refused before any run
     try:
         spec, table, info = run_trials(
-            spec, out, workers=workers, scheduler=scheduler, progress=progress
-        )
+            spec, out, workers=workers, scheduler=scheduler, progress=progress,
+            on_placed=start_example if beside else None,
+        )  # fmt: skip
         options = study if isinstance(study, RecoveryStudy) else None
         description = describe(spec, options, table)
         run = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
@@ -527,10 +537,18 @@ def _row_inputs(table: pd.DataFrame, run_id: int) -> dict[str, Any]:
 
 
 def _beside(workers: int | None, scheduler: Any) -> bool:
-    """Whether the example trial runs beside the trials: they run on other processes."""
+    """Whether the example trial runs beside the trials: they run on other processes.
+
+    ``workers=None`` is the sweep's default (:func:`quadimpact.sweep.run.default_workers`):
+    a pool when this process may use more than one core.
+    """
     if scheduler is not None:
         return True
-    return workers is not None and int(workers) > 1
+    if workers is None:
+        from quadimpact.sweep.run import default_workers
+
+        workers = default_workers()
+    return int(workers) > 1
 
 
 def _check_example(run_id: int, recovered: bool, table: pd.DataFrame) -> None:
@@ -562,9 +580,7 @@ class _EarlyExample:
         from quadimpact.sweep.pool import pool_context, start_server
         from quadimpact.sweep.tasks import _start_task_worker
 
-        check_out_dir(out, "recovery", where="")
-        _check_trial_base(spec, spec.where)
-        (out / SWEEP_DIR).mkdir(parents=True, exist_ok=True)  # a study's folder from now on
+        cls.check(spec, out)
         ctx = pool_context()
         if ctx.get_start_method() != "forkserver":
             return None  # a spawned process would import everything again: after the trials
@@ -573,6 +589,13 @@ class _EarlyExample:
         executor = ProcessPoolExecutor(1, mp_context=ctx, initializer=_start_task_worker)
         future = executor.submit(_example_task, spec.scenario_dict(run_id), run_id, out, animation)
         return cls(run_id, executor, future, out)
+
+    @staticmethod
+    def check(spec: SweepSpec, out: Path) -> None:
+        """Refuse a folder or sweep base the study cannot use; mark the folder as a study's."""
+        check_out_dir(out, "recovery", where="")
+        _check_trial_base(spec, spec.where)
+        (out / SWEEP_DIR).mkdir(parents=True, exist_ok=True)  # a study's folder from now on
 
     def result(self) -> tuple[Path, tuple[list[Path], list[str]], bool]:
         """Wait for the example (Ctrl-C and SIGTERM stop it); its folder, files, warnings."""

@@ -6,7 +6,7 @@ import contextlib
 import os
 import sys
 import time
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -137,6 +137,7 @@ def run_sweep(
     timeout: float | None = None,
     allow_large: bool = False,
     max_record_mb: float | None = None,
+    on_placed: Callable[[], None] | None = None,
 ) -> Any:
     """Run a sweep into ``out_dir`` (resuming whatever is already there) and return its table.
 
@@ -177,6 +178,12 @@ def run_sweep(
         Largest raw record one run may allocate, MB (default
         ``simulation.checks.MAX_RECORD_MB``): a run above it is refused before
         any starts.
+    on_placed : callable, keyword, optional
+        Called once, with no argument, when the sweep has decided where its
+        runs go (after the default's measured start; at once for given
+        workers, Dask, a serial sweep or nothing left to run): a task meant
+        to run beside the sweep (a study's example trial) starts then, so
+        that the default's measurement of the idle cores does not count it.
 
     Returns
     -------
@@ -212,6 +219,12 @@ def run_sweep(
     out = check_out_dir(Path(out_dir), "sweep", where="")
 
     saved = 0  # finished runs in the folder, as far as known
+    pending = [on_placed] if on_placed is not None else []
+
+    def placed() -> None:
+        while pending:
+            pending.pop()()
+
     try:
         with stop_signals() as stop, contextlib.ExitStack() as stack:
             if workers is not None and n_workers > 1 and spec.n_runs > 1:
@@ -245,16 +258,21 @@ def run_sweep(
 
                 try:
                     if client is not None:
+                        placed()
                         backend = f"dask, {threads} threads"
                         chunks = make_chunks(spec, todo, chunk_size(n_todo, threads))
                         run_dask(client, chunks, sink, limits=limits, stop=stop, note=note)
                     elif n_workers == 1 or n_todo == 1:
                         backend = "serial"
+                        placed()
                         run_serial(make_chunks(spec, todo, 16), sink)
                     else:
                         n_here = 0
                         if workers is None:  # the default: a measured start here
-                            n_here, n_workers = _start_here(spec, todo, n_todo, sink, n_workers)
+                            n_here, n_workers = _start_here(
+                                spec, todo, n_todo, sink, n_workers, placed
+                            )
+                        placed()
                         n_left = n_todo - n_here
                         if n_left:
                             n_workers = min(n_workers, n_left)
@@ -271,6 +289,7 @@ def run_sweep(
                     writer.flush()  # also on Ctrl-C or an error: keep every finished run
                     bar.close()
                     saved = n_before + writer.rows_written
+            placed()  # nothing was left to run
             consolidate(out, schema, spec.n_runs)
     except (SweepInterrupted, WorkerError) as exc:
         raise _stopped(exc, saved, spec.n_runs, out) from None
@@ -291,7 +310,12 @@ def run_sweep(
 
 
 def _start_here(
-    spec: SweepSpec, todo: Iterator[int], n_todo: int, sink: Sink, cores: int
+    spec: SweepSpec,
+    todo: Iterator[int],
+    n_todo: int,
+    sink: Sink,
+    cores: int,
+    placed: Callable[[], None] = lambda: None,
 ) -> tuple[int, int]:
     """The default start of a sweep on several cores: measured runs in this process.
 
@@ -306,6 +330,9 @@ def _start_here(
     loaded its own kernel (``pool.server_ready``; at most
     :data:`START_HERE_MAX_S`), so that no time is lost waiting for it.
     ``docs/SWEEPS.md`` has the measurements.
+
+    ``placed`` is called once the choice is made (pool or here), before the
+    runs that follow it.
 
     Returns
     -------
@@ -337,8 +364,10 @@ def _start_here(
                 break  # the other cores are busy: finish here
             start_server(ctx)  # it loads the kernel while the runs go on here
             started = now
+            placed()
         elif server_ready(ctx) or now - started > START_HERE_MAX_S:
             return n_here, workers
+    placed()
     run_serial(make_chunks(spec, todo, 16), sink)
     return n_todo, 1
 
