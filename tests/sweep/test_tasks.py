@@ -68,13 +68,26 @@ def test_an_error_in_a_task_is_raised_here_and_stops_the_others():
         run_tasks(_fail_on, [(k, 3) for k in range(40)], 2)
 
 
+def _interrupt_when_running(folder: Path, n: int, sent: list[float]) -> None:
+    """Send this process SIGINT once ``n`` tasks have noted their pid (not at a fixed time:
+    on a loaded machine the workers may take seconds to start); note when."""
+    end = time.monotonic() + 120.0
+    while len(list(folder.glob("*.pid"))) < n and time.monotonic() < end:
+        time.sleep(0.02)
+    sent.append(time.monotonic())
+    os.kill(os.getpid(), signal.SIGINT)
+
+
 def test_a_stop_signal_kills_the_workers_at_once(tmp_path):
-    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
-    timer.start()
-    t = time.monotonic()
+    sent: list[float] = []
+    watcher = threading.Thread(
+        target=_interrupt_when_running, args=(tmp_path, 2, sent), daemon=True
+    )
+    watcher.start()
     with pytest.raises(SweepInterrupted):
         run_tasks(_note_and_sleep, [(str(tmp_path), k) for k in range(4)], 2)
-    assert time.monotonic() - t < 10.0  # not the tasks' 60 s
+    assert time.monotonic() - sent[0] < 10.0  # at once, not after the tasks' 60 s
+    watcher.join()
     pids = [int(p.read_text()) for p in tmp_path.glob("*.pid")]
     assert len(pids) == 2  # two were running, the other two never started
     assert _gone(pids)
