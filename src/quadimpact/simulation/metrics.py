@@ -32,6 +32,9 @@ __all__ = [
     "attitude_excursion_deg",
     "classify_response",
     "closest_chaining",
+    "episode_lists",
+    "impact_rows",
+    "impacts_of",
     "RESPONSE_TYPE_MEANINGS",
     "graze_mask",
     "group_impacts",
@@ -80,6 +83,47 @@ def select(table: Table, rows: np.ndarray, names: Sequence[str]) -> dict[str, np
 _EPISODE_NEEDED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_delta_m", "peak_force_n")
 
 
+def episode_lists(table: Table, names: Sequence[str]) -> dict[str, list[Any]]:
+    """Columns of a table as Python lists (``surface`` as str): a run has a handful of
+    episodes, and plain Python on a few values is faster than NumPy's calls on them
+    (the same IEEE operations, so the same results)."""
+    out: dict[str, list[Any]] = {}
+    for name in names:
+        if name == "surface":
+            out[name] = [str(v) for v in column(table, name, dtype=object).tolist()]
+        elif name == "bumper":
+            out[name] = [int(v) for v in column(table, name, dtype=np.int64).tolist()]
+        else:
+            out[name] = column(table, name).tolist()
+    return out
+
+
+def _group(start: list[float], end: list[float], bumper: list[int] | None) -> list[list[int]]:
+    """:func:`group_impacts` on plain lists (positions into them)."""
+    if not start:
+        return []
+    if not all(math.isfinite(t) for t in start) or any(math.isnan(t) for t in end):
+        raise ValueError("episodes: t_start_s must be finite and t_end_s not NaN")
+    if bumper is not None:  # by start, ties by bumper, then as given (stable)
+        order = sorted(range(len(start)), key=lambda i: (start[i], bumper[i]))
+    else:
+        order = sorted(range(len(start)), key=start.__getitem__)
+    groups: list[list[int]] = []
+    current: list[int] = []
+    group_end = -math.inf
+    for i in order:
+        if current and start[i] <= group_end:
+            current.append(i)
+            group_end = max(group_end, end[i])
+        else:
+            if current:
+                groups.append(current)
+            current = [i]
+            group_end = max(end[i], start[i])
+    groups.append(current)
+    return groups
+
+
 def group_impacts(episodes: Table) -> list[list[int]]:
     """Group contact episodes into impacts (docs/STUDIES.md section 2).
 
@@ -108,30 +152,9 @@ def group_impacts(episodes: Table) -> list[list[int]]:
     """
     if n_rows(episodes) == 0:
         return []
-    start = column(episodes, "t_start_s")
-    end = column(episodes, "t_end_s")
-    if np.any(~np.isfinite(start)) or np.any(np.isnan(end)):
-        raise ValueError("episodes: t_start_s must be finite and t_end_s not NaN")
-    if has_column(episodes, "bumper"):
-        bumper = column(episodes, "bumper")
-        order = np.lexsort((bumper, start))
-    else:
-        order = np.argsort(start, kind="stable")
-    groups: list[list[int]] = []
-    current: list[int] = []
-    group_end = -math.inf
-    for pos in order:
-        i = int(pos)
-        if current and start[i] <= group_end:
-            current.append(i)
-            group_end = max(group_end, end[i])
-        else:
-            if current:
-                groups.append(current)
-            current = [i]
-            group_end = max(end[i], start[i])
-    groups.append(current)
-    return groups
+    names = ("t_start_s", "t_end_s", "bumper")[: 3 if has_column(episodes, "bumper") else 2]
+    cols = episode_lists(episodes, names)
+    return _group(cols["t_start_s"], cols["t_end_s"], cols.get("bumper"))
 
 
 def impulse_scale(episodes: Table) -> np.ndarray:
@@ -145,6 +168,23 @@ def impulse_scale(episodes: Table) -> np.ndarray:
         return np.zeros(0)
     duration = column(episodes, "t_end_s") - column(episodes, "t_start_s")
     return column(episodes, "peak_force_n") * np.maximum(duration, 0.0)
+
+
+def _grazes(cols: dict[str, list[Any]], exclude: Sequence[str], fraction: float) -> list[bool]:
+    """:func:`graze_mask` on the lists of :func:`_lists` (``surface``, times, peak force)."""
+    n = len(cols["t_start_s"])
+    if n == 0 or fraction <= 0.0:
+        return [False] * n
+    excluded = {str(s) for s in exclude}
+    obstacle = [s not in excluded for s in cols["surface"]]
+    if not any(obstacle):
+        return [False] * n
+    scale = [
+        f * max(e - s, 0.0)
+        for f, s, e in zip(cols["peak_force_n"], cols["t_start_s"], cols["t_end_s"], strict=True)
+    ]
+    limit = fraction * max(x for x, o in zip(scale, obstacle, strict=True) if o)
+    return [o and x < limit for x, o in zip(scale, obstacle, strict=True)]
 
 
 def graze_mask(
@@ -163,18 +203,31 @@ def graze_mask(
     0 (the default): no grazes.
     """
     n = n_rows(episodes)
-    grazes = np.zeros(n, dtype=bool)
     if n == 0 or fraction <= 0.0:
-        return grazes
-    obstacle = np.ones(n, dtype=bool)
-    if len(exclude_surfaces):
-        surface = column(episodes, "surface", dtype=object).astype(str)
-        obstacle = ~np.isin(surface, [str(s) for s in exclude_surfaces])
-    if not obstacle.any():
-        return grazes
-    scale = impulse_scale(episodes)
-    grazes[obstacle] = scale[obstacle] < fraction * float(np.max(scale[obstacle]))
-    return grazes
+        return np.zeros(n, dtype=bool)
+    cols = episode_lists(episodes, ("surface", "t_start_s", "t_end_s", "peak_force_n"))
+    return np.array(_grazes(cols, exclude_surfaces, fraction), dtype=bool)
+
+
+def impact_rows(
+    cols: dict[str, list[Any]], exclude: Sequence[str], graze_fraction: float
+) -> tuple[list[int], int]:
+    """Rows that make impacts (not on an excluded surface, not grazes), and the rows on
+    surfaces not excluded (grazes included)."""
+    excluded = {str(s) for s in exclude}
+    counted = [k for k, s in enumerate(cols["surface"]) if s not in excluded]
+    if counted and graze_fraction > 0.0:
+        grazes = _grazes(cols, exclude, graze_fraction)
+        return [k for k in counted if not grazes[k]], len(counted)
+    return counted, len(counted)
+
+
+def impacts_of(cols: dict[str, list[Any]], rows: list[int]) -> list[list[int]]:
+    """The impacts (:func:`group_impacts`) of these rows, as rows of ``cols``."""
+    start = [cols["t_start_s"][k] for k in rows]
+    end = [cols["t_end_s"][k] for k in rows]
+    bumper = [cols["bumper"][k] for k in rows]
+    return [[rows[i] for i in g] for g in _group(start, end, bumper)]
 
 
 def short_impacts(
@@ -193,14 +246,11 @@ def short_impacts(
     n = n_rows(episodes)
     if n == 0 or not period_s > 0.0:
         return 0, math.nan
-    keep = ~graze_mask(episodes, exclude_surfaces, graze_fraction)
-    if len(exclude_surfaces):
-        surface = column(episodes, "surface", dtype=object).astype(str)
-        keep &= ~np.isin(surface, [str(s) for s in exclude_surfaces])
-    eps = select(episodes, keep, _EPISODE_NEEDED)
+    cols = episode_lists(episodes, _EPISODE_NEEDED)
+    rows, _ = impact_rows(cols, exclude_surfaces, graze_fraction)
     durations = [
-        float(np.max(eps["t_end_s"][g]) - np.min(eps["t_start_s"][g]))
-        for g in (group_impacts(eps) if keep.any() else [])
+        max(cols["t_end_s"][k] for k in g) - min(cols["t_start_s"][k] for k in g)
+        for g in impacts_of(cols, rows)
     ]
     short = [d for d in durations if d < period_s]
     return len(short), (min(short) if short else math.nan)
@@ -248,16 +298,9 @@ def impact_metrics(
         has two episodes in that impact).
         Floats are NaN and lists empty when there is no episode.
     """
-    n = n_rows(episodes)
-    keep = np.ones(n, dtype=bool)
-    if n and len(exclude_surfaces):
-        surface = column(episodes, "surface", dtype=object).astype(str)
-        keep = ~np.isin(surface, [str(s) for s in exclude_surfaces])
-    n_all = int(keep.sum())
-    if n_all and graze_fraction > 0.0:
-        keep &= ~graze_mask(episodes, exclude_surfaces, graze_fraction)
-    eps = select(episodes, keep, _EPISODE_NEEDED) if n else dict.fromkeys(_EPISODE_NEEDED, [])
-    groups = group_impacts(eps)
+    cols = episode_lists(episodes, _EPISODE_NEEDED) if n_rows(episodes) else None
+    rows, n_all = impact_rows(cols, exclude_surfaces, graze_fraction) if cols else ([], 0)
+    groups = impacts_of(cols, rows) if cols else []
     out: dict[str, Any] = {
         "delta_init_m": math.nan,
         "peak_force_n": math.nan,
@@ -267,22 +310,23 @@ def impact_metrics(
         "leading_bumpers": [],
         "aft_bumpers": [],
         "n_episodes": n_all,
-        "n_grazes": n_all - n_rows(eps),
+        "n_grazes": n_all - len(rows),
         "n_subsequent_impacts": 0,
         "n_subsequent_episodes": 0,
         "subsequent_impacts": [],
     }
     if not groups:
         return out
-    first = np.asarray(groups[0], dtype=np.int64)
-    start = float(eps["t_start_s"][first].min())
-    end = float(max(eps["t_end_s"][first].max(), start))
-    bumper_col = np.asarray(eps["bumper"])
-    leading = sorted({int(b) for b in bumper_col[first]})
+    assert cols is not None
+    first = groups[0]
+    bumper = cols["bumper"]
+    start = min(cols["t_start_s"][k] for k in first)
+    end = max(max(cols["t_end_s"][k] for k in first), start)
+    leading = sorted({bumper[k] for k in first})
     out.update(
         {
-            "delta_init_m": float(eps["peak_delta_m"][first].max()),
-            "peak_force_n": float(eps["peak_force_n"][first].max()),
+            "delta_init_m": max(cols["peak_delta_m"][k] for k in first),
+            "peak_force_n": max(cols["peak_force_n"][k] for k in first),
             "initial_impact_start_s": start,
             "initial_impact_end_s": end,
             "initial_impact_duration_s": end - start,
@@ -290,7 +334,7 @@ def impact_metrics(
             "aft_bumpers": [b for b in range(1, n_features + 1) if b not in leading],
             "n_subsequent_impacts": len(groups) - 1,
             "n_subsequent_episodes": sum(len(g) for g in groups[1:]),
-            "subsequent_impacts": [[int(bumper_col[i]) for i in g] for g in groups[1:]],
+            "subsequent_impacts": [[bumper[k] for k in g] for g in groups[1:]],
         }
     )
     return out

@@ -23,12 +23,14 @@ from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
     Table,
-    column,
-    graze_mask,
-    group_impacts,
+    episode_lists,
+    impact_rows,
+    impacts_of,
     n_rows,
-    select,
 )
+
+EPISODE_COLUMNS_USED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_force_n")
+"""The episode columns the impacts after the detection are found from."""
 
 __all__ = ["RECOVERY_KEYS", "contact_normal", "recovery_metrics"]
 
@@ -88,14 +90,14 @@ def first_obstacle_episode(
     """(bumper 1-4, surface name) of the first contact with an obstacle (not the ground)."""
     if n_rows(episodes) == 0:
         return None
-    surface = column(episodes, "surface", dtype=object).astype(str)
-    rows = np.flatnonzero(np.isin(surface, list(obstacle_names)))
-    if rows.size == 0:
+    cols = episode_lists(episodes, ("bumper", "surface", "t_start_s"))
+    names = set(obstacle_names)
+    rows = [k for k, s in enumerate(cols["surface"]) if s in names]
+    if not rows:
         return None
-    start = column(episodes, "t_start_s")[rows]
-    bumper = column(episodes, "bumper")[rows]
-    first = rows[np.lexsort((bumper, start))[0]]
-    return int(column(episodes, "bumper")[first]), str(surface[first])
+    start, bumper = cols["t_start_s"], cols["bumper"]
+    first = min(rows, key=lambda k: (start[k], bumper[k]))  # ties: the first row
+    return bumper[first], cols["surface"][first]
 
 
 def recovery_metrics(
@@ -184,13 +186,11 @@ def recovery_metrics(
     out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
     # impacts (grazes excluded, obstacles only) that start after the detection
     if n_rows(episodes):
-        surface = column(episodes, "surface", dtype=object).astype(str)
-        keep = np.isin(surface, list(obstacle_names))
-        others = sorted(set(surface.tolist()) - set(obstacle_names))
-        keep &= ~graze_mask(episodes, others, GRAZE_IMPULSE_FRACTION)
-        eps = select(episodes, keep, ("bumper", "t_start_s", "t_end_s"))
-        starts = eps["t_start_s"]
-        out["impacts_after_detection"] = int(
-            sum(1 for g in group_impacts(eps) if starts[g].min() > t_detect)
+        cols = episode_lists(episodes, EPISODE_COLUMNS_USED)
+        others = sorted(set(cols["surface"]) - set(obstacle_names))
+        rows, _ = impact_rows(cols, others, GRAZE_IMPULSE_FRACTION)
+        starts = cols["t_start_s"]
+        out["impacts_after_detection"] = sum(
+            1 for g in impacts_of(cols, rows) if min(starts[k] for k in g) > t_detect
         )
     return out
