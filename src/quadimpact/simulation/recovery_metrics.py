@@ -165,7 +165,7 @@ def recovery_metrics(
             n_true = contact_normal(x_onset, feat, shapes, bumper - 1, s_index)
             n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
             if norm(n_est) > 0:
-                c = float(np.clip(dot(n_est, n_true) / norm(n_true), -1.0, 1.0))
+                c = min(max(float(dot(n_est, n_true) / norm(n_true)), -1.0), 1.0)
                 out["normal_error_deg"] = math.degrees(math.acos(c))
     p_detect = st[L.ST_DETECT_X + L.X_POS : L.ST_DETECT_X + L.X_POS + 3]
     for k, name in ((2, "stage2"), (3, "stage3"), (4, None)):
@@ -182,7 +182,7 @@ def recovery_metrics(
     t_hover = float(st[L.ST_T_HOVER])
     if math.isfinite(t_hover):
         out["time_to_hover_s"] = t_hover - t_detect
-    out["max_tilt_deg"] = math.degrees(math.acos(float(np.clip(st[L.ST_MIN_TILT_COS], -1, 1))))
+    out["max_tilt_deg"] = math.degrees(math.acos(min(max(float(st[L.ST_MIN_TILT_COS]), -1.0), 1.0)))
     out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
     # impacts (grazes excluded, obstacles only) that start after the detection
     if n_rows(episodes):
