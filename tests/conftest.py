@@ -70,6 +70,22 @@ def stop_signal_handlers_restored(request: pytest.FixtureRequest) -> Iterator[No
 
 
 @pytest.fixture
+def python_sigint() -> Iterator[None]:
+    """Python's own SIGINT handler during the test (a test that interrupts itself).
+
+    The tests may run where SIGINT is ignored (started in the background by a
+    non-interactive shell, or under ``nohup``: Python then keeps ignoring it),
+    and a sweep handles only what Python installs by default
+    (``sweep/interrupt.py``): the test gets what a terminal's foreground job has.
+    """
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
+
+
+@pytest.fixture
 def tmpdir_env() -> Iterator[Path]:
     """A short private folder for a command's ``TMPDIR`` (``helpers.short_tmpdir``)."""
     with short_tmpdir() as path:

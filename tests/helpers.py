@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import signal
 import tempfile
 import time
 from collections.abc import Iterator
@@ -118,3 +119,15 @@ def assert_same_table(a, b) -> None:
     from quadimpact.sweep import without_costs
 
     pd.testing.assert_frame_equal(without_costs(a), without_costs(b))
+
+
+def sigint_as_on_a_terminal() -> None:
+    """``preexec_fn`` of a command a test stops with SIGINT: SIGINT's default action in it.
+
+    A process started in the background by a non-interactive shell (``cmd &``,
+    ``nohup``) ignores SIGINT, and its children inherit that; Python then
+    keeps ignoring it, and so does a sweep (it leaves a handler it did not
+    expect alone, ``sweep/interrupt.py``). The command under test gets the
+    disposition of a terminal's foreground job, wherever the tests run.
+    """
+    signal.signal(signal.SIGINT, signal.SIG_DFL)

@@ -13,6 +13,8 @@ import pytest
 
 from quadimpact.cli import main
 
+from helpers import sigint_as_on_a_terminal
+
 
 def cli(capsys, *args: str) -> tuple[int, str, str]:
     """``quadimpact ARGS`` in this process: (exit status, stdout, stderr)."""
@@ -103,6 +105,7 @@ def test_recovery_stops_on_a_signal_like_sweep(tmp_path, signum, code, name) -> 
         [sys.executable, "-m", "quadimpact.cli", "recovery", "--n", "5000", "--out", "r",
          "--workers", "1", "--no-progress", "--no-animation"],
         cwd=tmp_path, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        preexec_fn=sigint_as_on_a_terminal,
     )  # fmt: skip
     try:
         end = time.monotonic() + 120

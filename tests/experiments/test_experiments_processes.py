@@ -15,7 +15,7 @@ import pytest
 
 import quadimpact
 
-from helpers import assert_all_gone, process_cpu_s
+from helpers import assert_all_gone, process_cpu_s, sigint_as_on_a_terminal
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 GONE_S = 5.0
@@ -30,6 +30,7 @@ def _start(out: Path, tmp: Path) -> subprocess.Popen:
         [sys.executable, "-m", "quadimpact.cli", "experiments", "--out", str(out),
          "--workers", "2"],
         env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+        preexec_fn=sigint_as_on_a_terminal,
     )  # fmt: skip
 
 

@@ -25,7 +25,7 @@ import pytest
 import quadimpact
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 
-from helpers import assert_all_gone, assert_same_table, process_cpu_s
+from helpers import assert_all_gone, assert_same_table, process_cpu_s, sigint_as_on_a_terminal
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
 GRID = {"heading_deg": "0:359:1", "final_time_s": [1.0]}  # 360 runs, ~7 ms each
@@ -57,6 +57,7 @@ class Sweep:
                 stdout=so,
                 stderr=se,
                 start_new_session=True,
+                preexec_fn=sigint_as_on_a_terminal,
             )
         self.children: dict[int, psutil.Process] = {}
 
@@ -297,6 +298,7 @@ def _start(log: Path, tmp: Path, *args: str) -> subprocess.Popen:
         return subprocess.Popen(
             [sys.executable, "-m", *args], cwd=tmp, env=env, stdout=out,
             stderr=subprocess.STDOUT, start_new_session=True,
+            preexec_fn=sigint_as_on_a_terminal,
         )  # fmt: skip
 
 

@@ -78,7 +78,7 @@ def _interrupt_when_running(folder: Path, n: int, sent: list[float]) -> None:
     os.kill(os.getpid(), signal.SIGINT)
 
 
-def test_a_stop_signal_kills_the_workers_at_once(tmp_path):
+def test_a_stop_signal_kills_the_workers_at_once(tmp_path, python_sigint):
     sent: list[float] = []
     watcher = threading.Thread(
         target=_interrupt_when_running, args=(tmp_path, 2, sent), daemon=True
