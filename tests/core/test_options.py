@@ -11,6 +11,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.run import execute, make_kernel
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
+from quadimpact.simulation.simulate import run_setup
 
 from helpers import run_packed, states
 
@@ -58,17 +59,11 @@ def test_ground_as_contact_surface_bounces_and_records_the_crash():
     assert after.max() > 0.5  # bounced well up (restitution 0.9 of a 2 m drop)
 
 
-@njit
-def _motors_off(x, ctrl, mem, veh, dt, cmd):
-    for j in range(4):
-        cmd[j] = 0.0
-
-
 def test_ground_episodes_are_not_impacts():
-    r = simulate(
-        FlightScenario(rotor_speeds_rad_s=(0, 0, 0, 0), ground="contact", final_time_s=1.0),
-        kernel=make_kernel(_motors_off),
-    )
+    scenario = FlightScenario(rotor_speeds_rad_s=(0, 0, 0, 0), ground="contact", final_time_s=1.0)
+    setup = prepare(scenario)
+    setup.ctrl[L.C_KIND] = L.CTRL_NONE  # the rotors held at their speeds: off, as they start
+    r = run_setup(setup, scenario)
     assert r.summary["crash_time_s"] is not None
     assert (r.episodes["surface"] == "ground").any()
     assert r.summary["n_episodes"] == 0 and r.summary["delta_init_m"] is None
