@@ -48,6 +48,7 @@ from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS, analysis
+from quadimpact.recovery.example import EarlyExample, beside, check_example, write_example
 from quadimpact.results.costs import cost_ratio
 from quadimpact.results.files import atomic_write, check_out_dir
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
@@ -81,7 +82,6 @@ TRIAL_FIELDS = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "seed")
 SWEEP_DIR = "sweep"
 TRIALS_PARQUET = "trials.parquet"
 STUDY_JSON = "study.json"
-EXAMPLE_DIR = "example"
 
 
 # ------------------------------------------------------------------ sampling
@@ -372,6 +372,13 @@ class RecoveryResult:
     warnings: list[str] = field(default_factory=list)
 
 
+def _claim_folder(spec: SweepSpec, out: Path) -> None:
+    """Refuse a folder or sweep base the study cannot use; mark the folder as a study's."""
+    check_out_dir(out, "recovery", where="")
+    _check_trial_base(spec, spec.where)
+    (out / SWEEP_DIR).mkdir(parents=True, exist_ok=True)  # a study's folder from now on
+
+
 def run_trials(
     study: RecoveryStudy | SweepSpec,
     out_dir: str | os.PathLike[str],
@@ -448,19 +455,20 @@ def run_study(
     # when they run on other processes (a pool or Dask), else after them, here. It
     # starts once the sweep has placed its runs (the default sweep measures the idle
     # cores first, which the example would take)
-    early: _EarlyExample | None = None
+    early: EarlyExample | None = None
 
     def start_example() -> None:
         nonlocal early
-        early = _EarlyExample.start(spec, out, animation)
+        run_id = analysis.example_trial(trial_inputs(spec).reset_index())
+        early = EarlyExample.start(spec.scenario_dict(run_id), run_id, out, animation)
 
-    beside = example and _beside(workers, scheduler)
-    if beside:
-        _EarlyExample.check(spec, out)  # a folder or base it cannot use: refused before any run
+    early_example = example and beside(workers, scheduler)
+    if early_example:
+        _claim_folder(spec, out)  # a folder or base it cannot use: refused before any run
     try:
         spec, table, info = run_trials(
             spec, out, workers=workers, scheduler=scheduler, progress=progress,
-            on_placed=start_example if beside else None,
+            on_placed=start_example if early_example else None,
         )  # fmt: skip
         options = study if isinstance(study, RecoveryStudy) else None
         description = describe(spec, options, table)
@@ -477,11 +485,11 @@ def run_study(
             run_id = analysis.example_trial(table)
             if early is not None and early.run_id == run_id:
                 example_dir, more, recovered = early.result()
-                _check_example(run_id, recovered, table)
+                check_example(run_id, recovered, table)
             else:
                 if early is not None:  # pragma: no cover (the same inputs, the same trial)
                     early.cancel()
-                example_dir, more = _write_example(spec, run_id, table, out, animation)
+                example_dir, more = write_example(spec, run_id, table, out, animation)
             paths += more[0]
             warnings += more[1]
             description["example"] = {"run_id": run_id, **_row_inputs(table, run_id)}
@@ -534,145 +542,3 @@ def _jsonable(value: Any) -> Any:
 def _row_inputs(table: pd.DataFrame, run_id: int) -> dict[str, Any]:
     row = table.loc[table["run_id"] == run_id].iloc[0]
     return {name: row[name].item() for name in (*TRIAL_FIELDS, "inclination_deg")}
-
-
-def _beside(workers: int | None, scheduler: Any) -> bool:
-    """Whether the example trial runs beside the trials: they run on other processes.
-
-    ``workers=None`` is the sweep's default (:func:`quadimpact.sweep.run.default_workers`):
-    a pool when this process may use more than one core.
-    """
-    if scheduler is not None:
-        return True
-    if workers is None:
-        from quadimpact.sweep.run import default_workers
-
-        workers = default_workers()
-    return int(workers) > 1
-
-
-def _check_example(run_id: int, recovered: bool, table: pd.DataFrame) -> None:
-    row = table.loc[table["run_id"] == run_id].iloc[0]
-    if bool(recovered) != bool(row["recovered"]):  # pragma: no cover
-        raise RuntimeError(f"trial {run_id}: the example run does not repeat its table row")
-
-
-class _EarlyExample:
-    """The example trial written on a process of its own while the trials run.
-
-    The trial nearest the median conditions (``analysis.example_trial``) is
-    known from the sweep's inputs before any trial runs, so its files,
-    figure, viewer and animation (about as much CPU time as 300 trials) are
-    made beside the sweep, on a process forked from the sweep's warm fork
-    server, instead of after it.
-    """
-
-    def __init__(self, run_id: int, executor: Any, future: Any, out: Path) -> None:
-        self.run_id = run_id
-        self._executor = executor
-        self._future = future
-        self._out = out
-
-    @classmethod
-    def start(cls, spec: SweepSpec, out: Path, animation: bool) -> _EarlyExample | None:
-        from concurrent.futures import ProcessPoolExecutor
-
-        from quadimpact.sweep.pool import pool_context, start_server
-        from quadimpact.sweep.tasks import _start_task_worker
-
-        cls.check(spec, out)
-        ctx = pool_context()
-        if ctx.get_start_method() != "forkserver":
-            return None  # a spawned process would import everything again: after the trials
-        run_id = analysis.example_trial(trial_inputs(spec).reset_index())
-        start_server(ctx)
-        executor = ProcessPoolExecutor(1, mp_context=ctx, initializer=_start_task_worker)
-        future = executor.submit(_example_task, spec.scenario_dict(run_id), run_id, out, animation)
-        return cls(run_id, executor, future, out)
-
-    @staticmethod
-    def check(spec: SweepSpec, out: Path) -> None:
-        """Refuse a folder or sweep base the study cannot use; mark the folder as a study's."""
-        check_out_dir(out, "recovery", where="")
-        _check_trial_base(spec, spec.where)
-        (out / SWEEP_DIR).mkdir(parents=True, exist_ok=True)  # a study's folder from now on
-
-    def result(self) -> tuple[Path, tuple[list[Path], list[str]], bool]:
-        """Wait for the example (Ctrl-C and SIGTERM stop it); its folder, files, warnings."""
-        from concurrent.futures import wait
-
-        from quadimpact.sweep.interrupt import stop_signals
-
-        try:
-            with stop_signals() as stop, stop.polled():
-                while not wait([self._future], timeout=0.2).done:
-                    stop.check()
-            d, paths, warnings, recovered = self._future.result()
-        except BaseException:
-            self.cancel()
-            raise
-        self._executor.shutdown(wait=True)
-        self._executor = None
-        return d, (paths, warnings), recovered
-
-    def cancel(self) -> None:
-        """Stop the example's process at once and remove its unfinished folder."""
-        import shutil
-
-        from quadimpact.sweep.tasks import _kill_workers
-
-        if self._executor is None:
-            return
-        pids = list(getattr(self._executor, "_processes", None) or {})
-        _kill_workers(self._executor)
-        self._executor.shutdown(wait=True, cancel_futures=True)
-        for pid in pids:
-            for stage in self._out.glob(f".{EXAMPLE_DIR}.partial-{pid}-*"):
-                shutil.rmtree(stage, ignore_errors=True)
-        self._executor = None
-
-
-def _example_task(
-    scenario_data: dict[str, Any], run_id: int, out: Path, animation: bool
-) -> tuple[Path, list[Path], list[str], bool]:
-    """The example trial's folder on a process of its own (see :class:`_EarlyExample`)."""
-    scenario = scenario_from_dict(scenario_data, where=f"run {run_id}")
-    d, (paths, warnings), recovered = _example_files(scenario, run_id, out, animation)
-    return d, paths, warnings, recovered
-
-
-def _write_example(
-    spec: SweepSpec, run_id: int, table: pd.DataFrame, out: Path, animation: bool
-) -> tuple[Path, tuple[list[Path], list[str]]]:
-    """Run trial ``run_id`` again into ``out/example`` with its figure, viewer and animation."""
-    scenario = scenario_from_dict(spec.scenario_dict(run_id), where=f"run {run_id}")
-    d, more, recovered = _example_files(scenario, run_id, out, animation)
-    _check_example(run_id, recovered, table)
-    return d, more
-
-
-def _example_files(
-    scenario: ImpactTrial, run_id: int, out: Path, animation: bool
-) -> tuple[Path, tuple[list[Path], list[str]], bool]:
-    from quadimpact.recovery import figures
-    from quadimpact.simulation import simulate
-    from quadimpact.viz.scene import Scene
-    from quadimpact.viz.viewer import write_viewer
-
-    result = simulate(scenario)
-    d = out / EXAMPLE_DIR
-    result.write(d)
-    paths = [figures.write_example(result, d / "recovery.png", run_id)]
-    warnings: list[str] = []
-    scene = Scene.from_result(result, vehicle=scenario.build_vehicle())
-    paths.append(write_viewer(d, scene=scene))
-    if animation:
-        try:
-            from quadimpact.viz.animation import write_animation
-
-            movie = write_animation(d, scene=scene).mp4
-            if movie is not None:
-                paths.append(Path(movie))
-        except Exception as exc:  # no ffmpeg (the viz extra): the study stands without it
-            warnings.append(f"example animation not written: {type(exc).__name__}: {exc}")
-    return d, (paths, warnings), bool(result.summary["recovered"])

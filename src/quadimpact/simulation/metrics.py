@@ -171,7 +171,7 @@ def impulse_scale(episodes: Table) -> np.ndarray:
 
 
 def _grazes(cols: dict[str, list[Any]], exclude: Sequence[str], fraction: float) -> list[bool]:
-    """:func:`graze_mask` on the lists of :func:`_lists` (``surface``, times, peak force)."""
+    """:func:`graze_mask` on the lists of :func:`episode_lists` (surface, times, peak force)."""
     n = len(cols["t_start_s"])
     if n == 0 or fraction <= 0.0:
         return [False] * n
