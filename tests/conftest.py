@@ -9,8 +9,6 @@ e.g. ``pytest -m "not slow and not data"``.
 from __future__ import annotations
 
 import signal
-import subprocess
-import sys
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -27,58 +25,18 @@ DATA_MISSING = (
 )
 
 
-# The learning environments' compiled stepping (core/batch.py), in every mode the tests
-# use: compiled into Numba's cache by a process of its own while the first tests run.
-_WARM_ENVS = """
-import gymnasium as gym
-import quadimpact.envs as E
-for action in ("rotors", "ctbr"):
-    for observe in ("imu", "state"):
-        env = gym.make(E.ENV_ID, action=action, observe=observe)
-        env.reset(seed=0)
-        env.step(env.action_space.sample())
-trials = E.TrialDistribution(estimator="ekf", sensors="impact")
-env = E.ImpactRecoveryEnv(observe="estimate", trials=trials)
-env.reset(seed=0)
-env.step(env.action_space.sample())
-vec = gym.make_vec(E.ENV_ID, num_envs=2)
-vec.reset(seed=0)
-vec.step(vec.action_space.sample())
-"""
-_warmers: list[subprocess.Popen] = []
-
-
 def pytest_sessionstart(session: pytest.Session) -> None:
     """Compile the simulator once, in this process, before any test.
 
     On a fresh checkout Numba's cache is cold: the first test to simulate would
     compile the loop (about 2 min of CPU on 2 cores), and a command-line test
     doing it in a subprocess would run past its time limit. Compiled here, the
-    on-disk cache serves every later process. The learning environments'
-    stepping (about 40 s more, used only by tests/envs) is then compiled by a
-    process of its own on the other core while the first tests run (it ends
-    with the session at the latest; if it fails, the tests compile it).
+    on-disk cache serves every later process.
     """
     from quadimpact import ImpactTrial, WallApproach, simulate
 
     simulate(WallApproach(final_time_s=0.6))
     simulate(ImpactTrial(final_time_s=0.05))
-    _warmers.append(
-        subprocess.Popen(
-            [sys.executable, "-c", _WARM_ENVS],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-        )
-    )
-
-
-def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
-    """End the environments' warm-up process if it still runs (no process outlives the tests)."""
-    while _warmers:
-        proc = _warmers.pop()
-        if proc.poll() is None:
-            proc.kill()
-        proc.wait()
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
