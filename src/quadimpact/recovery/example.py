@@ -38,6 +38,7 @@ def beside(workers: int | None, scheduler: Any) -> bool:
 
 
 def check_example(run_id: int, recovered: bool, table: pd.DataFrame) -> None:
+    """Raise if the example run of trial ``run_id`` did not recover as its table row says."""
     row = table.loc[table["run_id"] == run_id].iloc[0]
     if bool(recovered) != bool(row["recovered"]):  # pragma: no cover
         raise RuntimeError(f"trial {run_id}: the example run does not repeat its table row")
