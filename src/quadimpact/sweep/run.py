@@ -271,8 +271,8 @@ def run_sweep(
                         if workers is None:  # the default: a measured start here
                             n_here, n_workers = _start_here(
                                 spec, todo, n_todo, sink, n_workers, placed
-                            )
-                        placed()
+                            )  # calls placed() once it has chosen
+                        placed()  # given workers: at once
                         n_left = n_todo - n_here
                         if n_left:
                             n_workers = min(n_workers, n_left)
