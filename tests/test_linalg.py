@@ -14,7 +14,7 @@ import sys
 import numpy as np
 import pytest
 
-from quadimpact.linalg import dot, inverse, matvec, matvec_t, norm, solve
+from quadimpact.linalg import dot, inverse, lu_factor, lu_solve, matvec, matvec_t, norm, solve
 
 
 def test_solve_and_inverse_agree_with_lapack_to_rounding():
@@ -32,6 +32,41 @@ def test_solve_pivots_and_refuses_a_singular_matrix():
     assert solve(a, [2.0, 3.0]).tolist() == [3.0, 2.0]
     with pytest.raises(ValueError, match="singular"):
         solve(np.ones((3, 3)), np.ones(3))
+
+
+def _eliminate_augmented(a: np.ndarray, b: np.ndarray) -> list[float]:
+    """The textbook form: ``[A | b]`` eliminated with partial pivoting, then back-substituted."""
+    n = len(a)
+    m = [[float(v) for v in a[i]] + [float(b[i])] for i in range(n)]
+    for k in range(n):
+        p = max(range(k, n), key=lambda i: abs(m[i][k]))
+        m[k], m[p] = m[p], m[k]
+        for i in range(k + 1, n):
+            f = m[i][k] / m[k][k]
+            for j in range(k, n + 1):
+                m[i][j] -= f * m[k][j]
+    x = [0.0] * n
+    for i in reversed(range(n)):
+        s = m[i][n]
+        for k in range(i + 1, n):
+            s -= m[i][k] * x[k]
+        x[i] = s / m[i][i]
+    return x
+
+
+def test_a_factorisation_reused_gives_the_bits_of_eliminating_each_system():
+    """``lu_solve(lu_factor(A), b)`` (A eliminated once, e.g. per vehicle) is, bit for bit,
+    the elimination of ``[A | b]`` for every ``b``."""
+    rng = np.random.default_rng(11)
+    for n in (1, 2, 4, 5):
+        for _ in range(100):
+            a = rng.standard_normal((n, n)) * 10.0 ** rng.integers(-4, 5)
+            a[0, 0] *= 1e-3  # pivoting needed
+            lu = lu_factor(a)
+            for _ in range(5):
+                b = rng.standard_normal(n)
+                assert lu_solve(lu, b).tolist() == _eliminate_augmented(a, b)
+                assert solve(a, b).tolist() == _eliminate_augmented(a, b)
 
 
 def test_products_sum_in_index_order():

@@ -17,15 +17,40 @@ The sizes here are tiny (3x3 and 4x4); speed is not a concern.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["dot", "inverse", "matvec", "matvec_t", "norm", "solve"]
+__all__ = ["LU", "dot", "inverse", "lu_factor", "lu_solve", "matvec", "matvec_t", "norm", "solve"]
 
 
 def solve(a: ArrayLike, b: ArrayLike) -> np.ndarray:
     """``x`` with ``A x = b`` (A square), by Gaussian elimination with partial pivoting.
+
+    The same operations as :func:`lu_solve` of :func:`lu_factor` (which see).
+
+    Raises
+    ------
+    ValueError
+        ``A`` is singular (a zero pivot).
+    """
+    return lu_solve(lu_factor(a), b)
+
+
+class LU(NamedTuple):
+    """``A`` eliminated by :func:`lu_factor`: what :func:`lu_solve` applies to a right-hand side."""
+
+    pivots: tuple[int, ...]
+    """The row swapped with row ``k`` at step ``k``."""
+    factors: tuple[tuple[float, ...], ...]
+    """At step ``k``, the multiples of row ``k`` taken from rows ``k+1..n-1``."""
+    upper: tuple[tuple[float, ...], ...]
+    """The eliminated matrix (its upper triangle is used)."""
+
+
+def lu_factor(a: ArrayLike) -> LU:
+    """Gaussian elimination with partial pivoting of a square ``A`` (for :func:`lu_solve`).
 
     Raises
     ------
@@ -33,21 +58,40 @@ def solve(a: ArrayLike, b: ArrayLike) -> np.ndarray:
         ``A`` is singular (a zero pivot).
     """
     m = [[float(v) for v in row] for row in np.asarray(a, dtype=np.float64)]
-    rhs = np.asarray(b, dtype=np.float64)
-    cols = 1 if rhs.ndim == 1 else rhs.shape[1]
-    r = [[float(v) for v in np.atleast_1d(row)] for row in rhs.reshape(len(m), cols)]
     n = len(m)
+    pivots: list[int] = []
+    factors: list[tuple[float, ...]] = []
     for k in range(n):
         p = max(range(k, n), key=lambda i: abs(m[i][k]))
         if m[p][k] == 0.0:
             raise ValueError("solve: the matrix is singular")
         if p != k:
             m[k], m[p] = m[p], m[k]
-            r[k], r[p] = r[p], r[k]
+        pivots.append(p)
+        fs = []
         for i in range(k + 1, n):
             f = m[i][k] / m[k][k]
             for j in range(k, n):
                 m[i][j] -= f * m[k][j]
+            fs.append(f)
+        factors.append(tuple(fs))
+    return LU(tuple(pivots), tuple(factors), tuple(tuple(row) for row in m))
+
+
+def lu_solve(lu: LU, b: ArrayLike) -> np.ndarray:
+    """``x`` with ``A x = b`` from ``lu = lu_factor(A)``: the row operations of the
+    elimination applied to ``b`` in the same order, then back substitution (the
+    bits of eliminating ``[A | b]`` at once). ``b``: shape (n,) or (n, k)."""
+    m = lu.upper
+    n = len(m)
+    rhs = np.asarray(b, dtype=np.float64)
+    cols = 1 if rhs.ndim == 1 else rhs.shape[1]
+    r = [[float(v) for v in np.atleast_1d(row)] for row in rhs.reshape(n, cols)]
+    for k in range(n):
+        p = lu.pivots[k]
+        if p != k:
+            r[k], r[p] = r[p], r[k]
+        for i, f in zip(range(k + 1, n), lu.factors[k], strict=True):
             for j in range(cols):
                 r[i][j] -= f * r[k][j]
     x = [[0.0] * cols for _ in range(n)]

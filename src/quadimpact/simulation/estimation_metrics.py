@@ -44,18 +44,24 @@ ESTIMATION_KEYS: tuple[str, ...] = (
 """The metric keys, in summary order (``est_attitude_rms_pre_deg`` ...)."""
 
 
+_PHASE_KEYS: tuple[tuple[str, str], ...] = tuple(
+    (f"est_{q}_rms_{phase}_{unit}", f"est_{q}_max_{phase}_{unit}")
+    for q, unit in QUANTITIES
+    for phase in PHASES
+)
+"""The (rms, max) keys of each quantity and phase, in the stats' order."""
+
+
 def estimation_metrics(st: np.ndarray) -> dict[str, Any]:
     """RMS and maximum of each error in each phase, from the kernel's stats (``ST_EST_ERR``)."""
+    sums = st[L.ST_EST_ERR : L.ST_EST_ERR + 3 * len(_PHASE_KEYS)].tolist()  # Python floats
     out: dict[str, Any] = {}
-    for k, (q, unit) in enumerate(QUANTITIES):
-        for p, phase in enumerate(PHASES):
-            j = L.ST_EST_ERR + 3 * (L.N_PHASES * k + p)
-            n = float(st[j + 2])
-            ok = n > 0 and math.isfinite(float(st[j]))
-            out[f"est_{q}_rms_{phase}_{unit}"] = math.sqrt(float(st[j]) / n) if ok else None
-            out[f"est_{q}_max_{phase}_{unit}"] = float(st[j + 1]) if ok else None
-    j = L.ST_EST_ERR
-    sq = sum(float(st[j + 3 * p]) for p in range(L.N_PHASES))
-    n = sum(float(st[j + 3 * p + 2]) for p in range(L.N_PHASES))
+    for i, (rms_key, max_key) in enumerate(_PHASE_KEYS):
+        sq, peak, n = sums[3 * i], sums[3 * i + 1], sums[3 * i + 2]
+        ok = n > 0 and math.isfinite(sq)
+        out[rms_key] = math.sqrt(sq / n) if ok else None
+        out[max_key] = peak if ok else None
+    sq = sum(sums[3 * p] for p in range(L.N_PHASES))
+    n = sum(sums[3 * p + 2] for p in range(L.N_PHASES))
     out["est_attitude_rms_run_deg"] = math.sqrt(sq / n) if n > 0 and math.isfinite(sq) else None
     return out

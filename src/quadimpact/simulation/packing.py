@@ -18,7 +18,7 @@ from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Box, Cylinder, Plane
-from quadimpact.linalg import inverse, norm, solve
+from quadimpact.linalg import inverse, lu_factor, lu_solve, norm
 
 CONTROL_RATE_HZ = 200.0
 RPM = 2.0 * np.pi / 60.0  # rad/s per rpm
@@ -34,12 +34,17 @@ FRICTION_V_REG_M_S = 1e-2  # friction regularisation velocity
 MAX_STEPS_PER_S = 2_000_000
 
 
-_PACKED: dict[tuple[int, str], tuple[Vehicle, np.ndarray]] = {}
+_PACKED: dict[tuple[int, str], tuple[Vehicle, Any]] = {}
 _PACKED_LIMIT = 128
 
 
 def _memo(kind: str, v: Vehicle, make: Any) -> np.ndarray:
     """A copy of ``make()`` computed once per (frozen) vehicle object and kind."""
+    return _memo_value(kind, v, make).copy()
+
+
+def _memo_value(kind: str, v: Vehicle, make: Any) -> Any:
+    """``make()`` computed once per (frozen) vehicle object and kind (not copied: immutable)."""
     key = (id(v), kind)
     hit = _PACKED.get(key)
     if hit is None or hit[0] is not v:
@@ -47,7 +52,7 @@ def _memo(kind: str, v: Vehicle, make: Any) -> np.ndarray:
             _PACKED.pop(next(iter(_PACKED)))
         hit = (v, make())  # holds v, so its id stays its own
         _PACKED[key] = hit
-    return hit[1].copy()
+    return hit[1]
 
 
 def pack_vehicle(v: Vehicle) -> np.ndarray:
@@ -293,7 +298,8 @@ def allocation_matrix(v: Vehicle, yaw_paper: bool) -> np.ndarray:
 
 def trim_rotor_speeds(v: Vehicle, thrust_n: float, yaw_paper: bool) -> np.ndarray:
     """Rotor speeds (rad/s) giving total thrust ``thrust_n`` (N) and zero torques."""
-    w2 = solve(allocation_matrix(v, yaw_paper), [thrust_n, 0.0, 0.0, 0.0])
+    lu = _memo_value(f"alloc-lu-{yaw_paper}", v, lambda: lu_factor(allocation_matrix(v, yaw_paper)))
+    w2 = lu_solve(lu, [thrust_n, 0.0, 0.0, 0.0])  # = solve(A, b), A eliminated once per vehicle
     return np.sqrt(np.clip(w2, 0.0, None))
 
 

@@ -32,7 +32,7 @@ from quadimpact.simulation.metrics import (
 EPISODE_COLUMNS_USED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_force_n")
 """The episode columns the impacts after the detection are found from."""
 
-__all__ = ["RECOVERY_KEYS", "contact_normal", "recovery_metrics"]
+__all__ = ["RECOVERY_KEYS", "contact_normal", "first_contact_normal", "recovery_metrics"]
 
 RECOVERED_STAGE = 4
 
@@ -100,6 +100,32 @@ def first_obstacle_episode(
     return bumper[first], cols["surface"][first]
 
 
+def first_contact_normal(
+    st: np.ndarray,
+    episodes: Table,
+    feat: np.ndarray,
+    shapes: np.ndarray,
+    surface_names: Sequence[str],
+    obstacle_names: Sequence[str],
+) -> tuple[int, np.ndarray] | None:
+    """The first contact with an obstacle: its bumper and the contact normal at the onset.
+
+    Returns
+    -------
+    (int, numpy.ndarray (3,)) or None
+        The bumper (feature, 1-based) and the contact normal (inertial NED,
+        unit, out of the obstacle) at the state of the first onset
+        (``ST_ONSET_X``); None when the run touched no obstacle.
+    """
+    first = first_obstacle_episode(episodes, obstacle_names)
+    if first is None:
+        return None
+    bumper, surface = first
+    s_index = list(surface_names).index(surface)
+    x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
+    return bumper, contact_normal(x_onset, feat, shapes, bumper - 1, s_index)
+
+
 def recovery_metrics(
     st: np.ndarray,
     episodes: Table,
@@ -109,6 +135,7 @@ def recovery_metrics(
     surface_names: Sequence[str],
     obstacle_names: Sequence[str],
     final_state: np.ndarray,
+    first_obstacle_contact: tuple[int, np.ndarray] | None | str = "find",
 ) -> dict[str, Any]:
     """The metrics of docs/RECOVERY.md section 6 from a run's record.
 
@@ -126,6 +153,11 @@ def recovery_metrics(
         The surfaces that count as obstacles (the ground does not).
     final_state : numpy.ndarray (NX,)
         The state at the end of the run.
+    first_obstacle_contact : (int, numpy.ndarray) or None, optional
+        The first contact with an obstacle, when the caller has it: (bumper
+        1-based, contact normal there, inertial, unit), None where the run
+        touched no obstacle; by default found from the episodes and the
+        contact geometry (:func:`first_contact_normal`).
 
     Returns
     -------
@@ -157,12 +189,11 @@ def recovery_metrics(
 
     if contact and not false_detection:
         out["detection_latency_s"] = t_detect - first_contact
-        first = first_obstacle_episode(episodes, obstacle_names)
+        first = first_obstacle_contact
+        if isinstance(first, str):
+            first = first_contact_normal(st, episodes, feat, shapes, surface_names, obstacle_names)
         if first is not None:
-            bumper, surface = first
-            s_index = list(surface_names).index(surface)
-            x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
-            n_true = contact_normal(x_onset, feat, shapes, bumper - 1, s_index)
+            n_true = first[1]
             n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
             if norm(n_est) > 0:
                 c = min(max(float(dot(n_est, n_true) / norm(n_true)), -1.0), 1.0)

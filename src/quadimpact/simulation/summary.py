@@ -28,11 +28,7 @@ from quadimpact.simulation.metrics import (
     n_rows,
     short_impacts,
 )
-from quadimpact.simulation.recovery_metrics import (
-    contact_normal,
-    first_obstacle_episode,
-    recovery_metrics,
-)
+from quadimpact.simulation.recovery_metrics import first_contact_normal, recovery_metrics
 from quadimpact.simulation.setup import RunSetup
 
 __all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]
@@ -73,18 +69,17 @@ def build_summary(
 
     onset_t = float(st[L.ST_ONSET_T])
     speed = heading = incl = math.nan
-    first_normal = None
+    first_normal = None  # (bumper, contact normal) of the first obstacle contact
+    obstacles = _obstacle_names(setup)
     if not math.isnan(onset_t):
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
         q = xo[L.X_QUAT : L.X_QUAT + 4]
         vel = matvec(quat_to_matrix(q), xo[L.X_VEL : L.X_VEL + 3])
-        first = first_obstacle_episode(episodes, _obstacle_names(setup))
-        if first is not None:  # the contact normal there, from the contact geometry
-            bumper, surface = first
-            s_index = list(setup.shape_names).index(surface)
-            normal = contact_normal(xo, setup.feat, setup.shapes, bumper - 1, s_index)
-            speed = -dot(vel, normal)
-            first_normal = (bumper, normal)
+        first_normal = first_contact_normal(  # the normal there, from the contact geometry
+            st, episodes, setup.feat, setup.shapes, setup.shape_names, obstacles
+        )
+        if first_normal is not None:
+            speed = -dot(vel, first_normal[1])
         heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
         incl = inclination_deg_of(q)
 
@@ -190,8 +185,9 @@ def build_summary(
             feat=setup.feat,
             shapes=setup.shapes,
             surface_names=setup.shape_names,
-            obstacle_names=_obstacle_names(setup),
+            obstacle_names=obstacles,
             final_state=np.asarray(final_state, dtype=float),
+            first_obstacle_contact=first_normal,
         )
     )
     summary["final_altitude_m"] = _nan_to_none(-float(final_state[L.X_POS + 2]))

@@ -82,35 +82,44 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
     timings are dropped; keys outside :data:`SUMMARY_COLUMNS` go, as JSON, to
     ``summary_extra``; missing keys are null. Values take their column's type.
     """
-    flat: dict[str, Any] = {}
-
-    def walk(prefix: str, value: Any) -> None:
-        if isinstance(value, Mapping):
-            for k, v in value.items():
-                walk(f"{prefix}__{k}" if prefix else str(k), v)
-        else:
-            flat[prefix] = value
-
-    walk("", summary)
-    skip = set(skip)
+    skip = skip if isinstance(skip, (set, frozenset, dict)) else set(skip)
     row: dict[str, Any] = {}
     extra: dict[str, Any] = {}
-    for key, value in flat.items():
-        if _is_time_measurement(key) or key in skip:
-            continue
-        kind = _SUMMARY_KIND.get(key)
-        if kind is None or key == "summary_extra":
-            extra[key] = plain(value)
-            continue
-        row[key] = _typed(value, kind)
+    kinds = _SUMMARY_KIND
+
+    def walk(prefix: str, table: Mapping[str, Any]) -> None:
+        for k, value in table.items():
+            key = f"{prefix}{k}"
+            t = type(value)
+            if t is dict or (t not in _LEAF_TYPES and isinstance(value, Mapping)):
+                walk(key + "__", value)
+                continue
+            if key in skip or (key.startswith("integrator__") and _is_time_measurement(key)):
+                continue
+            kind = kinds.get(key)
+            if kind is None or key == "summary_extra":
+                extra[key] = plain(value)
+            elif value is None:  # the common cases of _typed, inline
+                row[key] = None
+            elif t is float and kind == "f":
+                row[key] = None if value != value else value
+            elif t is _EXACT_TYPE.get(kind):
+                row[key] = value
+            else:
+                row[key] = _typed(value, kind)
+
+    walk("", summary)
     for key, _kind in SUMMARY_COLUMNS:
-        if key not in skip:
-            row.setdefault(key, None)
+        if key not in row and key not in skip:
+            row[key] = None
     row["summary_extra"] = canonical(extra) if extra else None
     return row
 
 
 _PLAIN_TYPES = (float, int, str, bool)
+_LEAF_TYPES = frozenset((float, int, str, bool, list, type(None)))
+_EXACT_TYPE = {"i": int, "b": bool, "s": str}
+_JSON_TEXT = json.JSONEncoder(separators=(",", ":"))  # = json.dumps(v, separators=...)
 
 
 def _plain_list(value: Any) -> bool:
@@ -130,7 +139,7 @@ def _typed(value: Any, kind: str) -> Any:
         return bool(value)
     if kind == "s":
         return str(value)
-    return json.dumps(value, separators=(",", ":"))
+    return _JSON_TEXT.encode(value)
 
 
 def failed_row(reason: str, skip: Iterable[str]) -> dict[str, Any]:

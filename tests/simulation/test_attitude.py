@@ -1,0 +1,60 @@
+"""The compiled attitude excursion: the pruned pass equals the full evaluation bit for bit."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
+from quadimpact.simulation.attitude import excursion_from_quaternions, excursion_full
+
+
+def _same(a: tuple[float, ...], b: tuple[float, ...]) -> bool:
+    return all(x == y or (math.isnan(x) and math.isnan(y)) for x, y in zip(a, b, strict=True))
+
+
+def _random_walk(rng: np.random.Generator, n: int, step: float) -> np.ndarray:
+    """Unnormalised quaternions wandering over the sphere (tumbles, returns, long drifts)."""
+    return np.cumsum(rng.normal(size=(n, 4)) * step, axis=0) + rng.normal(size=4)
+
+
+@pytest.mark.parametrize("step", [1e-4, 1e-2, 0.3])
+def test_pruned_excursion_equals_full_evaluation_on_tumbles(step: float) -> None:
+    rng = np.random.default_rng(7)
+    for _ in range(40):
+        q = _random_walk(rng, int(rng.integers(1, 2000)), step)
+        refs = rng.uniform(-math.pi, math.pi, 3)
+        refs[1] = rng.uniform(-0.5 * math.pi, 0.5 * math.pi)
+        z = quat_to_matrix(euler_zyx_to_quat(*refs))[:, 2]
+        args = (q, *refs, np.ascontiguousarray(z))
+        assert _same(excursion_from_quaternions(*args), excursion_full(*args))
+
+
+def test_pruned_excursion_near_gimbal_lock_and_wrapping_references() -> None:
+    """Pitch within 1e-7 rad of +-90 deg (full evaluation), references at +-180 deg, a
+    pitch reference beyond 90 deg (no pruning of pitch), a NaN row."""
+    rng = np.random.default_rng(3)
+    h = math.sqrt(0.5)
+    for sign in (1.0, -1.0):
+        a = rng.normal(size=500) * 1e-7
+        q = np.stack([np.full(500, h), a, sign * np.full(500, h), 0.3 * a], axis=1)
+        q = np.concatenate([q, _random_walk(rng, 500, 0.05)])
+        for refs in ((math.pi, 0.2, -math.pi), (math.pi * (1 - 1e-12), 2.0, 0.5), (0.0, -2.5, 3.0)):
+            args = (q, *refs, np.array([0.0, 0.0, 1.0]))
+            assert _same(excursion_from_quaternions(*args), excursion_full(*args))
+        q[250] = np.nan
+        args = (q, 0.1, 0.2, 0.3, np.array([0.0, 0.0, 1.0]))
+        assert _same(excursion_from_quaternions(*args), excursion_full(*args))
+
+
+def test_excursion_of_a_known_rotation() -> None:
+    """Roll 30 deg then back: roll excursion 30 deg, tilt 30 deg, pitch and yaw 0."""
+    roll = np.radians(np.concatenate([np.linspace(0.0, 30.0, 301), np.linspace(30.0, 0.0, 301)]))
+    q = euler_zyx_to_quat(roll, np.zeros_like(roll), np.zeros_like(roll))
+    out = excursion_from_quaternions(np.ascontiguousarray(q), 0.0, 0.0, 0.0, np.array([0, 0, 1.0]))
+    assert out[0] == pytest.approx(30.0, abs=1e-12)
+    assert out[1] == pytest.approx(0.0, abs=1e-12)
+    assert out[2] == pytest.approx(0.0, abs=1e-12)
+    assert out[3] == pytest.approx(30.0, abs=1e-6)
