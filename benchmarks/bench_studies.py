@@ -27,11 +27,14 @@ measures (the targets of issue 21):
    <= 1.5), and CPU time over the kernel sum.
 
 The kernel sums of 1, 2 and 4 are measured in each round by a separate pass
-in one process (each run prepared, then ``core.run.BUILTIN.run`` timed with
-``time.thread_time``; a wall approach's shooting runs timed the same way), in
-the checkout given by ``--kernel-from`` (default: this one; the compiled loop
-is the same code in both checkouts); where the table has the cost columns
-(this checkout), the sum of ``cost__kernel_cpu_s`` is given beside it. CPU
+in one process for each checkout, in that checkout (``--kernel-from``: one
+checkout's passes for all): each run prepared, then ``core.run.BUILTIN.run``
+into the output a sweep's run fills (rows without contact columns where the
+checkout has them, ``simulation.batch``) timed with ``time.thread_time``; a
+wall approach's shooting runs timed the same way. A checkout whose sweeps run
+a cheaper loop thus has a smaller denominator: compare the CPU seconds too.
+Where the table has the cost columns, the sum of ``cost__kernel_cpu_s`` is
+given beside it. CPU
 time is ``time.thread_time``/``process_time`` and the children's
 ``RUSAGE_CHILDREN`` (the fork server is stopped and reaped, so that its
 workers' time is counted). About 4 minutes per round and checkout at the
@@ -63,6 +66,14 @@ import json, os, resource, statistics, sys, time
 def children_cpu():
     r = resource.getrusage(resource.RUSAGE_CHILDREN)
     return r.ru_utime + r.ru_stime
+def summary_output(m, n_imu):
+    # the output a sweep's run fills: rows without contact columns where the
+    # checkout has them (simulation.batch), else full rows
+    import inspect
+    from quadimpact.core.records import new_output
+    if "contact_columns" in inspect.signature(new_output).parameters:
+        return new_output(m, n_imu, 1024, contact_columns=False)
+    return new_output(m, n_imu, 1024)
 def stop_server():
     import multiprocessing.forkserver as fs
     server = getattr(fs, "_forkserver", None)
@@ -94,7 +105,7 @@ if __name__ == "__main__":
 
 KERNEL_TRIALS = r"""
 n = int(sys.argv[1])
-from quadimpact.core.run import BUILTIN, execute
+from quadimpact.core.run import BUILTIN
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.recovery.study import RecoveryStudy
 from quadimpact.simulation.setup import prepare
@@ -103,17 +114,18 @@ total = 0.0
 for i in range(n):
     setup = prepare(scenario_from_dict(spec.scenario_dict(i)))
     m = setup.model()
+    o = summary_output(m, setup.n_imu)
     if i == 0:
-        execute(m, n_imu=setup.n_imu)  # loaded, not counted
+        BUILTIN.run(m, o)  # loaded, not counted
     t = time.thread_time()
-    execute(m, n_imu=setup.n_imu)
+    BUILTIN.run(m, o)
     total += time.thread_time() - t
 print(json.dumps({"n": n, "kernel_cpu_s": total}))
 """
 
 KERNEL_FIG4 = r"""
 import quadimpact.simulation.approach as approach
-from quadimpact.core.run import execute
+from quadimpact.core.run import BUILTIN, execute
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.simulation.setup import prepare
 shooting = [0.0]
@@ -130,11 +142,12 @@ for h in (0.0, 45.0):
                              model="paper-replica")
             setup = prepare(s)
             m = setup.model()
+            o = summary_output(m, setup.n_imu)
             if first:
-                execute(m, n_imu=setup.n_imu); first = False; shooting[0] = 0.0
+                BUILTIN.run(m, o); first = False; shooting[0] = 0.0
                 setup = prepare(s)
             t = time.thread_time()
-            execute(m, n_imu=setup.n_imu)
+            BUILTIN.run(m, o)
             main += time.thread_time() - t
 print(json.dumps({"runs": 246, "kernel_cpu_s": main + shooting[0], "main_cpu_s": main,
                   "shooting_cpu_s": shooting[0]}))
@@ -273,7 +286,8 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", type=Path, help="another checkout, measured alternately")
     parser.add_argument("--after", type=Path, default=HERE, help="default: this checkout")
-    parser.add_argument("--kernel-from", type=Path, help="checkout of the kernel passes")
+    parser.add_argument("--kernel-from", type=Path, help="checkout of every kernel pass "
+                        "(default: each checkout its own)")  # fmt: skip
     parser.add_argument("--rounds", type=int, default=2)
     parser.add_argument("--n", type=int, default=2000, help="recovery trials")
     parser.add_argument("--repeat", type=int, default=20, help="simulate() calls per variant")
@@ -284,22 +298,22 @@ def main(argv: list[str] | None = None) -> None:
     checkouts = {"after": args.after.resolve()}
     if args.before is not None:
         checkouts = {"before": args.before.resolve(), **checkouts}
-    kernel_from = (args.kernel_from or args.after).resolve()
     info = machine()
     print(f"machine: {info}", flush=True)
-    for path in {*checkouts.values(), kernel_from}:  # compile or load each checkout's cache
-        _python(path, SIMULATE, "1")
+    for path in {*checkouts.values(), *([args.kernel_from] if args.kernel_from else [])}:
+        _python(path.resolve(), SIMULATE, "1")  # compile or load each checkout's cache
     rounds: dict[str, list[dict]] = {k: [] for k in checkouts}
-    kernel_rounds = []
+    kernel_rounds: list[dict] = []
     for k in range(args.rounds):
-        kernels = {}
-        if not (args.skip_trials and args.skip_commands):
-            kernels["trials"] = _python(kernel_from, KERNEL_TRIALS, str(args.n))["kernel_cpu_s"]
-        if not args.skip_commands:
-            kernels["fig4"] = _python(kernel_from, KERNEL_FIG4)["kernel_cpu_s"]
-        kernel_rounds.append(kernels)
-        print(f"round {k + 1}: kernel sums (CPU s) {kernels}", flush=True)
         for name, path in checkouts.items():
+            source = args.kernel_from.resolve() if args.kernel_from else path
+            kernels: dict[str, Any] = {"checkout": name}
+            if not (args.skip_trials and args.skip_commands):
+                kernels["trials"] = _python(source, KERNEL_TRIALS, str(args.n))["kernel_cpu_s"]
+            if not args.skip_commands:
+                kernels["fig4"] = _python(source, KERNEL_FIG4)["kernel_cpu_s"]
+            kernel_rounds.append(kernels)
+            print(f"round {k + 1}, {name}: kernel sums (CPU s) {kernels}", flush=True)
             rounds[name].append(one_round(name, path, args, kernels))
     print(f"\nmedians over {args.rounds} rounds (CPU and wall times in s; ratios to the "
           "compiled loop's CPU time of the same runs):")  # fmt: skip
@@ -327,9 +341,11 @@ def main(argv: list[str] | None = None) -> None:
             continue
         print(f"{label:48s}" + "".join(f"{v:12.3f}" for v in values))
     for key in ("trials", "fig4"):
-        values = [r[key] for r in kernel_rounds if key in r]
-        if values:
-            print(f"kernel sum {key}: " + ", ".join(f"{v:.1f}" for v in values) + " s CPU")
+        for name in checkouts:
+            values = [r[key] for r in kernel_rounds if key in r and r["checkout"] == name]
+            if values:
+                text = ", ".join(f"{v:.2f}" for v in values)
+                print(f"kernel sum {key}, {name}: {text} s CPU")
     if args.json:
         report = {"machine": info, "args": {k: str(v) for k, v in vars(args).items()},
                   "kernels": kernel_rounds, "rounds": rounds}  # fmt: skip

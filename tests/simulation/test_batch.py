@@ -1,11 +1,24 @@
-"""simulate_batch gives the summaries of single simulate() calls, bit for bit."""
+"""simulate_batch gives the summaries of single simulate() calls, bit for bit.
+
+Its runs record output rows without the contact columns (the loop skips the
+contact geometry at output times); nothing else of a run may change.
+"""
 
 from __future__ import annotations
 
 import json
 
+import numpy as np
+
 from quadimpact import FlightScenario, ImpactTrial, WallApproach, simulate
+from quadimpact.core import layout as L
+from quadimpact.core.records import new_output
+from quadimpact.core.run import BUILTIN
+from quadimpact.inputs.world import Cylinder
 from quadimpact.simulation.batch import simulate_batch
+from quadimpact.simulation.setup import prepare
+
+POLE = Cylinder(name="pole", point_m=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), radius_m=0.1)
 
 
 def _same(a, b):
@@ -25,6 +38,7 @@ def test_batch_equals_single_runs():
         ImpactTrial(roll_deg=5, pitch_deg=-30, yaw_deg=20, speed_m_s=1.5, imu="noisy", seed=3),
         FlightScenario(final_time_s=4.0),  # longer than the others: the buffers grow
         WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75, model="paper-replica"),
+        ImpactTrial(controller="recovery", roll_deg=10, speed_m_s=2.0, obstacles=(POLE,)),
     ]
     batch = simulate_batch(scenarios)
     assert len(batch) == len(scenarios)
@@ -38,3 +52,19 @@ def test_a_run_that_raises_is_a_failed_summary():
     out = simulate_batch([bad, good])
     assert out[0]["status"] == "failed" and out[0]["reason"]
     assert _same(out[1], simulate(good).summary)
+
+
+def test_rows_without_contact_columns_leave_the_run_unchanged():
+    """A run into rows of NOUT columns: the same time, state, command and stage in every
+    row, the same episodes, IMU samples and stats, bit for bit (a pole, a recovery)."""
+    s = ImpactTrial(controller="recovery", roll_deg=10, speed_m_s=2.0, obstacles=(POLE,))
+    m = prepare(s).model()
+    full = new_output(m, prepare(s).n_imu, 64)
+    lean = new_output(m, prepare(s).n_imu, 64, contact_columns=False)
+    BUILTIN.run(m, full)
+    BUILTIN.run(m, lean)
+    assert lean.out.shape[1] == L.NOUT < full.out.shape[1]
+    assert np.any(full.out[:, L.OUT_DELTA :] != 0.0)  # the contacts were there to skip
+    assert np.array_equal(full.out[:, : L.NOUT], lean.out)
+    for a, b in ((full.episodes, lean.episodes), (full.imu, lean.imu), (full.stats, lean.stats)):
+        assert np.array_equal(a, b, equal_nan=True)

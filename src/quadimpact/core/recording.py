@@ -61,19 +61,28 @@ from .sensors.disturbance import impact_onset
 
 @compiled
 def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
-    """Output row ``row`` at time ``t`` (s) of the state ``xs``: state, command, stage, contacts."""
+    """Output row ``row`` at time ``t`` (s) of the state ``xs``: state, command, stage, contacts.
+
+    The contacts (each feature's deflection and normal force, from the
+    contact geometry of every pair) only where the rows have their columns:
+    the summary-only runs of a sweep record rows of ``NOUT`` columns
+    (``records.new_output(..., contact_columns=False)``), which the summary
+    reads the attitude and the last state of, and skip that work.
+    """
     out = o.out
     nf = m.feat.shape[0]
     out[row, OUT_T] = t
     for i in range(NX):
         out[row, OUT_X + i] = xs[i]
     rotation_matrix(xs[X_QUAT : X_QUAT + 4], w.C)
-    for f in range(nf):
-        out[row, OUT_DELTA + f] = 0.0
-        out[row, OUT_DELTA + nf + f] = 0.0
     for j in range(N_ROTORS):
         out[row, OUT_CMD + j] = d.rin[RIN_CMD + j]
     out[row, OUT_STAGE] = d.ls[LS_STAGE]
+    if out.shape[1] <= OUT_DELTA:
+        return
+    for f in range(nf):
+        out[row, OUT_DELTA + f] = 0.0
+        out[row, OUT_DELTA + nf + f] = 0.0
     for c in range(d.cs.shape[0]):
         f = m.pairs[c, PR_FEATURE]
         dp, dd = pair_depth(xs, w.C, m.feat, m.shapes, m.pairs, c)

@@ -163,10 +163,16 @@ def new_data(m: Model) -> Data:
 
 
 @njit(cache=True)
-def new_output(m: Model, n_imu: int, max_episodes: int) -> Output:
-    """Zeroed outputs of the run ``m``: a row per output time, ``n_imu`` IMU rows."""
+def new_output(m: Model, n_imu: int, max_episodes: int, contact_columns: bool = True) -> Output:
+    """Zeroed outputs of the run ``m``: a row per output time, ``n_imu`` IMU rows.
+
+    ``contact_columns=False``: rows of ``NOUT`` columns (time, state, command,
+    stage), without the features' deflections and forces, which the loop
+    then does not compute (``recording.write_sample``): what a summary needs.
+    """
+    width = NOUT + 2 * m.feat.shape[0] if contact_columns else NOUT  # layout.out_width
     return Output(
-        np.zeros((m.t_out.shape[0], NOUT + 2 * m.feat.shape[0])),  # layout.out_width
+        np.zeros((m.t_out.shape[0], width)),
         np.zeros((max(n_imu, 0), NIMU)),
         np.zeros((max_episodes, NEP)),
         np.zeros(NSTAT),
