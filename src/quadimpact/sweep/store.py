@@ -495,8 +495,22 @@ def check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
         return
     if (out / "runs.parquet").exists() or any((out / "parts").glob("part-*.parquet")):
         raise InputError(f"{out}: has sweep results but no sweep.json; use another output folder")
-    text = json.dumps(record, indent=1, sort_keys=True, allow_nan=False) + "\n"
+    text = _record_text(record) + "\n"
     atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"), durable=True)
+
+
+def _record_text(value: Any, depth: int = 0) -> str:
+    """``sweep.json``'s text: keys sorted, one key per line down to the spec's fields, and
+    one run per line in a list of runs (a million-run study's is written by the C
+    encoder, not by ``json``'s indenting one in Python, which took 0.1 ms a run)."""
+    pad, inner = " " * depth, " " * (depth + 1)
+    if isinstance(value, dict) and value and depth < 3:
+        items = [f"{inner}{json.dumps(str(k))}: {_record_text(value[k], depth + 1)}" for k in
+                 sorted(value)]  # fmt: skip
+        return "{\n" + ",\n".join(items) + "\n" + pad + "}"
+    if isinstance(value, list) and value and depth < 3:
+        return "[\n" + ",\n".join(inner + _record_text(v, 3) for v in value) + "\n" + pad + "]"
+    return json.dumps(value, sort_keys=True, allow_nan=False, separators=(", ", ": "))
 
 
 @contextlib.contextmanager
