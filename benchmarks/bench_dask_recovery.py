@@ -80,6 +80,13 @@ class Sampler(threading.Thread):
             })  # fmt: skip
 
 
+def _sigint_default() -> None:
+    """In the child before it runs: Ctrl-C's default action, as on a terminal (a benchmark
+    started in the background, ``cmd &`` or ``nohup``, ignores SIGINT, and so would the
+    child, which Python keeps: the study would then never stop)."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def parts_rows(parts: Path) -> int:
     import pyarrow.parquet as pq
 
@@ -127,6 +134,7 @@ def main(argv: list[str] | None = None) -> None:
         child = subprocess.Popen(
             [sys.executable, "-c", CHILD, cluster.scheduler_address, str(args.n), str(out)],
             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+            preexec_fn=_sigint_default,
         )  # fmt: skip
         t0 = time.perf_counter()
         while child.poll() is None and parts_rows(parts) < args.stop_at * args.n:
