@@ -65,9 +65,9 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
 
     The contacts (each feature's deflection and normal force, from the
     contact geometry of every pair) only where the rows have their columns:
-    the summary-only runs of a sweep record rows of ``NOUT`` columns
-    (``records.new_output(..., contact_columns=False)``), which the summary
-    reads the attitude and the last state of, and skip that work.
+    a sweep's runs record rows of ``NOUT`` columns
+    (``records.new_output(..., contact_columns=False)``) and skip that work,
+    since their summary reads only the attitude and the last state.
     """
     out = o.out
     nf = m.feat.shape[0]
