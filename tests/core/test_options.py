@@ -4,11 +4,10 @@ import math
 
 import numpy as np
 import pytest
-from numba import njit
 
 from quadimpact import FlightScenario, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute, make_kernel
+from quadimpact.core.run import execute
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 from quadimpact.simulation.simulate import run_setup
@@ -95,13 +94,9 @@ def test_friction_impulse_is_mu_times_normal_impulse(mu):
     assert dvt == pytest.approx(mu * dvn, rel=1e-2, abs=1e-12)
 
 
-@njit
-def _step_to_600(x, ctrl, mem, veh, dt, cmd):
-    for j in range(4):
-        cmd[j] = 600.0
-
-
 def test_first_order_rotors_follow_their_time_constant():
+    """A step of the command from 500 to 600 rad/s at t = 0: the built-in hold controller
+    commands the rotors' own speeds, which the command floor of 600 rad/s lifts to 600."""
     setup = prepare(
         FlightScenario(
             rotor_speeds_rad_s=(500, 500, 500, 500), final_time_s=0.2, rotor_mode="first-order"
@@ -109,8 +104,11 @@ def test_first_order_rotors_follow_their_time_constant():
     )
     veh = setup.veh.copy()
     veh[L.V_GRAVITY] = 0.0
-    kernel = make_kernel(_step_to_600)
-    out = execute(setup.model(veh=veh), kernel=kernel).out
+    setup.ctrl[L.C_KIND] = L.CTRL_NONE
+    opts = setup.opts.copy()
+    opts[L.O_OMEGA_MIN], opts[L.O_OMEGA_MAX], opts[L.O_SLEW_MAX] = 600.0, 0.0, 0.0
+    out = execute(setup.model(veh=veh, opts=opts)).out
+    assert np.all(out[1:, L.OUT_CMD : L.OUT_CMD + 4] == 600.0)
     t = out[:, L.OUT_T]
     tau = setup.vehicle.motor_time_constant_s
     expected = 600.0 - 100.0 * np.exp(-t / tau)
