@@ -355,6 +355,39 @@ def test_default_pool_size(idle, cores, workers):
     assert pool_size(idle, cores) == workers
 
 
+@pytest.mark.parametrize(
+    ("idle", "before", "after", "window", "expected"),
+    [(0.2, 1.0, 1.2, 0.25, 1.0), (0.2, None, 1.2, 0.25, 0.2), (None, 1.0, 1.2, 0.25, None),
+     (1.0, 1.0, 1.0, 0.25, 1.0), (0.3, 2.0, 1.9, 0.25, 0.3)],
+)  # fmt: skip
+def test_own_server_counts_as_idle(idle, before, after, window, expected):
+    """The CPU the sweep's own warming fork server used is idle for the pool's size."""
+    from quadimpact.sweep.run import own_server_idle, pool_size
+
+    got = own_server_idle(idle, before, after, window)
+    assert got == pytest.approx(expected) if expected is not None else got is None
+    if expected is not None:
+        assert pool_size(got, 2) == pool_size(expected, 2)
+
+
+def test_process_cpu_time_read_from_proc():
+    """A process's CPU time from /proc agrees with its own clock to a few ticks."""
+    import os
+    import time
+
+    from quadimpact.sweep.pool import process_cpu_s
+
+    first = process_cpu_s(os.getpid())
+    if first is None:
+        pytest.skip("no /proc here")
+    end = time.process_time() + 0.2
+    while time.process_time() < end:  # burn 0.2 s of CPU
+        pass
+    tick = 1.0 / os.sysconf("SC_CLK_TCK")
+    assert process_cpu_s(os.getpid()) == pytest.approx(time.process_time(), abs=3 * tick)
+    assert process_cpu_s(2**22 + 12345) is None  # no such process
+
+
 def test_idle_cores_measured():
     """While this process burns CPU, at most the other cores are idle."""
     from quadimpact.sweep.run import cpu_sample, default_workers, idle_cores

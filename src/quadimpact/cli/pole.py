@@ -92,11 +92,14 @@ def pole(
       quadimpact pole --pitch-step 5 --offset-step 0.05 --out results/pole-coarse
       quadimpact pole --obstacle box-corner.toml --out results/box
     """
+    if scheduler is not None and workers is not None:
+        raise InputError("--workers and --scheduler: give one or the other")
+    from quadimpact.sweep.run import warm_pool
+
+    warm_pool(workers, scheduler)  # the pool's server warms up while the study is imported
     from quadimpact.pole.report import rate_text
     from quadimpact.pole.study import PoleStudy, run_pole_study
 
-    if scheduler is not None and workers is not None:
-        raise InputError("--workers and --scheduler: give one or the other")
     study = PoleStudy(
         vehicle=vehicle,
         pitch_max_deg=pitch_max_deg,

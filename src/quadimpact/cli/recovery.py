@@ -98,13 +98,20 @@ def recovery(
       quadimpact recovery --estimator ekf --sensors impact --out results/ekf-impact
       quadimpact recovery --sweep my-trials.toml --out results/mine
     """
-    from quadimpact.recovery.study import RecoveryStudy, run_study
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "recovery")
 
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
+    from quadimpact.sweep.run import warm_pool
+
+    # the pool's fork server imports the simulator and loads the kernel on another core
+    # while this process imports the study: the trials' pool and the example trial's
+    # process (docs/RECOVERY.md 8) then start from a warm server instead of waiting for it
+    warm_pool(workers, scheduler)
+    from quadimpact.recovery.study import RecoveryStudy, run_study
+
     if imu is not None and sensors is not None:
         raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
     values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)

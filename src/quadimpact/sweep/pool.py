@@ -99,6 +99,27 @@ def server_ready(ctx: Any) -> bool:
     return os.path.exists(os.path.join(util.get_temp_dir(), SERVER_READY))
 
 
+def process_cpu_s(pid: int) -> float | None:
+    """CPU time (s) process ``pid`` has used so far: its own user and system time, not
+    its children's (``/proc/<pid>/stat``; None off Linux or where it cannot be read)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as f:
+            fields = f.read().rsplit(")", 1)[1].split()  # the fields after the command's name
+        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")  # utime, stime
+    except (OSError, ValueError, IndexError, AttributeError):
+        return None
+
+
+def server_cpu_s(ctx: Any) -> float | None:
+    """CPU time (s) this process's fork server has used so far (None: no server, or unknown)."""
+    if ctx.get_start_method() != "forkserver":
+        return None
+    from multiprocessing import forkserver
+
+    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)
+    return process_cpu_s(pid) if pid else None
+
+
 class _Task:
     """Runs to do, in order; ``lost`` > 0 marks a lone run being redone after a loss.
 

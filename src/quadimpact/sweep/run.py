@@ -26,6 +26,7 @@ from quadimpact.sweep.pool import (
     WorkerError,
     pool_context,
     run_pool,
+    server_cpu_s,
     server_ready,
     start_server,
 )
@@ -347,7 +348,7 @@ def _start_here(
     started: float | None = None
     workers = 1
     busy, n_here = 0.0, 0
-    t0, sample0 = time.perf_counter(), cpu_sample()
+    t0, sample0, server0 = time.perf_counter(), cpu_sample(), server_cpu_s(ctx)
     for chunk in make_chunks(spec, todo, 1):  # one id at a time from the shared iterator
         t = time.perf_counter()
         run_serial(iter([chunk]), sink)
@@ -359,7 +360,8 @@ def _start_here(
         if started is None:
             if now - t0 < MEASURE_S:
                 continue
-            workers = pool_size(idle_cores(sample0, cpu_sample()), cores)
+            idle = idle_cores(sample0, cpu_sample())
+            workers = pool_size(own_server_idle(idle, server0, server_cpu_s(ctx), now - t0), cores)
             if workers < 2:
                 break  # the other cores are busy: finish here
             start_server(ctx)  # it loads the kernel while the runs go on here
@@ -388,6 +390,22 @@ def warm_pool(workers: int | None = None, scheduler: Any = None) -> None:
     ctx = pool_context()
     if ctx.get_start_method() == "forkserver":
         start_server(ctx)
+
+
+def own_server_idle(
+    idle: float | None, server_before_s: float | None, server_after_s: float | None, window_s: float
+) -> float | None:
+    """Idle CPUs over a window, counting the CPU this process's own fork server used as idle.
+
+    A server started early (:func:`warm_pool`) may still be importing while a
+    default sweep measures the idle cores: its core is busy with the sweep's
+    own work, which the pool will take over, not with someone else's.
+    ``server_*_s``: the server's CPU time at the window's ends (None: no
+    server, or unknown: ``idle`` as measured).
+    """
+    if idle is None or server_before_s is None or server_after_s is None or window_s <= 0.0:
+        return idle
+    return idle + max(0.0, server_after_s - server_before_s) / window_s
 
 
 def pool_size(idle: float | None, cores: int) -> int:
