@@ -187,3 +187,36 @@ def test_invalid_and_below_ground_trials_are_classed_and_left_out_of_the_rates()
         "3 of 6 trials (1 invalid: started in contact, 1 invalid: bumper model exceeded, 1 failed)"
     )
     assert excluded_text(analysis.summarise(_table([_row()]))) == "none (all 1 trials valid)"
+
+
+# ------------------------------------------------------------------ figures
+def test_figures_drawn_on_another_process_are_the_same_files(tmp_path) -> None:
+    """The distributions figure rendered elsewhere (``submit``) is written byte for byte as
+    here, and a failure there draws it here."""
+    from concurrent.futures import Future
+
+    from quadimpact.recovery import figures
+
+    t = _table([_row(height_loss_m=0.05 * k, time_to_recover_s=0.2 + 0.01 * k) for k in range(9)])
+    calls = []
+
+    def submit(fn, *args):  # "another process": run now, hand back a finished future
+        calls.append(args[0].columns.tolist())
+        done = Future()
+        done.set_result(fn(*args))
+        return done
+
+    def broken(fn, *args):
+        lost = Future()
+        lost.set_exception(RuntimeError("the process died"))
+        return lost
+
+    for name in ("here", "there", "fallback"):
+        (tmp_path / name).mkdir()
+    here = figures.write_figures(t, tmp_path / "here")
+    there = figures.write_figures(t, tmp_path / "there", submit=submit)
+    fallback = figures.write_figures(t, tmp_path / "fallback", submit=broken)
+    assert calls == [list(figures.DISTRIBUTION_COLUMNS)]  # only the columns it draws go there
+    for a, b, c in zip(here, there, fallback, strict=True):
+        assert a.name == b.name == c.name
+        assert a.read_bytes() == b.read_bytes() == c.read_bytes()

@@ -100,6 +100,16 @@ class EarlyExample:
         self._executor = None
         return d, (paths, warnings), recovered
 
+    def submit(self, fn: Any, *args: Any) -> Any:
+        """A future of ``fn(*args)`` on the example's process once the example is done
+        (it is then idle, with Matplotlib loaded); None before, or without the process."""
+        if self._executor is None or not self._future.done():
+            return None
+        try:
+            return self._executor.submit(fn, *args)
+        except Exception:  # a broken executor: the caller does the work itself
+            return None
+
     def cancel(self) -> None:
         """Stop the example's process at once and remove its unfinished folder."""
         import shutil

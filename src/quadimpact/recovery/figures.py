@@ -14,7 +14,9 @@ Inclination is toward the wall, ``-pitch`` (deg); speed toward the wall (m/s).
 
 from __future__ import annotations
 
+import io
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +26,7 @@ from matplotlib.figure import Figure
 
 from quadimpact.recovery import analysis
 from quadimpact.results.figures import (
+    FIG_DPI,
     STAGE_COLORS,
     STAGE_NAMES,
     break_wraps,
@@ -31,11 +34,13 @@ from quadimpact.results.figures import (
     new_figure,
     save_figure,
 )
+from quadimpact.results.files import atomic_write
 
 __all__ = [
     "FIGURES",
     "compare_by_bin_figure",
     "distributions_figure",
+    "distributions_png",
     "example_figure",
     "success_by_bin_figure",
     "success_map_figure",
@@ -50,6 +55,8 @@ DISTRIBUTIONS = (
     ("height_loss_m", "height loss (m)", 1.0),
     ("horizontal_drift_m", "horizontal drift (m)", 1.0),
 )
+#: The table's columns :func:`distributions_figure` reads.
+DISTRIBUTION_COLUMNS = ("outcome_class", *(column for column, _, _ in DISTRIBUTIONS))
 
 
 def success_map_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
@@ -225,20 +232,49 @@ def example_figure(result: Any, title: str | None = None) -> Figure:
     return fig
 
 
+def distributions_png(table: pd.DataFrame) -> bytes:
+    """:func:`distributions_figure` of ``table`` as PNG bytes (what another process renders)."""
+    buffer = io.BytesIO()
+    distributions_figure(table).savefig(buffer, format="png", dpi=FIG_DPI)
+    return buffer.getvalue()
+
+
 def write_figures(
-    table: pd.DataFrame, out_dir: str | os.PathLike[str], numbers: dict[str, Any] | None = None
+    table: pd.DataFrame,
+    out_dir: str | os.PathLike[str],
+    numbers: dict[str, Any] | None = None,
+    *,
+    submit: Callable[..., Any] | None = None,
 ) -> list[Path]:
     """Write :data:`FIGURES` into ``out_dir`` and return their paths.
 
     ``numbers`` are the table's :func:`analysis.summarise` (computed if not given).
+    ``submit(fn, *args)``: a future of ``fn(*args)`` on another process (the
+    study's idle example process, ``example.EarlyExample.submit``), or None:
+    the distributions figure (about half of the three figures' CPU time) is
+    then rendered there while this process draws the other two, and written
+    here; a failure there renders it here instead.
     """
     out = Path(out_dir)
     numbers = analysis.summarise(table) if numbers is None else numbers
-    return [
+    future = None
+    if submit is not None:
+        future = submit(distributions_png, table[list(DISTRIBUTION_COLUMNS)])
+    paths = [
         save_figure(success_map_figure(table), out / FIGURES[0]),
         save_figure(success_by_bin_figure(numbers), out / FIGURES[1]),
-        save_figure(distributions_figure(table), out / FIGURES[2]),
     ]
+    png = None
+    if future is not None:
+        try:
+            png = future.result()
+        except Exception:  # the other process failed or died: render it here
+            png = None
+    if png is None:
+        paths.append(save_figure(distributions_figure(table), out / FIGURES[2]))
+    else:
+        paths.append(atomic_write(out / FIGURES[2], lambda tmp: tmp.write_bytes(png)))
+    return paths
 
 
 def write_example(result: Any, path: str | os.PathLike[str], run_id: int) -> Path:

@@ -479,7 +479,8 @@ def run_study(
         numbers = analysis.summarise(table)
         warnings: list[str] = []
 
-        paths = figures.write_figures(table, out, numbers)
+        submit = early.submit if early is not None else None  # its idle process helps
+        paths = figures.write_figures(table, out, numbers, submit=submit)
         example_dir = None
         if example:
             run_id = analysis.example_trial(table)
