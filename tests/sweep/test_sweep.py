@@ -335,6 +335,7 @@ def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
         time.sleep(0.05)
     monkeypatch.setattr(run_module, "FINISH_HERE_S", 0.0)  # never "too little left"
     monkeypatch.setattr(run_module, "MEASURE_S", 0.0)  # decide after the first run
+    monkeypatch.setattr(run_module, "WARM_HANDOVER_RUNS", 10**9)  # time runs here first
     placed: list[str] = []
     table = run_sweep(spec, tmp_path / "d", on_placed=lambda: placed.append("placed"))
     assert placed == ["placed"]
@@ -342,6 +343,15 @@ def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
     # the pool, unless the other cores were measured busy
     handed_over = re.fullmatch(r"\d processes, the first [12] runs in this one", backend)
     assert backend == "serial" or handed_over, backend
+    assert_same_table(table, reference)
+    # from WARM_HANDOVER_RUNS runs on, a warm server takes every run (none here), unless
+    # the other cores are busy; the same table
+    monkeypatch.setattr(run_module, "WARM_HANDOVER_RUNS", 2)
+    placed.clear()
+    table = run_sweep(spec, tmp_path / "w", on_placed=lambda: placed.append("placed"))
+    backend = table.attrs["sweep"]["backend"]
+    assert placed == ["placed"]
+    assert backend == "serial" or re.fullmatch(r"\d processes", backend), backend
     assert_same_table(table, reference)
 
 
@@ -368,6 +378,16 @@ def test_own_server_counts_as_idle(idle, before, after, window, expected):
     assert got == pytest.approx(expected) if expected is not None else got is None
     if expected is not None:
         assert pool_size(got, 2) == pool_size(expected, 2)
+
+
+@pytest.mark.parametrize(("idle", "workers"), [(2.0, 2), (1.6, 2), (1.3, 1), (1.0, 1), (None, 2)])
+def test_warm_pool_size_takes_this_waiting_core_off(monkeypatch, idle, workers):
+    """Measured while this process waits, its own core is idle too: only the others count."""
+    import quadimpact.sweep.run as run_module
+
+    monkeypatch.setattr(run_module, "MEASURE_S", 0.0)
+    monkeypatch.setattr(run_module, "idle_cores", lambda before, after: idle)
+    assert run_module._warm_pool_size(2) == workers
 
 
 def test_process_cpu_time_read_from_proc():

@@ -99,6 +99,15 @@ def server_ready(ctx: Any) -> bool:
     return os.path.exists(os.path.join(util.get_temp_dir(), SERVER_READY))
 
 
+def server_started(ctx: Any) -> bool:
+    """Whether this process has started a fork server (warm or still warming up)."""
+    if ctx.get_start_method() != "forkserver":
+        return False
+    from multiprocessing import forkserver
+
+    return bool(getattr(forkserver._forkserver, "_forkserver_pid", None))
+
+
 def process_cpu_s(pid: int) -> float | None:
     """CPU time (s) process ``pid`` has used so far: its own user and system time, not
     its children's (``/proc/<pid>/stat``; None off Linux or where it cannot be read)."""

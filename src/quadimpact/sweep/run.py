@@ -28,6 +28,7 @@ from quadimpact.sweep.pool import (
     run_pool,
     server_cpu_s,
     server_ready,
+    server_started,
     start_server,
 )
 from quadimpact.sweep.progress import Progress
@@ -52,6 +53,12 @@ FINISH_HERE_WARM_S = 0.25
 :func:`warm_pool`): workers then start in milliseconds, s."""
 MEASURE_S = 0.25
 """A default sweep measures the idle cores over its first runs for this long, s."""
+WARM_HANDOVER_RUNS = 16
+"""From this many runs on, a default sweep whose pool server is already warm hands
+every run to the pool (after measuring the idle cores) instead of timing runs here."""
+WARM_WAIT_S = 0.5
+"""Longest such a sweep waits for a server this process started earlier to be warm, s
+(this process's own kernel load takes about as long)."""
 START_HERE_MAX_S = 3.0
 """Longest a default sweep runs in this process waiting for the pool's server to warm up, s."""
 VALIDATION_NOTE_RUNS = 100_000
@@ -320,7 +327,13 @@ def _start_here(
 ) -> tuple[int, int]:
     """The default start of a sweep on several cores: measured runs in this process.
 
-    The sweep process loads the kernel and does runs, timing them and
+    Where the pool's server is already warm (:func:`warm_pool`, an earlier
+    sweep) and at least :data:`WARM_HANDOVER_RUNS` runs are left, it only
+    measures the idle cores (:func:`_warm_pool_size`) and hands every run to
+    the pool if another core is idle (a server started earlier and still
+    warming up is waited for, at most :data:`WARM_WAIT_S`). Otherwise the
+    sweep process loads the
+    kernel and does runs, timing them and
     measuring how idle the cores it may use are (``/proc/stat``). It
     finishes the sweep itself when the runs left would take less than
     :data:`FINISH_HERE_S` here (:data:`FINISH_HERE_WARM_S` when the pool's
@@ -340,10 +353,22 @@ def _start_here(
     (int, int)
         Runs done here, and the pool's workers for the rest (1: none left).
     """
-    warm_up()
     ctx = pool_context()
     # a server this process already warmed (an earlier sweep, warm_pool) starts workers at once
     warm = ctx.get_start_method() == "forkserver" and server_ready(ctx)
+    if not warm and n_todo >= WARM_HANDOVER_RUNS and server_started(ctx):
+        # started early (warm_pool) and still warming: it is usually ready sooner than
+        # this process could load its own kernel
+        end = time.perf_counter() + WARM_WAIT_S
+        while not warm and time.perf_counter() < end:
+            time.sleep(0.02)
+            warm = server_ready(ctx)
+    if warm and n_todo >= WARM_HANDOVER_RUNS:
+        workers = _warm_pool_size(cores)
+        if workers > 1:  # no run here: the pool starts now, and this process loads no kernel
+            placed()
+            return 0, workers
+    warm_up()
     finish_here_s = FINISH_HERE_WARM_S if warm else FINISH_HERE_S
     started: float | None = None
     workers = 1
@@ -372,6 +397,20 @@ def _start_here(
     placed()
     run_serial(make_chunks(spec, todo, 16), sink)
     return n_todo, 1
+
+
+def _warm_pool_size(cores: int) -> int:
+    """Workers for a default sweep whose pool server is already warm: measured idle.
+
+    The cores' idle time over :data:`MEASURE_S` while this process waits (its
+    own core is then idle too, and is taken off): a busy machine still gets
+    one process. Workers forked from a warm server start in milliseconds, so
+    no run is timed here first.
+    """
+    before = cpu_sample()
+    time.sleep(MEASURE_S)
+    idle = idle_cores(before, cpu_sample())
+    return pool_size(None if idle is None else max(0.0, idle - 1.0), cores)
 
 
 def warm_pool(workers: int | None = None, scheduler: Any = None) -> None:
