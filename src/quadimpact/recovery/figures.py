@@ -30,6 +30,7 @@ from quadimpact.results.figures import (
     STAGE_COLORS,
     STAGE_NAMES,
     break_wraps,
+    fig_margins,
     mark_stages,
     new_figure,
     save_figure,
@@ -70,7 +71,8 @@ def success_map_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     xs = list(table["inclination_bin"].cat.categories)
     ys = list(table["speed_bin"].cat.categories)
     grid = np.full((len(ys), len(xs)), np.nan)
-    fig = new_figure(max(6.0, 1.6 + 0.95 * len(xs)), max(3.5, 1.4 + 0.55 * len(ys)))
+    w, h = max(6.0, 1.6 + 0.95 * len(xs)), max(3.5, 1.4 + 0.55 * len(ys))
+    fig = new_figure(w, h, margins=fig_margins(w, h, "title", bottom_in=0.85, right_in=0.1))
     ax = fig.add_subplot()
     for (yv, xv), r in cells.iterrows():
         i, j = ys.index(yv), xs.index(xv)
@@ -117,7 +119,11 @@ def _rate_panel(ax: Any, rates: pd.DataFrame, xlabel: str) -> None:
 
 def success_by_bin_figure(numbers: dict[str, Any], title: str | None = None) -> Figure:
     """Success rate by inclination bin and by speed bin (``analysis.summarise`` numbers)."""
-    fig = new_figure(11.0, 4.0)
+    fig = new_figure(
+        11.0,
+        4.0,
+        margins=fig_margins(11.0, 4.0, "title", wspace=0.15, bottom_in=0.95, right_in=0.45),
+    )
     left, right = fig.subplots(1, 2, sharey=True)
     _rate_panel(left, numbers["by_inclination"], "inclination toward the wall, -pitch (deg)")
     _rate_panel(right, numbers["by_speed"], "speed toward the wall (m/s)")
@@ -161,7 +167,7 @@ def compare_by_bin_figure(
 def distributions_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     """Histogram (top) and empirical CDF (bottom) of each recovery measure, recovered trials."""
     good = table[table["outcome_class"].astype(str) == "recovered"]
-    fig = new_figure(12.0, 6.0)
+    fig = new_figure(12.0, 6.0, margins=fig_margins(12.0, 6.0, "title", hspace=0.3, wspace=0.3))
     axes = fig.subplots(2, len(DISTRIBUTIONS), squeeze=False)
     for k, (column, label, scale) in enumerate(DISTRIBUTIONS):
         v = good[column].to_numpy(dtype=float) * scale
@@ -192,7 +198,8 @@ def example_figure(result: Any, title: str | None = None) -> Figure:
     """
     ts, summary = result.timeseries, result.summary
     t = ts["t_s"].to_numpy(dtype=float)
-    fig = new_figure(9.0, 8.0)
+    # fixed margins (the layout engine would cost about as much as the drawing)
+    fig = new_figure(9.0, 8.0, margins=fig_margins(9.0, 8.0, "title", hspace=0.22))
     axes = fig.subplots(4, 1, sharex=True)
     for col, color in (("roll_deg", "tab:blue"), ("pitch_deg", "tab:orange"),
                        ("yaw_deg", "tab:green")):  # fmt: skip

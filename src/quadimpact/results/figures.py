@@ -44,6 +44,7 @@ __all__ = [
     "unwrap_deg",
     "check_columns",
     "facet_panels",
+    "fig_margins",
     "field_label",
     "field_name",
     "field_value",
@@ -135,19 +136,28 @@ def compact_ticks(ax: Any) -> None:
         pass
 
 
-def _fig_margins(
-    width_in: float, height_in: float, title: str | None, hspace: float = 0.2, wspace: float = 0.2
+def fig_margins(
+    width_in: float,
+    height_in: float,
+    title: str | None,
+    hspace: float = 0.2,
+    wspace: float = 0.2,
+    *,
+    bottom_in: float = 0.55,
+    right_in: float = 0.2,
 ) -> dict[str, float]:
-    """Fixed margins of a per-run figure, in inches turned into figure fractions.
+    """Fixed margins of a figure, in inches turned into figure fractions.
 
     The left margin holds a y label and tick labels of up to six characters
-    (``-0.005``, ``1000``: :func:`compact_ticks` keeps them that short).
+    (``-0.005``, ``1000``: :func:`compact_ticks` keeps them that short); the
+    bottom one an x label and one line of tick labels (more for rotated ones:
+    ``bottom_in``). ``hspace``, ``wspace``: as ``Figure.subplots_adjust``.
     """
     top_in = 0.55 if title else 0.25
     return {
         "left": LEFT_MARGIN_IN / width_in,
-        "right": 1.0 - 0.2 / width_in,
-        "bottom": 0.55 / height_in,
+        "right": 1.0 - right_in / width_in,
+        "bottom": bottom_in / height_in,
         "top": 1.0 - top_in / height_in,
         "hspace": hspace,
         "wspace": wspace,
@@ -195,7 +205,7 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     matplotlib.figure.Figure
         One axes; line ``j-1`` is bumper ``j`` in millimetres.
     """
-    fig = new_figure(7.0, 3.8, margins=_fig_margins(7.0, 3.8, title))
+    fig = new_figure(7.0, 3.8, margins=fig_margins(7.0, 3.8, title))
     ax = fig.add_subplot()
     t = np.asarray(ts["t_s"], dtype=np.float64)
     lines = _feature_lines(ts)
@@ -247,7 +257,7 @@ def make_fig6(
         Axes in order X, roll, Y, pitch, altitude, yaw (row-major). In each
         axes the first line is the simulated quantity.
     """
-    fig = new_figure(10.0, 7.5, margins=_fig_margins(10.0, 7.5, title, hspace=0.12, wspace=0.25))
+    fig = new_figure(10.0, 7.5, margins=fig_margins(10.0, 7.5, title, hspace=0.12, wspace=0.25))
     axes = fig.subplots(3, 2, sharex=True)
     t = np.asarray(ts["t_s"], dtype=np.float64)
 
@@ -368,7 +378,7 @@ def make_imu(
     """
     n_panels = 3 if ts is not None and len(ts["t_s"]) else 2
     height = 2.4 * n_panels + 0.4
-    fig = new_figure(8.0, height, margins=_fig_margins(8.0, height, title, hspace=0.12))
+    fig = new_figure(8.0, height, margins=fig_margins(8.0, height, title, hspace=0.12))
     axes = list(np.atleast_1d(fig.subplots(n_panels, 1, sharex=True)))
     t = np.asarray(imu["t_s"], dtype=np.float64)
     if n_panels == 3:
