@@ -332,9 +332,9 @@ def _start_here(
     measures the idle cores (:func:`_warm_pool_size`) and hands every run to
     the pool if another core is idle (a server started earlier and still
     warming up is waited for, at most :data:`WARM_WAIT_S`). Otherwise the
-    sweep process loads the
-    kernel and does runs, timing them and
-    measuring how idle the cores it may use are (``/proc/stat``). It
+    sweep process loads the kernel and does runs, timing them and measuring
+    how idle the cores it may use are (``/proc/stat``; the CPU its own
+    warming server uses counts as idle, :func:`own_server_idle`). It
     finishes the sweep itself when the runs left would take less than
     :data:`FINISH_HERE_S` here (:data:`FINISH_HERE_WARM_S` when the pool's
     server is already warm), or when after :data:`MEASURE_S` fewer than
