@@ -189,6 +189,14 @@ def main(argv: list[str] | None = None) -> None:
             f"child: {stdout[-2000:]} {stderr[-2000:]}"
         )
         assert len(table) == args.n and table["run_id"].tolist() == list(range(args.n))
+        # each tenth of the study by run_id: the loop's and the whole trial's CPU per trial
+        # (a rate that changes over a long pass: the trials' own cost, or the machine?)
+        tenth = (table["run_id"] * 10 // args.n).rename("tenth")
+        costs = table.groupby(tenth)[["cost__kernel_cpu_s", "cost__total_cpu_s"]].mean()
+        report["cost_by_tenth_ms"] = [
+            {"tenth": int(k), "kernel": 1e3 * float(r.iloc[0]), "total": 1e3 * float(r.iloc[1])}
+            for k, r in costs.iterrows()
+        ]
         s = sampler.samples
         picks = [s[min(len(s) - 1, int(k * len(s) / 10))] for k in range(11)] if s else []
         report["memory"] = picks
@@ -219,6 +227,9 @@ def main(argv: list[str] | None = None) -> None:
     for x in report["memory"]:
         workers = ", ".join(f"{w:.0f}" for w in x["workers_mb"])
         print(f"  {x['t_s']:6.1f} {x['parts_rows']:8d} {x['client_mb']:8.0f}   {workers}")
+    print("CPU per trial (ms) by tenth of the study: loop / whole trial")
+    for x in report["cost_by_tenth_ms"]:
+        print(f"  {x['tenth']}: {x['kernel']:.2f} / {x['total']:.2f}")
     print(f"the first {check} trials: the same rows on one core (bit for bit, costs aside)")
     if args.json:
         args.json.write_text(json.dumps(report, indent=1, default=str))
