@@ -99,13 +99,18 @@ def server_ready(ctx: Any) -> bool:
     return os.path.exists(os.path.join(util.get_temp_dir(), SERVER_READY))
 
 
-def server_started(ctx: Any) -> bool:
-    """Whether this process has started a fork server (warm or still warming up)."""
+def _server_pid(ctx: Any) -> int | None:
+    """The pid of the fork server this process started (None: none, or not a fork server)."""
     if ctx.get_start_method() != "forkserver":
-        return False
+        return None
     from multiprocessing import forkserver
 
-    return bool(getattr(forkserver._forkserver, "_forkserver_pid", None))
+    return getattr(forkserver._forkserver, "_forkserver_pid", None) or None
+
+
+def server_started(ctx: Any) -> bool:
+    """Whether this process has started a fork server (warm or still warming up)."""
+    return _server_pid(ctx) is not None
 
 
 def process_cpu_s(pid: int) -> float | None:
@@ -121,12 +126,8 @@ def process_cpu_s(pid: int) -> float | None:
 
 def server_cpu_s(ctx: Any) -> float | None:
     """CPU time (s) this process's fork server has used so far (None: no server, or unknown)."""
-    if ctx.get_start_method() != "forkserver":
-        return None
-    from multiprocessing import forkserver
-
-    pid = getattr(forkserver._forkserver, "_forkserver_pid", None)
-    return process_cpu_s(pid) if pid else None
+    pid = _server_pid(ctx)
+    return None if pid is None else process_cpu_s(pid)
 
 
 class _Task:
