@@ -528,3 +528,46 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
     assert core.cache_is_warm()
     announce_compilation()
     assert capsys.readouterr().err == ""
+
+
+def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path: Path) -> None:
+    """A missing result folder, scenario file or an unusable --out is said before the
+    simulator (the compiled kernel's driver) or the drawing code (Matplotlib) is imported,
+    and, but for ``run`` (whose scenario fields name compiled controllers), before Numba."""
+    import sys
+
+    afile = tmp_path / "a-file"
+    afile.write_text("not a folder\n")
+    cases = [
+        ["view", str(tmp_path / "nowhere")],
+        ["animate", str(tmp_path / "nowhere")],
+        ["snapshots", str(tmp_path / "nowhere")],
+        ["reproduce", "--out", str(afile)],
+        ["experiments", "--out", str(afile)],
+        ["run", str(tmp_path / "nowhere.toml")],  # last: it loads Numba
+    ]
+    code = (
+        "import json, sys\n"
+        "from quadimpact.cli import main\n"
+        "seen = []\n"
+        f"for args in {cases!r}:\n"
+        "    try:\n"
+        "        main(args)\n"
+        "    except SystemExit as exc:\n"
+        "        names = ('numba', 'quadimpact.core.run', 'matplotlib')\n"
+        "        loaded = [m in sys.modules for m in names]\n"
+        "        seen.append([args[0], exc.code, *loaded])\n"
+        "print(json.dumps(seen))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=tmp_path
+    )
+    assert proc.returncode == 0, proc.stderr
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert [s[0] for s in seen] == [c[0] for c in cases]
+    for command, exit_code, numba_loaded, kernel_loaded, mpl_loaded in seen:
+        assert exit_code == 2, (command, proc.stderr)
+        assert not kernel_loaded and not mpl_loaded, (command, kernel_loaded, mpl_loaded)
+        assert command == "run" or not numba_loaded, command
+    errors = [line for line in proc.stderr.splitlines() if line.startswith("quadimpact: error:")]
+    assert len(errors) == len(cases) and "Traceback" not in proc.stderr, proc.stderr

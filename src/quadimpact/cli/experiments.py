@@ -69,10 +69,11 @@ def experiments(
     finished run (exit status 130, 143 for SIGTERM), saying how many; run the
     same command again to resume.
     """
-    from quadimpact.experiments.table3 import check_data_dir, logs_source, run_experiments
     from quadimpact.results.files import check_out_dir
 
-    check_out_dir(out, "experiments")
+    check_out_dir(out, "experiments")  # before the study's imports: a wrong folder is said at once
+    from quadimpact.experiments.table3 import check_data_dir, logs_source, run_experiments
+
     if data is not None:
         check_data_dir(data)
     announce_compilation()

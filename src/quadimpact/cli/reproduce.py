@@ -67,11 +67,12 @@ def reproduce(
     finished run (exit status 130, 143 for SIGTERM), saying how many; run the
     same command again to resume.
     """
-    from quadimpact.experiments.table3 import check_data_dir, logs_source
-    from quadimpact.paper.study import reproduce as run_study
     from quadimpact.results.files import check_out_dir
 
-    check_out_dir(out, "report")
+    check_out_dir(out, "report")  # before the study's imports: a wrong folder is said at once
+    from quadimpact.experiments.table3 import check_data_dir, logs_source
+    from quadimpact.paper.study import reproduce as run_study
+
     if data is not None and not no_experiments:
         check_data_dir(data)
     announce_compilation()

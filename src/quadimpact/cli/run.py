@@ -258,9 +258,10 @@ def run(
          NaN); its folder is still written, with the reason in summary.json
     """
     from quadimpact.results.files import check_out_dir
-    from quadimpact.simulation.checks import check_record_size
 
     built = build_scenario(scenario, flags, options, params=params, kind=kind)
+    from quadimpact.simulation.checks import check_record_size  # the compiled geometry
+
     check_record_size(built, max_record_mb, "--max-record-mb")
     check_out_dir(out, "run")
     vehicle = built.build_vehicle()

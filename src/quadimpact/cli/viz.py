@@ -73,7 +73,7 @@ def _camera(
     follow: str | None,
     span: float | None,
 ) -> Any:
-    from quadimpact.viz.scene import Camera
+    from quadimpact.viz.camera import Camera
 
     try:
         return Camera(
@@ -87,10 +87,13 @@ def _camera(
 
 
 def _scene(result_dir: Path, vehicle: str | None) -> Any:
-    """The scene of a result folder, with input errors as one line."""
+    """The scene of a result folder, with input errors as one line.
+
+    The folder is checked and read before the drawing code (and the simulator
+    it draws with) is imported: a wrong folder is said at once.
+    """
     from quadimpact.results.files import SUMMARY_JSON, TIMESERIES_PARQUET, check_writable
     from quadimpact.results.result import read_result
-    from quadimpact.viz.scene import Scene
 
     if not result_dir.is_dir():
         raise InputError(f"{result_dir}: result folder not found")
@@ -104,6 +107,8 @@ def _scene(result_dir: Path, vehicle: str | None) -> Any:
         veh = load_vehicle(vehicle)
     result = read_result(result_dir)  # a file that cannot be read: one line naming it
     check_writable(result_dir, f"{result_dir}: the pictures cannot be written there")
+    from quadimpact.viz.scene import Scene
+
     try:
         return Scene.from_result(result, vehicle=veh)
     except InputError as exc:
@@ -228,12 +233,14 @@ def animate(
     \b
       quadimpact animate results/paper-example-replica --slow 4 --start 0.4 --end 1.4
     """
-    from quadimpact.viz.animation import DEFAULT_ANIMATION_CAMERA, write_animation
+    from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA
 
     wh = _parse_size(size)
     camera = _camera(DEFAULT_ANIMATION_CAMERA, **cam)
     scene = _scene(result_dir, vehicle)
     _need_ffmpeg()
+    from quadimpact.viz.animation import write_animation
+
     info = write_animation(
         result_dir,
         fps=fps,
@@ -304,7 +311,7 @@ def snapshots(
     All frames are seen by the same camera, fixed at the impact point by
     default, with the time after the first contact under each.
     """
-    from quadimpact.viz.snapshots import DEFAULT_SNAPSHOT_CAMERA, write_snapshots
+    from quadimpact.viz.camera import DEFAULT_SNAPSHOT_CAMERA
 
     if times is not None and paper_figure is not None:
         raise InputError("--times and --paper-figure: give one of them, not both")
@@ -313,6 +320,8 @@ def snapshots(
         _check_frames(parsed, max_frames)
     camera = _camera(DEFAULT_SNAPSHOT_CAMERA, **cam)
     scene = _scene(result_dir, vehicle)
+    from quadimpact.viz.snapshots import write_snapshots
+
     png, pdf, warnings = write_snapshots(
         result_dir, parsed, None if paper_figure is None else int(paper_figure), camera, scene=scene
     )
@@ -340,10 +349,12 @@ def view(result_dir: Path, rate: float, vehicle: str | None, **cam: Any) -> None
     turn, wheel to zoom), time slider, play/pause, deflection and attitude
     plots linked to the slider. URL parameters: viewer.html#t=0.6&az=110&el=20.
     """
-    from quadimpact.viz.viewer import DEFAULT_VIEWER_CAMERA, write_viewer
+    from quadimpact.viz.camera import DEFAULT_VIEWER_CAMERA
 
     camera = _camera(DEFAULT_VIEWER_CAMERA, **cam)
     scene = _scene(result_dir, vehicle)
+    from quadimpact.viz.viewer import write_viewer
+
     path = write_viewer(result_dir, rate_hz=rate, camera=camera, scene=scene)
     click.echo(str(path.resolve()))
 

@@ -1,7 +1,8 @@
 """Pictures of a run: 3D snapshots, movies and an interactive HTML viewer.
 
+* :mod:`quadimpact.viz.camera`: the camera and each command's default view;
 * :mod:`quadimpact.viz.scene`: the geometry (NumPy; contact points from the
-  compiled contact law) and the camera;
+  compiled contact law);
 * :mod:`quadimpact.viz.render`: the scene as matplotlib artists updated in place;
 * :mod:`quadimpact.viz.snapshots`: ``snapshots.png``/``.pdf``;
 * :mod:`quadimpact.viz.animation`: ``animation.mp4``/``.gif``;

@@ -32,8 +32,9 @@ from matplotlib.figure import Figure
 
 from quadimpact.results.figures import set_time_limits, stage_label
 from quadimpact.results.files import atomic_write
+from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
-from quadimpact.viz.scene import BUMPER_COLORS_HEX, Camera, Scene
+from quadimpact.viz.scene import BUMPER_COLORS_HEX, Scene
 
 __all__ = [
     "ANIMATION_GIF",
@@ -48,10 +49,6 @@ __all__ = [
 ANIMATION_MP4 = "animation.mp4"
 ANIMATION_GIF = "animation.gif"
 
-#: Movies follow the vehicle by default (a crash falls out of any fixed view).
-DEFAULT_ANIMATION_CAMERA = Camera(
-    azimuth_deg=110.0, elevation_deg=20.0, follow="vehicle", span_m=0.9
-)
 
 _ATTITUDE_COLORS = {"roll": "#1b9e77", "pitch": "#d95f02", "yaw": "#7570b3"}
 

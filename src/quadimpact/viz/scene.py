@@ -23,10 +23,7 @@ and the sampled states of a run:
   (so the drawing shows the point the simulation pushed on), the deflection
   (the segment from that point along the contact normal, of length delta) and
   the normal force as an arrow along the contact normal;
-* the camera (:class:`Camera`): an orthographic view from a given azimuth and
-  elevation, altitude always up on screen and one metre the same length in
-  every direction (equal scaling), following the vehicle or fixed at the
-  impact point on the wall.
+* the camera is :class:`quadimpact.viz.camera.Camera` (re-exported here).
 
 A :class:`Scene` holds one run; :meth:`Scene.frame` gives every polyline and
 contact of one instant, and :meth:`Camera.project` puts points on the screen.
@@ -37,7 +34,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -49,6 +46,7 @@ from quadimpact.inputs.vehicle import Vehicle, load_vehicle
 from quadimpact.inputs.world import GROUND, Box, Cylinder, Plane, obstacle_from
 from quadimpact.rotations import quat_to_matrix, unwrap_deg
 from quadimpact.simulation.packing import pack_features, pack_surface_records, pack_surfaces
+from quadimpact.viz.camera import Camera
 
 __all__ = [
     "AXIS_LENGTH_M",
@@ -471,65 +469,6 @@ def plane_grid(
             base = p0 + k * step * axis
             segs.append([base + olo * other, base + ohi * other])
     return outline, np.array(segs, dtype=float).reshape(-1, 2, 3)
-
-
-@dataclass(frozen=True)
-class Camera:
-    """An orthographic camera: altitude up on screen, equal scaling.
-
-    Attributes
-    ----------
-    azimuth_deg : float
-        Direction from the target to the camera seen from above, deg from +X
-        (toward the wall) toward +Y (right); 90 looks from the starboard side
-        (the wall on the right of the picture), 180 from behind.
-    elevation_deg : float
-        Height of the camera above the horizontal through the target, deg in
-        [-89, 89]; positive looks down on the vehicle.
-    follow : {"vehicle", "wall"}
-        ``"vehicle"``: centred on the CM at every instant; ``"wall"``: fixed,
-        centred on the CM at the first contact (the impact point on the wall).
-    span_m : float
-        Height of the picture, m (the width follows from the aspect ratio).
-    """
-
-    azimuth_deg: float = 120.0
-    elevation_deg: float = 20.0
-    follow: Literal["vehicle", "wall"] = "vehicle"
-    span_m: float = 0.9
-
-    def __post_init__(self) -> None:
-        if self.follow not in ("vehicle", "wall"):
-            raise ValueError(f"follow must be 'vehicle' or 'wall' (got {self.follow!r})")
-        if not -89.0 <= self.elevation_deg <= 89.0:
-            raise ValueError("elevation_deg must lie in [-89, 89]")
-        if not self.span_m > 0:
-            raise ValueError("span_m must be > 0")
-
-    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Screen right, screen up and viewing direction (into the screen), NED unit vectors."""
-        az = math.radians(self.azimuth_deg)
-        el = math.radians(self.elevation_deg)
-        to_camera = np.array(
-            [math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), -math.sin(el)]
-        )
-        forward = -to_camera
-        world_up = np.array([0.0, 0.0, -1.0])  # NED: up is -Z
-        right = np.cross(forward, world_up)
-        right /= np.linalg.norm(right)
-        up = np.cross(right, forward)
-        return right, up, forward
-
-    def project(self, points: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """Screen coordinates (m, right and up from the picture centre) of NED points (..., 3)."""
-        right, up, _ = self.basis()
-        rel = np.asarray(points, dtype=float) - np.asarray(target, dtype=float)
-        return np.stack([rel @ right, rel @ up], axis=-1)
-
-    def depth(self, points: np.ndarray, target: np.ndarray) -> np.ndarray:
-        """Distance along the viewing direction (larger = farther from the camera), m."""
-        _, _, forward = self.basis()
-        return (np.asarray(points, dtype=float) - np.asarray(target, dtype=float)) @ forward
 
 
 @dataclass

@@ -16,8 +16,9 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from quadimpact.results.files import atomic_write
+from quadimpact.viz.camera import DEFAULT_SNAPSHOT_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
-from quadimpact.viz.scene import Camera, Scene
+from quadimpact.viz.scene import Scene
 
 __all__ = [
     "DEFAULT_SNAPSHOT_CAMERA",
@@ -42,9 +43,6 @@ PAPER_FIGURE_TIMES: dict[int, tuple[float, ...]] = {
 #: Times of the video frames set beside them in Figure 7.
 PAPER_VIDEO_TIMES: dict[int, tuple[float, ...]] = {7: (0.0, 0.1, 0.167, 0.233, 0.267, 0.333)}
 
-#: Snapshots default to a camera fixed at the impact point, from the starboard
-#: side and slightly behind, looking a little down.
-DEFAULT_SNAPSHOT_CAMERA = Camera(azimuth_deg=120.0, elevation_deg=20.0, follow="wall", span_m=1.0)
 
 SNAPSHOT_DPI = 150
 

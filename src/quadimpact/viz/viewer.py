@@ -3,7 +3,7 @@
 ``write_viewer(DIR)`` writes ``DIR/viewer.html``: the page template shipped
 with the package (``viewer_template.html``: vanilla JavaScript drawing on
 ``<canvas>`` with its own orthographic projection, the same as
-:class:`~quadimpact.viz.scene.Camera`) with the run's data embedded as JSON.
+:class:`~quadimpact.viz.camera.Camera`) with the run's data embedded as JSON.
 It opens offline from the file system: no server, no external script, style
 sheet or font, nothing fetched.
 
@@ -33,13 +33,13 @@ import numpy as np
 from quadimpact.inputs.world import Plane
 from quadimpact.results.figures import stage_label
 from quadimpact.results.files import atomic_write
+from quadimpact.viz.camera import DEFAULT_VIEWER_CAMERA, Camera
 from quadimpact.viz.render import WALL_WIDTH_M
-from quadimpact.viz.scene import BUMPER_NAMES, Camera, Scene, shape_lines
+from quadimpact.viz.scene import BUMPER_NAMES, Scene, shape_lines
 
 __all__ = ["DEFAULT_VIEWER_CAMERA", "VIEWER_HTML", "viewer_data", "viewer_html", "write_viewer"]
 
 VIEWER_HTML = "viewer.html"
-DEFAULT_VIEWER_CAMERA = Camera(azimuth_deg=110.0, elevation_deg=20.0, follow="vehicle", span_m=0.9)
 DEFAULT_RATE_HZ = 250.0
 _TEMPLATE = "viewer_template.html"
 _DATA_MARK = "__QUADIMPACT_DATA__"
