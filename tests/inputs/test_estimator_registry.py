@@ -102,6 +102,21 @@ def test_unknown_estimators_and_parameters_are_refused():
         unregister_estimator("ekf")
 
 
+def test_a_plain_python_estimator_step_is_refused_when_registered():
+    """The rule of the controllers: the compiled loop calls the step, so a plain Python
+    function is refused at registration, not when a run starts."""
+
+    def step(t, dt, meas, ecfg, est):  # not compiled
+        return None
+
+    with pytest.raises(TypeError, match="estimator 'plain-python': step must be compiled"):
+        register_estimator("plain-python", step=step)
+    with pytest.raises(ValueError, match="letters, digits"):
+        register_estimator("no spaces", kind=0)
+    with pytest.raises(ValueError, match="already registered"):
+        register_estimator("ekf", kind=0)
+
+
 def test_a_sensor_preset_fills_what_the_scenario_leaves():
     t = ImpactTrial(sensors="indoor")
     assert t.imu.preset == "impact" and t.magnetometer is not None and t.pose_sensor is not None

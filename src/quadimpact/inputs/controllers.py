@@ -26,12 +26,12 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, StrictBool, ValidationError
+from pydantic import BaseModel, Field, StrictBool
 
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import common as PID
 from quadimpact.core.controllers import recovery as REC
-from quadimpact.errors import InputError, input_error_from_validation, near_miss
+from quadimpact.inputs.registry import Registry
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
 
 __all__ = [
@@ -253,7 +253,14 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     return block
 
 
-_REGISTRY: dict[str, ControllerEntry] = {}
+_REGISTRY: Registry[ControllerEntry] = Registry(
+    "controller",
+    ("paper", "cascade-pid", "recovery"),
+    entry_type=ControllerEntry,
+    user_kind=L.CTRL_USER,
+    no_params=_NoParams,
+    empty_pack=_empty_block,
+)
 
 
 def register_controller(
@@ -291,49 +298,19 @@ def register_controller(
     -------
     ControllerEntry
     """
-    if not name or not all(c.isalnum() or c in "-_" for c in name):
-        raise ValueError(f"controller name {name!r}: letters, digits, '-' and '_' only")
-    if name in _REGISTRY and not replace:
-        raise ValueError(f"controller {name!r} is already registered (replace=True to replace)")
-    if step is None and kind is None:
-        raise ValueError(f"controller {name!r}: give its compiled step (or a built-in kind)")
-    if step is not None and not _is_compiled(step):
-        raise TypeError(
-            f"controller {name!r}: step must be compiled with numba.njit (got "
-            f"{type(step).__name__} {getattr(step, '__name__', step)!r}): the loop that calls "
-            "it is compiled, and a plain Python function would fail only when a run starts"
-        )
-    entry = ControllerEntry(
-        name=name,
-        kind=L.CTRL_USER if kind is None else int(kind),
-        params=params or _NoParams,
-        pack=pack or _empty_block,
-        step=step,
-        description=description,
+    return _REGISTRY.register(
+        name, step, params=params, pack=pack, kind=kind, description=description, replace=replace
     )
-    _REGISTRY[name] = entry
-    return entry
-
-
-def _is_compiled(step: Any) -> bool:
-    """Whether ``step`` is a Numba dispatcher (``njit``), which a compiled loop can call."""
-    try:
-        from numba.core.dispatcher import Dispatcher
-    except ImportError:  # pragma: no cover (numba is a dependency)
-        return callable(step)
-    return isinstance(step, Dispatcher)
 
 
 def unregister_controller(name: str) -> None:
     """Remove a registered controller (built-ins cannot be removed)."""
-    if name in ("paper", "cascade-pid", "recovery"):
-        raise ValueError(f"controller {name!r} is built in")
-    _REGISTRY.pop(name, None)
+    _REGISTRY.remove(name)
 
 
 def controller_names() -> tuple[str, ...]:
     """Names of every registered controller, built-ins first."""
-    return tuple(_REGISTRY)
+    return _REGISTRY.names()
 
 
 def controller_entry(name: str) -> ControllerEntry:
@@ -344,26 +321,12 @@ def controller_entry(name: str) -> ControllerEntry:
     InputError
         Unknown name (with the registered names and a near miss).
     """
-    try:
-        return _REGISTRY[name]
-    except (KeyError, TypeError):
-        known = ", ".join(repr(n) for n in _REGISTRY)
-        close = near_miss(str(name), list(_REGISTRY))
-        hint = f"; did you mean {close!r}?" if close else ""
-        raise InputError(f"controller: must be one of {known} (got {name!r}){hint}") from None
+    return _REGISTRY.entry(name)
 
 
 def validate_params(name: str, values: Mapping[str, Any] | BaseModel | None) -> BaseModel:
     """The validated parameters of controller ``name`` (defaults for what is not given)."""
-    entry = controller_entry(name)
-    if isinstance(values, entry.params):
-        return values
-    try:
-        return entry.params.model_validate(dict(values or {}))
-    except ValidationError as exc:
-        raise input_error_from_validation(
-            exc, prefix=("controller_params",), model=entry.params
-        ) from None
+    return _REGISTRY.params(name, values)
 
 
 register_controller(

@@ -28,10 +28,10 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, ValidationError
+from pydantic import BaseModel, Field
 
 from quadimpact.core import layout as L
-from quadimpact.errors import InputError, input_error_from_validation, near_miss
+from quadimpact.inputs.registry import Registry
 from quadimpact.inputs.types import MODEL_CONFIG, Real
 
 __all__ = [
@@ -250,8 +250,15 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     return e
 
 
-_REGISTRY: dict[str, EstimatorEntry] = {}
 BUILTIN = ("ideal", "complementary", "ekf")
+_REGISTRY: Registry[EstimatorEntry] = Registry(
+    "estimator",
+    BUILTIN,
+    entry_type=EstimatorEntry,
+    user_kind=L.EST_USER,
+    no_params=_NoParams,
+    empty_pack=_empty,
+)
 
 
 def register_estimator(
@@ -286,58 +293,29 @@ def register_estimator(
     replace : bool, optional
         Replace an entry of the same name instead of refusing.
     """
-    if not name or not all(c.isalnum() or c in "-_" for c in name):
-        raise ValueError(f"estimator name {name!r}: letters, digits, '-' and '_' only")
-    if name in _REGISTRY and not replace:
-        raise ValueError(f"estimator {name!r} is already registered (replace=True to replace)")
-    if step is None and kind is None:
-        raise ValueError(f"estimator {name!r}: give its compiled step (or a built-in kind)")
-    entry = EstimatorEntry(
-        name=name,
-        kind=L.EST_USER if kind is None else int(kind),
-        params=params or _NoParams,
-        pack=pack or _empty,
-        step=step,
-        description=description,
+    return _REGISTRY.register(
+        name, step, params=params, pack=pack, kind=kind, description=description, replace=replace
     )
-    _REGISTRY[name] = entry
-    return entry
 
 
 def unregister_estimator(name: str) -> None:
     """Remove a registered estimator (built-ins cannot be removed)."""
-    if name in BUILTIN:
-        raise ValueError(f"estimator {name!r} is built in")
-    _REGISTRY.pop(name, None)
+    _REGISTRY.remove(name)
 
 
 def estimator_names() -> tuple[str, ...]:
     """Names of every registered estimator, built-ins first."""
-    return tuple(_REGISTRY)
+    return _REGISTRY.names()
 
 
 def estimator_entry(name: str) -> EstimatorEntry:
     """The registry entry of ``name`` (``InputError`` for an unknown one)."""
-    try:
-        return _REGISTRY[name]
-    except (KeyError, TypeError):
-        known = ", ".join(repr(n) for n in _REGISTRY)
-        close = near_miss(str(name), list(_REGISTRY))
-        hint = f"; did you mean {close!r}?" if close else ""
-        raise InputError(f"estimator: must be one of {known} (got {name!r}){hint}") from None
+    return _REGISTRY.entry(name)
 
 
 def validate_estimator_params(name: str, values: Mapping[str, Any] | BaseModel | None):
     """The validated parameters of estimator ``name`` (defaults for what is not given)."""
-    entry = estimator_entry(name)
-    if isinstance(values, entry.params):
-        return values
-    try:
-        return entry.params.model_validate(dict(values or {}))
-    except ValidationError as exc:
-        raise input_error_from_validation(
-            exc, prefix=("estimator_params",), model=entry.params
-        ) from None
+    return _REGISTRY.params(name, values)
 
 
 def settings_text(params: BaseModel) -> str:
