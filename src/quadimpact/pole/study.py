@@ -38,6 +38,7 @@ from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
 from quadimpact.recovery.analysis import rate
 from quadimpact.results.files import atomic_write
+from quadimpact.results.study_files import sweep_history, write_report, write_study_json
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 
 __all__ = [
@@ -58,7 +59,6 @@ BASELINES = ("paper", "cascade-pid")
 BAND_DEG = 5.0
 SWEEP_DIR = "sweep"
 TRIALS_PARQUET = "trials.parquet"
-STUDY_JSON = "study.json"
 ARMS = ("baseline", "recovery")
 
 
@@ -393,37 +393,11 @@ def run_pole_study(
         "study": study.options(),
         "grid": {"pitch_deg": len(study.pitches()), "lateral_offset_m": len(study.offsets())},
         "run": run,
-        "sweeps": _sweep_history(out, run),
+        "sweeps": sweep_history(out, run),
         "elapsed_s": elapsed,
         "numbers": numbers,
     }
-    text = json.dumps(description, indent=1, sort_keys=True, default=_jsonable) + "\n"
-    atomic_write(out / STUDY_JSON, lambda tmp: tmp.write_text(text, encoding="utf-8"))
-    report_path = out / "report.md"
+    write_study_json(out, description)
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
-    atomic_write(report_path, lambda tmp: tmp.write_text(md, encoding="utf-8"))
+    report_path = write_report(out, md)
     return PoleResult(out, table, numbers, report_path, paths, info, elapsed)
-
-
-def _sweep_history(out: Path, run: dict[str, Any]) -> list[dict[str, Any]]:
-    """The invocations that ran trials of this study (``study.json``'s, then this one's)."""
-    history: list[dict[str, Any]] = []
-    path = out / STUDY_JSON
-    if run["n_already_done"] and path.is_file():
-        try:
-            history = list(json.loads(path.read_text(encoding="utf-8")).get("sweeps") or [])
-        except (OSError, ValueError):
-            history = []
-    if run["n_ran"]:
-        history.append({k: run[k] for k in ("n_ran", "sweep_s", "backend")})
-    return history
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return str(value)
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    raise TypeError(f"not JSON: {type(value).__name__}")

@@ -28,8 +28,6 @@ folder is refused), then writes into ``DIR``:
 
 from __future__ import annotations
 
-import json
-import math
 import os
 import sys
 import time
@@ -51,6 +49,7 @@ from quadimpact.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS, a
 from quadimpact.recovery.example import EarlyExample, beside, check_example, write_example
 from quadimpact.results.costs import cost_ratio
 from quadimpact.results.files import atomic_write, check_out_dir
+from quadimpact.results.study_files import sweep_history, write_report, write_study_json
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 
@@ -81,7 +80,6 @@ SEED_LIMIT = 2**53
 TRIAL_FIELDS = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "seed")
 SWEEP_DIR = "sweep"
 TRIALS_PARQUET = "trials.parquet"
-STUDY_JSON = "study.json"
 
 
 # ------------------------------------------------------------------ sampling
@@ -474,7 +472,7 @@ def run_study(
         description = describe(spec, options, table)
         run = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
         description["run"] = {**run, "sweep_s": float(info["elapsed_s"])}
-        description["sweeps"] = _sweep_history(out, description["run"])
+        description["sweeps"] = sweep_history(out, description["run"])
         description["cost"] = cost_ratio(table)
         numbers = analysis.summarise(table)
         warnings: list[str] = []
@@ -500,44 +498,14 @@ def run_study(
         raise
     elapsed = time.perf_counter() - start
     description["elapsed_s"] = elapsed
-    text = json.dumps(description, indent=1, sort_keys=True, default=_jsonable) + "\n"
-    atomic_write(out / STUDY_JSON, lambda tmp: tmp.write_text(text, encoding="utf-8"))
-    report_path = out / "report.md"
+    write_study_json(out, description)
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
-    atomic_write(report_path, lambda tmp: tmp.write_text(md, encoding="utf-8"))
+    report_path = write_report(out, md)
     for w in warnings:
         print(f"quadimpact: warning: {w}", file=sys.stderr)
     return RecoveryResult(
         out, table, description, numbers, report_path, paths, example_dir, info, elapsed, warnings
     )
-
-
-def _sweep_history(out: Path, run: dict[str, Any]) -> list[dict[str, Any]]:
-    """The invocations that ran trials of this study: the earlier ones (``study.json``), this one.
-
-    Each: ``n_ran``, ``sweep_s``, ``backend``. An earlier record is kept only
-    when its trials are still in the sweep (this invocation found some done).
-    """
-    history: list[dict[str, Any]] = []
-    path = out / STUDY_JSON
-    if run["n_already_done"] and path.is_file():
-        try:
-            history = list(json.loads(path.read_text(encoding="utf-8")).get("sweeps") or [])
-        except (OSError, ValueError):
-            history = []
-    if run["n_ran"]:
-        history.append({k: run[k] for k in ("n_ran", "sweep_s", "backend")})
-    return history
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, Path):
-        return str(value)
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    raise TypeError(f"not JSON: {type(value).__name__}")
 
 
 def _row_inputs(table: pd.DataFrame, run_id: int) -> dict[str, Any]:
