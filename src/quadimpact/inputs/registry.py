@@ -91,7 +91,7 @@ class Registry(Generic[E]):
         replace: bool,
     ) -> E:
         """Check and register one entry (the rules of the module docstring); the entry."""
-        self.check_new(name, step, kind, replace)
+        self._check_new(name, step, kind, replace)
         entry = self.entry_type(
             name=name,
             kind=self.user_kind if kind is None else int(kind),
@@ -103,7 +103,7 @@ class Registry(Generic[E]):
         self._entries[name] = entry
         return entry
 
-    def check_new(self, name: str, step: Callable | None, kind: int | None, replace: bool) -> None:
+    def _check_new(self, name: str, step: Callable | None, kind: int | None, replace: bool) -> None:
         """Refuse a registration that breaks the rules (``ValueError``, ``TypeError``)."""
         what = self.what
         if not name or not all(c.isalnum() or c in "-_" for c in name):
