@@ -119,20 +119,27 @@ def sweep(
       quadimpact sweep study.toml --grid restitution=0.2:0.8:0.1 --out restitution
     """
     from quadimpact.results.files import check_out_dir
+
+    if scheduler is not None and workers is not None:
+        raise InputError("--workers and --scheduler: give one or the other")
+    check_out_dir(out, "sweep")
+    extra = _parse_grid(grid)
+    if sweep_file is None and not extra:
+        raise InputError("sweep: give a sweep file or at least one --grid FIELD=VALUES")
+    if workers is not None and workers > 1:
+        from quadimpact.sweep.run import warm_pool
+
+        # the pool is certain: its fork server imports the simulator and loads the kernel
+        # on another core while this process imports it and checks the runs
+        warm_pool(workers, scheduler)
     from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
 
-    extra = _parse_grid(grid)
     if sweep_file is not None:
         spec = load_sweep_file(sweep_file)
         if extra:
             spec = spec.with_grid(extra)
     else:
-        if not extra:
-            raise InputError("sweep: give a sweep file or at least one --grid FIELD=VALUES")
         spec = SweepSpec(grid=extra, where="sweep")
-    if scheduler is not None and workers is not None:
-        raise InputError("--workers and --scheduler: give one or the other")
-    check_out_dir(out, "sweep")
     announce_compilation()
     # once stopped by a signal, every later one is ignored until the program has ended
     with stoppable():

@@ -105,7 +105,7 @@ def solid_depth(
     return plane_depth(px, py, pz, shapes, s)
 
 
-@njit(cache=True, inline="always")
+@compiled
 def solid_piece(
     px: float, py: float, pz: float, shapes: np.ndarray, s: int, k: int
 ) -> tuple[float, float, float, float]:
