@@ -360,7 +360,11 @@ def build_scenario(
     """
     from pydantic import ValidationError
 
-    from quadimpact.inputs.files import apply_overrides
+    from quadimpact.inputs.files import apply_overrides, read_toml_file
+
+    if scenario_path is not None:
+        # a missing, unreadable or malformed file is said before the scenarios' import (1 s)
+        read_toml_file(scenario_path)
     from quadimpact.inputs.model import ModelOptions
     from quadimpact.inputs.scenarios import _KINDS, load_scenario_file
 
