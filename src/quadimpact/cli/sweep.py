@@ -129,8 +129,8 @@ def sweep(
     if workers is not None and workers > 1:
         from quadimpact.sweep.run import warm_pool
 
-        # the pool is certain: its fork server imports the simulator and loads the kernel
-        # on another core while this process imports it and checks the runs
+        # N workers from the start (unless every run is done already): the fork server
+        # imports the simulator and loads the kernel on another core meanwhile
         warm_pool(workers, scheduler)
     from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
 
