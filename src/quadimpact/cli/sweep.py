@@ -131,7 +131,7 @@ def sweep(
 
         # N workers from the start (unless every run is done already): the fork server
         # imports the simulator and loads the kernel on another core meanwhile
-        warm_pool(workers, scheduler)
+        warm_pool(workers)
     from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
 
     if sweep_file is not None:
