@@ -2,8 +2,9 @@
 
 :func:`pack_estimation` fills the added sensors' slots of ``scfg`` (the IMU's
 impact disturbance and gyro bias random walk, the magnetometer, the pose
-sensor: layout ``SC_*``), draws their noise (``snoise``, layout ``SN_*``) and
-packs the estimator (``ecfg``, layout ``EC_*``) with its seeded initial error.
+sensor: layout ``SC_*``) and packs the estimator (``ecfg``, layout ``EC_*``);
+:func:`draw_estimation` makes a run's random part from its seed: the added
+sensors' noise (``snoise``, layout ``SN_*``) and the estimator's initial error.
 
 Random draws never touch the IMU's own (``packing.pack_sensors``: NumPy's
 PCG64 seeded with the run's seed): the added sensors draw from the stream
@@ -33,7 +34,7 @@ from quadimpact.inputs.estimators import (
 )
 from quadimpact.inputs.sensors import ResolvedImu
 
-__all__ = ["Estimation", "pack_estimation"]
+__all__ = ["Estimation", "draw_estimation", "pack_estimation"]
 
 SENSOR_STREAM = 1
 INIT_STREAM = 2
@@ -41,7 +42,11 @@ INIT_STREAM = 2
 
 @dataclass
 class Estimation:
-    """The packed estimator and added sensors of a run (and what the summary reports)."""
+    """The packed estimator and added sensors of a run (and what the summary reports).
+
+    ``ecfg`` has no initial error yet and ``snoise`` no draw: those are a
+    run's (:func:`draw_estimation`, from its seed).
+    """
 
     ecfg: np.ndarray
     snoise: np.ndarray
@@ -49,6 +54,13 @@ class Estimation:
     settings: str
     step: Any = None  # a plug-in estimator's compiled step
     resolved: dict[str, Any] | None = None
+    noisy: bool = False
+    """An added sensor needs noise: ``snoise`` gets one row of draws per IMU sample."""
+    entry: Any = None
+    """The estimator's registry entry."""
+    initial_std: np.ndarray | None = None
+    """Standard deviations of the initial estimate's error (rad, m/s, m, rad/s, 3 each),
+    None when no error is asked for."""
 
 
 def _stream(seed: int, key: int) -> np.random.Generator:
@@ -58,12 +70,12 @@ def _stream(seed: int, key: int) -> np.random.Generator:
 def pack_estimation(
     s: Any, imu: ResolvedImu, scfg: np.ndarray, n_imu: int, vehicle: Any
 ) -> Estimation:
-    """Fill ``scfg``'s added-sensor slots (in place); the estimator and the added draws.
+    """Fill ``scfg``'s added-sensor slots (in place) and pack the estimator (no random draw).
 
     ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU;
-    ``n_imu``: the IMU samples the run takes at most.
+    ``n_imu``: the IMU samples the run takes at most (the shape of the
+    empty ``snoise``).
     """
-    rate = float(imu.rate_hz)
     dist = imu.impact_disturbance
     if dist is not None:
         scfg[L.SC_IMPACT_F] = dist.accel_m_s2
@@ -83,7 +95,7 @@ def pack_estimation(
         scfg[L.SC_POSE_NOISE_P] = pose.position_noise_m
         scfg[L.SC_POSE_ATT] = 1.0 if pose.attitude else 0.0
         scfg[L.SC_POSE_NOISE_A] = math.radians(pose.attitude_noise_deg)
-        scfg[L.SC_POSE_LAG] = min(round(pose.latency_s * rate), L.MAX_POSE_LAG - 1)
+        scfg[L.SC_POSE_LAG] = min(round(pose.latency_s * float(imu.rate_hz)), L.MAX_POSE_LAG - 1)
     noisy = (
         (dist is not None and (dist.accel_m_s2 > 0.0 or dist.gyro_rad_s > 0.0))
         or imu.gyro_bias_walk_rad_s_sqrt_s > 0.0
@@ -93,10 +105,6 @@ def pack_estimation(
             and (pose.position_noise_m > 0.0 or (pose.attitude and pose.attitude_noise_deg > 0.0))
         )
     )
-    snoise = np.zeros((0, L.NSN))
-    if noisy:
-        snoise = _stream(s.seed, SENSOR_STREAM).standard_normal((n_imu, L.NSN))
-
     entry = estimator_entry(s.estimator)
     params = s.resolved_estimator_params()
     context = EstimatorContext(imu=imu, magnetometer=mag, pose_sensor=pose, vehicle=vehicle)
@@ -104,6 +112,7 @@ def pack_estimation(
     if ecfg.shape != (L.NECFG,):
         raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
     ecfg[L.EC_KIND] = entry.kind
+    initial_std = None
     if isinstance(params, EstimatorParams) and entry.kind != L.EST_IDEAL:
         std = np.repeat(
             [
@@ -115,14 +124,10 @@ def pack_estimation(
             3,
         )
         if np.any(std > 0.0):
-            draws = _stream(s.seed, INIT_STREAM).standard_normal(12) * std
-            ecfg[L.EC_INIT_ATT : L.EC_INIT_ATT + 3] = draws[0:3]
-            ecfg[L.EC_INIT_VEL : L.EC_INIT_VEL + 3] = draws[3:6]
-            ecfg[L.EC_INIT_POS : L.EC_INIT_POS + 3] = draws[6:9]
-            ecfg[L.EC_INIT_BIAS : L.EC_INIT_BIAS + 3] = draws[9:12]
+            initial_std = std
     return Estimation(
         ecfg=ecfg,
-        snoise=snoise,
+        snoise=np.zeros((0, L.NSN)),
         name=entry.name,
         settings=settings_text(params),
         step=entry.step,
@@ -133,4 +138,30 @@ def pack_estimation(
             "pose_sensor": pose.model_dump(mode="json") if pose is not None else None,
             "sensors": s.sensors,
         },
+        noisy=noisy,
+        entry=entry,
+        initial_std=initial_std,
     )
+
+
+def draw_estimation(est: Estimation, seed: int, n_imu: int) -> tuple[np.ndarray, np.ndarray]:
+    """A run's ``ecfg`` (with its initial estimate's error) and ``snoise``, from its seed.
+
+    The added sensors draw ``(n_imu, NSN)`` standard normal numbers from the
+    stream ``SENSOR_STREAM`` when one of them needs noise; the initial
+    error is twelve draws from ``INIT_STREAM`` times their standard
+    deviations (attitude rad, velocity m/s, position m, gyro bias rad/s;
+    three axes each). ``est.ecfg`` is not changed (a new array is returned).
+    """
+    snoise = est.snoise
+    if est.noisy:
+        snoise = _stream(seed, SENSOR_STREAM).standard_normal((n_imu, L.NSN))
+    ecfg = est.ecfg
+    if est.initial_std is not None:
+        ecfg = ecfg.copy()
+        draws = _stream(seed, INIT_STREAM).standard_normal(12) * est.initial_std
+        ecfg[L.EC_INIT_ATT : L.EC_INIT_ATT + 3] = draws[0:3]
+        ecfg[L.EC_INIT_VEL : L.EC_INIT_VEL + 3] = draws[3:6]
+        ecfg[L.EC_INIT_POS : L.EC_INIT_POS + 3] = draws[6:9]
+        ecfg[L.EC_INIT_BIAS : L.EC_INIT_BIAS + 3] = draws[9:12]
+    return ecfg, snoise

@@ -307,22 +307,16 @@ def pack_controller(
     entry: ControllerEntry,
     params: object,
     context: PackContext,
-    refs: dict[str, float],
     yaw_paper: bool,
 ) -> np.ndarray:
-    """Controller settings as the ``C_*`` vector.
+    """Controller settings as the ``C_*`` vector, references 0 (a run's: :func:`set_references`).
 
-    The common head (kind, references, inverse allocation, the vehicle's rotor
-    range) and the controller's parameter block (its registry entry's packer).
-    ``refs`` holds ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``.
+    The common head (kind, inverse allocation, the vehicle's rotor range)
+    and the controller's parameter block (its registry entry's packer).
     """
     v: Vehicle = context.vehicle
     ctrl = np.zeros(L.NCTRL)
     ctrl[L.C_KIND] = entry.kind
-    ctrl[L.C_H_REF] = refs["altitude_m"]
-    ctrl[L.C_PHI_REF] = refs["roll_rad"]
-    ctrl[L.C_THETA_REF] = refs["pitch_rad"]
-    ctrl[L.C_PSI_REF] = refs["yaw_rad"]
     ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = _memo(
         f"alloc-inv-{yaw_paper}", v, lambda: inverse(allocation_matrix(v, yaw_paper)).ravel()
     )
@@ -334,6 +328,18 @@ def pack_controller(
         raise ValueError(f"controller {entry.name!r}: its packer must return {L.NPARAM} numbers")
     ctrl[L.C_PARAMS : L.C_PARAMS + L.NPARAM] = block
     return ctrl
+
+
+def set_references(ctrl: np.ndarray, refs: Mapping[str, float]) -> None:
+    """Write the references into a ``C_*`` vector, in place (m and rad).
+
+    ``refs`` holds ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``;
+    the only slots of the controller's vector that depend on them.
+    """
+    ctrl[L.C_H_REF] = refs["altitude_m"]
+    ctrl[L.C_PHI_REF] = refs["roll_rad"]
+    ctrl[L.C_THETA_REF] = refs["pitch_rad"]
+    ctrl[L.C_PSI_REF] = refs["yaw_rad"]
 
 
 def pack_options(
@@ -402,20 +408,15 @@ def pack_sensors(
     imu: ResolvedImu,
     detection: DetectionSettings,
     v: Vehicle,
-    seed: int,
     duration_s: float,
-) -> tuple[np.ndarray, np.ndarray, int]:
-    """The IMU and detector as the ``SC_*`` vector, the run's noise draws and the sample count.
+) -> tuple[np.ndarray, int]:
+    """The IMU and detector as the ``SC_*`` vector and the sample count (no random draw).
 
-    Random draws (NumPy's PCG64 seeded with ``seed``): first the six biases
-    (standard normal times the configured bias standard deviation), then the
-    white noise, one row of six standard normal numbers per sample, only when
-    the IMU has noise or bias (an ideal IMU draws nothing).
+    The biases' slots stay 0 here: :func:`draw_imu_noise` fills them with the run's seed.
 
     Returns
     -------
     scfg : ndarray (NSCFG,)
-    noise : ndarray (n_imu, 6) or (0, 6)
     n_imu : int
         Samples the run takes at most: ``t0`` and every ``1/rate`` to the end.
     """
@@ -441,10 +442,25 @@ def pack_sensors(
         scfg[L.SC_DET_THRESHOLD] = detection.threshold_g * v.gravity_m_s2
     scfg[L.SC_DET_WORLD] = 1.0 if detection.frame == "world" else 0.0
     scfg[L.SC_DET_PERSIST] = float(detection.persistence)
-    noise = np.zeros((0, 6))
-    if imu.has_noise:
-        rng = np.random.default_rng(seed)
-        sigma_bias = np.array([imu.accel_bias_m_s2] * 3 + [imu.gyro_bias_rad_s] * 3)
-        scfg[L.SC_BIAS : L.SC_BIAS + 6] = rng.standard_normal(6) * sigma_bias
-        noise = rng.standard_normal((n_imu, 6))
-    return scfg, noise, n_imu
+    return scfg, n_imu
+
+
+def draw_imu_noise(imu: ResolvedImu, seed: int, n_imu: int, scfg: np.ndarray) -> np.ndarray:
+    """The IMU's random draws of a run: its biases (into ``scfg``, in place) and white noise.
+
+    NumPy's PCG64 seeded with ``seed``: first the six biases (standard
+    normal times the configured bias standard deviation: accelerometer
+    m/s^2, gyro rad/s, body axes), then one row of six standard normal
+    numbers per sample, only when the IMU has noise or bias (an ideal IMU
+    draws nothing and gets a (0, 6) array).
+
+    Returns
+    -------
+    noise : ndarray (n_imu, 6) or (0, 6)
+    """
+    if not imu.has_noise:
+        return np.zeros((0, 6))
+    rng = np.random.default_rng(seed)
+    sigma_bias = np.array([imu.accel_bias_m_s2] * 3 + [imu.gyro_bias_rad_s] * 3)
+    scfg[L.SC_BIAS : L.SC_BIAS + 6] = rng.standard_normal(6) * sigma_bias
+    return rng.standard_normal((n_imu, 6))

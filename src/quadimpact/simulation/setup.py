@@ -10,7 +10,7 @@ wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approac
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -21,18 +21,21 @@ from quadimpact.core.records import Model, model
 from quadimpact.core.run import Kernel, make_kernel
 from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import PackContext, controller_entry
+from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
+from quadimpact.inputs.sensors import ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_prepared, check_scenario_type
-from quadimpact.simulation.estimation import pack_estimation
+from quadimpact.simulation.estimation import Estimation, draw_estimation, pack_estimation
 from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
     RPM,
+    draw_imu_noise,
     pack_controller,
     pack_features,
     pack_options,
@@ -40,6 +43,7 @@ from quadimpact.simulation.packing import (
     pack_surfaces,
     pack_vehicle,
     schedule_rates,
+    set_references,
     trim_rotor_speeds,
 )
 
@@ -225,16 +229,37 @@ def _kernel(entry, estimator=None) -> Kernel | None:
     return entry.kernel_cache[key]
 
 
-def _setup(
+@dataclass
+class SharedSetup:
+    """The part of a run's packing that its initial state and its seed do not change.
+
+    :func:`_shared` packs it (the vehicle, features, surfaces, options,
+    controller without references, the IMU and estimator without their random
+    draws, the warnings); :func:`_for_run` completes a copy for one run. An
+    impact trial's is kept per process (:func:`_trial_shared`), so a study's
+    trials pack only what differs between them.
+    """
+
+    setup: RunSetup
+    """The packed run with ``x0`` 0, no references and no random draw."""
+    imu: ResolvedImu
+    est: Estimation
+    entries: tuple[Any, ...] = ()
+    """The registry entries it was packed with (controller, estimator): a new
+    registration under the same name packs again."""
+    front: tuple[float, np.ndarray] | None = None
+    """An impact trial toward an obstacle: :func:`obstacle_front` of it."""
+
+
+def _shared(
     s: RunSettings,
     v: Vehicle,
     o: ModelOptions,
-    refs: dict[str, float],
     surfaces: list[Plane],
     duration_s: float,
-    **fields: Any,
-) -> RunSetup:
-    """The packed run, common to every scenario kind (``fields``: ``x0``, ``t0``, ``wall``)."""
+    wall: Plane | None = None,
+) -> SharedSetup:
+    """The packing common to every scenario kind, without the run's state, references and draws."""
     yaw_paper = o.yaw_reaction == "paper"
     entry = controller_entry(s.controller)
     context = PackContext(
@@ -244,7 +269,7 @@ def _setup(
         nominal_controller=s.nominal_controller,
     )
     imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
-    scfg, noise, n_imu = pack_sensors(imu, s.detection, v, s.seed, duration_s)
+    scfg, n_imu = pack_sensors(imu, s.detection, v, duration_s)
     est = pack_estimation(s, imu, scfg, n_imu, v)
     params = s.resolved_controller_params()
     resolved = {
@@ -259,20 +284,22 @@ def _setup(
         **(est.resolved or {}),
     }
     setup = RunSetup(
+        x0=np.zeros(L.NX),
+        t0=0.0,
         tf=float(s.final_time_s),
         veh=pack_vehicle(v),
         feat=pack_features(v, s.friction_coefficient, o.bumper_force_scale),
         shapes=pack_surfaces(surfaces),
         opts=_packed_options(s, o, v, duration_s),
-        ctrl=pack_controller(entry, params, context, refs, yaw_paper),
+        ctrl=pack_controller(entry, params, context, yaw_paper),
         feature_names=v.feature_names(),
         shape_names=tuple(x.name for x in surfaces),
-        references=refs,
+        references={},
         vehicle=v,
         options=o,
         output_rate_hz=float(s.output_rate_hz),
+        wall=wall,
         scfg=scfg,
-        noise=noise,
         n_imu=n_imu,
         ecfg=est.ecfg,
         snoise=est.snoise,
@@ -281,7 +308,6 @@ def _setup(
         controller=s.controller,
         kernel=_kernel(entry, est.step),
         resolved=resolved,
-        **fields,
         **_schedule(s),
     )
     setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())
@@ -291,7 +317,37 @@ def _setup(
                 f"no rotor slew limit (vehicle {v.name} has none): the pre-impact spin-down "
                 "stops the rotors at the first tick"
             )
-    return setup
+    return SharedSetup(setup=setup, imu=imu, est=est, entries=(entry, est.entry))
+
+
+def _for_run(
+    shared: SharedSetup, s: RunSettings, refs: dict[str, float], **fields: Any
+) -> RunSetup:
+    """One run's :class:`RunSetup`: the shared packing with its references and seeded draws.
+
+    ``refs``: ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``;
+    ``fields``: ``x0``, ``t0``. The shared arrays that no run changes
+    (vehicle, features, surfaces, options) are the same objects in every run.
+    """
+    base = shared.setup
+    scfg = base.scfg.copy()
+    noise = draw_imu_noise(shared.imu, s.seed, base.n_imu, scfg)
+    ecfg, snoise = draw_estimation(shared.est, s.seed, base.n_imu)
+    ctrl = base.ctrl.copy()
+    set_references(ctrl, refs)
+    return replace(
+        base,
+        references=refs,
+        ctrl=ctrl,
+        scfg=scfg,
+        noise=noise,
+        ecfg=ecfg,
+        snoise=snoise,
+        warnings=list(base.warnings),
+        approach={},
+        resolved=dict(base.resolved),
+        **fields,
+    )
 
 
 # ------------------------------------------------------------- flight scenario
@@ -322,7 +378,7 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
     }
     surfaces = [*s.surfaces, *s.obstacles, *_ground(s)]
     duration = s.final_time_s - s.start_time_s
-    return _setup(s, v, o, refs, surfaces, duration, x0=x0, t0=float(s.start_time_s))
+    return _for_run(_shared(s, v, o, surfaces, duration), s, refs, x0=x0, t0=float(s.start_time_s))
 
 
 # --------------------------------------------------------------- wall approach
@@ -338,7 +394,7 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
     wall = Plane.wall(s.wall_distance_m)
     surfaces = [wall, *s.obstacles, *_ground(s)]
     duration = float(s.final_time_s)
-    setup = _setup(s, v, o, refs, surfaces, duration, x0=np.zeros(L.NX), t0=0.0, wall=wall)
+    setup = _for_run(_shared(s, v, o, surfaces, duration, wall=wall), s, refs)
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
     clock = CpuClock()
     setup.x0, setup.t0, setup.approach = solve_approach(
@@ -363,6 +419,23 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
 
 
 # ---------------------------------------------------------------- impact trial
+TRIAL_STATE_FIELDS = (
+    "roll_deg",
+    "pitch_deg",
+    "yaw_deg",
+    "speed_m_s",
+    "seed",
+    "start_distance_m",
+    "altitude_m",
+    "lateral_offset_m",
+)
+"""An impact trial's fields that set its initial state, references and random draws
+only: trials that differ in these alone share their :class:`SharedSetup`."""
+
+_TRIAL_SHARED: dict[str, SharedSetup] = {}
+_TRIAL_SHARED_LIMIT = 8
+
+
 def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     """The recovery benchmark's trial (docs/RECOVERY.md 5): the wall ``X = 0``, no shooting.
 
@@ -371,43 +444,28 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     rotation, with the rotor speeds of the collective thrust
     ``m g cos(roll) cos(pitch)`` and zero torques (multiplied by the cosines:
     the vehicle was flying level before it tilted, as in the authors' set-up).
+    With obstacles, the trial flies toward the first one (docs/OBSTACLES.md 2):
+    it starts ``start_distance_m`` before the obstacle's front, beside its
+    centre by ``lateral_offset_m``; the others stay where they are.
     """
-    v = s.build_vehicle()
-    o = s.resolved_model_options()
+    shared = _trial_shared(s)
+    v = shared.setup.vehicle
     roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.yaw_deg))
     weight = v.mass_kg * v.gravity_m_s2
     rotors = trim_rotor_speeds(
-        v, weight * math.cos(roll) * math.cos(pitch), o.yaw_reaction == "paper"
+        v, weight * math.cos(roll) * math.cos(pitch), shared.setup.options.yaw_reaction == "paper"
     )
-    if s.obstacles:
-        return _impact_trial_toward(s, v, o, (roll, pitch, yaw), rotors)
-    x0 = initial_state(
-        np.array([-float(s.start_distance_m), 0.0, -float(s.altitude_m)]),
-        np.array([float(s.speed_m_s), 0.0, 0.0]),
-        euler_zyx_to_quat(roll, pitch, yaw),
-        np.zeros(3),
-        rotors,
-    )
-    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    wall = Plane.wall(0.0)
-    surfaces = [wall, *_ground(s)]
-    return _setup(s, v, o, refs, surfaces, float(s.final_time_s), x0=x0, t0=0.0, wall=wall)
-
-
-def _impact_trial_toward(
-    s: ImpactTrial, v: Vehicle, o: ModelOptions, attitude: tuple, rotors: np.ndarray
-) -> RunSetup:
-    """The impact trial toward ``s.obstacles[0]`` (docs/OBSTACLES.md 2; the others stay)."""
-    roll, pitch, yaw = attitude
-    target = s.obstacles[0]
-    x_face, centre = obstacle_front(target)
-    start = np.array(
-        [
-            x_face - float(s.start_distance_m),
-            centre[1] + float(s.lateral_offset_m),
-            -float(s.altitude_m),
-        ]
-    )
+    if shared.front is None:
+        start = np.array([-float(s.start_distance_m), 0.0, -float(s.altitude_m)])
+    else:
+        x_face, centre = shared.front
+        start = np.array(
+            [
+                x_face - float(s.start_distance_m),
+                centre[1] + float(s.lateral_offset_m),
+                -float(s.altitude_m),
+            ]
+        )
     x0 = initial_state(
         start,
         np.array([float(s.speed_m_s), 0.0, 0.0]),
@@ -416,8 +474,42 @@ def _impact_trial_toward(
         rotors,
     )
     refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    surfaces = [*s.obstacles, *_ground(s)]
-    return _setup(s, v, o, refs, surfaces, float(s.final_time_s), x0=x0, t0=0.0)
+    return _for_run(shared, s, refs, x0=x0, t0=0.0)
+
+
+def _trial_shared(s: ImpactTrial) -> SharedSetup:
+    """The :class:`SharedSetup` of an impact trial, packed once per process for its other fields.
+
+    Kept (at most :data:`_TRIAL_SHARED_LIMIT`) under the trial's JSON
+    without :data:`TRIAL_STATE_FIELDS`, and used again only with the same
+    vehicle object (a vehicle file changed on disk loads as a new one) and
+    the same registry entries. Every value of a run is computed by the same
+    functions either way: a kept packing gives the same run, bit for bit.
+    """
+    v = s.build_vehicle()
+    key = s.model_dump_json(exclude=_STATE_EXCLUDE)
+    shared = _TRIAL_SHARED.get(key)
+    if (
+        shared is not None
+        and shared.setup.vehicle is v
+        and shared.entries == (controller_entry(s.controller), estimator_entry(s.estimator))
+    ):
+        return shared
+    o = s.resolved_model_options()
+    duration = float(s.final_time_s)
+    if s.obstacles:
+        shared = _shared(s, v, o, [*s.obstacles, *_ground(s)], duration)
+        shared.front = obstacle_front(s.obstacles[0])
+    else:
+        wall = Plane.wall(0.0)
+        shared = _shared(s, v, o, [wall, *_ground(s)], duration, wall=wall)
+    if len(_TRIAL_SHARED) >= _TRIAL_SHARED_LIMIT:
+        _TRIAL_SHARED.pop(next(iter(_TRIAL_SHARED)))
+    _TRIAL_SHARED[key] = shared
+    return shared
+
+
+_STATE_EXCLUDE = frozenset(TRIAL_STATE_FIELDS)
 
 
 def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:

@@ -1,0 +1,107 @@
+"""Impact trials share their packing: kept or not, a trial's packed run is the same, bit for bit.
+
+``simulation.setup`` packs the part of an impact trial that its initial
+state and seed do not change once per process (``SharedSetup``) and
+completes a copy per trial. These tests pack trials with the kept packing
+and alone (the cache emptied) and compare every array byte for byte; check
+that no state field reaches the shared part; and that a changed field or
+vehicle file packs again.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from quadimpact.inputs.scenarios import ImpactTrial
+from quadimpact.inputs.world import Cylinder
+from quadimpact.simulation import setup as S
+
+ARRAYS = ("x0", "veh", "feat", "shapes", "opts", "ctrl", "scfg", "noise", "ecfg", "snoise")
+NOISY = {
+    "imu": {"preset": "noisy", "gyro_bias_walk_rad_s_sqrt_s": 1e-3},
+    "magnetometer": {"noise": 0.01},
+    "estimator": "complementary",
+    "estimator_params": {"initial_attitude_error_deg": 2.0, "initial_bias_error_rad_s": 0.01},
+}
+POLE = {"obstacles": [Cylinder(name="pole", point_m=(0.0, 0.0, 0.0), radius_m=0.05)]}
+
+
+def _trials(extra: dict) -> list[ImpactTrial]:
+    rng = np.random.default_rng(11)
+    out = []
+    for k in range(6):
+        roll, pitch, yaw = rng.uniform(-30.0, 30.0, 3)
+        out.append(
+            ImpactTrial(
+                controller="recovery",
+                roll_deg=roll,
+                pitch_deg=pitch,
+                yaw_deg=yaw,
+                speed_m_s=rng.uniform(0.3, 1.2),
+                seed=k,
+                final_time_s=0.5,
+                **extra,
+            )
+        )
+    return out
+
+
+def _same(a: S.RunSetup, b: S.RunSetup) -> None:
+    for name in ARRAYS:
+        x, y = np.asarray(getattr(a, name)), np.asarray(getattr(b, name))
+        assert x.shape == y.shape and x.tobytes() == y.tobytes(), name
+    assert (a.t0, a.tf, a.n_imu) == (b.t0, b.tf, b.n_imu)
+    assert a.references == b.references and a.warnings == b.warnings
+    assert a.resolved == b.resolved and a.shape_names == b.shape_names
+
+
+@pytest.mark.parametrize("extra", [{}, NOISY, POLE], ids=["ideal-imu", "noisy-sensors", "pole"])
+def test_a_trial_packed_with_the_kept_packing_is_the_trial_packed_alone(extra: dict) -> None:
+    trials = _trials(extra)
+    kept = [S.prepare(t) for t in trials]  # the first packs the shared part, the rest reuse it
+    for trial, setup in zip(trials, kept, strict=True):
+        S._TRIAL_SHARED.clear()
+        _same(setup, S.prepare(trial))
+    # the kept runs do not share what a run owns
+    assert kept[0].ctrl is not kept[1].ctrl and kept[0].scfg is not kept[1].scfg
+    assert kept[0].warnings is not kept[1].warnings
+    if extra is NOISY:  # the seeds really draw: different noise, biases and initial errors
+        assert not np.array_equal(kept[0].noise, kept[1].noise)
+        assert not np.array_equal(kept[0].snoise, kept[1].snoise)
+        assert not np.array_equal(kept[0].ecfg, kept[1].ecfg)
+
+
+@pytest.mark.parametrize("field", S.TRIAL_STATE_FIELDS)
+def test_no_state_field_reaches_the_shared_packing(field: str) -> None:
+    base = {**NOISY, **POLE, "controller": "recovery", "final_time_s": 0.5}
+    changed = {
+        "seed": 7,
+        "start_distance_m": 0.4,
+        "lateral_offset_m": 0.02,
+        "altitude_m": 1.3,
+    }.get(field, 0.37 if field == "speed_m_s" else 12.5)
+    S._TRIAL_SHARED.clear()
+    one = S._trial_shared(ImpactTrial(**base))
+    S._TRIAL_SHARED.clear()
+    two = S._trial_shared(ImpactTrial(**base, **{field: changed}))
+    _same(one.setup, two.setup)
+    assert one.front is not None and one.front[0] == two.front[0]
+
+
+def test_a_changed_field_or_vehicle_file_packs_again(tmp_path: Path) -> None:
+    S._TRIAL_SHARED.clear()
+    a = S.prepare(ImpactTrial(controller="recovery", friction_coefficient=0.3, final_time_s=0.5))
+    b = S.prepare(ImpactTrial(controller="recovery", friction_coefficient=0.6, final_time_s=0.5))
+    assert not np.array_equal(a.feat, b.feat)
+    bundled = Path(S.__file__).parents[1] / "inputs" / "vehicles" / "navi.toml"
+    path = tmp_path / "mine.toml"
+    path.write_text(bundled.read_text())
+    trial = ImpactTrial(controller="recovery", vehicle=str(path), final_time_s=0.5)
+    mass = S.prepare(trial).veh.copy()
+    text = path.read_text()
+    old = next(line for line in text.splitlines() if line.startswith("mass_kg"))
+    path.write_text(text.replace(old, "mass_kg = 0.9"))
+    assert not np.array_equal(S.prepare(trial).veh, mass)
