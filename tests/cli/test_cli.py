@@ -531,10 +531,10 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
 
 
 def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path: Path) -> None:
-    """A missing result folder, scenario file or an unusable --out is said before the
-    simulator (the compiled kernel's driver), the drawing code (Matplotlib) or Numba is
-    imported (``run`` reads its file before the scenario fields, which name compiled
-    controllers)."""
+    """A missing result folder, scenario file, an unusable --out or a bad value is said
+    before the simulator (the compiled kernel's driver), the drawing code (Matplotlib) or
+    Numba is imported: the inputs and a sweep's checks pack and validate without the
+    compiled code (the controllers' slots are in ``core/layout.py``)."""
     import sys
 
     afile = tmp_path / "a-file"
@@ -546,6 +546,9 @@ def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path
         ["reproduce", "--out", str(afile)],
         ["experiments", "--out", str(afile)],
         ["run", str(tmp_path / "nowhere.toml")],
+        ["run", "--speed", "-1"],
+        ["sweep", "--grid", "speed_m_s=-1", "--workers", "1", "--out", str(tmp_path / "s")],
+        ["recovery", "--vehicle", "nowhere.toml", "--workers", "1", "--out", str(tmp_path / "r")],
     ]
     code = (
         "import json, sys\n"

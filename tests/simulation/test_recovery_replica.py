@@ -118,12 +118,11 @@ def test_pre_impact_spin_down_overrides_the_scenario():
     hold = prepare(ImpactTrial(**TRIAL, pre_impact="hold"))
     forced = prepare(ImpactTrial(**TRIAL, pre_impact="hold",
                                  model_options={"pre_impact": "spin-down"}))  # fmt: skip
-    from quadimpact.core.controllers import recovery as R
 
-    assert hold.ctrl[L.C_PARAMS + R.R_PRE_IMPACT] == R.PRE_HOLD
-    assert forced.ctrl[L.C_PARAMS + R.R_PRE_IMPACT] == R.PRE_SPIN_DOWN
-    np.testing.assert_array_equal(np.delete(hold.ctrl, L.C_PARAMS + R.R_PRE_IMPACT),
-                                  np.delete(forced.ctrl, L.C_PARAMS + R.R_PRE_IMPACT))  # fmt: skip
+    assert hold.ctrl[L.C_PARAMS + L.R_PRE_IMPACT] == L.PRE_HOLD
+    assert forced.ctrl[L.C_PARAMS + L.R_PRE_IMPACT] == L.PRE_SPIN_DOWN
+    np.testing.assert_array_equal(np.delete(hold.ctrl, L.C_PARAMS + L.R_PRE_IMPACT),
+                                  np.delete(forced.ctrl, L.C_PARAMS + L.R_PRE_IMPACT))  # fmt: skip
     np.testing.assert_array_equal(hold.opts, forced.opts)
     # and in the run: the first interval runs at the trimmed speed minus one slew step
     r = simulate(ImpactTrial(**TRIAL, pre_impact="hold", model_options={"pre_impact": "spin-down"}))

@@ -44,6 +44,7 @@ from .layout import (
     LS_PO_ACTIVE,
     LS_PO_T,
     LS_T0,
+    MOTOR_OFF,
     N_ROTORS,
     O_CUT_STEP_MOTORS,
     O_DT_CONTROL,
@@ -61,7 +62,6 @@ from .layout import (
 from .records import Data, Model
 
 ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
-MOTOR_OFF = -math.inf  # a schedule rate: the motor is off (speed 0 from the segment's start)
 
 
 @compiled

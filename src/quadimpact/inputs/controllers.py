@@ -29,8 +29,6 @@ import numpy as np
 from pydantic import BaseModel, Field, StrictBool
 
 from quadimpact.core import layout as L
-from quadimpact.core.controllers import common as PID
-from quadimpact.core.controllers import recovery as REC
 from quadimpact.inputs.registry import Registry
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
 
@@ -207,16 +205,16 @@ def _empty_block(params: BaseModel, ctx: PackContext) -> np.ndarray:
 
 def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block = np.zeros(L.NPARAM)
-    block[PID.P_GAINS : PID.P_GAINS + 15] = params.gains()
-    block[PID.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
+    block[L.P_GAINS : L.P_GAINS + 15] = params.gains()
+    block[L.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
     return block
 
 
 _PRE_IMPACT = {
-    "nominal": REC.PRE_NOMINAL,
-    "hold": REC.PRE_HOLD,
-    "spin-down": REC.PRE_SPIN_DOWN,
-    "immediate": REC.PRE_IMMEDIATE,
+    "nominal": L.PRE_NOMINAL,
+    "hold": L.PRE_HOLD,
+    "spin-down": L.PRE_SPIN_DOWN,
+    "immediate": L.PRE_IMMEDIATE,
 }
 PRE_IMPACT_CHOICES: tuple[str, ...] = tuple(_PRE_IMPACT)
 """The recovery controller's pre-impact behaviours."""
@@ -226,30 +224,30 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     nominal = controller_entry(ctx.nominal_controller)
     block = _pack_pid(nominal.params(), ctx)
     p: RecoveryParams = params  # type: ignore[assignment]
-    block[REC.R_NOMINAL_KIND] = nominal.kind
-    block[REC.R_PRE_IMPACT] = _PRE_IMPACT[ctx.pre_impact]
-    block[REC.R_K_ATT] = p.k_att_1_s
-    block[REC.R_K_RATE : REC.R_K_RATE + 3] = p.k_rate_1_s
-    block[REC.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
-    block[REC.R_K_Z : REC.R_K_Z + 4] = p.k_z_1_s
-    block[REC.R_Q_TOL] = p.tilt_error_tol
-    block[REC.R_RATE_TOL] = p.rate_tol_rad_s
-    block[REC.R_W_TOL] = p.w_tol_m_s
+    block[L.R_NOMINAL_KIND] = nominal.kind
+    block[L.R_PRE_IMPACT] = _PRE_IMPACT[ctx.pre_impact]
+    block[L.R_K_ATT] = p.k_att_1_s
+    block[L.R_K_RATE : L.R_K_RATE + 3] = p.k_rate_1_s
+    block[L.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
+    block[L.R_K_Z : L.R_K_Z + 4] = p.k_z_1_s
+    block[L.R_Q_TOL] = p.tilt_error_tol
+    block[L.R_RATE_TOL] = p.rate_tol_rad_s
+    block[L.R_W_TOL] = p.w_tol_m_s
     level = ctx.options.detection_tick_reference == "level"
-    block[REC.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
-    block[REC.R_HOVER] = 1.0 if p.hover else 0.0
+    block[L.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
+    block[L.R_HOVER] = 1.0 if p.hover else 0.0
     a_max = 0.5 * ctx.vehicle.gravity_m_s2 if p.hover_a_max_m_s2 is None else p.hover_a_max_m_s2
-    block[REC.R_HOVER_GAINS : REC.R_HOVER_GAINS + 5] = (
+    block[L.R_HOVER_GAINS : L.R_HOVER_GAINS + 5] = (
         p.hover_kp_1_s,
         p.hover_kv_1_s,
         p.hover_v_max_m_s,
         a_max,
         p.hover_k_yaw_1_s,
     )
-    block[REC.R_HOVER_MODE] = REC.HOLD_STOP if p.hover_hold == "stop" else REC.HOLD_ENTRY
+    block[L.R_HOVER_MODE] = L.HOLD_STOP if p.hover_hold == "stop" else L.HOLD_ENTRY
     if p.hover_set_point_m is not None:
-        block[REC.R_HOVER_MODE] = REC.HOLD_GIVEN
-        block[REC.R_HOVER_SET : REC.R_HOVER_SET + 3] = p.hover_set_point_m
+        block[L.R_HOVER_MODE] = L.HOLD_GIVEN
+        block[L.R_HOVER_SET : L.R_HOVER_SET + 3] = p.hover_set_point_m
     return block
 
 

@@ -31,7 +31,6 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
-from quadimpact.simulation.approach import feature_depths
 
 __all__ = [
     "INITIAL_PENETRATION_TOL_M",
@@ -127,6 +126,9 @@ def check_initial_contact(scenario: Any, setup: Any) -> None:
     InputError
         One line: the bumper, the surface, the depth and what to change.
     """
+    # the compiled contact geometry, loaded where runs are prepared (not by a sweep's checks)
+    from quadimpact.simulation.approach import feature_depths
+
     kind = getattr(scenario, "kind", "scenario")
     x0 = np.asarray(setup.x0, dtype=float)
     for s, name in enumerate(setup.shape_names):

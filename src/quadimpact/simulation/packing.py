@@ -11,7 +11,6 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.actuators import MOTOR_OFF
 from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import ControllerEntry, PackContext
 from quadimpact.inputs.features import ContactFeature
@@ -394,13 +393,13 @@ def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -
     """A power-off schedule's rates as the kernel takes them, rad/s^2.
 
     With ``zero_rate = "off"`` a rate of exactly 0 (or -0) is the motor
-    switched off over the segment (``core.actuators.MOTOR_OFF``: its speed 0
+    switched off over the segment (``core.actuators.L.MOTOR_OFF``: its speed 0
     from the segment's start); with ``"hold"`` it keeps its speed.
     """
     rpm = np.asarray(rates_rpm_per_s, dtype=float).reshape(-1, 4)
     rates = rpm * RPM
     if zero_rate == "off":
-        rates[rpm == 0.0] = MOTOR_OFF
+        rates[rpm == 0.0] = L.MOTOR_OFF
     return rates
 
 

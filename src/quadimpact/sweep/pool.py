@@ -2,7 +2,8 @@
 
 Each worker (:func:`~quadimpact.sweep.worker.pool_worker`) gets chunks of
 runs over its own pipe and sends back one message per finished run, so the
-parent knows at any moment which run each worker is on and since when:
+parent knows which run each worker is on and since when (it reads the pipes
+at most every :data:`GATHER_S`, the rows of that time together):
 
 * **time limits**: a run that takes longer than its limit
   (:class:`~quadimpact.sweep.limits.RunLimits`) has its worker killed
@@ -44,6 +45,11 @@ CHUNKS_PER_WORKER = 2
 """Chunks sent ahead to each worker (the next one waits in its pipe)."""
 POLL_S = 0.25
 """Longest wait between two looks at the stop flag and the clocks, s."""
+GATHER_S = 0.05
+"""Shortest time between two reads of the workers' pipes, s. The runs that finish
+meanwhile are read together: this process wakes up about once per ``GATHER_S`` instead
+of once per run, and so takes less of the cores the workers run on. A run's clock
+(its time limit) is read up to this late."""
 WAIT_NOTE_S = 30.0
 """Without a finished run for this long, say what the sweep is waiting for, s."""
 
@@ -215,6 +221,7 @@ class Pool:
         self.ever_ready = False
         self.last_progress = time.monotonic()
         self.last_note = 0.0
+        self.woke = 0.0  # when the last wait for the workers returned (monotonic s)
 
     # ------------------------------------------------------------ running
     def run(self, chunks: Iterator[list[Item]], stop: StopFlag) -> None:
@@ -272,11 +279,15 @@ class Pool:
             pass  # it died: its sentinel says so next
 
     def _wait(self, stop: StopFlag) -> None:
+        gap = self.woke + GATHER_S - time.monotonic()
+        if gap > 0.0:
+            time.sleep(gap)  # let more runs finish: their rows are read in one wake-up
         waitables: dict[Any, _Worker] = {}
         for w in self.workers:
             waitables[w.conn] = w
             waitables[w.proc.sentinel] = w
         ready = wait(list(waitables), timeout=POLL_S)
+        self.woke = time.monotonic()
         stop.check()  # a signal to the process group reaches the workers too: stop first
         if not ready:
             self.sink([])
@@ -291,24 +302,33 @@ class Pool:
             self._lost(w, _death(w))
 
     def _take_messages(self, w: _Worker) -> None:
-        """Handle what ``w`` sent (without waiting): ready, the start of a chunk, a row."""
-        while True:
-            try:
-                if not w.conn.poll():
-                    return
-                kind, *body = w.conn.recv()
-            except Exception:  # EOF, or a message cut short by the worker's death
-                return
-            w.since = time.monotonic()
-            if kind == "ready":
-                w.ready = self.ever_ready = True
-                self.start_failures = 0
-            elif kind == "start":
-                w.tasks[0].started = True
-            elif kind == "row":
-                self._row(w, *body)
+        """Handle what ``w`` sent (without waiting): ready, the start of a chunk, rows.
 
-    def _row(self, w: _Worker, row: dict[str, Any], cost: Any) -> None:
+        The rows read go to the sink together, once every message waiting is handled.
+        """
+        rows: list[dict[str, Any]] = []
+        try:
+            while True:
+                try:
+                    if not w.conn.poll():
+                        return
+                    kind, *body = w.conn.recv()
+                except Exception:  # EOF, or a message cut short by the worker's death
+                    return
+                w.since = time.monotonic()
+                if kind == "ready":
+                    w.ready = self.ever_ready = True
+                    self.start_failures = 0
+                elif kind == "start":
+                    w.tasks[0].started = True
+                elif kind == "row":
+                    rows.append(self._row(w, *body))
+        finally:
+            if rows:
+                self.sink(rows)
+
+    def _row(self, w: _Worker, row: dict[str, Any], cost: Any) -> dict[str, Any]:
+        """Count a finished run of ``w`` (its cost for the limits); its row."""
         task = w.tasks[0]
         self.limits.record(cost)
         w.n_done += 1
@@ -316,7 +336,7 @@ class Pool:
         if w.n_done == len(task.items):
             w.tasks.popleft()
             w.n_done = 0
-        self.sink([row])
+        return row
 
     def _check_clocks(self) -> None:
         now = time.monotonic()

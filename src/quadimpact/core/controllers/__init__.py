@@ -19,11 +19,14 @@ Interface of a controller step (built-in or plugged in, all Numba ``njit``)::
 The run loop then applies the generic speed and slew limits
 (``actuators.apply_command``) and holds the command for the period.
 
-One module per controller: ``paper.py``, ``cascade_pid.py``, ``recovery.py``.
-A new built-in is its module, a branch below, and an entry in the Python-side
-registry (``quadimpact.inputs.controllers``); a controller that is not
-built in is registered there with its step (``register_controller(name,
-step=...)``), and runs in a loop compiled around it (``core.run.make_kernel``).
+One module per controller: ``paper.py``, ``cascade_pid.py``, ``recovery.py``;
+their parameter blocks and memory slots (``P_*``, ``M_*``, ``R_*``, ``RM_*``)
+are declared at the end of ``core/layout.py``, which the Python side packs
+without loading this compiled code. A new built-in is its module, its block
+in ``layout.py``, a branch below, and an entry in the Python-side registry
+(``quadimpact.inputs.controllers``); a controller that is not built in is
+registered there with its step (``register_controller(name, step=...)``),
+and runs in a loop compiled around it (``core.run.make_kernel``).
 """
 
 import numpy as np

@@ -21,15 +21,6 @@ from ..layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
-    MS_X,
-    N_ROTORS,
-    NX,
-    V_GRAVITY,
-    V_MASS,
-    X_OMEGA,
-)
-from ..quaternion import wrap_pi
-from .common import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -49,8 +40,17 @@ from .common import (
     M_I_V,
     M_SATURATED,
     M_STARTED,
+    MS_X,
+    N_ROTORS,
+    NX,
     P_GAINS,
     P_THRUST_COS_FLOOR,
+    V_GRAVITY,
+    V_MASS,
+    X_OMEGA,
+)
+from ..quaternion import wrap_pi
+from .common import (
     allocate,
     attitude_altitude,
     linearised_torques,

@@ -23,14 +23,6 @@ from ..layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
-    MS_X,
-    NX,
-    V_GRAVITY,
-    V_MASS,
-    X_OMEGA,
-)
-from ..quaternion import wrap_pi
-from .common import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -43,7 +35,15 @@ from .common import (
     M_E_THETA,
     M_E_V,
     M_STARTED,
+    MS_X,
+    NX,
     P_GAINS,
+    V_GRAVITY,
+    V_MASS,
+    X_OMEGA,
+)
+from ..quaternion import wrap_pi
+from .common import (
     allocate,
     attitude_altitude,
     linearised_torques,

@@ -67,72 +67,56 @@ from ..layout import (
     C_OMEGA_MIN,
     C_PARAMS,
     CTRL_CASCADE_PID,
+    HOLD_CAPTURE_M_S,
+    HOLD_GIVEN,
+    HOLD_STOP,
     MEM_STAGE,
     MS_DETECTED,
     MS_NORMAL,
     MS_W_HAT,
     MS_X,
     N_ROTORS,
-    NPARAM,
     NX,
+    PRE_HOLD,
+    PRE_IMMEDIATE,
+    PRE_NOMINAL,
+    R_A_MAG,
+    R_FIRST_TICK_LEVEL,
+    R_HOVER,
+    R_HOVER_GAINS,
+    R_HOVER_MODE,
+    R_HOVER_SET,
+    R_K_ATT,
+    R_K_RATE,
+    R_K_Z,
+    R_NOMINAL_KIND,
+    R_PRE_IMPACT,
+    R_Q_TOL,
+    R_RATE_TOL,
+    R_W_TOL,
+    RM_HOLD,
+    RM_HOLD_PSI,
+    RM_HOLD_SET,
+    RM_QE_X,
+    RM_QE_Y,
+    STAGE_DETECTED,
+    STAGE_HOVER,
+    STAGE_LEVEL,
+    STAGE_PRE_IMPACT,
+    STAGE_RECOVERED,
+    STAGE_TILTED,
     V_GRAVITY,
     V_MASS,
     X_POS,
     X_QUAT,
     X_ROTOR,
     X_VEL,
-    Block,
 )
 from ..quaternion import rotation_matrix
 from .cascade_pid import cascade_pid_step
-from .common import N_PID_MEM, N_PID_PARAMS, allocate, linearised_torques
+from .common import allocate, linearised_torques
 from .hover import hover_acceleration, yaw_of
 from .paper import paper_step
-
-# ---- parameters, at ctrl[C_PARAMS + ...] (the PID block of common.py comes first)
-_params = Block("ctrl.params", "R_", start=N_PID_PARAMS, capacity=NPARAM)
-R_NOMINAL_KIND = _params.slot("R_NOMINAL_KIND")  # CTRL_PAPER or CTRL_CASCADE_PID (pre-impact)
-R_PRE_IMPACT = _params.slot("R_PRE_IMPACT")  # PRE_* below
-R_K_ATT = _params.slot("R_K_ATT")  # 1/s, tilt error -> rate reference
-R_K_RATE = _params.slot("R_K_RATE", 3)  # 1/s, rate error -> angular acceleration (p, q, r)
-R_A_MAG = _params.slot("R_A_MAG")  # m/s^2, stage 1 push away from the wall
-R_K_Z = _params.slot("R_K_Z", 4)  # 1/s, vertical-velocity gain of stages 1-4
-R_Q_TOL = _params.slot("R_Q_TOL")  # tilt-error tolerance of the stage 1 and 2 tests
-R_RATE_TOL = _params.slot("R_RATE_TOL")  # rad/s, |p|, |q| tolerance of the stage 1 and 2 tests
-R_W_TOL = _params.slot("R_W_TOL")  # m/s, body z velocity below which stage 3 ends
-R_FIRST_TICK_LEVEL = _params.slot("R_FIRST_TICK_LEVEL")  # 1: a_ref = 0 at detection (replica)
-R_HOVER = _params.slot("R_HOVER")  # 1: stage 5 (hold position and yaw) after stage 4
-R_HOVER_GAINS = _params.slot("R_HOVER_GAINS", 5)  # K_p 1/s, K_v 1/s, v_max m/s, a_max m/s^2,
-# K_psi 1/s (controllers/hover.py)
-R_HOVER_MODE = _params.slot("R_HOVER_MODE")  # HOLD_* below: which position stage 5 holds
-R_HOVER_SET = _params.slot("R_HOVER_SET", 3)  # m, the given set-point, inertial NED
-N_RECOVERY_PARAMS = _params.end("N_RECOVERY_PARAMS")
-
-HOLD_ENTRY = 0  # the position estimate at stage 4's entry
-HOLD_STOP = 1  # brake first; hold the position estimate where the speed fell below 0.2 m/s
-HOLD_GIVEN = 2  # R_HOVER_SET
-HOLD_CAPTURE_M_S = 0.2
-
-PRE_NOMINAL = 0
-PRE_HOLD = 1
-PRE_SPIN_DOWN = 2
-PRE_IMMEDIATE = 3
-
-# ---- memory (after the PID slots of the nominal controller)
-_mem = Block("mem", "RM_", start=N_PID_MEM, capacity=MEM_STAGE)
-RM_QE_X = _mem.slot("RM_QE_X")  # previous tick's tilt error quaternion, x and y
-RM_QE_Y = _mem.slot("RM_QE_Y")
-RM_HOLD = _mem.slot("RM_HOLD", 3)  # m, stage 5's position set-point, inertial NED
-RM_HOLD_PSI = _mem.slot("RM_HOLD_PSI")  # rad, stage 5's yaw set-point
-RM_HOLD_SET = _mem.slot("RM_HOLD_SET")  # 1 once the position set-point is set (HOLD_STOP)
-N_RECOVERY_MEM = _mem.end("N_RECOVERY_MEM")
-
-STAGE_PRE_IMPACT = 0
-STAGE_DETECTED = 1
-STAGE_TILTED = 2
-STAGE_LEVEL = 3
-STAGE_RECOVERED = 4
-STAGE_HOVER = 5
 
 
 @compiled
