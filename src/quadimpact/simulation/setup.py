@@ -5,6 +5,12 @@ or :class:`~quadimpact.inputs.scenarios.FlightScenario` into a :class:`RunSetup`
 flat arrays of the compiled core plus what the analysis needs to read the
 result (surface names, references, the approach solution, warnings). The
 wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approach`.
+
+Packing is two stages: :class:`SharedSetup` (what the run's initial state and
+seed do not change) and the run's own part (:func:`_for_run`: its state,
+references and random draws). An impact trial's shared part is kept per
+process (:func:`_trial_shared`), so the trials of a study pack only what
+differs between them, with the same functions: the same arrays, bit for bit.
 """
 
 from __future__ import annotations
@@ -432,6 +438,7 @@ TRIAL_STATE_FIELDS = (
 """An impact trial's fields that set its initial state, references and random draws
 only: trials that differ in these alone share their :class:`SharedSetup`."""
 
+_STATE_EXCLUDE = frozenset(TRIAL_STATE_FIELDS)
 _TRIAL_SHARED: dict[str, SharedSetup] = {}
 _TRIAL_SHARED_LIMIT = 8
 
@@ -489,10 +496,11 @@ def _trial_shared(s: ImpactTrial) -> SharedSetup:
     v = s.build_vehicle()
     key = s.model_dump_json(exclude=_STATE_EXCLUDE)
     shared = _TRIAL_SHARED.get(key)
+    entries = (controller_entry(s.controller), estimator_entry(s.estimator))
     if (
         shared is not None
         and shared.setup.vehicle is v
-        and shared.entries == (controller_entry(s.controller), estimator_entry(s.estimator))
+        and all(a is b for a, b in zip(shared.entries, entries, strict=True))
     ):
         return shared
     o = s.resolved_model_options()
@@ -507,9 +515,6 @@ def _trial_shared(s: ImpactTrial) -> SharedSetup:
         _TRIAL_SHARED.pop(next(iter(_TRIAL_SHARED)))
     _TRIAL_SHARED[key] = shared
     return shared
-
-
-_STATE_EXCLUDE = frozenset(TRIAL_STATE_FIELDS)
 
 
 def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
