@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import recovery as R
 
@@ -51,10 +52,10 @@ def _packed(mass=1.0, g=9.81):
     ctrl[L.C_OMEGA_MIN] = 0.0
     ctrl[L.C_OMEGA_MAX] = 1e9
     p = L.C_PARAMS
-    ctrl[p + L.R_K_ATT] = 20.0
-    ctrl[p + L.R_K_RATE : p + L.R_K_RATE + 3] = (20.0, 20.0, 2.0)
-    ctrl[p + L.R_A_MAG] = g
-    ctrl[p + L.R_K_Z : p + L.R_K_Z + 4] = (0.0, 0.0, 10.0, 10.0)
+    ctrl[p + CL.R_K_ATT] = 20.0
+    ctrl[p + CL.R_K_RATE : p + CL.R_K_RATE + 3] = (20.0, 20.0, 2.0)
+    ctrl[p + CL.R_A_MAG] = g
+    ctrl[p + CL.R_K_Z : p + CL.R_K_Z + 4] = (0.0, 0.0, 10.0, 10.0)
     return veh, ctrl
 
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, Simulation, simulate
+from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.inputs.controllers import RecoveryParams
 from quadimpact.rotations import quat_to_matrix
@@ -85,17 +86,17 @@ def test_defaults_are_the_documented_table():
     assert (p.tilt_error_tol, p.rate_tol_rad_s, p.w_tol_m_s) == (0.3, 0.5, 0.3)
     setup = prepare(FlightScenario(vehicle="navi", controller="recovery"))
     c = setup.ctrl[L.C_PARAMS :]
-    assert c[L.R_K_ATT] == 20.0 and tuple(c[L.R_K_RATE : L.R_K_RATE + 3]) == (20.0, 20.0, 2.0)
-    assert c[L.R_A_MAG] == 9.81 and tuple(c[L.R_K_Z : L.R_K_Z + 4]) == (0.0, 0.0, 10.0, 10.0)
-    assert (c[L.R_Q_TOL], c[L.R_RATE_TOL], c[L.R_W_TOL]) == (0.3, 0.5, 0.3)
-    assert c[L.R_PRE_IMPACT] == L.PRE_NOMINAL and c[L.R_NOMINAL_KIND] == L.CTRL_PAPER
-    assert c[L.R_FIRST_TICK_LEVEL] == 0.0
+    assert c[CL.R_K_ATT] == 20.0 and tuple(c[CL.R_K_RATE : CL.R_K_RATE + 3]) == (20.0, 20.0, 2.0)
+    assert c[CL.R_A_MAG] == 9.81 and tuple(c[CL.R_K_Z : CL.R_K_Z + 4]) == (0.0, 0.0, 10.0, 10.0)
+    assert (c[CL.R_Q_TOL], c[CL.R_RATE_TOL], c[CL.R_W_TOL]) == (0.3, 0.5, 0.3)
+    assert c[CL.R_PRE_IMPACT] == CL.PRE_NOMINAL and c[CL.R_NOMINAL_KIND] == L.CTRL_PAPER
+    assert c[CL.R_FIRST_TICK_LEVEL] == 0.0
     # every parameter reaches the packed block
     setup = prepare(FlightScenario(vehicle="navi", controller="recovery", controller_params={
         "k_att_1_s": 11, "k_rate_1_s": [12, 13, 14], "a_mag_m_s2": 5, "k_z_1_s": [1, 2, 3, 4],
         "tilt_error_tol": 0.2, "rate_tol_rad_s": 0.4, "w_tol_m_s": 0.1}))  # fmt: skip
     c = setup.ctrl[L.C_PARAMS :]
-    assert list(c[L.R_K_ATT : L.R_K_ATT + 12]) == [11, 12, 13, 14, 5, 1, 2, 3, 4, 0.2, 0.4, 0.1]
+    assert list(c[CL.R_K_ATT : CL.R_K_ATT + 12]) == [11, 12, 13, 14, 5, 1, 2, 3, 4, 0.2, 0.4, 0.1]
     # the vehicle's rotor range limits the staged law's commands
     lo, hi = setup.vehicle.rotor_speed_range_rpm
     assert setup.ctrl[L.C_OMEGA_MIN] == pytest.approx(lo * math.pi / 30)

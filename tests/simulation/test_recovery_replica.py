@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, simulate
+from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.core.rotors import rotor_wrench
 from quadimpact.inputs.model import MODEL_VARIANTS, resolve_model_options
@@ -119,10 +120,10 @@ def test_pre_impact_spin_down_overrides_the_scenario():
     forced = prepare(ImpactTrial(**TRIAL, pre_impact="hold",
                                  model_options={"pre_impact": "spin-down"}))  # fmt: skip
 
-    assert hold.ctrl[L.C_PARAMS + L.R_PRE_IMPACT] == L.PRE_HOLD
-    assert forced.ctrl[L.C_PARAMS + L.R_PRE_IMPACT] == L.PRE_SPIN_DOWN
-    np.testing.assert_array_equal(np.delete(hold.ctrl, L.C_PARAMS + L.R_PRE_IMPACT),
-                                  np.delete(forced.ctrl, L.C_PARAMS + L.R_PRE_IMPACT))  # fmt: skip
+    assert hold.ctrl[L.C_PARAMS + CL.R_PRE_IMPACT] == CL.PRE_HOLD
+    assert forced.ctrl[L.C_PARAMS + CL.R_PRE_IMPACT] == CL.PRE_SPIN_DOWN
+    np.testing.assert_array_equal(np.delete(hold.ctrl, L.C_PARAMS + CL.R_PRE_IMPACT),
+                                  np.delete(forced.ctrl, L.C_PARAMS + CL.R_PRE_IMPACT))  # fmt: skip
     np.testing.assert_array_equal(hold.opts, forced.opts)
     # and in the run: the first interval runs at the trimmed speed minus one slew step
     r = simulate(ImpactTrial(**TRIAL, pre_impact="hold", model_options={"pre_impact": "spin-down"}))

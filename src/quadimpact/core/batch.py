@@ -48,6 +48,16 @@ from typing import NamedTuple
 import numpy as np
 
 from .compiled import allocating, compiled
+from .controller_layout import (
+    R_FIRST_TICK_LEVEL,
+    R_Q_TOL,
+    R_RATE_TOL,
+    R_W_TOL,
+    STAGE_DETECTED,
+    STAGE_PRE_IMPACT,
+    STAGE_RECOVERED,
+    STAGE_TILTED,
+)
 from .controllers.recovery import (
     law_references,
     rate_loop,
@@ -81,19 +91,11 @@ from .layout import (
     NX,
     O_DT_CONTROL,
     O_SLEW_MAX,
-    R_FIRST_TICK_LEVEL,
-    R_Q_TOL,
-    R_RATE_TOL,
-    R_W_TOL,
     RIN_CMD,
     ST_CRASH_T,
     ST_STAGE_T,
     ST_STAGE_X,
     ST_STATUS,
-    STAGE_DETECTED,
-    STAGE_PRE_IMPACT,
-    STAGE_RECOVERED,
-    STAGE_TILTED,
     STATUS_FAILED,
     V_GRAVITY,
     V_KT,

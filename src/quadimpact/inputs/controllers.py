@@ -28,6 +28,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, StrictBool
 
+from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.inputs.registry import Registry
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
@@ -205,16 +206,16 @@ def _empty_block(params: BaseModel, ctx: PackContext) -> np.ndarray:
 
 def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block = np.zeros(L.NPARAM)
-    block[L.P_GAINS : L.P_GAINS + 15] = params.gains()
-    block[L.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
+    block[CL.P_GAINS : CL.P_GAINS + 15] = params.gains()
+    block[CL.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
     return block
 
 
 _PRE_IMPACT = {
-    "nominal": L.PRE_NOMINAL,
-    "hold": L.PRE_HOLD,
-    "spin-down": L.PRE_SPIN_DOWN,
-    "immediate": L.PRE_IMMEDIATE,
+    "nominal": CL.PRE_NOMINAL,
+    "hold": CL.PRE_HOLD,
+    "spin-down": CL.PRE_SPIN_DOWN,
+    "immediate": CL.PRE_IMMEDIATE,
 }
 PRE_IMPACT_CHOICES: tuple[str, ...] = tuple(_PRE_IMPACT)
 """The recovery controller's pre-impact behaviours."""
@@ -224,30 +225,30 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     nominal = controller_entry(ctx.nominal_controller)
     block = _pack_pid(nominal.params(), ctx)
     p: RecoveryParams = params  # type: ignore[assignment]
-    block[L.R_NOMINAL_KIND] = nominal.kind
-    block[L.R_PRE_IMPACT] = _PRE_IMPACT[ctx.pre_impact]
-    block[L.R_K_ATT] = p.k_att_1_s
-    block[L.R_K_RATE : L.R_K_RATE + 3] = p.k_rate_1_s
-    block[L.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
-    block[L.R_K_Z : L.R_K_Z + 4] = p.k_z_1_s
-    block[L.R_Q_TOL] = p.tilt_error_tol
-    block[L.R_RATE_TOL] = p.rate_tol_rad_s
-    block[L.R_W_TOL] = p.w_tol_m_s
+    block[CL.R_NOMINAL_KIND] = nominal.kind
+    block[CL.R_PRE_IMPACT] = _PRE_IMPACT[ctx.pre_impact]
+    block[CL.R_K_ATT] = p.k_att_1_s
+    block[CL.R_K_RATE : CL.R_K_RATE + 3] = p.k_rate_1_s
+    block[CL.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
+    block[CL.R_K_Z : CL.R_K_Z + 4] = p.k_z_1_s
+    block[CL.R_Q_TOL] = p.tilt_error_tol
+    block[CL.R_RATE_TOL] = p.rate_tol_rad_s
+    block[CL.R_W_TOL] = p.w_tol_m_s
     level = ctx.options.detection_tick_reference == "level"
-    block[L.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
-    block[L.R_HOVER] = 1.0 if p.hover else 0.0
+    block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
+    block[CL.R_HOVER] = 1.0 if p.hover else 0.0
     a_max = 0.5 * ctx.vehicle.gravity_m_s2 if p.hover_a_max_m_s2 is None else p.hover_a_max_m_s2
-    block[L.R_HOVER_GAINS : L.R_HOVER_GAINS + 5] = (
+    block[CL.R_HOVER_GAINS : CL.R_HOVER_GAINS + 5] = (
         p.hover_kp_1_s,
         p.hover_kv_1_s,
         p.hover_v_max_m_s,
         a_max,
         p.hover_k_yaw_1_s,
     )
-    block[L.R_HOVER_MODE] = L.HOLD_STOP if p.hover_hold == "stop" else L.HOLD_ENTRY
+    block[CL.R_HOVER_MODE] = CL.HOLD_STOP if p.hover_hold == "stop" else CL.HOLD_ENTRY
     if p.hover_set_point_m is not None:
-        block[L.R_HOVER_MODE] = L.HOLD_GIVEN
-        block[L.R_HOVER_SET : L.R_HOVER_SET + 3] = p.hover_set_point_m
+        block[CL.R_HOVER_MODE] = CL.HOLD_GIVEN
+        block[CL.R_HOVER_SET : CL.R_HOVER_SET + 3] = p.hover_set_point_m
     return block
 
 

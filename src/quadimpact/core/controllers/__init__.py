@@ -21,9 +21,9 @@ The run loop then applies the generic speed and slew limits
 
 One module per controller: ``paper.py``, ``cascade_pid.py``, ``recovery.py``;
 their parameter blocks and memory slots (``P_*``, ``M_*``, ``R_*``, ``RM_*``)
-are declared at the end of ``core/layout.py``, which the Python side packs
-without loading this compiled code. A new built-in is its module, its block
-in ``layout.py``, a branch below, and an entry in the Python-side registry
+are declared in ``core/controller_layout.py``, which the Python side packs
+without loading this compiled code. A new built-in is its module, its blocks
+there, a branch below, and an entry in the Python-side registry
 (``quadimpact.inputs.controllers``); a controller that is not built in is
 registered there with its step (``register_controller(name, step=...)``),
 and runs in a loop compiled around it (``core.run.make_kernel``).

@@ -13,14 +13,7 @@ import math
 import numpy as np
 
 from ..compiled import compiled
-from ..layout import (
-    C_H_REF,
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
-    C_PARAMS,
-    C_PHI_REF,
-    C_PSI_REF,
-    C_THETA_REF,
+from ..controller_layout import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -40,11 +33,20 @@ from ..layout import (
     M_I_V,
     M_SATURATED,
     M_STARTED,
+    P_GAINS,
+    P_THRUST_COS_FLOOR,
+)
+from ..layout import (
+    C_H_REF,
+    C_OMEGA_MAX,
+    C_OMEGA_MIN,
+    C_PARAMS,
+    C_PHI_REF,
+    C_PSI_REF,
+    C_THETA_REF,
     MS_X,
     N_ROTORS,
     NX,
-    P_GAINS,
-    P_THRUST_COS_FLOOR,
     V_GRAVITY,
     V_MASS,
     X_OMEGA,

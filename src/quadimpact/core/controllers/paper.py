@@ -17,12 +17,7 @@ import math
 import numpy as np
 
 from ..compiled import compiled
-from ..layout import (
-    C_H_REF,
-    C_PARAMS,
-    C_PHI_REF,
-    C_PSI_REF,
-    C_THETA_REF,
+from ..controller_layout import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -35,9 +30,16 @@ from ..layout import (
     M_E_THETA,
     M_E_V,
     M_STARTED,
+    P_GAINS,
+)
+from ..layout import (
+    C_H_REF,
+    C_PARAMS,
+    C_PHI_REF,
+    C_PSI_REF,
+    C_THETA_REF,
     MS_X,
     NX,
-    P_GAINS,
     V_GRAVITY,
     V_MASS,
     X_OMEGA,

@@ -62,21 +62,10 @@ import math
 import numpy as np
 
 from ..compiled import allocating, compiled
-from ..layout import (
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
-    C_PARAMS,
-    CTRL_CASCADE_PID,
+from ..controller_layout import (
     HOLD_CAPTURE_M_S,
     HOLD_GIVEN,
     HOLD_STOP,
-    MEM_STAGE,
-    MS_DETECTED,
-    MS_NORMAL,
-    MS_W_HAT,
-    MS_X,
-    N_ROTORS,
-    NX,
     PRE_HOLD,
     PRE_IMMEDIATE,
     PRE_NOMINAL,
@@ -105,6 +94,19 @@ from ..layout import (
     STAGE_PRE_IMPACT,
     STAGE_RECOVERED,
     STAGE_TILTED,
+)
+from ..layout import (
+    C_OMEGA_MAX,
+    C_OMEGA_MIN,
+    C_PARAMS,
+    CTRL_CASCADE_PID,
+    MEM_STAGE,
+    MS_DETECTED,
+    MS_NORMAL,
+    MS_W_HAT,
+    MS_X,
+    N_ROTORS,
+    NX,
     V_GRAVITY,
     V_MASS,
     X_POS,
