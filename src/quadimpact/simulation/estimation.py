@@ -67,14 +67,10 @@ def _stream(seed: int, key: int) -> np.random.Generator:
     return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(key,))))
 
 
-def pack_estimation(
-    s: Any, imu: ResolvedImu, scfg: np.ndarray, n_imu: int, vehicle: Any
-) -> Estimation:
+def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) -> Estimation:
     """Fill ``scfg``'s added-sensor slots (in place) and pack the estimator (no random draw).
 
-    ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU;
-    ``n_imu``: the IMU samples the run takes at most (the shape of the
-    empty ``snoise``).
+    ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU.
     """
     dist = imu.impact_disturbance
     if dist is not None:

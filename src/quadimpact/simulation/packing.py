@@ -393,7 +393,7 @@ def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -
     """A power-off schedule's rates as the kernel takes them, rad/s^2.
 
     With ``zero_rate = "off"`` a rate of exactly 0 (or -0) is the motor
-    switched off over the segment (``core.actuators.L.MOTOR_OFF``: its speed 0
+    switched off over the segment (``core.layout.MOTOR_OFF``: its speed 0
     from the segment's start); with ``"hold"`` it keeps its speed.
     """
     rpm = np.asarray(rates_rpm_per_s, dtype=float).reshape(-1, 4)

@@ -276,7 +276,7 @@ def _shared(
     )
     imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
     scfg, n_imu = pack_sensors(imu, s.detection, v, duration_s)
-    est = pack_estimation(s, imu, scfg, n_imu, v)
+    est = pack_estimation(s, imu, scfg, v)
     params = s.resolved_controller_params()
     resolved = {
         "model": s.model,
