@@ -9,8 +9,20 @@ import pytest
 from quadimpact.core import layout as L
 from quadimpact.results.files import EPISODE_COLUMNS, TIMESERIES_COLUMNS
 from quadimpact.rotations import euler_zyx_to_quat
-from quadimpact.simulation.metrics import attitude_excursion_deg, group_impacts, impact_metrics
-from quadimpact.simulation.record import episodes_frame, timeseries_frame
+from quadimpact.simulation.metrics import (
+    EpisodeLists,
+    attitude_excursion_deg,
+    group_impacts,
+    impact_metrics,
+    impacts_in,
+    short_impacts,
+)
+from quadimpact.simulation.record import (
+    episode_columns,
+    episode_lists_of,
+    episodes_frame,
+    timeseries_frame,
+)
 
 SURFACES = ("wall", "ground")
 D = math.pi / 180.0
@@ -66,17 +78,61 @@ def test_episodes_frame_empty_has_contract_columns() -> None:
     assert tuple(df.columns) == EPISODE_COLUMNS
 
 
-def test_episodes_frame_rejects_bad_indices() -> None:
+@pytest.mark.parametrize("build", [episodes_frame, episode_lists_of])
+def test_episodes_frame_rejects_bad_indices(build) -> None:
+    """The table and the summary's lists refuse the same records, with the same words."""
     raw = raw_episodes(ep(1, 0.5, 0.6))
     raw[0, L.E_SHAPE] = 5
-    with pytest.raises(ValueError, match="surface index"):
-        episodes_frame(raw, 1, SURFACES)
+    with pytest.raises(ValueError, match=r"surface index outside 0\.\.1 \(got \[5\]\)"):
+        build(raw, 1, SURFACES)
     raw = raw_episodes(ep(1, 0.5, 0.6))
-    raw[0, L.E_FEATURE] = 4  # bumper 5 of a four-bumper vehicle
-    with pytest.raises(ValueError, match="feature index"):
-        episodes_frame(raw, 1, SURFACES)
+    raw[0, L.E_FEATURE] = 3.6  # rounds to 4: bumper 5 of a four-bumper vehicle
+    with pytest.raises(ValueError, match=r"feature index outside 0\.\.3 \(got \[4\]\)"):
+        build(raw, 1, SURFACES)
     with pytest.raises(ValueError, match="row count"):
-        episodes_frame(raw, 10, SURFACES)
+        build(raw, 10, SURFACES)
+
+
+def test_episode_lists_are_the_columns_as_lists_ties_and_all() -> None:
+    """What a summary reads (lists from the raw rows) is the table's columns, same order:
+    by start, then bumper, and rows tied on both in the kernel's order."""
+    rng = np.random.default_rng(3)
+    for n in (0, 1, 2, 7, 15):
+        eps = [
+            ep(
+                int(rng.integers(1, 5)),
+                float(rng.choice([0.5, 0.51, 0.6])),  # many ties of start
+                0.0,
+                surface=str(rng.choice(SURFACES)),
+                peak=float(rng.random()),
+                force=float(rng.random()),
+                open=bool(rng.random() < 0.3),
+            )
+            for _ in range(n)
+        ]
+        for e in eps:
+            e["t1"] = e["t0"] + float(rng.choice([0.0, 0.01, 0.02]))
+        raw = raw_episodes(*eps)
+        cols = episode_columns(raw, n, SURFACES)
+        lists = episode_lists_of(raw, n, SURFACES)
+        assert type(lists) is EpisodeLists and list(lists) == list(cols)
+        for name, values in cols.items():
+            assert lists[name] == values.tolist(), name
+            assert [type(v) for v in lists[name]] == [type(v) for v in values.tolist()], name
+        assert impact_metrics(lists) == impact_metrics(cols)
+
+
+def test_the_impacts_of_episode_lists_are_found_once_per_exclusion() -> None:
+    """The summary's metrics, its short-impact warning and the recovery metrics share
+    one grouping per set of excluded surfaces, and get what a fresh grouping gives."""
+    raw = raw_episodes(ep(1, 0.5, 0.52), ep(2, 0.51, 0.55), ep(3, 0.7, 0.7001, surface="ground"))
+    lists = episode_lists_of(raw, 3, SURFACES)
+    first = impacts_in(lists, ("ground",), 0.01)
+    assert impacts_in(lists, ["ground"], 0.01) is first  # kept
+    assert impacts_in(lists, ("ground", "pole"), 0.01) is first  # no "pole" episode: the same
+    assert impacts_in(lists, (), 0.01) is not first  # another exclusion, found again
+    assert first == impacts_in(dict(lists), ("ground",), 0.01)  # a plain mapping: not kept
+    assert short_impacts(lists, 0.1, graze_fraction=0.01) == (1, 0.55 - 0.5)
 
 
 # ---------------------------------------------------------------- time series
@@ -309,6 +365,21 @@ def test_attitude_excursion(with_quat: bool) -> None:
     tilt_yaw = math.degrees(math.acos(s * s * math.cos(215 * D) + c * c))
     assert tilt_yaw > 25.0
     assert m["tilt_max_deg"] == pytest.approx(tilt_yaw, abs=1e-9)
+
+
+def test_attitude_excursion_of_a_strided_quaternion_array_is_the_tables() -> None:
+    """The summary passes a view of the kernel's output rows (q0..q3 of each row):
+    the same excursion, bit for bit, as the time-series table's quaternion columns."""
+    refs = {"roll_rad": 0.1, "pitch_rad": -15 * D, "yaw_rad": 45 * D, "altitude_m": 2.0}
+    rng = np.random.default_rng(7)
+    rows = [tuple(rng.uniform(-170.0, 170.0, 3)) for _ in range(50)]
+    ts = _euler_ts(rows, True)
+    out = np.zeros((len(rows), 9))
+    for k in range(4):
+        out[:, 2 + k] = ts[f"q{k}"].to_numpy()
+    view = out[:, 2:6]
+    assert not view.flags.c_contiguous
+    assert attitude_excursion_deg(view, refs) == attitude_excursion_deg(ts, refs)
 
 
 def test_attitude_excursion_roll_wraps_through_180() -> None:

@@ -105,3 +105,21 @@ def test_a_changed_field_or_vehicle_file_packs_again(tmp_path: Path) -> None:
     old = next(line for line in text.splitlines() if line.startswith("mass_kg"))
     path.write_text(text.replace(old, "mass_kg = 0.9"))
     assert not np.array_equal(S.prepare(trial).veh, mass)
+
+
+def test_kept_runs_share_their_output_times_and_pair_table_while_they_are_theirs() -> None:
+    """A trial's model takes the output times and the pair table its shared packing
+    computed once (the same arrays), equal to those computed afresh; a run whose
+    times or shapes differ gets its own."""
+    S._TRIAL_SHARED.clear()
+    a, b = (S.prepare(t) for t in _trials({})[:2])
+    ma, mb = a.model(), b.model()
+    assert ma.t_out is mb.t_out and ma.pairs is mb.pairs
+    fresh = S.prepare(_trials({})[3])
+    assert np.array_equal(ma.t_out, a.output_times())
+    assert np.array_equal(ma.pairs, S.pair_table(a.feat, a.shapes))
+    longer = S.replace(a, tf=0.75)
+    assert longer.model().t_out[-1] == 0.75 and longer.model().t_out.shape[0] > ma.t_out.shape[0]
+    other_shapes = a.shapes.copy()
+    assert a.model(shapes=other_shapes).pairs is not ma.pairs
+    assert fresh.model().t_out is ma.t_out  # the same kept packing (same fields but state)

@@ -254,6 +254,39 @@ def test_flatten_covers_the_summary():
     assert row["approach__start_time_s"] == summary["approach"]["start_time_s"]
 
 
+def test_a_row_has_every_column_once_typed_and_in_the_tables_order():
+    """A hand-made summary: nested tables joined with ``__``, lists as JSON, timings
+    dropped, inputs skipped, unknown keys in summary_extra, missing columns null,
+    ints given for floats as floats; and the row is the same built twice (its kept
+    template is not changed by a row)."""
+    summary = {
+        "status": "completed",
+        "delta_init_m": 1,  # an int for a float column
+        "peak_force_n": float("nan"),
+        "leading_bumpers": [1, 2],
+        "n_episodes": 3,
+        "bumper_model_valid": True,
+        "integrator": {"steps": 10, "wall_time_s": 0.5},
+        "model_options": {"bumper_force_scale": [1.0, 1.0, 1.0, 1.0]},
+        "speed_m_s": 0.75,  # an input: skipped
+        "not_a_column": {"a": 1},
+    }
+    skip = {"speed_m_s": 0.75}
+    row = flatten_summary(summary, skip=skip)
+    names = [name for name, _ in SUMMARY_COLUMNS if name not in skip]
+    assert list(row) == names
+    assert row["status"] == "completed" and row["n_episodes"] == 3
+    assert row["delta_init_m"] == 1.0 and type(row["delta_init_m"]) is float
+    assert row["peak_force_n"] is None
+    assert row["leading_bumpers"] == "[1,2]"
+    assert row["integrator__steps"] == 10 and "integrator__wall_time_s" not in row
+    assert row["model_options__bumper_force_scale"] == "[1.0,1.0,1.0,1.0]"
+    assert json.loads(row["summary_extra"]) == {"not_a_column__a": 1}
+    assert row["response_type"] is None  # not in the summary: null
+    assert flatten_summary(summary, skip=skip) == row
+    assert flatten_summary({}, skip=skip)["status"] is None
+
+
 # ------------------------------------------------------------- backends
 @pytest.fixture(scope="module")
 def serial_table(tmp_path_factory):

@@ -1,9 +1,10 @@
 """Checks of a prepared run before it runs: the initial state must not start inside a surface.
 
-:func:`check_prepared` is called once by ``simulation.setup.prepare`` (so by
-``simulate``, ``Simulation``, sweeps and the learning environment): the IMU
-must sit on the vehicle and read its hover (:func:`check_imu`), and the run
-must not start in contact (:func:`check_initial_contact`):
+``simulation.setup`` calls them for every prepared run (so for ``simulate``,
+``Simulation``, sweeps and the learning environment): the IMU must sit on the
+vehicle and read its hover (:func:`check_imu`, once per shared packing: what
+runs share), and the run must not start in contact
+(:func:`check_initial_contact`, through :func:`check_prepared`, once per run):
 
 * an **impact trial** starts its vehicle away from the wall (docs/RECOVERY.md
   5.1): a bumper already touching or in the wall at the start (depth > 0) is
@@ -52,11 +53,11 @@ STARTED_IN_CONTACT = "starts in contact with the wall"
 
 
 def check_prepared(scenario: Any, setup: Any) -> None:
-    """Every check of a prepared run (``simulation.setup.prepare`` calls this once).
+    """The checks of a prepared run's own state (``simulation.setup.prepare`` calls this once).
 
-    :func:`check_initial_contact` and :func:`check_imu`.
+    :func:`check_initial_contact`. :func:`check_imu` checks what runs share,
+    once per shared packing (``simulation.setup``), before this.
     """
-    check_imu(setup)
     check_initial_contact(scenario, setup)
 
 

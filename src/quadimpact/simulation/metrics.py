@@ -32,8 +32,10 @@ __all__ = [
     "attitude_excursion_deg",
     "classify_response",
     "closest_chaining",
+    "EpisodeLists",
     "episode_lists",
     "impact_rows",
+    "impacts_in",
     "impacts_of",
     "RESPONSE_TYPE_MEANINGS",
     "graze_mask",
@@ -83,10 +85,28 @@ def select(table: Table, rows: np.ndarray, names: Sequence[str]) -> dict[str, np
 _EPISODE_NEEDED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_delta_m", "peak_force_n")
 
 
+class EpisodeLists(dict):
+    """A run's episodes as Python lists, columns by name, in the table's order.
+
+    What :func:`episode_lists` gives for any table, built once for a run's
+    summary (``simulation.record.episode_lists_of``): the impacts found in it
+    are kept (:func:`impacts_in`), so the summary's metrics, its warnings and
+    the recovery metrics group the episodes once per set of excluded surfaces.
+    Not to be changed once built.
+    """
+
+    def __init__(self, columns: Mapping[str, list[Any]]) -> None:
+        super().__init__(columns)
+        self.impacts: dict[tuple[frozenset[str], float], Any] = {}
+
+
 def episode_lists(table: Table, names: Sequence[str]) -> dict[str, list[Any]]:
     """Columns of a table as Python lists (``surface`` as str): a run has a handful of
     episodes, and plain Python on a few values is faster than NumPy's calls on them
-    (the same IEEE operations, so the same results)."""
+    (the same IEEE operations, so the same results). An :class:`EpisodeLists` is
+    returned as it is (it has every column)."""
+    if type(table) is EpisodeLists:
+        return table
     out: dict[str, list[Any]] = {}
     for name in names:
         if name == "surface":
@@ -230,6 +250,27 @@ def impacts_of(cols: dict[str, list[Any]], rows: list[int]) -> list[list[int]]:
     return [[rows[i] for i in g] for g in _group(start, end, bumper)]
 
 
+def impacts_in(
+    cols: dict[str, list[Any]], exclude: Sequence[str], graze_fraction: float
+) -> tuple[list[int], int, list[list[int]]]:
+    """:func:`impact_rows` and :func:`impacts_of` of the lists of :func:`episode_lists`.
+
+    Returns the impact rows, the count of rows on surfaces not excluded and the
+    impacts (rows of ``cols``); kept in an :class:`EpisodeLists` for the next caller.
+    """
+    memo = cols.impacts if type(cols) is EpisodeLists else None
+    if memo is not None:  # kept by the surfaces excluded among those touched: the same rows
+        touched = set(cols["surface"])
+        key = (frozenset(str(s) for s in exclude if str(s) in touched), float(graze_fraction))
+        if key in memo:
+            return memo[key]
+    rows, n_all = impact_rows(cols, exclude, graze_fraction)
+    found = (rows, n_all, impacts_of(cols, rows))
+    if memo is not None:
+        memo[key] = found
+    return found
+
+
 def short_impacts(
     episodes: Table,
     period_s: float,
@@ -247,10 +288,9 @@ def short_impacts(
     if n == 0 or not period_s > 0.0:
         return 0, math.nan
     cols = episode_lists(episodes, _EPISODE_NEEDED)
-    rows, _ = impact_rows(cols, exclude_surfaces, graze_fraction)
+    _rows, _, groups = impacts_in(cols, exclude_surfaces, graze_fraction)
     durations = [
-        max(cols["t_end_s"][k] for k in g) - min(cols["t_start_s"][k] for k in g)
-        for g in impacts_of(cols, rows)
+        max(cols["t_end_s"][k] for k in g) - min(cols["t_start_s"][k] for k in g) for g in groups
     ]
     short = [d for d in durations if d < period_s]
     return len(short), (min(short) if short else math.nan)
@@ -299,8 +339,10 @@ def impact_metrics(
         Floats are NaN and lists empty when there is no episode.
     """
     cols = episode_lists(episodes, _EPISODE_NEEDED) if n_rows(episodes) else None
-    rows, n_all = impact_rows(cols, exclude_surfaces, graze_fraction) if cols else ([], 0)
-    groups = impacts_of(cols, rows) if cols else []
+    rows: list[int] = []
+    n_all, groups = 0, []
+    if cols:
+        rows, n_all, groups = impacts_in(cols, exclude_surfaces, graze_fraction)
     out: dict[str, Any] = {
         "delta_init_m": math.nan,
         "peak_force_n": math.nan,
@@ -345,12 +387,14 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
 
     Parameters
     ----------
-    ts : table
+    ts : table or numpy.ndarray (n, 4)
         Time series (:func:`~quadimpact.simulation.record.timeseries_frame` or
         its columns :func:`~quadimpact.simulation.record.timeseries_columns`):
         uses ``roll_deg``, ``pitch_deg``, ``yaw_deg`` and, for the tilt,
         ``q0..q3`` (falling back to the Euler angles when the quaternion
-        columns are absent).
+        columns are absent). Or the samples' quaternions themselves, one row
+        ``q0..q3`` (scalar first, body to inertial) per sample, any strides
+        (a view of the kernel's output rows: what a run's summary passes).
     refs : mapping
         ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (ZYX reference attitude,
         radians); other keys (``altitude_m``) are ignored.
@@ -372,12 +416,14 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
     roll_ref = float(refs["roll_rad"])
     pitch_ref = float(refs["pitch_rad"])
     yaw_ref = float(refs["yaw_rad"])
-    if all(has_column(ts, c) for c in ("q0", "q1", "q2", "q3")):
-        from quadimpact.simulation.attitude import excursion_from_quaternions
-
+    quat = ts if isinstance(ts, np.ndarray) else None
+    if quat is None and all(has_column(ts, c) for c in ("q0", "q1", "q2", "q3")):
         quat = np.ascontiguousarray(
             np.stack([column(ts, c) for c in ("q0", "q1", "q2", "q3")], axis=1)
         )
+    if quat is not None:
+        from quadimpact.simulation.attitude import excursion_from_quaternions
+
         z_ref = quat_to_matrix(euler_zyx_to_quat(roll_ref, pitch_ref, yaw_ref))[:, 2]
         values = excursion_from_quaternions(
             quat, roll_ref, pitch_ref, yaw_ref, np.ascontiguousarray(z_ref)

@@ -19,12 +19,14 @@ from quadimpact.core import layout as L
 from quadimpact.inputs.features import feature_column
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
 from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
+from quadimpact.simulation.metrics import EpisodeLists
 
 if TYPE_CHECKING:  # pandas is imported where a DataFrame is built
     import pandas as pd
 
 __all__ = [
     "episode_columns",
+    "episode_lists_of",
     "episodes_frame",
     "imu_columns",
     "imu_frame",
@@ -75,15 +77,13 @@ def episode_columns(
     rows = _rows(raw, n, L.NEP, "episodes")
     bumper_idx = np.rint(rows[:, L.E_FEATURE]).astype(np.int64)
     if np.any((bumper_idx < 0) | (bumper_idx >= n_features)):
-        raise ValueError(
-            f"episodes: feature index outside 0..{n_features - 1} (got {sorted(set(bumper_idx))})"
-        )
+        got = sorted(set(bumper_idx.tolist()))
+        raise ValueError(f"episodes: feature index outside 0..{n_features - 1} (got {got})")
     surf_idx = np.rint(rows[:, L.E_SHAPE]).astype(np.int64)
     names = list(surface_names)
     if np.any((surf_idx < 0) | (surf_idx >= len(names))):
-        raise ValueError(
-            f"episodes: surface index outside 0..{len(names) - 1} (got {sorted(set(surf_idx))})"
-        )
+        got = sorted(set(surf_idx.tolist()))
+        raise ValueError(f"episodes: surface index outside 0..{len(names) - 1} (got {got})")
     # sorted by start, then bumper; ties keep the kernel's order (a stable sort)
     order = np.lexsort((bumper_idx, rows[:, L.E_T_START]))
     data: dict[str, np.ndarray] = {
@@ -94,6 +94,45 @@ def episode_columns(
         data[name] = rows[order, col].copy()
     data["open"] = rows[order, L.E_OPEN] > 0.5
     return {name: data[name] for name in EPISODE_COLUMNS}
+
+
+def episode_lists_of(
+    raw: np.ndarray, n: int, surface_names: Sequence[str], n_features: int = len(BUMPERS)
+) -> EpisodeLists:
+    """The columns of :func:`episode_columns` as Python lists, same order and values.
+
+    What a run's summary reads: a run has a handful of episodes, and lists of
+    them (one conversion of the raw rows) cost less than NumPy columns.
+    ``surface`` holds names, ``bumper`` the feature 1-based, ``open`` bools.
+    """
+    rows = _rows(raw, n, L.NEP, "episodes").tolist()
+    names = [str(name) for name in surface_names]
+    start = [r[L.E_T_START] for r in rows]
+    if any(t != t for t in start):  # NaN starts: sorted as NumPy sorts them
+        cols = episode_columns(raw, n, surface_names, n_features)
+        return EpisodeLists({k: v.tolist() for k, v in cols.items()})
+    feature = [_index(r[L.E_FEATURE], n_features, "feature", rows, L.E_FEATURE) for r in rows]
+    surface = [_index(r[L.E_SHAPE], len(names), "surface", rows, L.E_SHAPE) for r in rows]
+    # by start, then feature; ties keep the kernel's order (a stable sort)
+    order = sorted(range(len(rows)), key=lambda i: (start[i], feature[i]))
+    data: dict[str, list[Any]] = {
+        "bumper": [feature[i] + 1 for i in order],
+        "surface": [names[surface[i]] for i in order],
+    }
+    for name, col in _EPISODE_FLOAT_SOURCES:
+        data[name] = [rows[i][col] for i in order]
+    data["open"] = [rows[i][L.E_OPEN] > 0.5 for i in order]
+    return EpisodeLists({name: data[name] for name in EPISODE_COLUMNS})
+
+
+def _index(value: float, count: int, what: str, rows: list[list[float]], col: int) -> int:
+    """A feature's or a surface's index in a raw episode (a whole float), checked to be in range."""
+    if value == value and abs(value) < 2.0**62:
+        k = round(value)  # half to even, as numpy.rint
+        if 0 <= k < count:
+            return k
+    got = sorted({int(np.rint(r[col])) if r[col] == r[col] else r[col] for r in rows})
+    raise ValueError(f"episodes: {what} index outside 0..{count - 1} (got {got})")
 
 
 def episodes_frame(

@@ -24,8 +24,7 @@ from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
     Table,
     episode_lists,
-    impact_rows,
-    impacts_of,
+    impacts_in,
     n_rows,
 )
 
@@ -219,9 +218,9 @@ def recovery_metrics(
     if n_rows(episodes):
         cols = episode_lists(episodes, EPISODE_COLUMNS_USED)
         others = sorted(set(cols["surface"]) - set(obstacle_names))
-        rows, _ = impact_rows(cols, others, GRAZE_IMPULSE_FRACTION)
+        _rows, _, groups = impacts_in(cols, others, GRAZE_IMPULSE_FRACTION)
         starts = cols["t_start_s"]
         out["impacts_after_detection"] = sum(
-            1 for g in impacts_of(cols, rows) if min(starts[k] for k in g) > t_detect
+            1 for g in groups if min(starts[k] for k in g) > t_detect
         )
     return out

@@ -36,7 +36,7 @@ from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
-from quadimpact.simulation.checks import check_prepared, check_scenario_type
+from quadimpact.simulation.checks import check_imu, check_prepared, check_scenario_type
 from quadimpact.simulation.estimation import Estimation, draw_estimation, pack_estimation
 from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
@@ -99,6 +99,10 @@ class RunSetup:
     """What the scenario's settings resolved to, as plain data (``scenario.json``'s
     ``resolved``): the model variant and every switch, the controller and its
     parameters with defaults, the pre-impact behaviour, the IMU and the slew limit."""
+    kept_grid: tuple[tuple[float, float, float], np.ndarray] | None = None
+    """The output times kept for (``t0``, ``tf``, ``output_rate_hz``) (see :meth:`model`)."""
+    kept_pairs: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    """``feat``, ``shapes`` and their pair table, kept (:meth:`keep_grid_and_pairs`)."""
     prepare_cpu_s: float = 0.0
     """CPU time of :func:`prepare` (this thread), s; the summary's ``cost`` adds it in."""
     kernel_cpu_s: float = 0.0
@@ -131,9 +135,31 @@ class RunSetup:
         }
         fields.update(changes)
         if "t_out" not in fields:
-            fields["t_out"] = self.output_times()
-        fields["pairs"] = pair_table(fields["feat"], fields["shapes"])
+            fields["t_out"] = self._output_grid()
+        kept = self.kept_pairs
+        if kept is not None and kept[0] is fields["feat"] and kept[1] is fields["shapes"]:
+            fields["pairs"] = kept[2]
+        else:
+            fields["pairs"] = pair_table(fields["feat"], fields["shapes"])
         return model(**fields)
+
+    def keep_grid_and_pairs(self) -> None:
+        """Compute the output times and the pair table now and keep them (no run changes them).
+
+        Runs made from this setup by ``dataclasses.replace`` (the shared
+        packing's runs) share them while their times, features and shapes are
+        this setup's (checked in :meth:`model`): the same arrays, not recomputed.
+        """
+        self._output_grid()
+        self.kept_pairs = (self.feat, self.shapes, pair_table(self.feat, self.shapes))
+
+    def _output_grid(self) -> np.ndarray:
+        """:meth:`output_times`, kept with the times and rate it is of."""
+        key = (self.t0, self.tf, self.output_rate_hz)
+        kept = self.kept_grid
+        if kept is None or kept[0] != key:
+            kept = self.kept_grid = (key, self.output_times())
+        return kept[1]
 
     def output_times(self) -> np.ndarray:
         """Output grid: ``t0``, the multiples of 1/rate inside (t0, tf), and ``tf`` (s)."""
@@ -323,6 +349,8 @@ def _shared(
                 f"no rotor slew limit (vehicle {v.name} has none): the pre-impact spin-down "
                 "stops the rotors at the first tick"
             )
+    check_imu(setup)  # of the shared packing: no draw changes what it checks
+    setup.keep_grid_and_pairs()
     return SharedSetup(setup=setup, imu=imu, est=est, entries=(entry, est.entry))
 
 

@@ -20,6 +20,7 @@ from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.packing import feature_records, surface_records
 from quadimpact.simulation.record import (
     episode_columns,
+    episode_lists_of,
     episodes_frame,
     imu_columns,
     imu_frame,
@@ -145,9 +146,9 @@ def analyse(
     """
     out, ep, st = rec.out, rec.episodes, rec.stats
     x0 = L.OUT_X + L.X_QUAT
-    quat = {f"q{k}": out[:, x0 + k] for k in range(4)}  # what the summary reads of the samples
+    quat = out[:, x0 : x0 + 4]  # what the summary reads of the samples (a view)
     nf = len(setup.feature_names)
-    episodes = episode_columns(ep, ep.shape[0], setup.shape_names, nf)
+    episodes = episode_lists_of(ep, ep.shape[0], setup.shape_names, nf)
     final_state = out[-1, L.OUT_X : L.OUT_X + L.NX] if out.shape[0] else setup.x0
     summary = build_summary(setup, scenario, quat, episodes, st, final_state=final_state)
     stats = {
@@ -172,8 +173,7 @@ def analyse(
         if name == "episodes":
             return episodes_frame(ep, ep.shape[0], names, nf)
         if name == "episodes_columns":
-            cols = dict(episodes)
-            return cols
+            return episode_columns(ep, ep.shape[0], names, nf)
         if name == "imu_columns":
             return imu_columns(imu)
         if name == "world":

@@ -49,15 +49,18 @@ def _nan_to_none(v: float) -> float | None:
 def build_summary(
     setup: RunSetup,
     scenario: Any,
-    ts,
-    episodes,
+    ts: Any,
+    episodes: Any,
     st: np.ndarray,
     final_state: np.ndarray | None = None,
 ) -> dict[str, Any]:
     """The summary (docs/STUDIES.md section 2, docs/RECOVERY.md section 6) of a run.
 
     From the raw stats, the tables and the state at the end of the run
-    (default: the last row of the time series).
+    (default: the last row of the time series). ``ts`` is the time-series
+    table or the samples' quaternions, an array (n, 4) (then ``final_state``
+    is needed); ``episodes`` the episodes table or its
+    :class:`~quadimpact.simulation.metrics.EpisodeLists`.
     """
     status_code = int(st[L.ST_STATUS])
     status = STATUS_NAMES[status_code]
@@ -170,7 +173,7 @@ def build_summary(
         summary["attitude_excursion"] = attitude_excursion_deg(ts, setup.references)
     if final_state is None:
         final_state = np.zeros(L.NX)
-        if n_rows(ts):
+        if n_rows(ts) and not isinstance(ts, np.ndarray):
             for k, name in enumerate(("x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s")):
                 final_state[k] = column(ts, name)[-1]
     summary["pre_impact"] = (

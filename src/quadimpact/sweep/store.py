@@ -81,26 +81,32 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
     Nested tables are joined with ``__``; lists become JSON text; wall-clock
     timings are dropped; keys outside :data:`SUMMARY_COLUMNS` go, as JSON, to
     ``summary_extra``; missing keys are null. Values take their column's type.
+    The row's keys are in the order of :data:`SUMMARY_COLUMNS`.
     """
-    skip = skip if isinstance(skip, (set, frozenset, dict)) else set(skip)
-    row: dict[str, Any] = {}
+    names = tuple(skip)
+    template = _ROW_TEMPLATES.get(names)
+    if template is None:
+        template = _ROW_TEMPLATES[names] = _row_template(set(names))
+    row = template.copy()
     extra: dict[str, Any] = {}
-    kinds = _SUMMARY_KIND
+    plan = _KEY_PLAN
 
     def walk(prefix: str, table: Mapping[str, Any]) -> None:
         for k, value in table.items():
-            key = f"{prefix}{k}"
+            key = f"{prefix}{k}" if prefix else k
             t = type(value)
             if t is dict or (t not in _LEAF_TYPES and isinstance(value, Mapping)):
                 walk(key + "__", value)
                 continue
-            if key in skip or (key.startswith("integrator__") and _is_time_measurement(key)):
+            if key not in row:  # skipped (an input), a timing, or outside the columns
+                if key not in names and not _is_time_measurement(key):
+                    extra[key] = plain(value)
                 continue
-            kind = kinds.get(key)
-            if kind is None or key == "summary_extra":
+            kind = plan.get(key) or _plan(key)
+            if kind == "x":
                 extra[key] = plain(value)
             elif value is None:  # the common cases of _typed, inline
-                row[key] = None
+                pass
             elif t is float and kind == "f":
                 row[key] = None if value != value else value
             elif t is _EXACT_TYPE.get(kind):
@@ -109,11 +115,25 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
                 row[key] = _typed(value, kind)
 
     walk("", summary)
-    for key, _kind in SUMMARY_COLUMNS:
-        if key not in row and key not in skip:
-            row[key] = None
     row["summary_extra"] = canonical(extra) if extra else None
     return row
+
+
+_KEY_PLAN: dict[str, str] = {}
+"""A row column's kind (``"x"``: summary_extra's own key, kept as extra), found once."""
+_ROW_TEMPLATES: dict[tuple[str, ...], dict[str, None]] = {}
+"""Rows of nulls, one per set of skipped (input) columns."""
+
+
+def _plan(key: str) -> str:
+    kind = "x" if key == "summary_extra" else _SUMMARY_KIND[key]
+    _KEY_PLAN[key] = kind
+    return kind
+
+
+def _row_template(skip: set[str]) -> dict[str, None]:
+    """Every summary column not skipped, null (timings are not columns)."""
+    return {key: None for key, _kind in SUMMARY_COLUMNS if key not in skip}
 
 
 _PLAIN_TYPES = (float, int, str, bool)
