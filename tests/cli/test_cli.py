@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -530,13 +531,39 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
     assert capsys.readouterr().err == ""
 
 
+def _refusals(cases: list[list[str]], modules: tuple[str, ...], cwd: Path) -> list[list[Any]]:
+    """Each command line run in one fresh process: ``[command, exit code, *(module loaded)]``
+    after it; its errors are checked to be one ``quadimpact: error:`` line each."""
+    import sys
+
+    code = (
+        "import json, sys\n"
+        "from quadimpact.cli import main\n"
+        "seen = []\n"
+        f"for args in {cases!r}:\n"
+        "    try:\n"
+        "        main(args)\n"
+        "    except SystemExit as exc:\n"
+        f"        loaded = [m in sys.modules for m in {modules!r}]\n"
+        "        seen.append([args[0], exc.code, *loaded])\n"
+        "print(json.dumps(seen))\n"
+    )
+    proc = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=cwd
+    )
+    assert proc.returncode == 0, proc.stderr
+    seen = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert [s[0] for s in seen] == [c[0] for c in cases]
+    errors = [line for line in proc.stderr.splitlines() if line.startswith("quadimpact: error:")]
+    assert len(errors) == len(cases) and "Traceback" not in proc.stderr, proc.stderr
+    return [[*s, e] for s, e in zip(seen, errors, strict=True)]
+
+
 def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path: Path) -> None:
     """A missing result folder, scenario file, an unusable --out or a bad value is said
     before the simulator (the compiled kernel's driver), the drawing code (Matplotlib) or
     Numba is imported: the inputs and a sweep's checks pack and validate without the
     compiled code (the controllers' slots are in ``core/layout.py``)."""
-    import sys
-
     afile = tmp_path / "a-file"
     afile.write_text("not a folder\n")
     cases = [
@@ -550,28 +577,26 @@ def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path
         ["sweep", "--grid", "speed_m_s=-1", "--workers", "1", "--out", str(tmp_path / "s")],
         ["recovery", "--vehicle", "nowhere.toml", "--workers", "1", "--out", str(tmp_path / "r")],
     ]
-    code = (
-        "import json, sys\n"
-        "from quadimpact.cli import main\n"
-        "seen = []\n"
-        f"for args in {cases!r}:\n"
-        "    try:\n"
-        "        main(args)\n"
-        "    except SystemExit as exc:\n"
-        "        names = ('numba', 'quadimpact.core.run', 'matplotlib')\n"
-        "        loaded = [m in sys.modules for m in names]\n"
-        "        seen.append([args[0], exc.code, *loaded])\n"
-        "print(json.dumps(seen))\n"
-    )
-    proc = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, timeout=120, cwd=tmp_path
-    )
-    assert proc.returncode == 0, proc.stderr
-    seen = json.loads(proc.stdout.strip().splitlines()[-1])
-    assert [s[0] for s in seen] == [c[0] for c in cases]
-    for command, exit_code, numba_loaded, kernel_loaded, mpl_loaded in seen:
-        assert exit_code == 2, (command, proc.stderr)
+    seen = _refusals(cases, ("numba", "quadimpact.core.run", "matplotlib"), tmp_path)
+    for command, exit_code, numba_loaded, kernel_loaded, mpl_loaded, _error in seen:
+        assert exit_code == 2, command
         assert not kernel_loaded and not mpl_loaded, (command, kernel_loaded, mpl_loaded)
         assert not numba_loaded, command
-    errors = [line for line in proc.stderr.splitlines() if line.startswith("quadimpact: error:")]
-    assert len(errors) == len(cases) and "Traceback" not in proc.stderr, proc.stderr
+
+
+def test_a_bad_recovery_option_is_refused_before_the_pool_or_pandas_start(tmp_path: Path) -> None:
+    """``quadimpact recovery`` checks its study's options with ``recovery.spec`` alone: a
+    bad vehicle, estimator or pair of options is said before the worker pool starts and
+    before pandas (the study's tables) is imported, and the folder is left unclaimed."""
+    out = tmp_path / "r"
+    cases = [
+        ["recovery", "--vehicle", "nowhere.toml", "--out", str(out)],
+        ["recovery", "--estimator", "no-such-estimator", "--out", str(out)],
+        ["recovery", "--imu", "noisy", "--sensors", "impact", "--out", str(out)],
+    ]
+    seen = _refusals(
+        cases, ("pandas", "quadimpact.sweep.run", "quadimpact.recovery.study"), tmp_path
+    )
+    assert [s[1:5] for s in seen] == [[2, False, False, False]] * len(cases), seen
+    assert "--vehicle" in seen[0][-1] and "--estimator" in seen[1][-1], seen
+    assert not out.exists() or not any(out.iterdir())

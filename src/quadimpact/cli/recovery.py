@@ -104,33 +104,34 @@ def recovery(
 
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
+    if imu is not None and sensors is not None:
+        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
+    values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
+    given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
+    study = None
+    if sweep_file is not None and given:
+        flag = "--" + next(iter(given)).replace("_", "-")
+        raise InputError(f"--sweep: the sweep file sets the trials; {flag} cannot be given with it")
+    if sweep_file is None:  # the options checked before anything heavy loads
+        from quadimpact.recovery.spec import RecoveryStudy
+
+        try:
+            study = RecoveryStudy(**given)
+        except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
+            field, sep, rest = str(exc).partition(":")
+            raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
     from quadimpact.sweep.run import warm_pool
 
     # the pool's fork server imports the simulator and loads the kernel on another core
     # while this process imports the study: the trials' pool and the example trial's
     # process (docs/RECOVERY.md 8) then start from a warm server instead of waiting for it
     warm_pool(workers, scheduler)
-    from quadimpact.recovery.study import RecoveryStudy, run_study
+    from quadimpact.recovery.study import run_study
 
-    if imu is not None and sensors is not None:
-        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
-    values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
-    given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
     if sweep_file is not None:
-        if given:
-            flag = "--" + next(iter(given)).replace("_", "-")
-            raise InputError(
-                f"--sweep: the sweep file sets the trials; {flag} cannot be given with it"
-            )
         from quadimpact.sweep import load_sweep_file
 
         study = load_sweep_file(sweep_file)
-    else:
-        try:
-            study = RecoveryStudy(**given)
-        except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
-            field, sep, rest = str(exc).partition(":")
-            raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
     with stoppable(out):
         result = run_study(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
