@@ -231,6 +231,21 @@ def test_render_time_per_frame_is_small(run_dir: Path) -> None:
     assert per_frame < 0.5, f"{per_frame:.3f} s per frame"
 
 
+def test_the_movie_reads_the_canvas_itself_and_the_picture_is_its_rgb(run_dir: Path) -> None:
+    """The encoder gets the RGBA canvas (no copy per frame); ``render`` is its RGB part."""
+    from quadimpact.viz.animation import DEFAULT_ANIMATION_CAMERA, AnimationFigure
+
+    fig = AnimationFigure(Scene.from_dir(run_dir), DEFAULT_ANIMATION_CAMERA, 320, 180)
+    rgba = fig.render_rgba(0.5)
+    assert rgba.shape == (180, 320, 4) and rgba.dtype == np.uint8 and rgba.flags.c_contiguous
+    assert np.shares_memory(rgba, np.asarray(fig.canvas.buffer_rgba()))
+    rgb = fig.render(0.5)
+    assert rgb.flags.c_contiguous and np.array_equal(rgb, rgba[:, :, :3])
+    right, up, forward = DEFAULT_ANIMATION_CAMERA.basis()
+    assert DEFAULT_ANIMATION_CAMERA.basis()[0] is right and not right.flags.writeable
+    assert abs(right @ up) < 1e-15 and abs(np.linalg.norm(forward) - 1.0) < 1e-15
+
+
 # ------------------------------------------------------------------ viewer
 def test_viewer_is_one_self_contained_file(run_dir: Path, tmp_path: Path) -> None:
     import json

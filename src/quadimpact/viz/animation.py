@@ -168,7 +168,15 @@ class AnimationFigure:
         self._background = None
 
     def render(self, t: float) -> np.ndarray:
-        """Draw time ``t``; return the pixels, shape (height, width, 3), uint8."""
+        """Draw time ``t``; return the pixels, shape (height, width, 3), uint8 (a copy)."""
+        return np.ascontiguousarray(self.render_rgba(t)[:, :, :3])
+
+    def render_rgba(self, t: float) -> np.ndarray:
+        """Draw time ``t``; return the canvas itself, shape (height, width, 4), uint8 RGBA.
+
+        A view of the figure's pixels (no copy), valid until the next frame is
+        drawn: what the movie's encoder reads (it drops the alpha channel).
+        """
         sc = self.scene
         self.view.update(t)
         k = int(np.searchsorted(self._t, t, side="right"))
@@ -204,7 +212,7 @@ class AnimationFigure:
             raise RuntimeError(
                 f"canvas is {buf.shape[1]}x{buf.shape[0]}, expected {self.width}x{self.height}"
             )
-        return np.ascontiguousarray(buf[:, :, :3])
+        return buf
 
 
 @dataclass
@@ -288,7 +296,7 @@ def write_animation(
                 (w, h),
                 fps=fps,
                 codec="libx264",
-                pix_fmt_in="rgb24",
+                pix_fmt_in="rgba",  # the canvas as it is: no copy to RGB per frame
                 pix_fmt_out="yuv420p",
                 quality=7,
                 # x264's "veryfast": 40 % less of ffmpeg's CPU than its default
@@ -301,12 +309,12 @@ def write_animation(
         sent = 0
         try:
             for k, t in enumerate(times):
-                pixels = fig.render(float(t))
+                pixels = fig.render_rgba(float(t))
                 if writer is not None:
-                    writer.send(pixels.tobytes())
+                    writer.send(pixels)  # written to ffmpeg's pipe from the canvas's memory
                     sent += 1
                 if gif and k % gif_step == 0:
-                    gif_frames.append(_gif_frame(pixels, gif_width))
+                    gif_frames.append(_gif_frame(pixels[:, :, :3], gif_width))
                 if progress is not None:
                     progress(k + 1, len(times))
         finally:

@@ -10,6 +10,7 @@ code.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Literal
@@ -58,18 +59,12 @@ class Camera:
             raise ValueError("span_m must be > 0")
 
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Screen right, screen up and viewing direction (into the screen), NED unit vectors."""
-        az = math.radians(self.azimuth_deg)
-        el = math.radians(self.elevation_deg)
-        to_camera = np.array(
-            [math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), -math.sin(el)]
-        )
-        forward = -to_camera
-        world_up = np.array([0.0, 0.0, -1.0])  # NED: up is -Z
-        right = np.cross(forward, world_up)
-        right /= np.linalg.norm(right)
-        up = np.cross(right, forward)
-        return right, up, forward
+        """Screen right, screen up and viewing direction (into the screen), NED unit vectors.
+
+        Computed once per azimuth and elevation (read-only arrays: a movie
+        projects with them many times a frame).
+        """
+        return _basis(float(self.azimuth_deg), float(self.elevation_deg))
 
     def project(self, points: np.ndarray, target: np.ndarray) -> np.ndarray:
         """Screen coordinates (m, right and up from the picture centre) of NED points (..., 3)."""
@@ -81,6 +76,21 @@ class Camera:
         """Distance along the viewing direction (larger = farther from the camera), m."""
         _, _, forward = self.basis()
         return (np.asarray(points, dtype=float) - np.asarray(target, dtype=float)) @ forward
+
+
+@functools.lru_cache(maxsize=64)
+def _basis(azimuth_deg: float, elevation_deg: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    az = math.radians(azimuth_deg)
+    el = math.radians(elevation_deg)
+    to_camera = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), -math.sin(el)])
+    forward = -to_camera
+    world_up = np.array([0.0, 0.0, -1.0])  # NED: up is -Z
+    right = np.cross(forward, world_up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    for v in (right, up, forward):
+        v.flags.writeable = False
+    return right, up, forward
 
 
 #: Movies follow the vehicle by default (a crash falls out of any fixed view).
