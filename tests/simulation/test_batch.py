@@ -1,7 +1,8 @@
 """simulate_batch gives the summaries of single simulate() calls, bit for bit.
 
-Its runs record output rows without the contact columns (the loop skips the
-contact geometry at output times); nothing else of a run may change.
+Its runs record no output rows (the loop samples at every output time for its
+stats, without writing a row or computing the contact geometry there); nothing
+else of a run may change.
 """
 
 from __future__ import annotations
@@ -68,3 +69,28 @@ def test_rows_without_contact_columns_leave_the_run_unchanged():
     assert np.array_equal(full.out[:, : L.NOUT], lean.out)
     for a, b in ((full.episodes, lean.episodes), (full.imu, lean.imu), (full.stats, lean.stats)):
         assert np.array_equal(a, b, equal_nan=True)
+
+
+def test_runs_without_rows_sample_the_same_and_keep_what_the_summary_reads():
+    """No output rows: the same episodes, IMU samples and stats, bit for bit, among them
+    the count of samples, their attitude excursion and the last sample's state (what
+    the summary reads); and those are the rows' (a noisy recovery trial, a pole)."""
+    for s in (
+        ImpactTrial(controller="recovery", roll_deg=10, pitch_deg=-30, speed_m_s=2.0,
+                    imu="noisy", seed=4),
+        ImpactTrial(controller="recovery", roll_deg=10, speed_m_s=2.0, obstacles=(POLE,)),
+    ):  # fmt: skip
+        setup = prepare(s)
+        m = setup.model()
+        full = new_output(m, setup.n_imu, 64)
+        none = new_output(m, setup.n_imu, 64, contact_columns=False, rows=False)
+        BUILTIN.run(m, full)
+        BUILTIN.run(m, none)
+        assert none.out.shape[0] == 0
+        for a, b in ((full.episodes, none.episodes), (full.imu, none.imu)):
+            assert np.array_equal(a, b, equal_nan=True)
+        assert np.array_equal(full.stats, none.stats, equal_nan=True)
+        n_out = int(none.stats[L.ST_N_OUT])
+        assert n_out == m.t_out.shape[0] or none.stats[L.ST_STATUS] != L.STATUS_COMPLETED
+        last = full.out[n_out - 1, L.OUT_X : L.OUT_X + L.NX]
+        assert np.array_equal(none.stats[L.ST_X_LAST : L.ST_X_LAST + L.NX], last)

@@ -289,6 +289,7 @@ C_H_REF = _ctrl.slot("C_H_REF")  # m, altitude reference
 C_PHI_REF = _ctrl.slot("C_PHI_REF")  # rad
 C_THETA_REF = _ctrl.slot("C_THETA_REF")  # rad
 C_PSI_REF = _ctrl.slot("C_PSI_REF")  # rad
+C_Z_REF = _ctrl.slot("C_Z_REF", 3)  # the reference attitude's body z axis, inertial (unit)
 C_ALLOC_INV = _ctrl.slot("C_ALLOC_INV", 16)  # inverse allocation matrix, row-major
 C_OMEGA_MIN = _ctrl.slot("C_OMEGA_MIN")  # rad/s, the vehicle's rotor speed range
 C_OMEGA_MAX = _ctrl.slot("C_OMEGA_MAX")
@@ -524,6 +525,15 @@ E_T_PEAK_FORCE = _ep.slot("E_T_PEAK_FORCE")  # s
 E_OPEN = _ep.slot("E_OPEN")  # 1 if the episode had not ended when the run stopped
 NEP = _ep.end("NEP")
 
+# ---- attitude excursion over the output samples (NEX), a part of stats
+# (ST_EXCURSION): core/excursion.py
+_ex = Block("stats.excursion", "EX_")
+EX_DEV = _ex.slot("EX_DEV", 3)  # rad, largest roll, pitch, yaw departures from the references
+EX_COS_TILT = _ex.slot("EX_COS_TILT")  # lowest cos of the body z axis from the reference's
+EX_DEV_TRIG = _ex.slot("EX_DEV_TRIG", 6)  # cos, sin of each largest departure so far
+EX_REF_TRIG = _ex.slot("EX_REF_TRIG", 6)  # cos, sin of the roll, pitch, yaw references
+NEX = _ex.end("NEX")
+
 # ---- run statistics stats (NSTAT)
 _st = Block("stats", "ST_")
 ST_STATUS = _st.slot("ST_STATUS")  # STATUS_*
@@ -560,6 +570,8 @@ N_PHASES = 3  # before the first contact, the crash (to stage 4), after stage 4
 ST_EST_ERR = _st.slot("ST_EST_ERR", 3 * N_EST_ERR * N_PHASES)  # (sum of squares, max, samples)
 ST_HOVER_RUN_T = _st.slot("ST_HOVER_RUN_T")  # s, first tick of the hover condition's run (NaN)
 ST_T_HOVER = _st.slot("ST_T_HOVER")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
+ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion (EX_*)
+ST_X_LAST = _st.slot("ST_X_LAST", NX)  # the state of the last output sample
 NSTAT = _st.end("NSTAT")
 
 

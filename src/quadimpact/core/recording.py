@@ -13,9 +13,14 @@ import numpy as np
 
 from .compiled import compiled
 from .contact import pair_damping, pair_normal_force
+from .excursion import excursion_add
 from .geometry import pair_depth
 from .integrator import dense_eval
 from .layout import (
+    C_PHI_REF,
+    C_PSI_REF,
+    C_THETA_REF,
+    C_Z_REF,
     CS_ACTIVE,
     CS_EPISODE,
     CS_LAMBDA,
@@ -31,6 +36,7 @@ from .layout import (
     E_V_I,
     LS_STAGE,
     N_ROTORS,
+    NEX,
     NX,
     O_V_MIN,
     OUT_CMD,
@@ -44,11 +50,13 @@ from .layout import (
     ST_CRASH_T,
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
+    ST_EXCURSION,
     ST_MAX_RATE,
     ST_MIN_ALT,
     ST_MIN_TILT_COS,
     ST_N_EPISODES,
     ST_STATUS,
+    ST_X_LAST,
     STATUS_CRASHED,
     X_OMEGA,
     X_POS,
@@ -61,20 +69,37 @@ from .sensors.disturbance import impact_onset
 
 @compiled
 def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
-    """Output row ``row`` at time ``t`` (s) of the state ``xs``: state, command, stage, contacts.
+    """The output sample ``row`` at time ``t`` (s) of the state ``xs``.
 
-    The contacts (each feature's deflection and normal force, from the
-    contact geometry of every pair) only where the rows have their columns:
-    a sweep's runs record rows of ``NOUT`` columns
-    (``records.new_output(..., contact_columns=False)``) and skip that work,
-    since their summary reads only the attitude and the last state.
+    Every sample: its attitude joins the run's excursion (``excursion_add``,
+    stats ``ST_EXCURSION``) and its state is kept as the last one
+    (``ST_X_LAST``). Its row (state, command, stage, contacts) is written
+    where the output has rows: a sweep's runs have none
+    (``records.new_output(..., rows=False)``), since their summary reads
+    only the excursion and the last state. The contacts (each feature's
+    deflection and normal force, from the contact geometry of every pair)
+    only where the rows have their columns
+    (``records.new_output(..., contact_columns=False)`` skips that work).
     """
     out = o.out
+    st = o.stats
     nf = m.feat.shape[0]
+    rotation_matrix(xs[X_QUAT : X_QUAT + 4], w.C)
+    excursion_add(
+        w.C,
+        m.ctrl[C_PHI_REF],
+        m.ctrl[C_THETA_REF],
+        m.ctrl[C_PSI_REF],
+        m.ctrl[C_Z_REF : C_Z_REF + 3],
+        st[ST_EXCURSION : ST_EXCURSION + NEX],
+    )
+    for i in range(NX):
+        st[ST_X_LAST + i] = xs[i]
+    if row >= out.shape[0]:
+        return
     out[row, OUT_T] = t
     for i in range(NX):
         out[row, OUT_X + i] = xs[i]
-    rotation_matrix(xs[X_QUAT : X_QUAT + 4], w.C)
     for j in range(N_ROTORS):
         out[row, OUT_CMD + j] = d.rin[RIN_CMD + j]
     out[row, OUT_STAGE] = d.ls[LS_STAGE]

@@ -163,16 +163,21 @@ def new_data(m: Model) -> Data:
 
 
 @njit(cache=True)
-def new_output(m: Model, n_imu: int, max_episodes: int, contact_columns: bool = True) -> Output:
+def new_output(
+    m: Model, n_imu: int, max_episodes: int, contact_columns: bool = True, rows: bool = True
+) -> Output:
     """Zeroed outputs of the run ``m``: a row per output time, ``n_imu`` IMU rows.
 
     ``contact_columns=False``: rows of ``NOUT`` columns (time, state, command,
     stage), without the features' deflections and forces, which the loop
-    then does not compute (``recording.write_sample``): what a summary needs.
+    then does not compute (``recording.write_sample``). ``rows=False``: no
+    row at all; the loop still samples at every output time for the stats
+    (the attitude excursion, the last sample's state, the count of samples):
+    what a summary needs.
     """
     width = NOUT + 2 * m.feat.shape[0] if contact_columns else NOUT  # layout.out_width
     return Output(
-        np.zeros((m.t_out.shape[0], width)),
+        np.zeros((m.t_out.shape[0] if rows else 0, width)),
         np.zeros((max(n_imu, 0), NIMU)),
         np.zeros((max_episodes, NEP)),
         np.zeros(NSTAT),

@@ -34,9 +34,13 @@ from .actuators import apply_command, cut_step
 from .compiled import allocating, compiled
 from .controllers import builtin_step
 from .estimators import at_tick, init_estimate
+from .excursion import excursion_start
 from .hover import track_hover
 from .interval import FAILED, RUNNING, contact_values, integrate_interval
 from .layout import (
+    C_PHI_REF,
+    C_PSI_REF,
+    C_THETA_REF,
     CRASH_PAPER_TICKS,
     CS_ACTIVE,
     CS_EPISODE,
@@ -63,6 +67,7 @@ from .layout import (
     MS_T_DETECT,
     N_ROTORS,
     N_STAGES,
+    NEX,
     O_CRASH_ALTITUDE,
     O_CRASH_RULE,
     O_DT_CONTROL,
@@ -78,6 +83,7 @@ from .layout import (
     SPAN_TF,
     SS_NEXT_T,
     ST_CRASH_T,
+    ST_EXCURSION,
     ST_HOVER_RUN_T,
     ST_IMPACT_T,
     ST_MAX_DELTA,
@@ -128,6 +134,10 @@ def start(m: Model, d: Data, o: Output) -> None:
     stats[ST_T_END] = t0
     stats[ST_MIN_ALT] = -x[X_POS + 2]
     stats[ST_MIN_TILT_COS] = 1.0
+    excursion_start(
+        m.ctrl[C_PHI_REF], m.ctrl[C_THETA_REF], m.ctrl[C_PSI_REF],
+        stats[ST_EXCURSION : ST_EXCURSION + NEX],
+    )  # fmt: skip
     dt_c = m.opts[O_DT_CONTROL]
     h_max = m.opts[O_H_MAX] if m.opts[O_H_MAX] > 0.0 else dt_c
     ls = d.ls

@@ -3,10 +3,11 @@
 What a sweep needs of each run is its summary. ``simulate_batch`` prepares
 each scenario, runs the compiled loop into output buffers allocated once for
 the whole batch (and grown when a run needs more), and computes each summary
-from the raw arrays; no table is built. Its output rows have no contact
-columns: the loop skips the contact geometry of every pair at every output
-time (about a sixth of a recovery trial's loop), which only the time-series
-table shows. Each run is the same computation as
+from the raw arrays; no table is built. Its runs record no output rows: the
+loop still samples at every output time, for the stats (the attitude
+excursion, the last sample's state), but writes no row and skips the contact
+geometry of every pair there (about a sixth of a recovery trial's loop),
+which only the time-series table shows. Each run is the same computation as
 :func:`quadimpact.simulate` (same kernel, same inputs), so the summaries are
 the same bit for bit. A scenario that cannot run (it raises while being
 prepared) gives a summary with ``status = "failed"`` and the reason; the
@@ -38,14 +39,14 @@ class _Buffers:
     def output(self, m: Model, n_imu: int) -> Output:
         """An :class:`Output` for the run ``m`` in the buffers (views of their first rows).
 
-        The rows have no contact columns (``new_output(..., contact_columns=False)``):
-        the summary reads the attitude and the last state of the samples only.
+        No output rows (``new_output(..., rows=False)``): the summary reads the
+        samples' attitude excursion and the last sample's state, which the loop
+        keeps in its stats.
         """
-        n_out = m.t_out.shape[0]
         o = self.o
-        if o is None or o.out.shape[0] < n_out or o.imu.shape[0] < n_imu:
-            o = self.o = new_output(m, n_imu, self.max_episodes, contact_columns=False)
-        return o._replace(out=o.out[:n_out], imu=o.imu[:n_imu])
+        if o is None or o.imu.shape[0] < n_imu:
+            o = self.o = new_output(m, n_imu, self.max_episodes, contact_columns=False, rows=False)
+        return o._replace(imu=o.imu[:n_imu])
 
 
 def _run(setup: RunSetup, buffers: _Buffers) -> tuple[RawRecord, float, float]:

@@ -18,6 +18,7 @@ from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Box, Cylinder, Plane
 from quadimpact.linalg import inverse, lu_factor, lu_solve, norm
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
 CONTROL_RATE_HZ = 200.0
 RPM = 2.0 * np.pi / 60.0  # rad/s per rpm
@@ -333,12 +334,22 @@ def set_references(ctrl: np.ndarray, refs: Mapping[str, float]) -> None:
     """Write the references into a ``C_*`` vector, in place (m and rad).
 
     ``refs`` holds ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``;
-    the only slots of the controller's vector that depend on them.
+    the only slots of the controller's vector that depend on them (with the
+    reference's body z axis, :func:`reference_z_axis`).
     """
     ctrl[L.C_H_REF] = refs["altitude_m"]
     ctrl[L.C_PHI_REF] = refs["roll_rad"]
     ctrl[L.C_THETA_REF] = refs["pitch_rad"]
     ctrl[L.C_PSI_REF] = refs["yaw_rad"]
+    ctrl[L.C_Z_REF : L.C_Z_REF + 3] = reference_z_axis(refs)
+
+
+def reference_z_axis(refs: Mapping[str, float]) -> np.ndarray:
+    """The reference attitude's body z axis in inertial axes (NED, unit): the third column
+    of ``C`` of the ZYX attitude (``roll_rad``, ``pitch_rad``, ``yaw_rad``), from which the
+    summary's tilt is measured."""
+    q = euler_zyx_to_quat(refs["roll_rad"], refs["pitch_rad"], refs["yaw_rad"])
+    return quat_to_matrix(q)[:, 2]
 
 
 def pack_options(

@@ -145,12 +145,9 @@ def analyse(
     ``cost``; null when not given).
     """
     out, ep, st = rec.out, rec.episodes, rec.stats
-    x0 = L.OUT_X + L.X_QUAT
-    quat = out[:, x0 : x0 + 4]  # what the summary reads of the samples (a view)
     nf = len(setup.feature_names)
     episodes = episode_lists_of(ep, ep.shape[0], setup.shape_names, nf)
-    final_state = out[-1, L.OUT_X : L.OUT_X + L.NX] if out.shape[0] else setup.x0
-    summary = build_summary(setup, scenario, quat, episodes, st, final_state=final_state)
+    summary = build_summary(setup, scenario, episodes, st)
     stats = {
         "steps": int(st[L.ST_N_STEPS]),
         "rejected_steps": int(st[L.ST_N_REJECTED]),

@@ -14,6 +14,7 @@ import numpy as np
 
 from quadimpact import __version__
 from quadimpact.core import layout as L
+from quadimpact.core.excursion import DEG
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
 from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
@@ -21,11 +22,8 @@ from quadimpact.simulation.approach import inclination_deg_of
 from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
-    attitude_excursion_deg,
     classify_response,
-    column,
     impact_metrics,
-    n_rows,
     short_impacts,
 )
 from quadimpact.simulation.recovery_metrics import first_contact_normal, recovery_metrics
@@ -46,21 +44,13 @@ def _nan_to_none(v: float) -> float | None:
     return None if v is None or (isinstance(v, float) and math.isnan(v)) else float(v)
 
 
-def build_summary(
-    setup: RunSetup,
-    scenario: Any,
-    ts: Any,
-    episodes: Any,
-    st: np.ndarray,
-    final_state: np.ndarray | None = None,
-) -> dict[str, Any]:
+def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray) -> dict[str, Any]:
     """The summary (docs/STUDIES.md section 2, docs/RECOVERY.md section 6) of a run.
 
-    From the raw stats, the tables and the state at the end of the run
-    (default: the last row of the time series). ``ts`` is the time-series
-    table or the samples' quaternions, an array (n, 4) (then ``final_state``
-    is needed); ``episodes`` the episodes table or its
-    :class:`~quadimpact.simulation.metrics.EpisodeLists`.
+    From the kernel's stats (among them the output samples' attitude
+    excursion and the last sample's state: the state at the end of the run)
+    and the episodes (the table or its
+    :class:`~quadimpact.simulation.metrics.EpisodeLists`); no time series.
     """
     status_code = int(st[L.ST_STATUS])
     status = STATUS_NAMES[status_code]
@@ -169,13 +159,10 @@ def build_summary(
                 warnings.append(
                     f"impact speed {speed:.6f} m/s differs from the requested {scenario.speed_m_s}"
                 )
-    if n_rows(ts):
-        summary["attitude_excursion"] = attitude_excursion_deg(ts, setup.references)
-    if final_state is None:
-        final_state = np.zeros(L.NX)
-        if n_rows(ts) and not isinstance(ts, np.ndarray):
-            for k, name in enumerate(("x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s")):
-                final_state[k] = column(ts, name)[-1]
+    final_state = setup.x0
+    if st[L.ST_N_OUT] > 0:
+        summary["attitude_excursion"] = excursion_deg(st)
+        final_state = st[L.ST_X_LAST : L.ST_X_LAST + L.NX]
     summary["pre_impact"] = (
         scenario.resolved_pre_impact() if getattr(scenario, "controller", None) == "recovery"
         else None
@@ -203,6 +190,19 @@ def build_summary(
     rings = setup.vehicle.features is None
     summary["outcome"] = describe_outcome(summary, None if rings else setup.feature_names)
     return summary
+
+
+def excursion_deg(st: np.ndarray) -> dict[str, float]:
+    """The output samples' attitude excursion (degrees), as
+    :func:`~quadimpact.simulation.metrics.attitude_excursion_deg` of the time series
+    gives it: the loop's ``ST_EXCURSION`` (``core/excursion.py``) in degrees."""
+    e = st[L.ST_EXCURSION : L.ST_EXCURSION + L.NEX].tolist()
+    return {
+        "roll_excursion_deg": e[L.EX_DEV] * DEG,
+        "pitch_excursion_deg": e[L.EX_DEV + 1] * DEG,
+        "yaw_excursion_deg": e[L.EX_DEV + 2] * DEG,
+        "tilt_max_deg": math.acos(e[L.EX_COS_TILT]) * DEG,
+    }
 
 
 def _estimation(setup: RunSetup, scenario: Any, st: np.ndarray) -> dict[str, Any]:
