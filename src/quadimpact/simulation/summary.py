@@ -1,8 +1,10 @@
 """The summary of a run (``summary.json``, docs/STUDIES.md section 2) and its one-line outcome.
 
-Built from the run's setup, its tables and the kernel's raw stats: the status,
-warnings, the impact conditions reached at the first onset, the approach
-solution and the metrics of :mod:`quadimpact.simulation.metrics`.
+Built from the run's setup, its episodes and the kernel's raw stats (never the
+time series: the loop keeps the samples' attitude excursion and the last
+state in its stats): the status, warnings, the impact conditions reached at
+the first onset, the approach solution and the metrics of
+:mod:`quadimpact.simulation.metrics`.
 """
 
 from __future__ import annotations
