@@ -86,6 +86,8 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
     names = tuple(skip)
     template = _ROW_TEMPLATES.get(names)
     if template is None:
+        if len(_ROW_TEMPLATES) >= 64:  # a process that flattens for many sweeps
+            _ROW_TEMPLATES.clear()
         template = _ROW_TEMPLATES[names] = _row_template(set(names))
     row = template.copy()
     extra: dict[str, Any] = {}
