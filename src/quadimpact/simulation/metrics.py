@@ -394,7 +394,8 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
         ``q0..q3`` (falling back to the Euler angles when the quaternion
         columns are absent). Or the samples' quaternions themselves, one row
         ``q0..q3`` (scalar first, body to inertial) per sample, any strides
-        (a view of the kernel's output rows: what a run's summary passes).
+        (a view of the kernel's output rows, say). A run's summary has the same
+        numbers from its loop (``core/excursion.py``).
     refs : mapping
         ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (ZYX reference attitude,
         radians); other keys (``altitude_m``) are ignored.
@@ -423,8 +424,9 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
         )
     if quat is not None:
         from quadimpact.simulation.attitude import excursion_from_quaternions
+        from quadimpact.simulation.packing import reference_z_axis
 
-        z_ref = quat_to_matrix(euler_zyx_to_quat(roll_ref, pitch_ref, yaw_ref))[:, 2]
+        z_ref = reference_z_axis({"roll_rad": roll_ref, "pitch_rad": pitch_ref, "yaw_rad": yaw_ref})
         values = excursion_from_quaternions(
             quat, roll_ref, pitch_ref, yaw_ref, np.ascontiguousarray(z_ref)
         )
