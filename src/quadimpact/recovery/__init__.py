@@ -5,8 +5,11 @@
 the sweep machinery (resumable, the same table on any number of cores) and
 writes ``trials.parquet``, the figures and ``report.md``.
 
-* :mod:`~quadimpact.recovery.study`: the Monte Carlo spec
-  (:class:`~quadimpact.recovery.study.RecoveryStudy`), the run
+* :mod:`~quadimpact.recovery.spec`: the Monte Carlo spec
+  (:class:`~quadimpact.recovery.spec.RecoveryStudy`, the authors'
+  distribution, the trials' sampling), light enough for the command line to
+  check a study's options before anything else loads;
+* :mod:`~quadimpact.recovery.study`: the run
   (:func:`~quadimpact.recovery.study.run_study`) and the trials table;
 * :mod:`~quadimpact.recovery.analysis`: pure functions of the table: the
   Wilson interval, bins, outcome classes, the numbers of the report;
