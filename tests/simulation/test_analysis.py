@@ -367,21 +367,6 @@ def test_attitude_excursion(with_quat: bool) -> None:
     assert m["tilt_max_deg"] == pytest.approx(tilt_yaw, abs=1e-9)
 
 
-def test_attitude_excursion_of_a_strided_quaternion_array_is_the_tables() -> None:
-    """The summary passes a view of the kernel's output rows (q0..q3 of each row):
-    the same excursion, bit for bit, as the time-series table's quaternion columns."""
-    refs = {"roll_rad": 0.1, "pitch_rad": -15 * D, "yaw_rad": 45 * D, "altitude_m": 2.0}
-    rng = np.random.default_rng(7)
-    rows = [tuple(rng.uniform(-170.0, 170.0, 3)) for _ in range(50)]
-    ts = _euler_ts(rows, True)
-    out = np.zeros((len(rows), 9))
-    for k in range(4):
-        out[:, 2 + k] = ts[f"q{k}"].to_numpy()
-    view = out[:, 2:6]
-    assert not view.flags.c_contiguous
-    assert attitude_excursion_deg(view, refs) == attitude_excursion_deg(ts, refs)
-
-
 def test_attitude_excursion_roll_wraps_through_180() -> None:
     refs = {"roll_rad": 170 * D, "pitch_rad": 0.0, "yaw_rad": 0.0, "altitude_m": 2.0}
     m = attitude_excursion_deg(_euler_ts([(-175.0, 0.0, 0.0)], True), refs)

@@ -387,15 +387,13 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
 
     Parameters
     ----------
-    ts : table or numpy.ndarray (n, 4)
+    ts : table
         Time series (:func:`~quadimpact.simulation.record.timeseries_frame` or
         its columns :func:`~quadimpact.simulation.record.timeseries_columns`):
         uses ``roll_deg``, ``pitch_deg``, ``yaw_deg`` and, for the tilt,
         ``q0..q3`` (falling back to the Euler angles when the quaternion
-        columns are absent). Or the samples' quaternions themselves, one row
-        ``q0..q3`` (scalar first, body to inertial) per sample, any strides
-        (a view of the kernel's output rows, say). A run's summary has the same
-        numbers from its loop (``core/excursion.py``).
+        columns are absent). A run's summary has the same numbers from its
+        loop (``core/excursion.py``).
     refs : mapping
         ``roll_rad``, ``pitch_rad``, ``yaw_rad`` (ZYX reference attitude,
         radians); other keys (``altitude_m``) are ignored.
@@ -417,15 +415,13 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
     roll_ref = float(refs["roll_rad"])
     pitch_ref = float(refs["pitch_rad"])
     yaw_ref = float(refs["yaw_rad"])
-    quat = ts if isinstance(ts, np.ndarray) else None
-    if quat is None and all(has_column(ts, c) for c in ("q0", "q1", "q2", "q3")):
-        quat = np.ascontiguousarray(
-            np.stack([column(ts, c) for c in ("q0", "q1", "q2", "q3")], axis=1)
-        )
-    if quat is not None:
+    if all(has_column(ts, c) for c in ("q0", "q1", "q2", "q3")):
         from quadimpact.simulation.attitude import excursion_from_quaternions
         from quadimpact.simulation.packing import reference_z_axis
 
+        quat = np.ascontiguousarray(
+            np.stack([column(ts, c) for c in ("q0", "q1", "q2", "q3")], axis=1)
+        )
         z_ref = reference_z_axis({"roll_rad": roll_ref, "pitch_rad": pitch_ref, "yaw_rad": yaw_ref})
         values = excursion_from_quaternions(
             quat, roll_ref, pitch_ref, yaw_ref, np.ascontiguousarray(z_ref)
