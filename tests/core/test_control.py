@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from quadimpact import FlightScenario, simulate
+from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.run import make_kernel
 
@@ -63,12 +63,35 @@ def _hold_initial_speeds(x, ctrl, mem, veh, dt, cmd):
         cmd[j] = mem[1 + j]
 
 
-def test_plugin_controller_runs_in_the_compiled_loop():
+@pytest.fixture(scope="module")
+def held_kernel():
+    """The loop compiled around ``_hold_initial_speeds`` (once for the module, ~20 s)."""
+    return make_kernel(_hold_initial_speeds)
+
+
+def test_plugin_controller_runs_in_the_compiled_loop(held_kernel):
     """A user's njit controller plugs into the same loop (here: open-loop hover speeds)."""
-    kernel = make_kernel(_hold_initial_speeds)
-    r = simulate(FlightScenario(final_time_s=1.0), kernel=kernel)
+    r = simulate(FlightScenario(final_time_s=1.0), kernel=held_kernel)
     ts = r.timeseries
     assert r.summary["integrator"]["control_ticks"] == 200
     np.testing.assert_allclose(ts["omega_cmd1_rad_s"], ts["omega1_rad_s"].iloc[0])
     # trimmed speeds balance the weight exactly: the vehicle stays put
     assert np.max(np.abs(ts["altitude_m"] - 2.0)) < 1e-9
+
+
+def test_a_plugin_loop_flies_the_wall_approach_with_its_own_controller(held_kernel):
+    """The approach's shooting runs are the plug-in loop's (``core/approach.py``, compiled
+    into the kernel): with the rotors held instead of the paper controller the run still
+    touches the wall first at T_c with V_c (a late start here: Brent's search too), from
+    another start than the paper controller needs."""
+    scenario = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.5)
+    held = simulate(scenario, kernel=held_kernel)
+    s = held.summary
+    assert s["first_contact_s"] == pytest.approx(0.5, abs=1e-6)
+    assert s["impact_speed_m_s"] == pytest.approx(0.5, abs=1e-6)
+    assert s["approach"]["late_start"] and abs(s["approach"]["speed_residual_m_s"]) <= 1e-12
+    ts = held.timeseries  # the rotors really were held from the start
+    before = ts[ts["t_s"] < 0.5 - 1e-6]
+    np.testing.assert_array_equal(before["omega_cmd1_rad_s"], before["omega1_rad_s"].iloc[0])
+    paper = simulate(scenario).summary["approach"]
+    assert s["approach"]["start_time_s"] != paper["start_time_s"]

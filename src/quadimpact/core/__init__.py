@@ -24,6 +24,8 @@ pipeline stage:
 * ``recording``: output rows, episodes and peaks, extremes, the crash;
 * ``step``: one control tick, the pipeline of the stages above;
 * ``run``: a whole run, the kernels (plug-ins), the Python entry;
+* ``approach``: the wall approach's shooting (free-flight runs of the loop,
+  the late start's search with ``roots``, Brent's method as compiled steps);
 * ``batch``: many runs stepped together under external commands (learning).
 
 Numba's on-disk cache checks only the file of each cached function, not the

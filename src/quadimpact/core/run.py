@@ -4,7 +4,8 @@
 to the end with the built-in controllers and geometry: it takes the run's
 :class:`~quadimpact.core.records.Model` and fills its
 :class:`~quadimpact.core.records.Output`. A :class:`Kernel` bundles the
-compiled entry points of one loop (``run``, ``start``, ``advance``);
+compiled entry points of one loop (``run``, ``start``, ``advance`` and the
+wall approach's shooting, ``approach``);
 :data:`BUILTIN` is the cached one.
 
 :func:`make_kernel` compiles the loop again around plug-ins: a user's
@@ -35,6 +36,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from . import geometry as _geometry
+from .approach import solve_approach
 from .geometry.record import no_contact
 from .layout import MS_X, NX, SH_KIND
 from .records import Model, Output, RawRecord, new_data, new_output, raw_record
@@ -59,17 +61,20 @@ def run(m: Model, o: Output) -> None:
 class Kernel:
     """The compiled entry points of one run loop.
 
-    ``run(m, o)``, ``start(m, d, o)``, ``advance(n, m, d, o) -> ticks``;
-    ``step``: the plug-in controller step compiled into it (None: built-ins).
+    ``run(m, o)``, ``start(m, d, o)``, ``advance(n, m, d, o) -> ticks``,
+    ``approach(m, o, wall, pairs, ap)`` (the wall approach's shooting, whose
+    free-flight runs are this loop's: ``core/approach.py``); ``step``: the
+    plug-in controller step compiled into it (None: built-ins).
     """
 
     run: Callable
     start: Callable
     advance: Callable
+    approach: Callable
     step: Callable | None = None
 
 
-BUILTIN = Kernel(run=run, start=start, advance=advance)
+BUILTIN = Kernel(run=run, start=start, advance=advance, approach=solve_approach)
 """The cached loop: built-in controllers, built-in geometry."""
 
 
@@ -266,6 +271,7 @@ def make_kernel(
         run=specialise(run, replacements, memo),
         start=specialise(start, replacements, memo),
         advance=specialise(advance, replacements, memo),
+        approach=specialise(solve_approach, replacements, memo),
         step=step,
     )
 

@@ -8,6 +8,9 @@ a correction of v0 and a shift of X0 make the first contact happen at ``T_c``
 with ``V_X = V_c`` (repeated until the residuals are below 1e-12). If that
 needs ``v0 < 0``, the vehicle starts later, at rest, at the ``t0`` found by
 Brent's method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial).
+
+The shooting runs in one compiled call (``core/approach.py``, the kernel's
+``approach``); :func:`solve_approach` packs its inputs and reads what it found.
 """
 
 from __future__ import annotations
@@ -18,13 +21,13 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.geometry import contact_record
-from quadimpact.core.records import Model
-from quadimpact.core.run import Kernel, execute
-from quadimpact.linalg import matvec, matvec_t
+from quadimpact.core.approach import APPROACH_MAX_ITER, APPROACH_TOL_M_S
+from quadimpact.core.geometry import contact_record, pair_table
+from quadimpact.core.records import Model, new_output
+from quadimpact.core.run import BUILTIN, Kernel
+from quadimpact.linalg import matvec_t
 from quadimpact.results.costs import CpuClock
 from quadimpact.rotations import inclination_deg, quat_to_matrix
-from quadimpact.simulation.roots import brentq
 
 __all__ = [
     "APPROACH_MAX_ITER",
@@ -40,8 +43,6 @@ __all__ = [
 
 PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (docs/VARIANTS.md 4.4)
 PAPER_FIT_SCALE = 1.3836686
-APPROACH_TOL_M_S = 1e-12  # shooting residuals (speed m/s, depth m)
-APPROACH_MAX_ITER = 4
 
 
 # ------------------------------------------------------------------ attitude
@@ -92,45 +93,6 @@ def initial_state(
 
 
 # ------------------------------------------------------------------ shooting
-def _free_flight_end(
-    run: Model,
-    x0: np.ndarray,
-    t0: float,
-    t_end: float,
-    free_opts: np.ndarray,
-    kernel: Kernel | None = None,
-    clock: CpuClock | None = None,
-) -> np.ndarray:
-    """State at ``t_end`` of the run ``run`` from ``(t0, x0)`` with no shapes, no IMU, no crash."""
-    span = np.zeros(L.NSPAN)
-    span[L.SPAN_T0] = t0
-    span[L.SPAN_TF] = t_end
-    m = run._replace(
-        x0=np.ascontiguousarray(x0, dtype=np.float64),
-        span=span,
-        shapes=np.zeros((0, L.NSHAPE)),
-        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
-        opts=free_opts,
-        scfg=np.zeros(L.NSCFG),
-        noise=np.zeros((0, 6)),
-        t_out=np.array([t_end]),
-    )
-    if clock is None:
-        rec = execute(m, max_episodes=1, kernel=kernel)
-    else:
-        with clock:
-            rec = execute(m, max_episodes=1, kernel=kernel)
-    if rec.stats[L.ST_STATUS] == L.STATUS_FAILED or rec.out.shape[0] != 1:
-        raise RuntimeError(
-            "approach shooting run failed: " + L.REASON_TEXT[int(rec.stats[L.ST_REASON])]
-        )
-    return rec.out[0, L.OUT_X : L.OUT_X + L.NX]
-
-
-def _inertial_velocity(x: np.ndarray) -> np.ndarray:
-    return matvec(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]), x[L.X_VEL : L.X_VEL + 3])
-
-
 def feature_depths(x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, s: int = 0) -> np.ndarray:
     """Penetration (m) of every contact feature into shape ``s`` at the state ``x``.
 
@@ -190,50 +152,45 @@ def solve_approach(
         ``start_time_s``, ``start_x_m``, ``start_speed_m_s``, ``late_start``,
         ``speed_residual_m_s`` (the summary's ``approach``).
     """
-    tc = float(impact_time_s)
-    vc = float(speed_m_s)
-
-    def shoot(t0: float, v0: float, x_start: float) -> tuple[np.ndarray, np.ndarray]:
-        pos = start + np.array([x_start, 0.0, 0.0])
-        x0 = initial_state(pos, np.array([v0, 0.0, 0.0]), q, np.zeros(3), rotors)
-        return x0, _free_flight_end(run, x0, t0, tc, free_opts, kernel, clock)
-
-    def solve_from(t0: float, v0: float) -> tuple[float, float, float, np.ndarray]:
-        """Correct v0 (unless at rest) and X0 until the residuals vanish."""
-        x_start = 0.0
-        for _ in range(APPROACH_MAX_ITER):
-            x0, xe = shoot(t0, v0, x_start)
-            dv = vc - _inertial_velocity(xe)[0]
-            depth = feature_depths(xe, run.feat, wall).max()
-            if abs(dv) <= APPROACH_TOL_M_S and abs(depth) <= APPROACH_TOL_M_S:
-                break
-            if t0 == 0.0 or v0 != 0.0:
-                v0 += dv
-                x_start -= depth + dv * (tc - t0)
-            else:
-                x_start -= depth
-        return v0, x_start, dv, x0
-
-    late = False
-    t0 = 0.0
-    v0, x_start, dv, x0 = solve_from(0.0, vc)
-    if v0 < 0.0:
-        late = late_start
-        if not late:  # the authors' rule: start later only from beyond the wall
-            late = feature_depths(x0, run.feat, wall).max() > 0.0
-    if late:
-
-        def residual(t_start: float) -> float:
-            _, xe = shoot(t_start, 0.0, 0.0)
-            return _inertial_velocity(xe)[0] - vc
-
-        t0 = brentq(residual, 0.0, tc - 1e-9, xtol=1e-14, rtol=4 * np.finfo(float).eps)
-        v0, x_start, dv, x0 = solve_from(t0, 0.0)
+    free = run._replace(
+        x0=np.zeros(L.NX),
+        span=np.zeros(L.NSPAN),
+        shapes=np.zeros((0, L.NSHAPE)),
+        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        opts=free_opts,
+        scfg=np.zeros(L.NSCFG),
+        noise=np.zeros((0, 6)),
+        t_out=np.array([float(impact_time_s)]),
+    )
+    ap = np.zeros(L.NAP)
+    ap[L.AP_TC] = impact_time_s
+    ap[L.AP_VC] = speed_m_s
+    ap[L.AP_LATE_RULE] = 1.0 if late_start else 0.0
+    ap[L.AP_START : L.AP_START + 3] = start
+    ap[L.AP_Q : L.AP_Q + 4] = q
+    ap[L.AP_ROTORS : L.AP_ROTORS + L.N_ROTORS] = rotors
+    solve = (kernel or BUILTIN).approach
+    args = (free, new_output(free, 0, 1), wall, pair_table(run.feat, wall), ap)
+    if clock is None:
+        solve(*args)
+    else:
+        with clock:
+            solve(*args)
+    status = int(ap[L.AP_STATUS])
+    if status == L.APPROACH_RUN_FAILED:
+        reason = L.REASON_TEXT.get(int(ap[L.AP_REASON]), "") or "no state sampled at T_c"
+        raise RuntimeError("approach shooting run failed: " + reason)
+    if status == L.APPROACH_NO_BRACKET:
+        raise ValueError(
+            "approach: no late start reaches the wall at the speed asked "
+            "(the speed residual has one sign over [0, T_c))"
+        )
+    x0 = ap[L.AP_X0 : L.AP_X0 + L.NX].copy()
     approach = {
-        "start_time_s": t0,
+        "start_time_s": float(ap[L.AP_T0]),
         "start_x_m": float(x0[L.X_POS]),
-        "start_speed_m_s": float(v0),
-        "late_start": bool(late),
-        "speed_residual_m_s": float(dv),
+        "start_speed_m_s": float(ap[L.AP_V0]),
+        "late_start": bool(ap[L.AP_LATE]),
+        "speed_residual_m_s": float(ap[L.AP_DV]),
     }
-    return x0, t0, approach
+    return x0, float(ap[L.AP_T0]), approach

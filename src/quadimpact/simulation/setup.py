@@ -8,14 +8,16 @@ wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approac
 
 Packing is two stages: :class:`SharedSetup` (what the run's initial state and
 seed do not change) and the run's own part (:func:`_for_run`: its state,
-references and random draws). An impact trial's shared part is kept per
-process (:func:`_trial_shared`), so the trials of a study pack only what
+references and random draws). An impact trial's and a wall approach's shared
+part is kept per process (:func:`_kept_shared`), so the trials of a study and
+the runs of a sweep over headings, inclinations and speeds pack only what
 differs between them, with the same functions: the same arrays, bit for bit.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -268,8 +270,9 @@ class SharedSetup:
     :func:`_shared` packs it (the vehicle, features, surfaces, options,
     controller without references, the IMU and estimator without their random
     draws, the warnings); :func:`_for_run` completes a copy for one run. An
-    impact trial's is kept per process (:func:`_trial_shared`), so a study's
-    trials pack only what differs between them.
+    impact trial's and a wall approach's are kept per process
+    (:func:`_kept_shared`), so a study's trials pack only what differs
+    between them.
     """
 
     setup: RunSetup
@@ -416,8 +419,11 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
 
 
 # --------------------------------------------------------------- wall approach
-def prepare_wall_approach(s: WallApproach) -> RunSetup:
-    """The paper's scenario, with the approach solved so that first contact is at T_c."""
+def prepare_wall_approach(s: WallApproach, kernel: Kernel | None = None) -> RunSetup:
+    """The paper's scenario, with the approach solved so that first contact is at T_c.
+
+    ``kernel``: a run loop in place of the scenario's (its shooting runs fly with it).
+    """
     v = s.build_vehicle()
     o = s.resolved_model_options()
     if s.roll_deg is not None and s.pitch_deg is not None:
@@ -425,16 +431,15 @@ def prepare_wall_approach(s: WallApproach) -> RunSetup:
     else:
         roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
     refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    wall = Plane.wall(s.wall_distance_m)
-    surfaces = [wall, *s.obstacles, *_ground(s)]
-    duration = float(s.final_time_s)
-    setup = _for_run(_shared(s, v, o, surfaces, duration, wall=wall), s, refs)
+    setup = _for_run(_wall_shared(s), s, refs)
+    if kernel is not None:
+        setup.kernel = kernel
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
     clock = CpuClock()
     setup.x0, setup.t0, setup.approach = solve_approach(
         run=setup.model(),
         free_opts=_packed_options(s, o, v, float(s.impact_time_s), free=True),
-        wall=pack_surfaces([wall]),
+        wall=setup.shapes[:1],  # the wall is the first surface
         q=euler_zyx_to_quat(roll, pitch, yaw),
         rotors=_initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper"),
         start=np.array([0.0, 0.0, -float(h0)]),
@@ -466,9 +471,24 @@ TRIAL_STATE_FIELDS = (
 """An impact trial's fields that set its initial state, references and random draws
 only: trials that differ in these alone share their :class:`SharedSetup`."""
 
-_STATE_EXCLUDE = frozenset(TRIAL_STATE_FIELDS)
-_TRIAL_SHARED: dict[str, SharedSetup] = {}
-_TRIAL_SHARED_LIMIT = 8
+WALL_STATE_FIELDS = (
+    "heading_deg",
+    "inclination_deg",
+    "speed_m_s",
+    "impact_time_s",
+    "altitude_m",
+    "roll_deg",
+    "pitch_deg",
+    "start_altitude_m",
+    "seed",
+)
+"""A wall approach's fields that set its attitude, references, approach and random draws
+only: approaches that differ in these alone share their :class:`SharedSetup`."""
+
+_TRIAL_STATE_EXCLUDE = frozenset(TRIAL_STATE_FIELDS)
+_WALL_STATE_EXCLUDE = frozenset(WALL_STATE_FIELDS)
+_SHARED: dict[str, SharedSetup] = {}
+_SHARED_LIMIT = 8
 
 
 def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
@@ -512,18 +532,21 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     return _for_run(shared, s, refs, x0=x0, t0=0.0)
 
 
-def _trial_shared(s: ImpactTrial) -> SharedSetup:
-    """The :class:`SharedSetup` of an impact trial, packed once per process for its other fields.
+def _kept_shared(
+    s: WallApproach | ImpactTrial, exclude: frozenset[str], pack: Callable[[], SharedSetup]
+) -> SharedSetup:
+    """The :class:`SharedSetup` of a run, packed (``pack()``) once per process for its other fields.
 
-    Kept (at most :data:`_TRIAL_SHARED_LIMIT`) under the trial's JSON
-    without :data:`TRIAL_STATE_FIELDS`, and used again only with the same
-    vehicle object (a vehicle file changed on disk loads as a new one) and
-    the same registry entries. Every value of a run is computed by the same
-    functions either way: a kept packing gives the same run, bit for bit.
+    Kept (at most :data:`_SHARED_LIMIT`) under the scenario's JSON without
+    the fields ``exclude`` (its state fields: :data:`TRIAL_STATE_FIELDS`,
+    :data:`WALL_STATE_FIELDS`), and used again only with the same vehicle
+    object (a vehicle file changed on disk loads as a new one) and the same
+    registry entries. Every value of a run is computed by the same functions
+    either way: a kept packing gives the same run, bit for bit.
     """
     v = s.build_vehicle()
-    key = s.model_dump_json(exclude=_STATE_EXCLUDE)
-    shared = _TRIAL_SHARED.get(key)
+    key = s.model_dump_json(exclude=exclude)
+    shared = _SHARED.get(key)
     entries = (controller_entry(s.controller), estimator_entry(s.estimator))
     if (
         shared is not None
@@ -531,18 +554,40 @@ def _trial_shared(s: ImpactTrial) -> SharedSetup:
         and all(a is b for a, b in zip(shared.entries, entries, strict=True))
     ):
         return shared
-    o = s.resolved_model_options()
-    duration = float(s.final_time_s)
-    if s.obstacles:
-        shared = _shared(s, v, o, [*s.obstacles, *_ground(s)], duration)
-        shared.front = obstacle_front(s.obstacles[0])
-    else:
-        wall = Plane.wall(0.0)
-        shared = _shared(s, v, o, [wall, *_ground(s)], duration, wall=wall)
-    if len(_TRIAL_SHARED) >= _TRIAL_SHARED_LIMIT:
-        _TRIAL_SHARED.pop(next(iter(_TRIAL_SHARED)))
-    _TRIAL_SHARED[key] = shared
+    shared = pack()
+    if len(_SHARED) >= _SHARED_LIMIT:
+        _SHARED.pop(next(iter(_SHARED)))
+    _SHARED[key] = shared
     return shared
+
+
+def _wall_shared(s: WallApproach) -> SharedSetup:
+    """The :class:`SharedSetup` of a wall approach, kept for its fields but the state's."""
+
+    def pack() -> SharedSetup:
+        wall = Plane.wall(s.wall_distance_m)
+        surfaces = [wall, *s.obstacles, *_ground(s)]
+        v, o = s.build_vehicle(), s.resolved_model_options()
+        return _shared(s, v, o, surfaces, float(s.final_time_s), wall=wall)
+
+    return _kept_shared(s, _WALL_STATE_EXCLUDE, pack)
+
+
+def _trial_shared(s: ImpactTrial) -> SharedSetup:
+    """The :class:`SharedSetup` of an impact trial, kept for its fields but the state's."""
+
+    def pack() -> SharedSetup:
+        v = s.build_vehicle()
+        o = s.resolved_model_options()
+        duration = float(s.final_time_s)
+        if s.obstacles:
+            shared = _shared(s, v, o, [*s.obstacles, *_ground(s)], duration)
+            shared.front = obstacle_front(s.obstacles[0])
+            return shared
+        wall = Plane.wall(0.0)
+        return _shared(s, v, o, [wall, *_ground(s)], duration, wall=wall)
+
+    return _kept_shared(s, _TRIAL_STATE_EXCLUDE, pack)
 
 
 def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
@@ -581,16 +626,25 @@ def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
     return float(centre[0] - inside), centre
 
 
-def prepare(scenario: WallApproach | FlightScenario | ImpactTrial) -> RunSetup:
-    """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``)."""
+def prepare(
+    scenario: WallApproach | FlightScenario | ImpactTrial, kernel: Kernel | None = None
+) -> RunSetup:
+    """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``).
+
+    ``kernel``: a run loop (``core.run.make_kernel``) in place of the one the
+    scenario's controller and estimator select; a wall approach's shooting
+    runs fly with it too.
+    """
     started = cpu_time()
     check_scenario_type(scenario)
     if isinstance(scenario, WallApproach):
-        setup = prepare_wall_approach(scenario)
+        setup = prepare_wall_approach(scenario, kernel)
     elif isinstance(scenario, ImpactTrial):
         setup = prepare_impact_trial(scenario)
     else:
         setup = prepare_flight(scenario)
+    if kernel is not None:
+        setup.kernel = kernel
     check_prepared(scenario, setup)
     setup.prepare_cpu_s = cpu_time() - started
     return setup

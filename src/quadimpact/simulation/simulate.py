@@ -50,6 +50,7 @@ def simulate(
     kernel : Kernel, optional
         A run loop from ``quadimpact.core.run.make_kernel`` (plug-ins);
         default: the registered controller's (the cached kernel for built-ins).
+        A wall approach's shooting runs fly with it too.
 
     Returns
     -------
@@ -57,8 +58,8 @@ def simulate(
         ``.summary`` (dict of summary.json), ``.episodes``, ``.timeseries`` and
         ``.imu`` (pandas DataFrames, SI units, inertial NED / body FRD).
     """
-    setup = prepare(scenario)
-    return run_setup(setup, scenario, max_episodes=max_episodes, kernel=kernel)
+    setup = prepare(scenario, kernel)
+    return run_setup(setup, scenario, max_episodes=max_episodes)
 
 
 def run_setup(

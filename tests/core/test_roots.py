@@ -1,5 +1,5 @@
-"""The late start's root finder takes SciPy's ``brentq`` steps exactly: the same points
-evaluated, the same root, to the bit."""
+"""The late start's root finder (``core/roots.py``, compiled steps) takes SciPy's
+``brentq`` steps exactly: the same points evaluated, the same root, to the bit."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.simulation.roots import brentq
+from quadimpact.core.roots import brentq
 
 optimize = pytest.importorskip("scipy.optimize")
 

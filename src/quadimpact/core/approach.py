@@ -1,0 +1,227 @@
+"""The wall approach's shooting, compiled: the start that brings first contact at T_c.
+
+The paper's wall approach (docs/STUDIES.md section 1) holds an attitude and
+an altitude from the start and must touch the wall first at ``T_c`` with the
+speed ``V_c`` toward it. Without aerodynamic drag nothing in the dynamics
+depends on X or V_X, so ``V_X(T_c) = v0 + A`` and the leading feature's depth
+at ``T_c`` shifts one to one with X0: one free-flight run (no shapes, no IMU,
+no crash) gives A and the depth, a correction of v0 and a shift of X0 make
+the first contact happen at ``T_c`` with ``V_X = V_c`` (repeated until both
+residuals are below ``APPROACH_TOL_M_S``, at most ``APPROACH_MAX_ITER``
+runs). If that needs ``v0 < 0``, the vehicle starts later, at rest, at the
+``t0`` found by Brent's method (``core/roots.py``) on ``V_X(T_c; t0) = V_c``,
+one free-flight run per evaluation.
+
+:func:`solve_approach` does all of it in one compiled call: the free-flight
+runs are the loop's own ``start`` and ``advance`` (so a plug-in kernel's
+copy, ``core.run.make_kernel``, shoots with the plug-in controller), the
+depths the contact geometry's. It reads its inputs from and writes what it
+found to one array (``ap``, slots ``AP_*`` in ``core/layout.py``);
+``quadimpact.simulation.approach`` packs it and reads it back.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .compiled import allocating, compiled
+from .geometry import pair_contact
+from .layout import (
+    AP_DV,
+    AP_LATE,
+    AP_LATE_RULE,
+    AP_Q,
+    AP_REASON,
+    AP_ROTORS,
+    AP_START,
+    AP_STATUS,
+    AP_T0,
+    AP_TC,
+    AP_V0,
+    AP_VC,
+    AP_X0,
+    APPROACH_NO_BRACKET,
+    APPROACH_RUN_FAILED,
+    APPROACH_SOLVED,
+    N_ROTORS,
+    NX,
+    OUT_X,
+    SPAN_T0,
+    SPAN_TF,
+    ST_N_OUT,
+    ST_REASON,
+    ST_STATUS,
+    STATUS_FAILED,
+    X_OMEGA,
+    X_POS,
+    X_QUAT,
+    X_ROTOR,
+    X_VEL,
+)
+from .quaternion import rotation_matrix
+from .records import Model, Output, new_data
+from .roots import BR_X, BRENT_ASK, BRENT_NO_BRACKET, NBR, brent_next, brent_start
+from .step import advance, start
+
+__all__ = ["APPROACH_MAX_ITER", "APPROACH_TOL_M_S", "solve_approach"]
+
+APPROACH_TOL_M_S = 1e-12  # shooting residuals (speed m/s, depth m)
+APPROACH_MAX_ITER = 4
+LATE_START_XTOL_S = 1e-14  # Brent's tolerances on the late start time
+LATE_START_RTOL = 4.0 * 2.220446049250313e-16
+LATE_START_MAXITER = 100
+LATE_START_END_GAP_S = 1e-9  # the bracket ends this far before T_c
+
+
+@allocating(inline="always")
+def _shoot(t0: float, v0: float, x_start: float, m: Model, o: Output, ap: np.ndarray) -> bool:
+    """Fly ``m`` from ``t0`` to ``T_c``, starting at ``V_X = v0`` and ``X0 + x_start``.
+
+    The initial state goes to ``m.x0`` and ``ap[AP_X0]``, the state at ``T_c``
+    to ``o.out[0]``; False if the run failed or sampled no state at ``T_c``.
+    """
+    x0 = m.x0
+    C = np.empty((3, 3))
+    rotation_matrix(ap[AP_Q : AP_Q + 4], C)
+    x0[:] = 0.0
+    x0[X_POS] = ap[AP_START] + x_start
+    x0[X_POS + 1] = ap[AP_START + 1] + 0.0
+    x0[X_POS + 2] = ap[AP_START + 2] + 0.0
+    for j in range(3):  # body velocity C^T (v0, 0, 0), summed in index order
+        x0[X_VEL + j] = C[0, j] * v0 + C[1, j] * 0.0 + C[2, j] * 0.0
+    x0[X_QUAT : X_QUAT + 4] = ap[AP_Q : AP_Q + 4]
+    x0[X_OMEGA : X_OMEGA + 3] = 0.0
+    x0[X_ROTOR : X_ROTOR + N_ROTORS] = ap[AP_ROTORS : AP_ROTORS + N_ROTORS]
+    ap[AP_X0 : AP_X0 + NX] = x0
+    m.span[SPAN_T0] = t0
+    m.span[SPAN_TF] = ap[AP_TC]
+    d = new_data(m)
+    start(m, d, o)
+    advance(-1, m, d, o)
+    if o.stats[ST_STATUS] == STATUS_FAILED or o.stats[ST_N_OUT] != 1:
+        ap[AP_STATUS] = APPROACH_RUN_FAILED
+        ap[AP_REASON] = o.stats[ST_REASON]
+        return False
+    return True
+
+
+@compiled
+def _inertial_vx(x: np.ndarray, C: np.ndarray) -> float:
+    """Inertial X velocity (m/s) of the state ``x``; ``C`` receives its rotation."""
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
+    return C[0, 0] * x[X_VEL] + C[0, 1] * x[X_VEL + 1] + C[0, 2] * x[X_VEL + 2]
+
+
+@compiled
+def _deepest(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, wall: np.ndarray, pairs: np.ndarray
+) -> float:
+    """Largest penetration (m) of any feature into the wall at ``x`` (NaN if any is NaN)."""
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
+    best = -math.inf
+    for c in range(pairs.shape[0]):
+        depth = pair_contact(x, C, feat, wall, pairs, c)[0]
+        if depth != depth:
+            return depth
+        if depth > best:
+            best = depth
+    return best
+
+
+@allocating(inline="always")
+def _solve_from(
+    t0: float, v0: float, m: Model, o: Output, wall: np.ndarray, pairs: np.ndarray, ap: np.ndarray
+) -> bool:
+    """Correct v0 (unless at rest after ``t0 > 0``) and X0 until the residuals vanish.
+
+    Writes ``AP_X0``, ``AP_V0``, ``AP_DV``; False if a run failed.
+    """
+    tc = ap[AP_TC]
+    vc = ap[AP_VC]
+    xe = np.empty(NX)
+    C = np.empty((3, 3))
+    x_start = 0.0
+    dv = 0.0
+    for _ in range(APPROACH_MAX_ITER):
+        if not _shoot(t0, v0, x_start, m, o, ap):
+            return False
+        xe[:] = o.out[0, OUT_X : OUT_X + NX]
+        dv = vc - _inertial_vx(xe, C)
+        depth = _deepest(xe, C, m.feat, wall, pairs)
+        if abs(dv) <= APPROACH_TOL_M_S and abs(depth) <= APPROACH_TOL_M_S:
+            break
+        if t0 == 0.0 or v0 != 0.0:
+            v0 += dv
+            x_start -= depth + dv * (tc - t0)
+        else:
+            x_start -= depth
+    ap[AP_V0] = v0
+    ap[AP_DV] = dv
+    return True
+
+
+@allocating
+def solve_approach(
+    m: Model, o: Output, wall: np.ndarray, pairs: np.ndarray, ap: np.ndarray
+) -> None:
+    """Find the initial state and time that bring the first contact at ``T_c`` with ``V_c``.
+
+    Parameters
+    ----------
+    m : Model
+        The free-flight run: the vehicle, its features, the controller and
+        the power-off schedule; no shapes, no IMU, no crash; ``t_out = [T_c]``.
+        Its ``x0`` and ``span`` are overwritten at every shooting run.
+    o : Output
+        Its output (one row, no IMU samples, one episode).
+    wall : numpy.ndarray, shape (1, NSHAPE)
+        The wall alone, inertial.
+    pairs : numpy.ndarray, shape (n_features, NPAIR), int64
+        The pair table of the vehicle's features against the wall.
+    ap : numpy.ndarray, shape (NAP,)
+        In: ``AP_TC``, ``AP_VC``, ``AP_LATE_RULE``, ``AP_START``, ``AP_Q``,
+        ``AP_ROTORS``. Out: ``AP_X0``, ``AP_T0``, ``AP_V0``, ``AP_DV``,
+        ``AP_LATE`` and ``AP_STATUS`` (``APPROACH_*``; ``AP_REASON`` for a
+        failed run).
+    """
+    ap[AP_STATUS] = APPROACH_SOLVED
+    ap[AP_REASON] = 0.0
+    ap[AP_T0] = 0.0
+    ap[AP_LATE] = 0.0
+    vc = ap[AP_VC]
+    if not _solve_from(0.0, vc, m, o, wall, pairs, ap):
+        return
+    late = False
+    if ap[AP_V0] < 0.0:
+        late = ap[AP_LATE_RULE] != 0.0
+        if not late:  # the authors' rule: start later only from beyond the wall
+            x0 = ap[AP_X0 : AP_X0 + NX].copy()
+            late = _deepest(x0, np.empty((3, 3)), m.feat, wall, pairs) > 0.0
+    if not late:
+        return
+    br = np.empty(NBR)
+    xe = np.empty(NX)
+    C = np.empty((3, 3))
+    brent_start(
+        br,
+        0.0,
+        ap[AP_TC] - LATE_START_END_GAP_S,
+        LATE_START_XTOL_S,
+        LATE_START_RTOL,
+        LATE_START_MAXITER,
+    )
+    code = BRENT_ASK
+    while code == BRENT_ASK:
+        if not _shoot(br[BR_X], 0.0, 0.0, m, o, ap):
+            return
+        xe[:] = o.out[0, OUT_X : OUT_X + NX]
+        code = brent_next(br, _inertial_vx(xe, C) - vc)
+    if code == BRENT_NO_BRACKET:
+        ap[AP_STATUS] = APPROACH_NO_BRACKET
+        return
+    t0 = br[BR_X]
+    ap[AP_T0] = t0
+    ap[AP_LATE] = 1.0
+    _solve_from(t0, 0.0, m, o, wall, pairs, ap)
