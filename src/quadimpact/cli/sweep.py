@@ -132,6 +132,8 @@ def sweep(
         # N workers from the start (unless every run is done already): the fork server
         # imports the simulator and loads the kernel on another core meanwhile
         warm_pool(workers)
+        if not no_plots:  # and this process loads the plotting (Matplotlib) on this one
+            import quadimpact.sweep.plots  # noqa: F401
     from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
 
     if sweep_file is not None:

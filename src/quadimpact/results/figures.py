@@ -639,7 +639,7 @@ def type_map_figure(
                         fontsize=max(5.0, min(12.0, size)),
                         color="white" if t in ("B", "D") else "black",
                         zorder=4,
-                    )
+                    ).set_in_layout(False)  # inside its cell: no margin to make room for
         ax.pcolormesh(
             np.arange(len(xs) + 1) - 0.5,
             np.arange(len(ys) + 1) - 0.5,
