@@ -196,3 +196,20 @@ def test_single_quaternion_path_is_the_array_path_bit_for_bit() -> None:
         assert np.array_equal(quat_to_matrix(q), c)
     with pytest.raises(ValueError, match="zero norm"):
         quat_to_matrix(np.zeros(4))
+
+
+def test_single_attitude_path_is_the_array_path_bit_for_bit() -> None:
+    """One attitude (Python floats) goes through three-element ufunc calls; it must equal
+    the broadcast path exactly, for wide and for tiny angles."""
+    rng = np.random.default_rng(8)
+    angles = rng.uniform(-np.pi, np.pi, size=(4000, 3))
+    angles[:500] *= 1e-7
+    angles[500:1000] = np.round(angles[500:1000], 2)
+    stacked = euler_zyx_to_quat(angles[:, 0], angles[:, 1], angles[:, 2])  # the array path
+    for (r, p, y), q in zip(angles.tolist(), stacked, strict=True):
+        single = euler_zyx_to_quat(r, p, y)
+        assert single.shape == (4,) and single.tobytes() == q.tobytes()
+    assert (
+        euler_zyx_to_quat(np.float64(0.1), 0.2, 0.3).tobytes()
+        == euler_zyx_to_quat(np.array(0.1), 0.2, 0.3).tobytes()
+    )
