@@ -8,10 +8,9 @@ process: to the compiled kernel's own time on the same runs. Measures:
 1. ``simulate()`` of the paper example (psi = 45 deg, iota = 15 deg,
    V_c = 0.75 m/s) in both model variants, warm, one core: its time / the
    kernel-only time of its main run (``core.run.execute`` of the prepared
-   setup's model). The approach shooting runs are kernel time too; they are
-   reported apart (their number is what the approach needs: 2 for a start at
-   t = 0, about 11 for a late start, kept so that every result stays bit for
-   bit the same).
+   setup's model). The approach's compiled shooting (``core/approach.py``:
+   2 free-flight runs for a start at t = 0, about 11 for a late start) is
+   kernel time too; it is reported apart.
 2. The Figure 4 grid (246 runs) in both variants: wall time x worker processes
    / the sum of the same runs' kernel-only times (main runs and shooting runs),
    serial in-process (``sweep.worker.run_chunk``) and with ``run_sweep`` on
@@ -70,23 +69,21 @@ class KernelClock:
 
         self.total = 0.0
         self._patches = []
-        real_execute = run.execute
-        real_kernel = run.BUILTIN.run
 
-        def timed_execute(*a, **k):
-            t = time.perf_counter()
-            r = real_execute(*a, **k)
-            self.total += time.perf_counter() - t
-            return r
+        def timed(fn):
+            def call(*a, **k):
+                t = time.perf_counter()
+                r = fn(*a, **k)
+                self.total += time.perf_counter() - t
+                return r
 
-        def timed_kernel(*a, **k):
-            t = time.perf_counter()
-            r = real_kernel(*a, **k)
-            self.total += time.perf_counter() - t
-            return r
+            return call
 
-        timed_builtin = dataclasses.replace(run.BUILTIN, run=timed_kernel)
-        self._patches = [(approach, "execute", timed_execute), (batch, "BUILTIN", timed_builtin)]
+        # the main runs (a sweep's, through simulation.batch) and the approach's compiled
+        # shooting (simulation.approach calls BUILTIN.approach for built-in controllers)
+        timed_run = dataclasses.replace(run.BUILTIN, run=timed(run.BUILTIN.run))
+        timed_shooting = dataclasses.replace(run.BUILTIN, approach=timed(run.BUILTIN.approach))
+        self._patches = [(approach, "BUILTIN", timed_shooting), (batch, "BUILTIN", timed_run)]
 
     def __enter__(self) -> KernelClock:
         self._saved = [(m, n, getattr(m, n)) for m, n, _ in self._patches]
