@@ -7,6 +7,7 @@ from numba import njit
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.run import make_kernel
+from quadimpact.simulation.stepping import Simulation
 
 CONTROLLERS = ["paper", "cascade-pid"]
 
@@ -95,3 +96,5 @@ def test_a_plugin_loop_flies_the_wall_approach_with_its_own_controller(held_kern
     np.testing.assert_array_equal(before["omega_cmd1_rad_s"], before["omega1_rad_s"].iloc[0])
     paper = simulate(scenario).summary["approach"]
     assert s["approach"]["start_time_s"] != paper["start_time_s"]
+    # the stepping front end prepares the same start with the kernel it is given
+    assert Simulation(scenario, kernel=held_kernel).setup.approach == s["approach"]

@@ -48,7 +48,7 @@ class Simulation:
         Size of the episode buffer.
     kernel : Kernel, optional
         A run loop from ``core.run.make_kernel`` (plug-ins); default the
-        registered controller's.
+        registered controller's. A wall approach's shooting runs fly with it too.
 
     Attributes
     ----------
@@ -60,8 +60,8 @@ class Simulation:
         self, scenario: Any, *, max_episodes: int = 1024, kernel: Kernel | None = None
     ) -> None:
         self.scenario = scenario
-        self.setup: RunSetup = prepare(scenario)
-        self._kernel = kernel or self.setup.kernel or BUILTIN
+        self.setup: RunSetup = prepare(scenario, kernel)
+        self._kernel = self.setup.kernel or BUILTIN
         self._m = self.setup.model()
         self._d = new_data(self._m)
         self._o = new_output(self._m, int(self.setup.n_imu), int(max_episodes))
