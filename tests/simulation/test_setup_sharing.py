@@ -3,11 +3,11 @@ same, bit for bit.
 
 ``simulation.setup`` packs the part of an impact trial or a wall approach
 that its initial state, attitude and seed do not change once per process
-(``SharedSetup``) and completes a copy per run. These tests pack runs with
-the kept packing and alone (the cache emptied) and compare every array byte
-for byte (a wall approach's solved start included); check that no state
-field reaches the shared part; and that a changed field or vehicle file
-packs again.
+(``SharedSetup``, kept by ``simulation/sharing.py``) and completes a copy
+per run. These tests pack runs with the kept packing and alone (the cache
+emptied) and compare every array byte for byte (a wall approach's solved
+start included); check that no state field reaches the shared part; and
+that a changed field or vehicle file packs again.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ import pytest
 from quadimpact.inputs.scenarios import ImpactTrial, WallApproach
 from quadimpact.inputs.world import Cylinder
 from quadimpact.simulation import setup as S
+from quadimpact.simulation.sharing import TRIAL_STATE_FIELDS, WALL_STATE_FIELDS, clear_kept
 
 ARRAYS = ("x0", "veh", "feat", "shapes", "opts", "ctrl", "scfg", "noise", "ecfg", "snoise")
 NOISY = {
@@ -65,7 +66,7 @@ def test_a_trial_packed_with_the_kept_packing_is_the_trial_packed_alone(extra: d
     trials = _trials(extra)
     kept = [S.prepare(t) for t in trials]  # the first packs the shared part, the rest reuse it
     for trial, setup in zip(trials, kept, strict=True):
-        S._SHARED.clear()
+        clear_kept()
         _same(setup, S.prepare(trial))
     # the kept runs do not share what a run owns
     assert kept[0].ctrl is not kept[1].ctrl and kept[0].scfg is not kept[1].scfg
@@ -76,7 +77,7 @@ def test_a_trial_packed_with_the_kept_packing_is_the_trial_packed_alone(extra: d
         assert not np.array_equal(kept[0].ecfg, kept[1].ecfg)
 
 
-@pytest.mark.parametrize("field", S.TRIAL_STATE_FIELDS)
+@pytest.mark.parametrize("field", TRIAL_STATE_FIELDS)
 def test_no_state_field_reaches_the_shared_packing(field: str) -> None:
     base = {**NOISY, **POLE, "controller": "recovery", "final_time_s": 0.5}
     changed = {
@@ -85,16 +86,16 @@ def test_no_state_field_reaches_the_shared_packing(field: str) -> None:
         "lateral_offset_m": 0.02,
         "altitude_m": 1.3,
     }.get(field, 0.37 if field == "speed_m_s" else 12.5)
-    S._SHARED.clear()
+    clear_kept()
     one = S._trial_shared(ImpactTrial(**base))
-    S._SHARED.clear()
+    clear_kept()
     two = S._trial_shared(ImpactTrial(**base, **{field: changed}))
     _same(one.setup, two.setup)
     assert one.front is not None and one.front[0] == two.front[0]
 
 
 def test_a_changed_field_or_vehicle_file_packs_again(tmp_path: Path) -> None:
-    S._SHARED.clear()
+    clear_kept()
     a = S.prepare(ImpactTrial(controller="recovery", friction_coefficient=0.3, final_time_s=0.5))
     b = S.prepare(ImpactTrial(controller="recovery", friction_coefficient=0.6, final_time_s=0.5))
     assert not np.array_equal(a.feat, b.feat)
@@ -113,7 +114,7 @@ def test_kept_runs_share_their_output_times_and_pair_table_while_they_are_theirs
     """A trial's model takes the output times and the pair table its shared packing
     computed once (the same arrays), equal to those computed afresh; a run whose
     times or shapes differ gets its own."""
-    S._SHARED.clear()
+    clear_kept()
     a, b = (S.prepare(t) for t in _trials({})[:2])
     ma, mb = a.model(), b.model()
     assert ma.t_out is mb.t_out and ma.pairs is mb.pairs
@@ -152,14 +153,14 @@ def test_a_wall_approach_packed_with_the_kept_packing_is_the_approach_packed_alo
     kept = [S.prepare(r) for r in runs]
     assert any(k.approach["late_start"] for k in kept)
     for run, setup in zip(runs, kept, strict=True):
-        S._SHARED.clear()
+        clear_kept()
         alone = S.prepare(run)
         _same(setup, alone)
         assert setup.approach == alone.approach and setup.x0.tobytes() == alone.x0.tobytes()
     assert kept[0].ctrl is not kept[1].ctrl and kept[0].noise is not kept[1].noise
 
 
-@pytest.mark.parametrize("field", S.WALL_STATE_FIELDS)
+@pytest.mark.parametrize("field", WALL_STATE_FIELDS)
 def test_no_wall_approach_state_field_reaches_the_shared_packing(field: str) -> None:
     base = {"imu": {"preset": "noisy"}, "final_time_s": 0.6}
     attitude = {"roll_deg": 3.0, "pitch_deg": -4.0}  # given together
@@ -172,8 +173,8 @@ def test_no_wall_approach_state_field_reaches_the_shared_packing(field: str) -> 
         "roll_deg": attitude,
         "pitch_deg": attitude,
     }.get(field, {field: 12.5})
-    S._SHARED.clear()
+    clear_kept()
     one = S._wall_shared(WallApproach(**base))
-    S._SHARED.clear()
+    clear_kept()
     two = S._wall_shared(WallApproach(**base, **changed))
     _same(one.setup, two.setup)

@@ -9,15 +9,14 @@ wall approach's attitude and shooting are in :mod:`quadimpact.simulation.approac
 Packing is two stages: :class:`SharedSetup` (what the run's initial state and
 seed do not change) and the run's own part (:func:`_for_run`: its state,
 references and random draws). An impact trial's and a wall approach's shared
-part is kept per process (:func:`_kept_shared`), so the trials of a study and
-the runs of a sweep over headings, inclinations and speeds pack only what
+part is kept per process (``simulation/sharing.py``), so the trials of a study
+and the runs of a sweep over headings, inclinations and speeds pack only what
 differs between them, with the same functions: the same arrays, bit for bit.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -29,17 +28,15 @@ from quadimpact.core.records import Model, model
 from quadimpact.core.run import Kernel, make_kernel
 from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import PackContext, controller_entry
-from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
-from quadimpact.inputs.sensors import ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_imu, check_prepared, check_scenario_type
-from quadimpact.simulation.estimation import Estimation, draw_estimation, pack_estimation
+from quadimpact.simulation.estimation import draw_estimation, pack_estimation
 from quadimpact.simulation.packing import (
     CONTROL_RATE_HZ,
     RPM,
@@ -54,6 +51,7 @@ from quadimpact.simulation.packing import (
     set_references,
     trim_rotor_speeds,
 )
+from quadimpact.simulation.sharing import SharedSetup, kept_shared
 
 __all__ = ["RunSetup", "prepare", "prepare_flight", "prepare_impact_trial", "prepare_wall_approach"]
 
@@ -263,29 +261,6 @@ def _kernel(entry, estimator=None) -> Kernel | None:
     return entry.kernel_cache[key]
 
 
-@dataclass
-class SharedSetup:
-    """The part of a run's packing that its initial state and its seed do not change.
-
-    :func:`_shared` packs it (the vehicle, features, surfaces, options,
-    controller without references, the IMU and estimator without their random
-    draws, the warnings); :func:`_for_run` completes a copy for one run. An
-    impact trial's and a wall approach's are kept per process
-    (:func:`_kept_shared`), so a study's trials pack only what differs
-    between them.
-    """
-
-    setup: RunSetup
-    """The packed run with ``x0`` 0, no references and no random draw."""
-    imu: ResolvedImu
-    est: Estimation
-    entries: tuple[Any, ...] = ()
-    """The registry entries it was packed with (controller, estimator): a new
-    registration under the same name packs again."""
-    front: tuple[float, np.ndarray] | None = None
-    """An impact trial toward an obstacle: :func:`obstacle_front` of it."""
-
-
 def _shared(
     s: RunSettings,
     v: Vehicle,
@@ -458,39 +433,6 @@ def prepare_wall_approach(s: WallApproach, kernel: Kernel | None = None) -> RunS
 
 
 # ---------------------------------------------------------------- impact trial
-TRIAL_STATE_FIELDS = (
-    "roll_deg",
-    "pitch_deg",
-    "yaw_deg",
-    "speed_m_s",
-    "seed",
-    "start_distance_m",
-    "altitude_m",
-    "lateral_offset_m",
-)
-"""An impact trial's fields that set its initial state, references and random draws
-only: trials that differ in these alone share their :class:`SharedSetup`."""
-
-WALL_STATE_FIELDS = (
-    "heading_deg",
-    "inclination_deg",
-    "speed_m_s",
-    "impact_time_s",
-    "altitude_m",
-    "roll_deg",
-    "pitch_deg",
-    "start_altitude_m",
-    "seed",
-)
-"""A wall approach's fields that set its attitude, references, approach and random draws
-only: approaches that differ in these alone share their :class:`SharedSetup`."""
-
-_TRIAL_STATE_EXCLUDE = frozenset(TRIAL_STATE_FIELDS)
-_WALL_STATE_EXCLUDE = frozenset(WALL_STATE_FIELDS)
-_SHARED: dict[str, SharedSetup] = {}
-_SHARED_LIMIT = 8
-
-
 def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     """The recovery benchmark's trial (docs/RECOVERY.md 5): the wall ``X = 0``, no shooting.
 
@@ -532,35 +474,6 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     return _for_run(shared, s, refs, x0=x0, t0=0.0)
 
 
-def _kept_shared(
-    s: WallApproach | ImpactTrial, exclude: frozenset[str], pack: Callable[[], SharedSetup]
-) -> SharedSetup:
-    """The :class:`SharedSetup` of a run, packed (``pack()``) once per process for its other fields.
-
-    Kept (at most :data:`_SHARED_LIMIT`) under the scenario's JSON without
-    the fields ``exclude`` (its state fields: :data:`TRIAL_STATE_FIELDS`,
-    :data:`WALL_STATE_FIELDS`), and used again only with the same vehicle
-    object (a vehicle file changed on disk loads as a new one) and the same
-    registry entries. Every value of a run is computed by the same functions
-    either way: a kept packing gives the same run, bit for bit.
-    """
-    v = s.build_vehicle()
-    key = s.model_dump_json(exclude=exclude)
-    shared = _SHARED.get(key)
-    entries = (controller_entry(s.controller), estimator_entry(s.estimator))
-    if (
-        shared is not None
-        and shared.setup.vehicle is v
-        and all(a is b for a, b in zip(shared.entries, entries, strict=True))
-    ):
-        return shared
-    shared = pack()
-    if len(_SHARED) >= _SHARED_LIMIT:
-        _SHARED.pop(next(iter(_SHARED)))
-    _SHARED[key] = shared
-    return shared
-
-
 def _wall_shared(s: WallApproach) -> SharedSetup:
     """The :class:`SharedSetup` of a wall approach, kept for its fields but the state's."""
 
@@ -570,7 +483,7 @@ def _wall_shared(s: WallApproach) -> SharedSetup:
         v, o = s.build_vehicle(), s.resolved_model_options()
         return _shared(s, v, o, surfaces, float(s.final_time_s), wall=wall)
 
-    return _kept_shared(s, _WALL_STATE_EXCLUDE, pack)
+    return kept_shared(s, pack)
 
 
 def _trial_shared(s: ImpactTrial) -> SharedSetup:
@@ -587,7 +500,7 @@ def _trial_shared(s: ImpactTrial) -> SharedSetup:
         wall = Plane.wall(0.0)
         return _shared(s, v, o, [wall, *_ground(s)], duration, wall=wall)
 
-    return _kept_shared(s, _TRIAL_STATE_EXCLUDE, pack)
+    return kept_shared(s, pack)
 
 
 def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
