@@ -54,7 +54,6 @@ from .layout import (
     ST_REASON,
     ST_STATUS,
     STATUS_FAILED,
-    X_OMEGA,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -85,14 +84,17 @@ def _shoot(t0: float, v0: float, x_start: float, m: Model, o: Output, ap: np.nda
     x0 = m.x0
     C = np.empty((3, 3))
     rotation_matrix(ap[AP_Q : AP_Q + 4], C)
-    x0[:] = 0.0
+    x0[:] = 0.0  # omega 0: the vehicle starts at rest in rotation
+    # the start shifted by (x_start, 0, 0) and the body velocity C^T (v0, 0, 0), with
+    # every term of the vector sums (the + 0.0 and * 0.0 turn -0.0 into +0.0 as the
+    # vector arithmetic does: the state is the same to the bit as from
+    # simulation.approach.initial_state)
     x0[X_POS] = ap[AP_START] + x_start
     x0[X_POS + 1] = ap[AP_START + 1] + 0.0
     x0[X_POS + 2] = ap[AP_START + 2] + 0.0
-    for j in range(3):  # body velocity C^T (v0, 0, 0), summed in index order
+    for j in range(3):
         x0[X_VEL + j] = C[0, j] * v0 + C[1, j] * 0.0 + C[2, j] * 0.0
     x0[X_QUAT : X_QUAT + 4] = ap[AP_Q : AP_Q + 4]
-    x0[X_OMEGA : X_OMEGA + 3] = 0.0
     x0[X_ROTOR : X_ROTOR + N_ROTORS] = ap[AP_ROTORS : AP_ROTORS + N_ROTORS]
     ap[AP_X0 : AP_X0 + NX] = x0
     m.span[SPAN_T0] = t0
