@@ -82,6 +82,27 @@ def test_products_sum_in_index_order():
     assert stacked.shape == (2, 3) and stacked[1].tolist() == (2 * matvec(m, v)).tolist()
 
 
+def test_one_vector_products_with_python_floats_are_the_array_path_bit_for_bit():
+    """A vector (dot) or a matrix and a vector (matvec) of floats take the Python-float path;
+    stacked inputs the array path: the same bits."""
+    rng = np.random.default_rng(11)
+    a = rng.standard_normal((3000, 4)) * rng.uniform(1e-8, 1e8, size=(3000, 1))
+    b = rng.standard_normal((3000, 4))
+    a[:100, 1] = -0.0
+    for n in (1, 3, 4):
+        stacked = dot(a[:, :n], b[:, :n])  # the array path
+        for i in range(len(a)):
+            single = dot(a[i, :n].copy(), b[i, :n].copy())
+            assert type(single) is float and single == stacked[i]
+            assert np.float64(single).tobytes() == stacked[i].tobytes()
+    assert norm(np.array([3.0, 4.0])) == 5.0 and dot(np.array([np.nan]), np.ones(1)) != 0.0
+    m = rng.standard_normal((500, 3, 4)) * 1e3
+    stacked = matvec(m, b[:500])  # the array path
+    for i in range(500):
+        single = matvec(m[i].copy(), b[i].copy())
+        assert single.shape == (3,) and single.tobytes() == stacked[i].tobytes()
+
+
 _SUMMARY = """
 import json
 from quadimpact import WallApproach, simulate

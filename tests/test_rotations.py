@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from quadimpact.rotations import (
+    GIMBAL_LOCK_COS,
     body_to_inertial,
     euler_zyx_to_quat,
     inclination_deg,
@@ -213,3 +214,24 @@ def test_single_attitude_path_is_the_array_path_bit_for_bit() -> None:
         euler_zyx_to_quat(np.float64(0.1), 0.2, 0.3).tobytes()
         == euler_zyx_to_quat(np.array(0.1), 0.2, 0.3).tobytes()
     )
+
+
+def test_single_quaternion_euler_angles_are_the_array_path_bit_for_bit() -> None:
+    """One quaternion's roll, pitch and yaw (Python floats, one ufunc call at a time) equal
+    the broadcast path's exactly: wide and tiny angles, every norm, the gimbal lock,
+    the wrap at +-180 deg."""
+    rng = np.random.default_rng(9)
+    qs = rng.normal(size=(4000, 4)) * rng.uniform(0.01, 100.0, size=(4000, 1))
+    qs[:300] = euler_zyx_to_quat(*(rng.uniform(-1e-7, 1e-7, size=(3, 300))))
+    pitch = np.where(rng.random(200) < 0.5, -1.0, 1.0) * (np.pi / 2 - rng.uniform(0, 1e-6, 200))
+    pitch[::2] = np.sign(pitch[::2]) * np.pi / 2  # locked: cos(pitch) below GIMBAL_LOCK_COS
+    qs[300:500] = euler_zyx_to_quat(rng.uniform(-3, 3, 200), pitch, rng.uniform(-3, 3, 200))
+    qs[500:600] = euler_zyx_to_quat(0.0, 0.0, np.full(100, np.pi))
+    stacked = quat_to_euler_zyx(qs)  # the array path
+    for i, q in enumerate(qs):
+        single = quat_to_euler_zyx(q.copy())
+        for got, want in zip(single, stacked, strict=True):
+            assert np.asarray(got).tobytes() == want[i].tobytes()
+        assert [np.ndim(a) for a in single] == [0, 0, 0]
+    c = quat_to_matrix(qs[300:500])
+    assert (np.hypot(c[:, 0, 0], c[:, 1, 0]) < GIMBAL_LOCK_COS).sum() >= 50  # the lock was met

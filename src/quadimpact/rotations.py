@@ -196,6 +196,8 @@ def quat_to_euler_zyx(
     ``yaw + roll`` (pitch -90 deg) is defined; roll is then reported as 0 and
     the rotation about the vertical as yaw, ``atan2(-C12, C22)``.
     """
+    if type(q) is np.ndarray and q.shape == (4,) and q.dtype == np.float64:
+        return _single_euler_zyx(q)
     c = quat_to_matrix(q)
     c00, c10, c20 = c[..., 0, 0], c[..., 1, 0], c[..., 2, 0]
     c21, c22 = c[..., 2, 1], c[..., 2, 2]
@@ -206,6 +208,31 @@ def quat_to_euler_zyx(
     roll = np.where(locked, 0.0, np.arctan2(c21, c22))
     yaw = np.where(locked, np.arctan2(-c01, c11), np.arctan2(c10, c00))
     return wrap_angle_rad(roll), pitch, wrap_angle_rad(yaw)
+
+
+def _single_euler_zyx(
+    q: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], np.float64, NDArray[np.float64]]:
+    """:func:`quat_to_euler_zyx` of one quaternion with Python floats (about 4x faster).
+
+    The same ufuncs on the same values as the array path, one at a time, and the
+    same types out (roll and yaw 0-d arrays, pitch a NumPy float): the same bits
+    (tested).
+    """
+    (c00, c01, _), (c10, c11, _), (c20, c21, c22) = _single_quat_matrix(q).tolist()
+    cos_pitch = np.hypot(c00, c10)
+    pitch = np.arctan2(-c20, cos_pitch)
+    if cos_pitch < GIMBAL_LOCK_COS:
+        roll, yaw = 0.0, float(np.arctan2(-c01, c11))
+    else:
+        roll, yaw = float(np.arctan2(c21, c22)), float(np.arctan2(c10, c00))
+    return np.asarray(_wrap_one(roll)), pitch, np.asarray(_wrap_one(yaw))
+
+
+def _wrap_one(angle: float) -> float:
+    """:func:`wrap_angle_rad` of one angle (rad): the same operations on a Python float."""
+    w = float(np.mod(angle + np.pi, 2.0 * np.pi)) - np.pi
+    return w + 2.0 * np.pi if w <= -np.pi else w
 
 
 def euler_zyx_to_quat(roll: ArrayLike, pitch: ArrayLike, yaw: ArrayLike) -> NDArray[np.float64]:
