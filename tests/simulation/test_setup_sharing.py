@@ -12,6 +12,7 @@ that a changed field or vehicle file packs again.
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -53,6 +54,8 @@ def _trials(extra: dict) -> list[ImpactTrial]:
 
 
 def _same(a: S.RunSetup, b: S.RunSetup) -> None:
+    names = {f.name for f in dataclasses.fields(S.RunSetup)}
+    assert set(vars(a)) == set(vars(b)) == names  # a run is a copy with its fields, no other
     for name in ARRAYS:
         x, y = np.asarray(getattr(a, name)), np.asarray(getattr(b, name))
         assert x.shape == y.shape and x.tobytes() == y.tobytes(), name
@@ -121,7 +124,7 @@ def test_kept_runs_share_their_output_times_and_pair_table_while_they_are_theirs
     fresh = S.prepare(_trials({})[3])
     assert np.array_equal(ma.t_out, a.output_times())
     assert np.array_equal(ma.pairs, S.pair_table(a.feat, a.shapes))
-    longer = S.replace(a, tf=0.75)
+    longer = dataclasses.replace(a, tf=0.75)
     assert longer.model().t_out[-1] == 0.75 and longer.model().t_out.shape[0] > ma.t_out.shape[0]
     other_shapes = a.shapes.copy()
     assert a.model(shapes=other_shapes).pairs is not ma.pairs

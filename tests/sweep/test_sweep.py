@@ -287,6 +287,20 @@ def test_a_row_has_every_column_once_typed_and_in_the_tables_order():
     assert flatten_summary({}, skip=skip)["status"] is None
 
 
+def test_tuples_kept_between_rows_are_typed_as_their_own_values():
+    """The JSON text of a tuple is kept from row to row: tuples equal under ``==`` but
+    written differently (1 and 1.0, 0.0 and -0.0, True and 1) each keep their own text,
+    as they were before they were kept (a NaN as NaN, as in a list)."""
+    texts = []
+    for value in [(1, 2), (1.0, 2.0), (0.0,), (-0.0,), (True,), (1,), (1, 2), (float("nan"),)]:
+        row = flatten_summary({"model_options": {"bumper_force_scale": value}})
+        texts.append(row["model_options__bumper_force_scale"])
+    assert texts == ["[1,2]", "[1.0,2.0]", "[0.0]", "[-0.0]", "[true]", "[1]", "[1,2]", "[NaN]"]
+    nested = ((1.0, 2.0), [3.0])
+    row = flatten_summary({"model_options": {"cut_step_motors": nested}})
+    assert row["model_options__cut_step_motors"] == "[[1.0,2.0],[3.0]]"
+
+
 # ------------------------------------------------------------- backends
 @pytest.fixture(scope="module")
 def serial_table(tmp_path_factory):

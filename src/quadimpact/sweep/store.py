@@ -84,28 +84,27 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
     The row's keys are in the order of :data:`SUMMARY_COLUMNS`.
     """
     names = tuple(skip)
-    template = _ROW_TEMPLATES.get(names)
-    if template is None:
-        if len(_ROW_TEMPLATES) >= 64:  # a process that flattens for many sweeps
-            _ROW_TEMPLATES.clear()
-        template = _ROW_TEMPLATES[names] = _row_template(set(names))
+    plan = _ROW_PLANS.get(names)
+    if plan is None:
+        if len(_ROW_PLANS) >= 64:  # a process that flattens for many sweeps
+            _ROW_PLANS.clear()
+        plan = _ROW_PLANS[names] = _row_plan(set(names))
+    template, kinds = plan
     row = template.copy()
     extra: dict[str, Any] = {}
-    plan = _KEY_PLAN
 
     def walk(prefix: str, table: Mapping[str, Any]) -> None:
         for k, value in table.items():
-            key = f"{prefix}{k}" if prefix else k
+            key = prefix + k if prefix else k
             t = type(value)
             if t is dict or (t not in _LEAF_TYPES and isinstance(value, Mapping)):
                 walk(key + "__", value)
                 continue
-            if key not in row:  # skipped (an input), a timing, or outside the columns
+            kind = kinds.get(key)
+            if kind is None:  # skipped (an input), a timing, or outside the columns
                 if key not in names and not _is_time_measurement(key):
                     extra[key] = plain(value)
-                continue
-            kind = plan.get(key) or _plan(key)
-            if kind == "x":
+            elif kind == "x":  # summary_extra's own key, kept as extra
                 extra[key] = plain(value)
             elif value is None:  # the common cases of _typed, inline
                 pass
@@ -113,6 +112,8 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
                 row[key] = None if value != value else value
             elif t is _EXACT_TYPE.get(kind):
                 row[key] = value
+            elif t is tuple:  # the same tuples run after run (model options): typed once
+                row[key] = _typed_tuple(value, kind)
             else:
                 row[key] = _typed(value, kind)
 
@@ -121,21 +122,35 @@ def flatten_summary(summary: Mapping[str, Any], skip: Iterable[str] = ()) -> dic
     return row
 
 
-_KEY_PLAN: dict[str, str] = {}
-"""A row column's kind (``"x"``: summary_extra's own key, kept as extra), found once."""
-_ROW_TEMPLATES: dict[tuple[str, ...], dict[str, None]] = {}
-"""Rows of nulls, one per set of skipped (input) columns."""
+_ROW_PLANS: dict[tuple[str, ...], tuple[dict[str, None], dict[str, str]]] = {}
+"""Per set of skipped (input) columns: a row of nulls, and each row key's column kind
+(``"x"`` for ``summary_extra``, whose own key is kept as extra)."""
+_TYPED_TUPLES: dict[tuple[str, str], Any] = {}
 
 
-def _plan(key: str) -> str:
-    kind = "x" if key == "summary_extra" else _SUMMARY_KIND[key]
-    _KEY_PLAN[key] = kind
-    return kind
+def _row_plan(skip: set[str]) -> tuple[dict[str, None], dict[str, str]]:
+    """Every summary column not skipped, null (timings are not columns), and its kind."""
+    template = {key: None for key, _kind in SUMMARY_COLUMNS if key not in skip}
+    kinds = {key: "x" if key == "summary_extra" else _SUMMARY_KIND[key] for key in template}
+    return template, kinds
 
 
-def _row_template(skip: set[str]) -> dict[str, None]:
-    """Every summary column not skipped, null (timings are not columns)."""
-    return {key: None for key, _kind in SUMMARY_COLUMNS if key not in skip}
+def _typed_tuple(value: tuple[Any, ...], kind: str) -> Any:
+    """:func:`_typed` of a tuple, kept for the next rows when its items are plain.
+
+    Kept under its ``repr`` (which tells ``1`` from ``1.0`` and ``0.0`` from
+    ``-0.0``, unlike ``==``); at most 256 kept.
+    """
+    if not all(type(v) in _PLAIN_TYPES for v in value):
+        return _typed(value, kind)
+    key = (kind, repr(value))
+    typed = _TYPED_TUPLES.get(key)
+    if typed is None:
+        typed = _typed(value, kind)
+        if len(_TYPED_TUPLES) >= 256:
+            _TYPED_TUPLES.clear()
+        _TYPED_TUPLES[key] = typed
+    return typed
 
 
 _PLAIN_TYPES = (float, int, str, bool)
