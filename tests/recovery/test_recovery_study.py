@@ -178,3 +178,23 @@ def test_the_example_runs_beside_the_trials_on_a_pool(tmp_path, study_dir) -> No
     assert ex == ex_serial
     assert sorted(p.name for p in r.figures) == sorted(p.name for p in serial.figures)
     assert not list(tmp_path.glob(".example.partial-*"))
+
+
+def test_a_script_that_imports_the_studies_costs_their_workers_no_pandas() -> None:
+    """A pool's workers run the main script again (multiprocessing, so that its plug-ins
+    register): importing the study modules loads no pandas (0.4 s of CPU per worker),
+    while running a study still has it (the table is read with it)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys\n"
+        "import quadimpact.recovery.study, quadimpact.pole.study\n"
+        "print('pandas' in sys.modules)\n"
+        "quadimpact.recovery.study.trial_inputs(quadimpact.recovery.study.RecoveryStudy(n=3)"
+        ".sweep_spec())\n"
+        "print('pandas' in sys.modules)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["False", "True"]

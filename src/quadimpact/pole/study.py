@@ -26,20 +26,24 @@ import os
 import time
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
-from quadimpact.recovery.analysis import rate
 from quadimpact.results.files import atomic_write
 from quadimpact.results.study_files import sweep_history, write_report, write_study_json
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+
+if TYPE_CHECKING:
+    import pandas as pd
+# pandas and the recovery analysis are imported where used: a script that imports this
+# module has every worker of its sweeps import it again (multiprocessing runs the main
+# script in each), which must not cost them pandas (0.4 s of CPU each)
 
 __all__ = [
     "BASELINES",
@@ -240,6 +244,8 @@ def pitch_bands(abs_pitch: np.ndarray) -> list[str]:
 
 def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
     """``trials.parquet``: the sweep's rows and the study's columns (module docstring)."""
+    import pandas as pd
+
     t = runs.sort_values("run_id").reset_index(drop=True)
     t["arm"] = np.where(t["run_id"].to_numpy() % 2 == 0, ARMS[0], ARMS[1])
     t["pitch_deg"] = t["pitch_deg"].astype(float)
@@ -255,6 +261,8 @@ def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
 
 def summarise(table: pd.DataFrame) -> dict[str, Any]:
     """The headline numbers: success per arm, per pitch band, and how recovery fails."""
+    from quadimpact.recovery.analysis import rate
+
     out: dict[str, Any] = {"n_points": int(len(table) // 2), "arms": {}, "bands": []}
     for arm in ARMS:
         part = table[table["arm"] == arm]
@@ -281,6 +289,8 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
 
 def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
     """Where recovery fails and why: its failures against the baseline at the same point."""
+    import pandas as pd
+
     base = table[table["arm"] == "baseline"].set_index(["pitch_deg", "lateral_offset_m"])
     rec = table[table["arm"] == "recovery"].set_index(["pitch_deg", "lateral_offset_m"])
     rec = rec.reindex(base.index)

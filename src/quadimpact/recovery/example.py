@@ -10,12 +10,13 @@ pool or Dask) it is made beside them, on a process of its own
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
-
-import pandas as pd
+from typing import TYPE_CHECKING, Any
 
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.sweep import SweepSpec
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["EXAMPLE_DIR", "EarlyExample", "beside", "check_example", "write_example"]
 

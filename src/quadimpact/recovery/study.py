@@ -34,15 +34,11 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
-
-import pandas as pd
+from typing import TYPE_CHECKING, Any
 
 from quadimpact import __version__
 from quadimpact.errors import InputError
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
-from quadimpact.recovery import analysis
-from quadimpact.recovery.example import EarlyExample, beside, check_example, write_example
 from quadimpact.recovery.spec import (  # noqa: F401  (the spec, here too)
     DISTRIBUTION,
     SEED_LIMIT,
@@ -57,6 +53,14 @@ from quadimpact.results.files import atomic_write, check_out_dir
 from quadimpact.results.study_files import sweep_history, write_report, write_study_json
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from quadimpact.recovery.example import EarlyExample
+# pandas, the analysis and the example are imported where used: a script that imports this
+# module has every worker of its sweeps import it again (multiprocessing runs the main
+# script in each), which must not cost them pandas (0.4 s of CPU each)
 
 __all__ = [
     "DISTRIBUTION",
@@ -84,6 +88,8 @@ def trial_inputs(spec: SweepSpec) -> pd.DataFrame:
     From each run's scenario (base and swept values), the impact trial's
     defaults where neither sets a field. Indexed by ``run_id``.
     """
+    import pandas as pd
+
     rows = []
     for run_id in range(spec.n_runs):
         scenario = spec.scenario_dict(run_id)
@@ -97,6 +103,8 @@ def trial_inputs(spec: SweepSpec) -> pd.DataFrame:
 
 def trial_table(runs: pd.DataFrame, spec: SweepSpec) -> pd.DataFrame:
     """``trials.parquet``: the sweep's rows, the trial inputs and the derived columns."""
+    from quadimpact.recovery import analysis
+
     table = runs.sort_values("run_id").reset_index(drop=True)
     inputs = trial_inputs(spec).reindex(table["run_id"].to_numpy())
     for name in TRIAL_FIELDS:
@@ -121,6 +129,8 @@ def describe(spec: SweepSpec, study: RecoveryStudy | None, table: pd.DataFrame) 
     give the values actually in force in every run (model, switches, vehicle,
     controller, pre-impact behaviour, detection threshold).
     """
+    import pandas as pd
+
     first = scenario_from_dict(spec.scenario_dict(0), where="recovery: run 0")
     vehicle = first.build_vehicle()
     imu = first.imu.resolved(vehicle.imu_position_m, CONTROL_RATE_HZ)
@@ -268,7 +278,8 @@ def run_study(
         A sweep whose base is not an impact trial, a folder holding a
         different study, bad workers or scheduler.
     """
-    from quadimpact.recovery import figures, report
+    from quadimpact.recovery import analysis, figures, report
+    from quadimpact.recovery.example import EarlyExample, beside, check_example, write_example
 
     start = time.perf_counter()
     out = Path(out_dir)
