@@ -8,6 +8,7 @@ else of a run may change.
 from __future__ import annotations
 
 import json
+import time
 
 import numpy as np
 
@@ -16,7 +17,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.records import new_output
 from quadimpact.core.run import BUILTIN
 from quadimpact.inputs.world import Cylinder
-from quadimpact.simulation.batch import simulate_batch
+from quadimpact.simulation.batch import GROUP_MAX, GROUP_S, BatchRunner, simulate_batch
 from quadimpact.simulation.setup import prepare
 
 POLE = Cylinder(name="pole", point_m=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0), radius_m=0.1)
@@ -53,6 +54,44 @@ def test_a_run_that_raises_is_a_failed_summary():
     out = simulate_batch([bad, good])
     assert out[0]["status"] == "failed" and out[0]["reason"]
     assert _same(out[1], simulate(good).summary)
+
+
+def test_a_group_in_passes_gives_each_run_its_own_summary_and_cost():
+    """Runs prepared, then run, then summarised as one group: each summary is its single
+    run's, bit for bit, whatever ran before or after it in the group (the same scenario
+    twice, a noisy IMU, a pole, a wall approach's late start); a run that raises in its
+    preparation is that run's error alone; each cost is the run's own (its loop within it,
+    the group's costs within the group's CPU time)."""
+    bad = WallApproach(vehicle_overrides={"thrust_coefficient": 1e-12})  # cannot hover
+    scenarios = [
+        ImpactTrial(controller="recovery", roll_deg=10, pitch_deg=-15, speed_m_s=0.8),
+        WallApproach(heading_deg=45, inclination_deg=20, speed_m_s=0.5),  # a late start
+        bad,
+        ImpactTrial(roll_deg=5, pitch_deg=-30, yaw_deg=20, speed_m_s=1.5, imu="noisy", seed=3),
+        ImpactTrial(controller="recovery", roll_deg=10, speed_m_s=2.0, obstacles=(POLE,)),
+        ImpactTrial(controller="recovery", roll_deg=10, pitch_deg=-15, speed_m_s=0.8),
+    ]
+    runner = BatchRunner()
+    assert runner.group_size() == 1  # no run measured yet
+    looped = []
+    cpu = time.thread_time()
+    done = runner.run_group([(lambda s=s: s) for s in scenarios], before_loop=looped.append)
+    cpu = time.thread_time() - cpu
+    assert looped == [0, 1, 3, 4, 5]  # the run that could not be prepared has no loop
+    assert done[2].summary is None and "hover" in str(done[2].error)
+    for s, d in zip(scenarios, done, strict=True):
+        if s is not bad:
+            assert d.error is None
+            assert d.kernel_s == d.summary["integrator"]["wall_time_s"] < d.wall_s
+            cost = d.summary["cost"]
+            assert 0.0 < cost["kernel_cpu_s"] < cost["total_cpu_s"] <= d.cpu_s
+            assert _same(d.summary, simulate(s).summary)
+    assert sum(d.cpu_s for d in done) <= cpu
+    # the next group holds about GROUP_S of runs at this group's pace
+    pace = runner.run_wall_s
+    assert pace is not None and pace > 0.0
+    assert runner.group_size() == max(1, min(GROUP_MAX, int(GROUP_S / pace)))
+    assert runner.group_size(limit=1) == 1
 
 
 def test_rows_without_contact_columns_leave_the_run_unchanged():

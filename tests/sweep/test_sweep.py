@@ -301,6 +301,46 @@ def test_tuples_kept_between_rows_are_typed_as_their_own_values():
     assert row["model_options__cut_step_motors"] == "[[1.0,2.0],[3.0]]"
 
 
+def test_a_chunk_runs_in_groups_with_the_rows_of_runs_alone(monkeypatch):
+    """A worker runs a chunk in groups (prepare all, run all, summarise all): the first
+    group alone (nothing measured yet), then groups of several; it says each group's
+    size and each loop's start; the rows are those of the runs done one by one, bit for
+    bit but for their costs, and each cost is the run's own."""
+    from quadimpact.sweep import worker
+    from quadimpact.sweep.backends import make_chunks
+    from quadimpact.sweep.worker import run_item, run_items
+
+    monkeypatch.setattr(worker, "_RUNNER", None)  # a worker's first chunk: nothing measured
+    spec = SweepSpec(base=BASE, grid={"inclination_deg": "-10:13:1"})
+    spec.validate()
+    (chunk,) = list(make_chunks(spec, range(spec.n_runs), 32))
+    events: list[tuple[str, int]] = []
+    done = list(
+        run_items(
+            chunk,
+            on_group=lambda n: events.append(("group", n)),
+            on_loop=lambda k: events.append(("loop", k)),
+        )
+    )
+    sizes = [n for kind, n in events if kind == "group"]
+    assert sum(sizes) == len(chunk) == 24 and sizes[0] == 1 and max(sizes) > 1
+    at = 0
+    for n in sizes:  # each group: its size, then its loops in order
+        assert events[at] == ("group", n) and events[at + 1 : at + 1 + n] == [
+            ("loop", k) for k in range(n)
+        ]
+        at += 1 + n
+    from quadimpact.sweep.store import COST_COLUMNS as costs
+
+    for item, (row, cost) in zip(chunk, done, strict=True):
+        alone, _ = run_item(item)
+        assert {k: v for k, v in row.items() if k not in costs} == {
+            k: v for k, v in alone.items() if k not in costs
+        }
+        assert 0.0 < row["cost__kernel_cpu_s"] < row["cost__total_cpu_s"]
+        assert 0.0 < cost.kernel_s < cost.wall_s and cost.steps > 0
+
+
 # ------------------------------------------------------------- backends
 @pytest.fixture(scope="module")
 def serial_table(tmp_path_factory):

@@ -2,7 +2,7 @@
 
 Each backend takes the chunks of missing runs (:func:`make_chunks`) and hands
 the rows of finished runs to a ``sink`` as they complete; all call
-:func:`~quadimpact.sweep.worker.run_item` (which :func:`run_chunk` repeats).
+:func:`~quadimpact.sweep.worker.run_items` (runs in groups, which :func:`run_chunk` collects).
 The local pool is in :mod:`quadimpact.sweep.pool`."""
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from quadimpact.sweep.worker import (
     Item,
     failed_rows,
     run_chunk_measured,
-    run_item,
+    run_items,
     warm_up,
     worker_info,
 )
@@ -65,8 +65,8 @@ def chunk_size(n_todo: int, slots: int) -> int:
 def run_serial(chunks: Iterator[list[Item]], sink: Sink) -> None:
     """Run in this process, each finished run to ``sink`` at once (Ctrl-C keeps them)."""
     for chunk in chunks:
-        for item in chunk:
-            sink([run_item(item)[0]])
+        for row, _cost in run_items(chunk):
+            sink([row])
 
 
 @contextlib.contextmanager

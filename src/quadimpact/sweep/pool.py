@@ -1,17 +1,21 @@
 """The local worker pool of a sweep: processes forked from a warm server, one pipe each.
 
 Each worker (:func:`~quadimpact.sweep.worker.pool_worker`) gets chunks of
-runs over its own pipe and sends back one message per finished run, so the
-parent knows which run each worker is on and since when (it reads the pipes
+runs over its own pipe, runs them in groups of about 0.1 s of runs
+(:func:`~quadimpact.sweep.worker.run_items`), says when a group starts and
+how many runs it holds, and sends back one message per finished run, so the
+parent knows which runs each worker is on and since when (it reads the pipes
 at most every :data:`GATHER_S`, the rows of that time together):
 
-* **time limits**: a run that takes longer than its limit
-  (:class:`~quadimpact.sweep.limits.RunLimits`) has its worker killed
-  (a stopped worker included);
+* **time limits**: a run whose compiled loop goes on longer than its limit
+  (:class:`~quadimpact.sweep.limits.RunLimits`) has its worker killed (a
+  stopped worker included); its group's preparations and summaries, about
+  a millisecond a run, count toward the first and the last run's limit;
 * **lost runs**: when a worker dies or is killed, the runs it finished are
-  kept, the run it was on is redone once on another worker (a second loss
-  records it as failed, with the reason), and the rest of its chunks go back
-  to the queue;
+  kept, the run it was on and the unfinished others of its group are each
+  redone once, alone, on another worker (the run that killed it dies again
+  alone and is recorded as failed, with the reason; the others finish), and
+  the rest of its chunks go back to the queue;
 * **stopping**: no threads, no queues: on Ctrl-C, SIGTERM or an error the
   parent kills its workers and waits for them (:meth:`Pool.close`).
 
@@ -168,13 +172,21 @@ class _Worker:
         self.ready = False
         self.tasks: deque[_Task] = deque()
         self.n_done = 0  # runs of tasks[0] already reported
+        self.group = 1  # runs of tasks[0] from n_done on in its group in progress
+        self.loop = 0  # which of them is in its compiled loop (or was last)
         self.since = time.monotonic()  # start, or the last report
 
     def current(self) -> Item | None:
-        """The run this worker is on (None when idle, or when it did not begin its chunk)."""
+        """The run this worker is on (None when idle, or when it did not begin its chunk): the
+        run of its group in its compiled loop, or that was last (the group's first before)."""
+        group = self.in_flight()
+        return group[min(self.loop, len(group) - 1)] if group else None
+
+    def in_flight(self) -> list[Item]:
+        """The runs of the group this worker is on ([] when idle or not begun)."""
         if self.ready and self.tasks and self.tasks[0].started:
-            return self.tasks[0].items[self.n_done]
-        return None
+            return self.tasks[0].items[self.n_done : self.n_done + max(1, self.group)]
+        return []
 
     def kill(self) -> None:
         """SIGKILL (a stopped process too), then reap."""
@@ -321,6 +333,11 @@ class Pool:
                     self.start_failures = 0
                 elif kind == "start":
                     w.tasks[0].started = True
+                    w.group, w.loop = 1, 0
+                elif kind == "group":
+                    w.group, w.loop = int(body[0]), 0
+                elif kind == "loop":
+                    w.loop = int(body[0])
                 elif kind == "row":
                     rows.append(self._row(w, *body))
         finally:
@@ -332,10 +349,12 @@ class Pool:
         task = w.tasks[0]
         self.limits.record(cost)
         w.n_done += 1
+        w.group, w.loop = max(1, w.group - 1), max(0, w.loop - 1)
         self.last_progress = w.since
         if w.n_done == len(task.items):
             w.tasks.popleft()
             w.n_done = 0
+            w.group, w.loop = 1, 0
         return row
 
     def _check_clocks(self) -> None:
@@ -371,9 +390,10 @@ class Pool:
             back.extend(w.tasks)  # nothing of it ran: no loss to count
         elif w.tasks:
             head = w.tasks.popleft()
-            current, rest = head.items[w.n_done], head.items[w.n_done + 1 :]
-            run_id = current[0]
-            if head.lost:
+            k = w.n_done + max(1, w.group)
+            group, rest = head.items[w.n_done : k], head.items[k:]
+            run_id = group[min(w.loop, len(group) - 1)][0]
+            if head.lost:  # a lone run redone: it was the one
                 if timed_out is not None:
                     reason = (
                         f"no result within {seconds(timed_out)} s, twice ({self.limits.describe()})"
@@ -381,13 +401,18 @@ class Pool:
                 else:
                     reason = "worker process died while running it, twice (crash in native code?)"
                 self.note(f"warning: run {run_id}: {reason}; recorded as failed")
-                self.sink(failed_rows([current], reason))
+                self.sink(failed_rows(group[:1], reason))
             else:
-                self.note(
-                    f"warning: sweep worker process {w.pid} {why} in run {run_id}; "
-                    "the run is redone on another worker"
-                )
-                back.append(_Task([current], lost=1))
+                if len(group) == 1:
+                    what = "the run is redone on another worker"
+                else:  # the others of its group, unfinished, are redone alone too
+                    ids = ", ".join(str(item[0]) for item in group)
+                    what = (
+                        f"it and the other runs of its group ({ids}) are each redone alone "
+                        "on another worker"
+                    )
+                self.note(f"warning: sweep worker process {w.pid} {why} in run {run_id}; {what}")
+                back.extend(_Task([item], lost=1) for item in group)
             if rest:
                 back.append(_Task(list(rest)))
             back.extend(w.tasks)

@@ -5,11 +5,12 @@ set-up, and the forkserver's preload (:func:`preload`)."""
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import signal
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, NamedTuple
 
 from quadimpact.results.costs import COST_KEYS, cpu_time
@@ -37,35 +38,69 @@ class RunCost(NamedTuple):
 _RUNNER: Any = None  # this process's BatchRunner (its output buffers serve every run)
 
 
-def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
-    """One run of a sweep: its ``runs.parquet`` row and what it cost (see :func:`run_chunk`).
-
-    The run goes through :class:`~quadimpact.simulation.batch.BatchRunner`
-    (the summary of ``simulate``, bit for bit, without its tables).
-    """
+def _runner() -> Any:
     global _RUNNER
-    from quadimpact.simulation.batch import BatchRunner
-
     if _RUNNER is None:
-        _RUNNER = BatchRunner()
+        from quadimpact.simulation.batch import BatchRunner
 
-    run_id, scenario_data, inputs = item
-    head = {"run_id": int(run_id), **inputs}
+        _RUNNER = BatchRunner()
+    return _RUNNER
+
+
+def run_items(
+    items: Sequence[Item],
+    on_group: Callable[[int], None] | None = None,
+    on_loop: Callable[[int], None] | None = None,
+) -> Iterator[tuple[dict[str, Any], RunCost]]:
+    """The ``runs.parquet`` row of each run and what it cost, in order, runs done in groups.
+
+    The runs go through :meth:`~quadimpact.simulation.batch.BatchRunner.run_group`
+    (the summary of ``simulate``, bit for bit, without its tables), a group
+    of about 0.1 s of runs at a time: the group's scenarios made and
+    prepared, then run, then summarised, then its rows built (each pass warm
+    in the CPU's caches). ``on_group(n)`` is told the size of each group before
+    it starts and ``on_loop(k)`` when the group's run ``k`` starts its compiled
+    loop (the pool's workers tell the sweep which runs are in flight and which
+    one is running). A run's costs are its own passes' (``cost__total_cpu_s``:
+    from its scenario to its row).
+    """
+    runner = _runner()
+    i = 0
+    while i < len(items):
+        group = items[i : i + runner.group_size(len(items) - i)]
+        if on_group is not None:
+            on_group(len(group))
+        makers = [functools.partial(scenario_of, data, f"run {rid}") for rid, data, _ in group]
+        done_runs = runner.run_group(makers, before_loop=on_loop)
+        for (run_id, _data, inputs), done in zip(group, done_runs, strict=True):
+            yield _row(int(run_id), inputs, done)
+        i += len(group)
+
+
+def _row(run_id: int, inputs: dict[str, Any], done: Any) -> tuple[dict[str, Any], RunCost]:
+    """A run's row from its :class:`~quadimpact.simulation.batch.GroupRun`, and its cost."""
     start = time.perf_counter()
     cpu_start = cpu_time()
     kernel_s, steps = 0.0, 0
     try:
-        scenario = scenario_of(scenario_data, where=f"run {run_id}")
-        summary = _RUNNER.summary(scenario)
+        if done.error is not None:
+            raise done.error
+        summary = done.summary
         counters = summary.get("integrator") or {}
         kernel_s = float(counters.get("wall_time_s") or 0.0)
         steps = int(counters.get("steps") or 0) + int(counters.get("rejected_steps") or 0)
         row = flatten_summary(summary, skip=inputs)
         if TOTAL_COST in row:  # the whole run: its scenario and its row included
-            row[TOTAL_COST] = cpu_time() - cpu_start
+            row[TOTAL_COST] = done.cpu_s + (cpu_time() - cpu_start)
     except Exception as exc:  # a failed run is a row; the sweep goes on
         row = failed_row(f"{type(exc).__name__}: {exc}", inputs)
-    return {**head, **row}, RunCost(time.perf_counter() - start, kernel_s, steps)
+    wall = done.wall_s + (time.perf_counter() - start)
+    return {"run_id": run_id, **inputs, **row}, RunCost(wall, kernel_s, steps)
+
+
+def run_item(item: Item) -> tuple[dict[str, Any], RunCost]:
+    """One run of a sweep alone: its ``runs.parquet`` row and what it cost (:func:`run_items`)."""
+    return next(run_items([item]))
 
 
 def run_chunk(items: Sequence[Item]) -> list[dict[str, Any]]:
@@ -84,7 +119,7 @@ def run_chunk(items: Sequence[Item]) -> list[dict[str, Any]]:
         and ``reason = "<ExceptionType>: <message>"``; a run that fails in the
         integrator has the kernel's status and reason.
     """
-    return [run_item(item)[0] for item in items]
+    return [row for row, _cost in run_items(items)]
 
 
 def failed_rows(items: Sequence[Item], reason: str) -> list[dict[str, Any]]:
@@ -94,7 +129,7 @@ def failed_rows(items: Sequence[Item], reason: str) -> list[dict[str, Any]]:
 
 def run_chunk_measured(items: Sequence[Item]) -> tuple[list[dict[str, Any]], list[RunCost]]:
     """:func:`run_chunk` and what each run cost (what Dask workers run)."""
-    done = [run_item(item) for item in items]
+    done = list(run_items(items))
     return [row for row, _ in done], [cost for _, cost in done]
 
 
@@ -155,8 +190,10 @@ def pool_worker(conn: Any) -> None:
     """The loop of a local pool worker (``pool.py``): chunks in, one message per run out.
 
     Messages to the sweep: ``("ready", pid)`` once the kernel is loaded, then
-    per chunk ``("start",)`` and ``("row", row, cost)`` after each run. A
-    chunk is a list of items; None
+    per chunk ``("start",)``, and per group of runs (:func:`run_items`)
+    ``("group", n)`` before its ``n`` runs start, ``("loop", k)`` as its run
+    ``k`` starts its compiled loop, and ``("row", row, cost)`` for each of
+    them once the group is done. A chunk is a list of items; None
     (or the sweep's end of the pipe closing) ends the worker. The worker dies
     with its parent (the fork server, which dies with the sweep): SIGKILL, so
     that a stopped or busy worker goes too. Ctrl-C is ignored: the sweep
@@ -177,8 +214,12 @@ def pool_worker(conn: Any) -> None:
             if chunk is None:
                 return
             conn.send(("start",))
-            for item in chunk:
-                row, cost = run_item(item)
+            told = run_items(
+                chunk,
+                on_group=lambda n: conn.send(("group", n)),
+                on_loop=lambda k: conn.send(("loop", k)),
+            )
+            for row, cost in told:
                 conn.send(("row", row, cost))
     except (EOFError, OSError):  # the sweep is gone
         return
