@@ -55,7 +55,7 @@ Output folder ``DIR``:
 Runs execute in parallel on local worker processes (``workers``, default
 the cores this process may use), in-process (``workers=1``), or on a Dask
 cluster (``scheduler="tcp://host:port"``); all call the same pure function
-(:func:`run_chunk`, run by run). A run gets a time limit on workers
+(:func:`run_chunk`, in groups of runs). A run gets a time limit on workers
 (``timeout``, default derived from its final time and the measured cost of
 runs: :mod:`quadimpact.sweep.limits`); a run whose worker dies or exceeds it
 is redone once on another worker, then recorded as failed with the reason.

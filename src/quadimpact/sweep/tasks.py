@@ -1,6 +1,6 @@
 """Independent tasks of a study on the local cores (the crashes of Table III, for instance).
 
-A sweep runs many scenarios through one function (``worker.run_item``); a
+A sweep runs many scenarios through one function (``worker.run_items``); a
 study also has a few larger pieces of work that do not depend on each other
 (each crash of Table III: its runs, their files and figures, its small
 sweeps). :func:`run_tasks` runs such pieces on worker processes forked from
