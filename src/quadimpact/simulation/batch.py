@@ -20,8 +20,8 @@ with its own code and data; the Python of a preparation or a summary that
 follows it starts cold, and took about twice as long as the same code
 repeated. In passes, each pass's code and data stay warm from one run to the
 next: a recovery trial's Python took 0.8-1.0 ms instead of 1.4-1.6 ms
-(groups of 8-32 trials, 400 trials in one process, eight runs). A group holds about
-:data:`GROUP_S` of runs (:meth:`BatchRunner.group_size`, from the runs so
+(400 trials in one process, groups of 8-32, eight measurements). A group
+holds about :data:`GROUP_S` of runs (:meth:`BatchRunner.group_size`, from the runs so
 far), at most :data:`GROUP_MAX`, so that a sweep's worker still reports its
 runs within a fraction of a second. Each run is the same computation in the
 same order of its own operations (only runs are interleaved), so the results
