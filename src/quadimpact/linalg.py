@@ -11,8 +11,9 @@ these functions instead: plain IEEE multiplications and additions in index
 order (NumPy's element-wise ufuncs, or Python floats), which every machine
 rounds alike.
 
-The sizes here are tiny (3x3 and 4x4). Two vectors of floats take a path with
-Python floats (the same operations; a run's summary calls it a few times).
+The sizes here are tiny (3x3 and 4x4). One vector, or one matrix and one vector,
+of floats take a path with Python floats (the same operations; a run's summary
+calls them a few times).
 """
 
 from __future__ import annotations
@@ -117,17 +118,21 @@ def dot(a: ArrayLike, b: ArrayLike) -> np.ndarray | float:
     if _vector(a) and _vector(b) and len(a) == len(b):
         # two vectors of floats: the same products and sums with Python floats (about
         # 5x faster; IEEE multiplications and additions round as NumPy's do)
-        xs, ys = a.tolist(), b.tolist()
-        s = xs[0] * ys[0]
-        for k in range(1, len(xs)):
-            s = s + xs[k] * ys[k]
-        return s
+        return _float_dot(a.tolist(), b.tolist())
     a = np.asarray(a, dtype=np.float64)
     b = np.asarray(b, dtype=np.float64)
     s = a[..., 0] * b[..., 0]
     for k in range(1, a.shape[-1]):
         s = s + a[..., k] * b[..., k]
     return float(s) if np.ndim(s) == 0 else s
+
+
+def _float_dot(xs: list[float], ys: list[float]) -> float:
+    """``sum_k xs[k] ys[k]`` of Python floats, summed in index order (:func:`dot`'s order)."""
+    s = xs[0] * ys[0]
+    for k in range(1, len(xs)):
+        s = s + xs[k] * ys[k]
+    return s
 
 
 def _vector(a: object) -> bool:
@@ -151,13 +156,7 @@ def matvec(m: ArrayLike, v: ArrayLike) -> np.ndarray:
         and m.shape[1] == len(v)
     ):  # one matrix and one vector: :func:`dot`'s Python floats, row by row
         vs = v.tolist()
-        out = []
-        for row in m.tolist():
-            s = row[0] * vs[0]
-            for k in range(1, len(vs)):
-                s = s + row[k] * vs[k]
-            out.append(s)
-        return np.array(out, dtype=np.float64)
+        return np.array([_float_dot(row, vs) for row in m.tolist()], dtype=np.float64)
     m = np.asarray(m, dtype=np.float64)
     v = np.asarray(v, dtype=np.float64)
     return dot(m, v[..., None, :])
