@@ -75,6 +75,18 @@ def test_an_impact_trial_sweep_file_runs_with_quadimpact_sweep(tmp_path: Path) -
     assert (t.loc[ok, "t_stage4_s"] > t.loc[ok, "t_detect_s"]).all()
 
 
+def test_the_recovery_command_without_the_example_writes_no_example(tmp_path: Path) -> None:
+    proc = run_cli("recovery", "--n", "3", "--out", "r", "--workers", "1", "--no-example",
+                   "--no-progress", cwd=tmp_path)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "r"
+    assert len(pd.read_parquet(out / "trials.parquet")) == 3
+    assert not (out / "example").exists()
+    assert (out / "success_map.png").is_file()
+    report = (out / "report.md").read_text()
+    assert "## Example trial" not in report and "example/" not in report
+
+
 @pytest.mark.slow  # three processes, one with the example and its viewer
 def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
     proc = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",

@@ -58,6 +58,11 @@ _STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimat
     help="Run this sweep file (its base an impact trial) instead of the authors' distribution.",
 )  # fmt: skip
 @click.option("--no-animation", is_flag=True, help="Do not write the example's animation.")
+@click.option(
+    "--no-example", is_flag=True,
+    help="Do not write the example trial (example/: its files, figure, viewer and animation): "
+    "the study is its trials, table, figures and report. A small study's largest fixed cost.",
+)  # fmt: skip
 @parallel_options
 def recovery(
     out: Path,
@@ -71,6 +76,7 @@ def recovery(
     sensors: str | None,
     sweep_file: Path | None,
     no_animation: bool,
+    no_example: bool,
     workers: int | None,
     scheduler: str | None,
     no_progress: bool,
@@ -135,7 +141,7 @@ def recovery(
     with stoppable(out):
         result = run_study(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
-            animation=not no_animation,
+            example=not no_example, animation=not no_animation,
         )  # fmt: skip
     click.echo(_summary(result))
 
