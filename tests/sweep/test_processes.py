@@ -28,9 +28,11 @@ from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 from helpers import assert_all_gone, assert_same_table, process_cpu_s, sigint_as_on_a_terminal
 
 SRC = Path(quadimpact.__file__).resolve().parents[1]
-GRID = {"heading_deg": "0:359:1", "final_time_s": [1.0]}  # 360 runs, ~7 ms each
-GRID_ARGS = ["--grid=heading_deg=0:359:1", "--grid=final_time_s=1"]
-N_RUNS = 360
+# 720 runs of 3-7 ms each (360 of them, on a fast machine, were done before the fourth
+# sweep's workers had been busy long enough for the test to see them)
+GRID = {"heading_deg": "0:359.5:0.5", "final_time_s": [1.0]}
+GRID_ARGS = ["--grid=heading_deg=0:359.5:0.5", "--grid=final_time_s=1"]
+N_RUNS = 720
 GONE_S = 5.0  # a child may outlive the sweep by this much at most
 
 

@@ -338,8 +338,8 @@ class Pool:
                     w.group, w.loop = int(body[0]), 0
                 elif kind == "loop":
                     w.loop = int(body[0])
-                elif kind == "row":
-                    rows.append(self._row(w, *body))
+                elif kind == "rows":  # a group's rows, in order
+                    rows.extend(self._row(w, row, cost) for row, cost in body[0])
         finally:
             if rows:
                 self.sink(rows)
