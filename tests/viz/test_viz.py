@@ -246,6 +246,34 @@ def test_the_movie_reads_the_canvas_itself_and_the_picture_is_its_rgb(run_dir: P
     assert abs(right @ up) < 1e-15 and abs(np.linalg.norm(forward) - 1.0) < 1e-15
 
 
+def test_stamped_frames_are_the_frames_drawn_in_full(run_dir: Path) -> None:
+    """The texts pasted from stamps (viz/stamps.py) leave each frame as matplotlib draws it
+    in full, but for rounding: a text a pixel over, its edges anti-aliased a bit apart."""
+    from quadimpact.viz.animation import DEFAULT_ANIMATION_CAMERA, AnimationFigure
+
+    scene = Scene.from_dir(run_dir)
+    stamped = AnimationFigure(scene, DEFAULT_ANIMATION_CAMERA, 640, 360)
+    drawn = AnimationFigure(scene, DEFAULT_ANIMATION_CAMERA, 640, 360)
+    assert len([s for s in stamped._stamps.values() if s is not None]) == 8  # x y z, 1-4, compass
+    bare = AnimationFigure(scene, DEFAULT_ANIMATION_CAMERA, 640, 360)
+    bare._stamps = dict.fromkeys(bare._stamps)  # every stamped artist left out
+    drawn._stamps = {}
+    for t in (0.0, 0.4, 0.9, 1.2):
+        a = stamped.render_rgba(t).astype(int)
+        b = drawn.render_rgba(t).astype(int)
+        without = bare.render_rgba(t).astype(int)
+        assert (np.abs(a - without).max(axis=2) > 8).sum() > 100  # the pasted texts are there
+        near = np.full(a.shape[:2], 255)  # each pixel against the drawn one or a neighbour
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                shifted = np.roll(b, (dy, dx), axis=(0, 1))
+                near = np.minimum(near, np.abs(a - shifted).max(axis=2))
+        # Agg renders a glyph at its sub-pixel offset: an edge pixel may differ by a third
+        # of full scale from the drawn one's neighbours; a misplaced or mis-layered text
+        # would differ by most of it on most of its ~500 pixels
+        assert near.max() < 100 and (near > 32).sum() < 50, (near.max(), (near > 32).sum())
+
+
 # ------------------------------------------------------------------ viewer
 def test_viewer_is_one_self_contained_file(run_dir: Path, tmp_path: Path) -> None:
     import json

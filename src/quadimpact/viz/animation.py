@@ -9,7 +9,10 @@ legends, the faint whole-run curves) is rendered once and kept as a
 background; every frame restores it, moves the changing artists
 (:class:`~quadimpact.viz.render.SceneArtists`, the live lines, cursors and
 clock) and draws only those (blitting), then hands the pixels to ffmpeg's
-pipe: a 3-s run at 30 fps (91 frames) renders in a few seconds.
+pipe: a 3-s run at 30 fps (91 frames) renders in a few seconds. The texts
+that only move (the body axes' names, the bumper numbers) and the compass are
+drawn once and pasted at each frame (:mod:`quadimpact.viz.stamps`): a recovery
+trial's 91 frames took 1.24 s of CPU instead of 1.71 s.
 
 Frame ``k`` shows simulated time ``t0 + k / (fps * slow)``; the movie has
 ``round((t1 - t0) * fps * slow) + 1`` frames, so ``slow = 4`` plays the run
@@ -27,6 +30,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -35,6 +39,7 @@ from quadimpact.results.files import atomic_write
 from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, Scene
+from quadimpact.viz.stamps import Stamp, text_anchor
 
 __all__ = [
     "ANIMATION_GIF",
@@ -165,6 +170,15 @@ class AnimationFigure:
         for _ax, arts in self.dynamic:
             for art in arts:
                 art.set_animated(True)
+        # the texts that never change and the compass: drawn once, pasted (viz/stamps.py);
+        # None marks the compass's other artists, pasted with its first
+        self._stamps: dict[Artist, Stamp | None] = {
+            text: Stamp([text], text_anchor(text)) for text in self.view.constant_texts()
+        }
+        compass = self.view.compass
+        if compass:
+            self._stamps[compass[0]] = Stamp(compass, lambda: (0.0, 0.0))  # it stays put
+            self._stamps.update(dict.fromkeys(compass[1:]))
         self._background = None
 
     def render(self, t: float) -> np.ndarray:
@@ -203,11 +217,18 @@ class AnimationFigure:
             self.canvas.draw()
             self.fig.set_layout_engine("none")
             self._background = self.canvas.copy_from_bbox(self.fig.bbox)
+            for stamp in self._stamps.values():
+                if stamp is not None:
+                    stamp.capture(self.canvas)
         self.canvas.restore_region(self._background)
+        buf = np.asarray(self.canvas.buffer_rgba())
+        stamps = self._stamps
         for ax, arts in self.dynamic:
             for art in sorted(arts, key=lambda a: a.get_zorder()):
-                ax.draw_artist(art)
-        buf = np.asarray(self.canvas.buffer_rgba())
+                if art not in stamps:
+                    ax.draw_artist(art)
+                elif stamps[art] is not None:
+                    stamps[art].paste(buf)  # in its turn: what lies over it still does
         if buf.shape[:2] != (self.height, self.width):
             raise RuntimeError(
                 f"canvas is {buf.shape[1]}x{buf.shape[0]}, expected {self.width}x{self.height}"

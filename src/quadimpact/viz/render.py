@@ -395,6 +395,10 @@ class SceneArtists:
         _, point, side = best
         return point, ("left" if side >= 0.0 else "right")
 
+    def constant_texts(self) -> list:
+        """The texts that only move (the body axes' names, the bumper numbers): visible ones."""
+        return [t for t in (*self.axes_text, *self.labels) if t.get_visible()]
+
     def artists(self) -> list:
         """Every artist this view draws (for blitting: all change between frames
         or lie over ones that do), in drawing order (by zorder)."""
