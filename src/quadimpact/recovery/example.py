@@ -50,7 +50,7 @@ class EarlyExample:
 
     The trial nearest the median conditions (``analysis.example_trial``) is
     known from the sweep's inputs before any trial runs, so its files,
-    figure, viewer and animation (about as much CPU time as 300 trials) are
+    figure, viewer and animation (about as much CPU time as 1,000 trials) are
     made beside the sweep, on a process forked from the sweep's warm fork
     server, instead of after it.
     """
