@@ -6,7 +6,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.viz.stamps import Stamp, text_anchor
+from quadimpact.viz.stamps import Stamp, TextStamp, text_anchor
 
 
 def _canvas() -> tuple[FigureCanvasAgg, Figure]:
@@ -53,3 +53,18 @@ def test_a_hidden_or_empty_stamp_pastes_nothing() -> None:
     text.set_visible(False)
     stamp.paste(pixels)
     assert (pixels == 7).all()
+
+
+def test_a_text_stamp_is_whole_though_its_text_was_cut_by_the_edge_when_captured() -> None:
+    canvas, fig = _canvas()
+    text = fig.text(197.0, 40.6, "4z", transform=None, fontsize=9, color="#d95f02",
+                    ha="center", va="center")  # fmt: skip
+    canvas.draw()
+    stamp = TextStamp(text)
+    stamp.capture(canvas)
+    assert text.get_position() == (197.0, 40.6)  # put back
+    text.set_position((100.0, 40.6))  # whole pixels away: the same sub-pixel place
+    pixels = np.full((100, 200, 4), 255, dtype=np.uint8)
+    stamp.paste(pixels)
+    expected = _drawn(100.0, 40.6)
+    assert np.abs(pixels.astype(int) - expected.astype(int)).max() <= 1

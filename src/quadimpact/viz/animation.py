@@ -39,7 +39,7 @@ from quadimpact.results.files import atomic_write
 from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import BUMPER_COLORS_HEX, Scene
-from quadimpact.viz.stamps import Stamp, text_anchor
+from quadimpact.viz.stamps import Stamp, TextStamp
 
 __all__ = [
     "ANIMATION_GIF",
@@ -173,7 +173,7 @@ class AnimationFigure:
         # the texts that never change and the compass: drawn once, pasted (viz/stamps.py);
         # None marks the compass's other artists, pasted with its first
         self._stamps: dict[Artist, Stamp | None] = {
-            text: Stamp([text], text_anchor(text)) for text in self.view.constant_texts()
+            text: TextStamp(text) for text in self.view.constant_texts()
         }
         compass = self.view.compass
         if compass:

@@ -17,6 +17,7 @@ to a unit of rounding.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -24,7 +25,7 @@ from matplotlib.artist import Artist
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.text import Text
 
-__all__ = ["Stamp", "text_anchor"]
+__all__ = ["Stamp", "TextStamp", "text_anchor"]
 
 
 def text_anchor(text: Text) -> Callable[[], tuple[float, float]]:
@@ -98,3 +99,34 @@ class Stamp:
         alpha = src[:, :, 3:4].astype(np.uint16)
         mixed = src[:, :, :3] * alpha + dst * (255 - alpha) + 127
         dst[...] = mixed // 255
+
+
+class TextStamp(Stamp):
+    """A text's stamp, captured with the text moved to the middle of its axes (of the
+    canvas without axes) by whole pixels, so that an edge never cuts what is kept and
+    its sub-pixel place is kept too; then put back."""
+
+    def __init__(self, text: Text) -> None:
+        super().__init__([text], text_anchor(text))
+        self.text = text
+
+    def capture(self, canvas: FigureCanvasAgg) -> None:
+        text = self.text
+        if text.axes is not None:
+            middle = (
+                text.axes.bbox.x0 + 0.5 * text.axes.bbox.width,
+                (text.axes.bbox.y0 + 0.5 * text.axes.bbox.height),
+            )
+        else:
+            width, height = canvas.get_width_height()
+            middle = 0.5 * width, 0.5 * height
+        x, y = self.anchor()
+        if np.isfinite(x) and np.isfinite(y):  # whole pixels: the sub-pixel offset kept
+            middle = (math.floor(middle[0]) + x - math.floor(x),
+                      math.floor(middle[1]) + y - math.floor(y))  # fmt: skip
+        saved = text.get_position()
+        text.set_position(text.get_transform().inverted().transform(middle))
+        try:
+            super().capture(canvas)
+        finally:
+            text.set_position(saved)
