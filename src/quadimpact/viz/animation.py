@@ -38,8 +38,9 @@ from quadimpact.results.figures import set_time_limits, stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
-from quadimpact.viz.scene import BUMPER_COLORS_HEX, Scene
+from quadimpact.viz.scene import Scene
 from quadimpact.viz.stamps import Stamp, TextStamp
+from quadimpact.viz.vehicle_drawing import BUMPER_COLORS_HEX
 
 __all__ = [
     "ANIMATION_GIF",

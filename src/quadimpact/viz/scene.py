@@ -27,26 +27,44 @@ and the sampled states of a run:
 
 A :class:`Scene` holds one run; :meth:`Scene.frame` gives every polyline and
 contact of one instant, and :meth:`Camera.project` puts points on the screen.
+The vehicle's drawing is :mod:`quadimpact.viz.vehicle_drawing`, the surfaces'
+:mod:`quadimpact.viz.world` (their names are importable from here too).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from pydantic import ValidationError
 
 from quadimpact.core import layout as L
-from quadimpact.errors import input_error_from_validation
-from quadimpact.inputs.vehicle import Vehicle, load_vehicle
-from quadimpact.inputs.world import GROUND, Box, Cylinder, Plane, obstacle_from
+from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.inputs.world import Plane
 from quadimpact.rotations import quat_to_matrix, unwrap_deg
-from quadimpact.simulation.packing import pack_features, pack_surface_records, pack_surfaces
+from quadimpact.simulation.packing import pack_surface_records, pack_surfaces
 from quadimpact.viz.camera import Camera
+
+# the vehicle and the world as drawn, each in its module; here too, with the scene
+from quadimpact.viz.vehicle_drawing import (
+    AXIS_LENGTH_M,
+    BUMPER_COLORS_HEX,
+    BUMPER_NAMES,
+    ROTOR_DISC_FRACTION,
+    VehicleDrawing,
+    scene_vehicle,
+    to_inertial,
+)
+from quadimpact.viz.world import (
+    plane_axes,
+    plane_grid,
+    rim_points,
+    scene_surfaces,
+    shape_lines,
+    world_part,
+)
 
 __all__ = [
     "AXIS_LENGTH_M",
@@ -69,304 +87,8 @@ __all__ = [
     "to_inertial",
 ]
 
-#: Where each bumper sits on the Spiri (rotor j, body FRD).
-BUMPER_NAMES = {1: "starboard front", 2: "starboard rear", 3: "port rear", 4: "port front"}
-
-#: Bumper colours, the same as the plots' ``BUMPER_COLORS`` (matplotlib tab10).
-BUMPER_COLORS_HEX = {1: "#1f77b4", 2: "#ff7f0e", 3: "#2ca02c", 4: "#d62728"}
-#: Colours of named features, in order (matplotlib tab10 after the bumpers').
-FEATURE_COLORS_HEX = ("#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22", "#17becf")
-#: Drawn radius of a point feature's marker circles, m.
-POINT_MARK_M = 0.012
-
-
-def feature_color(j: int, name: str) -> str:
-    """Colour of feature ``j`` (1-based): a bumper's ``"1"``-``"4"`` colour, else the palette's."""
-    if name.isdigit() and int(name) in BUMPER_COLORS_HEX:
-        return BUMPER_COLORS_HEX[int(name)]
-    return FEATURE_COLORS_HEX[(j - 1) % len(FEATURE_COLORS_HEX)]
-
-
-#: Rotor discs are drawn with this fraction of the bumper radius (a drawing
-#: choice: the parameter file has no propeller radius).
-ROTOR_DISC_FRACTION = 0.8
-
 #: Length of the force arrows, m per N (10 N is drawn 10 cm long).
 FORCE_SCALE_M_PER_N = 0.01
-
-#: Length of the drawn body axes, m.
-AXIS_LENGTH_M = 0.09
-
-#: Half size of the drawn hub square, m.
-HUB_HALF_M = 0.035
-
-
-def to_inertial(points_b: np.ndarray, position: np.ndarray, C: np.ndarray) -> np.ndarray:
-    """Body-frame points (..., 3) to inertial NED: ``p + C r``."""
-    return np.asarray(position, dtype=float) + np.asarray(points_b, dtype=float) @ C.T
-
-
-def rim_points(
-    centre: np.ndarray, u: np.ndarray, n: np.ndarray, radius: float, beta: np.ndarray
-) -> np.ndarray:
-    """Points ``c + R (cos b u + sin b (n x u))`` of a circle (docs/MODEL.md 4), (len(beta), 3)."""
-    w = np.cross(n, u)
-    b = np.asarray(beta, dtype=float)[:, None]
-    return centre + radius * (np.cos(b) * u + np.sin(b) * w)
-
-
-@dataclass(frozen=True)
-class VehicleDrawing:
-    """Body-frame polylines of a vehicle, built from its parameters.
-
-    Attributes
-    ----------
-    vehicle : Vehicle
-        The vehicle drawn.
-    centres, u, n : numpy.ndarray, shape (4, 3)
-        Bumper circle centres, in-plane outward and normal unit vectors
-        (:meth:`Vehicle.bumper_frames`), body FRD.
-    radius_m : float
-        Bumper radius Rb, m.
-    circles : numpy.ndarray, shape (4, N + 1, 3)
-        Closed bumper rims (last point = first), body FRD, m.
-    discs : numpy.ndarray, shape (4, N + 1, 3)
-        Closed rotor discs (in the body x-y plane through each hub).
-    hub : numpy.ndarray, shape (5, 3)
-        Closed hub square.
-    arms : numpy.ndarray, shape (4, 2, 3)
-        Segments from the CM to each rotor.
-    axes : numpy.ndarray, shape (3, 3)
-        Tips of the body x, y, z axes (rows).
-    label_points : numpy.ndarray, shape (n_features, 3)
-        Where the feature labels go (outside each rim, along ``u_j``).
-    packed : numpy.ndarray
-        The vehicle's contact features as the compiled core's ``F_*`` table.
-    line_feature : numpy.ndarray, shape (n_lines,)
-        The feature (0-based) each of ``circles`` draws (a sphere has three,
-        a point three small ones).
-    names : tuple of str
-        The features' names (``"1"``-``"4"`` for the bumpers).
-    colors : tuple of str
-        Their colours (:func:`feature_color`).
-    """
-
-    vehicle: Vehicle
-    centres: np.ndarray
-    u: np.ndarray
-    n: np.ndarray
-    radius_m: float
-    circles: np.ndarray
-    discs: np.ndarray
-    hub: np.ndarray
-    arms: np.ndarray
-    axes: np.ndarray
-    label_points: np.ndarray
-    packed: np.ndarray
-    line_feature: np.ndarray = field(default_factory=lambda: np.arange(4))
-    names: tuple[str, ...] = ("1", "2", "3", "4")
-    colors: tuple[str, ...] = tuple(BUMPER_COLORS_HEX[j] for j in (1, 2, 3, 4))
-
-    @property
-    def n_features(self) -> int:
-        return len(self.names)
-
-    @classmethod
-    def from_vehicle(cls, vehicle: Vehicle, n_points: int = 72) -> VehicleDrawing:
-        """Build the drawing of ``vehicle`` with ``n_points`` segments per circle."""
-        if vehicle.features is not None:
-            return cls._from_features(vehicle, n_points)
-        centres, u, n = vehicle.bumper_frames()
-        rb = float(vehicle.bumper_radius_m)
-        beta = np.linspace(0.0, 2.0 * math.pi, n_points + 1)
-        circles = np.stack([rim_points(centres[j], u[j], n[j], rb, beta) for j in range(4)])
-        e_z = np.array([0.0, 0.0, 1.0])
-        e_x = np.array([1.0, 0.0, 0.0])
-        discs = np.stack(
-            [rim_points(centres[j], e_x, -e_z, ROTOR_DISC_FRACTION * rb, beta) for j in range(4)]
-        )
-        z_hub = float(np.mean(centres[:, 2]))
-        h = HUB_HALF_M
-        hub = np.array(
-            [[h, h, z_hub], [-h, h, z_hub], [-h, -h, z_hub], [h, -h, z_hub], [h, h, z_hub]]
-        )
-        arms = np.stack([np.stack([np.zeros(3), centres[j]]) for j in range(4)])
-        axes = AXIS_LENGTH_M * np.eye(3)
-        label_points = centres + 1.3 * rb * u
-        return cls(
-            vehicle=vehicle,
-            centres=centres,
-            u=u,
-            n=n,
-            radius_m=rb,
-            circles=circles,
-            discs=discs,
-            hub=hub,
-            arms=arms,
-            axes=axes,
-            label_points=label_points,
-            packed=pack_features(vehicle, 0.0),
-        )
-
-    @classmethod
-    def _from_features(cls, vehicle: Vehicle, n_points: int) -> VehicleDrawing:
-        """The drawing of a vehicle with its own ``[[features]]``."""
-        beta = np.linspace(0.0, 2.0 * math.pi, n_points + 1)
-        features = vehicle.contact_features()
-        lines, owner, labels = [], [], []
-        eye = np.eye(3)
-        for k, f in enumerate(features):
-            c = np.asarray(f.centre_m, dtype=float)
-            if f.kind == "ring":
-                nrm = np.asarray(f.normal, dtype=float)
-                u = np.cross(nrm, eye[int(np.argmin(np.abs(nrm)))])
-                u /= np.linalg.norm(u)
-                lines.append(rim_points(c, u, nrm, f.radius_m, beta))
-                owner.append(k)
-                labels.append(c + 1.3 * f.radius_m * u)
-                continue
-            radius = f.radius_m if f.kind == "sphere" else POINT_MARK_M
-            for axis in range(3):  # three great circles (a point: three small ones)
-                lines.append(rim_points(c, eye[(axis + 1) % 3], eye[axis], radius, beta))
-                owner.append(k)
-            outward = c / np.linalg.norm(c) if np.linalg.norm(c) > 1e-9 else eye[0]
-            labels.append(c + (radius + 0.03) * outward)
-        rotors = vehicle.rotor_positions
-        arm = float(np.mean(np.linalg.norm(rotors[:, :2], axis=1)))
-        e_z = np.array([0.0, 0.0, 1.0])
-        discs = np.stack([rim_points(rotors[j], eye[0], -e_z, 0.5 * arm, beta) for j in range(4)])
-        z_hub = float(np.mean(rotors[:, 2]))
-        h = HUB_HALF_M
-        hub = np.array(
-            [[h, h, z_hub], [-h, h, z_hub], [-h, -h, z_hub], [h, -h, z_hub], [h, h, z_hub]]
-        )
-        names = tuple(f.name for f in features)
-        return cls(
-            vehicle=vehicle,
-            centres=np.array([f.centre_m for f in features], dtype=float),
-            u=np.zeros((len(features), 3)),
-            n=np.array([f.normal for f in features], dtype=float),
-            radius_m=float(max(f.radius_m for f in features)),
-            circles=np.stack(lines),
-            discs=discs,
-            hub=hub,
-            arms=np.stack([np.stack([np.zeros(3), rotors[j]]) for j in range(4)]),
-            axes=AXIS_LENGTH_M * np.eye(3),
-            label_points=np.array(labels),
-            packed=pack_features(vehicle, 0.0),
-            line_feature=np.array(owner),
-            names=names,
-            colors=tuple(feature_color(k + 1, name) for k, name in enumerate(names)),
-        )
-
-
-def _world_part(world: Mapping[str, Any] | None, key: str) -> Any:
-    return world.get(key) if isinstance(world, Mapping) else None
-
-
-def scene_vehicle(summary: Mapping[str, Any], world: Mapping[str, Any] | None = None) -> Vehicle:
-    """The vehicle of a run: the world record's (overrides applied), else the named bundled one.
-
-    Raises
-    ------
-    InputError
-        A world record whose vehicle breaks a rule, or (without a record) a
-        vehicle name that is not bundled.
-    """
-    data = _world_part(world, "vehicle")
-    if isinstance(data, Mapping):
-        try:
-            return Vehicle.model_validate(dict(data))
-        except ValidationError as exc:
-            raise input_error_from_validation(exc, "scenario.json: vehicle") from None
-    return load_vehicle(summary.get("vehicle") or None)
-
-
-def scene_surfaces(
-    summary: Mapping[str, Any],
-    episodes: pd.DataFrame | None = None,
-    world: Mapping[str, Any] | None = None,
-) -> list[Plane | Cylinder | Box]:
-    """The contact surfaces of a run: the world record's, else from the summary and episodes.
-
-    With a world record (``scenario.json``), exactly its ``surfaces``, in the
-    kernel's order (possibly none). Without one (a folder written before that
-    file existed): the wall ``X = wall_distance_m`` (normal -X) of a wall
-    approach, and the ground (altitude 0, normal up) when an episode touched it.
-    """
-    records = _world_part(world, "surfaces")
-    if isinstance(records, Sequence):
-        return [_surface_of_record(r) for r in records]
-    out: list[Plane] = []
-    if summary.get("wall_distance_m") is not None:
-        out.append(Plane.wall(summary["wall_distance_m"]))
-    touched = set()
-    if episodes is not None and len(episodes) and "surface" in episodes:
-        touched = {str(x) for x in episodes["surface"]}
-    if "ground" in touched and "ground" not in {s.name for s in out}:
-        out.append(GROUND)
-    return out
-
-
-def _surface_of_record(r: Mapping[str, Any]) -> Plane | Cylinder | Box:
-    """The shape of a ``scenario.json`` surface record (its drawing; the kernel's numbers are
-    packed from the records themselves)."""
-    kind = r.get("kind", "plane")
-    if kind == "cylinder":
-        return obstacle_from(
-            {k: r[k] for k in ("name", "point_m", "axis", "radius_m", "length_m")}
-            | {"kind": "cylinder"}
-        )
-    if kind == "box":
-        # the box's axes as recorded: its drawing reads them from the packed row
-        return Box(name=str(r["name"]), centre_m=r["centre_m"], half_extents_m=r["half_extents_m"])
-    return Plane(
-        name=str(r["name"]),
-        point_m=tuple(float(c) for c in r["point_m"]),
-        normal=tuple(float(c) for c in r["normal"]),
-        is_ground=bool(r.get("is_ground", False)),
-    )
-
-
-def shape_lines(row: np.ndarray, centre: np.ndarray, extent: float = 1.5) -> list[np.ndarray]:
-    """Polylines (inertial NED) drawing a packed cylinder or box (``SH_*``); a plane: none.
-
-    A cylinder: its two end rims (an infinite one: ``extent`` m each way of
-    ``centre``'s axial coordinate) and eight generators; a box: its twelve
-    edges.
-    """
-    kind = int(row[L.SH_KIND])
-    o = row[L.SH_POINT : L.SH_POINT + 3]
-    if kind == L.SHAPE_CYLINDER:
-        e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
-        r = float(row[L.SH_RADIUS])
-        length = float(row[L.SH_LENGTH])
-        if np.isfinite(length):
-            z0, z1 = -0.5 * length, 0.5 * length
-        else:
-            zc = float((np.asarray(centre, dtype=float) - o) @ e)
-            z0, z1 = zc - extent, zc + extent
-        k = np.eye(3)[int(np.argmin(np.abs(e)))]
-        u = np.cross(e, k)
-        u /= np.linalg.norm(u)
-        beta = np.linspace(0.0, 2.0 * math.pi, 73)
-        lines = [rim_points(o + z * e, u, e, r, beta) for z in (z0, z1)]
-        for b in np.linspace(0.0, 2.0 * math.pi, 8, endpoint=False):
-            p = rim_points(o, u, e, r, np.array([b]))[0]
-            lines.append(np.array([p + z0 * e, p + z1 * e]))
-        return lines
-    if kind == L.SHAPE_BOX:
-        axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
-        half = row[L.SH_HALF : L.SH_HALF + 3]
-        lines = []
-        for i in range(3):
-            j, k = (i + 1) % 3, (i + 2) % 3
-            for sj in (-1.0, 1.0):
-                for sk in (-1.0, 1.0):
-                    base = o + sj * half[j] * axes[j] + sk * half[k] * axes[k]
-                    lines.append(np.array([base - half[i] * axes[i], base + half[i] * axes[i]]))
-        return lines
-    return []
 
 
 def contact_points(
@@ -409,66 +131,6 @@ def contact_points(
             m = np.array(rec[8:11])
             normals[j, s] = m / np.linalg.norm(m)
     return points, depths, normals
-
-
-def plane_axes(normal: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors spanning a plane: ``e1`` horizontal (for a non-horizontal
-    plane), ``e2 = m x e1`` its steepest direction."""
-    m = np.asarray(normal, dtype=float)
-    m = m / np.linalg.norm(m)
-    ref = np.array([0.0, 0.0, 1.0]) if abs(m[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    e1 = np.cross(m, ref)
-    e1 /= np.linalg.norm(e1)
-    return e1, np.cross(m, e1)
-
-
-def plane_grid(
-    point: np.ndarray,
-    normal: np.ndarray,
-    centre: np.ndarray,
-    half_size: float,
-    step: float = 0.1,
-    range1: tuple[float, float] | None = None,
-) -> tuple[np.ndarray, np.ndarray]:
-    """A rectangular patch of a plane around ``centre`` and grid lines fixed in space.
-
-    Parameters
-    ----------
-    point, normal : array_like
-        The plane (NED).
-    centre : array_like
-        Point whose projection onto the plane is the patch's reference.
-    half_size : float
-        Extent each way along ``e2`` (:func:`plane_axes`), m.
-    step : float
-        Grid spacing, m; the lines sit at multiples of ``step`` from ``point``.
-    range1 : (float, float), optional
-        Extent along ``e1`` from the reference, m; default ``(-half_size, half_size)``.
-        A wall drawn with ``(-w, 0)`` or ``(0, w)`` is cut by the vertical plane
-        through ``centre``, so the cut edge shows where the vehicle meets it.
-
-    Returns
-    -------
-    outline : numpy.ndarray, shape (5, 3)
-        Closed rectangle in the plane.
-    segments : numpy.ndarray, shape (k, 2, 3)
-        Grid lines inside it.
-    """
-    p0 = np.asarray(point, dtype=float)
-    e1, e2 = plane_axes(normal)
-    rel = np.asarray(centre, dtype=float) - p0
-    a0, b0 = float(rel @ e1), float(rel @ e2)
-    lo1, hi1 = (-half_size, half_size) if range1 is None else range1
-    ranges = ((a0 + lo1, a0 + hi1), (b0 - half_size, b0 + half_size))
-    (a_lo, a_hi), (b_lo, b_hi) = ranges
-    corners = [(a_lo, b_lo), (a_hi, b_lo), (a_hi, b_hi), (a_lo, b_hi), (a_lo, b_lo)]
-    outline = np.array([p0 + a * e1 + b * e2 for a, b in corners])
-    segs = []
-    for axis, other, (lo, hi), (olo, ohi) in ((e1, e2, *ranges), (e2, e1, *ranges[::-1])):
-        for k in range(math.ceil(lo / step - 1e-9), math.floor(hi / step + 1e-9) + 1):
-            base = p0 + k * step * axis
-            segs.append([base + olo * other, base + ohi * other])
-    return outline, np.array(segs, dtype=float).reshape(-1, 2, 3)
 
 
 @dataclass
@@ -575,7 +237,7 @@ class Scene:
         if vehicle is None:
             vehicle = scene_vehicle(summary, self.world)
         self.drawing = VehicleDrawing.from_vehicle(vehicle, n_points)
-        records = _world_part(self.world, "surfaces")
+        records = world_part(self.world, "surfaces")
         if surfaces is not None:
             self.surfaces = list(surfaces)
         else:
@@ -782,7 +444,7 @@ class Scene:
 
         s = self.summary
         parts = []
-        scenario = _world_part(self.world, "scenario") or {}
+        scenario = world_part(self.world, "scenario") or {}
         kind = scenario.get("kind")
         if kind in ("flight", "impact-trial"):
             parts.append(str(kind).replace("-", " "))
