@@ -589,6 +589,35 @@ def test_dask_table_is_identical(serial_table, dask_cluster, tmp_path):
     assert_same_table(table, serial_table)
 
 
+def test_a_dask_result_lost_with_its_worker_is_awaited_again_without_blocking():
+    """A chunk finished, but its worker went before its rows were fetched: Dask computes it
+    again (its client logs "Couldn't gather ... rescheduling"). The sweep waits for it at most
+    DASK_GATHER_S at a time and awaits it again, so its loop goes on meanwhile (it used to
+    block in the fetch until a worker came back: no "waiting for Dask workers" note)."""
+    from quadimpact.sweep.backends import DASK_GATHER_S, _Dask, _DaskTask
+
+    class LostResult:
+        status = "finished"
+
+        def __init__(self) -> None:
+            self.timeouts: list[float | None] = []
+            self.callbacks: list = []
+
+        def result(self, timeout: float | None = None):
+            self.timeouts.append(timeout)
+            raise TimeoutError
+
+        def add_done_callback(self, fn) -> None:
+            self.callbacks.append(fn)
+
+    rows: list = []
+    loop = _Dask(None, limits=None, sink=rows.extend, note=lambda message: None)
+    fut, task = LostResult(), _DaskTask([(0, None, {})])
+    loop.finished(fut, task)
+    assert fut.timeouts == [DASK_GATHER_S] and loop.pending == {fut: task}
+    assert fut.callbacks == [loop.done.put] and rows == [] and not loop.retry
+
+
 def test_bad_scheduler(tmp_path):
     pytest.importorskip("distributed")
     with pytest.raises(InputError, match="must be an address like tcp://HOST:PORT"):

@@ -135,6 +135,9 @@ DASK_FIRST_NOTE_S = 5.0
 """Without any Dask worker for this long, say so (then every ``DASK_NOTE_EVERY_S``)."""
 DASK_NOTE_EVERY_S = 30.0
 DASK_POLL_S = 0.25
+DASK_GATHER_S = 0.5
+"""Longest wait for a finished chunk's rows: a result whose worker died before it was fetched
+is computed again by Dask, and the loop goes on meanwhile (its notes, clocks, Ctrl-C)."""
 
 
 class _DaskTask:
@@ -214,7 +217,14 @@ class _Dask:
 
     def finished(self, fut: Any, task: _DaskTask) -> None:
         if fut.status == "finished":
-            rows, costs = fut.result()
+            try:
+                rows, costs = fut.result(timeout=DASK_GATHER_S)
+            except TimeoutError:  # its worker went before the rows were fetched ("Couldn't
+                # gather ... rescheduling"): Dask runs the chunk again; it is awaited again,
+                # without blocking the loop until a worker comes back
+                self.pending[fut] = task
+                fut.add_done_callback(self.done.put)
+                return
             fut.release()
             for cost in costs:
                 self.limits.record(cost)
