@@ -592,8 +592,9 @@ def test_dask_table_is_identical(serial_table, dask_cluster, tmp_path):
 def test_a_dask_result_lost_with_its_worker_is_awaited_again_without_blocking():
     """A chunk finished, but its worker went before its rows were fetched: Dask computes it
     again (its client logs "Couldn't gather ... rescheduling"). The sweep waits for it at most
-    DASK_GATHER_S at a time and awaits it again, so its loop goes on meanwhile (it used to
-    block in the fetch until a worker came back: no "waiting for Dask workers" note)."""
+    DASK_GATHER_S (doubled at each new try) and awaits it again, so its loop goes on meanwhile
+    (it used to block in the fetch until a worker came back: no "waiting for Dask workers"
+    note)."""
     from quadimpact.sweep.backends import DASK_GATHER_S, _Dask, _DaskTask
 
     class LostResult:
@@ -616,6 +617,10 @@ def test_a_dask_result_lost_with_its_worker_is_awaited_again_without_blocking():
     loop.finished(fut, task)
     assert fut.timeouts == [DASK_GATHER_S] and loop.pending == {fut: task}
     assert fut.callbacks == [loop.done.put] and rows == [] and not loop.retry
+    for _ in range(8):  # each new try waits twice as long, up to 64 times the first
+        loop.finished(fut, loop.pending.pop(fut))
+    assert fut.timeouts == [DASK_GATHER_S * 2**k for k in (0, 1, 2, 3, 4, 5, 6, 6, 6)]
+    assert loop.pending == {fut: task} and len(fut.callbacks) == 9
 
 
 def test_bad_scheduler(tmp_path):

@@ -136,8 +136,9 @@ DASK_FIRST_NOTE_S = 5.0
 DASK_NOTE_EVERY_S = 30.0
 DASK_POLL_S = 0.25
 DASK_GATHER_S = 0.5
-"""Longest wait for a finished chunk's rows: a result whose worker died before it was fetched
-is computed again by Dask, and the loop goes on meanwhile (its notes, clocks, Ctrl-C)."""
+"""First wait for a finished chunk's rows (doubled at each new try of the same chunk, up to 64
+times: a slow link still gets its rows through): a result whose worker died before it was
+fetched is computed again by Dask, and the loop goes on meanwhile (its notes, clocks, Ctrl-C)."""
 
 
 class _DaskTask:
@@ -148,6 +149,7 @@ class _DaskTask:
         self.lost = lost
         self.avoid = avoid
         self.active_s = 0.0
+        self.fetches = 0  # tries to fetch its rows that timed out
 
 
 class _Dask:
@@ -218,10 +220,11 @@ class _Dask:
     def finished(self, fut: Any, task: _DaskTask) -> None:
         if fut.status == "finished":
             try:
-                rows, costs = fut.result(timeout=DASK_GATHER_S)
+                rows, costs = fut.result(timeout=DASK_GATHER_S * 2 ** min(task.fetches, 6))
             except TimeoutError:  # its worker went before the rows were fetched ("Couldn't
                 # gather ... rescheduling"): Dask runs the chunk again; it is awaited again,
                 # without blocking the loop until a worker comes back
+                task.fetches += 1
                 self.pending[fut] = task
                 fut.add_done_callback(self.done.put)
                 return
