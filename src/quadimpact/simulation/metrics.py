@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -38,12 +39,16 @@ __all__ = [
     "impacts_in",
     "impacts_of",
     "RESPONSE_TYPE_MEANINGS",
+    "RunImpacts",
     "graze_mask",
     "group_impacts",
     "impact_metrics",
+    "impact_metrics_of",
+    "impacts_of_table",
     "impulse_scale",
     "response_type_applies",
     "short_impacts",
+    "short_impacts_of",
 ]
 
 
@@ -82,7 +87,8 @@ def select(table: Table, rows: np.ndarray, names: Sequence[str]) -> dict[str, np
     return out
 
 
-_EPISODE_NEEDED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_delta_m", "peak_force_n")
+IMPACT_COLUMNS = ("bumper", "surface", "t_start_s", "t_end_s", "peak_delta_m", "peak_force_n")
+"""The episode columns the impacts and their metrics are found from."""
 
 
 class EpisodeLists(dict):
@@ -284,16 +290,74 @@ def short_impacts(
     (int, float)
         Their number and the shortest impact's duration, s (NaN when none).
     """
-    n = n_rows(episodes)
-    if n == 0 or not period_s > 0.0:
+    if n_rows(episodes) == 0 or not period_s > 0.0:
         return 0, math.nan
-    cols = episode_lists(episodes, _EPISODE_NEEDED)
-    _rows, _, groups = impacts_in(cols, exclude_surfaces, graze_fraction)
-    durations = [
-        max(cols["t_end_s"][k] for k in g) - min(cols["t_start_s"][k] for k in g) for g in groups
-    ]
+    return short_impacts_of(impacts_of_table(episodes, exclude_surfaces, graze_fraction), period_s)
+
+
+def short_impacts_of(impacts: RunImpacts, period_s: float) -> tuple[int, float]:
+    """:func:`short_impacts` of a run's :class:`RunImpacts`: their number and the shortest, s."""
+    if not period_s > 0.0:
+        return 0, math.nan
+    durations = [e - s for s, e in zip(impacts.start_s, impacts.end_s, strict=True)]
     short = [d for d in durations if d < period_s]
     return len(short), (min(short) if short else math.nan)
+
+
+@dataclass(frozen=True)
+class RunImpacts:
+    """A run's impacts: its episodes grouped (:func:`group_impacts`), some surfaces and the
+    grazes left out, what the summary's metrics are computed from.
+
+    Found from a table by :func:`impacts_of_table` (the reference), or from the
+    loop's raw episodes by the compiled pass of ``core/impacts.py``
+    (``simulation.impacts``): the same numbers, bit for bit. Impacts in time
+    order; times in s.
+    """
+
+    n_episodes: int
+    """Episodes on the surfaces not left out (grazes included)."""
+    n_grazes: int
+    """Of those, the grazes (:func:`graze_mask`)."""
+    bumpers: list[list[int]]
+    """Each impact's episodes' features (1-based), in start order."""
+    start_s: list[float]
+    """Each impact's earliest episode start."""
+    end_s: list[float]
+    """Each impact's latest episode end (an open episode's: the run's end)."""
+    peak_delta_m: list[float]
+    """Each impact's largest peak deflection, m."""
+    peak_force_n: list[float]
+    """Each impact's largest peak normal force, N."""
+
+
+NO_IMPACTS = RunImpacts(0, 0, [], [], [], [], [])
+"""The :class:`RunImpacts` of a run without episodes."""
+
+
+def impacts_of_table(
+    episodes: Table, exclude_surfaces: Sequence[str] = ("ground",), graze_fraction: float = 0.0
+) -> RunImpacts:
+    """The :class:`RunImpacts` of an episodes table (Python; the compiled pass's reference).
+
+    Episodes on ``exclude_surfaces`` and grazes (``graze_fraction``,
+    :func:`graze_mask`) are left out; the rest are grouped by :func:`group_impacts`.
+    """
+    if n_rows(episodes) == 0:
+        return NO_IMPACTS
+    cols = episode_lists(episodes, IMPACT_COLUMNS)
+    rows, n_all, groups = impacts_in(cols, exclude_surfaces, graze_fraction)
+    start, end = cols["t_start_s"], cols["t_end_s"]
+    delta, force, bumper = cols["peak_delta_m"], cols["peak_force_n"], cols["bumper"]
+    return RunImpacts(
+        n_episodes=n_all,
+        n_grazes=n_all - len(rows),
+        bumpers=[[bumper[k] for k in g] for g in groups],
+        start_s=[min(start[k] for k in g) for g in groups],
+        end_s=[max(end[k] for k in g) for g in groups],
+        peak_delta_m=[max(delta[k] for k in g) for g in groups],
+        peak_force_n=[max(force[k] for k in g) for g in groups],
+    )
 
 
 def impact_metrics(
@@ -338,11 +402,12 @@ def impact_metrics(
         has two episodes in that impact).
         Floats are NaN and lists empty when there is no episode.
     """
-    cols = episode_lists(episodes, _EPISODE_NEEDED) if n_rows(episodes) else None
-    rows: list[int] = []
-    n_all, groups = 0, []
-    if cols:
-        rows, n_all, groups = impacts_in(cols, exclude_surfaces, graze_fraction)
+    impacts = impacts_of_table(episodes, exclude_surfaces, graze_fraction)
+    return impact_metrics_of(impacts, n_features)
+
+
+def impact_metrics_of(impacts: RunImpacts, n_features: int = len(BUMPERS)) -> dict[str, Any]:
+    """:func:`impact_metrics` of a run's :class:`RunImpacts` (the same dict)."""
     out: dict[str, Any] = {
         "delta_init_m": math.nan,
         "peak_force_n": math.nan,
@@ -351,24 +416,22 @@ def impact_metrics(
         "initial_impact_duration_s": math.nan,
         "leading_bumpers": [],
         "aft_bumpers": [],
-        "n_episodes": n_all,
-        "n_grazes": n_all - len(rows),
+        "n_episodes": impacts.n_episodes,
+        "n_grazes": impacts.n_grazes,
         "n_subsequent_impacts": 0,
         "n_subsequent_episodes": 0,
         "subsequent_impacts": [],
     }
+    groups = impacts.bumpers
     if not groups:
         return out
-    assert cols is not None
-    first = groups[0]
-    bumper = cols["bumper"]
-    start = min(cols["t_start_s"][k] for k in first)
-    end = max(max(cols["t_end_s"][k] for k in first), start)
-    leading = sorted({bumper[k] for k in first})
+    start = impacts.start_s[0]
+    end = max(impacts.end_s[0], start)
+    leading = sorted(set(groups[0]))
     out.update(
         {
-            "delta_init_m": max(cols["peak_delta_m"][k] for k in first),
-            "peak_force_n": max(cols["peak_force_n"][k] for k in first),
+            "delta_init_m": impacts.peak_delta_m[0],
+            "peak_force_n": impacts.peak_force_n[0],
             "initial_impact_start_s": start,
             "initial_impact_end_s": end,
             "initial_impact_duration_s": end - start,
@@ -376,7 +439,7 @@ def impact_metrics(
             "aft_bumpers": [b for b in range(1, n_features + 1) if b not in leading],
             "n_subsequent_impacts": len(groups) - 1,
             "n_subsequent_episodes": sum(len(g) for g in groups[1:]),
-            "subsequent_impacts": [[bumper[k] for k in g] for g in groups[1:]],
+            "subsequent_impacts": [list(g) for g in groups[1:]],
         }
     )
     return out
@@ -557,7 +620,7 @@ def closest_chaining(episodes: Table, crashed: bool) -> dict[str, Any] | None:
         return None
     surface = column(episodes, "surface", dtype=object).astype(str)
     keep = (surface != "ground") & ~graze_mask(episodes, ("ground",), GRAZE_IMPULSE_FRACTION)
-    eps = select(episodes, keep, _EPISODE_NEEDED)
+    eps = select(episodes, keep, IMPACT_COLUMNS)
     order = np.lexsort((np.asarray(eps["bumper"], float), eps["t_start_s"]))
     if len(order) < 2:
         return None

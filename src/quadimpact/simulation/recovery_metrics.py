@@ -22,6 +22,7 @@ from quadimpact.linalg import dot, norm
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
+    RunImpacts,
     Table,
     episode_lists,
     impacts_in,
@@ -31,7 +32,13 @@ from quadimpact.simulation.metrics import (
 EPISODE_COLUMNS_USED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_force_n")
 """The episode columns the impacts after the detection are found from."""
 
-__all__ = ["RECOVERY_KEYS", "contact_normal", "first_contact_normal", "recovery_metrics"]
+__all__ = [
+    "RECOVERY_KEYS",
+    "contact_normal",
+    "first_contact_normal",
+    "onset_normal",
+    "recovery_metrics",
+]
 
 RECOVERED_STAGE = 4
 
@@ -116,7 +123,18 @@ def first_contact_normal(
         unit, out of the obstacle) at the state of the first onset
         (``ST_ONSET_X``); None when the run touched no obstacle.
     """
-    first = first_obstacle_episode(episodes, obstacle_names)
+    return onset_normal(st, first_obstacle_episode(episodes, obstacle_names), feat, shapes,
+                        surface_names)  # fmt: skip
+
+
+def onset_normal(
+    st: np.ndarray,
+    first: tuple[int, str] | None,
+    feat: np.ndarray,
+    shapes: np.ndarray,
+    surface_names: Sequence[str],
+) -> tuple[int, np.ndarray] | None:
+    """:func:`first_contact_normal` given the first obstacle episode (bumper, surface) or None."""
     if first is None:
         return None
     bumper, surface = first
@@ -127,7 +145,7 @@ def first_contact_normal(
 
 def recovery_metrics(
     st: np.ndarray,
-    episodes: Table,
+    episodes: Table | None,
     *,
     feat: np.ndarray,
     shapes: np.ndarray,
@@ -135,6 +153,7 @@ def recovery_metrics(
     obstacle_names: Sequence[str],
     final_state: np.ndarray,
     first_obstacle_contact: tuple[int, np.ndarray] | None | str = "find",
+    impacts: RunImpacts | None = None,
 ) -> dict[str, Any]:
     """The metrics of docs/RECOVERY.md section 6 from a run's record.
 
@@ -142,8 +161,10 @@ def recovery_metrics(
     ----------
     st : numpy.ndarray (NSTAT,)
         The kernel's stats (layout ``ST_*``).
-    episodes : table
-        The episodes (``simulation.record.episodes_frame`` or ``episode_columns``).
+    episodes : table or None
+        The episodes (``simulation.record.episodes_frame`` or
+        ``episode_columns``); not read (None) when ``first_obstacle_contact``
+        and ``impacts`` are given.
     feat, shapes : numpy.ndarray
         The packed contact features and shapes (for the true contact normal).
     surface_names : sequence of str
@@ -157,6 +178,9 @@ def recovery_metrics(
         1-based, contact normal there, inertial, unit), None where the run
         touched no obstacle; by default found from the episodes and the
         contact geometry (:func:`first_contact_normal`).
+    impacts : RunImpacts, optional
+        The run's impacts on the obstacles (grazes left out), when the caller
+        has them; by default found from the episodes.
 
     Returns
     -------
@@ -215,12 +239,14 @@ def recovery_metrics(
     out["max_tilt_deg"] = math.degrees(math.acos(min(max(float(st[L.ST_MIN_TILT_COS]), -1.0), 1.0)))
     out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
     # impacts (grazes excluded, obstacles only) that start after the detection
-    if n_rows(episodes):
+    if impacts is not None:
+        starts = impacts.start_s
+    elif n_rows(episodes):
         cols = episode_lists(episodes, EPISODE_COLUMNS_USED)
         others = sorted(set(cols["surface"]) - set(obstacle_names))
         _rows, _, groups = impacts_in(cols, others, GRAZE_IMPULSE_FRACTION)
-        starts = cols["t_start_s"]
-        out["impacts_after_detection"] = sum(
-            1 for g in groups if min(starts[k] for k in g) > t_detect
-        )
+        starts = [min(cols["t_start_s"][k] for k in g) for g in groups]
+    else:
+        starts = []
+    out["impacts_after_detection"] = sum(1 for t in starts if t > t_detect)
     return out

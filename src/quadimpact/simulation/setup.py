@@ -410,7 +410,7 @@ def prepare_wall_approach(s: WallApproach, kernel: Kernel | None = None) -> RunS
     else:
         roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
     refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    setup = _for_run(_wall_shared(s), s, refs)
+    setup = _for_run(_wall_shared(s, v), s, refs)
     if kernel is not None:
         setup.kernel = kernel
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
@@ -478,16 +478,18 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     return _for_run(shared, s, refs, x0=x0, t0=0.0)
 
 
-def _wall_shared(s: WallApproach) -> SharedSetup:
-    """The :class:`SharedSetup` of a wall approach, kept for its fields but the state's."""
+def _wall_shared(s: WallApproach, v: Vehicle) -> SharedSetup:
+    """The :class:`SharedSetup` of a wall approach, kept for its fields but the state's.
+
+    ``v``: the scenario's vehicle (``s.build_vehicle()``).
+    """
 
     def pack() -> SharedSetup:
         wall = Plane.wall(s.wall_distance_m)
         surfaces = [wall, *s.obstacles, *_ground(s)]
-        v, o = s.build_vehicle(), s.resolved_model_options()
-        return _shared(s, v, o, surfaces, float(s.final_time_s), wall=wall)
+        return _shared(s, v, s.resolved_model_options(), surfaces, float(s.final_time_s), wall=wall)
 
-    return kept_shared(s, pack)
+    return kept_shared(s, pack, v)
 
 
 def _trial_shared(s: ImpactTrial) -> SharedSetup:

@@ -95,16 +95,19 @@ KEPT_LIMIT = 8
 """The most shared packings a process keeps (the oldest goes first)."""
 
 
-def kept_shared(s: WallApproach | ImpactTrial, pack: Callable[[], SharedSetup]) -> SharedSetup:
+def kept_shared(
+    s: WallApproach | ImpactTrial, pack: Callable[[], SharedSetup], vehicle: Any = None
+) -> SharedSetup:
     """The :class:`SharedSetup` of a run, packed (``pack()``) once per process for its other fields.
 
     Kept (at most :data:`KEPT_LIMIT`) under the scenario's JSON without its
     state fields, and used again only with the same vehicle object (a vehicle
     file changed on disk loads as a new one) and the same registry entries.
     Every value of a run is computed by the same functions either way: a kept
-    packing gives the same run, bit for bit.
+    packing gives the same run, bit for bit. ``vehicle``: ``s.build_vehicle()``
+    when the caller has it.
     """
-    v = s.build_vehicle()
+    v = s.build_vehicle() if vehicle is None else vehicle
     key = s.model_dump_json(exclude=_EXCLUDED[s.kind])
     shared = _KEPT.get(key)
     entries = (controller_entry(s.controller), estimator_entry(s.estimator))

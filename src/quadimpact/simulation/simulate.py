@@ -17,10 +17,10 @@ from quadimpact.core.run import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.costs import cpu_time
 from quadimpact.results.result import SimulationResult
+from quadimpact.simulation.impacts import run_episodes
 from quadimpact.simulation.packing import feature_records, surface_records
 from quadimpact.simulation.record import (
     episode_columns,
-    episode_lists_of,
     episodes_frame,
     imu_columns,
     imu_frame,
@@ -138,7 +138,8 @@ def analyse(
 ):
     """Summary, tables and world record of a raw record (``core.run.RawRecord``) of ``setup``.
 
-    The summary is computed from the raw arrays (no DataFrame); the result's
+    The summary is computed from the raw arrays (no DataFrame; the impacts by
+    one compiled pass over the episodes, ``simulation.impacts``); the result's
     ``timeseries``, ``episodes`` and ``imu`` tables and its ``world`` record
     are built when first read. ``kernel_cpu_s``: the CPU time of the run's
     compiled loop; ``since``: :func:`~quadimpact.results.costs.cpu_time`
@@ -147,7 +148,7 @@ def analyse(
     """
     out, ep, st = rec.out, rec.episodes, rec.stats
     nf = len(setup.feature_names)
-    episodes = episode_lists_of(ep, ep.shape[0], setup.shape_names, nf)
+    episodes = run_episodes(ep, ep.shape[0], setup.shape_names, nf, setup.shapes)
     summary = build_summary(setup, scenario, episodes, st)
     stats = {
         "steps": int(st[L.ST_N_STEPS]),

@@ -22,13 +22,9 @@ from quadimpact.linalg import dot, matvec
 from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.approach import inclination_deg_of
 from quadimpact.simulation.estimation_metrics import estimation_metrics
-from quadimpact.simulation.metrics import (
-    GRAZE_IMPULSE_FRACTION,
-    classify_response,
-    impact_metrics,
-    short_impacts,
-)
-from quadimpact.simulation.recovery_metrics import first_contact_normal, recovery_metrics
+from quadimpact.simulation.impacts import RunEpisodes
+from quadimpact.simulation.metrics import classify_response, impact_metrics_of, short_impacts_of
+from quadimpact.simulation.recovery_metrics import onset_normal, recovery_metrics
 from quadimpact.simulation.setup import RunSetup
 
 __all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]
@@ -51,27 +47,29 @@ def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray)
 
     From the kernel's stats (among them the output samples' attitude
     excursion and the last sample's state: the state at the end of the run)
-    and the episodes (the table or its
-    :class:`~quadimpact.simulation.metrics.EpisodeLists`); no time series.
+    and the episodes (a :class:`~quadimpact.simulation.impacts.RunEpisodes`,
+    or a table of them); no time series.
     """
+    obstacles = _obstacle_names(setup)
+    if not isinstance(episodes, RunEpisodes):
+        episodes = RunEpisodes.of_table(episodes, obstacles)
     status_code = int(st[L.ST_STATUS])
     status = STATUS_NAMES[status_code]
     warnings = list(setup.warnings)
     reason = L.REASON_TEXT[int(st[L.ST_REASON])]
     n_features = len(setup.feature_names)
-    metrics = impact_metrics(episodes, graze_fraction=GRAZE_IMPULSE_FRACTION, n_features=n_features)
+    metrics = impact_metrics_of(episodes.impacts, n_features)
     rb = setup.vehicle.valid_depth_m()
 
     onset_t = float(st[L.ST_ONSET_T])
     speed = heading = incl = math.nan
     first_normal = None  # (bumper, contact normal) of the first obstacle contact
-    obstacles = _obstacle_names(setup)
     if not math.isnan(onset_t):
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
         q = xo[L.X_QUAT : L.X_QUAT + 4]
         vel = matvec(quat_to_matrix(q), xo[L.X_VEL : L.X_VEL + 3])
-        first_normal = first_contact_normal(  # the normal there, from the contact geometry
-            st, episodes, setup.feat, setup.shapes, setup.shape_names, obstacles
+        first_normal = onset_normal(  # the normal there, from the contact geometry
+            st, episodes.first_obstacle, setup.feat, setup.shapes, setup.shape_names
         )
         if first_normal is not None:
             speed = -dot(vel, first_normal[1])
@@ -82,7 +80,7 @@ def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray)
     crash_pos = st[L.ST_CRASH_X : L.ST_CRASH_X + 3]
     max_pen = float(st[L.ST_MAX_DELTA])
     if max_pen > rb:
-        warnings.append(_too_deep(setup, episodes, max_pen, rb))
+        warnings.append(_too_deep(setup, episodes.table(), max_pen, rb))
     if st[L.ST_MISSED_ONSETS] > 0:
         warnings.append(
             f"{int(st[L.ST_MISSED_ONSETS])} contact(s) found already penetrating "
@@ -173,13 +171,14 @@ def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray)
     summary.update(
         recovery_metrics(
             st,
-            episodes,
+            None,  # the episodes' impacts and first obstacle contact are given
             feat=setup.feat,
             shapes=setup.shapes,
             surface_names=setup.shape_names,
             obstacle_names=obstacles,
             final_state=np.asarray(final_state, dtype=float),
             first_obstacle_contact=first_normal,
+            impacts=episodes.obstacle_impacts,
         )
     )
     summary["final_altitude_m"] = _nan_to_none(-float(final_state[L.X_POS + 2]))
@@ -239,7 +238,7 @@ def _too_deep(setup: RunSetup, episodes: Any, max_pen: float, rb: float) -> str:
     )
 
 
-def _short_contact_warning(setup: RunSetup, episodes: Any) -> str:
+def _short_contact_warning(setup: RunSetup, episodes: RunEpisodes) -> str:
     """A warning when an impact is shorter than the IMU's sample period ('' otherwise).
 
     Such an impact can fall between two IMU samples: the IMU (and the
@@ -248,7 +247,7 @@ def _short_contact_warning(setup: RunSetup, episodes: Any) -> str:
     rate = float(setup.scfg[L.SC_RATE])
     if not rate > 0.0:
         return ""
-    count, shortest = short_impacts(episodes, 1.0 / rate, graze_fraction=GRAZE_IMPULSE_FRACTION)
+    count, shortest = short_impacts_of(episodes.impacts, 1.0 / rate)
     if not count:
         return ""
     return (

@@ -1,0 +1,164 @@
+"""A run's episodes as its summary reads them: the impacts, found by one compiled pass.
+
+The summary needs of a run's episodes its impacts twice over (on every
+surface but the one named ``"ground"``, for the impact metrics and the
+short-impact warning; on the obstacles, for the impacts after a detection:
+the same sets unless a surface other than the ground is flagged as one) and
+the first episode on an obstacle. :func:`run_episodes` finds them from the
+loop's raw episode rows with ``core/impacts.py`` (sort, grazes, grouping in
+compiled code) and makes :class:`~quadimpact.simulation.metrics.RunImpacts`
+of them: the same numbers, bit for bit, as the Python reference
+(:func:`~quadimpact.simulation.metrics.impacts_of_table` of the episodes
+table), which takes over for a record the compiled pass leaves to it (a
+start that is not finite, an index out of range: see ``core/impacts.py``).
+No table is built unless asked for (:meth:`RunEpisodes.table`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from quadimpact.core import layout as L
+from quadimpact.core.impacts import GRAZE, episodes_usable, find_impacts, sort_episodes
+from quadimpact.simulation.metrics import (
+    GRAZE_IMPULSE_FRACTION,
+    IMPACT_COLUMNS,
+    NO_IMPACTS,
+    RunImpacts,
+    Table,
+    episode_lists,
+    impacts_of_table,
+    n_rows,
+)
+from quadimpact.simulation.record import episode_lists_of
+from quadimpact.simulation.recovery_metrics import first_obstacle_episode
+
+__all__ = ["GROUND_NAME", "RunEpisodes", "run_episodes"]
+
+GROUND_NAME = "ground"
+"""The surface the summary's impact metrics leave out (docs/STUDIES.md 2)."""
+
+
+@dataclass
+class RunEpisodes:
+    """A run's episodes as its summary reads them.
+
+    ``impacts``: the impacts on every surface but :data:`GROUND_NAME`
+    (grazes left out); ``obstacle_impacts``: those on the obstacles (the
+    surfaces not flagged as the ground); ``first_obstacle``: ``(bumper,
+    surface)`` of the first episode on an obstacle (None: none). The episodes
+    table itself (:meth:`table`) is built when first asked for.
+    """
+
+    impacts: RunImpacts
+    obstacle_impacts: RunImpacts
+    first_obstacle: tuple[int, str] | None
+    make_table: Callable[[], Table] = field(repr=False)
+    _table: Table | None = field(default=None, repr=False)
+
+    def table(self) -> Table:
+        """The episodes (columns by name, in time order), built on first use."""
+        if self._table is None:
+            self._table = self.make_table()
+        return self._table
+
+    @classmethod
+    def of_table(cls, episodes: Table, obstacle_names: Sequence[str]) -> RunEpisodes:
+        """The same from an episodes table, by the Python reference."""
+        if n_rows(episodes) == 0:
+            return cls(NO_IMPACTS, NO_IMPACTS, None, lambda: episodes)
+        cols = episode_lists(episodes, IMPACT_COLUMNS)
+        others = sorted(set(cols["surface"]) - set(obstacle_names))
+        return cls(
+            impacts=impacts_of_table(cols, (GROUND_NAME,), GRAZE_IMPULSE_FRACTION),
+            obstacle_impacts=impacts_of_table(cols, others, GRAZE_IMPULSE_FRACTION),
+            first_obstacle=first_obstacle_episode(cols, obstacle_names),
+            make_table=lambda: episodes,
+        )
+
+
+def run_episodes(
+    raw: np.ndarray,
+    n: int,
+    surface_names: Sequence[str],
+    n_features: int,
+    shapes: np.ndarray,
+) -> RunEpisodes:
+    """The :class:`RunEpisodes` of a run from the loop's raw episode rows.
+
+    Parameters
+    ----------
+    raw : numpy.ndarray (max_episodes, NEP)
+        The loop's episodes (``E_*``), the first ``n`` recorded.
+    n : int
+        Episodes recorded.
+    surface_names : sequence of str
+        The packed shapes' names, in order.
+    n_features : int
+        The vehicle's contact features.
+    shapes : numpy.ndarray (n_shapes, NSH)
+        The packed shapes (``SH_IS_GROUND`` says which are not obstacles).
+    """
+    names = list(surface_names)
+    obstacles = [k for k in range(len(names)) if shapes[k, L.SH_IS_GROUND] < 0.5]
+
+    def table() -> Table:
+        return episode_lists_of(raw, n, names, n_features)
+
+    if n == 0:
+        return RunEpisodes(NO_IMPACTS, NO_IMPACTS, None, table)
+    if not episodes_usable(raw, n, n_features, len(names)):  # the reference's path (it may raise)
+        return RunEpisodes.of_table(table(), [names[k] for k in obstacles])
+    order = np.empty(n, dtype=np.int64)
+    sort_episodes(raw, n, order)
+    rows = raw[:n].tolist()
+    sorted_rows = [rows[k] for k in order.tolist()]
+    ground = np.array([1.0 if name == GROUND_NAME else 0.0 for name in names])
+    not_obstacle = np.ones(len(names))
+    not_obstacle[obstacles] = 0.0
+    impacts = _impacts(raw, order, n, ground, sorted_rows)
+    same = bool(np.array_equal(ground, not_obstacle))
+    first = None
+    for row in sorted_rows:
+        shape = round(row[L.E_SHAPE])
+        if not_obstacle[shape] < 0.5:
+            first = (round(row[L.E_FEATURE]) + 1, names[shape])
+            break
+    return RunEpisodes(
+        impacts=impacts,
+        obstacle_impacts=impacts if same else _impacts(raw, order, n, not_obstacle, sorted_rows),
+        first_obstacle=first,
+        make_table=table,
+    )
+
+
+def _impacts(
+    raw: np.ndarray, order: np.ndarray, n: int, excluded: np.ndarray, sorted_rows: list[Any]
+) -> RunImpacts:
+    """The compiled pass with one set of excluded shapes, as a :class:`RunImpacts`."""
+    impact_of = np.empty(n, dtype=np.int64)
+    found = np.empty((n, L.NIM))
+    count = find_impacts(raw, order, n, excluded, GRAZE_IMPULSE_FRACTION, impact_of, found)
+    groups: list[list[int]] = [[] for _ in range(count)]
+    n_all = n_grazes = 0
+    for g, row in zip(impact_of.tolist(), sorted_rows, strict=True):
+        if g >= 0:
+            groups[g].append(round(row[L.E_FEATURE]) + 1)
+            n_all += 1
+        elif g == GRAZE:
+            n_all += 1
+            n_grazes += 1
+    table = found[:count].T.tolist()  # one list per IM_ column
+    return RunImpacts(
+        n_episodes=n_all,
+        n_grazes=n_grazes,
+        bumpers=groups,
+        start_s=table[L.IM_START],
+        end_s=table[L.IM_END],
+        peak_delta_m=table[L.IM_PEAK_DELTA],
+        peak_force_n=table[L.IM_PEAK_FORCE],
+    )
