@@ -32,6 +32,7 @@ __all__ = [
     "body_to_inertial",
     "euler_zyx_to_quat",
     "inclination_deg",
+    "matrix_to_euler_zyx",
     "matrix_to_euler_zyx_deg",
     "matrix_to_quat",
     "matrix_to_rotvec",
@@ -219,7 +220,19 @@ def _single_euler_zyx(
     same types out (roll and yaw 0-d arrays, pitch a NumPy float): the same bits
     (tested).
     """
-    (c00, c01, _), (c10, c11, _), (c20, c21, c22) = _single_quat_matrix(q).tolist()
+    return matrix_to_euler_zyx(_single_quat_matrix(q))
+
+
+def matrix_to_euler_zyx(
+    C: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], np.float64, NDArray[np.float64]]:
+    """:func:`quat_to_euler_zyx` of one rotation matrix ``C`` (3, 3), rad.
+
+    The same rule (``atan2`` pitch, the gimbal-lock rule) and types as
+    :func:`quat_to_euler_zyx` (roll and yaw 0-d arrays, pitch a NumPy float):
+    of ``C = quat_to_matrix(q)``, the same bits as ``quat_to_euler_zyx(q)``.
+    """
+    (c00, c01, _), (c10, c11, _), (c20, c21, c22) = C.tolist()
     cos_pitch = np.hypot(c00, c10)
     pitch = np.arctan2(-c20, cos_pitch)
     if cos_pitch < GIMBAL_LOCK_COS:

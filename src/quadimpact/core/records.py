@@ -18,8 +18,9 @@ spirit of MuJoCo MJX's ``Model``/``Data``:
 * :class:`Work`: scratch space of one control tick.
 
 Every slot of every field is named in ``core/layout.py``. The factories
-below (``new_data``, ``new_output``, ``new_work``) are compiled, so the
-compiled ``run`` and the Python side allocate through the same code;
+``new_data`` and ``new_work`` are compiled, so the compiled ``run`` and the
+Python side allocate through the same code; ``new_output`` (what the caller
+allocates) is plain NumPy;
 :func:`model` builds a :class:`Model` from packed arrays (Python), and
 :func:`raw_record` reads an :class:`Output` into the :class:`RawRecord` that
 ``quadimpact.simulation`` analyses. The ``*_row`` functions give run ``k`` of
@@ -162,7 +163,6 @@ def new_data(m: Model) -> Data:
     )
 
 
-@njit(cache=True)
 def new_output(
     m: Model, n_imu: int, max_episodes: int, contact_columns: bool = True, rows: bool = True
 ) -> Output:
@@ -174,6 +174,10 @@ def new_output(
     row at all; the loop still samples at every output time for the stats
     (the attitude excursion, the last sample's state, the count of samples):
     what a summary needs.
+
+    Plain NumPy (the caller is Python; no compiled function allocates an
+    output): handing the whole :class:`Model` to a compiled factory cost
+    more than its four allocations (Numba unboxes every field of the record).
     """
     width = NOUT + 2 * m.feat.shape[0] if contact_columns else NOUT  # layout.out_width
     return Output(

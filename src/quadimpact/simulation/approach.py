@@ -22,7 +22,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.approach import APPROACH_MAX_ITER, APPROACH_TOL_M_S
-from quadimpact.core.geometry import contact_record, pair_table
+from quadimpact.core.geometry import pair_depths, pair_table
 from quadimpact.core.records import Model, new_output
 from quadimpact.core.run import BUILTIN, Kernel
 from quadimpact.linalg import matvec_t
@@ -35,6 +35,7 @@ __all__ = [
     "PAPER_FIT_OFFSET_RAD",
     "PAPER_FIT_SCALE",
     "feature_depths",
+    "pair_depths_at",
     "inclination_deg_of",
     "initial_state",
     "solve_approach",
@@ -98,9 +99,19 @@ def feature_depths(x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, s: int =
 
     The compiled contact geometry (``core.geometry``), called from Python.
     """
+    return pair_depths_at(x, feat, shapes[s : s + 1], pair_table(feat, shapes[s : s + 1]))
+
+
+def pair_depths_at(
+    x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray
+) -> np.ndarray:
+    """Penetration (m) of every pair of the table ``pairs`` (``c = shape * n_features +
+    feature``, ``core.geometry.pair_table``) at the state ``x``, in one compiled call."""
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
-    return np.array([contact_record(xq, C, feat, shapes, f, s)[0] for f in range(feat.shape[0])])
+    depths = np.empty(pairs.shape[0])
+    pair_depths(xq, C, feat, shapes, pairs, depths)
+    return depths
 
 
 def solve_approach(

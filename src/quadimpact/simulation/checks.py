@@ -128,14 +128,15 @@ def check_initial_contact(scenario: Any, setup: Any) -> None:
         One line: the bumper, the surface, the depth and what to change.
     """
     # the compiled contact geometry, loaded where runs are prepared (not by a sweep's checks)
-    from quadimpact.simulation.approach import feature_depths
+    from quadimpact.simulation.approach import pair_depths_at
 
     kind = getattr(scenario, "kind", "scenario")
-    x0 = np.asarray(setup.x0, dtype=float)
+    n_features = setup.feat.shape[0]
+    if n_features == 0:
+        return
+    every = pair_depths_at(setup.x0, setup.feat, setup.shapes, setup.pair_table())
     for s, name in enumerate(setup.shape_names):
-        depths = feature_depths(x0, setup.feat, setup.shapes, s)
-        if depths.size == 0:
-            return
+        depths = every[s * n_features : (s + 1) * n_features]  # pair c = s * n_features + f
         deepest = int(np.argmax(depths))
         depth = float(depths[deepest])
         feature = _feature_label(setup.feature_names[deepest])

@@ -137,12 +137,19 @@ class RunSetup:
         fields.update(changes)
         if "t_out" not in fields:
             fields["t_out"] = self._output_grid()
-        kept = self.kept_pairs
-        if kept is not None and kept[0] is fields["feat"] and kept[1] is fields["shapes"]:
-            fields["pairs"] = kept[2]
+        if fields["feat"] is self.feat and fields["shapes"] is self.shapes:
+            fields["pairs"] = self.pair_table()
         else:
             fields["pairs"] = pair_table(fields["feat"], fields["shapes"])
         return model(**fields)
+
+    def pair_table(self) -> np.ndarray:
+        """The contact-pair table of the features and shapes (``core.geometry.pair_table``):
+        pair ``c = shape * n_features + feature``; the kept one where it is of these arrays."""
+        kept = self.kept_pairs
+        if kept is not None and kept[0] is self.feat and kept[1] is self.shapes:
+            return kept[2]
+        return pair_table(self.feat, self.shapes)
 
     def keep_grid_and_pairs(self) -> None:
         """Compute the output times and the pair table now and keep them (no run changes them).
@@ -478,11 +485,13 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
     return _for_run(shared, s, refs, x0=x0, t0=0.0)
 
 
-def _wall_shared(s: WallApproach, v: Vehicle) -> SharedSetup:
+def _wall_shared(s: WallApproach, v: Vehicle | None = None) -> SharedSetup:
     """The :class:`SharedSetup` of a wall approach, kept for its fields but the state's.
 
-    ``v``: the scenario's vehicle (``s.build_vehicle()``).
+    ``v``: the scenario's vehicle (``s.build_vehicle()``), when the caller has it.
     """
+    if v is None:
+        v = s.build_vehicle()
 
     def pack() -> SharedSetup:
         wall = Plane.wall(s.wall_distance_m)

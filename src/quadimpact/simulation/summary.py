@@ -19,8 +19,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.excursion import DEG
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
-from quadimpact.rotations import quat_to_euler_zyx, quat_to_matrix
-from quadimpact.simulation.approach import inclination_deg_of
+from quadimpact.rotations import inclination_deg, matrix_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.impacts import RunEpisodes
 from quadimpact.simulation.metrics import classify_response, impact_metrics_of, short_impacts_of
@@ -66,15 +65,15 @@ def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray)
     first_normal = None  # (bumper, contact normal) of the first obstacle contact
     if not math.isnan(onset_t):
         xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
-        q = xo[L.X_QUAT : L.X_QUAT + 4]
-        vel = matvec(quat_to_matrix(q), xo[L.X_VEL : L.X_VEL + 3])
+        C = quat_to_matrix(xo[L.X_QUAT : L.X_QUAT + 4])  # the attitude at the onset
+        vel = matvec(C, xo[L.X_VEL : L.X_VEL + 3])
         first_normal = onset_normal(  # the normal there, from the contact geometry
             st, episodes.first_obstacle, setup.feat, setup.shapes, setup.shape_names
         )
         if first_normal is not None:
             speed = -dot(vel, first_normal[1])
-        heading = float(np.degrees(quat_to_euler_zyx(q)[2]))
-        incl = inclination_deg_of(q)
+        heading = float(np.degrees(matrix_to_euler_zyx(C)[2]))
+        incl = float(inclination_deg(C))
 
     crash_t = float(st[L.ST_CRASH_T])
     crash_pos = st[L.ST_CRASH_X : L.ST_CRASH_X + 3]

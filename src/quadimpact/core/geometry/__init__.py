@@ -85,6 +85,7 @@ __all__ = [
     "contact_record",
     "geometry_id",
     "pair_contact",
+    "pair_depths",
     "pair_table",
     "plugin_geometries",
     "register_geometry",
@@ -207,6 +208,20 @@ def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) 
     if kind == SHAPE_BOX:
         return box_distance(px, py, pz, shapes, s)
     return plugin_distance(px, py, pz, shapes, s)
+
+
+@compiled
+def pair_depths(
+    x: np.ndarray,
+    C: np.ndarray,
+    feat: np.ndarray,
+    shapes: np.ndarray,
+    pairs: np.ndarray,
+    depths: np.ndarray,
+) -> None:
+    """``depths[c]``: the penetration (m) of every pair ``c`` of the table at the state ``x``."""
+    for c in range(pairs.shape[0]):
+        depths[c] = pair_contact(x, C, feat, shapes, pairs, c)[0]
 
 
 @compiled
