@@ -66,6 +66,7 @@ def test_a_factorisation_reused_gives_the_bits_of_eliminating_each_system():
             for _ in range(5):
                 b = rng.standard_normal(n)
                 assert lu_solve(lu, b).tolist() == _eliminate_augmented(a, b)
+                assert lu_solve(lu, b[:, None])[:, 0].tolist() == _eliminate_augmented(a, b)
                 assert solve(a, b).tolist() == _eliminate_augmented(a, b)
 
 

@@ -87,7 +87,9 @@ def lu_solve(lu: LU, b: ArrayLike) -> np.ndarray:
     m = lu.upper
     n = len(m)
     rhs = np.asarray(b, dtype=np.float64)
-    cols = 1 if rhs.ndim == 1 else rhs.shape[1]
+    if rhs.ndim == 1:
+        return _lu_solve_vector(lu, rhs.tolist())
+    cols = rhs.shape[1]
     r = rhs.reshape(n, cols).tolist()  # Python floats
     for k in range(n):
         p = lu.pivots[k]
@@ -103,8 +105,29 @@ def lu_solve(lu: LU, b: ArrayLike) -> np.ndarray:
             for k in range(i + 1, n):
                 s -= m[i][k] * x[k][j]
             x[i][j] = s / m[i][i]
-    out = np.array(x, dtype=np.float64)
-    return out[:, 0] if rhs.ndim == 1 else out
+    return np.array(x, dtype=np.float64)
+
+
+def _lu_solve_vector(lu: LU, r: list[float]) -> np.ndarray:
+    """:func:`lu_solve` of one right-hand side (a list, changed): the same operations in the
+    same order on plain floats, without the columns' loops (a run's trim solves one)."""
+    m = lu.upper
+    n = len(m)
+    for k in range(n):
+        p = lu.pivots[k]
+        if p != k:
+            r[k], r[p] = r[p], r[k]
+        rk = r[k]
+        for i, f in zip(range(k + 1, n), lu.factors[k], strict=True):
+            r[i] -= f * rk
+    x = [0.0] * n
+    for i in reversed(range(n)):
+        row = m[i]
+        s = r[i]
+        for k in range(i + 1, n):
+            s -= row[k] * x[k]
+        x[i] = s / row[i]
+    return np.array(x, dtype=np.float64)
 
 
 def inverse(a: ArrayLike) -> np.ndarray:

@@ -215,3 +215,26 @@ def find_impacts(
             group_end = _larger(end, start)
             count += 1
     return count
+
+
+@compiled
+def sort_and_find_impacts(
+    episodes: np.ndarray,
+    n: int,
+    n_features: int,
+    excluded: np.ndarray,
+    graze_fraction: float,
+    order: np.ndarray,
+    impact_of: np.ndarray,
+    impacts: np.ndarray,
+) -> int:
+    """:func:`episodes_usable`, :func:`sort_episodes` and :func:`find_impacts` in one call.
+
+    Returns the number of impacts, or -1 (nothing written) when the record is
+    not usable here (``excluded`` has one entry per shape). One call from
+    Python instead of three: a summary's first calls after the loop run cold.
+    """
+    if not episodes_usable(episodes, n, n_features, excluded.shape[0]):
+        return -1
+    sort_episodes(episodes, n, order)
+    return find_impacts(episodes, order, n, excluded, graze_fraction, impact_of, impacts)

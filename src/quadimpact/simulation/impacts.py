@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.impacts import GRAZE, episodes_usable, find_impacts, sort_episodes
+from quadimpact.core.impacts import GRAZE, find_impacts, sort_and_find_impacts
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
     IMPACT_COLUMNS,
@@ -104,45 +104,47 @@ def run_episodes(
         The packed shapes (``SH_IS_GROUND`` says which are not obstacles).
     """
     names = list(surface_names)
-    obstacles = [k for k in range(len(names)) if shapes[k, L.SH_IS_GROUND] < 0.5]
+    not_obstacle = [float(not flag < 0.5) for flag in shapes[:, L.SH_IS_GROUND].tolist()]
 
     def table() -> Table:
         return episode_lists_of(raw, n, names, n_features)
 
     if n == 0:
         return RunEpisodes(NO_IMPACTS, NO_IMPACTS, None, table)
-    if not episodes_usable(raw, n, n_features, len(names)):  # the reference's path (it may raise)
-        return RunEpisodes.of_table(table(), [names[k] for k in obstacles])
+    ground = [1.0 if name == GROUND_NAME else 0.0 for name in names]
     order = np.empty(n, dtype=np.int64)
-    sort_episodes(raw, n, order)
+    impact_of = np.empty(n, dtype=np.int64)
+    found = np.empty((n, L.NIM))
+    excluded = np.array(ground)
+    count = sort_and_find_impacts(
+        raw, n, n_features, excluded, GRAZE_IMPULSE_FRACTION, order, impact_of, found
+    )
+    if count < 0:  # the reference's path (it may raise)
+        obstacles = [name for name, flag in zip(names, not_obstacle, strict=True) if not flag]
+        return RunEpisodes.of_table(table(), obstacles)
     rows = raw[:n].tolist()
     sorted_rows = [rows[k] for k in order.tolist()]
-    ground = np.array([1.0 if name == GROUND_NAME else 0.0 for name in names])
-    not_obstacle = np.ones(len(names))
-    not_obstacle[obstacles] = 0.0
-    impacts = _impacts(raw, order, n, ground, sorted_rows)
-    same = bool(np.array_equal(ground, not_obstacle))
+    impacts = _impacts(sorted_rows, impact_of, found, count)
+    if ground == not_obstacle:  # the obstacles are every surface but the ground
+        obstacle_impacts = impacts
+    else:
+        excluded = np.array(not_obstacle)
+        count = find_impacts(raw, order, n, excluded, GRAZE_IMPULSE_FRACTION, impact_of, found)
+        obstacle_impacts = _impacts(sorted_rows, impact_of, found, count)
     first = None
     for row in sorted_rows:
         shape = round(row[L.E_SHAPE])
-        if not_obstacle[shape] < 0.5:
+        if not not_obstacle[shape]:
             first = (round(row[L.E_FEATURE]) + 1, names[shape])
             break
-    return RunEpisodes(
-        impacts=impacts,
-        obstacle_impacts=impacts if same else _impacts(raw, order, n, not_obstacle, sorted_rows),
-        first_obstacle=first,
-        make_table=table,
-    )
+    return RunEpisodes(impacts, obstacle_impacts, first, table)
 
 
 def _impacts(
-    raw: np.ndarray, order: np.ndarray, n: int, excluded: np.ndarray, sorted_rows: list[Any]
+    sorted_rows: list[Any], impact_of: np.ndarray, found: np.ndarray, count: int
 ) -> RunImpacts:
-    """The compiled pass with one set of excluded shapes, as a :class:`RunImpacts`."""
-    impact_of = np.empty(n, dtype=np.int64)
-    found = np.empty((n, L.NIM))
-    count = find_impacts(raw, order, n, excluded, GRAZE_IMPULSE_FRACTION, impact_of, found)
+    """A :class:`RunImpacts` of what the compiled pass wrote (``impact_of``, ``count`` rows of
+    ``found``) for the episodes in order (``sorted_rows``)."""
     groups: list[list[int]] = [[] for _ in range(count)]
     n_all = n_grazes = 0
     for g, row in zip(impact_of.tolist(), sorted_rows, strict=True):

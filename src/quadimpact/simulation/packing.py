@@ -300,7 +300,7 @@ def trim_rotor_speeds(v: Vehicle, thrust_n: float, yaw_paper: bool) -> np.ndarra
     """Rotor speeds (rad/s) giving total thrust ``thrust_n`` (N) and zero torques."""
     lu = _memo_value(f"alloc-lu-{yaw_paper}", v, lambda: lu_factor(allocation_matrix(v, yaw_paper)))
     w2 = lu_solve(lu, [thrust_n, 0.0, 0.0, 0.0])  # = solve(A, b), A eliminated once per vehicle
-    return np.sqrt(np.clip(w2, 0.0, None))
+    return np.sqrt(np.maximum(w2, 0.0))  # np.clip's bits (the -0.0 and NaN cases too), faster
 
 
 def pack_controller(

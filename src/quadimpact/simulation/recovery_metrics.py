@@ -78,14 +78,22 @@ def _finite(v: float) -> float | None:
 
 
 def contact_normal(
-    x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, feature: int, shape: int
+    x: np.ndarray,
+    feat: np.ndarray,
+    shapes: np.ndarray,
+    feature: int,
+    shape: int,
+    C: np.ndarray | None = None,
 ) -> np.ndarray:
     """The contact normal (inertial, unit, out of the obstacle) of a feature-shape pair at ``x``.
 
     From the compiled contact geometry, whatever the kinds (``core.geometry``).
+    ``C``: ``quat_to_matrix`` of ``x``'s quaternion, when the caller has it.
     """
     xq = np.ascontiguousarray(x, dtype=float)
-    C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
+    if C is None:
+        C = quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4])
+    C = np.ascontiguousarray(C)
     rec = contact_record(xq, C, feat, shapes, int(feature), int(shape))
     return np.array(rec[8:11])
 
@@ -133,14 +141,18 @@ def onset_normal(
     feat: np.ndarray,
     shapes: np.ndarray,
     surface_names: Sequence[str],
+    C: np.ndarray | None = None,
 ) -> tuple[int, np.ndarray] | None:
-    """:func:`first_contact_normal` given the first obstacle episode (bumper, surface) or None."""
+    """:func:`first_contact_normal` given the first obstacle episode (bumper, surface) or None.
+
+    ``C``: the attitude matrix at the onset, when the caller has it.
+    """
     if first is None:
         return None
     bumper, surface = first
     s_index = list(surface_names).index(surface)
     x_onset = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
-    return bumper, contact_normal(x_onset, feat, shapes, bumper - 1, s_index)
+    return bumper, contact_normal(x_onset, feat, shapes, bumper - 1, s_index, C)
 
 
 def recovery_metrics(

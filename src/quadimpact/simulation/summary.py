@@ -68,7 +68,7 @@ def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray)
         C = quat_to_matrix(xo[L.X_QUAT : L.X_QUAT + 4])  # the attitude at the onset
         vel = matvec(C, xo[L.X_VEL : L.X_VEL + 3])
         first_normal = onset_normal(  # the normal there, from the contact geometry
-            st, episodes.first_obstacle, setup.feat, setup.shapes, setup.shape_names
+            st, episodes.first_obstacle, setup.feat, setup.shapes, setup.shape_names, C
         )
         if first_normal is not None:
             speed = -dot(vel, first_normal[1])
