@@ -15,7 +15,9 @@ import math
 import numpy as np
 import pytest
 
+from quadimpact import WallApproach
 from quadimpact.core import layout as L
+from quadimpact.core.run import execute
 from quadimpact.simulation.impacts import RunEpisodes, run_episodes
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
@@ -24,6 +26,8 @@ from quadimpact.simulation.metrics import (
     impact_metrics_of,
 )
 from quadimpact.simulation.record import episodes_frame
+from quadimpact.simulation.setup import prepare
+from quadimpact.simulation.summary import build_summary
 
 NAMES = ("wall", "pole", "ground")
 
@@ -130,3 +134,20 @@ def test_a_record_the_compiled_pass_cannot_group_takes_the_definition_and_its_er
     raw[1, L.E_SHAPE] = 5.0  # no such surface
     with pytest.raises(ValueError, match="surface index outside"):
         run_episodes(raw, 2, NAMES, 4, _shapes((False, False, True)))
+
+
+@pytest.mark.parametrize("model", ["paper-replica", "default"])
+def test_a_summary_from_the_compiled_pass_equals_the_summary_from_the_episodes_table(model):
+    """The paper's example (an initial impact, several later ones, a detection, a crash):
+    every summary value the same from the raw record as from its episodes table."""
+    scenario = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75, model=model)
+    setup = prepare(scenario)
+    rec = execute(setup.model(), n_imu=setup.n_imu, kernel=setup.kernel)
+    n, nf = rec.episodes.shape[0], len(setup.feature_names)
+    compiled = run_episodes(rec.episodes, n, setup.shape_names, nf, setup.shapes)
+    assert len(compiled.impacts.bumpers) >= 3  # an initial impact and later ones
+    from_raw = build_summary(setup, scenario, compiled, rec.stats)
+    from_table = build_summary(
+        setup, scenario, episodes_frame(rec.episodes, n, setup.shape_names, nf), rec.stats
+    )
+    assert repr(from_raw) == repr(from_table)  # NaN and None alike, every float to its repr
