@@ -37,7 +37,7 @@ import pandas as pd
 from quadimpact import simulate
 from quadimpact.experiments.crashes import MATCHED_CONTACT_TIME_S, TABLE3, Crash
 from quadimpact.experiments.table3 import offs_within_segment
-from quadimpact.simulation.metrics import closest_chaining
+from quadimpact.simulation.response_types import closest_chaining
 
 VARIANTS = ("default", "paper-replica")
 

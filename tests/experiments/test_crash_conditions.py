@@ -208,7 +208,7 @@ def test_chaining_margin_names_the_overlap_a_type_hinges_on():
     chaining turns D into B within a few milliseconds (docs/STUDIES.md 2)."""
     import pandas as pd
 
-    from quadimpact.simulation.metrics import closest_chaining
+    from quadimpact.simulation.response_types import closest_chaining
 
     eps = pd.DataFrame({
         "bumper": [2, 3, 1, 4], "surface": ["wall"] * 4,

@@ -15,7 +15,7 @@ from quadimpact.experiments.table3 import (
     TABLE3_COLUMNS,
     run_experiments,
 )
-from quadimpact.simulation.metrics import RESPONSE_TYPES
+from quadimpact.simulation.response_types import RESPONSE_TYPES
 
 
 def test_crash_scenarios_match_table3():

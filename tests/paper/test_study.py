@@ -8,7 +8,7 @@ import pytest
 from quadimpact.paper import study
 from quadimpact.paper.study import reproduce
 from quadimpact.recovery.report import rate_text
-from quadimpact.simulation.metrics import RESPONSE_TYPES
+from quadimpact.simulation.response_types import RESPONSE_TYPES
 
 from helpers import assert_same_table
 

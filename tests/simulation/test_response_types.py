@@ -4,12 +4,8 @@ import pandas as pd
 import pytest
 
 from quadimpact import WallApproach, simulate
-from quadimpact.simulation.metrics import (
-    GRAZE_IMPULSE_FRACTION,
-    classify_response,
-    graze_mask,
-    impact_metrics,
-)
+from quadimpact.simulation.metrics import GRAZE_IMPULSE_FRACTION, graze_mask, impact_metrics
+from quadimpact.simulation.response_types import classify_response
 
 
 def episodes(*rows):

@@ -486,7 +486,7 @@ def _recovery_lines(summary: Mapping[str, Any]) -> list[str]:
 
 def _response_type(summary: Mapping[str, Any], scenario: Any) -> str:
     """The response type with its meaning, or why there is none (docs/STUDIES.md 3)."""
-    from quadimpact.simulation.metrics import RESPONSE_TYPE_MEANINGS, response_type_applies
+    from quadimpact.simulation.response_types import RESPONSE_TYPE_MEANINGS, response_type_applies
 
     kind = getattr(scenario, "kind", None)
     if scenario is not None and not response_type_applies(kind, getattr(scenario, "ground", None)):

@@ -49,7 +49,7 @@ import pandas as pd
 from quadimpact.experiments.estimation import MOCAP_GAP_S, bumper_rim_extent
 from quadimpact.experiments.logs import FlightLog, PreImpact
 from quadimpact.rotations import quat_to_matrix, unwrap_deg, wrap_angle_deg
-from quadimpact.simulation.metrics import classify_response
+from quadimpact.simulation.response_types import classify_response
 
 __all__ = [
     "CONTACT_TOL_M",

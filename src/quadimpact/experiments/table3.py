@@ -69,7 +69,7 @@ from quadimpact.experiments.report import (  # noqa: F401 (the verdict rule, her
 from quadimpact.experiments.spiri_mat import SpiriMatLog
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.simulation import simulate
-from quadimpact.simulation.metrics import RESPONSE_TYPES, closest_chaining
+from quadimpact.simulation.response_types import RESPONSE_TYPES, closest_chaining
 from quadimpact.sweep import SweepSpec, run_sweep
 
 SENSITIVITY_RUNS = 300  # per crash
@@ -152,7 +152,7 @@ EXTRA_COLUMNS = (
 #: start), the errors against the log over the first 0.3 s
 #: (attitude: RMS rotation angle; position: RMS of the X, Y, altitude
 #: displacements since the impact), and the chaining decision closest to going
-#: the other way (:func:`~quadimpact.simulation.metrics.closest_chaining`: its
+#: the other way (:func:`~quadimpact.simulation.response_types.closest_chaining`: its
 #: margin in ms, negative an overlap, its bumper, and the type had it gone the
 #: other way).
 RUN_COLUMNS = (

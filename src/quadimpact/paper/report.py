@@ -14,7 +14,7 @@ from quadimpact import __version__
 from quadimpact.experiments.report import table3_markdown
 from quadimpact.recovery.report import percent, rate_text
 from quadimpact.results.costs import cost_ratio, cost_text
-from quadimpact.simulation.metrics import RESPONSE_TYPES
+from quadimpact.simulation.response_types import RESPONSE_TYPES
 
 __all__ = [
     "recovery_markdown",

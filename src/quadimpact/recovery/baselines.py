@@ -24,7 +24,7 @@ from quadimpact.experiments.crashes import TABLE3, scenario_path
 from quadimpact.inputs.files import locate_vehicle, read_toml_file
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.simulation import simulate
-from quadimpact.simulation.metrics import RESPONSE_TYPES
+from quadimpact.simulation.response_types import RESPONSE_TYPES
 
 __all__ = [
     "crashes_without_power_off",

@@ -22,8 +22,9 @@ from quadimpact.linalg import dot, matvec
 from quadimpact.rotations import inclination_deg, matrix_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.impacts import RunEpisodes
-from quadimpact.simulation.metrics import classify_response, impact_metrics_of, short_impacts_of
+from quadimpact.simulation.metrics import impact_metrics_of, short_impacts_of
 from quadimpact.simulation.recovery_metrics import onset_normal, recovery_metrics
+from quadimpact.simulation.response_types import classify_response
 from quadimpact.simulation.setup import RunSetup
 
 __all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]

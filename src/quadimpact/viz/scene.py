@@ -440,7 +440,7 @@ class Scene:
 
     def describe(self) -> str:
         """One line naming the run (kind, heading, inclination, speed, model, outcome type)."""
-        from quadimpact.simulation.metrics import response_type_applies
+        from quadimpact.simulation.response_types import response_type_applies
 
         s = self.summary
         parts = []
