@@ -24,6 +24,7 @@ DECLARING = (
     "quadimpact.core.controller_layout",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
+    "quadimpact.core.env_layout",
     "quadimpact.core.batch",
 )
 # constants that carry a block's prefix without being one of its slots

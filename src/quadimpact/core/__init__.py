@@ -26,7 +26,9 @@ pipeline stage:
 * ``run``: a whole run, the kernels (plug-ins), the Python entry;
 * ``approach``: the wall approach's shooting (free-flight runs of the loop,
   the late start's search with ``roots``, Brent's method as compiled steps);
-* ``batch``: many runs stepped together under external commands (learning).
+* ``batch``: many runs stepped together under external commands (learning);
+  ``env_layout``, ``env_actions``, ``env_observation``, ``env_reward``: its
+  record and slots, action maps, observations and reward.
 
 Numba's on-disk cache checks only the file of each cached function, not the
 files of the functions it calls and inlines: an edited ``controllers/paper.py``

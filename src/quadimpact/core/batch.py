@@ -17,6 +17,11 @@ apply), then computes the run's next observation, reward and termination (all in
 :func:`reset_slot` starts a run and, in detection mode, runs its pre-impact
 behaviour with the built-in controller until the detector fires.
 
+The environments' record and slots (``env_layout``), the action maps
+(``env_actions``), the observations (``env_observation``) and the reward and
+envelope (``env_reward``) have modules of their own; their names are
+re-exported here (``batch.B_OUTCOME``, ``batch.observe``...).
+
 Frames and units: inertial NED, body FRD, SI, rotor speeds in rad/s.
 
 Action maps (``a`` clipped to [-1, 1]):
@@ -42,9 +47,6 @@ its own stage record; with either, the episode ends as recovered once stage 4
 is reached and the recovered condition has held for the window.
 """
 
-import math
-from typing import NamedTuple
-
 import numpy as np
 
 from .compiled import allocating, compiled
@@ -60,253 +62,223 @@ from .controller_layout import (
 )
 from .controllers.recovery import (
     law_references,
-    rate_loop,
     recovery_step,
     staged_references,
 )
-from .estimators import write_estimate
+from .env_actions import (
+    action_command,
+    affine_inverse,
+    affine_map,
+    max_thrust,
+    rotor_range,
+)
+from .env_layout import (
+    ACT_CTBR,
+    ACT_ROTORS,
+    B_ACTIVE,
+    B_H_REF,
+    B_HOLD,
+    B_HOLD_P,
+    B_HOLD_T,
+    B_INEXACT,
+    B_LEVEL_N,
+    B_LEVEL_P,
+    B_LEVEL_T,
+    B_OUTCOME,
+    B_POLICY,
+    B_RETURN,
+    B_STAGE,
+    B_STEPS,
+    B_X_REF,
+    B_Y_REF,
+    EP_ACTION,
+    EP_END_ON_RECOVERY,
+    EP_FAIL_REMAINING,
+    EP_GROUND,
+    EP_HOLD_TICKS,
+    EP_MAX_DIST,
+    EP_MAX_DROP,
+    EP_MAX_RATE,
+    EP_MAX_TILT_COS,
+    EP_OBS_CLIP,
+    EP_OBS_F,
+    EP_OBS_POS,
+    EP_OBS_T,
+    EP_OBS_V,
+    EP_OBS_W,
+    EP_OBSERVE,
+    EP_RATE_MAX,
+    EP_S_HEIGHT,
+    EP_S_RATE,
+    EP_S_VZ,
+    EP_W_EFFORT,
+    EP_W_FAILURE,
+    EP_W_HEIGHT,
+    EP_W_RATE,
+    EP_W_RECOVERY,
+    EP_W_TILT,
+    EP_W_VZ,
+    EP_ZERO_LOW,
+    N_OBS_ESTIMATE,
+    N_OBS_IMU,
+    N_OBS_STATE,
+    NB,
+    NPAR,
+    OBS_EST_BIAS,
+    OBS_EST_F,
+    OBS_EST_POS,
+    OBS_EST_RATE,
+    OBS_EST_ROTOR,
+    OBS_EST_VEL,
+    OBS_ESTIMATE,
+    OBS_IMU,
+    OBS_STATE,
+    OC_ALTITUDE,
+    OC_DISTANCE,
+    OC_FAILED,
+    OC_GROUND,
+    OC_RATE,
+    OC_RECOVERED,
+    OC_RUNNING,
+    OC_TILT,
+    OC_TIME_LIMIT,
+    Env,
+    n_observations,
+)
+from .env_observation import (
+    measurement_from_estimate,
+    observe,
+    observe_estimate,
+    tick_measurement,
+)
+from .env_reward import (
+    cost_rate,
+    envelope_outcome,
+    max_cost_rate,
+)
 from .integrator import all_finite, copy_into
 from .layout import (
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
     C_PARAMS,
     LS_DONE,
     LS_EXT,
     LS_EXT_CMD,
-    LS_K,
     LS_T,
-    LS_T0,
     LS_TF,
     MEM_STAGE,
-    MS_BIAS_HAT,
     MS_DETECTED,
-    MS_IMU_F,
-    MS_IMU_W,
     MS_NORMAL,
     MS_T,
-    MS_T_DETECT,
     MS_W_HAT,
     MS_X,
     N_ROTORS,
     NX,
     O_DT_CONTROL,
     O_SLEW_MAX,
-    RIN_CMD,
     ST_CRASH_T,
     ST_STAGE_T,
     ST_STAGE_X,
     ST_STATUS,
     STATUS_FAILED,
-    V_GRAVITY,
-    V_KT,
-    V_MASS,
-    X_OMEGA,
     X_POS,
-    X_QUAT,
     X_ROTOR,
     X_VEL,
-    Block,
 )
-from .quaternion import normalise_quaternion, rotation_matrix
 from .records import Data, Model, Output, Work, data_row, model_row, new_work, output_row
 from .step import finish, start, tick
 
-
-# ---------------------------------------------------------------- records
-class Env(NamedTuple):
-    """The environments' own arrays, stacked like the runs' records (row ``k``: run ``k``)."""
-
-    state: np.ndarray  # (N, NB) per-run episode state (B_*)
-    par: np.ndarray  # (NPAR,) parameters shared by the runs (EP_*)
-    tmeas: np.ndarray  # (N, NMEAS) the measurement record of each run's next tick
-    reported: np.ndarray  # (N,) the stage the policy reports for this tick (< 0: none)
-    obs: np.ndarray  # (N, n_obs) float32 observations
-    reward: np.ndarray  # (N,)
-    terminated: np.ndarray  # (N,) bool
-    truncated: np.ndarray  # (N,) bool
-
-
-# ---------------------------------------------------------------- per-run env state (N, NB)
-_b = Block("env.state", "B_")
-B_ACTIVE = _b.slot("B_ACTIVE")  # 1 while the episode runs
-B_STAGE = _b.slot("B_STAGE")  # stage in force (the policy's or the observer's)
-B_POLICY = _b.slot("B_POLICY")  # 1 once the policy has reported a stage this episode
-B_HOLD = _b.slot("B_HOLD")  # consecutive ticks (after the takeover) the recovered condition held
-B_H_REF = _b.slot("B_H_REF")  # m, altitude at the takeover (height-loss reference)
-B_X_REF = _b.slot("B_X_REF")  # m, CM X and Y at the takeover (distance reference)
-B_Y_REF = _b.slot("B_Y_REF")
-B_STEPS = _b.slot("B_STEPS")  # steps taken this episode
-B_OUTCOME = _b.slot("B_OUTCOME")  # OC_* below
-B_RETURN = _b.slot("B_RETURN")  # sum of the rewards of the episode
-B_INEXACT = _b.slot("B_INEXACT")  # policy commands the action map could not give exactly
-B_LEVEL_N = _b.slot("B_LEVEL_N")  # consecutive ticks (after the takeover) the level test held
-B_LEVEL_T = _b.slot("B_LEVEL_T")  # s, first tick of that run
-B_LEVEL_P = _b.slot("B_LEVEL_P", 3)  # CM position there, inertial, m
-B_HOLD_T = _b.slot("B_HOLD_T")  # s, first tick of the recovered condition's run
-B_HOLD_P = _b.slot("B_HOLD_P", 3)  # CM position there, inertial, m
-NB = _b.end("NB")
-
-OC_RUNNING = 0
-OC_RECOVERED = 1
-OC_GROUND = 2
-OC_TILT = 3
-OC_ALTITUDE = 4
-OC_DISTANCE = 5
-OC_RATE = 6
-OC_TIME_LIMIT = 7
-OC_FAILED = 8
-
-# ---------------------------------------------------------------- parameters (NPAR)
-_ep = Block("env.par", "EP_")
-EP_ACTION = _ep.slot("EP_ACTION")  # ACT_* below
-EP_OBSERVE = _ep.slot("EP_OBSERVE")  # OBS_* below
-EP_ZERO_LOW = _ep.slot("EP_ZERO_LOW")  # 1: rotor actions map onto [0, hi], not [lo, hi]
-EP_RATE_MAX = _ep.slot("EP_RATE_MAX", 3)  # ctbr rate reference scale (p, q, r), rad/s
-EP_W_TILT = _ep.slot("EP_W_TILT")  # reward weights per second of simulated time
-EP_W_RATE = _ep.slot("EP_W_RATE")
-EP_W_VZ = _ep.slot("EP_W_VZ")
-EP_W_HEIGHT = _ep.slot("EP_W_HEIGHT")
-EP_W_EFFORT = _ep.slot("EP_W_EFFORT")
-EP_W_RECOVERY = _ep.slot("EP_W_RECOVERY")  # bonus on the recovered termination
-EP_W_FAILURE = _ep.slot("EP_W_FAILURE")  # penalty on a failure termination (ground, envelope)
-EP_FAIL_REMAINING = _ep.slot("EP_FAIL_REMAINING")  # 1: a failure costs the top rate to the end
-EP_S_RATE = _ep.slot("EP_S_RATE")  # rad/s, scale of the rate cost
-EP_S_VZ = _ep.slot("EP_S_VZ")  # m/s, scale of the vertical-speed cost
-EP_S_HEIGHT = _ep.slot("EP_S_HEIGHT")  # m, scale of the height-loss cost
-EP_MAX_TILT_COS = _ep.slot("EP_MAX_TILT_COS")  # envelope: cos of the largest tilt from vertical
-EP_MAX_DROP = _ep.slot("EP_MAX_DROP")  # m, envelope: altitude below the takeover altitude
-EP_MAX_DIST = _ep.slot("EP_MAX_DIST")  # m, envelope: horizontal distance from the takeover
-EP_MAX_RATE = _ep.slot("EP_MAX_RATE")  # rad/s, envelope: |omega|
-EP_HOLD_TICKS = _ep.slot("EP_HOLD_TICKS")  # confirmation window of the level test, ticks
-EP_GROUND = _ep.slot("EP_GROUND")  # 1: the first ground contact ends the episode
-EP_OBS_F = _ep.slot("EP_OBS_F")  # observation scales: specific force m/s^2, rates rad/s,
-EP_OBS_W = _ep.slot("EP_OBS_W")  # speed m/s, time s, position m; observations are
-EP_OBS_V = _ep.slot("EP_OBS_V")  # clipped to +-EP_OBS_CLIP
-EP_OBS_T = _ep.slot("EP_OBS_T")
-EP_OBS_POS = _ep.slot("EP_OBS_POS")
-EP_OBS_CLIP = _ep.slot("EP_OBS_CLIP")
-EP_END_ON_RECOVERY = _ep.slot("EP_END_ON_RECOVERY")  # 1: the episode ends once recovered
-NPAR = _ep.end("NPAR")
-
-ACT_ROTORS = 0
-ACT_CTBR = 1
-OBS_IMU = 0
-OBS_STATE = 1
-OBS_ESTIMATE = 2
-N_OBS_IMU = 24
-N_OBS_STATE = 19
-N_OBS_ESTIMATE = 30
-# the estimate mode's scales: powers of two, so that value = observation * scale exactly
-# (observations float64): the staged controller can act on its observation alone
-OBS_EST_VEL = 2.0  # m/s
-OBS_EST_POS = 8.0  # m
-OBS_EST_RATE = 8.0  # rad/s
-OBS_EST_F = 16.0  # m/s^2
-OBS_EST_BIAS = 0.125  # rad/s
-OBS_EST_ROTOR = 1024.0  # rad/s
-
-
-def n_observations(mode: int) -> int:
-    """The observation length of a mode (``OBS_*``)."""
-    if mode == OBS_STATE:
-        return N_OBS_STATE
-    if mode == OBS_ESTIMATE:
-        return N_OBS_ESTIMATE
-    return N_OBS_IMU
-
-
-# ---------------------------------------------------------------- action maps
-@compiled
-def affine_map(a: float, lo: float, hi: float) -> float:
-    """``lo + (a + 1) (hi - lo)/2`` for ``a`` in [-1, 1], rounded as finely as floats allow.
-
-    Evaluated from the nearer end (``lo + (1 + a) h`` for ``a < -1/2``,
-    ``hi - (1 - a) h`` for ``a > 1/2``) or from the middle (``m + a h``), so that
-    ``1 + a`` and ``1 - a`` are exact: every float command from
-    ``lo + (hi - lo)/4`` to ``hi`` is the map of some float ``a``. Below, only a
-    part is (near ``a = -1`` floats are ``2^-53`` apart, which the map spreads
-    over more commands than there are floats ``a``). ``a = -1`` gives ``lo`` and
-    ``a = 1`` gives ``hi`` exactly.
-    """
-    h = 0.5 * (hi - lo)
-    if a < -0.5:
-        return lo + (1.0 + a) * h
-    if a > 0.5:
-        return hi - (1.0 - a) * h
-    return (lo + h) + a * h
-
-
-@compiled
-def affine_inverse(w: float, lo: float, hi: float) -> tuple[float, bool]:
-    """The ``a`` in [-1, 1] whose :func:`affine_map` is ``w``; False if none (the nearest then).
-
-    Newton steps on the map, then a walk with ``nextafter`` to the exact value.
-    """
-    h = 0.5 * (hi - lo)
-    if w <= lo:
-        return -1.0, w == lo
-    if w >= hi:
-        return 1.0, w == hi
-    a = min(max((w - lo) / h - 1.0, -1.0), 1.0)
-    for _ in range(3):
-        a = min(max(a + (w - affine_map(a, lo, hi)) / h, -1.0), 1.0)
-    best = a
-    best_err = abs(affine_map(a, lo, hi) - w)
-    for _ in range(64):
-        m = affine_map(a, lo, hi)
-        if m == w:
-            return a, True
-        err = abs(m - w)
-        if err < best_err:
-            best = a
-            best_err = err
-        a = np.nextafter(a, 2.0) if m < w else np.nextafter(a, -2.0)
-        if a < -1.0 or a > 1.0:
-            break
-    return best, False
-
-
-@compiled
-def rotor_range(ctrl: np.ndarray, par: np.ndarray) -> tuple[float, float]:
-    """The rotor-speed range (rad/s) that rotor actions map onto."""
-    lo = 0.0 if par[EP_ZERO_LOW] > 0.5 else ctrl[C_OMEGA_MIN]
-    return lo, ctrl[C_OMEGA_MAX]
-
-
-@compiled
-def max_thrust(veh: np.ndarray, ctrl: np.ndarray) -> float:
-    """``4 kt hi^2`` (N): all rotors at the top of the range."""
-    hi = ctrl[C_OMEGA_MAX]
-    return 4.0 * veh[V_KT] * hi * hi
-
-
-@allocating
-def action_command(
-    action: np.ndarray,
-    meas: np.ndarray,
-    veh: np.ndarray,
-    ctrl: np.ndarray,
-    par: np.ndarray,
-    cmd: np.ndarray,
-) -> None:
-    """Rotor speed commands (rad/s) of a normalised action, into ``cmd``.
-
-    ``meas``: the tick's measurement record (the gyro for the ctbr rate loop).
-    """
-    a = np.empty(4)
-    for j in range(N_ROTORS):
-        v = action[j]
-        a[j] = -1.0 if not v >= -1.0 else (1.0 if v > 1.0 else v)  # NaN -> -1
-    if int(par[EP_ACTION]) == ACT_CTBR:
-        thrust = affine_map(a[0], 0.0, max_thrust(veh, ctrl))
-        rates = (a[1] * par[EP_RATE_MAX], a[2] * par[EP_RATE_MAX + 1], a[3] * par[EP_RATE_MAX + 2])
-        rate_loop(
-            thrust, rates[0], rates[1], rates[2], meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd
-        )
-    else:
-        lo, hi = rotor_range(ctrl, par)
-        for j in range(N_ROTORS):
-            cmd[j] = affine_map(a[j], lo, hi)
+__all__ = [
+    "ACT_CTBR",
+    "ACT_ROTORS",
+    "B_ACTIVE",
+    "B_HOLD",
+    "B_HOLD_P",
+    "B_HOLD_T",
+    "B_H_REF",
+    "B_INEXACT",
+    "B_LEVEL_N",
+    "B_LEVEL_P",
+    "B_LEVEL_T",
+    "B_OUTCOME",
+    "B_POLICY",
+    "B_RETURN",
+    "B_STAGE",
+    "B_STEPS",
+    "B_X_REF",
+    "B_Y_REF",
+    "EP_ACTION",
+    "EP_END_ON_RECOVERY",
+    "EP_FAIL_REMAINING",
+    "EP_GROUND",
+    "EP_HOLD_TICKS",
+    "EP_MAX_DIST",
+    "EP_MAX_DROP",
+    "EP_MAX_RATE",
+    "EP_MAX_TILT_COS",
+    "EP_OBSERVE",
+    "EP_OBS_CLIP",
+    "EP_OBS_F",
+    "EP_OBS_POS",
+    "EP_OBS_T",
+    "EP_OBS_V",
+    "EP_OBS_W",
+    "EP_RATE_MAX",
+    "EP_S_HEIGHT",
+    "EP_S_RATE",
+    "EP_S_VZ",
+    "EP_W_EFFORT",
+    "EP_W_FAILURE",
+    "EP_W_HEIGHT",
+    "EP_W_RATE",
+    "EP_W_RECOVERY",
+    "EP_W_TILT",
+    "EP_W_VZ",
+    "EP_ZERO_LOW",
+    "Env",
+    "NB",
+    "NPAR",
+    "N_OBS_ESTIMATE",
+    "N_OBS_IMU",
+    "N_OBS_STATE",
+    "OBS_ESTIMATE",
+    "OBS_EST_BIAS",
+    "OBS_EST_F",
+    "OBS_EST_POS",
+    "OBS_EST_RATE",
+    "OBS_EST_ROTOR",
+    "OBS_EST_VEL",
+    "OBS_IMU",
+    "OBS_STATE",
+    "OC_ALTITUDE",
+    "OC_DISTANCE",
+    "OC_FAILED",
+    "OC_GROUND",
+    "OC_RATE",
+    "OC_RECOVERED",
+    "OC_RUNNING",
+    "OC_TILT",
+    "OC_TIME_LIMIT",
+    "action_command",
+    "affine_inverse",
+    "affine_map",
+    "cost_rate",
+    "envelope_outcome",
+    "level_and_recovered",
+    "level_test",
+    "max_cost_rate",
+    "max_thrust",
+    "measurement_from_estimate",
+    "n_observations",
+    "observe",
+    "observe_estimate",
+    "recovered_condition",
+    "reset_slot",
+    "rotor_range",
+    "staged_actions",
+    "staged_policy",
+    "step_batch",
+    "takeover_stage",
+    "tick_measurement",
+]
 
 
 # ---------------------------------------------------------------- observer
@@ -398,201 +370,6 @@ def _observe_stages(env: np.ndarray, stats: np.ndarray, mem: np.ndarray, par: np
         stage = STAGE_RECOVERED
     env[B_STAGE] = stage
     mem[MEM_STAGE] = stage
-
-
-@allocating
-def tick_measurement(m: Model, d: Data, tmeas: np.ndarray) -> None:
-    """What a controller sees at the next tick: ``d.meas`` with the estimate of that tick.
-
-    The state is renormalised on a copy, as ``step.tick`` renormalises it
-    before the estimator runs (the same arithmetic, so the same bits), and the
-    estimate written by the estimator stage (``estimators.write_estimate``, through
-    the one writer of the measurement record).
-    """
-    tmeas[:] = d.meas
-    x = d.x.copy()
-    normalise_quaternion(x, X_QUAT)
-    write_estimate(d.ls[LS_T0] + int(d.ls[LS_K]) * m.opts[O_DT_CONTROL], x, m, d, tmeas)
-
-
-# ---------------------------------------------------------------- observation, reward
-@compiled
-def _clip(v: float, c: float) -> float:
-    if not v == v:  # NaN (a failed run)
-        return 0.0
-    return min(max(v, -c), c)
-
-
-@allocating
-def observe(
-    tmeas: np.ndarray,
-    rin: np.ndarray,
-    ctrl: np.ndarray,
-    par: np.ndarray,
-    env: np.ndarray,
-    obs: np.ndarray,
-) -> None:
-    """The normalised observation of a tick (layouts in docs/LEARNING.md)."""
-    x = tmeas[MS_X : MS_X + NX]
-    C = np.empty((3, 3))
-    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
-    clip = par[EP_OBS_CLIP]
-    vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
-    detected = tmeas[MS_DETECTED] > 0.5
-    since = tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0
-    lo, hi = rotor_range(ctrl, par)
-    h = 0.5 * (hi - lo)
-    if int(par[EP_OBSERVE]) == OBS_ESTIMATE:
-        observe_estimate(tmeas, par, obs)
-        return
-    if int(par[EP_OBSERVE]) == OBS_STATE:
-        obs[0] = _clip(x[X_POS] / par[EP_OBS_POS], clip)
-        obs[1] = _clip((x[X_POS + 1] - env[B_Y_REF]) / par[EP_OBS_POS], clip)
-        obs[2] = _clip((-x[X_POS + 2] - env[B_H_REF]) / par[EP_OBS_POS], clip)
-        for i in range(3):
-            obs[3 + i] = _clip(x[X_VEL + i] / par[EP_OBS_V], clip)
-        sign = -1.0 if x[X_QUAT] < 0.0 else 1.0
-        for i in range(4):
-            obs[6 + i] = _clip(sign * x[X_QUAT + i], clip)
-        for i in range(3):
-            obs[10 + i] = _clip(x[X_OMEGA + i] / par[EP_OBS_W], clip)
-        for j in range(N_ROTORS):
-            obs[13 + j] = _clip((x[X_ROTOR + j] - lo) / h - 1.0, clip)
-        obs[17] = _clip(since / par[EP_OBS_T], clip)
-        obs[18] = 1.0 if detected else 0.0
-        return
-    for i in range(3):
-        obs[i] = _clip(tmeas[MS_IMU_F + i] / par[EP_OBS_F], clip)
-        obs[3 + i] = _clip(tmeas[MS_IMU_W + i] / par[EP_OBS_W], clip)
-    for r in range(3):
-        for c in range(3):
-            obs[6 + 3 * r + c] = _clip(C[r, c], clip)
-    obs[15] = _clip(-vz / par[EP_OBS_V], clip)
-    obs[16] = _clip(since / par[EP_OBS_T], clip)
-    obs[17] = 1.0 if detected else 0.0
-    obs[18] = _clip(tmeas[MS_NORMAL], clip)
-    obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
-    for j in range(N_ROTORS):
-        obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
-
-
-@compiled
-def observe_estimate(tmeas: np.ndarray, par: np.ndarray, obs: np.ndarray) -> None:
-    """The estimate mode's observation: what an on-board controller sees (docs/LEARNING.md).
-
-    The estimator's output (attitude, body velocity, position, rates, gyro
-    bias), the IMU sample, the detector, the rotor speeds; every value divided
-    by a power of two (so exactly recoverable from the float64 observation),
-    then clipped.
-    """
-    x = tmeas[MS_X : MS_X + NX]
-    clip = par[EP_OBS_CLIP]
-    for i in range(4):
-        obs[i] = _clip(x[X_QUAT + i], clip)
-    for i in range(3):
-        obs[4 + i] = _clip(x[X_VEL + i] / OBS_EST_VEL, clip)
-        obs[7 + i] = _clip(x[X_POS + i] / OBS_EST_POS, clip)
-        obs[10 + i] = _clip(tmeas[MS_W_HAT + i] / OBS_EST_RATE, clip)
-        obs[13 + i] = _clip(tmeas[MS_IMU_F + i] / OBS_EST_F, clip)
-        obs[16 + i] = _clip(tmeas[MS_IMU_W + i] / OBS_EST_RATE, clip)
-        obs[19 + i] = _clip(tmeas[MS_BIAS_HAT + i] / OBS_EST_BIAS, clip)
-    detected = tmeas[MS_DETECTED] > 0.5
-    obs[22] = 1.0 if detected else 0.0
-    obs[23] = _clip(tmeas[MS_T] - tmeas[MS_T_DETECT] if detected else 0.0, clip)
-    obs[24] = _clip(tmeas[MS_NORMAL], clip)
-    obs[25] = _clip(tmeas[MS_NORMAL + 1], clip)
-    for j in range(4):
-        obs[26 + j] = _clip(x[X_ROTOR + j] / OBS_EST_ROTOR, clip)
-
-
-@compiled
-def measurement_from_estimate(obs: np.ndarray, meas: np.ndarray) -> None:
-    """The measurement record an estimate-mode observation stands for (its inverse).
-
-    Fills what the staged controller reads: the state estimate, the estimated
-    rates and bias, the IMU sample, the detector's verdict and normal.
-    """
-    meas[:] = 0.0
-    for i in range(4):
-        meas[MS_X + X_QUAT + i] = obs[i]
-    for i in range(3):
-        meas[MS_X + X_VEL + i] = obs[4 + i] * OBS_EST_VEL
-        meas[MS_X + X_POS + i] = obs[7 + i] * OBS_EST_POS
-        meas[MS_X + X_OMEGA + i] = obs[10 + i] * OBS_EST_RATE
-        meas[MS_W_HAT + i] = obs[10 + i] * OBS_EST_RATE
-        meas[MS_IMU_F + i] = obs[13 + i] * OBS_EST_F
-        meas[MS_IMU_W + i] = obs[16 + i] * OBS_EST_RATE
-        meas[MS_BIAS_HAT + i] = obs[19 + i] * OBS_EST_BIAS
-    meas[MS_DETECTED] = obs[22]
-    meas[MS_T_DETECT] = 0.0 if obs[22] > 0.5 else np.nan
-    meas[MS_T] = obs[23]
-    meas[MS_NORMAL] = obs[24]
-    meas[MS_NORMAL + 1] = obs[25]
-    for j in range(4):
-        meas[MS_X + X_ROTOR + j] = obs[26 + j] * OBS_EST_ROTOR
-
-
-@allocating
-def cost_rate(
-    x: np.ndarray,
-    rin: np.ndarray,
-    veh: np.ndarray,
-    ctrl: np.ndarray,
-    par: np.ndarray,
-    h_ref: float,
-) -> float:
-    """Weighted cost per second of a state and the command in force (each term in [0, 1])."""
-    q1 = x[X_QUAT + 1]
-    q2 = x[X_QUAT + 2]
-    n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
-    c22 = 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2  # cos of the tilt from vertical
-    tilt = 0.5 * (1.0 - c22)
-    w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
-    rate = min(w / par[EP_S_RATE], 1.0)
-    C = np.empty((3, 3))
-    rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
-    vz = C[2, 0] * x[X_VEL] + C[2, 1] * x[X_VEL + 1] + C[2, 2] * x[X_VEL + 2]
-    vert = min(abs(vz) / par[EP_S_VZ], 1.0)
-    height = min(max(h_ref + x[X_POS + 2], 0.0) / par[EP_S_HEIGHT], 1.0)
-    hover = math.sqrt(veh[V_MASS] * veh[V_GRAVITY] / (4.0 * veh[V_KT]))
-    span = ctrl[C_OMEGA_MAX] - ctrl[C_OMEGA_MIN]
-    effort = 0.0
-    for j in range(N_ROTORS):
-        d = (rin[RIN_CMD + j] - hover) / span
-        effort += 0.25 * d * d
-    effort = min(effort, 1.0)
-    total = (
-        par[EP_W_TILT] * tilt
-        + par[EP_W_RATE] * rate
-        + par[EP_W_VZ] * vert
-        + par[EP_W_HEIGHT] * height
-        + par[EP_W_EFFORT] * effort
-    )
-    return total if total == total else max_cost_rate(par)
-
-
-@compiled
-def max_cost_rate(par: np.ndarray) -> float:
-    """The largest cost per second (every term at 1)."""
-    return par[EP_W_TILT] + par[EP_W_RATE] + par[EP_W_VZ] + par[EP_W_HEIGHT] + par[EP_W_EFFORT]
-
-
-@compiled
-def envelope_outcome(x: np.ndarray, env: np.ndarray, par: np.ndarray) -> int:
-    """``OC_*`` of the first envelope limit the state breaks (``OC_RUNNING``: none)."""
-    q1 = x[X_QUAT + 1]
-    q2 = x[X_QUAT + 2]
-    n2 = x[X_QUAT] ** 2 + q1 * q1 + q2 * q2 + x[X_QUAT + 3] ** 2
-    if 1.0 - 2.0 * (q1 * q1 + q2 * q2) / n2 < par[EP_MAX_TILT_COS]:
-        return OC_TILT
-    if -x[X_POS + 2] < env[B_H_REF] - par[EP_MAX_DROP]:
-        return OC_ALTITUDE
-    if math.hypot(x[X_POS] - env[B_X_REF], x[X_POS + 1] - env[B_Y_REF]) > par[EP_MAX_DIST]:
-        return OC_DISTANCE
-    w = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
-    if w > par[EP_MAX_RATE]:
-        return OC_RATE
-    return OC_RUNNING
 
 
 # ---------------------------------------------------------------- reset and step
