@@ -25,12 +25,9 @@ from quadimpact.simulation.metrics import (
     RunImpacts,
     Table,
     episode_lists,
-    impacts_in,
+    impacts_of_table,
     n_rows,
 )
-
-EPISODE_COLUMNS_USED = ("bumper", "surface", "t_start_s", "t_end_s", "peak_force_n")
-"""The episode columns the impacts after the detection are found from."""
 
 __all__ = [
     "RECOVERY_KEYS",
@@ -251,14 +248,9 @@ def recovery_metrics(
     out["max_tilt_deg"] = math.degrees(math.acos(min(max(float(st[L.ST_MIN_TILT_COS]), -1.0), 1.0)))
     out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
     # impacts (grazes excluded, obstacles only) that start after the detection
-    if impacts is not None:
-        starts = impacts.start_s
-    elif n_rows(episodes):
-        cols = episode_lists(episodes, EPISODE_COLUMNS_USED)
-        others = sorted(set(cols["surface"]) - set(obstacle_names))
-        _rows, _, groups = impacts_in(cols, others, GRAZE_IMPULSE_FRACTION)
-        starts = [min(cols["t_start_s"][k] for k in g) for g in groups]
-    else:
-        starts = []
+    if impacts is None and n_rows(episodes):
+        others = sorted(set(episode_lists(episodes, ("surface",))["surface"]) - set(obstacle_names))
+        impacts = impacts_of_table(episodes, others, GRAZE_IMPULSE_FRACTION)
+    starts = impacts.start_s if impacts is not None else []
     out["impacts_after_detection"] = sum(1 for t in starts if t > t_detect)
     return out
