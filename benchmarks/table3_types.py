@@ -16,7 +16,7 @@ switches) it runs the matched scenario as made, then one change at a time:
   segment's start (F = 0, the authors' reading). A segment runs from one of
   the log's motor samples, the motor still running, to the next, which reads
   it off: the log puts the switch-off anywhere in the segment, F = 1 being
-  the latest (``experiments.table3.offs_within_segment``);
+  the latest (``experiments.switch_runs.offs_within_segment``);
 * ``roll/pitch/heading +/-D deg``, ``speed +/-0.1 m/s``: the matched
   conditions moved (the heading as ``yaw_from_wall_normal_deg``).
 
@@ -36,7 +36,7 @@ import pandas as pd
 
 from quadimpact import simulate
 from quadimpact.experiments.crashes import MATCHED_CONTACT_TIME_S, TABLE3, Crash
-from quadimpact.experiments.table3 import offs_within_segment
+from quadimpact.experiments.switch_runs import offs_within_segment
 from quadimpact.simulation.response_types import closest_chaining
 
 VARIANTS = ("default", "paper-replica")

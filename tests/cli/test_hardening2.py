@@ -282,7 +282,7 @@ def test_run_has_flags_for_an_impact_trial_and_controller_parameters() -> None:
 # ------------------------------------------------------------------ item 16
 def test_the_flight_log_folder_used_is_said(tmp_path, monkeypatch) -> None:
     from quadimpact.experiments import logs
-    from quadimpact.experiments.table3 import logs_source
+    from quadimpact.experiments.crash_logs import logs_source
 
     data = tmp_path / "data"
     (data / "spiri-crash-set-1").mkdir(parents=True)

@@ -5,13 +5,13 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.experiments.crashes import TABLE3, scenario_file
-from quadimpact.experiments.table3 import (
+from quadimpact.experiments.crash_logs import (
     LOG_RANGE_SIGMAS,
     log_conditions,
     log_sensitivity_spec,
     read_log,
 )
+from quadimpact.experiments.crashes import TABLE3, scenario_file
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.simulation import simulate
 

@@ -5,12 +5,11 @@ import math
 import pandas as pd
 import pytest
 
-from quadimpact.experiments.crashes import TABLE3, scenario_file
+from quadimpact.experiments.crashes import SWITCH_CHANGES, TABLE3, scenario_file
 from quadimpact.experiments.logs import data_dir
 from quadimpact.experiments.table3 import (
     EXTRA_COLUMNS,
     RUN_COLUMNS,
-    SWITCH_CHANGES,
     SWITCH_COLUMNS,
     TABLE3_COLUMNS,
     run_experiments,

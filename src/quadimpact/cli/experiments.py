@@ -72,7 +72,8 @@ def experiments(
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "experiments")  # before the study's imports: a wrong folder is said at once
-    from quadimpact.experiments.table3 import check_data_dir, logs_source, run_experiments
+    from quadimpact.experiments.crash_logs import check_data_dir, logs_source
+    from quadimpact.experiments.table3 import run_experiments
 
     if data is not None:
         check_data_dir(data)

@@ -70,7 +70,7 @@ def reproduce(
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "report")  # before the study's imports: a wrong folder is said at once
-    from quadimpact.experiments.table3 import check_data_dir, logs_source
+    from quadimpact.experiments.crash_logs import check_data_dir, logs_source
     from quadimpact.paper.study import reproduce as run_study
 
     if data is not None and not no_experiments:

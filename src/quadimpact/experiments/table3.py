@@ -10,17 +10,17 @@ and compares each run with its flight log where the log is available
 matched conditions it also runs the replica with each of its crash-run
 switches off in turn, crash I-03's hand modification on, and both variants
 with a zero scheduled rate read the old way (the motor held, not switched
-off): what each changes. A sensitivity sweep over Table III's stated
-uncertainty (heading +- 6.4 deg, speed +- 0.01 m/s, inclination +- its own,
-uniform, seeded) gives the share of each response type at the nominal
-conditions.
+off): what each changes (the changes: :mod:`quadimpact.experiments.switch_runs`).
+A sensitivity sweep over Table III's stated uncertainty (heading +- 6.4 deg,
+speed +- 0.01 m/s, inclination +- its own, uniform, seeded) gives the share of
+each response type at the nominal conditions.
 
 Where the log shows the wall contact, the crash is also simulated at the
 log's own pre-impact estimates (heading, speed at the contact, roll and pitch
 from the motion capture, :meth:`FlightLog.pre_impact`): once at the estimates
 and over their uncertainty (uniform within ``LOG_RANGE_SIGMAS`` standard
-uncertainties). The log's own response type (classified from its motion) is
-given too.
+uncertainties; the logs' part: :mod:`quadimpact.experiments.crash_logs`). The
+log's own response type (classified from its motion) is given too.
 
 It writes ``table3.csv`` (one row per crash; the stable interface:
 ``TABLE3_COLUMNS``, then ``EXTRA_COLUMNS``), ``table3_runs.csv`` (one row per
@@ -44,20 +44,23 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from quadimpact.experiments.crash_logs import (
+    LOG_SENSITIVITY_RUNS,
+    check_data_dir,
+    log_conditions,
+    log_sensitivity_spec,
+    read_log,
+)
 from quadimpact.experiments.crashes import (
     CONDITIONS,
-    HAND_MODIFICATION,
     HEADING_UNCERTAINTY_DEG,
-    REPLICA_CRASH_SWITCHES,
     SPEED_UNCERTAINTY_M_S,
-    SWITCH_CHANGES,
     TABLE3,
     VARIANTS,
     Crash,
     scenario_file,
     scenario_path,
 )
-from quadimpact.experiments.logs import PreImpact, data_dir
 from quadimpact.experiments.report import (  # noqa: F401 (the verdict rule, here as before)
     CHAINING_NOTE_MS,
     MOTION_RMS_DEG,
@@ -67,16 +70,12 @@ from quadimpact.experiments.report import (  # noqa: F401 (the verdict rule, her
     table3_markdown,
 )
 from quadimpact.experiments.spiri_mat import SpiriMatLog
-from quadimpact.inputs.files import read_toml_file
+from quadimpact.experiments.switch_runs import switch_changes
 from quadimpact.simulation import simulate
 from quadimpact.simulation.response_types import RESPONSE_TYPES, closest_chaining
 from quadimpact.sweep import SweepSpec, run_sweep
 
 SENSITIVITY_RUNS = 300  # per crash
-#: Runs per crash over the log estimates' uncertainty.
-LOG_SENSITIVITY_RUNS = 100
-#: Half-width of the log-conditions sample, in standard uncertainties.
-LOG_RANGE_SIGMAS = 2.0
 TABLE3_COLUMNS = (
     "crash",
     "heading_deg",
@@ -177,7 +176,6 @@ SWITCH_COLUMNS = (
     "contact_altitude_m", "contact_climb_m_s", "contact_drift_m_s", "contact_inclination_deg",
     "contact_after_start_s", "attitude_rms_deg_0_3s", "position_rms_mm_0_3s",
 )  # fmt: skip
-_LOG_FIELDS = ("heading_deg", "speed_m_s", "roll_deg", "pitch_deg")
 
 
 def sensitivity_spec(crash: Crash, n: int = SENSITIVITY_RUNS) -> SweepSpec:
@@ -203,122 +201,6 @@ def _shares(sweep: pd.DataFrame, prefix: str) -> dict[str, float]:
     """Share of each response type among a sweep's runs, as ``{prefix + type: share}``."""
     counts = sweep["response_type"].value_counts()
     return {f"{prefix}{t}": float(counts.get(t, 0)) / len(sweep) for t in RESPONSE_TYPES}
-
-
-def check_data_dir(data: str | Path | None, where: str = "--data") -> Path | None:
-    """The data folder to read the logs from, checked before any work.
-
-    Parameters
-    ----------
-    data : path or None
-        A folder given explicitly (``--data``): it must hold at least one of
-        the seven crashes' logs, else this is an input error. ``None``: the
-        default folder (:func:`quadimpact.experiments.logs.data_dir`), if any;
-        a ``$QUADIMPACT_DATA`` that holds no logs is said in a warning on
-        stderr (the log columns then stay empty).
-    where : str
-        How the folder was given, for the message.
-
-    Returns
-    -------
-    pathlib.Path or None
-        The folder holding ``spiri-crash-set-1/`` (None: no logs).
-
-    Raises
-    ------
-    InputError
-        A given folder that is absent, is a file or holds none of the logs.
-    """
-    import os
-
-    from quadimpact.errors import InputError
-    from quadimpact.experiments.logs import DATA_ENV_VAR
-
-    logs = [c.log_file for c in TABLE3]
-    if data is None:
-        found = data_dir()
-        env = os.environ.get(DATA_ENV_VAR)
-        if found is None and env:
-            print(f"quadimpact: warning: ${DATA_ENV_VAR}={env} holds none of the crash logs "
-                  f"({logs[0]}, ...): the comparisons with the logs are left out",
-                  file=sys.stderr)  # fmt: skip
-        return found
-    root = Path(data)
-    if not root.exists():
-        raise InputError(f"{where} {root}: no such folder")
-    if not root.is_dir():
-        raise InputError(f"{where} {root}: is a file, not a folder")
-    if any((root / name).is_file() for name in logs):
-        return root
-    if any((root / Path(name).name).is_file() for name in logs):
-        raise InputError(
-            f"{where} {root}: is the crash set's own folder; give the folder that holds it, "
-            f"{root.resolve().parent}"
-        )
-    raise InputError(
-        f"{where} {root}: holds none of the crash logs (expected {logs[0]} ... "
-        f"{Path(logs[-1]).name})"
-    )
-
-
-def logs_source(data: str | Path | None) -> str:
-    """One line saying which folder the flight logs are read from, and how it was found.
-
-    ``data``: the folder given (``--data``), or None for the default search
-    (:func:`quadimpact.experiments.logs.find_data_dir`).
-    """
-    from quadimpact.experiments.logs import find_data_dir
-
-    if data is not None:
-        return f"flight logs read from {Path(data).resolve()} (--data)"
-    found, how = find_data_dir()
-    if found is None:
-        return f"no flight logs: {how}; the comparisons with the logs are left out"
-    return f"flight logs read from {found} (found: {how})"
-
-
-def read_log(crash: Crash, data: str | Path | None = None) -> SpiriMatLog | None:
-    """The crash's flight log, None where the data folder or the file is absent."""
-    root = Path(data) if data is not None else data_dir()
-    if root is None or not (root / crash.log_file).is_file():
-        return None
-    return SpiriMatLog(root / crash.log_file)
-
-
-def log_conditions(crash: Crash, pre: PreImpact) -> dict[str, Any] | None:
-    """The crash's scenario fields at the log's estimates, None without an observed contact.
-
-    Heading (the log frame, rear first like the scenario, taken within 180 deg
-    of the scenario's), speed toward the wall at the contact, and the measured
-    roll and pitch (explicit attitude: the body z axis need not lie in the
-    X-Z plane). Altitude and motor schedule stay the scenario's.
-    """
-    if not pre.contact_observed:
-        return None
-    psi0 = scenario_file(crash.number).heading_deg
-    psi = psi0 + ((pre.heading_deg - psi0 + 180.0) % 360.0 - 180.0)
-    fields = read_toml_file(scenario_path(crash.number))
-    fields.update(
-        heading_deg=round(psi, 2),
-        speed_m_s=round(pre.speed_m_s, 3),
-        roll_deg=round(pre.roll_deg, 2),
-        pitch_deg=round(pre.pitch_deg, 2),
-    )
-    return fields
-
-
-def log_sensitivity_spec(
-    crash: Crash, pre: PreImpact, n: int = LOG_SENSITIVITY_RUNS
-) -> SweepSpec | None:
-    """Uniform sample within ``LOG_RANGE_SIGMAS`` standard uncertainties of the log's estimates."""
-    base = log_conditions(crash, pre)
-    if base is None:
-        return None
-    ranges = {}
-    for name in _LOG_FIELDS:
-        half = LOG_RANGE_SIGMAS * pre.uncertainty[name]
-        ranges[name] = [base[name] - half, base[name] + half]
-    return SweepSpec(base=base, sample={"n": n, "seed": 100 + crash.number, "ranges": ranges})
 
 
 def _log_row(
@@ -437,108 +319,6 @@ def _mm(x: float | None) -> float:
     return math.nan if x is None else 1e3 * x
 
 
-#: The earlier reading of the schedules: a motor whose rates never exceed this
-#: (rpm/s) stalled at the impact; any other zero rate held the motor's speed.
-HELD_STALL_RPM_PER_S = 100.0
-
-
-def _zero_rate_held(scenario: Any) -> Any:
-    """The scenario with its schedule read the earlier way: a zero rate holds the motor's
-    speed, and a motor whose rates never exceed ``HELD_STALL_RPM_PER_S`` stops at the
-    trigger (``stopped_motors``), unless the run cuts it at the next tick
-    (``cut_step_motors``: the cut is the switch's, not the reading's)."""
-    po = scenario.power_off
-    rates = po.rates_rpm_per_s
-    cut = scenario.resolved_model_options().cut_step_motors
-    quiet = [all(abs(r[j]) <= HELD_STALL_RPM_PER_S for r in rates) for j in range(4)]
-    stalled = tuple(j + 1 for j in range(4) if quiet[j] and j + 1 not in cut)
-    held = po.model_copy(update={"zero_rate": "hold", "stopped_motors": stalled})
-    return scenario.model_copy(update={"power_off": held})
-
-
-#: A held rate in :func:`offs_within_segment`: not exactly 0, so not a switch-off.
-HELD_RATE_RPM_PER_S = 1e-12
-
-
-def offs_within_segment(power_off: Any, fraction: float) -> Any:
-    """The schedule with each switch-off after the contact moved inside its segment.
-
-    A motor's first zero rate in a segment ``k > 0`` switches it off from the
-    segment's start (the authors' reading). The segment runs from one of the
-    log's motor samples, the motor still running, to the next, which reads it
-    off, so the log puts the switch-off anywhere in it. Here the motor keeps
-    its speed over ``fraction`` of that segment (the last segment: of 0.1 s)
-    and is off after it: 0 is the schedule as given, 1 the latest switch-off
-    the log allows. Zero rates from the first segment (off from the contact)
-    and the other rates are kept; the segments are split where needed.
-    """
-    starts, rates = list(power_off.segment_start_s), power_off.rates_rpm_per_s
-    n = len(starts)
-    off: dict[tuple[int, int], float] = {}  # (motor, its first zero segment) -> switch-off
-    for j in range(4):
-        for k in range(1, n):
-            if rates[k][j] == 0.0 and rates[k - 1][j] != 0.0:
-                end = starts[k + 1] if k + 1 < n else starts[k] + 0.1
-                off[(j, k)] = starts[k] + fraction * (end - starts[k])
-    cuts = sorted(set(starts) | set(off.values()))
-    new = []
-    for t in cuts:
-        k = max(i for i in range(n) if starts[i] <= t)
-        row = []
-        for j in range(4):
-            r = rates[k][j]
-            first = k
-            while r == 0.0 and first > 0 and rates[first - 1][j] == 0.0:
-                first -= 1
-            if r == 0.0 and t < off.get((j, first), -math.inf):
-                r = HELD_RATE_RPM_PER_S
-            row.append(r)
-        new.append(tuple(row))
-    return power_off.model_copy(
-        update={"segment_start_s": tuple(cuts), "rates_rpm_per_s": tuple(new)}
-    )
-
-
-def _switch_changes(crash: Crash, model: str) -> list[tuple[str, Any]]:
-    """The switch runs of a crash in a variant (matched conditions): (change, scenario).
-
-    The changes are those of :data:`SWITCH_CHANGES` that apply to the variant.
-    """
-    from quadimpact.experiments.crashes import MATCHED_APPROACH_OPTIONS
-
-    base = crash.scenario(model, "matched")
-    options = base.model_options.model_dump(exclude_none=True)
-
-    def changed(**fields: Any) -> Any:  # validated again
-        return type(base).model_validate({**base.model_dump(exclude_unset=True), **fields})
-
-    mirrored = changed(heading_deg=180.0 - crash.matched.yaw_from_wall_normal_deg)
-    late = base.model_copy(update={"power_off": offs_within_segment(base.power_off, 1.0)})
-    changes: list[tuple[str, Any]] = [
-        ("zero rate held", _zero_rate_held(base)),
-        ("offs at the segment's end", late),
-    ]
-    if model == "default":
-        own = {k: v for k, v in options.items() if k not in MATCHED_APPROACH_OPTIONS}
-        changes += [
-            ("late start", changed(model_options=own)),
-            ("heading 180 - yaw", mirrored),
-            ("with motor2_cut_step", crash.scenario(model, "matched", ["motor2_cut_step"])),
-            ("with thrust_coefficient", crash.scenario(model, "matched", ["thrust_coefficient"])),
-        ]
-    else:
-        changes.append(("heading 180 - yaw", mirrored))
-        for switch in REPLICA_CRASH_SWITCHES:
-            others = [k for k in REPLICA_CRASH_SWITCHES if k != switch]
-            changes.append((f"without {switch}", crash.scenario(model, "matched", others)))
-        if crash.number == 1:
-            with_hand = [*REPLICA_CRASH_SWITCHES, HAND_MODIFICATION]
-            changes.append((f"with {HAND_MODIFICATION}",
-                            crash.scenario(model, "matched", with_hand)))  # fmt: skip
-    assert all(name in SWITCH_CHANGES for name, _ in changes)
-    return changes
-
-
 def switch_records(
     crash: Crash, log: SpiriMatLog | None, runs: dict[tuple[str, str], Any]
 ) -> list[dict[str, Any]]:
@@ -553,7 +333,7 @@ def switch_records(
     for model in VARIANTS:
         result, comparison = runs[("matched", model)]
         todo: list[tuple[str, Any, Any]] = [("as run", result, comparison)]
-        for change, scenario in _switch_changes(crash, model):
+        for change, scenario in switch_changes(crash, model):
             r = simulate(scenario)
             c = None if log is None else compare(r, log, classify_log=False)
             todo.append((change, r, c))

@@ -250,15 +250,13 @@ def reproduce(
     their logs when ``data_dir`` (or the default data folder) holds them.
     With ``recovery``, "Beyond the paper: recovery" (:func:`recovery_part`).
     """
-    from quadimpact.experiments.table3 import (
+    from quadimpact.experiments.crash_logs import (
         LOG_SENSITIVITY_RUNS,
-        SENSITIVITY_RUNS,
-        TABLE3,
         check_data_dir,
         logs_source,
-        prepare_experiments,
-        write_table3,
     )
+    from quadimpact.experiments.crashes import TABLE3
+    from quadimpact.experiments.table3 import SENSITIVITY_RUNS, prepare_experiments, write_table3
     from quadimpact.results.files import check_out_dir
     from quadimpact.sweep.run import _resolve_workers
     from quadimpact.sweep.tasks import run_tasks
