@@ -62,7 +62,7 @@ from quadimpact.recovery.baselines import (
 )
 from quadimpact.recovery.figures import compare_by_bin_figure
 from quadimpact.recovery.study import RecoveryStudy, run_trials
-from quadimpact.results import figures
+from quadimpact.results import figures, sweep_figures
 from quadimpact.results.costs import cost_ratio
 from quadimpact.simulation import simulate
 from quadimpact.sweep import SweepSpec, run_sweep
@@ -493,7 +493,7 @@ def fig4_figure(table: pd.DataFrame, variant: str) -> Figure:
 
 def type_map_figure(table: pd.DataFrame, variant: str) -> Figure:
     """Table II as a picture: response type over inclination and speed, one panel per heading."""
-    return figures.type_map_figure(
+    return sweep_figures.type_map_figure(
         table, "inclination_deg", "speed_m_s", facet="heading_deg", label=type_label,
         title=f"Table II, {variant}: response type (C/D with the number of subsequent impacts)",
         text_meaning="C3, D4...: the type and the number of subsequent impacts",

@@ -23,7 +23,8 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from quadimpact.errors import InputError
-from quadimpact.results.figures import (
+from quadimpact.results.figures import new_figure, save_figure
+from quadimpact.results.sweep_figures import (
     INVALID_LABEL,
     TYPE_COLOURS,
     check_columns,
@@ -32,8 +33,6 @@ from quadimpact.results.figures import (
     field_unit,
     field_value,
     invalid_runs,
-    new_figure,
-    save_figure,
     sorted_levels,
     type_map_figure,
 )
@@ -42,7 +41,7 @@ from quadimpact.sweep.store import read_runs
 __all__ = ["TYPE_COLORS", "plot_metric", "plot_type_map", "auto_plots"]
 
 TYPE_COLORS = TYPE_COLOURS
-"""The type map's colours (:data:`quadimpact.results.figures.TYPE_COLOURS`)."""
+"""The type map's colours (:data:`quadimpact.results.sweep_figures.TYPE_COLOURS`)."""
 
 MAX_AUTO_RUNS = 50_000
 """``auto_plots`` does nothing for larger sweeps (keep ``quadimpact sweep`` cheap)."""
@@ -142,7 +141,7 @@ def plot_type_map(
     title: str | None = None,
 ) -> Figure:
     """Response type over two fields, one panel per ``facet`` value: the type map
-    (:func:`quadimpact.results.figures.type_map_figure`) of a sweep table, with
+    (:func:`quadimpact.results.sweep_figures.type_map_figure`) of a sweep table, with
     ``n_subsequent_impacts`` in the cells."""
     return type_map_figure(table, x, y, facet, title=title, path=path)
 
