@@ -69,7 +69,7 @@ Worker processes never outlive the sweep, even after ``kill -9``
 from quadimpact.sweep.interrupt import SweepInterrupted
 from quadimpact.sweep.pool import WorkerError
 from quadimpact.sweep.run import LARGE_SWEEP_RUNS, run_sweep
-from quadimpact.sweep.spec import SweepSpec, load_sweep_file, parse_values
+from quadimpact.sweep.spec import SweepSpec, load_sweep_file
 from quadimpact.sweep.store import (
     COST_COLUMNS,
     SUMMARY_COLUMNS,
@@ -77,6 +77,7 @@ from quadimpact.sweep.store import (
     read_runs,
     without_costs,
 )
+from quadimpact.sweep.values import parse_values
 from quadimpact.sweep.worker import run_chunk
 
 __all__ = [

@@ -27,7 +27,8 @@ from typing import Any
 from quadimpact.errors import InputError, one_line
 from quadimpact.results.files import atomic_write
 from quadimpact.results.schema import SUMMARY_KEYS
-from quadimpact.sweep.spec import SweepSpec, canonical, plain
+from quadimpact.sweep.spec import SweepSpec
+from quadimpact.sweep.values import canonical, plain
 
 FLUSH_ROWS = 1024
 """A part file is written when this many completed runs are waiting..."""
