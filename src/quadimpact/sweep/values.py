@@ -132,10 +132,13 @@ def plain(value: Any) -> Any:
 
 
 def canonical(value: Any) -> str:
+    """A plain value's canonical JSON text (keys sorted, no spaces; NaN refused): what a
+    sweep's fingerprint, its equality and the store's keys compare."""
     return json.dumps(value, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
 def is_number(v: Any) -> bool:
+    """Whether ``v`` is an int or a float (not a bool)."""
     return isinstance(v, (int, float)) and not isinstance(v, bool)
 
 
@@ -143,6 +146,8 @@ _PLAIN_TYPES = {bool: "b", int: "f", float: "f", str: "s"}
 
 
 def column_kind(values: Iterable[Any]) -> str:
+    """How a swept field's values are stored in ``runs.parquet``: ``"b"`` booleans,
+    ``"f"`` numbers (as floats), ``"s"`` strings, ``"j"`` anything else (canonical JSON)."""
     values = list(values)
     kinds = {_PLAIN_TYPES.get(t, "?") for t in set(map(type, values))}
     if len(kinds) == 1 and "?" not in kinds:  # plain values of one kind (the fast path)
