@@ -2,6 +2,8 @@
 #   make run    set up .venv (once) and reproduce the paper's study (report in results/paper)
 #   make test   set up .venv (once), install headless Chromium if missing (root only), run the
 #               tests but those marked slow (what CI runs)
+#   make test-avx2 the tests marked pinned again, NumPy's SIMD dispatch limited to AVX2 (CI
+#               runs it after make test: what an AVX2-only CPU computes, checked on any CPU)
 #   make test-all  every test, the slow ones (compiling plug-in kernels, whole studies) included
 #   make lint   ruff check and ruff format --check
 #   make bench  timing benchmark of the compiled core
@@ -13,7 +15,7 @@ STAMP  := $(VENV)/.quadimpact-installed
 
 OUT := results/paper
 
-.PHONY: setup run test test-all lint bench clean browser
+.PHONY: setup run test test-avx2 test-all lint bench clean browser
 
 setup: $(STAMP)
 
@@ -45,6 +47,12 @@ browser:
 
 test: $(STAMP) browser
 	$(BIN)/python -m pytest -m "not slow"
+
+# NumPy picks SVML loops for some ufuncs on AVX-512 CPUs and the C library on AVX2 ones:
+# the pinned numbers must hold on both (quadimpact.libm, tests/test_libm.py).
+test-avx2: $(STAMP)
+	NPY_DISABLE_CPU_FEATURES="$$($(BIN)/python tests/cpu_dispatch.py)" \
+	  $(BIN)/python -m pytest -m "pinned and not slow"
 
 test-all: $(STAMP) browser
 	$(BIN)/python -m pytest

@@ -2,8 +2,8 @@
 relative) of every module, parsed with ``ast``, against the layer order.
 
 1. ``quadimpact.core`` imports nothing of quadimpact outside ``core``; the
-   base modules (``errors``, ``linalg``, ``rotations``) import nothing of
-   quadimpact but ``errors`` and ``linalg`` (the package root and ``_legacy``
+   base modules (``errors``, ``libm``, ``linalg``, ``rotations``) import nothing of
+   quadimpact but ``errors``, ``libm`` and ``linalg`` (the package root and ``_legacy``
    nothing but ``_legacy``);
 2. no import cycle between modules anywhere in the package;
 3. no module imports a layer above its own (:data:`LAYERS`, lowest first);
@@ -35,6 +35,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
         (
             "quadimpact.core",
             "quadimpact.errors",
+            "quadimpact.libm",
             "quadimpact.linalg",
             "quadimpact.rotations",
             "quadimpact._legacy",
@@ -55,8 +56,9 @@ BASE_ALLOWED: dict[str, tuple[str, ...]] = {
     "quadimpact": ("quadimpact._legacy",),
     "quadimpact._legacy": (),
     "quadimpact.errors": (),
+    "quadimpact.libm": (),
     "quadimpact.linalg": (),
-    "quadimpact.rotations": ("quadimpact.errors", "quadimpact.linalg"),
+    "quadimpact.rotations": ("quadimpact.errors", "quadimpact.libm", "quadimpact.linalg"),
 }
 
 

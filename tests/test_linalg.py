@@ -14,7 +14,19 @@ import sys
 import numpy as np
 import pytest
 
-from quadimpact.linalg import dot, inverse, lu_factor, lu_solve, matvec, matvec_t, norm, solve
+from quadimpact.linalg import (
+    dot,
+    inverse,
+    lstsq,
+    lu_factor,
+    lu_solve,
+    matvec,
+    matvec_t,
+    norm,
+    solve,
+)
+
+pytestmark = pytest.mark.pinned  # CI runs these again under NumPy's AVX2 dispatch
 
 
 def test_solve_and_inverse_agree_with_lapack_to_rounding():
@@ -102,6 +114,27 @@ def test_one_vector_products_with_python_floats_are_the_array_path_bit_for_bit()
     for i in range(500):
         single = matvec(m[i].copy(), b[i].copy())
         assert single.shape == (3,) and single.tobytes() == stacked[i].tobytes()
+
+
+def test_least_squares_fits_exact_data_exactly_and_agrees_with_lapack():
+    """Exact data give the polynomial back; noisy data the LAPACK solution and
+    ``(A^T A)^-1`` to rounding; a dependent column (all zeros: the fit's
+    change-point column before the change) gets 0, as LAPACK's minimum-norm solution."""
+    t = np.linspace(-0.3, 0.0, 31)
+    a = np.vander(t, 3)
+    coef, _ = lstsq(a, 2.0 * t**2 - 0.5 * t + 1.25)
+    assert np.allclose(coef, [2.0, -0.5, 1.25], rtol=1e-12, atol=1e-12)
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        tt = np.sort(rng.uniform(-0.4, 0.0, 40))
+        a = np.vander(tt, 4)
+        y = rng.standard_normal(40)
+        coef, g = lstsq(a, y)
+        assert np.allclose(coef, np.linalg.lstsq(a, y, rcond=None)[0], rtol=1e-9, atol=1e-9)
+        assert np.allclose(g, np.linalg.inv(a.T @ a), rtol=1e-7, atol=1e-9)
+    a = np.column_stack([np.ones(20), t[:20], np.zeros(20)])
+    coef, g = lstsq(a, rng.standard_normal(20))
+    assert coef[2] == 0.0 and (g[2] == 0.0).all() and (g[:, 2] == 0.0).all()
 
 
 _SUMMARY = """

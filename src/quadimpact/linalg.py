@@ -24,7 +24,18 @@ from typing import NamedTuple
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["LU", "dot", "inverse", "lu_factor", "lu_solve", "matvec", "matvec_t", "norm", "solve"]
+__all__ = [
+    "LU",
+    "dot",
+    "inverse",
+    "lstsq",
+    "lu_factor",
+    "lu_solve",
+    "matvec",
+    "matvec_t",
+    "norm",
+    "solve",
+]
 
 
 def solve(a: ArrayLike, b: ArrayLike) -> np.ndarray:
@@ -188,3 +199,85 @@ def matvec(m: ArrayLike, v: ArrayLike) -> np.ndarray:
 def matvec_t(m: ArrayLike, v: ArrayLike) -> np.ndarray:
     """``M^T v`` for matrices ``(..., r, c)`` and vectors ``(..., r)``."""
     return matvec(np.swapaxes(np.asarray(m, dtype=np.float64), -1, -2), v)
+
+
+def lstsq(a: ArrayLike, y: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Least squares ``min |A c - y|`` and ``(A^T A)^-1``, by modified Gram-Schmidt.
+
+    For the small fits of the flight logs (``m`` samples of a few columns):
+    the columns of ``A`` are orthogonalised one after the other (``A = Q R``),
+    ``y`` is projected on them in the same order, and ``R c = Q^T y`` is solved
+    by back substitution, every sum in index order. A column that is (to
+    ``max(m, n) * eps`` of its norm) a combination of the earlier ones is
+    left out, its coefficient 0, as LAPACK's minimum-norm solution does for an
+    exactly dependent column (for instance a column of zeros).
+
+    Parameters
+    ----------
+    a : array_like, shape (m, n)
+        The design matrix.
+    y : array_like, shape (m,)
+        The observations.
+
+    Returns
+    -------
+    coef : numpy.ndarray, shape (n,)
+        The coefficients.
+    gram_inverse : numpy.ndarray, shape (n, n)
+        ``(A^T A)^-1`` (``R^-1 R^-T``), rows and columns of left-out columns 0;
+        times the residual variance it is the coefficients' covariance.
+    """
+    a = np.asarray(a, dtype=np.float64)
+    b = np.array(y, dtype=np.float64)
+    m, n = a.shape
+    q = np.zeros((n, m))
+    r = np.zeros((n, n))
+    kept: list[int] = []
+    for j in range(n):
+        v = a[:, j].copy()
+        size = math.sqrt(_sum_sq(v))
+        for i in kept:
+            r[i, j] = _sum_prod(q[i], v)
+            v = v - r[i, j] * q[i]
+        r_jj = math.sqrt(_sum_sq(v))
+        if r_jj <= max(m, n) * np.finfo(np.float64).eps * size or r_jj == 0.0:
+            continue  # dependent on the earlier columns: left out
+        r[j, j] = r_jj
+        q[j] = v / r_jj
+        kept.append(j)
+    c = np.zeros(n)
+    for i in kept:
+        c[i] = _sum_prod(q[i], b)
+        b = b - c[i] * q[i]
+    coef = np.zeros(n)
+    for i in reversed(kept):
+        s = c[i]
+        for k in kept:
+            if k > i:
+                s -= r[i, k] * coef[k]
+        coef[i] = s / r[i, i]
+    # R^-1 of the kept columns, then R^-1 R^-T
+    r_inv = np.zeros((n, n))
+    for col in kept:
+        for i in reversed(kept):
+            if i > col:
+                continue
+            s = 1.0 if i == col else 0.0
+            for k in kept:
+                if i < k <= col:
+                    s -= r[i, k] * r_inv[k, col]
+            r_inv[i, col] = s / r[i, i]
+    gram_inverse = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            gram_inverse[i, j] = _float_dot(r_inv[i].tolist(), r_inv[j].tolist())
+    return coef, gram_inverse
+
+
+def _sum_prod(a: np.ndarray, b: np.ndarray) -> float:
+    """``sum(a * b)`` of two float64 vectors: NumPy's pairwise sum, the same on every CPU."""
+    return float(np.add.reduce(a * b))
+
+
+def _sum_sq(a: np.ndarray) -> float:
+    return _sum_prod(a, a)

@@ -25,6 +25,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from quadimpact import libm
 from quadimpact.linalg import dot, matvec, norm
 
 __all__ = [
@@ -204,10 +205,10 @@ def quat_to_euler_zyx(
     c21, c22 = c[..., 2, 1], c[..., 2, 2]
     c01, c11 = c[..., 0, 1], c[..., 1, 1]
     cos_pitch = np.hypot(c00, c10)
-    pitch = np.arctan2(-c20, cos_pitch)
+    pitch = libm.arctan2(-c20, cos_pitch)
     locked = cos_pitch < GIMBAL_LOCK_COS
-    roll = np.where(locked, 0.0, np.arctan2(c21, c22))
-    yaw = np.where(locked, np.arctan2(-c01, c11), np.arctan2(c10, c00))
+    roll = np.where(locked, 0.0, libm.arctan2(c21, c22))
+    yaw = np.where(locked, libm.arctan2(-c01, c11), libm.arctan2(c10, c00))
     return wrap_angle_rad(roll), pitch, wrap_angle_rad(yaw)
 
 
@@ -234,11 +235,11 @@ def matrix_to_euler_zyx(
     """
     (c00, c01, _), (c10, c11, _), (c20, c21, c22) = C.tolist()
     cos_pitch = np.hypot(c00, c10)
-    pitch = np.arctan2(-c20, cos_pitch)
+    pitch = libm.arctan2(-c20, cos_pitch)
     if cos_pitch < GIMBAL_LOCK_COS:
-        roll, yaw = 0.0, float(np.arctan2(-c01, c11))
+        roll, yaw = 0.0, float(libm.arctan2(-c01, c11))
     else:
-        roll, yaw = float(np.arctan2(c21, c22)), float(np.arctan2(c10, c00))
+        roll, yaw = float(libm.arctan2(c21, c22)), float(libm.arctan2(c10, c00))
     return np.asarray(_wrap_one(roll)), pitch, np.asarray(_wrap_one(yaw))
 
 
@@ -382,9 +383,9 @@ def matrix_to_euler_zyx_deg(
     yaw in [-180, 180] as ``atan2`` gives them.
     """
     C = np.asarray(C, dtype=np.float64)
-    roll = np.degrees(np.arctan2(C[..., 2, 1], C[..., 2, 2]))
-    pitch = np.degrees(np.arctan2(-C[..., 2, 0], np.hypot(C[..., 0, 0], C[..., 1, 0])))
-    yaw = np.degrees(np.arctan2(C[..., 1, 0], C[..., 0, 0]))
+    roll = np.degrees(libm.arctan2(C[..., 2, 1], C[..., 2, 2]))
+    pitch = np.degrees(libm.arctan2(-C[..., 2, 0], np.hypot(C[..., 0, 0], C[..., 1, 0])))
+    yaw = np.degrees(libm.arctan2(C[..., 1, 0], C[..., 0, 0]))
     return roll, pitch, yaw
 
 
@@ -395,14 +396,14 @@ def inclination_deg(C: ArrayLike) -> NDArray[np.float64]:
     the inertial Z axis; positive when the vehicle leans toward +X (the wall).
     """
     C = np.asarray(C, dtype=np.float64)
-    return np.degrees(np.arctan2(-C[..., 0, 2], C[..., 2, 2]))
+    return np.degrees(libm.arctan2(-C[..., 0, 2], C[..., 2, 2]))
 
 
 def matrix_to_rotvec(R: ArrayLike) -> NDArray[np.float64]:
     """Rotation vectors (axis times angle, rad) of rotation matrices, shape (..., 3)."""
     R = np.asarray(R, dtype=np.float64)
     cos = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-    ang = np.arccos(cos)
+    ang = libm.arccos(cos)
     v = np.stack(
         [R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0], R[..., 1, 0] - R[..., 0, 1]],
         -1,

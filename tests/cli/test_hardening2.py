@@ -294,5 +294,6 @@ def test_the_flight_log_folder_used_is_said(tmp_path, monkeypatch) -> None:
     from quadimpact.cli.experiments import experiments
 
     data_help = next(p.help for p in experiments.params if p.name == "data")
-    assert "$QUADIMPACT_DATA" in data_help and "/work/shared/data" in data_help
+    assert "$QUADIMPACT_DATA" in data_help and "../shared/data" in data_help
+    assert "/work" not in data_help  # no machine's own path
     assert "The folder used is printed" in data_help

@@ -34,8 +34,9 @@ from quadimpact.cli.options import (
 @data_option(
     "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
     "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
-    "shared/data beside the checkout's folder, else /work/shared/data; without logs the "
-    "comparisons with them are left out] The folder used is printed."
+    "shared/data or ../shared/data under the working folder, else ../shared/data beside "
+    "the source checkout; without logs the comparisons with them are left out] The folder "
+    "used is printed."
 )
 @parallel_options
 def reproduce(

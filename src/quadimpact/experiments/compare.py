@@ -46,8 +46,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from quadimpact import libm
 from quadimpact.experiments.estimation import MOCAP_GAP_S, bumper_rim_extent
 from quadimpact.experiments.logs import FlightLog, PreImpact
+from quadimpact.linalg import norm
 from quadimpact.rotations import quat_to_matrix, unwrap_deg, wrap_angle_deg
 from quadimpact.simulation.response_types import classify_response
 
@@ -563,14 +565,14 @@ def _rotation_error(sim: pd.DataFrame, sel: pd.DataFrame) -> np.ndarray:
     qs = np.column_stack([np.interp(tau, sim["tau_s"], sim[c], left=np.nan, right=np.nan)
                           for c in ("q0", "q1", "q2", "q3")])  # fmt: skip
     ql = sel[["q0", "q1", "q2", "q3"]].to_numpy(dtype=float)
-    qs = qs / np.linalg.norm(qs, axis=1, keepdims=True)
-    ql = ql / np.linalg.norm(ql, axis=1, keepdims=True)
+    qs = qs / norm(qs)[:, None]
+    ql = ql / norm(ql)[:, None]
     # relative rotation conj(q_log) * q_sim; angle = 2 atan2(|vector|, |scalar|) (stable near 0)
     w1, v1 = ql[:, 0], -ql[:, 1:]
     w2, v2 = qs[:, 0], qs[:, 1:]
     w = w1 * w2 - np.sum(v1 * v2, axis=1)
     v = w1[:, None] * v2 + w2[:, None] * v1 + np.cross(v1, v2)
-    err = np.degrees(2.0 * np.arctan2(np.linalg.norm(v, axis=1), np.abs(w)))
+    err = np.degrees(2.0 * libm.arctan2(norm(v), np.abs(w)))
     return err[np.isfinite(err)]
 
 

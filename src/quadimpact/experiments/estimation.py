@@ -19,6 +19,7 @@ import pandas as pd
 
 from quadimpact.experiments.logs import PreImpact
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
+from quadimpact.linalg import dot, lstsq, matvec, norm
 from quadimpact.rotations import inclination_deg, matrix_to_euler_zyx_deg, wrap_angle_deg
 
 __all__ = [
@@ -124,9 +125,9 @@ def bumper_rim_extent(
     m = np.asarray(direction, dtype=float)
     centres = np.einsum("...ij,kj->...ki", C, rotors)  # (..., 4, 3)
     normals = np.einsum("...ij,kj->...ki", C, n)
-    w = m - np.einsum("...k,...ki->...ki", normals @ m, normals)
-    wn = np.linalg.norm(w, axis=-1)
-    return centres @ m + radius * wn  # (w/|w|).m = |w|
+    w = m - np.einsum("...k,...ki->...ki", dot(normals, m), normals)
+    wn = norm(w)
+    return dot(centres, m) + radius * wn  # (w/|w|).m = |w|
 
 
 # ------------------------------------------------------------------ fits
@@ -140,12 +141,11 @@ def segments(t: np.ndarray, gap: float) -> np.ndarray:
 def polyfit_at(t: np.ndarray, y: np.ndarray, deg: int) -> tuple[np.ndarray, np.ndarray]:
     """Least-squares polynomial (np.polyfit order) and its covariance; t already centred."""
     A = np.vander(t, deg + 1)
-    coef, *_ = np.linalg.lstsq(A, y, rcond=None)
-    r = y - A @ coef
+    coef, gram_inverse = lstsq(A, y)
+    r = y - matvec(A, coef)
     dof = max(len(t) - (deg + 1), 1)
-    s2 = float(r @ r) / dof
-    cov = s2 * np.linalg.pinv(A.T @ A)
-    return coef, cov
+    s2 = float(np.add.reduce(r * r)) / dof
+    return coef, s2 * gram_inverse
 
 
 # ------------------------------------------------------------------ the impact
@@ -261,11 +261,11 @@ def locate_contact(
             tau = tf - tc
             A = np.column_stack([np.ones_like(tau), tau, tau**2,
                                  -0.5 * np.maximum(tau, 0.0) ** 2])  # fmt: skip
-            co, *_ = np.linalg.lstsq(A, xf, rcond=None)
-            sse = float(np.sum((xf - A @ co) ** 2))
+            co = lstsq(A, xf)[0]
+            sse = float(np.sum((xf - matvec(A, co)) ** 2))
             if sse0 is None:
-                c0, *_ = np.linalg.lstsq(A[:, :3], xf, rcond=None)
-                sse0 = float(np.sum((xf - A[:, :3] @ c0) ** 2))
+                c0 = lstsq(A[:, :3], xf)[0]
+                sse0 = float(np.sum((xf - matvec(A[:, :3], c0)) ** 2))
             if co[3] < 0:
                 continue
             if best is None or sse < best[1]:

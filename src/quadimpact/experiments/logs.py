@@ -40,6 +40,7 @@ __all__ = [
     "FlightLog",
     "PreImpact",
     "data_dir",
+    "data_search_folders",
     "find_data_dir",
     "rpm_to_rad_s",
 ]
@@ -51,29 +52,43 @@ DATA_ENV_VAR = "QUADIMPACT_DATA"
 
 #: Where the flight logs are looked for without --data, in order (docs/EXPERIMENTS.md).
 DATA_SEARCH = (
-    f"${DATA_ENV_VAR} when set (then only it), else the folder shared/data beside the "
-    "checkout's folder, else /work/shared/data (the project's workspace)"
+    f"${DATA_ENV_VAR} when set (then only it), else shared/data or ../shared/data under "
+    "the working folder, else ../shared/data beside the source checkout quadimpact runs from"
 )
 
 
+def data_search_folders(cwd: Path | None = None) -> list[tuple[Path, str]]:
+    """The folders searched without ``$QUADIMPACT_DATA``, in order, each with how it is named.
+
+    Only folders relative to the working folder ``cwd`` (default: the current
+    one) and, when quadimpact runs from a source checkout (``src/`` layout
+    beside a ``pyproject.toml``), to that checkout: never a fixed path of any
+    machine.
+    """
+    base = Path.cwd() if cwd is None else Path(cwd)
+    folders = [
+        (base / "shared" / "data", "shared/data under the working folder"),
+        (base / ".." / "shared" / "data", "../shared/data beside the working folder"),
+    ]
+    here = Path(__file__).resolve()  # <checkout>/src/quadimpact/experiments/logs.py
+    if len(here.parents) > 3 and (here.parents[3] / "pyproject.toml").is_file():
+        folders.append((here.parents[3] / ".." / "shared" / "data", "beside the checkout"))
+    return folders
+
+
 def find_data_dir() -> tuple[Path | None, str]:
-    """The data folder and how it was found (``$QUADIMPACT_DATA``, beside the checkout...).
+    """The data folder and how it was found (``$QUADIMPACT_DATA``, the folders searched).
 
     In the order of :data:`DATA_SEARCH`; a folder counts only if it holds
     ``spiri-crash-set-1/``. Returns ``(None, why)`` when there is none.
     """
-    candidates: list[tuple[Path, str]] = []
     env = os.environ.get(DATA_ENV_VAR)
     if env:
         p = Path(env).resolve()
         if (p / "spiri-crash-set-1").is_dir():
             return p, f"${DATA_ENV_VAR}"
         return None, f"${DATA_ENV_VAR}={env} holds no spiri-crash-set-1/"
-    here = Path(__file__).resolve()
-    if len(here.parents) > 3:  # .../<checkout>/src/quadimpact/experiments/logs.py
-        candidates.append((here.parents[3] / ".." / "shared" / "data", "beside the checkout"))
-    candidates.append((Path("/work/shared/data"), "the workspace's data folder"))
-    for c, how in candidates:
+    for c, how in data_search_folders():
         c = c.resolve()
         if (c / "spiri-crash-set-1").is_dir():
             return c, how

@@ -296,10 +296,12 @@ class SpiriMatLog(FlightLog):
             return None
         v = self._raw["vicon"]
         t = v["t_raw_s"].to_numpy()
-        p = v[["x_m", "y_m", "z_m"]].to_numpy() @ MOCAP_TO_NED.T
-        C = MOCAP_TO_NED @ quat_xyzw_to_matrix(v[["qx", "qy", "qz", "qw"]].to_numpy())
+        # the products with the diagonal sign matrices as sign flips (exact, and no BLAS)
+        signs = np.diag(MOCAP_TO_NED)
+        p = v[["x_m", "y_m", "z_m"]].to_numpy() * signs  # MOCAP_TO_NED p
+        C = signs[:, None] * quat_xyzw_to_matrix(v[["qx", "qy", "qz", "qw"]].to_numpy())
         if self.front_first:
-            C = C @ np.diag([-1.0, -1.0, 1.0])
+            C = C * np.array([-1.0, -1.0, 1.0])  # C diag(-1, -1, 1)
         return {"t": t, "p": p, "C": C}
 
     def pose(self) -> pd.DataFrame:

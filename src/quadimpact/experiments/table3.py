@@ -71,6 +71,7 @@ from quadimpact.experiments.report import (  # noqa: F401 (the verdict rule, her
 )
 from quadimpact.experiments.spiri_mat import SpiriMatLog
 from quadimpact.experiments.switch_runs import switch_changes
+from quadimpact.linalg import norm
 from quadimpact.simulation import simulate
 from quadimpact.simulation.response_types import RESPONSE_TYPES, closest_chaining
 from quadimpact.sweep import SweepSpec, run_sweep
@@ -263,7 +264,7 @@ def _contact_state(result: Any) -> dict[str, float]:
     values = [float(np.interp(t_c, t, ts[c].to_numpy())) for c in cols]
     values[1] = -values[1]  # climb: -V_Z (NED)
     q = np.array([np.interp(t_c, t, ts[c].to_numpy()) for c in ("q0", "q1", "q2", "q3")])
-    values.append(float(inclination_deg(quat_to_matrix(q / np.linalg.norm(q)))))
+    values.append(float(inclination_deg(quat_to_matrix(q / norm(q)))))
     values.append(float(t_c - t[0]))
     return dict(zip(keys, values, strict=True))
 

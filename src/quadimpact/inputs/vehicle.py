@@ -32,6 +32,7 @@ from quadimpact.errors import InputError, input_error_from_validation, near_miss
 from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.files import read_toml_file
 from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec3, Vec4
+from quadimpact.linalg import norm
 
 __all__ = ["Vehicle", "load_vehicle", "bundled_vehicles"]
 
@@ -257,7 +258,7 @@ class Vehicle(BaseModel):
                 f"inertia_kg_m2: principal moments must lie in [1e-12, 1e9] kg m^2 "
                 f"(got {a:.4g} to {c:.4g})"
             )
-        arms = np.linalg.norm(np.asarray(self.rotor_positions_m, dtype=float)[:, :2], axis=1)
+        arms = norm(np.asarray(self.rotor_positions_m, dtype=float)[:, :2])
         if not (arms.min() >= 0.005 and arms.max() <= 5.0):
             raise ValueError(
                 "rotor_positions_m: rotor arms (horizontal distance from the CM) must lie in "
@@ -270,7 +271,7 @@ class Vehicle(BaseModel):
                 "the CM and cross the other rotors (each bumper is a circle around one rotor)"
             )
         reach = self.reach_m()
-        imu = float(np.linalg.norm(np.asarray(self.imu_position_m, dtype=float)))
+        imu = float(norm(np.asarray(self.imu_position_m, dtype=float)))
         if imu > reach:
             raise ValueError(
                 f"imu_position_m: {imu:.3g} m from the CM, off the vehicle (its rotors and "
@@ -314,7 +315,7 @@ class Vehicle(BaseModel):
 
     def _plausibility_warnings(self) -> list[str]:
         out = []
-        arms = np.linalg.norm(self.rotor_positions[:, :2], axis=1)
+        arms = norm(self.rotor_positions[:, :2])
         rings = self.features is None
         if rings and self.bumper_radius_m < 0.3 * arms.mean():
             out.append(
@@ -322,7 +323,7 @@ class Vehicle(BaseModel):
                 f"{arms.mean():.3g} m (a bumper circle around each rotor)"
             )
         r = self.rotor_positions[:, :2]
-        gaps = [float(np.linalg.norm(r[i] - r[j])) for i in range(4) for j in range(i + 1, 4)]
+        gaps = [float(norm(r[i] - r[j])) for i in range(4) for j in range(i + 1, 4)]
         if rings and 2.0 * self.bumper_radius_m > min(gaps):
             out.append(
                 f"bumper rings overlap: 2 x bumper_radius_m = {2 * self.bumper_radius_m:.3g} m "
@@ -422,10 +423,12 @@ class Vehicle(BaseModel):
     def reach_m(self) -> float:
         """How far the vehicle reaches from its CM, m: the longest rotor arm plus the bumper
         radius, or the farthest of its rotors and its features' extents."""
-        arm = float(np.linalg.norm(np.asarray(self.rotor_positions_m, float), axis=1).max())
+        arm = float(norm(np.asarray(self.rotor_positions_m, float)).max())
         if self.features is None:
             return arm + float(self.bumper_radius_m)
-        extents = [float(np.linalg.norm(f.centre_m)) + float(f.radius_m) for f in self.features]
+        extents = [
+            float(norm(np.asarray(f.centre_m, float))) + float(f.radius_m) for f in self.features
+        ]
         return max([arm, *extents])
 
     def valid_depth_m(self) -> float:

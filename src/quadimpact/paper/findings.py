@@ -23,6 +23,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
+from quadimpact import libm
+
 # thresholds of the verdicts
 PEAK_NEAR_DEG = 10.0  # "the peak is at about +10 deg"
 PEAK_TOL_DEG = 3.0  # ... within this
@@ -128,7 +130,10 @@ def steeper_negative(table: pd.DataFrame) -> Finding:
         def mean_slope(s: pd.Series) -> float:
             return float(np.mean(np.abs(np.diff(s.to_numpy()) / np.diff(s.index.to_numpy()))))
 
-        rel.append((mean_slope(np.log(neg)), mean_slope(np.log(pos))))
+        def log_of(s: pd.Series) -> pd.Series:
+            return pd.Series(libm.log(s.to_numpy()), index=s.index)
+
+        rel.append((mean_slope(log_of(neg)), mean_slope(log_of(pos))))
         absolute.append((mean_slope(neg), mean_slope(pos)))
     share_abs = float(np.mean([a > b for a, b in absolute]))
     share_rel = float(np.mean([a > b for a, b in rel]))

@@ -24,6 +24,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
+from quadimpact import libm
 from quadimpact.recovery import analysis
 from quadimpact.results.figures import (
     FIG_DPI,
@@ -208,7 +209,7 @@ def example_figure(result: Any, title: str | None = None) -> Figure:
     axes[0].set_ylabel("attitude (deg)")
     q = ts[["q0", "q1", "q2", "q3"]].to_numpy(dtype=float)
     c33 = q[:, 0] ** 2 - q[:, 1] ** 2 - q[:, 2] ** 2 + q[:, 3] ** 2  # body z . inertial Z
-    axes[1].plot(t, np.degrees(np.arccos(np.clip(c33, -1, 1))), color="tab:purple", lw=1.2,
+    axes[1].plot(t, np.degrees(libm.arccos(np.clip(c33, -1, 1))), color="tab:purple", lw=1.2,
                  label="tilt")  # fmt: skip
     axes[1].set_ylabel("tilt from vertical (deg)")
     axes[2].plot(t, ts["altitude_m"].to_numpy(dtype=float), color="tab:blue", lw=1.2,

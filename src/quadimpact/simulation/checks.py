@@ -32,6 +32,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
+from quadimpact.linalg import norm
 
 __all__ = [
     "INITIAL_PENETRATION_TOL_M",
@@ -85,7 +86,7 @@ def check_imu(setup: Any) -> None:
     vehicle = setup.vehicle
     position = np.asarray(scfg[L.SC_POS : L.SC_POS + 3], dtype=float)
     reach = vehicle.reach_m()
-    distance = float(np.linalg.norm(position))
+    distance = float(norm(np.asarray(position, dtype=np.float64)))
     if distance > reach:
         shown = ", ".join(f"{c:g}" for c in position)
         raise InputError(

@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact import libm
 from quadimpact.linalg import dot
 from quadimpact.results.files import BUMPERS
 from quadimpact.rotations import (
@@ -494,7 +495,7 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
     quat = euler_zyx_to_quat(roll, pitch, yaw)
     z_body = quat_to_matrix(quat)[:, :, 2]
     z_ref = quat_to_matrix(euler_zyx_to_quat(roll_ref, pitch_ref, yaw_ref))[:, 2]
-    tilt = np.arccos(np.clip(dot(z_body, z_ref), -1.0, 1.0))
+    tilt = libm.arccos(np.clip(dot(z_body, z_ref), -1.0, 1.0))
     return {
         "roll_excursion_deg": float(np.degrees(np.max(d_roll))),
         "pitch_excursion_deg": float(np.degrees(np.max(d_pitch))),
