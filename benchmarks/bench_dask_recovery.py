@@ -7,7 +7,7 @@ The recipe of docs/RECOVERY.md ("A million trials on a Dask cluster") at a size
 that fits a small machine, on a ``distributed.LocalCluster`` of ``--workers``
 single-threaded worker processes started here:
 
-1. **Interrupted**: the study's trials (``quadimpact.recovery.study.run_trials``
+1. **Interrupted**: the study's trials (``quadimpact.studies.recovery.recovery_study.run_trials``
    with ``scheduler=``) run in a child process that gets SIGINT once
    ``--stop-at`` of the trials are in the sweep's parts (as Ctrl-C would);
 2. **Resumed**: the same call again, in this process, to the end: it must
@@ -41,7 +41,7 @@ import psutil
 CHILD = r"""
 import sys
 from dask.distributed import Client
-from quadimpact.recovery.study import RecoveryStudy, run_trials
+from quadimpact.studies.recovery.recovery_study import RecoveryStudy, run_trials
 from quadimpact.sweep import SweepInterrupted
 address, n, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 client = Client(address)
@@ -130,7 +130,12 @@ def main(argv: list[str] | None = None) -> None:
     import pandas as pd
     from dask.distributed import Client, LocalCluster
 
-    from quadimpact.recovery.study import SWEEP_DIR, TRIALS_PARQUET, RecoveryStudy, run_trials
+    from quadimpact.studies.recovery.recovery_study import (
+        SWEEP_DIR,
+        TRIALS_PARQUET,
+        RecoveryStudy,
+        run_trials,
+    )
     from quadimpact.sweep import without_costs
 
     report: dict = {"n": args.n, "workers": args.workers, "cpu_count": os.cpu_count(),

@@ -39,8 +39,8 @@ import numpy as np
 
 import quadimpact.envs as E
 from quadimpact import simulate
+from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import new_output
-from quadimpact.core.run import BUILTIN
 from quadimpact.simulation.setup import prepare
 
 SAME_TICKS = {

@@ -30,7 +30,7 @@ import statistics
 import time
 
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.simulation.setup import prepare
 

@@ -5,9 +5,9 @@ Run: ``python benchmarks/bench_recovery.py [--n 10000] [--n-variants 2000]
 [--skip-friction] [--json PATH]``.
 
 1. **Navi Monte Carlo**, ``--n`` trials (default 10,000) of the authors'
-   distribution (``quadimpact.recovery.study.RecoveryStudy``, seed 0), in the
+   distribution (``quadimpact.studies.recovery.recovery_study.RecoveryStudy``, seed 0), in the
    ``default`` and ``recovery-replica`` variants, each with
-   ``quadimpact.recovery.study.run_study`` on ``--workers`` local processes
+   ``quadimpact.studies.recovery.recovery_study.run_study`` on ``--workers`` local processes
    (default 2) without the example run: the sweep's wall time (target
    <= 120 s per 10,000 trials) and the whole study's (table, figures and
    report), the success rate (recovered / all trials) with its 95 % Wilson
@@ -61,7 +61,7 @@ def machine() -> dict[str, Any]:
 
 # ------------------------------------------------------------- the studies
 def study_numbers(name: str, study: Any, out: Path, workers: int) -> dict[str, Any]:
-    from quadimpact.recovery.study import run_study
+    from quadimpact.studies.recovery.recovery_study import run_study
 
     t0 = time.perf_counter()
     r = run_study(study, out / name, workers=workers, example=False)
@@ -117,7 +117,7 @@ def print_study(r: dict[str, Any]) -> None:
 
 def cpu_per_trial(model: str, n: int) -> float:
     """CPU seconds per trial in this process (``run_chunk``, the sweep workers' function)."""
-    from quadimpact.recovery.study import RecoveryStudy
+    from quadimpact.studies.recovery.recovery_study import RecoveryStudy
     from quadimpact.sweep import run_chunk
 
     spec = RecoveryStudy(n=n, model=model).sweep_spec()
@@ -153,8 +153,8 @@ def friction_check(n: int, workers: int) -> dict[str, Any]:
     import numpy as np
     import pandas as pd
 
-    from quadimpact.recovery.study import RecoveryStudy
     from quadimpact.simulation.packing import FRICTION_V_REG_M_S
+    from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 
     assert FRICTION_V_REG_M_S == V_REGS[0], "the default v_reg is the first of V_REGS"
     out: dict[str, Any] = {}
@@ -236,7 +236,7 @@ def main() -> None:
     ap.add_argument("--json", type=Path)
     args = ap.parse_args()
 
-    from quadimpact.recovery.study import RecoveryStudy
+    from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 
     info = machine()
     print(f"machine: {info['cpu_count']} cores ({info['cpu_model']}), Python {info['python']}, "

@@ -49,7 +49,7 @@ def best(fn, repeat: int) -> float:
 
 def quadimpact_times(repeat: int) -> dict:
     from quadimpact import FlightScenario, simulate
-    from quadimpact.core.run import execute
+    from quadimpact.core.kernel import execute
     from quadimpact.simulation.setup import prepare
 
     s = FlightScenario(euler_deg=(ROLL_DEG, 0.0, 0.0), attitude_ref_deg=(0.0, 0.0, 0.0),

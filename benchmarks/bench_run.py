@@ -35,7 +35,7 @@ import numpy as np
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.simulation.setup import prepare
 
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}

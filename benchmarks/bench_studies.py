@@ -10,7 +10,7 @@ round, each in fresh interpreters that import that checkout's ``src``
 (``PYTHONPATH``), so that the drift of a busy machine falls on both. The
 measures (the targets of issue 21):
 
-1. **Recovery trials**: ``quadimpact.recovery.study.run_trials`` of the
+1. **Recovery trials**: ``quadimpact.studies.recovery.recovery_study.run_trials`` of the
    authors' study, ``--n`` trials on 2 local worker processes, in a fresh
    process: the CPU time of every process of the sweep (this one during the
    sweep, the pool's fork server and its workers, reaped at the end) over the
@@ -97,7 +97,7 @@ def stop_server():
 TRIALS = r"""
 def main():
     n, out = int(sys.argv[1]), sys.argv[2]
-    from quadimpact.recovery.study import RecoveryStudy, run_trials
+    from quadimpact.studies.recovery.recovery_study import RecoveryStudy, run_trials
     study = RecoveryStudy(n=n)
     c0, w0 = time.process_time(), time.perf_counter()
     spec, table, info = run_trials(study, out, workers=2)
@@ -115,9 +115,9 @@ if __name__ == "__main__":
 
 KERNEL_TRIALS = r"""
 n = int(sys.argv[1])
-from quadimpact.core.run import BUILTIN
+from quadimpact.core.kernel import BUILTIN
 from quadimpact.inputs.scenarios import scenario_from_dict
-from quadimpact.recovery.study import RecoveryStudy
+from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 from quadimpact.simulation.setup import prepare
 spec = RecoveryStudy(n=n).sweep_spec()
 total = 0.0
@@ -135,7 +135,7 @@ print(json.dumps({"n": n, "kernel_cpu_s": total}))
 
 KERNEL_FIG4 = r"""
 import quadimpact.simulation.approach as approach
-from quadimpact.core.run import BUILTIN, execute
+from quadimpact.core.kernel import BUILTIN, execute
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.simulation.setup import prepare
 shooting = [0.0]
@@ -171,7 +171,7 @@ SIMULATE = r"""
 repeat = int(sys.argv[1])
 import quadimpact.simulation.approach as approach
 from quadimpact import WallApproach, simulate
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.simulation.setup import prepare
 res = {}
 for model in ("paper-replica", "default"):

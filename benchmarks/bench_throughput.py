@@ -63,7 +63,7 @@ class KernelClock:
     def __init__(self) -> None:
         import dataclasses
 
-        import quadimpact.core.run as run
+        import quadimpact.core.kernel as run
         import quadimpact.simulation.approach as approach
         import quadimpact.simulation.batch as batch
 
@@ -98,7 +98,7 @@ class KernelClock:
 
 def bench_simulate(repeat: int) -> dict:
     from quadimpact import WallApproach, simulate
-    from quadimpact.core.run import execute
+    from quadimpact.core.kernel import execute
     from quadimpact.simulation.setup import prepare
 
     res = {}

@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 from quadimpact import WallApproach, simulate
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.simulation.packing import DEFAULT_ATOL, DEFAULT_RTOL
 from quadimpact.simulation.setup import prepare
 

@@ -47,9 +47,9 @@ try:
     from quadimpact.simulation.setup import prepare
 except ImportError:
     from quadimpact.scenario import prepare
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.inputs.scenarios import scenario_from_dict
-from quadimpact.recovery.study import RecoveryStudy
+from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 from quadimpact.simulation.batch import BatchRunner
 repeat, trials = int(sys.argv[1]), int(sys.argv[2])
 

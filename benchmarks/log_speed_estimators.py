@@ -48,7 +48,7 @@ import numpy as np
 from scipy import signal
 
 from quadimpact.experiments.crashes import TABLE3
-from quadimpact.experiments.estimation import LOOKBACK_S
+from quadimpact.experiments.log_estimates import LOOKBACK_S
 from quadimpact.experiments.logs import data_dir
 from quadimpact.experiments.spiri_mat import SpiriMatLog, crash_set_1
 

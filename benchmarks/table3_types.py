@@ -36,8 +36,8 @@ import pandas as pd
 
 from quadimpact import simulate
 from quadimpact.experiments.crashes import MATCHED_CONTACT_TIME_S, TABLE3, Crash
-from quadimpact.experiments.switch_runs import offs_within_segment
 from quadimpact.simulation.response_types import closest_chaining
+from quadimpact.studies.table3.switch_runs import offs_within_segment
 
 VARIANTS = ("default", "paper-replica")
 

@@ -15,7 +15,7 @@ import psutil
 
 import quadimpact
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.simulation.setup import RunSetup
 
 #: The bundled Spiri's parameter file.

@@ -12,7 +12,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from quadimpact.experiments.estimation import POWER_OFF_RPM, bumper_rim_extent
+from quadimpact.experiments.log_estimates import POWER_OFF_RPM, bumper_rim_extent
 from quadimpact.experiments.logs import FlightLog, PreImpact, rpm_to_rad_s
 from quadimpact.rotations import quat_to_matrix
 

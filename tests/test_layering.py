@@ -3,8 +3,7 @@ relative) of every module, parsed with ``ast``, against the layer order.
 
 1. ``quadimpact.core`` imports nothing of quadimpact outside ``core``; the
    base modules (``errors``, ``libm``, ``linalg``, ``rotations``) import nothing of
-   quadimpact but ``errors``, ``libm`` and ``linalg`` (the package root and ``_legacy``
-   nothing but ``_legacy``);
+   quadimpact but ``errors``, ``libm`` and ``linalg`` (the package root nothing);
 2. no import cycle between modules anywhere in the package;
 3. no module imports a layer above its own (:data:`LAYERS`, lowest first);
    a module may import its own layer and the layers below.
@@ -38,7 +37,6 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
             "quadimpact.libm",
             "quadimpact.linalg",
             "quadimpact.rotations",
-            "quadimpact._legacy",
         ),
     ),
     ("inputs", ("quadimpact.inputs",)),
@@ -46,15 +44,12 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("simulation", ("quadimpact.simulation",)),
     ("sweep, viz, envs", ("quadimpact.sweep", "quadimpact.viz", "quadimpact.envs")),
     ("experiments", ("quadimpact.experiments",)),
-    ("recovery", ("quadimpact.recovery",)),
-    ("pole", ("quadimpact.pole",)),
-    ("paper", ("quadimpact.paper",)),
+    ("studies", ("quadimpact.studies",)),
     ("cli", ("quadimpact.cli",)),
 ]
 #: What the base modules may import of quadimpact (rule 1).
 BASE_ALLOWED: dict[str, tuple[str, ...]] = {
-    "quadimpact": ("quadimpact._legacy",),
-    "quadimpact._legacy": (),
+    "quadimpact": (),
     "quadimpact.errors": (),
     "quadimpact.libm": (),
     "quadimpact.linalg": (),
@@ -258,7 +253,7 @@ def test_every_module_is_in_a_layer_and_the_parse_sees_imports(package_imports) 
     # from quadimpact import simulate
     assert ("quadimpact.sweep.worker", "quadimpact.simulation") in targets
     assert ("quadimpact.results.result", "quadimpact.results.figures") in targets  # in a function
-    assert ("quadimpact.core.step", "quadimpact.core.interval") in targets  # relative
+    assert ("quadimpact.core.step", "quadimpact.core.interval") in targets
 
 
 # ------------------------------------------------------------------ the checks can fail
@@ -269,24 +264,24 @@ def _fake(**modules: str) -> dict[str, tuple[bool, str]]:
 def test_the_checks_name_the_offending_import() -> None:
     found = imports(
         _fake(
-            quadimpact__core__run="import numpy\nfrom quadimpact.errors import InputError\n",
+            quadimpact__core__kernel="import numpy\nfrom quadimpact.errors import InputError\n",
             quadimpact__errors="",
-            quadimpact__results__files="def f():\n    from quadimpact.simulation import record\n",
-            quadimpact__simulation__record="from ..results import files\n",
+            quadimpact__results__files="def f():\n    from quadimpact.simulation import tables\n",
+            quadimpact__simulation__tables="from ..results import files\n",
             quadimpact__simulation="",
             quadimpact__results="",
             quadimpact__core="",
         )
     )
     assert base_violations(found) == [
-        "quadimpact.core.run (line 2) imports quadimpact.errors: "
+        "quadimpact.core.kernel (line 2) imports quadimpact.errors: "
         "core imports nothing outside quadimpact.core"
     ]
     (layer,) = layer_violations(found)
     assert layer.startswith(
-        "quadimpact.results.files (line 2) imports quadimpact.simulation.record: "
+        "quadimpact.results.files (line 2) imports quadimpact.simulation.tables: "
         "layer 'results' may not import layer 'simulation'"
     )
     (cycle,) = cycles(found)
-    assert "quadimpact.results.files (line 2) imports quadimpact.simulation.record" in cycle
-    assert "quadimpact.simulation.record (line 1) imports quadimpact.results.files" in cycle
+    assert "quadimpact.results.files (line 2) imports quadimpact.simulation.tables" in cycle
+    assert "quadimpact.simulation.tables (line 1) imports quadimpact.results.files" in cycle

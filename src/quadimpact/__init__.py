@@ -2,8 +2,6 @@
 
 The public names are imported lazily, so that ``import quadimpact`` (and the
 command line's ``--help``) stays fast until the simulator is actually used.
-The modules of the layout before ``inputs/``, ``simulation/``, ``results/``...
-still import under their old names, with a DeprecationWarning (``_legacy``).
 
 Examples
 --------
@@ -16,11 +14,7 @@ from __future__ import annotations
 from importlib import import_module
 from typing import Any
 
-from quadimpact import _legacy
-
 __version__ = "0.1.0"
-
-_legacy.install()  # the old flat module paths (quadimpact.config...) still import
 
 _EXPORTS = {
     "WallApproach": "quadimpact.inputs.scenarios",

@@ -248,7 +248,7 @@ def test_experiments_writes_table3(tmp_path: Path) -> None:
     """The stable interface: ``quadimpact experiments --out DIR [--data PATH]``."""
     import pandas as pd
 
-    from quadimpact.experiments.table3 import EXTRA_COLUMNS, TABLE3_COLUMNS
+    from quadimpact.studies.table3.table3_study import EXTRA_COLUMNS, TABLE3_COLUMNS
 
     missing = tmp_path / "no-data"
     missing.mkdir()
@@ -460,7 +460,7 @@ def test_a_garbage_crash_log_is_named_before_any_run(tmp_path: Path) -> None:
 
 def test_every_run_flag_is_also_named_by_its_file_key(tmp_path: Path) -> None:
     """--heading and --heading-deg, --friction and --friction-coefficient...: both work."""
-    from quadimpact.cli.run import _FLAGS, run
+    from quadimpact.cli.run_command import _FLAGS, run
 
     names = {p.name: p.opts for p in run.params}
     for param, (field, flag) in _FLAGS.items():
@@ -522,10 +522,10 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) ->
         "quadimpact: compiling the simulator (first run only: about 120 s of CPU on a 2-core "
         "machine, more on a slower one) ...\n"
     )
-    run_py = str(Path(core.__file__).parent / "run.py")
+    run_py = str(Path(core.__file__).parent / "kernel.py")
     where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
     where.mkdir(parents=True)
-    (where / "run.run-44.py311.nbi").write_bytes(b"")
+    (where / "kernel.run-44.py311.nbi").write_bytes(b"")
     assert core.cache_is_warm()
     announce_compilation()
     assert capsys.readouterr().err == ""
@@ -577,7 +577,7 @@ def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path
         ["sweep", "--grid", "speed_m_s=-1", "--workers", "1", "--out", str(tmp_path / "s")],
         ["recovery", "--vehicle", "nowhere.toml", "--workers", "1", "--out", str(tmp_path / "r")],
     ]
-    seen = _refusals(cases, ("numba", "quadimpact.core.run", "matplotlib"), tmp_path)
+    seen = _refusals(cases, ("numba", "quadimpact.core.kernel", "matplotlib"), tmp_path)
     for command, exit_code, numba_loaded, kernel_loaded, mpl_loaded, _error in seen:
         assert exit_code == 2, command
         assert not kernel_loaded and not mpl_loaded, (command, kernel_loaded, mpl_loaded)
@@ -595,7 +595,9 @@ def test_a_bad_recovery_option_is_refused_before_the_pool_or_pandas_start(tmp_pa
         ["recovery", "--imu", "noisy", "--sensors", "impact", "--out", str(out)],
     ]
     seen = _refusals(
-        cases, ("pandas", "quadimpact.sweep.run", "quadimpact.recovery.study"), tmp_path
+        cases,
+        ("pandas", "quadimpact.sweep.runner", "quadimpact.studies.recovery.recovery_study"),
+        tmp_path,
     )
     assert [s[1:5] for s in seen] == [[2, False, False, False]] * len(cases), seen
     assert "--vehicle" in seen[0][-1] and "--estimator" in seen[1][-1], seen

@@ -6,7 +6,7 @@ from numba import njit
 
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.run import make_kernel
+from quadimpact.core.kernel import make_kernel
 from quadimpact.simulation.stepping import Simulation
 
 CONTROLLERS = ["paper", "cascade-pid"]
@@ -55,10 +55,10 @@ def test_paper_controller_sinks_when_tilted():
 
 
 @njit(cache=False)
-def _hold_initial_speeds(x, ctrl, mem, veh, dt, cmd):
+def _hold_initial_speeds(t, meas, ctrl, mem, veh, dt, cmd):
     if mem[0] == 0.0:
         for j in range(4):
-            mem[1 + j] = x[L.X_ROTOR + j]
+            mem[1 + j] = meas[L.MS_X + L.X_ROTOR + j]
         mem[0] = 1.0
     for j in range(4):
         cmd[j] = mem[1 + j]

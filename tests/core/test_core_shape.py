@@ -19,7 +19,7 @@ MAX_TICK_LINES = 80
 
 
 DECORATORS = {"njit", "compiled", "allocating"}  # core/compiled.py
-REFCOUNTED_MODULES = {"records.py", "run.py"}  # build and hand out records: plain njit
+REFCOUNTED_MODULES = {"records.py", "kernel.py"}  # build and hand out records: plain njit
 
 
 def _decorator(fn: ast.FunctionDef) -> ast.expr | None:

@@ -9,7 +9,7 @@ import pytest
 
 from quadimpact import FlightScenario
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 

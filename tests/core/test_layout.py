@@ -24,8 +24,8 @@ DECLARING = (
     "quadimpact.core.controller_layout",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
-    "quadimpact.core.env_layout",
-    "quadimpact.core.batch",
+    "quadimpact.core.envs.episode_layout",
+    "quadimpact.core.envs.stacked",
 )
 # constants that carry a block's prefix without being one of its slots
 NOT_SLOTS = {"OUT_DELTA"}  # the first per-feature column: the end of the fixed columns

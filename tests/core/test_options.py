@@ -7,7 +7,7 @@ import pytest
 
 from quadimpact import FlightScenario, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 from quadimpact.simulation.simulate import run_setup

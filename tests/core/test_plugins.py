@@ -26,9 +26,9 @@ from scipy.integrate import solve_ivp
 
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
-from quadimpact.core.geometry.record import material_record
+from quadimpact.core.geometry.contact_record import material_record
+from quadimpact.core.kernel import make_kernel
 from quadimpact.core.records import model, new_output
-from quadimpact.core.run import make_kernel
 
 FEAT_BALL = 50  # the new feature kind: a sphere of radius F_RADIUS at F_CENTRE
 SHAPE_SPHERE = 60  # the new shape kind: a sphere of radius SH_RADIUS at SH_POINT

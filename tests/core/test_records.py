@@ -59,12 +59,13 @@ EDITS: list[tuple[str, str, str]] = [
     ),
     ("core/records.py", "O.episodes[k], O.stats[k])", "O.episodes[k], O.stats[k], O.baro[k])"),
     (
-        "core/sensors/stage.py",
-        "from .imu import imu_sample\n",
-        "from .baro import baro_sample\nfrom .imu import imu_sample\n",
+        "core/sensing.py",
+        "from quadimpact.core.sensors.imu import imu_sample\n",
+        "from quadimpact.core.sensors.baro import baro_sample\n"
+        "from quadimpact.core.sensors.imu import imu_sample\n",
     ),
     (
-        "core/sensors/stage.py",
+        "core/sensing.py",
         "    plugin_sensor(t, xs, xd, w.C, m, d)\n",
         "    plugin_sensor(t, xs, xd, w.C, m, d)\n    baro_sample(t, xs, d, o)\n",
     ),
@@ -76,8 +77,8 @@ NEW_FILES = {
         import numpy as np
         from numba import njit
 
-        from ..layout import SS_N, X_POS
-        from ..records import Data, Output
+        from quadimpact.core.layout import SS_N, X_POS
+        from quadimpact.core.records import Data, Output
 
 
         @njit(cache=True)
@@ -149,7 +150,7 @@ def test_a_new_per_run_array_touches_three_files(tmp_path: Path, jit: bool):
     for rel, text in NEW_FILES.items():
         (root / rel).write_text(textwrap.dedent(text).lstrip())
     touched = _touched(PACKAGE, root)
-    assert touched == {"core/records.py", "core/sensors/stage.py", "core/sensors/baro.py"}
+    assert touched == {"core/records.py", "core/sensing.py", "core/sensors/baro.py"}
     env = dict(os.environ, PYTHONPATH=str(root.parent), NUMBA_CACHE_DIR=str(tmp_path / "nb"))
     if not jit:
         env["NUMBA_DISABLE_JIT"] = "1"  # the same code, run by Python (seconds, not a compile)

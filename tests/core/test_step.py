@@ -7,8 +7,8 @@ import pytest
 
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
+from quadimpact.core.kernel import execute
 from quadimpact.core.records import new_data, new_output
-from quadimpact.core.run import execute
 from quadimpact.core.step import advance, start
 from quadimpact.simulation.setup import prepare
 

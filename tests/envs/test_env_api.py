@@ -10,8 +10,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import quadimpact.envs as E
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 
 
 @pytest.mark.parametrize("start", ["detection", "trial"])

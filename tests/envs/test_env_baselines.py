@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import quadimpact.envs as E
-from quadimpact.core import batch as B
+from quadimpact.core.envs import stacked as B
 from quadimpact.simulation.batch import simulate_batch
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import quadimpact.envs as E
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS
 
 

@@ -14,8 +14,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import quadimpact.envs as E
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 from quadimpact.simulation.batch import simulate_batch
 
 TRIALS = E.TrialDistribution(estimator="ekf", sensors="impact")

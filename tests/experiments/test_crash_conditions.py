@@ -239,7 +239,7 @@ def test_offs_within_segment_move_only_the_switch_offs_after_the_contact():
     """Crash 5: motor 2 off from the contact, motor 3 from 82 ms, motor 4 from 197 ms,
     motor 1 from 374 ms; fraction 0 is the schedule itself, 1 keeps each motor running to
     its segment's end (the log's next sample) and nothing else changes."""
-    from quadimpact.experiments.switch_runs import HELD_RATE_RPM_PER_S, offs_within_segment
+    from quadimpact.studies.table3.switch_runs import HELD_RATE_RPM_PER_S, offs_within_segment
 
     scenario = TABLE3[4].scenario("default", "matched")
     po = scenario.power_off

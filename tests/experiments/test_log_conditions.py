@@ -5,15 +5,15 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.experiments.crash_logs import (
+from quadimpact.experiments.crashes import TABLE3, scenario_file
+from quadimpact.inputs.scenarios import WallApproach
+from quadimpact.simulation import simulate
+from quadimpact.studies.table3.crash_logs import (
     LOG_RANGE_SIGMAS,
     log_conditions,
     log_sensitivity_spec,
     read_log,
 )
-from quadimpact.experiments.crashes import TABLE3, scenario_file
-from quadimpact.inputs.scenarios import WallApproach
-from quadimpact.simulation import simulate
 
 pytestmark = pytest.mark.data
 

@@ -24,7 +24,7 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.experiments.estimation import (
+from quadimpact.experiments.log_estimates import (
     IMPACT_RATE_THRESHOLD,
     IMPACT_SEARCH_AFTER_S,
     IMPACT_SEARCH_BEFORE_S,

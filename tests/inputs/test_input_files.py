@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from quadimpact.errors import InputError
-from quadimpact.inputs.files import apply_overrides, locate_vehicle, read_toml_file
+from quadimpact.inputs.toml_files import apply_overrides, locate_vehicle, read_toml_file
 
 
 def test_reader_names_the_file_or_the_given_place(tmp_path: Path) -> None:

@@ -22,7 +22,7 @@ from quadimpact.results.files import (
     write_timeseries_parquet,
 )
 from quadimpact.results.result import SimulationResult, read_result
-from quadimpact.simulation.record import episodes_frame
+from quadimpact.simulation.tables import episodes_frame
 
 
 def make_timeseries(n: int = 50) -> pd.DataFrame:

@@ -17,7 +17,7 @@ from quadimpact.simulation.metrics import (
     impacts_in,
     short_impacts,
 )
-from quadimpact.simulation.record import (
+from quadimpact.simulation.tables import (
     episode_columns,
     episode_lists_of,
     episodes_frame,

@@ -14,8 +14,8 @@ import numpy as np
 
 from quadimpact import FlightScenario, ImpactTrial, WallApproach, simulate
 from quadimpact.core import layout as L
+from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import new_output
-from quadimpact.core.run import BUILTIN
 from quadimpact.inputs.world import Cylinder
 from quadimpact.simulation.batch import GROUP_MAX, GROUP_S, BatchRunner, simulate_batch
 from quadimpact.simulation.setup import prepare

@@ -10,7 +10,7 @@ import pytest
 
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.simulation.setup import prepare
 
 G = 9.81

@@ -17,9 +17,9 @@ import pytest
 
 from quadimpact import simulate
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial
-from quadimpact.recovery.study import sample_trials
 from quadimpact.simulation.batch import simulate_batch
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS
+from quadimpact.studies.recovery.recovery_study import sample_trials
 
 TRIAL = {"roll_deg": 8.0, "pitch_deg": -25.0, "yaw_deg": 10.0, "speed_m_s": 1.6, "seed": 11}
 UP_TO_STAGE4 = [k for k in RECOVERY_KEYS if k not in (

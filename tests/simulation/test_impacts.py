@@ -17,7 +17,7 @@ import pytest
 
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
-from quadimpact.core.run import execute
+from quadimpact.core.kernel import execute
 from quadimpact.simulation.impacts import RunEpisodes, run_episodes
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
@@ -25,9 +25,9 @@ from quadimpact.simulation.metrics import (
     impact_metrics,
     impact_metrics_of,
 )
-from quadimpact.simulation.record import episodes_frame
 from quadimpact.simulation.setup import prepare
 from quadimpact.simulation.summary import build_summary
+from quadimpact.simulation.tables import episodes_frame
 
 NAMES = ("wall", "pole", "ground")
 

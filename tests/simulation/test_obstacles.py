@@ -22,8 +22,8 @@ from scipy.integrate import solve_ivp
 
 from quadimpact import simulate
 from quadimpact.core import layout as L
+from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import new_output
-from quadimpact.core.run import BUILTIN
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, scenario_from_dict
 from quadimpact.inputs.world import Box, Cylinder
 from quadimpact.simulation.setup import prepare

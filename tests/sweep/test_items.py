@@ -14,7 +14,7 @@ import pytest
 
 from quadimpact.inputs.derive import ScenarioFactory, same_scenario
 from quadimpact.inputs.scenarios import scenario_from_dict
-from quadimpact.recovery.study import RecoveryStudy
+from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 from quadimpact.sweep import SweepSpec
 from quadimpact.sweep.backends import make_chunks
 from quadimpact.sweep.items import RunInputs, scenario_of

@@ -411,7 +411,7 @@ def test_on_placed_is_called_once_whatever_the_backend(serial_table, tmp_path):
 def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
     """By default the first runs are done here, then (if other cores are idle) the pool does
     the rest once its server is warm; one table, the same as in-process."""
-    import quadimpact.sweep.run as run_module
+    import quadimpact.sweep.runner as run_module
     from quadimpact.sweep.pool import pool_context, server_ready, start_server
 
     spec = SweepSpec(base=BASE, grid={"heading_deg": [0, 45], "inclination_deg": "-4:10:2"})
@@ -449,7 +449,7 @@ def test_default_hands_over_to_the_pool(monkeypatch, tmp_path):
     [(None, 4, 4), (0.0, 2, 1), (0.4, 2, 1), (0.5, 2, 2), (0.95, 2, 2), (6.7, 8, 8), (2.2, 8, 3)],
 )
 def test_default_pool_size(idle, cores, workers):
-    from quadimpact.sweep.run import pool_size
+    from quadimpact.sweep.runner import pool_size
 
     assert pool_size(idle, cores) == workers
 
@@ -461,7 +461,7 @@ def test_default_pool_size(idle, cores, workers):
 )  # fmt: skip
 def test_own_server_counts_as_idle(idle, before, after, window, expected):
     """The CPU the sweep's own warming fork server used is idle for the pool's size."""
-    from quadimpact.sweep.run import own_server_idle, pool_size
+    from quadimpact.sweep.runner import own_server_idle, pool_size
 
     got = own_server_idle(idle, before, after, window)
     assert got == pytest.approx(expected) if expected is not None else got is None
@@ -472,7 +472,7 @@ def test_own_server_counts_as_idle(idle, before, after, window, expected):
 @pytest.mark.parametrize(("idle", "workers"), [(2.0, 2), (1.6, 2), (1.3, 1), (1.0, 1), (None, 2)])
 def test_warm_pool_size_takes_this_waiting_core_off(monkeypatch, idle, workers):
     """Measured while this process waits, its own core is idle too: only the others count."""
-    import quadimpact.sweep.run as run_module
+    import quadimpact.sweep.runner as run_module
 
     monkeypatch.setattr(run_module, "MEASURE_S", 0.0)
     monkeypatch.setattr(run_module, "idle_cores", lambda before, after: idle)
@@ -499,7 +499,7 @@ def test_process_cpu_time_read_from_proc():
 
 def test_idle_cores_measured():
     """While this process burns CPU, at most the other cores are idle."""
-    from quadimpact.sweep.run import cpu_sample, default_workers, idle_cores
+    from quadimpact.sweep.runner import cpu_sample, default_workers, idle_cores
 
     before = cpu_sample()
     if before is None:

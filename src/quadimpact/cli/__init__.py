@@ -1,11 +1,11 @@
 """Command-line interface: the ``quadimpact`` group, one module per command.
 
-* :mod:`~quadimpact.cli.run`: ``quadimpact run``;
-* :mod:`~quadimpact.cli.sweep`: ``quadimpact sweep``;
-* :mod:`~quadimpact.cli.reproduce`: ``quadimpact reproduce``;
-* :mod:`~quadimpact.cli.experiments`: ``quadimpact experiments``;
-* :mod:`~quadimpact.cli.recovery`: ``quadimpact recovery``;
-* :mod:`~quadimpact.cli.viz`: ``quadimpact animate``, ``snapshots``, ``view``;
+* :mod:`~quadimpact.cli.run_command`: ``quadimpact run``;
+* :mod:`~quadimpact.cli.sweep_command`: ``quadimpact sweep``;
+* :mod:`~quadimpact.cli.reproduce_command`: ``quadimpact reproduce``;
+* :mod:`~quadimpact.cli.experiments_command`: ``quadimpact experiments``;
+* :mod:`~quadimpact.cli.recovery_command`: ``quadimpact recovery``;
+* :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
 
 Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
@@ -26,8 +26,13 @@ from typing import Any
 
 import click
 
-from quadimpact.cli import experiments, pole, recovery, reproduce, run, sweep, viz
-from quadimpact.cli.run import build_scenario, format_summary
+from quadimpact.cli.experiments_command import experiments
+from quadimpact.cli.pole_command import pole
+from quadimpact.cli.recovery_command import recovery
+from quadimpact.cli.reproduce_command import reproduce
+from quadimpact.cli.run_command import build_scenario, format_summary, run
+from quadimpact.cli.sweep_command import sweep
+from quadimpact.cli.viz_commands import animate, snapshots, view
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
 __all__ = ["build_scenario", "cli", "format_summary", "main"]
@@ -80,15 +85,8 @@ def cli() -> None:
 
 
 # ---- the commands, each in its own module: one registration line each ----
-cli.add_command(run.run)
-cli.add_command(viz.animate)
-cli.add_command(viz.snapshots)
-cli.add_command(viz.view)
-cli.add_command(sweep.sweep)
-cli.add_command(reproduce.reproduce)
-cli.add_command(experiments.experiments)
-cli.add_command(recovery.recovery)
-cli.add_command(pole.pole)
+for _command in (run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole):
+    cli.add_command(_command)
 
 
 def _fail(message: str, code: int) -> None:

@@ -31,7 +31,7 @@ def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
                 raise InputError("--workers and --scheduler: give one or the other")
             check_scheduler(scheduler)
         if kwargs.get("workers") is not None:
-            from quadimpact.sweep.run import cap_workers
+            from quadimpact.sweep.runner import cap_workers
 
             kwargs["workers"], note = cap_workers(kwargs["workers"])
             if note:

@@ -69,9 +69,9 @@ def _cache_dirs() -> list[Path]:
 def cache_is_warm() -> bool:
     """Whether the compiled loop is in Numba's on-disk cache (else the first run compiles it).
 
-    Cheap: looks for the index file of ``run.run_builtin`` (no Numba import).
+    Cheap: looks for the index file of ``kernel.run`` (no Numba import).
     """
-    return any(_numba_dir(_HERE).glob("run.run-*.nbi"))
+    return any(_numba_dir(_HERE).glob("kernel.run-*.nbi"))
 
 
 def ensure_fresh_cache() -> None:

@@ -38,8 +38,8 @@ import math
 
 import numpy as np
 
-from .compiled import compiled
-from .layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import (
     LS_K,
     LS_PO_ACTIVE,
     LS_PO_T,
@@ -59,7 +59,7 @@ from .layout import (
     V_TAU_M,
     X_ROTOR,
 )
-from .records import Data, Model
+from quadimpact.core.records import Data, Model
 
 ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
 

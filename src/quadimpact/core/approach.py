@@ -26,9 +26,9 @@ import math
 
 import numpy as np
 
-from .compiled import allocating, compiled
-from .geometry import pair_contact
-from .layout import (
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.geometry import pair_contact
+from quadimpact.core.layout import (
     AP_DV,
     AP_LATE,
     AP_LATE_RULE,
@@ -59,10 +59,10 @@ from .layout import (
     X_ROTOR,
     X_VEL,
 )
-from .quaternion import rotation_matrix
-from .records import Model, Output, new_data
-from .roots import BR_X, BRENT_ASK, BRENT_NO_BRACKET, NBR, brent_next, brent_start
-from .step import advance, start
+from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.records import Model, Output, new_data
+from quadimpact.core.roots import BR_X, BRENT_ASK, BRENT_NO_BRACKET, NBR, brent_next, brent_start
+from quadimpact.core.step import advance, start
 
 __all__ = ["APPROACH_MAX_ITER", "APPROACH_TOL_M_S", "solve_approach"]
 

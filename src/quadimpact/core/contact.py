@@ -29,9 +29,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .compiled import compiled
-from .geometry import pair_contact, shape_distance
-from .layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.geometry import pair_contact, shape_distance
+from quadimpact.core.layout import (
     CS_ACTIVE,
     CS_LAMBDA,
     F_E,
@@ -46,7 +46,7 @@ from .layout import (
     PR_SHAPE,
     X_POS,
 )
-from .records import Model
+from quadimpact.core.records import Model
 
 
 @compiled

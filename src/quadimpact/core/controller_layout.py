@@ -7,7 +7,7 @@ blocks live at ``ctrl[C_PARAMS + ...]`` (capacity ``NPARAM``) and in the
 controller's memory ``mem`` (before ``MEM_STAGE``).
 """
 
-from .layout import MEM_STAGE, NPARAM, Block
+from quadimpact.core.layout import MEM_STAGE, NPARAM, Block
 
 # ---- PID (controllers/common.py)
 # The two PID controllers (paper, cascade-pid) and the recovery controller's

@@ -7,10 +7,10 @@ functions without touching the others.
 
 import numpy as np
 
-from .actuators import rotor_rates
-from .compiled import compiled
-from .contact import contact_wrench
-from .layout import (
+from quadimpact.core.actuators import rotor_rates
+from quadimpact.core.compiled import compiled
+from quadimpact.core.contact import contact_wrench
+from quadimpact.core.layout import (
     N_ROTORS,
     O_SPINUP_PAPER,
     O_YAW_REACTION_PAPER,
@@ -21,10 +21,10 @@ from .layout import (
     X_QUAT,
     X_ROTOR,
 )
-from .quaternion import rotation_matrix
-from .records import Data, Model, Work
-from .rigid_body import rigid_body_derivative
-from .rotors import rotor_wrench
+from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.records import Data, Model, Work
+from quadimpact.core.rigid_body import rigid_body_derivative
+from quadimpact.core.rotors import rotor_wrench
 
 
 @compiled(inline="always")

@@ -16,13 +16,13 @@ regula falsi, bracketing all along, to ``opts[O_EVENT_TOL]`` in time.
 
 import numpy as np
 
-from .compiled import compiled
-from .contact import contact_gap
-from .geometry import pair_depth
-from .integrator import dense_eval
-from .layout import CS_ACTIVE, O_EVENT_TOL, X_POS, X_QUAT
-from .quaternion import rotation_matrix
-from .records import Data, Model, Work
+from quadimpact.core.compiled import compiled
+from quadimpact.core.contact import contact_gap
+from quadimpact.core.geometry import pair_depth
+from quadimpact.core.integrator import dense_eval
+from quadimpact.core.layout import CS_ACTIVE, O_EVENT_TOL, X_POS, X_QUAT
+from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.records import Data, Model, Work
 
 EV_GAP = 0
 EV_RATE = 1

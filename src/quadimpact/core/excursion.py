@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-from .compiled import compiled
-from .layout import EX_COS_TILT, EX_DEV, EX_DEV_TRIG, EX_REF_TRIG
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import EX_COS_TILT, EX_DEV, EX_DEV_TRIG, EX_REF_TRIG
 
 GIMBAL_LOCK_COS = 1e-9
 """``cos(pitch)`` below which only the rotation about the vertical is defined (as

@@ -28,8 +28,8 @@ import math
 
 import numpy as np
 
-from .compiled import compiled
-from .layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import (
     E_FEATURE,
     E_PEAK_DELTA,
     E_PEAK_FORCE,

@@ -9,7 +9,7 @@ the run loop; nothing here knows about quadrotors.
 
 import numpy as np
 
-from .compiled import compiled
+from quadimpact.core.compiled import compiled
 
 # Butcher tableau
 C2, C3, C4, C5 = 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0

@@ -17,13 +17,13 @@ events, so a trial step never integrates a force switched on mid-step.
 
 import numpy as np
 
-from .actuators import apply_segment, next_boundary, segment_at
-from .compiled import compiled
-from .contact import contact_gap
-from .dynamics import state_derivative
-from .events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
-from .geometry import pair_depth
-from .integrator import (
+from quadimpact.core.actuators import apply_segment, next_boundary, segment_at
+from quadimpact.core.compiled import compiled
+from quadimpact.core.contact import contact_gap
+from quadimpact.core.dynamics import state_derivative
+from quadimpact.core.events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
+from quadimpact.core.geometry import pair_depth
+from quadimpact.core.integrator import (
     all_finite,
     copy_into,
     dense_coefficients,
@@ -32,7 +32,7 @@ from .integrator import (
     stage_state,
     step_factor,
 )
-from .layout import (
+from quadimpact.core.layout import (
     CRASH_CM_GROUND,
     CS_ACTIVE,
     CS_EPISODE,
@@ -79,8 +79,8 @@ from .layout import (
     X_QUAT,
     X_ROTOR,
 )
-from .quaternion import rotation_matrix
-from .recording import (
+from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.recording import (
     close_episode,
     observe_peak,
     open_episode,
@@ -88,8 +88,8 @@ from .recording import (
     track_extremes,
     write_sample,
 )
-from .records import Data, Model, Output, Work
-from .sensors.stage import sample_at, take_sample
+from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.sensing import sample_at, take_sample
 
 MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
 

@@ -109,7 +109,7 @@ class ControllerKind(IntEnum):
     PAPER = 1
     CASCADE_PID = 2
     RECOVERY = 3
-    USER = 99  # a plug-in compiled into its own loop (core/run.py, make_kernel)
+    USER = 99  # a plug-in compiled into its own loop (core/kernel.py, make_kernel)
 
 
 class EstimatorKind(IntEnum):
@@ -118,7 +118,7 @@ class EstimatorKind(IntEnum):
     IDEAL = 0  # the true state (and the gyro as measured): every result as before estimators
     COMPLEMENTARY = 1  # Mahony-type nonlinear complementary filter
     EKF = 2  # multiplicative (error-state) extended Kalman filter
-    USER = 99  # a plug-in compiled into its own loop (core/run.py, make_kernel)
+    USER = 99  # a plug-in compiled into its own loop (core/kernel.py, make_kernel)
 
 
 class RotorMode(IntEnum):
@@ -460,7 +460,9 @@ MS_MAG_T = _ms.slot("MS_MAG_T")  # s, its time (NaN: none)
 MS_POSE = _ms.slot("MS_POSE", 7)  # latest pose measurement: position (inertial, m), quaternion
 MS_POSE_T = _ms.slot("MS_POSE_T")  # s, the IMU sample at which it arrived (NaN: none)
 N_USER_MEAS = 8
-MS_USER = _ms.slot("MS_USER", N_USER_MEAS)  # a plug-in sensor's readings (core/run.py, make_kernel)
+MS_USER = _ms.slot(
+    "MS_USER", N_USER_MEAS
+)  # a plug-in sensor's readings (core/kernel.py, make_kernel)
 NMEAS = _ms.end("NMEAS")
 
 # ---- sensor state sst (NSST)

@@ -10,7 +10,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .compiled import compiled
+from quadimpact.core.compiled import compiled
 
 
 @njit(cache=True, inline="always")

@@ -11,12 +11,12 @@ import math
 
 import numpy as np
 
-from .compiled import compiled
-from .contact import pair_damping, pair_normal_force
-from .excursion import excursion_add
-from .geometry import pair_depth
-from .integrator import dense_eval
-from .layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.contact import pair_damping, pair_normal_force
+from quadimpact.core.excursion import excursion_add
+from quadimpact.core.geometry import pair_depth
+from quadimpact.core.integrator import dense_eval
+from quadimpact.core.layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
@@ -62,9 +62,9 @@ from .layout import (
     X_POS,
     X_QUAT,
 )
-from .quaternion import rotation_matrix
-from .records import Data, Model, Output, Work
-from .sensors.disturbance import impact_onset
+from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.sensors.disturbance import impact_onset
 
 
 @compiled

@@ -39,7 +39,7 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
-from .layout import (
+from quadimpact.core.layout import (
     MAX_AVERAGE_WINDOW,
     N_ROTORS,
     NCS,

@@ -6,8 +6,8 @@
 
 import numpy as np
 
-from .compiled import compiled
-from .layout import V_INERTIA, V_INERTIA_INV, V_MASS, X_OMEGA, X_POS, X_QUAT, X_VEL
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import V_INERTIA, V_INERTIA_INV, V_MASS, X_OMEGA, X_POS, X_QUAT, X_VEL
 
 
 @compiled

@@ -20,7 +20,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .compiled import compiled
+from quadimpact.core.compiled import compiled
 
 __all__ = [
     "BRENT_ASK",

@@ -15,8 +15,8 @@ spin-up term without the spin sign, ``-Jr sum_j Omega_dot_j``
 
 import numpy as np
 
-from .compiled import compiled
-from .layout import N_ROTORS, V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import N_ROTORS, V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
 
 
 @compiled

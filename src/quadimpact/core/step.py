@@ -21,7 +21,7 @@ Everything that survives from one tick to the next is in the run's records
 ``d`` and the :class:`Output` ``o`` (counters are live in ``o.stats``, so a
 run stopped after any tick can be read). :func:`start` initialises ``d`` and
 ``o``, :func:`advance` runs ``n`` ticks (or to the end) and :func:`finish`
-closes the open episodes; ``run.run`` is ``start`` + ``advance`` to the end.
+closes the open episodes; ``kernel.run`` is ``start`` + ``advance`` to the end.
 A run advanced tick by tick is the same computation as one advanced all at
 once, bit for bit.
 """
@@ -30,14 +30,14 @@ import math
 
 import numpy as np
 
-from .actuators import apply_command, cut_step
-from .compiled import allocating, compiled
-from .controllers import builtin_step
-from .estimators import at_tick, init_estimate
-from .excursion import excursion_start
-from .hover import track_hover
-from .interval import FAILED, RUNNING, contact_values, integrate_interval
-from .layout import (
+from quadimpact.core.actuators import apply_command, cut_step
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.controllers import builtin_step
+from quadimpact.core.estimators import at_tick, init_estimate
+from quadimpact.core.excursion import excursion_start
+from quadimpact.core.hover_tracking import track_hover
+from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
+from quadimpact.core.layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
@@ -107,10 +107,10 @@ from .layout import (
     X_QUAT,
     X_ROTOR,
 )
-from .quaternion import normalise_quaternion
-from .recording import record_crash, write_sample
-from .records import Data, Model, Output, Work, new_work
-from .sensors.stage import sample_at
+from quadimpact.core.quaternion import normalise_quaternion
+from quadimpact.core.recording import record_crash, write_sample
+from quadimpact.core.records import Data, Model, Output, Work, new_work
+from quadimpact.core.sensing import sample_at
 
 controller_step = builtin_step  # rebound by run.make_kernel for plug-in controllers
 

@@ -16,8 +16,8 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 from quadimpact.core.records import (
     Data,
     Output,
@@ -31,10 +31,10 @@ from quadimpact.core.step import finish
 from quadimpact.envs.settings import TrialDistribution
 from quadimpact.inputs.scenarios import ImpactTrial
 from quadimpact.results.result import SimulationResult
-from quadimpact.simulation.record import episode_columns
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS, recovery_metrics
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
+from quadimpact.simulation.tables import episode_columns
 
 __all__ = ["OUTCOMES", "Slots"]
 

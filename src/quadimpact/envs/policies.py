@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 
 __all__ = ["HoverPolicy", "RandomPolicy", "RecoveryPolicy"]
 

@@ -20,7 +20,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from quadimpact.core import batch as B
+from quadimpact.core.envs import stacked as B
 from quadimpact.inputs.scenarios import ImpactTrial
 
 __all__ = [

@@ -12,8 +12,8 @@ from typing import Any, Literal
 import gymnasium as gym
 import numpy as np
 
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 from quadimpact.envs.engine import Slots
 from quadimpact.envs.settings import (
     Envelope,

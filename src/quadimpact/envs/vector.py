@@ -19,8 +19,8 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode, VectorEnv
 from gymnasium.vector.utils import batch_space
 
-from quadimpact.core import batch as B
 from quadimpact.core import layout as L
+from quadimpact.core.envs import stacked as B
 from quadimpact.envs.single import check_actions, check_options, configure, spaces_for
 
 __all__ = ["BatchedImpactRecoveryEnv"]

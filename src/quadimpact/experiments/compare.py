@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 
 from quadimpact import libm
-from quadimpact.experiments.estimation import MOCAP_GAP_S, bumper_rim_extent
+from quadimpact.experiments.log_estimates import MOCAP_GAP_S, bumper_rim_extent
 from quadimpact.experiments.logs import FlightLog, PreImpact
 from quadimpact.linalg import norm
 from quadimpact.rotations import quat_to_matrix, unwrap_deg, wrap_angle_deg

@@ -15,7 +15,7 @@ first body -> inertial, ZYX Euler angles), on one reference clock:
   rates in quadimpact's frames.
 
 The Spiri crash-set reader is :class:`~quadimpact.experiments.spiri_mat.SpiriMatLog`;
-the estimators it uses are in :mod:`~quadimpact.experiments.estimation`. What
+the estimators it uses are in :mod:`~quadimpact.experiments.log_estimates`. What
 was established from the data, the frames and the estimation methods are
 written in ``docs/EXPERIMENTS.md``.
 

@@ -4,7 +4,7 @@
 bags) as a :class:`~quadimpact.experiments.logs.FlightLog`; what was
 established from the data and the frames are written in
 ``docs/EXPERIMENTS.md``. The estimates (impact, contact, pre-impact
-conditions) are :mod:`~quadimpact.experiments.estimation`'s.
+conditions) are :mod:`~quadimpact.experiments.log_estimates`'s.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from quadimpact.experiments.estimation import (
+from quadimpact.experiments.log_estimates import (
     MOCAP_GAP_S,
     POWER_OFF_RPM,
     estimate_pre_impact,
@@ -26,7 +26,7 @@ from quadimpact.experiments.estimation import (
     segments,
 )
 from quadimpact.experiments.logs import DATA_ENV_VAR, FlightLog, PreImpact, data_dir, rpm_to_rad_s
-from quadimpact.inputs.files import read_toml_file
+from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.rotations import (
     matrix_to_euler_zyx_deg,
     matrix_to_quat,
@@ -356,7 +356,7 @@ class SpiriMatLog(FlightLog):
 
     def pre_impact(self) -> PreImpact:
         """Pre-impact conditions from the motion capture
-        (:func:`~quadimpact.experiments.estimation.estimate_pre_impact`: method in
+        (:func:`~quadimpact.experiments.log_estimates.estimate_pre_impact`: method in
         ``docs/EXPERIMENTS.md``; the set's wall plane ``SET1_WALL_X_M`` and clock
         offset ``SET1_MOCAP_CLOCK_OFFSET_S`` serve where the contact is not observed)."""
         return self._pre_impact

@@ -1,7 +1,7 @@
 """What users write, validated: vehicles, scenarios, surfaces, model options, input files.
 
 * :mod:`~quadimpact.inputs.types`: validated number and array types;
-* :mod:`~quadimpact.inputs.files`: the TOML reader, the vehicle-path rule and
+* :mod:`~quadimpact.inputs.toml_files`: the TOML reader, the vehicle-path rule and
   the overrides of file values (flags, swept values);
 * :mod:`~quadimpact.inputs.vehicle`: :class:`Vehicle`, the bundled vehicles
   (``vehicles/*.toml``);

@@ -25,8 +25,8 @@ import typing
 from collections.abc import Iterable, Mapping
 from typing import Any, Literal
 
-from quadimpact.inputs.files import apply_overrides
 from quadimpact.inputs.scenarios import Scenario, scenario_from_dict
+from quadimpact.inputs.toml_files import apply_overrides
 
 __all__ = ["ScenarioFactory", "same_scenario"]
 

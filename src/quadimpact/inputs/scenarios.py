@@ -59,8 +59,8 @@ from typing import Any, ClassVar, Literal
 from pydantic import Field, ValidationError, field_validator, model_validator
 
 from quadimpact.errors import InputError, format_value, input_error_from_validation
-from quadimpact.inputs.files import locate_vehicle, read_toml_file
 from quadimpact.inputs.run_settings import PowerOff, RunSettings, check_before_final, check_euler
+from quadimpact.inputs.toml_files import locate_vehicle, read_toml_file
 from quadimpact.inputs.types import Real, Vec3, Vec4
 from quadimpact.inputs.world import Plane
 
@@ -345,7 +345,7 @@ def load_scenario_file(path: str | Path) -> Scenario:
     """Read and validate a scenario TOML file (format in this module's docstring).
 
     A relative ``vehicle`` path is looked up next to the scenario file first
-    (:func:`~quadimpact.inputs.files.locate_vehicle`).
+    (:func:`~quadimpact.inputs.toml_files.locate_vehicle`).
     The vehicle and its overrides are validated too, so that a bad vehicle
     is reported now, naming the file and field.
 

@@ -30,7 +30,7 @@ from pydantic import BaseModel, Field, ValidationError, field_validator, model_v
 
 from quadimpact.errors import InputError, input_error_from_validation, near_miss
 from quadimpact.inputs.features import ContactFeature
-from quadimpact.inputs.files import read_toml_file
+from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec3, Vec4
 from quadimpact.linalg import norm
 

@@ -3,7 +3,7 @@
 * :mod:`~quadimpact.simulation.packing`: validated inputs -> the kernel's flat arrays;
 * :mod:`~quadimpact.simulation.approach`: the wall approach's attitude and shooting;
 * :mod:`~quadimpact.simulation.setup`: :class:`RunSetup`, ``prepare(scenario)``;
-* :mod:`~quadimpact.simulation.record`: raw kernel arrays -> episodes and time series;
+* :mod:`~quadimpact.simulation.tables`: raw kernel arrays -> episodes and time series;
 * :mod:`~quadimpact.simulation.metrics`: impacts, metrics, response types;
 * :mod:`~quadimpact.simulation.summary`: the summary of a run;
 * :mod:`~quadimpact.simulation.recovery_metrics`: detection and recovery metrics;

@@ -23,8 +23,8 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core.approach import APPROACH_MAX_ITER, APPROACH_TOL_M_S
 from quadimpact.core.geometry import pair_depths, pair_table
+from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
-from quadimpact.core.run import BUILTIN, Kernel
 from quadimpact.linalg import matvec_t
 from quadimpact.results.costs import CpuClock
 from quadimpact.rotations import inclination_deg, quat_to_matrix

@@ -37,8 +37,8 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import Model, Output, RawRecord, new_output, raw_record
-from quadimpact.core.run import BUILTIN
 from quadimpact.results.costs import cpu_time
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse

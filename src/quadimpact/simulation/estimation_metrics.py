@@ -1,7 +1,7 @@
 """Estimation metrics of a run (docs/ESTIMATION.md 4): the estimate's errors by phase.
 
 The loop accumulates, at every IMU sample, each error of the estimate
-against the truth (``core/estimators/errors.py``): the attitude error (the
+against the truth (``core/estimators/estimate_errors.py``): the attitude error (the
 angle of ``q_hat (x) q^-1``, deg), the velocity error (``|v_hat - v|``, m/s,
 inertial CM velocity), the gyro-bias error (``|b_hat - b|``, rad/s) and the
 position error (``|p_hat - p|``, m), in three phases: ``pre`` (before the

@@ -34,8 +34,8 @@ from quadimpact.simulation.metrics import (
     impacts_of_table,
     n_rows,
 )
-from quadimpact.simulation.record import episode_lists_of
 from quadimpact.simulation.recovery_metrics import first_obstacle_episode
+from quadimpact.simulation.tables import episode_lists_of
 
 __all__ = ["GROUND_NAME", "RunEpisodes", "run_episodes"]
 

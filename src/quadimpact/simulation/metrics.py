@@ -4,7 +4,7 @@ attitude excursion and the response type.
 Everything here is a pure function of tables or plain lists, so it can be
 tested on hand-made inputs. A "table" is anything whose columns are read
 with ``table[name]``: a pandas DataFrame (the episodes and time series of
-:mod:`quadimpact.simulation.record`) or a plain mapping of NumPy arrays (what
+:mod:`quadimpact.simulation.tables`) or a plain mapping of NumPy arrays (what
 ``simulate`` uses, so that a summary needs no DataFrame). Definitions follow
 docs/STUDIES.md sections 2 and 3; frames and units docs/MODEL.md section 1
 (inertial NED, body FRD, SI).
@@ -367,8 +367,8 @@ def impact_metrics(
     Parameters
     ----------
     episodes : table
-        Episodes (:func:`~quadimpact.simulation.record.episodes_frame`, or its
-        columns as arrays: :func:`~quadimpact.simulation.record.episode_columns`).
+        Episodes (:func:`~quadimpact.simulation.tables.episodes_frame`, or its
+        columns as arrays: :func:`~quadimpact.simulation.tables.episode_columns`).
     exclude_surfaces : sequence of str
         Surfaces whose episodes are ignored (by default the ground, when it is
         a contact surface: touching down is not an impact with the obstacle).
@@ -447,8 +447,8 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
     Parameters
     ----------
     ts : table
-        Time series (:func:`~quadimpact.simulation.record.timeseries_frame` or
-        its columns :func:`~quadimpact.simulation.record.timeseries_columns`):
+        Time series (:func:`~quadimpact.simulation.tables.timeseries_frame` or
+        its columns :func:`~quadimpact.simulation.tables.timeseries_columns`):
         uses ``roll_deg``, ``pitch_deg``, ``yaw_deg`` and, for the tilt,
         ``q0..q3`` (falling back to the Euler angles when the quaternion
         columns are absent). A run's summary has the same numbers from its

@@ -25,8 +25,8 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
+from quadimpact.core.kernel import Kernel, make_kernel
 from quadimpact.core.records import Model, model
-from quadimpact.core.run import Kernel, make_kernel
 from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions

@@ -2,7 +2,7 @@
 
 ``simulate`` prepares the packed inputs (:func:`~quadimpact.simulation.setup.prepare`),
 runs the compiled loop once, and reads its raw record into tables
-(:mod:`~quadimpact.simulation.record`) and the summary
+(:mod:`~quadimpact.simulation.tables`) and the summary
 (:mod:`~quadimpact.simulation.summary`).
 """
 
@@ -13,13 +13,15 @@ from typing import Any
 
 from quadimpact import __version__
 from quadimpact.core import layout as L
-from quadimpact.core.run import Kernel, execute
+from quadimpact.core.kernel import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.results.costs import cpu_time
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.impacts import run_episodes
 from quadimpact.simulation.packing import feature_records, surface_records
-from quadimpact.simulation.record import (
+from quadimpact.simulation.setup import RunSetup, prepare
+from quadimpact.simulation.summary import build_summary
+from quadimpact.simulation.tables import (
     episode_columns,
     episodes_frame,
     imu_columns,
@@ -27,8 +29,6 @@ from quadimpact.simulation.record import (
     timeseries_columns,
     timeseries_frame,
 )
-from quadimpact.simulation.setup import RunSetup, prepare
-from quadimpact.simulation.summary import build_summary
 
 __all__ = ["analyse", "run_cost", "run_setup", "simulate", "world_record"]
 
@@ -48,7 +48,7 @@ def simulate(
     max_episodes : int
         Size of the episode buffer; episodes beyond it are counted and reported.
     kernel : Kernel, optional
-        A run loop from ``quadimpact.core.run.make_kernel`` (plug-ins);
+        A run loop from ``quadimpact.core.kernel.make_kernel`` (plug-ins);
         default: the registered controller's (the cached kernel for built-ins).
         A wall approach's shooting runs fly with it too.
 

@@ -27,8 +27,8 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core import step as core_step
+from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import new_data, new_output, raw_record
-from quadimpact.core.run import BUILTIN, Kernel
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.checks import whole_ticks
 from quadimpact.simulation.setup import RunSetup, prepare

@@ -68,7 +68,7 @@ Worker processes never outlive the sweep, even after ``kill -9``
 
 from quadimpact.sweep.interrupt import SweepInterrupted
 from quadimpact.sweep.pool import WorkerError
-from quadimpact.sweep.run import LARGE_SWEEP_RUNS, run_sweep
+from quadimpact.sweep.runner import LARGE_SWEEP_RUNS, run_sweep
 from quadimpact.sweep.spec import SweepSpec, load_sweep_file
 from quadimpact.sweep.store import (
     COST_COLUMNS,

@@ -17,7 +17,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from quadimpact.inputs.files import apply_overrides
+from quadimpact.inputs.toml_files import apply_overrides
 
 __all__ = ["RunInputs", "SweepBase", "scenario_of"]
 

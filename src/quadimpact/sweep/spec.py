@@ -12,7 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from quadimpact.errors import InputError, format_value
-from quadimpact.inputs.files import apply_overrides, locate_vehicle, read_toml_file
+from quadimpact.inputs.toml_files import apply_overrides, locate_vehicle, read_toml_file
 from quadimpact.sweep.items import SweepBase
 from quadimpact.sweep.values import (
     MAX_RUNS,

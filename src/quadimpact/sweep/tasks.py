@@ -89,7 +89,7 @@ def run_tasks(
             if on_done is not None:
                 on_done(i, results[-1])
         return results
-    from quadimpact.sweep.run import _refuse_in_a_starting_worker
+    from quadimpact.sweep.runner import _refuse_in_a_starting_worker
 
     _refuse_in_a_starting_worker()
     ctx = pool_context()

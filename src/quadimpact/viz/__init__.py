@@ -7,7 +7,7 @@
 * :mod:`quadimpact.viz.snapshots`: ``snapshots.png``/``.pdf``;
 * :mod:`quadimpact.viz.animation`: ``animation.mp4``/``.gif``;
 * :mod:`quadimpact.viz.viewer`: ``viewer.html``;
-* the commands ``quadimpact snapshots|animate|view`` are in :mod:`quadimpact.cli.viz`.
+* the commands ``quadimpact snapshots|animate|view`` are in :mod:`quadimpact.cli.viz_commands`.
 
 Submodules are imported on demand (matplotlib and the compiled core are not
 loaded by ``import quadimpact.viz``).

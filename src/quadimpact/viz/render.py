@@ -22,7 +22,7 @@ from matplotlib.patches import FancyArrowPatch, Polygon
 from quadimpact.core import layout as L
 from quadimpact.viz.camera import Camera
 from quadimpact.viz.scene import Scene
-from quadimpact.viz.world import plane_axes, plane_grid, shape_lines
+from quadimpact.viz.world_drawing import plane_axes, plane_grid, shape_lines
 
 __all__ = ["FORCE_COLOR", "GROUND_COLOR", "SceneArtists", "WALL_COLOR", "wall_range"]
 

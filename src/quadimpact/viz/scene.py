@@ -28,7 +28,7 @@ and the sampled states of a run:
 A :class:`Scene` holds one run; :meth:`Scene.frame` gives every polyline and
 contact of one instant, and :meth:`Camera.project` puts points on the screen.
 The vehicle's drawing is :mod:`quadimpact.viz.vehicle_drawing`, the surfaces'
-:mod:`quadimpact.viz.world` (their names are importable from here too).
+:mod:`quadimpact.viz.world_drawing` (their names are importable from here too).
 """
 
 from __future__ import annotations
@@ -57,7 +57,7 @@ from quadimpact.viz.vehicle_drawing import (
     scene_vehicle,
     to_inertial,
 )
-from quadimpact.viz.world import (
+from quadimpact.viz.world_drawing import (
     plane_axes,
     plane_grid,
     rim_points,

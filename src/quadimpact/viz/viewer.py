@@ -37,7 +37,7 @@ from quadimpact.viz.camera import DEFAULT_VIEWER_CAMERA, Camera
 from quadimpact.viz.render import WALL_WIDTH_M
 from quadimpact.viz.scene import Scene
 from quadimpact.viz.vehicle_drawing import BUMPER_NAMES
-from quadimpact.viz.world import shape_lines
+from quadimpact.viz.world_drawing import shape_lines
 
 __all__ = ["DEFAULT_VIEWER_CAMERA", "VIEWER_HTML", "viewer_data", "viewer_html", "write_viewer"]
 

@@ -31,11 +31,19 @@ and runs in a loop compiled around it (``core.run.make_kernel``).
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import C_KIND, CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, MS_X, N_ROTORS, X_ROTOR
-from .cascade_pid import cascade_pid_step
-from .paper import paper_step
-from .recovery import recovery_step
+from quadimpact.core.compiled import compiled
+from quadimpact.core.controllers.cascade_pid import cascade_pid_step
+from quadimpact.core.controllers.paper import paper_step
+from quadimpact.core.controllers.recovery import recovery_step
+from quadimpact.core.layout import (
+    C_KIND,
+    CTRL_CASCADE_PID,
+    CTRL_PAPER,
+    CTRL_RECOVERY,
+    MS_X,
+    N_ROTORS,
+    X_ROTOR,
+)
 
 
 @compiled

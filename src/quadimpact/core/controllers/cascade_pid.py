@@ -12,8 +12,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..controller_layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.controller_layout import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -36,7 +36,12 @@ from ..controller_layout import (
     P_GAINS,
     P_THRUST_COS_FLOOR,
 )
-from ..layout import (
+from quadimpact.core.controllers.common import (
+    allocate,
+    attitude_altitude,
+    linearised_torques,
+)
+from quadimpact.core.layout import (
     C_H_REF,
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -51,12 +56,7 @@ from ..layout import (
     V_MASS,
     X_OMEGA,
 )
-from ..quaternion import wrap_pi
-from .common import (
-    allocate,
-    attitude_altitude,
-    linearised_torques,
-)
+from quadimpact.core.quaternion import wrap_pi
 
 FADE_POWER = 4.0  # thrust fade beyond the tilt floor (tilt_compensation)
 

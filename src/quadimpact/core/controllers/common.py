@@ -7,8 +7,8 @@ import math
 
 import numpy as np
 
-from ..compiled import allocating, compiled
-from ..layout import (
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.layout import (
     C_ALLOC_INV,
     N_ROTORS,
     V_INERTIA,
@@ -17,7 +17,7 @@ from ..layout import (
     X_QUAT,
     X_VEL,
 )
-from ..quaternion import euler_zyx
+from quadimpact.core.quaternion import euler_zyx
 
 
 @compiled

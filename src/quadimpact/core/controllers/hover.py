@@ -25,9 +25,9 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import X_POS, X_QUAT, X_VEL
-from ..quaternion import wrap_pi
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import X_POS, X_QUAT, X_VEL
+from quadimpact.core.quaternion import wrap_pi
 
 
 @compiled

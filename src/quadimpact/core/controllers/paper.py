@@ -16,8 +16,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..controller_layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.controller_layout import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -32,7 +32,12 @@ from ..controller_layout import (
     M_STARTED,
     P_GAINS,
 )
-from ..layout import (
+from quadimpact.core.controllers.common import (
+    allocate,
+    attitude_altitude,
+    linearised_torques,
+)
+from quadimpact.core.layout import (
     C_H_REF,
     C_PARAMS,
     C_PHI_REF,
@@ -44,12 +49,7 @@ from ..layout import (
     V_MASS,
     X_OMEGA,
 )
-from ..quaternion import wrap_pi
-from .common import (
-    allocate,
-    attitude_altitude,
-    linearised_torques,
-)
+from quadimpact.core.quaternion import wrap_pi
 
 
 @compiled

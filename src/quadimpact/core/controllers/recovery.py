@@ -61,8 +61,8 @@ import math
 
 import numpy as np
 
-from ..compiled import allocating, compiled
-from ..controller_layout import (
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.controller_layout import (
     HOLD_CAPTURE_M_S,
     HOLD_GIVEN,
     HOLD_STOP,
@@ -95,7 +95,11 @@ from ..controller_layout import (
     STAGE_RECOVERED,
     STAGE_TILTED,
 )
-from ..layout import (
+from quadimpact.core.controllers.cascade_pid import cascade_pid_step
+from quadimpact.core.controllers.common import allocate, linearised_torques
+from quadimpact.core.controllers.hover import hover_acceleration, yaw_of
+from quadimpact.core.controllers.paper import paper_step
+from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
     C_PARAMS,
@@ -114,11 +118,7 @@ from ..layout import (
     X_ROTOR,
     X_VEL,
 )
-from ..quaternion import rotation_matrix
-from .cascade_pid import cascade_pid_step
-from .common import allocate, linearised_torques
-from .hover import hover_acceleration, yaw_of
-from .paper import paper_step
+from quadimpact.core.quaternion import rotation_matrix
 
 
 @compiled

@@ -31,8 +31,11 @@ import math
 import numpy as np
 from numba import njit
 
-from ..compiled import allocating, compiled
-from ..layout import (
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.estimators.complementary import complementary_sample
+from quadimpact.core.estimators.ekf import ekf_init, ekf_sample
+from quadimpact.core.estimators.estimate_errors import record_estimate
+from quadimpact.core.layout import (
     EC_INIT_ATT,
     EC_INIT_BIAS,
     EC_INIT_POS,
@@ -59,12 +62,9 @@ from ..layout import (
     X_QUAT,
     X_VEL,
 )
-from ..records import Data, Model, Output, Work
-from ..sensors.measurement import measure
-from ..sensors.rotvec import dcm, rotate_by
-from .complementary import complementary_sample
-from .ekf import ekf_init, ekf_sample
-from .errors import record_estimate
+from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.sensors.measurement import measure
+from quadimpact.core.sensors.rotvec import dcm, rotate_by
 
 
 @njit(cache=True, inline="always")

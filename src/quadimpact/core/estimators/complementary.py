@@ -37,8 +37,9 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.layout import (
     EC_GATE,
     EC_K_ACC,
     EC_K_BIAS,
@@ -60,9 +61,8 @@ from ..layout import (
     SC_POSE_ATT,
     V_GRAVITY,
 )
-from ..records import Data, Model
-from ..sensors.rotvec import dcm, error_vector, rotate_by
-from .navigation import integrate_navigation
+from quadimpact.core.records import Data, Model
+from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
 
 
 @compiled

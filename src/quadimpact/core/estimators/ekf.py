@@ -41,8 +41,9 @@ import math
 
 import numpy as np
 
-from ..compiled import allocating, compiled
-from ..layout import (
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.layout import (
     EC_DEWEIGHT,
     EC_GATE,
     EC_GATE_MODE,
@@ -75,9 +76,8 @@ from ..layout import (
     SC_POSE_ATT,
     V_GRAVITY,
 )
-from ..records import Data, Model
-from ..sensors.rotvec import dcm, error_vector, rotate_by
-from .navigation import integrate_navigation
+from quadimpact.core.records import Data, Model
+from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
 
 
 @compiled

@@ -14,8 +14,8 @@ position estimate quadratically.
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import ES_POS, ES_VEL
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import ES_POS, ES_VEL
 
 
 @compiled

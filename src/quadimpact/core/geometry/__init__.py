@@ -56,8 +56,13 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..compiled import compiled
-from ..layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.geometry.box import box_distance, point_box, sphere_box
+from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
+from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
+from quadimpact.core.geometry.plane import plane_distance, point_plane, ring_plane, sphere_plane
+from quadimpact.core.geometry.ring import ring_solid
+from quadimpact.core.layout import (
     F_KIND,
     FEAT_POINT,
     FEAT_RING,
@@ -73,11 +78,6 @@ from ..layout import (
     FeatureKind,
     ShapeKind,
 )
-from .box import box_distance, point_box, sphere_box
-from .cylinder import cylinder_distance, point_cylinder, sphere_cylinder
-from .plane import plane_distance, point_plane, ring_plane, sphere_plane
-from .record import ContactRecord, no_contact
-from .ring import ring_solid
 
 __all__ = [
     "GEOMETRIES",

@@ -24,8 +24,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ..layout import F_CENTRE, F_NORMAL, F_RADIUS, SH_NORMAL, SH_POINT, X_POS
-from .record import ContactRecord, feature_offset, material_record
+from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
+from quadimpact.core.layout import F_CENTRE, F_NORMAL, F_RADIUS, SH_NORMAL, SH_POINT, X_POS
 
 PARALLEL_EPS = 1e-12  # |w| below this: the circle is parallel to the plane
 

@@ -62,8 +62,13 @@ import math
 import numpy as np
 from numba import njit
 
-from ..compiled import allocating, compiled
-from ..layout import (
+from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.geometry.box import box_depth, box_piece
+from quadimpact.core.geometry.contact_record import ContactRecord, material_record
+from quadimpact.core.geometry.cylinder import cylinder_depth, cylinder_piece
+from quadimpact.core.geometry.plane import plane_depth, plane_distance
+from quadimpact.core.geometry.ring_box import ring_box_exact
+from quadimpact.core.layout import (
     F_CENTRE,
     F_NORMAL,
     F_RADIUS,
@@ -74,11 +79,6 @@ from ..layout import (
     SHAPE_CYLINDER,
     X_POS,
 )
-from .box import box_depth, box_piece
-from .cylinder import cylinder_depth, cylinder_piece
-from .plane import plane_depth, plane_distance
-from .record import ContactRecord, material_record
-from .ring_box import ring_box_exact
 
 TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum
 CREASE_TOL = 1e-9  # m: two faces this close in depth at the deepest point: a crease

@@ -27,8 +27,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import (
     I_HORIZONTAL,
     MS_DETECTED,
     MS_IMU_F,
@@ -45,7 +45,7 @@ from ..layout import (
     ST_N_DETECTIONS,
     ST_T_DETECT,
 )
-from ..records import Data, Model, Output
+from quadimpact.core.records import Data, Model, Output
 
 
 @compiled

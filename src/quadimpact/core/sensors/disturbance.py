@@ -20,8 +20,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import SC_IMPACT_TAU, ST_IMPACT_T, ST_IMPACT_V
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import SC_IMPACT_TAU, ST_IMPACT_T, ST_IMPACT_V
 
 
 @compiled

@@ -36,8 +36,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import (
     FILTER_FIRST_ORDER,
     FILTER_MOVING_AVERAGE,
     I_F,
@@ -73,8 +73,8 @@ from ..layout import (
     X_OMEGA,
     X_VEL,
 )
-from ..records import Data, Model, Output
-from .disturbance import impact_factor
+from quadimpact.core.records import Data, Model, Output
+from quadimpact.core.sensors.disturbance import impact_factor
 
 
 @compiled

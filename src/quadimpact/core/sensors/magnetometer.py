@@ -12,9 +12,18 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import I_MAG, MS_MAG, MS_MAG_T, SC_MAG, SC_MAG_FIELD, SC_MAG_NOISE, SN_MAG, SS_N
-from ..records import Data, Model, Output
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import (
+    I_MAG,
+    MS_MAG,
+    MS_MAG_T,
+    SC_MAG,
+    SC_MAG_FIELD,
+    SC_MAG_NOISE,
+    SN_MAG,
+    SS_N,
+)
+from quadimpact.core.records import Data, Model, Output
 
 
 @compiled

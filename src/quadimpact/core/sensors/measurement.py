@@ -8,8 +8,8 @@ the IMU and the detector write their own fields (``MS_IMU_*``,
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import MS_T, MS_X, NX
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import MS_T, MS_X, NX
 
 
 @compiled

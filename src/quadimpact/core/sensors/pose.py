@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..layout import (
+from quadimpact.core.compiled import compiled
+from quadimpact.core.layout import (
     I_POSE,
     LS_T0,
     MAX_POSE_LAG,
@@ -39,8 +39,8 @@ from ..layout import (
     X_POS,
     X_QUAT,
 )
-from ..records import Data, Model, Output
-from .rotvec import rotate_by
+from quadimpact.core.records import Data, Model, Output
+from quadimpact.core.sensors.rotvec import rotate_by
 
 
 @compiled

@@ -9,8 +9,8 @@ import math
 
 import numpy as np
 
-from ..compiled import compiled
-from ..quaternion import rotation_matrix
+from quadimpact.core.compiled import compiled
+from quadimpact.core.quaternion import rotation_matrix
 
 
 @compiled

@@ -1,0 +1,179 @@
+"""``quadimpact recovery``: the recovery Monte Carlo to a study folder.
+
+The study itself is :mod:`quadimpact.studies.recovery`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from quadimpact.cli.options import out_option, parallel_options, stoppable
+from quadimpact.errors import InputError
+from quadimpact.studies.recovery import DEFAULT_N, ESTIMATORS, IMUS, MODELS, PRE_IMPACTS, SENSORS
+
+__all__ = ["recovery"]
+
+_STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimator", "sensors")
+
+
+@click.command("recovery")
+@out_option(
+    "results/recovery",
+    "Study folder: trials.parquet, report.md, the figures, example/; the sweep itself in "
+    "sweep/ (run the same command again to resume it).",
+)
+@click.option(
+    "--vehicle",
+    metavar="navi|spiri|FILE",
+    help="Bundled vehicle name or a vehicle TOML file. A vehicle without a rotor slew limit "
+    "gets the Navi's (70,000 RPM/s). [default: navi]",
+)
+@click.option(
+    "--n", "n", type=click.IntRange(min=1), metavar="N",
+    help=f"Number of trials. [default: {DEFAULT_N}]",
+)  # fmt: skip
+@click.option(
+    "--seed", type=click.IntRange(min=0), metavar="S",
+    help="Seed of the trials' conditions and of their IMU seeds. [default: 0]",
+)  # fmt: skip
+@click.option("--model", type=click.Choice(MODELS), help="Model variant. [default: default]")
+@click.option("--imu", type=click.Choice(IMUS), help="IMU preset. [default: ideal]")
+@click.option(
+    "--pre-impact", "pre_impact", type=click.Choice(PRE_IMPACTS),
+    help="Rotors before the detection: spin down at the slew limit, or hold. "
+    "[default: spin-down]",
+)  # fmt: skip
+@click.option(
+    "--estimator", metavar="|".join(ESTIMATORS),
+    help="State estimator the controller and the detector read (docs/ESTIMATION.md); a "
+    "registered one is accepted too. [default: ideal]",
+)  # fmt: skip
+@click.option(
+    "--sensors", type=click.Choice(SENSORS),
+    help="A preset of sensors (replaces --imu): impact = the noisy IMU with the impact "
+    "disturbance and a gyro bias walk; indoor = impact + magnetometer + pose sensor.",
+)  # fmt: skip
+@click.option(
+    "--sweep", "sweep_file", type=click.Path(dir_okay=False, path_type=Path),
+    metavar="SWEEP.toml",
+    help="Run this sweep file (its base an impact trial) instead of the authors' distribution.",
+)  # fmt: skip
+@click.option("--no-animation", is_flag=True, help="Do not write the example's animation.")
+@click.option(
+    "--no-example", is_flag=True,
+    help="Do not write the example trial (example/: its files, figure, viewer and animation): "
+    "the study is its trials, table, figures and report. A small study's largest fixed cost.",
+)  # fmt: skip
+@parallel_options
+def recovery(
+    out: Path,
+    vehicle: str | None,
+    n: int | None,
+    seed: int | None,
+    model: str | None,
+    imu: str | None,
+    pre_impact: str | None,
+    estimator: str | None,
+    sensors: str | None,
+    sweep_file: Path | None,
+    no_animation: bool,
+    no_example: bool,
+    workers: int | None,
+    scheduler: str | None,
+    no_progress: bool,
+) -> None:
+    """Monte Carlo of impact trials with the recovery controller.
+
+    N impact trials (docs/RECOVERY.md) drawn from the authors' distribution:
+    roll uniform in +-15 deg, pitch in +-45 deg, yaw in +-45 deg, speed toward
+    the wall in [0.5, 2.5] m/s, each with its own IMU seed from (S, trial
+    index). Writes DIR/trials.parquet (one row per trial: inputs, every
+    metric, inclination_deg = -pitch, bins, outcome class), the success map,
+    success by inclination and speed bin with 95 % Wilson intervals, the
+    distributions of time to recover, height loss and drift, the example
+    trial (figure, viewer, animation) and DIR/report.md. The table is the
+    same on any number of cores or a Dask cluster.
+
+    Ctrl-C (any number of times) or SIGTERM stops it at once and keeps every
+    finished run (exit status 130, 143 for SIGTERM), saying how many; run the
+    same command again to resume.
+
+    \b
+    Examples:
+      quadimpact recovery --out results/recovery
+      quadimpact recovery --vehicle spiri --n 2000 --imu noisy --out results/spiri-noisy
+      quadimpact recovery --estimator ekf --sensors impact --out results/ekf-impact
+      quadimpact recovery --sweep my-trials.toml --out results/mine
+    """
+    from quadimpact.results.files import check_out_dir
+
+    check_out_dir(out, "recovery")
+
+    if scheduler is not None and workers is not None:
+        raise InputError("--workers and --scheduler: give one or the other")
+    if imu is not None and sensors is not None:
+        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
+    values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
+    given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
+    study = None
+    if sweep_file is not None and given:
+        flag = "--" + next(iter(given)).replace("_", "-")
+        raise InputError(f"--sweep: the sweep file sets the trials; {flag} cannot be given with it")
+    if sweep_file is None:  # the options checked before anything heavy loads
+        from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
+
+        try:
+            study = RecoveryStudy(**given)
+        except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
+            field, sep, rest = str(exc).partition(":")
+            raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
+    from quadimpact.sweep.runner import warm_pool
+
+    # the pool's fork server imports the simulator and loads the kernel on another core
+    # while this process imports the study: the trials' pool and the example trial's
+    # process (docs/RECOVERY.md 8) then start from a warm server instead of waiting for it
+    warm_pool(workers, scheduler)
+    from quadimpact.studies.recovery.recovery_study import run_study
+
+    if sweep_file is not None:
+        from quadimpact.sweep import load_sweep_file
+
+        study = load_sweep_file(sweep_file)
+    with stoppable(out):
+        result = run_study(
+            study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
+            example=not no_example, animation=not no_animation,
+        )  # fmt: skip
+    click.echo(_summary(result))
+
+
+def _summary(result) -> str:
+    from quadimpact.results.costs import cost_text
+    from quadimpact.studies.recovery.recovery_report import excluded_text, rate_text
+
+    info, numbers = result.run_info, result.numbers
+    c = numbers["classes"]
+    if info["n_ran"] == 0:
+        ran = "all done before, nothing to run"
+    else:
+        before = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
+        ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{before}"
+    rows = [
+        ("trials", f"{numbers['n']} ({ran})"),
+        ("success", f"{rate_text(numbers['success'])} (recovered / valid trials, 95 % Wilson)"),
+        ("excluded", excluded_text(numbers)),
+        ("if detected", f"{rate_text(numbers['success_detected'])} (recovered / detected impacts)"),
+        (
+            "other",
+            f"recovered below ground level {c['recovered below ground level']} (not "
+            f"successes), not detected {c['not detected']}, false detections "
+            f"{c['false detection']}",
+        ),
+        ("cost", cost_text(result.description["cost"])),
+        ("table", str(result.out_dir / "trials.parquet")),
+        ("report", str(result.report)),
+        ("time", f"{result.elapsed_s:.1f} s"),
+    ]
+    return "\n".join(f"{label:<12}{text}" for label, text in rows)

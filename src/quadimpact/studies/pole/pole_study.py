@@ -1,0 +1,414 @@
+"""The pole study's spec, its run on the sweep machinery and its trials table.
+
+:class:`PoleStudy` is the authors' grid (docs/OBSTACLES.md 3) with options:
+the pitch and offset grids, the baseline controller (the recovery
+controller flies it until the detection), the pole (or any obstacle from a
+file), the vehicle. :func:`run_pole_study` runs every trial through
+:func:`quadimpact.sweep.run_sweep` into ``DIR/sweep/`` (resumable: the same
+command again resumes; a different study in the same folder is refused) and
+writes into ``DIR``:
+
+* ``trials.parquet``: one row per trial and controller: the sweep's row
+  (inputs, outcome, the recovery metrics, the first contact's bumper and
+  normal, ``final_altitude_m``) with ``arm`` (``"baseline"`` or
+  ``"recovery"``), ``pitch_deg``, ``abs_pitch_deg``, ``lateral_offset_m``,
+  ``height_lost_m`` (altitude at the start minus at the end), ``success``
+  (``height_lost_m`` below :data:`SUCCESS_LOSS_M`) and ``pitch_band``;
+* ``study.json``: what ran and the headline numbers;
+* the figures (:mod:`quadimpact.studies.pole.pole_figures`) and ``report.md``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import time
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from quadimpact import __version__
+from quadimpact.errors import InputError, format_value
+from quadimpact.inputs.toml_files import read_toml_file
+from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
+from quadimpact.inputs.world import obstacle_from
+from quadimpact.results.files import atomic_write
+from quadimpact.results.study_files import sweep_history, write_report, write_study_json
+from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+
+if TYPE_CHECKING:
+    import pandas as pd
+# pandas and the recovery analysis are imported where used: a script that imports this
+# module has every worker of its sweeps import it again (multiprocessing runs the main
+# script in each), which must not cost them pandas (0.4 s of CPU each)
+
+__all__ = [
+    "BASELINES",
+    "SUCCESS_LOSS_M",
+    "PoleResult",
+    "PoleStudy",
+    "pole_table",
+    "run_pole_study",
+    "summarise",
+]
+
+#: Height lost over the run below which a trial is a success (the authors' criterion), m.
+SUCCESS_LOSS_M = 2.0
+#: Baseline controllers (the recovery controller flies the same until it detects).
+BASELINES = ("paper", "cascade-pid")
+#: Width of the pitch bands of the success table, deg.
+BAND_DEG = 5.0
+SWEEP_DIR = "sweep"
+TRIALS_PARQUET = "trials.parquet"
+ARMS = ("baseline", "recovery")
+
+
+def _grid(start: float, stop: float, step: float, name: str) -> list[float]:
+    """``start``, ``start + step``, ... to ``stop`` inclusive, rounded to 1e-9."""
+    if not step > 0:
+        raise InputError(f"{name}: the step must be > 0 (got {format_value(step)})")
+    n = int(math.floor((stop - start) / step + 1e-9)) + 1
+    if n < 1:
+        raise InputError(f"{name}: empty range {start:g} to {stop:g}")
+    return [round(start + k * step, 9) + 0.0 for k in range(n)]
+
+
+@dataclass(frozen=True)
+class PoleStudy:
+    """The pole grid and its options (defaults: the authors', docs/OBSTACLES.md 3).
+
+    Attributes
+    ----------
+    vehicle : str
+        Bundled vehicle name or a vehicle TOML file (default the Navi).
+    pitch_max_deg, pitch_step_deg : float
+        Pitch from 0 down to ``-pitch_max_deg`` in steps of ``pitch_step_deg``
+        (negative pitch leans the top toward the pole): 45 and 1.
+    offset_max_m, offset_step_m : float
+        Sideways offset from ``-offset_max_m`` to ``+offset_max_m`` in steps of
+        ``offset_step_m``: 0.35 and 0.01 m.
+    baseline : {"paper", "cascade-pid"}
+        The controller without recovery, holding the initial attitude and the
+        altitude; the recovery controller flies it until the detection.
+    radius_m : float
+        The pole's radius (a vertical infinite cylinder through the origin), m.
+    obstacle_file : str or None
+        A TOML file with ``[[obstacles]]`` (the first is the target) instead of
+        the pole.
+    speed_m_s, altitude_m, start_distance_m : float
+        Speed along +X, initial altitude, CM distance from the obstacle's
+        surface along +X at the start (0.3 m: X = -0.4 m for the pole).
+    friction_coefficient : float
+        Coulomb friction at the bumpers (0.3).
+    final_time_s : float
+        Length of a run, s.
+    """
+
+    vehicle: str = "navi"
+    pitch_max_deg: float = 45.0
+    pitch_step_deg: float = 1.0
+    offset_max_m: float = 0.35
+    offset_step_m: float = 0.01
+    baseline: str = "paper"
+    radius_m: float = 0.1
+    obstacle_file: str | None = None
+    speed_m_s: float = 2.0
+    altitude_m: float = 2.0
+    start_distance_m: float = 0.3
+    friction_coefficient: float = 0.3
+    final_time_s: float = 3.0
+    _vehicle_ref: str = field(init=False, repr=False, compare=False)
+    _obstacles: tuple = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if self.baseline not in BASELINES:
+            known = ", ".join(repr(b) for b in BASELINES)
+            raise InputError(f"baseline: must be one of {known} (got {self.baseline!r})")
+        for name in ("pitch_max_deg", "offset_max_m"):
+            if not getattr(self, name) >= 0:
+                raise InputError(f"{name}: must be >= 0 (got {getattr(self, name)!r})")
+        if not self.radius_m > 0:
+            raise InputError(f"radius_m: must be > 0 (got {self.radius_m!r})")
+        self.pitches()
+        self.offsets()
+        load_vehicle(self.vehicle)
+        ref = self.vehicle
+        if ref not in bundled_vehicles():
+            ref = str(Path(ref).resolve())
+        object.__setattr__(self, "_vehicle_ref", ref)
+        object.__setattr__(self, "_obstacles", tuple(self._read_obstacles()))
+
+    def _read_obstacles(self) -> list[dict[str, Any]]:
+        if self.obstacle_file is None:
+            return [
+                {
+                    "kind": "cylinder",
+                    "name": "pole",
+                    "point_m": [0.0, 0.0, 0.0],
+                    "axis": [0.0, 0.0, 1.0],
+                    "radius_m": float(self.radius_m),
+                }
+            ]
+        where = str(self.obstacle_file)
+        data = read_toml_file(Path(self.obstacle_file), where)
+        items = data.get("obstacles")
+        if not isinstance(items, list) or not items:
+            raise InputError(f"{where}: obstacles: must list at least one [[obstacles]] table")
+        out = []
+        for i, item in enumerate(items):
+            name = item.get("name") if isinstance(item, dict) else None
+            label = f"obstacle {i + 1}" + (f" ({name!r})" if isinstance(name, str) else "")
+            try:
+                obstacle_from(item, label)
+            except ValueError as exc:
+                raise InputError(f"{where}: obstacles: {exc}") from None
+            out.append(dict(item))
+        return out
+
+    def pitches(self) -> list[float]:
+        """Pitch values, deg: 0, -step, ... down to ``-pitch_max_deg``."""
+        values = _grid(0.0, self.pitch_max_deg, self.pitch_step_deg, "pitch_step_deg")
+        return [-v + 0.0 for v in values]
+
+    def offsets(self) -> list[float]:
+        """Offsets, m: ``-offset_max_m`` to ``+offset_max_m``."""
+        m = self.offset_max_m
+        return _grid(-m, m, self.offset_step_m, "offset_step_m")
+
+    def base(self) -> dict[str, Any]:
+        """The impact trial every run starts from (a scenario-file mapping)."""
+        return {
+            "kind": "impact-trial",
+            "vehicle": self._vehicle_ref,
+            "obstacles": [dict(o) for o in self._obstacles],
+            "speed_m_s": float(self.speed_m_s),
+            "altitude_m": float(self.altitude_m),
+            "start_distance_m": float(self.start_distance_m),
+            "friction_coefficient": float(self.friction_coefficient),
+            "final_time_s": float(self.final_time_s),
+            "roll_deg": 0.0,
+            "yaw_deg": 0.0,
+        }
+
+    def arms(self) -> list[dict[str, Any]]:
+        """The two controllers as sweep runs: the baseline, then recovery flying it."""
+        return [
+            {"controller": self.baseline},
+            {
+                "controller": "recovery",
+                "pre_impact": "nominal",
+                "nominal_controller": self.baseline,
+            },
+        ]
+
+    def sweep_spec(self) -> SweepSpec:
+        """The study as a sweep: pitch x offset grid, each point with both controllers."""
+        return SweepSpec(
+            base=self.base(),
+            grid={"pitch_deg": self.pitches(), "lateral_offset_m": self.offsets()},
+            runs=self.arms(),
+            where="pole",
+        )
+
+    def options(self) -> dict[str, Any]:
+        """The options as plain data (``study.json``)."""
+        d = asdict(self)
+        d.pop("_vehicle_ref", None)
+        d.pop("_obstacles", None)
+        d["obstacles"] = [dict(o) for o in self._obstacles]
+        return d
+
+
+# ------------------------------------------------------------------- tables
+def pitch_bands(abs_pitch: np.ndarray) -> list[str]:
+    """Each |pitch|'s band of :data:`BAND_DEG` (0-4, 5-9, ...), labelled by the values in it.
+
+    The largest |pitch| joins the band below when it would be alone in its own
+    (the authors' 45 deg joins 40-44: 40-45).
+    """
+    a = np.asarray(abs_pitch, dtype=float)
+    idx = np.floor(a / BAND_DEG + 1e-9).astype(int)
+    top = int(idx.max()) if idx.size else 0
+    if top > 0 and np.unique(a[idx == top]).size == 1:
+        idx[idx == top] = top - 1
+    labels = {}
+    for k in np.unique(idx):
+        values = a[idx == k]
+        lo, hi = float(values.min()), float(values.max())
+        labels[k] = f"{lo:g}-{hi:g}" if hi > lo else f"{lo:g}"
+    return [labels[k] for k in idx]
+
+
+def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
+    """``trials.parquet``: the sweep's rows and the study's columns (module docstring)."""
+    import pandas as pd
+
+    t = runs.sort_values("run_id").reset_index(drop=True)
+    t["arm"] = np.where(t["run_id"].to_numpy() % 2 == 0, ARMS[0], ARMS[1])
+    t["pitch_deg"] = t["pitch_deg"].astype(float)
+    t["abs_pitch_deg"] = t["pitch_deg"].abs()
+    t["lateral_offset_m"] = t["lateral_offset_m"].astype(float)
+    final = pd.to_numeric(t["final_altitude_m"], errors="coerce").astype(float)
+    t["height_lost_m"] = float(study.altitude_m) - final
+    lost = t["height_lost_m"].to_numpy(dtype=float)
+    t["success"] = np.isfinite(lost) & (lost < SUCCESS_LOSS_M) & (t["status"] != "failed")
+    t["pitch_band"] = pitch_bands(t["abs_pitch_deg"].to_numpy())
+    return t
+
+
+def summarise(table: pd.DataFrame) -> dict[str, Any]:
+    """The headline numbers: success per arm, per pitch band, and how recovery fails."""
+    from quadimpact.studies.recovery.recovery_analysis import rate
+
+    out: dict[str, Any] = {"n_points": int(len(table) // 2), "arms": {}, "bands": []}
+    for arm in ARMS:
+        part = table[table["arm"] == arm]
+        r = rate(int(part["success"].sum()), len(part))
+        contact = part["first_contact_s"].notna()
+        out["arms"][arm] = {
+            "success": asdict(r),
+            "failed_runs": int((part["status"] == "failed").sum()),
+            "contact": int(contact.sum()),
+            "detected": int(part["detected"].fillna(False).astype(bool).sum()),
+            "recovered": int(part["recovered"].fillna(False).astype(bool).sum()),
+            "height_lost_median_m": float(np.nanmedian(part["height_lost_m"])),
+        }
+    bands = sorted(set(table["pitch_band"]), key=lambda b: float(b.split("-")[0]))
+    for band in bands:
+        row: dict[str, Any] = {"band": band}
+        for arm in ARMS:
+            part = table[(table["arm"] == arm) & (table["pitch_band"] == band)]
+            row[arm] = asdict(rate(int(part["success"].sum()), len(part)))
+        out["bands"].append(row)
+    out["failures"] = failure_analysis(table)
+    return out
+
+
+def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
+    """Where recovery fails and why: its failures against the baseline at the same point."""
+    import pandas as pd
+
+    base = table[table["arm"] == "baseline"].set_index(["pitch_deg", "lateral_offset_m"])
+    rec = table[table["arm"] == "recovery"].set_index(["pitch_deg", "lateral_offset_m"])
+    rec = rec.reindex(base.index)
+    b_ok = base["success"].to_numpy(dtype=bool)
+    r_ok = rec["success"].to_numpy(dtype=bool)
+    fail = rec[~r_ok]
+    stage = np.zeros(len(fail), dtype=int)
+    for k in (1, 2, 3, 4):
+        stage = np.where(fail[f"t_stage{k}_s"].notna().to_numpy(), k, stage)
+
+    def spread(values: pd.Series | np.ndarray) -> dict[str, float]:
+        v = np.asarray(values, dtype=float)
+        v = v[np.isfinite(v)]
+        if v.size == 0:
+            return {"n": 0}
+        return {
+            "n": int(v.size),
+            "min": float(v.min()),
+            "median": float(np.median(v)),
+            "max": float(v.max()),
+        }
+
+    abs_pitch = np.abs(np.asarray(fail.index.get_level_values(0), dtype=float))
+    offsets = np.asarray(fail.index.get_level_values(1), dtype=float)
+    tilt = pd.to_numeric(fail["max_tilt_deg"], errors="coerce").to_numpy(dtype=float)
+    normals = [n for n in fail["first_contact_normal"] if isinstance(n, str)]
+    lateral = [abs(json.loads(n)[1]) for n in normals]
+    ok_normals = [n for n in rec[r_ok]["first_contact_normal"] if isinstance(n, str)]
+    ok_lateral = [abs(json.loads(n)[1]) for n in ok_normals]
+    return {
+        "n_points": int(len(base)),
+        "recovery_fails": int((~r_ok).sum()),
+        "both_fail": int((~r_ok & ~b_ok).sum()),
+        "recovery_saves": int((r_ok & ~b_ok).sum()),
+        "recovery_loses": int((~r_ok & b_ok).sum()),
+        "no_contact": int(fail["first_contact_s"].isna().sum()),
+        "not_detected": int(fail["not_detected"].fillna(False).astype(bool).sum()),
+        "stage_reached": {str(k): int((stage == k).sum()) for k in range(5)},
+        "flipped": int(np.sum(tilt > 90.0)),
+        "impacts_after_detection": int(
+            (pd.to_numeric(fail["impacts_after_detection"], errors="coerce") > 0).sum()
+        ),
+        "impacts_after_detection_failures": spread(
+            pd.to_numeric(fail["impacts_after_detection"], errors="coerce")
+        ),
+        "impacts_after_detection_successes": spread(
+            pd.to_numeric(rec[r_ok]["impacts_after_detection"], errors="coerce")
+        ),
+        "max_tilt_deg_successes": spread(
+            pd.to_numeric(rec[r_ok]["max_tilt_deg"], errors="coerce").to_numpy(dtype=float)
+        ),
+        "t_stage4_failures_s": spread(pd.to_numeric(fail["t_stage4_s"], errors="coerce")),
+        "abs_pitch_deg": spread(abs_pitch),
+        "abs_offset_m": spread(np.abs(offsets)),
+        "max_tilt_deg": spread(tilt),
+        "lateral_normal_failures": spread(lateral),
+        "lateral_normal_successes": spread(ok_lateral),
+        "normal_error_deg_failures": spread(pd.to_numeric(fail["normal_error_deg"])),
+        "normal_error_deg_successes": spread(pd.to_numeric(rec[r_ok]["normal_error_deg"])),
+    }
+
+
+# ---------------------------------------------------------------------- run
+@dataclass
+class PoleResult:
+    """What :func:`run_pole_study` produced."""
+
+    out_dir: Path
+    table: pd.DataFrame
+    numbers: dict[str, Any]
+    report: Path
+    figures: list[Path]
+    run_info: dict[str, Any]
+    elapsed_s: float
+
+
+def run_pole_study(
+    study: PoleStudy,
+    out_dir: str | os.PathLike[str],
+    *,
+    workers: int | None = None,
+    scheduler: Any = None,
+    progress: bool = False,
+) -> PoleResult:
+    """Run the pole study into ``out_dir`` (see the module docstring) and report it.
+
+    Raises
+    ------
+    InputError
+        A folder holding a different study, bad workers or scheduler.
+    """
+    from quadimpact.studies.pole import pole_figures as figures
+    from quadimpact.studies.pole import pole_report as report
+
+    start = time.perf_counter()
+    out = Path(out_dir)
+    spec = study.sweep_spec()
+    info = run_sweep(
+        spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
+        load=False,
+    )  # fmt: skip
+    table = pole_table(read_runs(out / SWEEP_DIR), study)
+    atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
+    numbers = summarise(table)
+    paths = figures.write_figures(table, out)
+    elapsed = time.perf_counter() - start
+    run = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
+    run["sweep_s"] = float(info["elapsed_s"])
+    description = {
+        "quadimpact_version": __version__,
+        "study": study.options(),
+        "grid": {"pitch_deg": len(study.pitches()), "lateral_offset_m": len(study.offsets())},
+        "run": run,
+        "sweeps": sweep_history(out, run),
+        "elapsed_s": elapsed,
+        "numbers": numbers,
+    }
+    write_study_json(out, description)
+    md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
+    report_path = write_report(out, md)
+    return PoleResult(out, table, numbers, report_path, paths, info, elapsed)
