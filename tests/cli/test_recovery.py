@@ -105,7 +105,8 @@ def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
                     "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
     assert again.returncode == 0 and "all done before, nothing to run" in again.stdout
     other = run_cli("recovery", "--n", "7", "--out", "r", "--workers", "1", cwd=tmp_path)
-    assert_input_error(other, "holds a different sweep")
+    assert_input_error(other, "holds a recovery study with other options (--n 6 there, 7 asked; "
+                              "--seed 1 there, 0 asked)")  # fmt: skip
 
 
 @pytest.mark.slow  # the study's example with its viewer

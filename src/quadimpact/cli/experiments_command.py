@@ -74,8 +74,9 @@ def experiments(
 
     check_out_dir(out, "experiments")  # before the study's imports: a wrong folder is said at once
     from quadimpact.studies.table3.crash_logs import check_data_dir, logs_source
-    from quadimpact.studies.table3.table3_study import run_experiments
+    from quadimpact.studies.table3.table3_study import run_experiments, study_folder
 
+    study_folder(out, samples, log_samples, where="--out").check()  # other options: refused
     if data is not None:
         check_data_dir(data)
     announce_compilation()

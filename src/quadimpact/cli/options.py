@@ -14,6 +14,17 @@ import click
 from quadimpact.errors import InputError, format_value
 
 
+def allow_large_option(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Add ``--allow-large``: confirm more than a million runs (checked before any planning)."""
+    from quadimpact.sweep.values import LARGE_RUNS
+
+    return click.option(
+        "--allow-large",
+        is_flag=True,
+        help=f"Confirm a study of more than {LARGE_RUNS:,} runs (refused otherwise, at once).",
+    )(command)
+
+
 def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``.
 
@@ -269,10 +280,16 @@ def stopped(exc: BaseException, out: Path | None = None) -> int:
     from quadimpact.sweep import SweepInterrupted
     from quadimpact.sweep.interrupt import signal_name
 
+    if out is not None:
+        from quadimpact.results.files import remove_stale_temporaries
+
+        remove_stale_temporaries(out)  # a worker stopped while writing leaves none behind
     if getattr(exc, "saved", None) is not None:
         resume = f"{exc.saved} of {exc.n_runs} runs saved in {exc.out_dir}; {RESUME}"
-    elif out is not None:
+    elif out is not None and out.is_dir() and any(out.iterdir()):
         resume = f"every finished sweep is saved in {out}; {RESUME}"
+    elif out is not None:
+        resume = f"nothing was saved yet ({out} was not written)"
     else:
         resume = RESUME
     if isinstance(exc, SweepInterrupted):

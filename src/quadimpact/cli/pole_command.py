@@ -6,7 +6,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import out_option, parallel_options
+from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
 
 __all__ = ["pole"]
@@ -57,6 +57,7 @@ __all__ = ["pole"]
     "--speed", "speed_m_s", type=float, default=2.0, show_default=True, metavar="M/S",
     help="Speed along +X.",
 )  # fmt: skip
+@allow_large_option
 @parallel_options
 def pole(
     out: Path,
@@ -69,6 +70,7 @@ def pole(
     radius_m: float,
     obstacle_file: Path | None,
     speed_m_s: float,
+    allow_large: bool,
     workers: int | None,
     scheduler: str | None,
     no_progress: bool,
@@ -94,11 +96,9 @@ def pole(
     """
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
-    from quadimpact.sweep.runner import warm_pool
-
-    warm_pool(workers, scheduler)  # the pool's server warms up while the study is imported
-    from quadimpact.studies.pole.pole_report import rate_text
-    from quadimpact.studies.pole.pole_study import PoleStudy, run_pole_study
+    from quadimpact.studies.pole.pole_study import PoleStudy, run_pole_study, study_folder
+    from quadimpact.studies.statistics import rate_text
+    from quadimpact.sweep.values import check_size
 
     study = PoleStudy(
         vehicle=vehicle,
@@ -111,9 +111,18 @@ def pole(
         obstacle_file=None if obstacle_file is None else str(obstacle_file),
         speed_m_s=speed_m_s,
     )
-    result = run_pole_study(
-        study, out, workers=workers, scheduler=scheduler, progress=not no_progress
-    )
+    n_runs = 2 * len(study.pitches()) * len(study.offsets())
+    check_size(n_runs, allow_large, f"--pitch-step {pitch_step_deg:g}, --offset-step "
+               f"{offset_step_m:g}")  # fmt: skip
+    study_folder(study, out).check()  # another study, or other options: refused at once
+    from quadimpact.sweep.runner import warm_pool
+
+    warm_pool(workers, scheduler)  # the pool's server warms up while the study is imported
+    with stoppable(out):
+        result = run_pole_study(
+            study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
+            allow_large=allow_large,
+        )  # fmt: skip
     arms = result.numbers["arms"]
     info = result.run_info
     click.echo(

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import click
 
-from quadimpact.cli.options import out_option, parallel_options, stoppable
+from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
 from quadimpact.studies.recovery import DEFAULT_N, ESTIMATORS, IMUS, MODELS, PRE_IMPACTS, SENSORS
 
@@ -66,6 +66,7 @@ _STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimat
     help="Do not write the example trial (example/: its files, figure, viewer and animation): "
     "the study is its trials, table, figures and report. A small study's largest fixed cost.",
 )  # fmt: skip
+@allow_large_option
 @parallel_options
 def recovery(
     out: Path,
@@ -80,6 +81,7 @@ def recovery(
     sweep_file: Path | None,
     no_animation: bool,
     no_example: bool,
+    allow_large: bool,
     workers: int | None,
     scheduler: str | None,
     no_progress: bool,
@@ -108,7 +110,10 @@ def recovery(
       quadimpact recovery --sweep my-trials.toml --out results/mine
     """
     from quadimpact.results.files import check_out_dir
+    from quadimpact.sweep.values import check_size
 
+    if n is not None:  # refused at once, before anything is planned or loaded
+        check_size(n, allow_large, f"--n {n}")
     check_out_dir(out, "recovery")
 
     if scheduler is not None and workers is not None:
@@ -141,17 +146,22 @@ def recovery(
         from quadimpact.sweep import load_sweep_file
 
         study = load_sweep_file(sweep_file)
+        check_size(study.n_runs, allow_large, str(sweep_file))
+    from quadimpact.studies.recovery.recovery_study import study_folder
+
+    study_folder(study, out).check()  # another study, or other options: refused at once
     with stoppable(out):
         result = run_study(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
-            example=not no_example, animation=not no_animation,
+            example=not no_example, animation=not no_animation, allow_large=allow_large,
         )  # fmt: skip
     click.echo(_summary(result))
 
 
 def _summary(result) -> str:
     from quadimpact.results.costs import cost_text
-    from quadimpact.studies.recovery.recovery_report import excluded_text, rate_text
+    from quadimpact.studies.recovery.recovery_report import excluded_text
+    from quadimpact.studies.statistics import rate_text
 
     info, numbers = result.run_info, result.numbers
     c = numbers["classes"]

@@ -72,8 +72,12 @@ def reproduce(
 
     check_out_dir(out, "report")  # before the study's imports: a wrong folder is said at once
     from quadimpact.studies.paper.paper_study import reproduce as run_study
+    from quadimpact.studies.paper.paper_study import study_folder
     from quadimpact.studies.table3.crash_logs import check_data_dir, logs_source
 
+    parts = {"ablation": not no_ablation, "experiments": not no_experiments,
+             "recovery": not no_recovery}  # fmt: skip
+    study_folder(out, where="--out", **parts).check()  # other parts: refused at once
     if data is not None and not no_experiments:
         check_data_dir(data)
     announce_compilation()
@@ -95,7 +99,7 @@ def reproduce(
                                                                             "disagrees"))
         )  # fmt: skip
     if result.recovery is not None:
-        from quadimpact.studies.recovery.recovery_report import rate_text
+        from quadimpact.studies.statistics import rate_text
 
         for variant, numbers in result.recovery.monte_carlo.items():
             click.echo(f"recovery       {variant}: {rate_text(numbers['success'])}")

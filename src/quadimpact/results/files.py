@@ -36,6 +36,7 @@ import errno
 import json
 import math
 import os
+import re
 import secrets
 import shutil
 import sys
@@ -72,16 +73,19 @@ __all__ = [
     "DERIVED_FILES",
     "FOLDER_MARKERS",
     "RUN_FILES",
+    "STUDY_JSON",
     "atomic_write",
     "check_out_dir",
     "check_writable",
     "column_unit",
     "folder_kind",
+    "kind_words",
     "staged_folder",
     "read_episodes_csv",
     "read_summary_json",
     "read_timeseries_parquet",
     "read_timeseries_units",
+    "remove_stale_temporaries",
     "split_unit",
     "to_jsonable",
     "write_episodes_csv",
@@ -114,9 +118,12 @@ DERIVED_FILES: tuple[str, ...] = (
 #: order they are recognised.
 #: A study stopped early holds only the folders it had begun (``sweep/`` of a recovery
 #: study, ``sweeps/`` of a report, ``sensitivity/`` of the experiments): they mark it too.
+#: The file a study writes first into its folder (``studies/study_folder.py``): its
+#: ``kind`` says which study the folder is.
+STUDY_JSON = "study.json"
 FOLDER_MARKERS: dict[str, tuple[str, ...]] = {
     "sweep": ("sweep.json", "runs.parquet", "parts"),
-    "recovery": ("study.json", "trials.parquet", "sweep"),
+    "recovery": (STUDY_JSON, "trials.parquet", "sweep"),
     "report": ("report.md", "findings.parquet", "sweeps", "experiments", "recovery"),
     "experiments": ("table3.csv", "table3.parquet", "sensitivity", "sensitivity-log"),
     "run": (SUMMARY_JSON, TIMESERIES_PARQUET),
@@ -124,11 +131,30 @@ FOLDER_MARKERS: dict[str, tuple[str, ...]] = {
 _KIND_WORDS = {
     "sweep": "a sweep",
     "recovery": "a recovery study",
+    "pole": "a pole study",
+    "benchmark": "a benchmark",
+    "estimators": "an estimator study",
     "report": "a study report",
     "experiments": "the crash experiments",
     "run": "a run",
     "other": "files that are not quadimpact's",
 }
+
+
+def kind_words(kind: str) -> str:
+    """What a folder of ``kind`` holds, in words (``"a recovery study"``)."""
+    return _KIND_WORDS.get(kind, f"a {kind} study")
+
+
+def _study_kind(folder: Path) -> str | None:
+    """The ``kind`` a folder's ``study.json`` names (None: no such file or no kind in it)."""
+    try:
+        data = json.loads((folder / STUDY_JSON).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    kind = data.get("kind") if isinstance(data, dict) else None
+    return kind if isinstance(kind, str) and kind in _KIND_WORDS else None
+
 
 #: Schema metadata key holding ``{column: unit}`` as a JSON string.
 UNITS_METADATA_KEY = "quadimpact.units"
@@ -286,6 +312,54 @@ def atomic_write(
     return target
 
 
+#: A temporary file of :func:`atomic_write` (``.<name>.<pid>.<8 hex digits><suffix>``) or a
+#: folder of :func:`staged_folder` (``.<name>.partial-<pid>-<random>``).
+_TEMPORARY = re.compile(
+    r"^\..+?(?:\.(?P<pid>\d+)\.[0-9a-f]{8}(?:\.[^/]*)?|\.partial-(?P<pid2>\d+)-\w+)$"
+)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # another user's process: alive
+        return True
+    return True
+
+
+def remove_stale_temporaries(folder: str | os.PathLike[str]) -> list[Path]:
+    """Remove, under ``folder``, the temporary files and folders of writers no longer running.
+
+    :func:`atomic_write` and :func:`staged_folder` name their temporaries
+    after their process; a process killed while writing (a study's worker
+    stopped by Ctrl-C, ``kill -9``) leaves them behind. Those of a process that
+    no longer exists are removed; those of running processes are kept.
+    Returns what was removed.
+    """
+    removed: list[Path] = []
+    root = Path(folder)
+    if not root.is_dir():
+        return removed
+    for path in sorted(root.rglob(".*")):
+        m = _TEMPORARY.match(path.name)
+        if m is None:
+            continue
+        pid = int(m.group("pid") or m.group("pid2"))
+        if pid == os.getpid() or _alive(pid):
+            continue
+        try:
+            if path.is_dir() and not path.is_symlink():
+                shutil.rmtree(path)
+            else:
+                path.unlink()
+        except OSError:
+            continue
+        removed.append(path)
+    return removed
+
+
 def folder_kind(path: str | os.PathLike[str]) -> tuple[str | None, list[str]]:
     """What an output folder holds, and the names that say so.
 
@@ -311,6 +385,10 @@ def folder_kind(path: str | os.PathLike[str]) -> tuple[str | None, list[str]]:
     if not names:
         return None, []
     present = set(names)
+    if STUDY_JSON in present:  # a study's first file names its kind
+        kind = _study_kind(d)
+        if kind is not None:
+            return kind, [STUDY_JSON]
     for kind, markers in FOLDER_MARKERS.items():
         found = [m for m in markers if m in present]
         if found:
@@ -413,8 +491,8 @@ def check_out_dir(
     advice = {
         "run": "a new or empty folder, or a run folder (whose run it replaces)",
         "sweep": "a new or empty folder, or this sweep's own folder (to resume it)",
-    }.get(kind, f"a new or empty folder, or a folder of {_KIND_WORDS[kind]} (to resume it)")
-    raise InputError(f"{label}: holds {_KIND_WORDS[held]} ({', '.join(names)}); use {advice}")
+    }.get(kind, f"a new or empty folder, or a folder of {kind_words(kind)} (to resume it)")
+    raise InputError(f"{label}: holds {kind_words(held)} ({', '.join(names)}); use {advice}")
 
 
 @contextlib.contextmanager

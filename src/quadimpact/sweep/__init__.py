@@ -2,10 +2,13 @@
 
 A sweep names a **base** scenario (the keys of a scenario file) and the runs
 to make from it: a **grid** (every combination of the listed values, the
-last field varying fastest), an explicit list of **runs**, or a random
-**sample** (``n`` points, a ``seed``, uniform ``ranges`` and/or ``choices``).
-A grid can be combined with ``runs`` or ``sample``: every grid point is then
-run with every entry. Fields are scenario fields (``heading_deg``,
+last field varying fastest), an explicit list of **runs**, a random
+**sample** (``n`` points, a ``seed``, uniform ``ranges`` and/or ``choices``),
+or random **trials** (``n`` trials, each drawn when it runs from a random
+stream of its own, ``(seed, trial)``: memory flat in ``n``; an optional
+``seed_field`` gets each trial's own integer seed; :mod:`quadimpact.sweep.trials`).
+A grid can be combined with ``runs``, ``sample`` or ``trials``: every grid
+point is then run with every entry. Fields are scenario fields (``heading_deg``,
 ``inclination_deg``, ``speed_m_s``, ``final_time_s``, ``model``...) or vehicle
 fields (``restitution``, ``contact_stiffness``, ``mass_kg``...), named as in
 scenario and vehicle files; vehicle fields go to the run's
@@ -26,9 +29,15 @@ scenario and vehicle files; vehicle fields go to the run's
     # seed = 1
     # ranges = { inclination_deg = [-20, 20] }   # uniform in [low, high]
     # choices = { heading_deg = [0, 45] }        # one of the values
+    # [trials]                    # ... or random trials, each drawn when it runs
+    # n = 1000000
+    # seed = 0
+    # ranges = { pitch_deg = [-45, 45], speed_m_s = [0.5, 2.5] }
+    # seed_field = "seed"         # each trial's own seed (IMU noise...)
 
-The whole sweep (every run's scenario and vehicle) is validated before any
-run starts; problems are one-line :class:`~quadimpact.errors.InputError`.
+The whole sweep (every run's scenario and vehicle; with ``trials``, the
+first trials and the bounds of the ranges) is validated before any run
+starts; problems are one-line :class:`~quadimpact.errors.InputError`.
 
 Output folder ``DIR``:
 
@@ -66,32 +75,38 @@ Worker processes never outlive the sweep, even after ``kill -9``
 ``allow_large=True``. The details, with measurements: ``docs/SWEEPS.md``.
 """
 
-from quadimpact.sweep.interrupt import SweepInterrupted
-from quadimpact.sweep.pool import WorkerError
-from quadimpact.sweep.runner import LARGE_SWEEP_RUNS, run_sweep
-from quadimpact.sweep.spec import SweepSpec, load_sweep_file
-from quadimpact.sweep.store import (
-    COST_COLUMNS,
-    SUMMARY_COLUMNS,
-    flatten_summary,
-    read_runs,
-    without_costs,
-)
-from quadimpact.sweep.values import parse_values
-from quadimpact.sweep.worker import run_chunk
+from importlib import import_module
+from typing import Any
 
-__all__ = [
-    "COST_COLUMNS",
-    "LARGE_SWEEP_RUNS",
-    "SweepInterrupted",
-    "SweepSpec",
-    "SUMMARY_COLUMNS",
-    "WorkerError",
-    "load_sweep_file",
-    "parse_values",
-    "read_runs",
-    "run_chunk",
-    "run_sweep",
-    "flatten_summary",
-    "without_costs",
-]
+# The public names are imported when first used, so that the light modules of this
+# package (its values, its trials) load without the runner, the pool and pandas (the
+# command line checks a study's options with them before anything heavy loads).
+_EXPORTS = {
+    "COST_COLUMNS": "quadimpact.sweep.store",
+    "LARGE_SWEEP_RUNS": "quadimpact.sweep.runner",
+    "SUMMARY_COLUMNS": "quadimpact.sweep.store",
+    "SweepInterrupted": "quadimpact.sweep.interrupt",
+    "SweepSpec": "quadimpact.sweep.spec",
+    "WorkerError": "quadimpact.sweep.pool",
+    "flatten_summary": "quadimpact.sweep.store",
+    "load_sweep_file": "quadimpact.sweep.spec",
+    "parse_values": "quadimpact.sweep.values",
+    "read_runs": "quadimpact.sweep.store",
+    "run_chunk": "quadimpact.sweep.worker",
+    "run_sweep": "quadimpact.sweep.runner",
+    "without_costs": "quadimpact.sweep.store",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    if name in _EXPORTS:
+        value = getattr(import_module(_EXPORTS[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'quadimpact.sweep' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(__all__)

@@ -186,7 +186,8 @@ def auto_plots(out_dir: str | os.PathLike[str], spec: Any) -> list[Path]:
         The files written (none for other sweeps, or above
         :data:`MAX_AUTO_RUNS` runs).
     """
-    if spec.runs or spec.sample is not None or spec.n_runs > MAX_AUTO_RUNS:
+    drawn = spec.sample is not None or spec.trials is not None
+    if spec.runs or drawn or spec.n_runs > MAX_AUTO_RUNS:
         return []
     choice = choose_plot_fields(spec.columns, spec.grid)
     if choice is None:
@@ -226,6 +227,8 @@ def fixed_parameters(spec: Any) -> str:
     varied = set(spec.varying_fields()) | {k for e in spec.runs or [] for k in e}
     if spec.sample is not None:
         varied |= set(spec.sample["ranges"]) | set(spec.sample["choices"])
+    if spec.trials is not None:
+        varied |= set(spec.columns) - set(spec.grid)
     scenario = scenario_from_dict(spec.base, where="sweep: base").model_dump(mode="json")
     scenario.update({k: v[0] for k, v in spec.grid.items() if len(v) == 1})
     names = [f for f in TITLE_FIELDS if f in scenario]

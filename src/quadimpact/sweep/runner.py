@@ -42,9 +42,10 @@ from quadimpact.sweep.store import (
     scan_done,
     schema_of,
 )
+from quadimpact.sweep.values import LARGE_RUNS, check_size
 from quadimpact.sweep.worker import warm_up
 
-LARGE_SWEEP_RUNS = 1_000_000
+LARGE_SWEEP_RUNS = LARGE_RUNS
 """Sweeps with more runs than this need ``allow_large=True`` (``--allow-large``)."""
 FINISH_HERE_S = 1.0
 """A default sweep finishes in this process when its runs left would take less than this, s."""
@@ -219,11 +220,7 @@ def run_sweep(
         raise InputError("give workers or scheduler, not both")
     n_workers = 1 if scheduler is not None else _resolve_workers(workers)
     limits = RunLimits(timeout)
-    if spec.n_runs > LARGE_SWEEP_RUNS and not allow_large:
-        raise InputError(
-            f"{spec.where}: {spec.n_runs} runs, more than {LARGE_SWEEP_RUNS}: confirm with "
-            "--allow-large (allow_large=True) to run it"
-        )
+    check_size(spec.n_runs, allow_large, spec.where)
     out = check_out_dir(Path(out_dir), "sweep", where="")
 
     saved = 0  # finished runs in the folder, as far as known

@@ -7,7 +7,7 @@ import difflib
 import hashlib
 import math
 import os
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +24,9 @@ from quadimpact.sweep.values import (
     parse_values,
     plain,
 )
+
+#: A sweep with ``trials`` validates this many trials at each grid point, and their bounds.
+TRIALS_CHECKED = 64
 
 
 def _short(inputs: Mapping[str, Any]) -> str:
@@ -51,6 +54,13 @@ class SweepSpec:
         "choices": {field: [values]}}``: ``n`` random points, each field uniform
         in ``[low, high]`` or drawn uniformly from ``choices`` (NumPy's PCG64
         generator seeded with ``seed``).
+    trials : mapping, optional
+        ``{"n": int, "seed": int (default 0), "ranges": {field: [low, high]},
+        "seed_field": str (optional)}``: ``n`` random trials, trial ``i``
+        drawn from a random stream of its own (``(seed, i)``,
+        :mod:`quadimpact.sweep.trials`), when it is needed: memory stays
+        flat in ``n``. ``seed_field`` (e.g. ``"seed"``, a run's own seed)
+        gets an integer in ``[0, 2**53)``.
     where : str, optional
         Start of error messages (the sweep file's name).
 
@@ -73,6 +83,7 @@ class SweepSpec:
         grid: Mapping[str, Any] | None = None,
         runs: Sequence[Mapping[str, Any]] | None = None,
         sample: Mapping[str, Any] | None = None,
+        trials: Mapping[str, Any] | None = None,
         *,
         where: str = "sweep",
     ) -> None:
@@ -99,16 +110,19 @@ class SweepSpec:
                 self._check_field(str(name), "grid")
                 self.grid[str(name)] = self._grid_values(str(name), values)
 
-        if runs is not None and sample is not None:
-            raise InputError(f"{where}: give either runs or sample, not both")
+        if sum(x is not None for x in (runs, sample, trials)) > 1:
+            raise InputError(f"{where}: give one of runs, sample and trials, not two")
         self.runs: list[dict[str, Any]] | None = None
         if runs is not None:
             self.runs = self._read_runs(runs)
         self.sample: dict[str, Any] | None = None
         if sample is not None:
             self.sample = self._read_sample(sample)
-        if not self.grid and not self.runs and self.sample is None:
-            raise InputError(f"{where}: empty sweep: give a grid, runs or a sample")
+        self.trials: dict[str, Any] | None = None
+        if trials is not None:
+            self.trials = self._read_trials(trials)
+        if not self.grid and not self.runs and self.sample is None and self.trials is None:
+            raise InputError(f"{where}: empty sweep: give a grid, runs, a sample or trials")
 
         # input columns, in order, and their kinds
         fields: dict[str, list[Any]] = {k: list(v) for k, v in self.grid.items()}
@@ -120,12 +134,19 @@ class SweepSpec:
                 fields[k] = [0.0]
             for k, v in self.sample["choices"].items():
                 fields[k] = list(v)
+        if self.trials is not None:
+            for k in self._trial_fields():
+                fields[k] = [0.0]  # drawn numbers (a seed too: exact below 2**53)
         inner = {k for e in self.runs or [] for k in e}
         if self.sample is not None:
             inner |= set(self.sample["ranges"]) | set(self.sample["choices"])
+        if self.trials is not None:
+            inner |= set(self._trial_fields())
         for k in self.grid:
             if k in inner:
-                raise InputError(f"{where}: {k}: swept both in the grid and in runs/sample")
+                raise InputError(
+                    f"{where}: {k}: swept both in the grid and in runs, sample or trials"
+                )
         self.columns: dict[str, str] = {k: column_kind(v) for k, v in fields.items()}
         # numbers as floats (one type per column, so equal sweeps compare equal)
         for k, values in self.grid.items():
@@ -141,7 +162,15 @@ class SweepSpec:
                     self.sample["choices"][k] = [float(v) for v in values]
 
         self._sizes = [len(v) for v in self.grid.values()]
-        self._inner = len(self.runs) if self.runs else (self.sample["n"] if self.sample else 1)
+        self._inner = (
+            len(self.runs)
+            if self.runs
+            else self.sample["n"]
+            if self.sample
+            else self.trials["n"]
+            if self.trials
+            else 1
+        )
         n = math.prod(self._sizes) * self._inner
         if n > MAX_RUNS:
             raise InputError(f"{where}: {n} runs, more than {MAX_RUNS}")
@@ -264,6 +293,32 @@ class SweepSpec:
             raise InputError(f"{w}: give ranges and/or choices to draw from")
         return {"n": n, "seed": seed, "ranges": ranges, "choices": choices}
 
+    def _read_trials(self, trials: Any) -> dict[str, Any]:
+        w = f"{self.where}: trials"
+        if not isinstance(trials, Mapping):
+            raise InputError(f"{w}: must be a table with n, seed, ranges and seed_field")
+        unknown = set(trials) - {"n", "seed", "ranges", "seed_field"}
+        if unknown:
+            key = sorted(unknown)[0]
+            raise InputError(f"{w}: {key}: unknown key (n, seed, ranges, seed_field)")
+        probe = self._read_sample({"n": trials.get("n"), "seed": trials.get("seed", 0),
+                                   "ranges": trials.get("ranges") or {}})  # fmt: skip
+        seed_field = trials.get("seed_field")
+        if seed_field is not None:
+            if not isinstance(seed_field, str) or not seed_field:
+                got = format_value(seed_field)
+                raise InputError(f"{w}: seed_field: must be a field name (got {got})")
+            self._check_field(seed_field, "trials.seed_field")
+            if seed_field in probe["ranges"]:
+                raise InputError(f"{w}: {seed_field}: both in ranges and seed_field")
+        return {"n": probe["n"], "seed": probe["seed"], "ranges": probe["ranges"],
+                "seed_field": seed_field}  # fmt: skip
+
+    def _trial_fields(self) -> list[str]:
+        assert self.trials is not None
+        extra = [self.trials["seed_field"]] if self.trials["seed_field"] else []
+        return [*self.trials["ranges"], *extra]
+
     # --------------------------------------------------------- enumeration
     def _draws(self) -> dict[str, list[Any]]:
         if self._drawn is None:
@@ -297,7 +352,18 @@ class SweepSpec:
         elif self.sample is not None:
             for name, drawn in self._draws().items():
                 values[name] = drawn[j]
+        elif self.trials is not None:
+            values.update(self._trial(j))
         return values
+
+    def _trial(self, j: int) -> dict[str, Any]:
+        """Trial ``j``'s drawn values, numbers as the sweep stores them (floats)."""
+        from quadimpact.sweep.trials import trial_draws
+
+        t = self.trials
+        assert t is not None
+        drawn = trial_draws(t["seed"], j, t["ranges"], t["seed_field"])
+        return {k: float(v) for k, v in drawn.items()}
 
     def scenario_dict(self, run_id: int, inputs: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """The scenario mapping of run ``run_id`` (base + swept values)."""
@@ -313,6 +379,12 @@ class SweepSpec:
         self, check: Callable[[int], None] | None = None, *, max_record_mb: float | None = None
     ) -> None:
         """Build and validate every run's scenario and vehicle (raises the first problem).
+
+        A sweep with ``trials`` checks, at every grid point, its first
+        :data:`TRIALS_CHECKED` trials and the bounds of its ranges
+        (:func:`quadimpact.sweep.trials.trial_corners`: every trial's values lie
+        within them), not each of possibly millions of trials; a trial that
+        still fails becomes a failed row, with its reason, when it runs.
 
         Parameters
         ----------
@@ -346,8 +418,7 @@ class SweepSpec:
         checked: set[str] = set()
         n_features: dict[str, int] = {}  # per vehicle and overrides (built once, not per run)
         self._derive = False
-        for run_id in range(self.n_runs):
-            inputs = self.inputs(run_id)
+        for run_id, inputs in self._checked_runs():
             try:
                 scenario = scenario_from_dict(self.scenario_dict(run_id, inputs), where="")
                 if derive:  # the workers may copy this run from the base: is it the same?
@@ -369,12 +440,29 @@ class SweepSpec:
                         checked.add(key)
             except InputError as exc:
                 message = str(exc).removeprefix(": ")
-                raise InputError(
-                    f"{self.where}: run {run_id} ({_short(inputs)}): {message}"
-                ) from None
-            if check is not None:
+                which = f"run {run_id}" if run_id >= 0 else "the bounds of its trials"
+                raise InputError(f"{self.where}: {which} ({_short(inputs)}): {message}") from None
+            if check is not None and run_id >= 0:
                 check(run_id)
         self._derive = derive
+
+    def _checked_runs(self) -> Iterator[tuple[int, dict[str, Any]]]:
+        """``(run_id, inputs)`` of the runs :meth:`validate` checks (``-1``: a bound of trials)."""
+        if self.trials is None:
+            for run_id in range(self.n_runs):
+                yield run_id, self.inputs(run_id)
+            return
+        from quadimpact.sweep.trials import trial_corners
+
+        first = min(self.trials["n"], TRIALS_CHECKED)
+        corners = list(trial_corners(self.trials["ranges"], self.trials["seed_field"]))
+        for point in range(self.n_runs // self._inner):
+            for j in range(first):
+                run_id = point * self._inner + j
+                yield run_id, self.inputs(run_id)
+            at_point = self.inputs(point * self._inner)
+            for corner in corners:
+                yield -1, {**at_point, **{k: float(v) for k, v in corner.items()}}
 
     def sweep_base(self) -> SweepBase:
         """What every run shares, for the workers (``sweep.items``).
@@ -394,6 +482,7 @@ class SweepSpec:
             "grid": self.grid,
             "runs": self.runs,
             "sample": self.sample,
+            **({"trials": self.trials} if self.trials is not None else {}),
         }
 
     @classmethod
@@ -401,17 +490,19 @@ class SweepSpec:
         """Build a spec from :meth:`to_dict`'s output (or a sweep file's table)."""
         if not isinstance(data, Mapping):
             raise InputError(f"{where}: must be a table")
-        unknown = set(data) - {"base", "grid", "runs", "sample"}
+        keys = ["base", "grid", "runs", "sample", "trials"]
+        unknown = set(data) - set(keys)
         if unknown:
             key = sorted(unknown)[0]
-            close = difflib.get_close_matches(key, ["base", "grid", "runs", "sample"], n=1)
-            hint = f"; did you mean {close[0]!r}?" if close else " (base, grid, runs, sample)"
+            close = difflib.get_close_matches(key, keys, n=1)
+            hint = f"; did you mean {close[0]!r}?" if close else f" ({', '.join(keys)})"
             raise InputError(f"{where}: {key}: unknown key{hint}")
         return cls(
             base=data.get("base"),
             grid=data.get("grid"),
             runs=data.get("runs"),
             sample=data.get("sample"),
+            trials=data.get("trials"),
             where=where,
         )
 
@@ -424,7 +515,7 @@ class SweepSpec:
         """A copy whose grid has these fields replaced or added (``--grid`` on a file)."""
         merged = dict(self.grid)
         merged.update(grid)
-        return SweepSpec(self.base, merged, self.runs, self.sample, where=self.where)
+        return SweepSpec(self.base, merged, self.runs, self.sample, self.trials, where=self.where)
 
     def varying_fields(self) -> list[str]:
         """Grid fields with more than one value."""
@@ -445,12 +536,14 @@ class SweepSpec:
     __hash__ = None  # type: ignore[assignment]
 
     def __repr__(self) -> str:
-        mode = "runs" if self.runs else "sample" if self.sample else "grid"
+        modes = {"runs": self.runs, "sample": self.sample, "trials": self.trials}
+        mode = next((name for name, given in modes.items() if given), "grid")
         return f"SweepSpec({self.n_runs} runs, {mode}, grid={list(self.grid)})"
 
 
 def load_sweep_file(path: str | os.PathLike[str]) -> SweepSpec:
-    """Read a sweep TOML file: ``base`` (table or scenario path), ``grid``, ``runs``, ``sample``.
+    """Read a sweep TOML file: ``base`` (table or scenario path), ``grid``, and ``runs``,
+    ``sample`` or ``trials``.
 
     A relative ``base`` path (and a relative ``vehicle`` path in the base) is
     looked up beside the sweep file.

@@ -23,7 +23,9 @@ from quadimpact.errors import InputError, format_value
 from quadimpact.results.files import to_jsonable
 
 __all__ = [
+    "LARGE_RUNS",
     "MAX_RUNS",
+    "check_size",
     "canonical",
     "column_kind",
     "column_value",
@@ -36,6 +38,35 @@ __all__ = [
 
 MAX_RUNS = 10_000_000
 """Largest number of runs in one sweep."""
+LARGE_RUNS = 1_000_000
+"""Sweeps (and studies) with more runs than this need ``allow_large=True`` (``--allow-large``)."""
+
+
+def check_size(n_runs: int, allow_large: bool, what: str) -> None:
+    """Refuse, before anything is planned, a sweep or study too large to run as asked.
+
+    Parameters
+    ----------
+    n_runs : int
+        The runs it would make.
+    allow_large : bool
+        More than :data:`LARGE_RUNS` runs were confirmed (``--allow-large``).
+    what : str
+        What sets the size, for the message (``"--n 2000000"``, a sweep file's name).
+
+    Raises
+    ------
+    InputError
+        More than :data:`MAX_RUNS` runs, or more than :data:`LARGE_RUNS` unconfirmed.
+    """
+    if n_runs > MAX_RUNS:
+        raise InputError(f"{what}: {n_runs} runs, more than {MAX_RUNS} (the most one sweep holds)")
+    if n_runs > LARGE_RUNS and not allow_large:
+        raise InputError(
+            f"{what}: {n_runs} runs, more than {LARGE_RUNS}: confirm with --allow-large "
+            "(allow_large=True) to run it"
+        )
+
 
 _INT_RE = re.compile(r"^[+-]?\d+$")
 _NUM_RE = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")

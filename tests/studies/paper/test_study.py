@@ -8,7 +8,7 @@ import pytest
 from quadimpact.simulation.response_types import RESPONSE_TYPES
 from quadimpact.studies.paper import paper_study as study
 from quadimpact.studies.paper.paper_study import reproduce
-from quadimpact.studies.recovery.recovery_report import rate_text
+from quadimpact.studies.statistics import rate_text
 
 from helpers import assert_same_table
 

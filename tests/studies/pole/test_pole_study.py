@@ -66,7 +66,7 @@ def test_the_study_writes_its_table_figures_and_report(study_dir):
     numbers = json.loads((study_dir / "study.json").read_text())["numbers"]
     k = int(table[table["arm"] == "recovery"]["success"].sum())
     assert numbers["arms"]["recovery"]["success"]["k"] == k
-    assert f"{k}/9 = " in report
+    assert f"{k} / 9 = " in report
 
 
 def test_rerunning_resumes(study_dir):

@@ -1,4 +1,4 @@
-"""The recovery study's numbers: Wilson intervals, bins, outcome classes, the summary."""
+"""The recovery study's numbers: bins, outcome classes, the summary."""
 
 from __future__ import annotations
 
@@ -9,39 +9,9 @@ import pandas as pd
 import pytest
 
 from quadimpact.studies.recovery import recovery_analysis as analysis
-from quadimpact.studies.recovery.recovery_study import DISTRIBUTION, SEED_LIMIT, sample_trials
-
-
-# ------------------------------------------------------------------- Wilson
-@pytest.mark.parametrize(
-    ("k", "n", "low", "high"),
-    [  # Newcombe (1998), Statistics in Medicine 17:857, Table I, method 3 (Wilson score)
-        (81, 263, 0.2553, 0.3662),
-        (15, 148, 0.0624, 0.1605),
-        (0, 20, 0.0000, 0.1611),
-        (1, 29, 0.0061, 0.1718),
-    ],
-)
-def test_wilson_interval_against_published_values(k, n, low, high) -> None:
-    lo, hi = analysis.wilson_interval(k, n)
-    assert lo == pytest.approx(low, abs=5e-5) and hi == pytest.approx(high, abs=5e-5)
-
-
-def test_wilson_interval_against_scipy_and_its_symmetry() -> None:
-    stats = pytest.importorskip("scipy.stats")
-    for k, n in [(0, 1), (3, 7), (50, 100), (9223, 10000), (10000, 10000)]:
-        ci = stats.binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
-        lo, hi = analysis.wilson_interval(k, n, z=stats.norm.ppf(0.975))
-        assert (lo, hi) == pytest.approx((ci.low, ci.high), abs=1e-12)
-        mlo, mhi = analysis.wilson_interval(n - k, n)
-        assert (mlo, mhi) == pytest.approx(
-            (1 - analysis.wilson_interval(k, n)[1], 1 - analysis.wilson_interval(k, n)[0]),
-            abs=1e-12,
-        )
-    assert analysis.wilson_interval(0, 5)[0] == 0.0 and analysis.wilson_interval(5, 5)[1] == 1.0
-    assert all(math.isnan(x) for x in analysis.wilson_interval(0, 0))
-    with pytest.raises(ValueError):
-        analysis.wilson_interval(6, 5)
+from quadimpact.studies.recovery.recovery_study import DISTRIBUTION, sample_trials
+from quadimpact.studies.statistics import wilson_interval
+from quadimpact.sweep.trials import SEED_LIMIT
 
 
 # --------------------------------------------------------------------- bins
@@ -125,7 +95,7 @@ def test_rate_by_counts_every_bin_with_its_interval() -> None:
     t = _table([_row(pitch_deg=-40.0), _row(**FAILED), _row(pitch_deg=0.0)])
     r = analysis.rate_by(t, "inclination_bin").set_index("bin")
     assert r.loc["[35, 45]", "n"] == 2 and r.loc["[35, 45]", "recovered"] == 1
-    assert (r.loc["[35, 45]", "low"], r.loc["[35, 45]", "high"]) == analysis.wilson_interval(1, 2)
+    assert (r.loc["[35, 45]", "low"], r.loc["[35, 45]", "high"]) == wilson_interval(1, 2)
     assert r.loc["[15, 25)", "n"] == 0 and math.isnan(r.loc["[15, 25)", "rate"])
     assert r["n"].sum() == 3
 

@@ -13,8 +13,8 @@ import pytest
 from quadimpact.errors import InputError
 from quadimpact.simulation.packing import RPM
 from quadimpact.studies.recovery import recovery_analysis as analysis
-from quadimpact.studies.recovery.recovery_report import percent
 from quadimpact.studies.recovery.recovery_study import RecoveryStudy, run_study, sample_trials
+from quadimpact.studies.statistics import percent, wilson_interval
 from quadimpact.sweep import SUMMARY_COLUMNS, SweepSpec
 
 from helpers import assert_same_table
@@ -67,7 +67,7 @@ def test_the_report_numbers_are_the_tables(study_dir) -> None:
     table = pd.read_parquet(out / "trials.parquet")
     text = (out / "report.md").read_text()
     k, n = int(table["recovered"].fillna(False).sum()), len(table)
-    lo, hi = analysis.wilson_interval(k, n)
+    lo, hi = wilson_interval(k, n)
     assert (f"**{k} / {n} = {percent(k / n)} [{percent(lo)}, {percent(hi)}]**") in text
     assert f"**Trials**: {N} impact trials" in text and "study seed 5" in text
     for cls in analysis.OUTCOME_CLASSES:
@@ -85,8 +85,12 @@ def test_the_report_numbers_are_the_tables(study_dir) -> None:
 def test_rerunning_resumes_and_gives_the_same_table(study_dir) -> None:
     out, first = study_dir
     before = pd.read_parquet(out / "trials.parquet")
+    drawn = {p: p.stat().st_mtime_ns for p in out.iterdir() if p.suffix in (".png", ".md")}
     again = run_study(RecoveryStudy(n=N, seed=5), out, workers=1, example=False)
     assert again.run_info["n_ran"] == 0 and again.run_info["n_already_done"] == N
+    # nothing ran: nothing is drawn again, the numbers are the table's
+    assert {p: p.stat().st_mtime_ns for p in drawn} == drawn
+    assert again.numbers["success"] == first.numbers["success"]
     first_sweep = first.run_info["elapsed_s"]
     assert f"the trials were run {N} in {first_sweep:.1f} s (serial)" in again.report.read_text()
     pd.testing.assert_frame_equal(pd.read_parquet(out / "trials.parquet"), before)
@@ -96,7 +100,8 @@ def test_rerunning_resumes_and_gives_the_same_table(study_dir) -> None:
     resumed = run_study(RecoveryStudy(n=N, seed=5), out, workers=1, example=False)
     assert resumed.run_info["n_already_done"] == 10 and resumed.run_info["n_ran"] == N - 10
     assert_same_table(pd.read_parquet(out / "trials.parquet"), before)
-    with pytest.raises(InputError, match="holds a different sweep"):
+    with pytest.raises(InputError, match=r"holds a recovery study with other options "
+                                         r"\(--seed 5 there, 6 asked\)"):  # fmt: skip
         run_study(RecoveryStudy(n=N, seed=6), out, workers=1, example=False)
 
 

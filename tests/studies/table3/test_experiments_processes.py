@@ -73,3 +73,39 @@ def test_stopping_experiments_leaves_nothing_running(tmp_path, tmpdir_env, how):
             except (ProcessLookupError, PermissionError):
                 pass
         proc.wait(timeout=10)
+
+
+@pytest.mark.slow
+def test_experiments_interrupted_early_resume_to_the_same_tables(tmp_path, tmpdir_env) -> None:
+    """Ctrl-C as soon as the crashes' workers are busy (the folder holds only the study's
+    first file and unfinished crash folders), then the same command: it resumes in its own
+    folder, leaves no temporary file and gives the tables of an uninterrupted run."""
+    import pandas as pd
+
+    def start(out: Path) -> subprocess.Popen:
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+        env["TMPDIR"] = str(tmpdir_env)
+        return subprocess.Popen(
+            [sys.executable, "-m", "quadimpact.cli", "experiments", "--out", str(out),
+             "--samples", "0", "--log-samples", "0", "--workers", "2", "--no-progress"],
+            env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True,
+            preexec_fn=sigint_as_on_a_terminal,
+        )  # fmt: skip
+
+    out = tmp_path / "ex2"
+    proc = start(out)
+    seen: dict[int, psutil.Process] = {}
+    _busy_workers(proc, seen)
+    os.killpg(proc.pid, signal.SIGINT)
+    assert proc.wait(timeout=30) == 130
+    assert (out / "study.json").is_file()
+    again = start(out)
+    assert again.wait(timeout=900) == 0, again.stderr.read().decode()
+    assert not [p for p in out.rglob(".*")], "temporary files left"
+    reference = start(tmp_path / "reference")
+    assert reference.wait(timeout=900) == 0
+    for name in ("table3.parquet", "table3_runs.parquet", "table3_switches.parquet"):
+        a = pd.read_parquet(out / name)
+        b = pd.read_parquet(tmp_path / "reference" / name)
+        pd.testing.assert_frame_equal(a, b)

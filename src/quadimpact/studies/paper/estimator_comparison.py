@@ -22,8 +22,8 @@ import pandas as pd
 from quadimpact.results.estimate_figures import make_error_comparison
 from quadimpact.results.figures import save_figure
 from quadimpact.studies.recovery import recovery_analysis as analysis
-from quadimpact.studies.recovery.recovery_report import rate_text
 from quadimpact.studies.recovery.recovery_study import RecoveryStudy, run_trials
+from quadimpact.studies.statistics import rate_text
 
 __all__ = ["AUTHORS", "COMPARE_N", "ESTIMATORS", "compare_estimators", "estimators_markdown"]
 

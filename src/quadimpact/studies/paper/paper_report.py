@@ -13,7 +13,7 @@ import pandas as pd
 from quadimpact import __version__
 from quadimpact.results.costs import cost_ratio, cost_text
 from quadimpact.simulation.response_types import RESPONSE_TYPES
-from quadimpact.studies.recovery.recovery_report import percent, rate_text
+from quadimpact.studies.statistics import percent, rate_text
 from quadimpact.studies.table3.table3_report import table3_markdown
 
 __all__ = [
@@ -274,7 +274,6 @@ def _crashes_markdown(crashes: pd.DataFrame) -> list[str]:
 
 def pole_markdown(result: Any) -> str:
     """ "Beyond the paper: the pole" from a ``quadimpact.studies.pole.pole_study.PoleResult``."""
-    from quadimpact.studies.pole.pole_report import rate_text as pole_rate
 
     arms = result.numbers["arms"]
     n = result.numbers["n_points"]
@@ -289,8 +288,8 @@ def pole_markdown(result: Any) -> str:
         "",
         "| | lose less than 2 m (95 % Wilson) |",
         "|---|---|",
-        f"| without recovery (the paper controller) | {pole_rate(arms['baseline']['success'])} |",
-        f"| with recovery | {pole_rate(arms['recovery']['success'])} |",
+        f"| without recovery (the paper controller) | {rate_text(arms['baseline']['success'])} |",
+        f"| with recovery | {rate_text(arms['recovery']['success'])} |",
         "",
         "![The pole: height lost](pole/maps.png)",
     ]

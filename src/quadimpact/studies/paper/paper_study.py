@@ -65,6 +65,7 @@ from quadimpact.studies.recovery.baselines import (
 )
 from quadimpact.studies.recovery.recovery_figures import compare_by_bin_figure
 from quadimpact.studies.recovery.recovery_study import RecoveryStudy, run_trials
+from quadimpact.studies.study_folder import StudyFolder
 from quadimpact.sweep import SweepSpec, run_sweep
 from quadimpact.sweep.runner import warm_pool
 from quadimpact.viz.scene import Scene
@@ -251,7 +252,6 @@ def reproduce(
     With ``recovery``, "Beyond the paper: recovery" (:func:`recovery_part`).
     """
     from quadimpact.experiments.crashes import TABLE3
-    from quadimpact.results.files import check_out_dir
     from quadimpact.studies.table3.crash_logs import (
         LOG_SENSITIVITY_RUNS,
         check_data_dir,
@@ -267,10 +267,11 @@ def reproduce(
 
     start = time.perf_counter()
     clock = StageClock(progress)
-    out = check_out_dir(Path(out_dir), "report", where="")
+    folder = study_folder(out_dir, ablation=ablation, experiments=experiments, recovery=recovery)
+    folder.check()
     if experiments and data_dir is not None:
         data_dir = check_data_dir(data_dir, "data_dir")
-    out.mkdir(parents=True, exist_ok=True)
+    out = folder.claim()
     warm_pool(workers, scheduler)  # the sweeps below find the pool's server ready
     processes = 1 if scheduler is not None else _resolve_workers(workers)
     here = {"workers": workers, "scheduler": scheduler, "progress": progress}
@@ -289,7 +290,8 @@ def reproduce(
             task = ("variant", _ablation_name(switch), base, out, False, options)
             pieces.append((f"ablation {k} of {len(SWITCHES)}: the replica without {switch}", task))
     if experiments:
-        exp_out, logs = prepare_experiments(out / "experiments", data_dir)
+        exp_folder, logs = prepare_experiments(out / "experiments", data_dir)
+        exp_out = exp_folder.path
         pieces += [
             (f"Table III: crash {c.number} of {len(TABLE3)}",
              ("crash", c, logs[c.number], exp_out, SENSITIVITY_RUNS, LOG_SENSITIVITY_RUNS, options))
@@ -331,6 +333,8 @@ def reproduce(
     ablation_df = pd.DataFrame(ablation_rows)
     findings = findings_frame(found)
     table3 = write_table3(crash_rows, exp_out) if experiments else None
+    if experiments:
+        exp_folder.finish({"crashes": len(crash_rows)})
     if table3 is not None:
         table3.attrs["logs"] = logs_source(data_dir)  # said in the report's Table III
     table3_extras = [
@@ -352,8 +356,8 @@ def reproduce(
         type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
     clock.stop()
     elapsed = time.perf_counter() - start
-    report = out / "report.md"
-    report.write_text(
+    report = folder.finish(
+        {"elapsed_s": elapsed},
         render_report(
             tables,
             findings,
@@ -366,12 +370,26 @@ def reproduce(
             pole=pole,
             table3_runs=table3_extras[0],
             table3_switches=table3_extras[1],
-        )  # fmt: skip
-    )
+        ),
+    )  # fmt: skip
     return StudyResult(
         out, report, tables, findings, ablation_df, elapsed, part, pole, clock.times,
         clock.pieces,
     )  # fmt: skip
+
+
+def study_folder(
+    out_dir: str | Path,
+    *,
+    ablation: bool = True,
+    experiments: bool = True,
+    recovery: bool = True,
+    where: str = "",
+) -> StudyFolder:
+    """The study's report folder: which parts it has decides what it runs."""
+    identity = {"ablation": ablation, "experiments": experiments, "recovery": recovery}
+    flags = {k: f"{k} (--no-{k})" for k in identity}
+    return StudyFolder(Path(out_dir), "report", identity, where=where, flags=flags)
 
 
 #: The pole study's coarser grid in ``reproduce`` (the full one: ``quadimpact pole``).

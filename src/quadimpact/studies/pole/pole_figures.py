@@ -18,7 +18,7 @@ from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
 from quadimpact.results.figures import new_figure, save_figure
-from quadimpact.studies.recovery.recovery_analysis import rate
+from quadimpact.studies.statistics import rate
 
 __all__ = ["FIGURES", "maps_figure", "success_by_pitch_figure", "write_figures"]
 

@@ -5,17 +5,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-__all__ = ["rate_text", "render_report"]
+from quadimpact.studies.statistics import rate_text
 
-
-def rate_text(r: dict[str, Any]) -> str:
-    """``k/n = p % [low, high]`` of a rate (a dict of ``recovery_analysis.Rate``)."""
-    if not r["n"]:
-        return "no trials"
-    return (
-        f"{r['k']}/{r['n']} = {100 * r['value']:.1f} % "
-        f"[{100 * r['low']:.1f}, {100 * r['high']:.1f}]"
-    )
+__all__ = ["render_report"]
 
 
 def _spread(s: dict[str, Any], unit: str, scale: float = 1.0, digits: int = 2) -> str:

@@ -36,8 +36,9 @@ from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
 from quadimpact.results.files import atomic_write
-from quadimpact.results.study_files import sweep_history, write_report, write_study_json
+from quadimpact.studies.study_folder import SWEEP_DIR, TRIALS_PARQUET, StudyFolder, describe_run
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+from quadimpact.sweep.values import check_size
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -61,8 +62,6 @@ SUCCESS_LOSS_M = 2.0
 BASELINES = ("paper", "cascade-pid")
 #: Width of the pitch bands of the success table, deg.
 BAND_DEG = 5.0
-SWEEP_DIR = "sweep"
-TRIALS_PARQUET = "trials.parquet"
 ARMS = ("baseline", "recovery")
 
 
@@ -261,7 +260,7 @@ def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
 
 def summarise(table: pd.DataFrame) -> dict[str, Any]:
     """The headline numbers: success per arm, per pitch band, and how recovery fails."""
-    from quadimpact.studies.recovery.recovery_analysis import rate
+    from quadimpact.studies.statistics import rate
 
     out: dict[str, Any] = {"n_points": int(len(table) // 2), "arms": {}, "bands": []}
     for arm in ARMS:
@@ -367,6 +366,19 @@ class PoleResult:
     elapsed_s: float
 
 
+#: The pole study's options as its command line names them (messages).
+FLAGS = {
+    "vehicle": "--vehicle", "pitch_max_deg": "--pitch-max", "pitch_step_deg": "--pitch-step",
+    "offset_max_m": "--offset-max", "offset_step_m": "--offset-step", "baseline": "--baseline",
+    "radius_m": "--radius", "obstacles": "--obstacle", "speed_m_s": "--speed",
+}  # fmt: skip
+
+
+def study_folder(study: PoleStudy, out_dir: str | os.PathLike[str]) -> StudyFolder:
+    """The study's folder: its options decide its runs."""
+    return StudyFolder(Path(out_dir), "pole", study.options(), where="", flags=FLAGS)
+
+
 def run_pole_study(
     study: PoleStudy,
     out_dir: str | os.PathLike[str],
@@ -374,41 +386,56 @@ def run_pole_study(
     workers: int | None = None,
     scheduler: Any = None,
     progress: bool = False,
+    allow_large: bool = False,
 ) -> PoleResult:
     """Run the pole study into ``out_dir`` (see the module docstring) and report it.
+
+    The folder is claimed (``study.json`` first) before any run; a rerun of a
+    finished study with nothing left to run draws nothing again.
 
     Raises
     ------
     InputError
-        A folder holding a different study, bad workers or scheduler.
+        A folder holding another study (or this study with other options),
+        more than :data:`quadimpact.sweep.values.LARGE_RUNS` runs without
+        ``allow_large``, bad workers or scheduler.
     """
     from quadimpact.studies.pole import pole_figures as figures
     from quadimpact.studies.pole import pole_report as report
 
     start = time.perf_counter()
-    out = Path(out_dir)
     spec = study.sweep_spec()
+    check_size(spec.n_runs, allow_large, "pole")
+    folder = study_folder(study, out_dir)
+    out = folder.claim()
+    unchanged = folder.finished_description(*figures.FIGURES)
     info = run_sweep(
         spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
-        load=False,
+        load=False, allow_large=allow_large,
     )  # fmt: skip
+    if info["n_ran"] == 0 and unchanged is not None and (out / TRIALS_PARQUET).is_file():
+        import pandas as pd
+
+        table = pd.read_parquet(out / TRIALS_PARQUET)
+        paths = [out / name for name in figures.FIGURES]
+        elapsed = time.perf_counter() - start
+        return PoleResult(out, table, unchanged["numbers"], folder.report_path(), paths, info,
+                          elapsed)  # fmt: skip
     table = pole_table(read_runs(out / SWEEP_DIR), study)
     atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
     numbers = summarise(table)
     paths = figures.write_figures(table, out)
     elapsed = time.perf_counter() - start
-    run = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
-    run["sweep_s"] = float(info["elapsed_s"])
+    run = describe_run(info)
     description = {
         "quadimpact_version": __version__,
         "study": study.options(),
         "grid": {"pitch_deg": len(study.pitches()), "lateral_offset_m": len(study.offsets())},
         "run": run,
-        "sweeps": sweep_history(out, run),
+        "sweeps": folder.sweep_history(run),
         "elapsed_s": elapsed,
         "numbers": numbers,
     }
-    write_study_json(out, description)
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
-    report_path = write_report(out, md)
+    report_path = folder.finish(description, md)
     return PoleResult(out, table, numbers, report_path, paths, info, elapsed)

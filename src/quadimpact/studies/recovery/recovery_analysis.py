@@ -46,13 +46,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from quadimpact.studies.recovery.estimation_numbers import estimation_numbers
+from quadimpact.studies.statistics import rate
 
 __all__ = [
     "BELOW_GROUND",
@@ -60,8 +60,6 @@ __all__ = [
     "INCLINATION_BIN",
     "OUTCOME_CLASSES",
     "SPEED_BIN",
-    "Z_95",
-    "Rate",
     "add_derived",
     "bin_edges",
     "binned",
@@ -70,16 +68,12 @@ __all__ = [
     "failure_analysis",
     "outcome_class",
     "quantiles",
-    "rate",
     "rate_by",
     "success_mask",
     "summarise",
     "valid_mask",
-    "wilson_interval",
 ]
 
-#: The normal quantile of a two-sided 95 % interval, as docs/RECOVERY.md 8 gives it.
-Z_95 = 1.96
 #: (width, offset) of the inclination bins, deg: edges at offset + k width.
 INCLINATION_BIN = (10.0, 5.0)
 #: (width, offset) of the speed bins, m/s.
@@ -103,58 +97,6 @@ EXCLUDED_CLASSES = ("invalid: started in contact", "invalid: bumper model exceed
 FLIP_DEG = 90.0
 #: The trial conditions, for the example trial (nearest the medians of these).
 CONDITIONS = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s")
-
-
-# ------------------------------------------------------------ proportions
-def wilson_interval(k: int, n: int, z: float = Z_95) -> tuple[float, float]:
-    """The Wilson score interval of a binomial proportion ``k / n``.
-
-    Parameters
-    ----------
-    k : int
-        Successes, ``0 <= k <= n``.
-    n : int
-        Trials; ``n = 0`` gives ``(nan, nan)``.
-    z : float
-        Normal quantile (1.96: 95 %).
-
-    Returns
-    -------
-    (low, high) : tuple of float
-        ``centre -+ halfwidth`` with ``p = k/n``,
-        ``centre = (p + z²/(2n)) / (1 + z²/n)`` and
-        ``halfwidth = z sqrt(p(1-p)/n + z²/(4n²)) / (1 + z²/n)``; exactly 0
-        (1) at ``k = 0`` (``k = n``), where the formula gives it but for rounding.
-    """
-    if n <= 0:
-        return (math.nan, math.nan)
-    if not 0 <= k <= n:
-        raise ValueError(f"k must be in [0, n] (got k={k}, n={n})")
-    p = k / n
-    z2 = z * z
-    denominator = 1.0 + z2 / n
-    centre = (p + z2 / (2 * n)) / denominator
-    half = z * math.sqrt(p * (1 - p) / n + z2 / (4 * n * n)) / denominator
-    low = 0.0 if k == 0 else max(0.0, centre - half)
-    high = 1.0 if k == n else min(1.0, centre + half)
-    return (low, high)
-
-
-@dataclass(frozen=True)
-class Rate:
-    """A proportion ``k / n`` with its 95 % Wilson interval ``[low, high]``."""
-
-    k: int
-    n: int
-    value: float
-    low: float
-    high: float
-
-
-def rate(k: int, n: int) -> Rate:
-    """``k / n`` and its Wilson interval (NaN when ``n = 0``)."""
-    low, high = wilson_interval(int(k), int(n))
-    return Rate(int(k), int(n), k / n if n else math.nan, low, high)
 
 
 # ------------------------------------------------------------------- bins
@@ -453,14 +395,21 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
     }
 
 
+#: The example trial is chosen among this many first trials of a study.
+EXAMPLE_AMONG = 10_000
+
+
 def example_trial(table: pd.DataFrame) -> int:
-    """The ``run_id`` of the trial nearest the median conditions.
+    """The ``run_id`` of the trial nearest the median conditions, among the first trials.
 
     Distance: the root sum of squares over roll, pitch, yaw and speed of each
     condition's difference from its median, divided by that condition's
     range in the table (1 where it does not vary); ties go to the lowest run_id.
+    Only the first :data:`EXAMPLE_AMONG` trials (by ``run_id``) are considered,
+    so that a study of millions chooses it at once, before its trials run.
     """
     t = table.sort_values("run_id")
+    t = t[t["run_id"] < EXAMPLE_AMONG] if len(t) > EXAMPLE_AMONG else t
     d = np.zeros(len(t))
     for name in CONDITIONS:
         x = t[name].to_numpy(dtype=float)

@@ -17,13 +17,12 @@ import pandas as pd
 
 from quadimpact.results.costs import cost_text
 from quadimpact.studies.recovery.estimation_numbers import estimation_lines
-from quadimpact.studies.recovery.recovery_analysis import FLIP_DEG, OUTCOME_CLASSES, Rate
+from quadimpact.studies.recovery.recovery_analysis import FLIP_DEG, OUTCOME_CLASSES
+from quadimpact.studies.statistics import percent, rate_text
 
 __all__ = [
     "bin_table",
     "excluded_text",
-    "percent",
-    "rate_text",
     "render_report",
     "spread_table",
 ]
@@ -36,18 +35,6 @@ _MEASURES = (
     ("stage2_duration_s", "time in stage 2 (levelling)", "s", 3),
     ("stage3_duration_s", "time in stage 3 (arresting the descent)", "s", 3),
 )
-
-
-def percent(x: float, digits: int = 1) -> str:
-    """A share as a percentage (``–`` when undefined)."""
-    return "–" if x is None or not math.isfinite(x) else f"{100 * x:.{digits}f} %"
-
-
-def rate_text(r: Rate) -> str:
-    """``k / n = p % [low, high]`` (the 95 % Wilson interval)."""
-    if r.n == 0:
-        return "no trials"
-    return f"{r.k} / {r.n} = {percent(r.value)} [{percent(r.low)}, {percent(r.high)}]"
 
 
 def excluded_text(numbers: dict[str, Any]) -> str:

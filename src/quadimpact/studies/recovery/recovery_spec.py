@@ -12,8 +12,6 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
@@ -26,12 +24,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "DISTRIBUTION",
-    "SEED_LIMIT",
     "SLEW_DONOR",
     "TRIAL_FIELDS",
     "RecoveryStudy",
     "sample_trials",
-    "trial_rng",
 ]
 
 #: The authors' distribution: field -> (low, high), each uniform.
@@ -43,18 +39,11 @@ DISTRIBUTION: dict[str, tuple[float, float]] = {
 }
 #: The vehicle whose rotor slew limit a vehicle without one borrows.
 SLEW_DONOR = "navi"
-#: IMU seeds are below 2**53, so that they are exact as the sweep's float inputs.
-SEED_LIMIT = 2**53
 #: The trial inputs every row of ``trials.parquet`` carries.
 TRIAL_FIELDS = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "seed")
 
 
 # ------------------------------------------------------------------ sampling
-def trial_rng(seed: int, index: int) -> np.random.Generator:
-    """Trial ``index``'s own random stream (PCG64) of a study seeded with ``seed``."""
-    return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(index,))))
-
-
 def sample_trials(
     n: int, seed: int, ranges: dict[str, tuple[float, float]] | None = None
 ) -> list[dict[str, float | int]]:
@@ -74,20 +63,13 @@ def sample_trials(
     list of dict
         Per trial, in order: the fields of ``ranges`` and ``seed`` (the run's
         IMU seed, an integer in [0, 2**53)). Trial ``i`` depends on ``seed``
-        and ``i`` only (:func:`trial_rng`).
+        and ``i`` only (:func:`quadimpact.sweep.trials.trial_draws`), as the
+        study's sweep draws it (its ``trials``, when it runs).
     """
+    from quadimpact.sweep.trials import trial_draws
+
     ranges = DISTRIBUTION if ranges is None else ranges
-    trials = []
-    for i in range(n):
-        rng = trial_rng(seed, i)
-        u = rng.random(len(ranges))
-        trial: dict[str, float | int] = {
-            name: float(lo + (hi - lo) * x)
-            for (name, (lo, hi)), x in zip(ranges.items(), u, strict=True)
-        }
-        trial["seed"] = int(rng.integers(0, SEED_LIMIT))
-        trials.append(trial)
-    return trials
+    return [trial_draws(seed, i, ranges, "seed") for i in range(n)]
 
 
 # --------------------------------------------------------------------- spec
@@ -207,10 +189,12 @@ class RecoveryStudy:
         return base
 
     def sweep_spec(self) -> SweepSpec:
-        """The study as a sweep: the base and one ``[[runs]]`` entry per trial."""
+        """The study as a sweep: the base and its ``trials`` (each drawn when it runs)."""
         from quadimpact.sweep.spec import SweepSpec
 
-        return SweepSpec(base=self.base(), runs=sample_trials(self.n, self.seed), where="recovery")
+        ranges = {name: list(bounds) for name, bounds in DISTRIBUTION.items()}
+        trials = {"n": self.n, "seed": self.seed, "ranges": ranges, "seed_field": "seed"}
+        return SweepSpec(base=self.base(), trials=trials, where="recovery")
 
     def options(self) -> dict[str, Any]:
         """The study's options as plain data (``study.json``)."""

@@ -40,19 +40,23 @@ from quadimpact import __version__
 from quadimpact.errors import InputError
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 from quadimpact.results.costs import cost_ratio
-from quadimpact.results.files import atomic_write, check_out_dir
-from quadimpact.results.study_files import sweep_history, write_report, write_study_json
+from quadimpact.results.files import atomic_write
 from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.studies.recovery.recovery_spec import (  # noqa: F401  (the spec, here too)
     DISTRIBUTION,
-    SEED_LIMIT,
     SLEW_DONOR,
     TRIAL_FIELDS,
     RecoveryStudy,
     sample_trials,
-    trial_rng,
+)
+from quadimpact.studies.study_folder import (
+    SWEEP_DIR,
+    TRIALS_PARQUET,
+    StudyFolder,
+    describe_run,
 )
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
+from quadimpact.sweep.values import check_size
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -74,29 +78,36 @@ __all__ = [
     "trial_table",
 ]
 
-SWEEP_DIR = "sweep"
-TRIALS_PARQUET = "trials.parquet"
-
 
 # ------------------------------------------------------------------- tables
 _TRIAL_DEFAULTS = {name: ImpactTrial.model_fields[name].default for name in TRIAL_FIELDS}
 
 
-def trial_inputs(spec: SweepSpec) -> pd.DataFrame:
+def trial_inputs(spec: SweepSpec, runs: pd.DataFrame | None = None) -> pd.DataFrame:
     """Roll, pitch, yaw (deg), speed (m/s) and IMU seed of every run of a sweep.
 
-    From each run's scenario (base and swept values), the impact trial's
-    defaults where neither sets a field. Indexed by ``run_id``.
+    From each run's swept value (its input column in ``runs``, the sweep's
+    table, when given), else the base scenario's, else the impact trial's
+    default. Indexed by ``run_id``; without ``runs``, each run's inputs are
+    computed from the spec (slower: a million trials take seconds).
     """
+    import numpy as np
     import pandas as pd
 
-    rows = []
-    for run_id in range(spec.n_runs):
-        scenario = spec.scenario_dict(run_id)
-        rows.append({name: scenario.get(name, _TRIAL_DEFAULTS[name]) for name in TRIAL_FIELDS})
-    frame = pd.DataFrame(rows, index=pd.RangeIndex(spec.n_runs, name="run_id"))
-    for name in TRIAL_FIELDS[:-1]:
-        frame[name] = frame[name].astype("float64")
+    index = pd.RangeIndex(spec.n_runs, name="run_id")
+    if runs is None:
+        rows = [spec.inputs(run_id) for run_id in range(spec.n_runs)]
+        runs = pd.DataFrame({name: [r.get(name) for r in rows] for name in spec.columns})
+        runs["run_id"] = np.arange(spec.n_runs)
+    by_id = runs.set_index("run_id").reindex(index)
+    frame = pd.DataFrame(index=index)
+    for name in TRIAL_FIELDS:
+        fallback = float(spec.base.get(name, _TRIAL_DEFAULTS[name]))
+        if name in spec.columns:
+            values = pd.to_numeric(by_id[name], errors="coerce").to_numpy(dtype=float)
+            frame[name] = np.where(np.isnan(values), fallback, values)
+        else:
+            frame[name] = np.full(spec.n_runs, fallback)
     frame["seed"] = frame["seed"].astype("int64")
     return frame
 
@@ -106,10 +117,17 @@ def trial_table(runs: pd.DataFrame, spec: SweepSpec) -> pd.DataFrame:
     from quadimpact.studies.recovery import recovery_analysis as analysis
 
     table = runs.sort_values("run_id").reset_index(drop=True)
-    inputs = trial_inputs(spec).reindex(table["run_id"].to_numpy())
+    inputs = trial_inputs(spec, table).reindex(table["run_id"].to_numpy())
     for name in TRIAL_FIELDS:
         table[name] = inputs[name].to_numpy()
     return analysis.add_derived(table)
+
+
+def _first_runs(spec: SweepSpec, n: int) -> SweepSpec:
+    """``spec`` itself, or, for a sweep of more than ``n`` trials, a sweep of its first ``n``."""
+    if spec.trials is None or spec.n_runs <= n or spec.grid:
+        return spec
+    return SweepSpec(spec.base, trials={**spec.trials, "n": n}, where=spec.where)
 
 
 def _check_trial_base(spec: SweepSpec, where: str) -> None:
@@ -204,11 +222,28 @@ class RecoveryResult:
     warnings: list[str] = field(default_factory=list)
 
 
-def _claim_folder(spec: SweepSpec, out: Path) -> None:
-    """Refuse a folder or sweep base the study cannot use; mark the folder as a study's."""
-    check_out_dir(out, "recovery", where="")
-    _check_trial_base(spec, spec.where)
-    (out / SWEEP_DIR).mkdir(parents=True, exist_ok=True)  # a study's folder from now on
+#: The recovery study's options as its command line names them (messages).
+FLAGS = {
+    "vehicle": "--vehicle", "n": "--n", "seed": "--seed", "model": "--model", "imu": "--imu",
+    "pre_impact": "--pre-impact", "estimator": "--estimator", "sensors": "--sensors",
+    "sweep": "--sweep",
+}  # fmt: skip
+
+
+def study_folder(study: RecoveryStudy | SweepSpec, out_dir: str | os.PathLike[str]) -> StudyFolder:
+    """The study's folder: a study's options (a sweep's fingerprint) decide its trials.
+
+    Raises
+    ------
+    InputError
+        A sweep whose base is not an impact trial.
+    """
+    if isinstance(study, SweepSpec):
+        _check_trial_base(study, study.where)
+        identity: dict[str, Any] = {"sweep": study.fingerprint()}
+    else:
+        identity = study.options()
+    return StudyFolder(Path(out_dir), "recovery", identity, where="", flags=FLAGS)
 
 
 def run_trials(
@@ -218,12 +253,14 @@ def run_trials(
     workers: int | None = None,
     scheduler: Any = None,
     progress: bool = False,
+    allow_large: bool = False,
     on_placed: Callable[[], None] | None = None,
 ) -> tuple[SweepSpec, pd.DataFrame, dict[str, Any]]:
     """Run the trials into ``out_dir/sweep`` and write ``out_dir/trials.parquet``.
 
-    The part of :func:`run_study` without figures, report and example.
-    ``on_placed``: as :func:`quadimpact.sweep.run_sweep`'s.
+    The part of :func:`run_study` without figures, report and example; the
+    folder is claimed (``study.json`` first) before any trial runs.
+    ``allow_large``, ``on_placed``: as :func:`quadimpact.sweep.run_sweep`'s.
 
     Returns
     -------
@@ -231,19 +268,33 @@ def run_trials(
         The sweep, the trials table (:func:`trial_table`) and
         :func:`quadimpact.sweep.run_sweep`'s run information.
     """
-    out = check_out_dir(Path(out_dir), "recovery", where="")
-    if isinstance(study, SweepSpec):
-        spec = study
-        _check_trial_base(spec, spec.where)
-    else:
-        spec = study.sweep_spec()
+    spec = study if isinstance(study, SweepSpec) else study.sweep_spec()
+    check_size(spec.n_runs, allow_large, spec.where)
+    out = study_folder(study, out_dir).claim()
     info = run_sweep(
         spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
-        load=False, on_placed=on_placed,
+        load=False, allow_large=allow_large, on_placed=on_placed,
     )  # fmt: skip
-    table = trial_table(read_runs(out / SWEEP_DIR), spec)
-    atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
+    table = _kept_table(out, info)
+    if table is None:
+        table = trial_table(read_runs(out / SWEEP_DIR), spec)
+        atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
     return spec, table, info
+
+
+def _kept_table(out: Path, info: dict[str, Any]) -> pd.DataFrame | None:
+    """``trials.parquet`` as it is, when nothing ran and it is newer than the sweep's table."""
+    import pandas as pd
+
+    trials, runs = out / TRIALS_PARQUET, out / SWEEP_DIR / "runs.parquet"
+    if info["n_ran"] or not trials.is_file() or not runs.is_file():
+        return None
+    if trials.stat().st_mtime_ns < runs.stat().st_mtime_ns:
+        return None
+    try:
+        return pd.read_parquet(trials)
+    except (OSError, ValueError):
+        return None
 
 
 def run_study(
@@ -255,6 +306,7 @@ def run_study(
     progress: bool = False,
     example: bool = True,
     animation: bool = True,
+    allow_large: bool = False,
 ) -> RecoveryResult:
     """Run the recovery study into ``out_dir`` (see the module docstring) and report it.
 
@@ -265,32 +317,32 @@ def run_study(
         base is an impact trial.
     out_dir : path-like
         The study folder; its ``sweep/`` subfolder is the resumable sweep.
-    workers, scheduler, progress
+    workers, scheduler, progress, allow_large
         As :func:`quadimpact.sweep.run_sweep`.
     example : bool
         Run the example trial again with its files, figure and viewer.
     animation : bool
         Also write the example's animation (needs the ``viz`` extra).
 
+    A rerun of a finished study with nothing left to run draws nothing again:
+    it reads the table, and the figures, example and report are those already
+    there.
+
     Raises
     ------
     InputError
-        A sweep whose base is not an impact trial, a folder holding a
-        different study, bad workers or scheduler.
+        A sweep whose base is not an impact trial, a folder holding another
+        study (or this study with other options), too many trials without
+        ``allow_large``, bad workers or scheduler.
     """
     from quadimpact.studies.recovery import recovery_analysis as analysis
-    from quadimpact.studies.recovery import recovery_figures as figures
-    from quadimpact.studies.recovery import recovery_report as report
-    from quadimpact.studies.recovery.example_trial import (
-        EarlyExample,
-        beside,
-        check_example,
-        write_example,
-    )
+    from quadimpact.studies.recovery.example_trial import EarlyExample, beside
 
     start = time.perf_counter()
-    out = Path(out_dir)
     spec = study if isinstance(study, SweepSpec) else study.sweep_spec()
+    check_size(spec.n_runs, allow_large, spec.where)
+    folder = study_folder(study, out_dir)
+    out = folder.path
     # the example trial depends on the trials' inputs only: it runs beside the trials
     # when they run on other processes (a pool or Dask), else after them, here. It
     # starts once the sweep has placed its runs (the default sweep measures the idle
@@ -299,54 +351,119 @@ def run_study(
 
     def start_example() -> None:
         nonlocal early
-        run_id = analysis.example_trial(trial_inputs(spec).reset_index())
+        first = trial_inputs(_first_runs(spec, analysis.EXAMPLE_AMONG))
+        run_id = analysis.example_trial(first.reset_index())
         early = EarlyExample.start(spec.scenario_dict(run_id), run_id, out, animation)
 
-    early_example = example and beside(workers, scheduler)
-    if early_example:
-        _claim_folder(spec, out)  # a folder or base it cannot use: refused before any run
+    folder.claim()  # a folder or base it cannot use: refused before any run
+    unchanged = folder.finished_description()
+    early_example = example and beside(workers, scheduler) and unchanged is None
     try:
         spec, table, info = run_trials(
-            spec, out, workers=workers, scheduler=scheduler, progress=progress,
+            spec if isinstance(study, SweepSpec) else study, out, workers=workers,
+            scheduler=scheduler, progress=progress, allow_large=allow_large,
             on_placed=start_example if early_example else None,
         )  # fmt: skip
-        options = study if isinstance(study, RecoveryStudy) else None
-        description = describe(spec, options, table)
-        run = {k: info[k] for k in ("n_runs", "n_already_done", "n_ran", "backend")}
-        description["run"] = {**run, "sweep_s": float(info["elapsed_s"])}
-        description["sweeps"] = sweep_history(out, description["run"])
-        description["cost"] = cost_ratio(table)
         numbers = analysis.summarise(table)
-        warnings: list[str] = []
-
-        submit = early.submit if early is not None else None  # its idle process helps
-        paths = figures.write_figures(table, out, numbers, submit=submit)
-        example_dir = None
-        if example:
-            run_id = analysis.example_trial(table)
-            if early is not None and early.run_id == run_id:
-                example_dir, more, recovered = early.result()
-                check_example(run_id, recovered, table)
-            else:
-                if early is not None:  # pragma: no cover (the same inputs, the same trial)
-                    early.cancel()
-                example_dir, more = write_example(spec, run_id, table, out, animation)
-            paths += more[0]
-            warnings += more[1]
-            description["example"] = {"run_id": run_id, **_row_inputs(table, run_id)}
+        if info["n_ran"] == 0 and unchanged is not None and _drawn(unchanged, out, example):
+            return _as_before(unchanged, table, numbers, folder, info, start)
+        description = describe(spec, study if isinstance(study, RecoveryStudy) else None, table)
+        description["run"] = describe_run(info)
+        description["sweeps"] = folder.sweep_history(description["run"])
+        description["cost"] = cost_ratio(table)
+        paths, example_dir, warnings = _draw(spec, table, numbers, description, out,
+                                             early, example, animation)  # fmt: skip
     except BaseException:
         if early is not None:
             early.cancel()
         raise
+    return _finish(folder, description, table, numbers, paths, example_dir, info, start, warnings)
+
+
+def _draw(
+    spec: SweepSpec,
+    table: pd.DataFrame,
+    numbers: dict[str, Any],
+    description: dict[str, Any],
+    out: Path,
+    early: EarlyExample | None,
+    example: bool,
+    animation: bool,
+) -> tuple[list[Path], Path | None, list[str]]:
+    """The figures and the example trial (its folder, figure, viewer, animation)."""
+    from quadimpact.studies.recovery import recovery_analysis as analysis
+    from quadimpact.studies.recovery import recovery_figures as figures
+    from quadimpact.studies.recovery.example_trial import check_example, write_example
+
+    submit = early.submit if early is not None else None  # its idle process helps
+    paths = figures.write_figures(table, out, numbers, submit=submit)
+    example_dir, warnings = None, []
+    if example:
+        run_id = analysis.example_trial(table)
+        if early is not None and early.run_id == run_id:
+            example_dir, more, recovered = early.result()
+            check_example(run_id, recovered, table)
+        else:
+            if early is not None:  # pragma: no cover (the same inputs, the same trial)
+                early.cancel()
+            example_dir, more = write_example(spec, run_id, table, out, animation)
+        paths += more[0]
+        warnings += more[1]
+        description["example"] = {"run_id": run_id, **_row_inputs(table, run_id)}
+    return paths, example_dir, warnings
+
+
+def _finish(
+    folder: StudyFolder,
+    description: dict[str, Any],
+    table: pd.DataFrame,
+    numbers: dict[str, Any],
+    paths: list[Path],
+    example_dir: Path | None,
+    info: dict[str, Any],
+    start: float,
+    warnings: list[str],
+) -> RecoveryResult:
+    """Write ``study.json`` and ``report.md``; say the warnings; the result."""
+    from quadimpact.studies.recovery import recovery_report as report
+
+    out = folder.path
     elapsed = time.perf_counter() - start
     description["elapsed_s"] = elapsed
-    write_study_json(out, description)
+    description["figures"] = [str(p.relative_to(out)) for p in paths]
+    description["example_dir"] = None if example_dir is None else str(example_dir.relative_to(out))
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
-    report_path = write_report(out, md)
+    report_path = folder.finish(description, md)
     for w in warnings:
         print(f"quadimpact: warning: {w}", file=sys.stderr)
     return RecoveryResult(
         out, table, description, numbers, report_path, paths, example_dir, info, elapsed, warnings
+    )
+
+
+def _drawn(held: dict[str, Any], out: Path, example: bool) -> bool:
+    """Whether a finished study's figures (and example, if asked for) are all there."""
+    names = list(held.get("figures") or [])
+    if not names or (example and not held.get("example_dir")):
+        return False
+    return all((out / name).exists() for name in names)
+
+
+def _as_before(
+    held: dict[str, Any],
+    table: pd.DataFrame,
+    numbers: dict[str, Any],
+    folder: StudyFolder,
+    info: dict[str, Any],
+    start: float,
+) -> RecoveryResult:
+    """The result of a finished study that had nothing left to run: its files as they are."""
+    out = folder.path
+    paths = [out / name for name in held["figures"]]
+    example_dir = out / held["example_dir"] if held.get("example_dir") else None
+    elapsed = time.perf_counter() - start
+    return RecoveryResult(
+        out, table, held, numbers, folder.report_path(), paths, example_dir, info, elapsed
     )
 
 

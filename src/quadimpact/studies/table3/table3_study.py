@@ -58,6 +58,7 @@ from quadimpact.experiments.spiri_mat import SpiriMatLog
 from quadimpact.linalg import norm
 from quadimpact.simulation import simulate
 from quadimpact.simulation.response_types import RESPONSE_TYPES, closest_chaining
+from quadimpact.studies.study_folder import StudyFolder
 from quadimpact.studies.table3.crash_logs import (
     LOG_SENSITIVITY_RUNS,
     check_data_dir,
@@ -473,7 +474,8 @@ def run_experiments(
     from quadimpact.sweep.runner import _resolve_workers
     from quadimpact.sweep.tasks import run_tasks
 
-    out, logs = prepare_experiments(out_dir, data_dir)
+    folder, logs = prepare_experiments(out_dir, data_dir, samples, log_samples)
+    out = folder.path
     n = len(TABLE3)
     processes = 1 if scheduler is not None else _resolve_workers(workers)
     if processes > 1:  # one crash per process, each with its sweeps in that process
@@ -500,23 +502,40 @@ def run_experiments(
             row, _ = crash_task(crash, logs[crash.number], out, samples, log_samples,
                                 sweep_options)  # fmt: skip
             rows.append(row)
-    return write_table3(rows, out)
+    table = write_table3(rows, out)
+    folder.finish({"crashes": len(rows)})
+    return table
+
+
+def study_folder(
+    out_dir: str | Path,
+    samples: int = SENSITIVITY_RUNS,
+    log_samples: int = LOG_SENSITIVITY_RUNS,
+    where: str = "",
+) -> StudyFolder:
+    """The experiments' folder: the runs over the uncertainties decide its sweeps."""
+    identity = {"samples": samples, "log_samples": log_samples}
+    flags = {"samples": "--samples", "log_samples": "--log-samples"}
+    return StudyFolder(Path(out_dir), "experiments", identity, where=where, flags=flags)
 
 
 def prepare_experiments(
-    out_dir: str | Path, data_dir: str | Path | None
-) -> tuple[Path, dict[int, SpiriMatLog | None]]:
-    """The experiments' folder (checked, created) and each crash's log (None where absent).
+    out_dir: str | Path,
+    data_dir: str | Path | None,
+    samples: int = SENSITIVITY_RUNS,
+    log_samples: int = LOG_SENSITIVITY_RUNS,
+) -> tuple[StudyFolder, dict[int, SpiriMatLog | None]]:
+    """The experiments' folder (checked, claimed) and each crash's log (None where absent).
 
-    A ``data_dir`` given that holds no logs, a folder of another kind, or a
-    log that cannot be read is an error here, before any run.
+    A ``data_dir`` given that holds no logs, a folder of another kind (or of
+    these experiments with other ``samples``), or a log that cannot be read is
+    an error here, before any run. The folder is the experiments' own from
+    its first file (``study.json``): an interrupted run resumes in it.
     """
-    from quadimpact.results.files import check_out_dir
-
     data_dir = check_data_dir(data_dir, "data_dir")
-    out = check_out_dir(Path(out_dir), "experiments", where="")
-    out.mkdir(parents=True, exist_ok=True)
-    return out, {crash.number: read_log(crash, data_dir) for crash in TABLE3}
+    folder = study_folder(out_dir, samples, log_samples)
+    folder.claim()
+    return folder, {crash.number: read_log(crash, data_dir) for crash in TABLE3}
 
 
 def write_table3(rows: list[dict[str, Any]], out: Path) -> pd.DataFrame:
