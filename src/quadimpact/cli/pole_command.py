@@ -114,10 +114,12 @@ def pole(
     n_runs = 2 * len(study.pitches()) * len(study.offsets())
     check_size(n_runs, allow_large, f"--pitch-step {pitch_step_deg:g}, --offset-step "
                f"{offset_step_m:g}")  # fmt: skip
-    study_folder(study, out).check()  # another study, or other options: refused at once
+    folder = study_folder(study, out)
+    folder.check()  # another study, or other options: refused at once
     from quadimpact.sweep.runner import warm_pool
 
-    warm_pool(workers, scheduler)  # the pool's server warms up while the study is imported
+    if folder.finished_description() is None:  # a finished study has nothing left to run
+        warm_pool(workers, scheduler)  # the pool's server warms up while the study loads
     with stoppable(out):
         result = run_pole_study(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,

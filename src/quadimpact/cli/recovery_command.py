@@ -134,12 +134,18 @@ def recovery(
         except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
             field, sep, rest = str(exc).partition(":")
             raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
+    from quadimpact.studies.study_folder import StudyFolder
     from quadimpact.sweep.runner import warm_pool
 
     # the pool's fork server imports the simulator and loads the kernel on another core
     # while this process imports the study: the trials' pool and the example trial's
     # process (docs/RECOVERY.md 8) then start from a warm server instead of waiting for it
-    warm_pool(workers, scheduler)
+    # (not for a finished study of the same options: it has nothing left to run)
+    finished = study is not None and (
+        StudyFolder(out, "recovery", study.options()).finished_description() is not None
+    )
+    if not finished:
+        warm_pool(workers, scheduler)
     from quadimpact.studies.recovery.recovery_study import run_study
 
     if sweep_file is not None:
