@@ -42,8 +42,9 @@ def main() -> None:
                "--allow-large", "--no-example", "--workers", str(a.workers),
                "--out", str(out)]  # fmt: skip
         start = time.perf_counter()
-        proc = subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True, bufsize=1)
-        os.set_blocking(proc.stderr.fileno(), False)
+        proc = subprocess.Popen(cmd, stderr=subprocess.PIPE)
+        fd = proc.stderr.fileno()
+        os.set_blocking(fd, False)
         me = psutil.Process(proc.pid)
         peak_cmd = peak_all = 0
         first_line = None
@@ -58,17 +59,23 @@ def main() -> None:
             except psutil.NoSuchProcess:
                 break
             peak_cmd, peak_all = max(peak_cmd, rss), max(peak_all, total)
-            chunk = proc.stderr.read() or ""
+            try:
+                chunk = os.read(fd, 1 << 16).decode(errors="replace")
+            except BlockingIOError:
+                chunk = ""
             if chunk:
                 lines += chunk.splitlines()
                 if first_line is None:
                     first_line = time.perf_counter() - start
             time.sleep(0.05)
         proc.send_signal(signal.SIGINT)
-        tail, _ = proc.communicate(timeout=120)
-        lines += (tail or "").splitlines()
-        time.sleep(1.0)
+        _, tail = proc.communicate(timeout=120)
+        lines += (tail or b"").decode(errors="replace").splitlines()
+        gone_by = time.perf_counter() + 10.0  # processes ended by the command have gone by then
         alive = [pid for pid in children if psutil.pid_exists(pid)]
+        while alive and time.perf_counter() < gone_by:
+            time.sleep(0.1)
+            alive = [pid for pid in alive if _running(pid)]
         print(
             f"trials                 {a.n:,} on {a.workers} workers, stopped after {a.seconds:g} s"
         )
@@ -77,7 +84,14 @@ def main() -> None:
         print(f"first progress line    {first_line:.2f} s" if first_line else "no progress line")
         print(f"exit status            {proc.returncode}")
         print(f"last line              {lines[-1] if lines else ''}")
-        print(f"processes left         {len(alive)}")
+        print(f"processes left         {len(alive)} (10 s after the command ended)")
+
+
+def _running(pid: int) -> bool:
+    try:
+        return psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    except psutil.NoSuchProcess:
+        return False
 
 
 def _rss(p: psutil.Process) -> int:
