@@ -43,6 +43,8 @@ __all__ = [
     "RecoveryParams",
     "controller_entry",
     "controller_names",
+    "param_index",
+    "param_slots",
     "register_controller",
     "unregister_controller",
 ]
@@ -200,8 +202,53 @@ class _NoParams(BaseModel):
     model_config = MODEL_CONFIG
 
 
-def _empty_block(params: BaseModel, ctx: PackContext) -> np.ndarray:
-    return np.zeros(L.NPARAM)
+def param_slots(params: type[BaseModel]) -> dict[str, tuple[int, int]]:
+    """Where the default packing puts each field of a parameter model: ``{name: (offset,
+    width)}`` in the controller's parameter block (``quadimpact.core.named.params(ctrl)``).
+
+    The fields in their declared order: a number or a flag takes one slot, a
+    tuple or list of ``n`` numbers ``n`` slots (its default's length).
+
+    Raises
+    ------
+    TypeError
+        A field of another kind (text, a table), or more than ``NPARAM`` slots.
+    """
+    slots: dict[str, tuple[int, int]] = {}
+    offset = 0
+    for name, info in params.model_fields.items():
+        default = info.get_default(call_default_factory=True)
+        if isinstance(default, (bool, int, float)) and not isinstance(default, str):
+            width = 1
+        elif isinstance(default, (tuple, list)) and all(
+            isinstance(v, (int, float)) for v in default
+        ):
+            width = len(default)
+        else:
+            raise TypeError(
+                f"{params.__name__}.{name}: the default packing takes numbers, flags and tuples "
+                f"of numbers (got {default!r}); give register_controller a pack function"
+            )
+        slots[name] = (offset, width)
+        offset += width
+    if offset > L.NPARAM:
+        raise TypeError(f"{params.__name__}: {offset} parameter slots, more than {L.NPARAM}")
+    return slots
+
+
+def param_index(params: type[BaseModel], name: str) -> int:
+    """The offset of field ``name`` of a parameter model in its packed block (see
+    :func:`param_slots`): ``named.params(ctrl)[param_index(MyParams, "k_p")]``."""
+    return param_slots(params)[name][0]
+
+
+def _pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    """The default packing: the model's fields in order (:func:`param_slots`)."""
+    block = np.zeros(L.NPARAM)
+    for name, (offset, width) in param_slots(type(params)).items():
+        value = getattr(params, name)
+        block[offset : offset + width] = np.asarray(value, dtype=float).reshape(width)
+    return block
 
 
 def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
@@ -258,7 +305,7 @@ _REGISTRY: Registry[ControllerEntry] = Registry(
     entry_type=ControllerEntry,
     user_kind=L.CTRL_USER,
     no_params=_NoParams,
-    empty_pack=_empty_block,
+    empty_pack=_pack_fields,
 )
 
 
@@ -285,7 +332,8 @@ def register_controller(
         Its parameters with defaults (default: none).
     pack : callable, optional
         ``pack(params, context) -> ndarray (NPARAM,)``, the parameter block at
-        ``ctrl[C_PARAMS:]`` (default: zeros).
+        ``ctrl[C_PARAMS:]`` (default: the model's fields in order,
+        :func:`param_slots`; a step reads them by :func:`param_index`).
     kind : int, optional
         A built-in ``CTRL_*`` id of the cached kernel.
     description : str, optional
@@ -297,6 +345,8 @@ def register_controller(
     -------
     ControllerEntry
     """
+    if pack is None and params is not None:
+        param_slots(params)  # the default packing can pack it (TypeError now, not at a run)
     return _REGISTRY.register(
         name, step, params=params, pack=pack, kind=kind, description=description, replace=replace
     )

@@ -28,6 +28,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core import step as core_step
 from quadimpact.core.kernel import BUILTIN, Kernel
+from quadimpact.core.named import MEASUREMENT_FIELDS, STATE_FIELDS, NamedVector, block_fields
 from quadimpact.core.records import new_data, new_output, raw_record
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.checks import whole_ticks
@@ -35,6 +36,8 @@ from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.simulate import analyse
 
 __all__ = ["Simulation"]
+
+_STATS_FIELDS = block_fields("stats", "ST_")
 
 
 class Simulation:
@@ -122,15 +125,20 @@ class Simulation:
         return float(self.setup.opts[L.O_DT_CONTROL])
 
     @property
-    def state(self) -> np.ndarray:
-        """A copy of the state (layout ``X_*``: position inertial NED m, velocity body m/s,
-        quaternion body -> inertial, body rates rad/s, rotor speeds rad/s)."""
-        return self._d.x.copy()
+    def state(self) -> NamedVector:
+        """A read-only copy of the state, by name: ``position`` (inertial NED, m),
+        ``velocity_body`` (body FRD, m/s), ``attitude`` (quaternion, scalar first, body ->
+        inertial), ``body_rates`` (rad/s), ``rotor_speeds`` (rad/s); as an array, layout
+        ``X_*`` (``quadimpact.core.named.STATE_FIELDS``)."""
+        return NamedVector(self._d.x, STATE_FIELDS)
 
     @property
-    def measurement(self) -> np.ndarray:
-        """A copy of the measurement record (layout ``MS_*``) of the last tick."""
-        return self._d.meas.copy()
+    def measurement(self) -> NamedVector:
+        """A read-only copy of the last tick's measurement record, by name (what the
+        controller read: the estimate's ``position``, ``attitude``..., ``imu_specific_force``,
+        ``detected``, ``wall_normal``...: ``quadimpact.core.named.MEASUREMENT_FIELDS``); as an
+        array, layout ``MS_*``."""
+        return NamedVector(self._d.meas, MEASUREMENT_FIELDS)
 
     @property
     def stage(self) -> int:
@@ -138,9 +146,10 @@ class Simulation:
         return int(self._d.ls[L.LS_STAGE])
 
     @property
-    def stats(self) -> np.ndarray:
-        """A copy of the run's counters and records (layout ``ST_*``)."""
-        return self._o.stats.copy()
+    def stats(self) -> NamedVector:
+        """A read-only copy of the run's counters and records, by the names of their slots
+        (``t_end``, ``n_steps``, ``crash_t``, ``onset_t``...); as an array, layout ``ST_*``."""
+        return NamedVector(self._o.stats, _STATS_FIELDS)
 
     def result(self) -> SimulationResult:
         """The result so far (the whole run's once :attr:`done`), as ``simulate`` returns it.
