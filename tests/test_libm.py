@@ -98,7 +98,8 @@ def test_the_ufuncs_used_directly_are_the_c_library_under_this_dispatch():
 CPU_DEPENDENT = {
     "arctan2", "arccos", "arcsin", "arctan", "arccosh", "arcsinh", "arctanh", "exp", "exp2",
     "expm1", "log", "log2", "log10", "log1p", "power", "float_power", "cbrt", "tan", "sinh",
-    "cosh", "dot", "vdot", "inner", "matmul", "tensordot",
+    "cosh", "dot", "vdot", "inner", "matmul", "tensordot", "polyfit", "cov", "corrcoef",
+    "correlate", "convolve",
 }  # fmt: skip
 #: Where such calls stay, and why (none of them reaches a result a test pins or a table holds).
 ALLOWED = {

@@ -181,20 +181,8 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
     reach = bumper_rim_extent(C, np.array([1.0, 0.0, 0.0]))
     rim = pose["x_m"].to_numpy()[idx][:, None] + reach  # (n, 4)
     touching = rim >= wall - contact_tol_m
-    # impacts: runs of touching samples separated by full separation
     separated = (rim < wall - SEPARATION_M).all(axis=1)
-    impacts: list[list[int]] = []
-    current: list[int] | None = None
-    for k in range(len(tp)):
-        if touching[k].any():
-            if current is None:
-                current = []
-                impacts.append(current)
-            for b in np.flatnonzero(touching[k]) + 1:
-                if int(b) not in current:
-                    current.append(int(b))
-        elif separated[k]:
-            current = None
+    impacts = _rim_impacts(touching, separated)
     if not impacts:
         pi = log.pre_impact()
         lead = [pi.leading_bumper] if isinstance(pi, PreImpact) and pi.leading_bumper else []
@@ -203,17 +191,8 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
                      "taken from the pre-impact estimate")  # fmt: skip
     leading = tuple(impacts[0])
     subsequent = tuple(tuple(i) for i in impacts[1:])
-    # landing
-    alt = pose["altitude_m"].to_numpy()[idx]
-    alt0 = float(alt[0])
-    landing: float | None = None
-    crashed: bool | None = None
-    if alt.min() < alt0 - LANDING_DROP_M:
-        k = int(np.argmax(alt <= alt.min() + LANDING_TOL_M))
-        settled = tp[-1] - tp[int(np.argmin(alt))] >= LANDING_HOLD_S
-        if settled or crashed_motors:
-            landing = float(tp[k])
-            crashed = True
+    landing = _landing(pose["altitude_m"].to_numpy()[idx], tp, crashed_motors)
+    crashed: bool | None = True if landing is not None else None
     observed_to_end = end == len(np.flatnonzero(post)) and tracked_until >= t[-1] - 1e-9
     if landing is None:
         if crashed_motors:
@@ -243,6 +222,35 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
     return LogResponse(kind, crashed=crashed, landing_time_s=landing, leading_bumpers=leading,
                        subsequent_impacts=subsequent, tracked_until_s=tracked_until,
                        notes=tuple(notes))  # fmt: skip
+
+
+def _rim_impacts(touching: np.ndarray, separated: np.ndarray) -> list[list[int]]:
+    """The impacts seen in the motion capture: runs of samples with a rim touching the wall,
+    each ended by a sample with every rim fully separated; each impact's bumpers (1-4) in
+    the order they touched."""
+    impacts: list[list[int]] = []
+    current: list[int] | None = None
+    for k in range(len(touching)):
+        if touching[k].any():
+            if current is None:
+                current = []
+                impacts.append(current)
+            for b in np.flatnonzero(touching[k]) + 1:
+                if int(b) not in current:
+                    current.append(int(b))
+        elif separated[k]:
+            current = None
+    return impacts
+
+
+def _landing(alt: np.ndarray, t: np.ndarray, crashed_motors: bool) -> float | None:
+    """The landing's time: the altitude dropped :data:`LANDING_DROP_M` below the impact's
+    and settled (or the motors are off); None without one."""
+    if not alt.min() < float(alt[0]) - LANDING_DROP_M:
+        return None
+    k = int(np.argmax(alt <= alt.min() + LANDING_TOL_M))
+    settled = t[-1] - t[int(np.argmin(alt))] >= LANDING_HOLD_S
+    return float(t[k]) if settled or crashed_motors else None
 
 
 def _impact_starts(touching: np.ndarray, separated: np.ndarray, t: np.ndarray) -> list[float]:
@@ -464,16 +472,8 @@ def compare(
     t_log0 = float(log.impact_time_s)
     notes: list[str] = []
 
-    sim = pd.DataFrame({"tau_s": ts["t_s"].to_numpy(dtype=float) - t_impact_sim})
-    for _, (_, quantities) in GROUPS.items():
-        for _, col, wrapped in quantities:
-            if col in ts:
-                v = ts[col].to_numpy(dtype=float)
-                sim[col] = unwrap_deg(v) if wrapped else v
+    sim = _sim_on_tau(ts, t_impact_sim)
     quats = ["q0", "q1", "q2", "q3"]
-    for c in quats:
-        if c in ts:
-            sim[c] = ts[c].to_numpy(dtype=float)
     pose = log.pose().copy()
     pose.insert(0, "tau_s", pose["t_s"].to_numpy(dtype=float) - t_log0)
     have_quats = all(c in sim for c in quats) and all(c in pose for c in quats)
@@ -495,19 +495,63 @@ def compare(
     motors.insert(0, "tau_s", motors["t_s"].to_numpy(dtype=float) - t_log0)
 
     if relative_position:
-        for col in ("x_m", "y_m", "altitude_m"):
-            if col in sim:
-                sim[col] = sim[col] - np.interp(0.0, sim["tau_s"], sim[col])
-            if col in pose and len(pose):
-                tp = pose["tau_s"].to_numpy()
-                ref = _interp_segments(np.array([0.0]), tp, pose[col].to_numpy(), MOCAP_GAP_S)[0]
-                if not math.isfinite(ref):
-                    k = int(np.argmin(np.abs(tp)))
-                    ref = float(pose[col].iloc[k])
-                    notes.append(f"{col}: no log sample around the impact; reference taken "
-                                 f"at tau = {tp[k]:+.3f} s")  # fmt: skip
-                pose[col] = pose[col] - ref
+        _displacements_since_impact(sim, pose, notes)
+    errors = _errors(sim, pose, motors, windows, have_quats)
+    resp = log_response(log) if classify_log else None
+    return Comparison(
+        name=getattr(log, "name", "") or "log",
+        windows=tuple(float(w) for w in windows),
+        errors=errors,
+        sim=sim,
+        log_pose=pose,
+        log_motors=motors,
+        t_impact_sim=t_impact_sim,
+        t_impact_log=t_log0,
+        sim_response=sim_type,
+        log_response=resp,
+        notes=notes,
+    )
 
+
+def _sim_on_tau(ts: pd.DataFrame, t_impact_sim: float) -> pd.DataFrame:
+    """The run's compared columns on the time since its impact (roll and yaw unwrapped)."""
+    sim = pd.DataFrame({"tau_s": ts["t_s"].to_numpy(dtype=float) - t_impact_sim})
+    for _, (_, quantities) in GROUPS.items():
+        for _, col, wrapped in quantities:
+            if col in ts:
+                v = ts[col].to_numpy(dtype=float)
+                sim[col] = unwrap_deg(v) if wrapped else v
+    for c in ("q0", "q1", "q2", "q3"):
+        if c in ts:
+            sim[c] = ts[c].to_numpy(dtype=float)
+    return sim
+
+
+def _displacements_since_impact(sim: pd.DataFrame, pose: pd.DataFrame, notes: list[str]) -> None:
+    """X, Y and altitude of both sides made displacements since the impact (in place)."""
+    for col in ("x_m", "y_m", "altitude_m"):
+        if col in sim:
+            sim[col] = sim[col] - np.interp(0.0, sim["tau_s"], sim[col])
+        if col in pose and len(pose):
+            tp = pose["tau_s"].to_numpy()
+            ref = _interp_segments(np.array([0.0]), tp, pose[col].to_numpy(), MOCAP_GAP_S)[0]
+            if not math.isfinite(ref):
+                k = int(np.argmin(np.abs(tp)))
+                ref = float(pose[col].iloc[k])
+                notes.append(f"{col}: no log sample around the impact; reference taken "
+                             f"at tau = {tp[k]:+.3f} s")  # fmt: skip
+            pose[col] = pose[col] - ref
+
+
+def _errors(
+    sim: pd.DataFrame,
+    pose: pd.DataFrame,
+    motors: pd.DataFrame,
+    windows: tuple[float, ...],
+    have_quats: bool,
+) -> pd.DataFrame:
+    """The error table: per window, group and quantity, the run minus the log on the log's
+    samples (RMS, largest, count), each group's all-quantity row and the rotation angle."""
     rows: list[dict[str, Any]] = []
     for w in windows:
         for group, (unit, quantities) in GROUPS.items():
@@ -528,22 +572,8 @@ def compare(
             rows.append(_row(group, "all", unit, w, cat))
             if group == "attitude" and have_quats:
                 rows.append(_row(group, "rotation", unit, w, _rotation_error(sim, sel)))
-    errors = pd.DataFrame(rows, columns=["group", "quantity", "unit", "window_s", "rms",
-                                         "max_abs", "n"])  # fmt: skip
-    resp = log_response(log) if classify_log else None
-    return Comparison(
-        name=getattr(log, "name", "") or "log",
-        windows=tuple(float(w) for w in windows),
-        errors=errors,
-        sim=sim,
-        log_pose=pose,
-        log_motors=motors,
-        t_impact_sim=t_impact_sim,
-        t_impact_log=t_log0,
-        sim_response=sim_type,
-        log_response=resp,
-        notes=notes,
-    )
+    return pd.DataFrame(rows, columns=["group", "quantity", "unit", "window_s", "rms",
+                                       "max_abs", "n"])  # fmt: skip
 
 
 def _unwrap_onto(tau: np.ndarray, angle_deg: np.ndarray, reference_deg: float) -> np.ndarray:

@@ -148,6 +148,46 @@ def polyfit_at(t: np.ndarray, y: np.ndarray, deg: int) -> tuple[np.ndarray, np.n
     return coef, s2 * gram_inverse
 
 
+def _velocity_fit(
+    tau: np.ndarray, positions: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Velocity, acceleration and the velocity's variance at ``tau = 0`` of each position
+    component (quadratic fits over the samples at ``tau``, s before the contact)."""
+    vel = np.empty(3)
+    acc = np.empty(3)
+    var = np.empty(3)
+    for i in range(3):
+        co, cov = polyfit_at(tau, positions[:, i], 2)
+        vel[i], acc[i], var[i] = co[1], 2.0 * co[0], cov[1, 1]
+    return vel, acc, var
+
+
+def _attitude_at(
+    tau: np.ndarray, C: np.ndarray, dtc: float
+) -> tuple[dict[str, float], dict[str, float]]:
+    """Roll, pitch, yaw (unwrapped) and inclination at ``tau = 0`` (deg; linear fits over
+    the attitude samples ``C`` at ``tau``), and their uncertainties: the fit's residual
+    scatter, the slope times the contact time's uncertainty ``dtc`` (s), and
+    :data:`ATTITUDE_SYSTEMATIC_DEG`."""
+    roll, pitch, yaw = matrix_to_euler_zyx_deg(C)
+    yaw_u = np.degrees(np.unwrap(np.radians(yaw)))
+    incl = inclination_deg(C)
+    ang: dict[str, float] = {}
+    unc: dict[str, float] = {}
+    for key, series in (("roll_deg", roll), ("pitch_deg", pitch), ("yaw_deg", yaw_u),
+                        ("inclination_deg", incl)):  # fmt: skip
+        if len(tau) >= 3:
+            co, cov = polyfit_at(tau, series, 1)
+            val = float(co[1])
+            resid = float(np.sqrt(cov[1, 1]))
+            slope = float(co[0])
+        else:
+            val, resid, slope = float(np.mean(series)), float(np.std(series)), 0.0
+        ang[key] = val
+        unc[key] = math.sqrt(resid**2 + (slope * dtc) ** 2 + ATTITUDE_SYSTEMATIC_DEG**2)
+    return ang, unc
+
+
 # ------------------------------------------------------------------ the impact
 def find_impact(
     accel: pd.DataFrame | None, motors: pd.DataFrame | None, name: str
@@ -206,7 +246,7 @@ def approach_speed(t: np.ndarray, x: np.ndarray) -> np.ndarray:
     for k in range(len(t)):
         s = np.abs(t - t[k]) <= STOP_HALF_WINDOW_S
         if s.sum() >= 3:
-            v[k] = np.polyfit(t[s] - t[k], x[s], 1)[0]
+            v[k] = lstsq(np.vander(t[s] - t[k], 2), x[s])[0][0]
     return v
 
 
@@ -230,57 +270,79 @@ def locate_contact(
     if mc is None:
         res["notes"].append("no motion capture in this log")
         return res
-    t, p = mc["t"], mc["p"]
+    t, x = mc["t"], mc["p"][:, 0]
     ti = impact_s
-    near = np.flatnonzero(np.abs(t - ti) <= CONTACT_SEARCH_S)
-    x = p[:, 0]
-    stop = None
-    if near.size:
-        lo = max(near[0] - 60, 0)
-        sl = slice(lo, near[-1] + 1)
-        ts, xs = t[sl], x[sl]
-        vloc = approach_speed(ts, xs)
-        for k in range(len(ts)):
-            if abs(ts[k] - ti) > CONTACT_SEARCH_S:
-                continue
-            ref = (ts >= ts[k] - STOP_REF_S[0]) & (ts <= ts[k] - STOP_REF_S[1])
-            if ref.sum() < 5 or np.isnan(vloc[ref]).all():
-                continue
-            vr = float(np.nanmedian(vloc[ref]))
-            if vr > STOP_MIN_APPROACH_M_S and vloc[k] < STOP_FRACTION * vr:
-                stop = float(ts[k])
-                break
+    stop = _stop(t, x, ti)
     if stop is not None:
-        f = (t >= stop - CHANGEPOINT_BEFORE_S - FIT_WINDOW_S) & (t <= stop + CHANGEPOINT_AFTER_S)
-        tf, xf = t[f], x[f]
-        best: tuple[float, float, np.ndarray] | None = None
-        sse0 = None
-        grid = np.arange(stop - CHANGEPOINT_BEFORE_S, stop + 0.5 * CHANGEPOINT_STEP_S,
-                         CHANGEPOINT_STEP_S)  # fmt: skip
-        for tc in grid:
-            tau = tf - tc
-            A = np.column_stack([np.ones_like(tau), tau, tau**2,
-                                 -0.5 * np.maximum(tau, 0.0) ** 2])  # fmt: skip
-            co = lstsq(A, xf)[0]
-            sse = float(np.sum((xf - matvec(A, co)) ** 2))
-            if sse0 is None:
-                c0 = lstsq(A[:, :3], xf)[0]
-                sse0 = float(np.sum((xf - matvec(A[:, :3], c0)) ** 2))
-            if co[3] < 0:
-                continue
-            if best is None or sse < best[1]:
-                best = (float(tc), sse, co)
         res["stop"] = stop
-        if best is not None and best[2][3] >= CONTACT_MIN_DECELERATION_M_S2:
-            res.update(t_mocap=best[0], method="changepoint", observed=True,
-                       a_dec=float(best[2][3]))  # fmt: skip
+        best = _changepoint(t, x, stop)
+        if best is not None and best[1] >= CONTACT_MIN_DECELERATION_M_S2:
+            res.update(t_mocap=best[0], method="changepoint", observed=True, a_dec=best[1])
             res["offset"] = best[0] - ti
             return res
         res["notes"].append(
             f"a stop at {stop - ti:+.3f} s (mocap clock - impact) without a clear "
             "deceleration; not taken as the contact"
         )
-    # not observed: extrapolate to the set's wall plane, or use the clock offset
+    _unobserved_contact(res, mc, ti, stop, wall_x_default, offset_default)
+    return res
+
+
+def _stop(t: np.ndarray, x: np.ndarray, ti: float) -> float | None:
+    """The first motion-capture time within ``CONTACT_SEARCH_S`` of the impact ``ti`` where
+    the approach speed drops below ``STOP_FRACTION`` of its recent median (None: none)."""
+    near = np.flatnonzero(np.abs(t - ti) <= CONTACT_SEARCH_S)
+    if not near.size:
+        return None
+    lo = max(near[0] - 60, 0)
+    sl = slice(lo, near[-1] + 1)
+    ts, xs = t[sl], x[sl]
+    vloc = approach_speed(ts, xs)
+    for k in range(len(ts)):
+        if abs(ts[k] - ti) > CONTACT_SEARCH_S:
+            continue
+        ref = (ts >= ts[k] - STOP_REF_S[0]) & (ts <= ts[k] - STOP_REF_S[1])
+        if ref.sum() < 5 or np.isnan(vloc[ref]).all():
+            continue
+        vr = float(np.nanmedian(vloc[ref]))
+        if vr > STOP_MIN_APPROACH_M_S and vloc[k] < STOP_FRACTION * vr:
+            return float(ts[k])
+    return None
+
+
+def _changepoint(t: np.ndarray, x: np.ndarray, stop: float) -> tuple[float, float] | None:
+    """The contact time and deceleration of the best change-point fit of ``X(t)`` around
+    the stop: quadratic before, an extra constant deceleration after (None: no fit with a
+    deceleration)."""
+    f = (t >= stop - CHANGEPOINT_BEFORE_S - FIT_WINDOW_S) & (t <= stop + CHANGEPOINT_AFTER_S)
+    tf, xf = t[f], x[f]
+    best: tuple[float, float, np.ndarray] | None = None
+    grid = np.arange(stop - CHANGEPOINT_BEFORE_S, stop + 0.5 * CHANGEPOINT_STEP_S,
+                     CHANGEPOINT_STEP_S)  # fmt: skip
+    for tc in grid:
+        tau = tf - tc
+        A = np.column_stack([np.ones_like(tau), tau, tau**2,
+                             -0.5 * np.maximum(tau, 0.0) ** 2])  # fmt: skip
+        co = lstsq(A, xf)[0]
+        sse = float(np.sum((xf - matvec(A, co)) ** 2))
+        if co[3] < 0:
+            continue
+        if best is None or sse < best[1]:
+            best = (float(tc), sse, co)
+    return None if best is None else (best[0], float(best[2][3]))
+
+
+def _unobserved_contact(
+    res: dict[str, Any],
+    mc: dict[str, np.ndarray],
+    ti: float,
+    stop: float | None,
+    wall_x_default: float,
+    offset_default: float,
+) -> None:
+    """A contact not observed: the position fit extrapolated to the set's wall plane, or
+    the on-board impact plus the set's clock offset (``res`` updated, with a note)."""
+    t, x = mc["t"], mc["p"][:, 0]
     t_lim = ti + offset_default
     # usable approach: the gap-free segment holding the last sample before the
     # expected contact, up to its end (at most CONTACT_SEARCH_S later) or the stop
@@ -288,16 +350,15 @@ def locate_contact(
     before = np.flatnonzero(t <= t_lim)
     if before.size == 0:
         res["notes"].append("no motion capture before the impact")
-        return res
+        return
     usable = (seg == seg[before[-1]]) & (t <= t_lim + CONTACT_SEARCH_S)
     if stop is not None:
         usable &= t < stop
     last = int(np.flatnonzero(usable)[-1]) if usable.any() else int(before[-1])
     f = usable & (t >= t[last] - FIT_WINDOW_S) & (t <= t[last])
+    reach = bumper_rim_extent(mc["C"][last][None], np.array([1.0, 0.0, 0.0]))[0].max()
     if f.sum() >= 6:
-        tau = t[f] - t[last]
-        cx, _ = polyfit_at(tau, x[f], 2)
-        reach = bumper_rim_extent(mc["C"][last][None], np.array([1.0, 0.0, 0.0]))[0].max()
+        cx, _ = polyfit_at(t[f] - t[last], x[f], 2)
         # solve x_fit(tau) + reach = wall for tau in [0, MAX_EXTRAPOLATION_S]
         taus = np.linspace(0.0, MAX_EXTRAPOLATION_S, 1501)
         gap = np.polyval(cx, taus) + reach - wall_x_default
@@ -309,21 +370,18 @@ def locate_contact(
                 f"contact not observed: position fit extrapolated {taus[k]:.3f} s past "
                 f"the last usable sample to the set's wall plane X = {wall_x_default} m"
             )
-            return res
-    tcm = t_lim
-    if t[last] < tcm - MAX_EXTRAPOLATION_S:
+            return
+    if t[last] < t_lim - MAX_EXTRAPOLATION_S:
         res["notes"].append(
-            f"motion capture ends {tcm - t[last]:.3f} s before the impact: no estimate"
+            f"motion capture ends {t_lim - t[last]:.3f} s before the impact: no estimate"
         )
-        return res
-    res.update(t_mocap=tcm, method="clock-offset")
-    reach = bumper_rim_extent(mc["C"][last][None], np.array([1.0, 0.0, 0.0]))[0].max()
+        return
+    res.update(t_mocap=t_lim, method="clock-offset")
     far = wall_x_default - (x[last] + reach)
     res["notes"].append(
         "contact not observed: impact placed at the on-board impact plus the set's clock "
         f"offset; the vehicle is {far:.2f} m short of the set's wall plane there"
     )
-    return res
 
 
 def estimate_pre_impact(
@@ -373,15 +431,7 @@ def estimate_pre_impact(
         dtc = max(tc - t[last], 0.01)
 
     def fit(window: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        s = pre & (t >= tc - window)
-        tau = t[s] - tc
-        vel = np.empty(3)
-        acc = np.empty(3)
-        var = np.empty(3)
-        for i in range(3):
-            co, cov = polyfit_at(tau, p[s, i], 2)
-            vel[i], acc[i], var[i] = co[1], 2.0 * co[0], cov[1, 1]
-        return vel, acc, var
+        return _velocity_fit(t[pre & (t >= tc - window)] - tc, p[pre & (t >= tc - window)])
 
     n_fit = int((pre & (t >= tc - FIT_WINDOW_S)).sum())
     if n_fit < 6:
@@ -403,24 +453,7 @@ def estimate_pre_impact(
     sa = pre & (t >= tc - ATTITUDE_WINDOW_S)
     if sa.sum() < 3:
         sa = pre & (t >= t[last] - ATTITUDE_WINDOW_S)
-    Ca = C[sa]
-    roll, pitch, yaw = matrix_to_euler_zyx_deg(Ca)
-    yaw_u = np.degrees(np.unwrap(np.radians(yaw)))
-    incl = inclination_deg(Ca)
-    tau_a = t[sa] - tc
-    ang: dict[str, float] = {}
-    unc: dict[str, float] = {}
-    for key, series in (("roll_deg", roll), ("pitch_deg", pitch), ("yaw_deg", yaw_u),
-                        ("inclination_deg", incl)):  # fmt: skip
-        if len(tau_a) >= 3:
-            co, cov = polyfit_at(tau_a, series, 1)
-            val = float(co[1])
-            resid = float(np.sqrt(cov[1, 1]))
-            slope = float(co[0])
-        else:
-            val, resid, slope = float(np.mean(series)), float(np.std(series)), 0.0
-        ang[key] = val
-        unc[key] = math.sqrt(resid**2 + (slope * dtc) ** 2 + ATTITUDE_SYSTEMATIC_DEG**2)
+    ang, unc = _attitude_at(t[sa] - tc, C[sa], dtc)
     heading = float(wrap_angle_deg(ang["yaw_deg"]))
     rear = abs(heading) > 90.0
     equiv = float(wrap_angle_deg(heading - 180.0)) if rear else heading

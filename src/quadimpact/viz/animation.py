@@ -28,9 +28,11 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.artist import Artist
+from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
@@ -124,11 +126,25 @@ class AnimationFigure:
             bbox={"boxstyle": "round", "facecolor": "white", "alpha": 0.8, "edgecolor": "#cccccc"},
         )
 
-        t = scene.t
         t0 = scene.t_start if t0 is None else t0
         t1 = scene.t_end if t1 is None else t1
-        self._t = t
-        # deflections (mm): the whole run faint, the part up to the clock bold
+        self._t = scene.t
+        self._plot_deflections(ax_d)
+        self._plot_attitude(ax_a)
+        for ax in (ax_d, ax_a):
+            ax.grid(True, alpha=0.35)
+            set_time_limits(ax, [t0, t1])
+            if scene.first_contact_s is not None:
+                ax.axvline(scene.first_contact_s, color="k", linestyle=":", linewidth=0.8)
+            if scene.crash_time_s is not None:
+                ax.axvline(scene.crash_time_s, color="k", linestyle="--", linewidth=0.8)
+            ax.tick_params(labelsize=8)
+        self.cursors = [ax.axvline(t0, color="#555555", linewidth=1.0) for ax in (ax_d, ax_a)]
+        self._prepare_blitting(ax3d, ax_d, ax_a)
+
+    def _plot_deflections(self, ax_d: Axes) -> None:
+        """Deflections (mm): the whole run faint, the part up to the clock bold (live)."""
+        scene, t = self.scene, self._t
         self.defl_live = []
         self.defl_dots = []
         for j in (1, 2, 3, 4):
@@ -141,7 +157,10 @@ class AnimationFigure:
         ax_d.legend(loc="upper right", fontsize=8, ncol=2)
         ymax = max(1.0, float(np.nanmax(1e3 * scene.deltas)) * 1.1)
         ax_d.set_ylim(-0.03 * ymax, ymax)
-        # attitude (deg)
+
+    def _plot_attitude(self, ax_a: Axes) -> None:
+        """Attitude (deg): the whole run faint, the part up to the clock bold (live)."""
+        scene, t = self.scene, self._t
         self.att_live = []
         self.att_data = []
         for k, name in enumerate(("roll", "pitch", "yaw")):
@@ -153,15 +172,9 @@ class AnimationFigure:
         ax_a.set_ylabel("attitude (deg)")
         ax_a.set_xlabel("time (s)")
         ax_a.legend(loc="upper right", fontsize=8, ncol=3)
-        for ax in (ax_d, ax_a):
-            ax.grid(True, alpha=0.35)
-            set_time_limits(ax, [t0, t1])
-            if scene.first_contact_s is not None:
-                ax.axvline(scene.first_contact_s, color="k", linestyle=":", linewidth=0.8)
-            if scene.crash_time_s is not None:
-                ax.axvline(scene.crash_time_s, color="k", linestyle="--", linewidth=0.8)
-            ax.tick_params(labelsize=8)
-        self.cursors = [ax.axvline(t0, color="#555555", linewidth=1.0) for ax in (ax_d, ax_a)]
+
+    def _prepare_blitting(self, ax3d: Axes, ax_d: Axes, ax_a: Axes) -> None:
+        """Mark what changes every frame; stamp what never does (the rest is the background)."""
         # blitting: these change every frame; the rest is the background
         self.dynamic = [
             (ax3d, [*self.view.artists(), self.clock]),
@@ -309,25 +322,7 @@ def write_animation(
 
     def render(movie: Path | None) -> None:
         """Draw every frame: into the movie (when given) and the GIF's frames."""
-        writer = None
-        if movie is not None:
-            import imageio_ffmpeg
-
-            writer = imageio_ffmpeg.write_frames(
-                str(movie),
-                (w, h),
-                fps=fps,
-                codec="libx264",
-                pix_fmt_in="rgba",  # the canvas as it is: no copy to RGB per frame
-                pix_fmt_out="yuv420p",
-                quality=7,
-                # x264's "veryfast": 40 % less of ffmpeg's CPU than its default
-                # ("medium") for a 2 % larger file at the same quality setting
-                output_params=["-preset", "veryfast"],
-                macro_block_size=2,
-                ffmpeg_log_level="error",
-            )
-            writer.send(None)
+        writer = None if movie is None else _movie_writer(movie, (w, h), fps)
         sent = 0
         try:
             for k, t in enumerate(times):
@@ -341,14 +336,7 @@ def write_animation(
                     progress(k + 1, len(times))
         finally:
             if writer is not None:
-                # failed before the first frame: the error says why, not ffmpeg's
-                # "No frames have been written" (the half movie is removed anyway)
-                log = logging.getLogger("imageio_ffmpeg")
-                quiet, log.disabled = log.disabled, log.disabled or sent == 0
-                try:
-                    writer.close()
-                finally:
-                    log.disabled = quiet
+                _close_movie(writer, sent)
 
     mp4_path = out / ANIMATION_MP4
     if mp4:
@@ -357,20 +345,7 @@ def write_animation(
         render(None)
     gif_path = None
     if gif:
-        duration = int(round(1000.0 * gif_step / fps))
-        gif_path = out / ANIMATION_GIF
-        atomic_write(
-            gif_path,
-            lambda tmp: gif_frames[0].save(
-                tmp,
-                format="GIF",
-                save_all=True,
-                append_images=gif_frames[1:],
-                duration=duration,
-                loop=0,
-                disposal=1,
-            ),
-        )
+        gif_path = _write_gif(out / ANIMATION_GIF, gif_frames, int(round(1000.0 * gif_step / fps)))
     return AnimationInfo(
         mp4=mp4_path if mp4 else None,
         gif=gif_path,
@@ -378,6 +353,55 @@ def write_animation(
         fps=fps,
         size=(w, h),
         seconds=time.perf_counter() - started,
+    )
+
+
+def _movie_writer(movie: Path, size: tuple[int, int], fps: float) -> Any:
+    """A started ffmpeg writer of H.264 frames (RGBA in, as the canvas holds them)."""
+    import imageio_ffmpeg
+
+    writer = imageio_ffmpeg.write_frames(
+        str(movie),
+        size,
+        fps=fps,
+        codec="libx264",
+        pix_fmt_in="rgba",  # the canvas as it is: no copy to RGB per frame
+        pix_fmt_out="yuv420p",
+        quality=7,
+        # x264's "veryfast": 40 % less of ffmpeg's CPU than its default
+        # ("medium") for a 2 % larger file at the same quality setting
+        output_params=["-preset", "veryfast"],
+        macro_block_size=2,
+        ffmpeg_log_level="error",
+    )
+    writer.send(None)
+    return writer
+
+
+def _close_movie(writer: Any, sent: int) -> None:
+    """Close the writer; when it failed before its first frame, the error says why, not
+    ffmpeg's "No frames have been written" (the half movie is removed anyway)."""
+    log = logging.getLogger("imageio_ffmpeg")
+    quiet, log.disabled = log.disabled, log.disabled or sent == 0
+    try:
+        writer.close()
+    finally:
+        log.disabled = quiet
+
+
+def _write_gif(path: Path, frames: list[Any], duration_ms: int) -> Path:
+    """The GIF of ``frames`` (each shown ``duration_ms``), written atomically."""
+    return atomic_write(
+        path,
+        lambda tmp: frames[0].save(
+            tmp,
+            format="GIF",
+            save_all=True,
+            append_images=frames[1:],
+            duration=duration_ms,
+            loop=0,
+            disposal=1,
+        ),
     )
 
 

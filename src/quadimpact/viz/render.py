@@ -110,6 +110,19 @@ class SceneArtists:
         self._forward = forward
         lw = linewidth
 
+        self._add_surfaces(lw, right, forward)
+        self._add_vehicle(lw, labels)
+        self._add_contacts(lw)
+        self.show_force_text = labels
+
+        self.compass: list = []
+        if compass:
+            self._draw_compass(right, up)
+
+    # ------------------------------------------------------------ the artists
+    def _add_surfaces(self, lw: float, right: np.ndarray, forward: np.ndarray) -> None:
+        """The planes (contact surfaces and the ground, for reference) and the solids' lines."""
+        ax, scene = self.ax, self.scene
         # planes: the contact surfaces, and the ground plane for reference
         self.planes: list[tuple[np.ndarray, np.ndarray, Any, Polygon, LineCollection]] = []
         sf = scene.surf
@@ -153,6 +166,9 @@ class SceneArtists:
         )
         ax.add_collection(self.solid_lines)
 
+    def _add_vehicle(self, lw: float, labels: bool) -> None:
+        """The vehicle: rotor discs, arms, hub, body axes and the features with their names."""
+        ax, scene = self.ax, self.scene
         self.discs = [
             Polygon(
                 np.zeros((2, 2)),
@@ -211,6 +227,10 @@ class SceneArtists:
             )
             for j, name in enumerate(d.names)
         ]
+
+    def _add_contacts(self, lw: float) -> None:
+        """Per contact: its deepest point, deflection segment, force arrow and force value."""
+        ax = self.ax
         # contacts: deepest point, deflection segment, force arrow, force value
         self.points: list[Line2D] = []
         self.deflections: list[Line2D] = []
@@ -247,11 +267,6 @@ class SceneArtists:
             self.deflections.append(dl)
             self.arrows.append(arrow)
             self.force_texts.append(txt)
-        self.show_force_text = labels
-
-        self.compass: list = []
-        if compass:
-            self._draw_compass(right, up)
 
     # ------------------------------------------------------------ static parts
     def _draw_compass(self, right: np.ndarray, up: np.ndarray) -> None:

@@ -72,7 +72,44 @@ def viewer_data(
     from the start to the end of the run.
     """
     cam = camera or DEFAULT_VIEWER_CAMERA
-    t_all = scene.t
+    idx = _frame_indices(scene.t, rate_hz)
+    stages = None if scene.stages is None else scene.stages[idx]
+    s = scene.summary
+    origin = "first contact" if scene.first_contact_s is not None else "start"
+    subtitle = (
+        f"vehicle {scene.drawing.vehicle.name}; status {s.get('status', 'n/a')}; "
+        f"{s.get('outcome', '')}; time after {origin} at t = {scene.t_ref:.3f} s"
+    )
+    surfaces, solids = _world(scene)
+    return {
+        "title": f"quadimpact: {scene.describe()}",
+        "subtitle": subtitle,
+        "t_ref": scene.t_ref,
+        "first_contact": scene.first_contact_s,
+        "crash": scene.crash_time_s,
+        "wall_x": scene.wall_x_m,
+        "wall_width": WALL_WIDTH_M,
+        "anchor": _r(scene.anchor, 5),
+        "camera": {
+            "az": cam.azimuth_deg,
+            "el": cam.elevation_deg,
+            "follow": cam.follow,
+            "span": cam.span_m,
+        },
+        "surfaces": surfaces,
+        "solids": solids,
+        # the stage of each frame and the names of the stages met (null: no stages)
+        "stage_labels": None
+        if stages is None
+        else {str(k): stage_label(k) for k in sorted(set(stages.tolist()))},
+        "vehicle": _vehicle(scene),
+        "frames": _frames(scene, idx, stages),
+        "estimator": s.get("estimator"),
+    }
+
+
+def _frame_indices(t_all: np.ndarray, rate_hz: float) -> np.ndarray:
+    """The samples shown: every ``1 / rate_hz`` s, and the last one (the crash)."""
     if len(t_all) > 1:
         dt_out = float(np.median(np.diff(t_all)))
         stride = max(1, int(round(1.0 / (rate_hz * dt_out)))) if rate_hz > 0 else 1
@@ -81,25 +118,11 @@ def viewer_data(
     idx = np.arange(0, len(t_all), stride)
     if idx[-1] != len(t_all) - 1:
         idx = np.append(idx, len(t_all) - 1)  # keep the last sample (the crash)
-    contacts = []
-    for i in idx:
-        fr = scene.frame(float(t_all[i]))
-        contacts.append(
-            [
-                [
-                    c.bumper,
-                    *_r(c.point, 5),
-                    *_r(c.surface_point, 5),
-                    *_r(c.arrow_tip, 5),
-                    round(1e3 * c.delta_m, 3),
-                    round(c.force_n, 3),
-                ]
-                for c in fr.contacts
-            ]
-        )
-    d = scene.drawing
-    # a coarser circle is plenty on screen
-    step = max(1, (d.circles.shape[1] - 1) // 48)
+    return idx
+
+
+def _world(scene: Scene) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """The planes (with the ground, drawn for reference) and the solids as fixed polylines."""
     cuts = scene.first_contact_points()  # a wall panel's edge: where it was first touched
     surfaces = [
         {
@@ -132,69 +155,66 @@ def viewer_data(
                 "contact": False,
             }
         )
-    stages = None if scene.stages is None else scene.stages[idx]
-    s = scene.summary
-    origin = "first contact" if scene.first_contact_s is not None else "start"
-    subtitle = (
-        f"vehicle {d.vehicle.name}; status {s.get('status', 'n/a')}; "
-        f"{s.get('outcome', '')}; time after {origin} at t = {scene.t_ref:.3f} s"
-    )
+    return surfaces, solids
+
+
+def _vehicle(scene: Scene) -> dict[str, Any]:
+    """The vehicle's drawing in body axes (a coarser circle is plenty on screen)."""
+    d = scene.drawing
+    step = max(1, (d.circles.shape[1] - 1) // 48)
     return {
-        "title": f"quadimpact: {scene.describe()}",
-        "subtitle": subtitle,
-        "t_ref": scene.t_ref,
-        "first_contact": scene.first_contact_s,
-        "crash": scene.crash_time_s,
-        "wall_x": scene.wall_x_m,
-        "wall_width": WALL_WIDTH_M,
-        "anchor": _r(scene.anchor, 5),
-        "camera": {
-            "az": cam.azimuth_deg,
-            "el": cam.elevation_deg,
-            "follow": cam.follow,
-            "span": cam.span_m,
-        },
-        "surfaces": surfaces,
-        "solids": solids,
-        # the stage of each frame and the names of the stages met (null: no stages)
-        "stage_labels": None
-        if stages is None
-        else {str(k): stage_label(k) for k in sorted(set(stages.tolist()))},
-        "vehicle": {
-            "name": d.vehicle.name,
-            "colors": list(d.colors),
-            "names": [BUMPER_NAMES[j] for j in (1, 2, 3, 4)]
-            if d.vehicle.features is None
-            else list(d.names),
-            "label_text": list(d.names),
-            "kind_name": "bumper" if d.vehicle.features is None else "feature",
-            "centres": _r(d.centres, 6),
-            "line_centres": _r(d.circles.mean(axis=1), 6),
-            "line_feature": [int(f) for f in d.line_feature],
-            "circles": _r(d.circles[:, ::step], 5),
-            "discs": _r(d.discs[:, ::step], 5),
-            "hub": _r(d.hub, 5),
-            "arms": _r(d.arms, 5),
-            "axes": _r(d.axes, 5),
-            "labels": _r(d.label_points, 5),
-        },
-        "frames": {
-            "t": _r(t_all[idx], 5),
-            "pos": _r(scene.states[idx, 0:3], 5),
-            "quat": _r(scene.states[idx, 6:10], 6),
-            "delta": _r(1e3 * scene.deltas[idx], 3),
-            "force": _r(scene.forces[idx], 3),
-            "euler": _r(scene.euler_deg[idx], 2),
-            "alt": _r(scene.altitude[idx], 4),
-            "contacts": contacts,
-            "stage": None if stages is None else stages.tolist(),
-            # the estimator's attitude (null with the ideal estimator) and its error, deg
-            "quat_hat": None if scene.q_hat is None else _r(scene.q_hat[idx], 6),
-            "att_err": None
-            if scene.attitude_error_deg is None
-            else _r(scene.attitude_error_deg[idx], 3),
-        },
-        "estimator": s.get("estimator"),
+        "name": d.vehicle.name,
+        "colors": list(d.colors),
+        "names": [BUMPER_NAMES[j] for j in (1, 2, 3, 4)]
+        if d.vehicle.features is None
+        else list(d.names),
+        "label_text": list(d.names),
+        "kind_name": "bumper" if d.vehicle.features is None else "feature",
+        "centres": _r(d.centres, 6),
+        "line_centres": _r(d.circles.mean(axis=1), 6),
+        "line_feature": [int(f) for f in d.line_feature],
+        "circles": _r(d.circles[:, ::step], 5),
+        "discs": _r(d.discs[:, ::step], 5),
+        "hub": _r(d.hub, 5),
+        "arms": _r(d.arms, 5),
+        "axes": _r(d.axes, 5),
+        "labels": _r(d.label_points, 5),
+    }
+
+
+def _frames(scene: Scene, idx: np.ndarray, stages: np.ndarray | None) -> dict[str, Any]:
+    """The shown samples: time, pose, deflections, forces, contacts, stage, the estimate."""
+    contacts = []
+    for i in idx:
+        fr = scene.frame(float(scene.t[i]))
+        contacts.append(
+            [
+                [
+                    c.bumper,
+                    *_r(c.point, 5),
+                    *_r(c.surface_point, 5),
+                    *_r(c.arrow_tip, 5),
+                    round(1e3 * c.delta_m, 3),
+                    round(c.force_n, 3),
+                ]
+                for c in fr.contacts
+            ]
+        )
+    return {
+        "t": _r(scene.t[idx], 5),
+        "pos": _r(scene.states[idx, 0:3], 5),
+        "quat": _r(scene.states[idx, 6:10], 6),
+        "delta": _r(1e3 * scene.deltas[idx], 3),
+        "force": _r(scene.forces[idx], 3),
+        "euler": _r(scene.euler_deg[idx], 2),
+        "alt": _r(scene.altitude[idx], 4),
+        "contacts": contacts,
+        "stage": None if stages is None else stages.tolist(),
+        # the estimator's attitude (null with the ideal estimator) and its error, deg
+        "quat_hat": None if scene.q_hat is None else _r(scene.q_hat[idx], 6),
+        "att_err": None
+        if scene.attitude_error_deg is None
+        else _r(scene.attitude_error_deg[idx], 3),
     }
 
 
