@@ -14,34 +14,21 @@ phase without samples), and the attitude error's RMS over the whole run.
 from __future__ import annotations
 
 import math
+from dataclasses import fields
 from typing import Any
 
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.results.summary_record import PHASES, QUANTITIES, EstimationPart
 
 __all__ = ["ESTIMATION_KEYS", "PHASES", "QUANTITIES", "estimation_metrics"]
 
-#: (name in the keys, unit suffix) of the four errors, in the loop's order.
-QUANTITIES: tuple[tuple[str, str], ...] = (
-    ("attitude", "deg"),
-    ("velocity", "m_s"),
-    ("bias", "rad_s"),
-    ("position", "m"),
+ESTIMATION_KEYS: tuple[str, ...] = tuple(
+    f.name for f in fields(EstimationPart) if f.name.startswith("est_")
 )
-#: The phases, in the loop's order.
-PHASES: tuple[str, ...] = ("pre", "crash", "post")
-
-ESTIMATION_KEYS: tuple[str, ...] = (
-    *(
-        f"est_{q}_{stat}_{phase}_{unit}"
-        for q, unit in QUANTITIES
-        for phase in PHASES
-        for stat in ("rms", "max")
-    ),
-    "est_attitude_rms_run_deg",
-)
-"""The metric keys, in summary order (``est_attitude_rms_pre_deg`` ...)."""
+"""The metric keys, in summary order (``est_attitude_rms_pre_deg`` ...): the estimation
+part's (:class:`quadimpact.results.summary_record.EstimationPart`)."""
 
 
 _PHASE_KEYS: tuple[tuple[str, str], ...] = tuple(

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import fields
 from typing import Any
 
 import numpy as np
@@ -19,6 +20,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
 from quadimpact.linalg import dot, norm
+from quadimpact.results.summary_record import RecoveryPart
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
@@ -39,33 +41,17 @@ __all__ = [
 
 RECOVERED_STAGE = 4
 
-RECOVERY_KEYS: tuple[str, ...] = (
-    "detected",
-    "not_detected",
-    "false_detection",
-    "n_detections",
-    "t_detect_s",
-    "detection_latency_s",
-    "normal_error_deg",
-    "t_stage1_s",
-    "t_stage2_s",
-    "t_stage3_s",
-    "t_stage4_s",
-    "recovered",
-    "time_to_recover_s",
-    "t_stage5_s",
-    "time_to_hover_s",
-    "height_loss_stage2_m",
-    "height_loss_stage3_m",
-    "height_loss_m",
-    "horizontal_drift_stage2_m",
-    "horizontal_drift_stage3_m",
-    "horizontal_drift_m",
-    "min_altitude_m",
-    "impacts_after_detection",
-    "max_tilt_deg",
-    "max_rate_rad_s",
-    "final_speed_m_s",
+#: The fields of the summary's recovery part that the scenario or the run's end do not set
+#: (:class:`quadimpact.results.summary_record.RecoveryPart`, where each is declared).
+_SET_ELSEWHERE = (
+    "pre_impact",
+    "detection_threshold_m_s2",
+    "final_altitude_m",
+    "first_contact_bumper",
+    "first_contact_normal",
+)
+RECOVERY_KEYS: tuple[str, ...] = tuple(
+    f.name for f in fields(RecoveryPart) if f.name not in _SET_ELSEWHERE
 )
 """The metric keys, in summary order."""
 

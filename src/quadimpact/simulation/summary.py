@@ -10,6 +10,8 @@ the first onset, the approach solution and the metrics of
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -19,6 +21,23 @@ from quadimpact.core import layout as L
 from quadimpact.core.excursion import DEG
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
+from quadimpact.results.summary_record import (
+    ApproachTable,
+    EstimationPart,
+    ExcursionPart,
+    ExcursionTable,
+    ImpactPart,
+    ModelOptionsTable,
+    OutcomePart,
+    RecoveryPart,
+    ReferencesTable,
+    RequestedTable,
+    RequestPart,
+    RunPart,
+    SpanPart,
+    Summary,
+    WallPart,
+)
 from quadimpact.rotations import inclination_deg, matrix_to_euler_zyx, quat_to_matrix
 from quadimpact.simulation.estimation_metrics import estimation_metrics
 from quadimpact.simulation.impacts import RunEpisodes
@@ -27,7 +46,7 @@ from quadimpact.simulation.recovery_metrics import onset_normal, recovery_metric
 from quadimpact.simulation.response_types import classify_response
 from quadimpact.simulation.setup import RunSetup
 
-__all__ = ["STATUS_NAMES", "build_summary", "describe_outcome"]
+__all__ = ["KIND_PARTS", "STATUS_NAMES", "build_summary", "describe_outcome", "summary_record"]
 
 STATUS_NAMES = {
     L.STATUS_COMPLETED: "completed",
@@ -43,41 +62,141 @@ def _nan_to_none(v: float) -> float | None:
 
 
 def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray) -> dict[str, Any]:
-    """The summary (docs/STUDIES.md section 2, docs/RECOVERY.md section 6) of a run.
+    """The summary (docs/STUDIES.md section 2, docs/RECOVERY.md section 6) of a run, as
+    ``summary.json`` holds it: :func:`summary_record`'s parts, in order."""
+    return summary_record(setup, scenario, episodes, st).to_dict()
+
+
+@dataclass(frozen=True)
+class _Onset:
+    """The first contact with an obstacle: time, speed along its normal, heading and
+    inclination (deg) there, and the (bumper, normal) of that contact (None: no contact)."""
+
+    t: float
+    speed: float
+    heading: float
+    inclination: float
+    first_normal: tuple[int, np.ndarray] | None
+
+
+def summary_record(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray) -> Summary:
+    """The typed summary of a run (:class:`quadimpact.results.summary_record.Summary`).
 
     From the kernel's stats (among them the output samples' attitude
     excursion and the last sample's state: the state at the end of the run)
     and the episodes (a :class:`~quadimpact.simulation.impacts.RunEpisodes`,
-    or a table of them); no time series.
+    or a table of them); no time series. The parts a scenario kind adds are
+    :data:`KIND_PARTS`'s.
     """
     obstacles = _obstacle_names(setup)
     if not isinstance(episodes, RunEpisodes):
         episodes = RunEpisodes.of_table(episodes, obstacles)
-    status_code = int(st[L.ST_STATUS])
-    status = STATUS_NAMES[status_code]
+    status = STATUS_NAMES[int(st[L.ST_STATUS])]
     warnings = list(setup.warnings)
-    reason = L.REASON_TEXT[int(st[L.ST_REASON])]
-    n_features = len(setup.feature_names)
-    metrics = impact_metrics_of(episodes.impacts, n_features)
-    rb = setup.vehicle.valid_depth_m()
+    onset = _onset(setup, episodes, st)
+    impact = _impact_part(setup, episodes, st, onset, status)
+    warnings += _run_warnings(setup, episodes, st)
+    request = (
+        KIND_PARTS[scenario.kind](scenario, onset, warnings)
+        if scenario.kind in KIND_PARTS
+        else None
+    )
+    if request is not None:
+        impact.heading_deg = request.requested.heading_deg
+        impact.inclination_deg = request.requested.inclination_deg
+    final_state = setup.x0
+    excursion = None
+    if st[L.ST_N_OUT] > 0:
+        excursion = ExcursionPart(ExcursionTable(**excursion_deg(st)))
+        final_state = st[L.ST_X_LAST : L.ST_X_LAST + L.NX]
+    summary = Summary(
+        run=RunPart(
+            status=status,
+            reason=L.REASON_TEXT[int(st[L.ST_REASON])],
+            warnings=warnings,
+            model=scenario.model,
+            model_options=ModelOptionsTable(**setup.options.model_dump()),
+            controller=scenario.controller,
+            vehicle=setup.vehicle.name,
+        ),
+        impact=impact,
+        span=SpanPart(
+            t_start_s=float(setup.t0),
+            t_final_s=float(st[L.ST_T_END]),
+            references=ReferencesTable(**{k: float(v) for k, v in setup.references.items()}),
+            quadimpact_version=__version__,
+        ),
+        wall=_wall_part(setup, st),
+        request=request,
+        excursion=excursion,
+        recovery=_recovery_part(setup, scenario, st, episodes, onset, final_state, obstacles),
+        estimation=EstimationPart(**_estimation(setup, scenario, st)),
+        outcome=OutcomePart(),
+    )
+    rings = setup.vehicle.features is None
+    summary.outcome.outcome = describe_outcome(
+        summary.to_dict(), None if rings else setup.feature_names
+    )
+    return summary
 
-    onset_t = float(st[L.ST_ONSET_T])
-    speed = heading = incl = math.nan
-    first_normal = None  # (bumper, contact normal) of the first obstacle contact
-    if not math.isnan(onset_t):
-        xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
-        C = quat_to_matrix(xo[L.X_QUAT : L.X_QUAT + 4])  # the attitude at the onset
-        vel = matvec(C, xo[L.X_VEL : L.X_VEL + 3])
-        first_normal = onset_normal(  # the normal there, from the contact geometry
-            st, episodes.first_obstacle, setup.feat, setup.shapes, setup.shape_names, C
-        )
-        if first_normal is not None:
-            speed = -dot(vel, first_normal[1])
-        heading = float(np.degrees(matrix_to_euler_zyx(C)[2]))
-        incl = float(inclination_deg(C))
 
+def _onset(setup: RunSetup, episodes: RunEpisodes, st: np.ndarray) -> _Onset:
+    """The state at the first contact with an obstacle (NaN and None without one)."""
+    t = float(st[L.ST_ONSET_T])
+    if math.isnan(t):
+        return _Onset(t, math.nan, math.nan, math.nan, None)
+    xo = st[L.ST_ONSET_X : L.ST_ONSET_X + L.NX]
+    C = quat_to_matrix(xo[L.X_QUAT : L.X_QUAT + 4])  # the attitude at the onset
+    vel = matvec(C, xo[L.X_VEL : L.X_VEL + 3])
+    first_normal = onset_normal(  # the normal there, from the contact geometry
+        st, episodes.first_obstacle, setup.feat, setup.shapes, setup.shape_names, C
+    )
+    speed = -dot(vel, first_normal[1]) if first_normal is not None else math.nan
+    heading = float(np.degrees(matrix_to_euler_zyx(C)[2]))
+    return _Onset(t, speed, heading, float(inclination_deg(C)), first_normal)
+
+
+def _impact_part(
+    setup: RunSetup, episodes: RunEpisodes, st: np.ndarray, onset: _Onset, status: str
+) -> ImpactPart:
+    """The initial impact, the later ones and the crash."""
+    metrics = impact_metrics_of(episodes.impacts, len(setup.feature_names))
     crash_t = float(st[L.ST_CRASH_T])
     crash_pos = st[L.ST_CRASH_X : L.ST_CRASH_X + 3]
+    max_pen = float(st[L.ST_MAX_DELTA])
+    return ImpactPart(
+        delta_init_m=_nan_to_none(metrics["delta_init_m"]),
+        peak_force_n=_nan_to_none(metrics["peak_force_n"]),
+        initial_impact_duration_s=_nan_to_none(metrics["initial_impact_duration_s"]),
+        first_contact_s=_nan_to_none(onset.t),
+        impact_speed_m_s=_nan_to_none(onset.speed),
+        impact_heading_deg=_nan_to_none(onset.heading),
+        impact_inclination_deg=_nan_to_none(onset.inclination),
+        leading_bumpers=metrics["leading_bumpers"],
+        aft_bumpers=metrics["aft_bumpers"],
+        response_type=None
+        if status == "failed"
+        else classify_response(
+            metrics["leading_bumpers"], metrics["subsequent_impacts"], not math.isnan(crash_t)
+        ),
+        n_episodes=int(metrics["n_episodes"]),
+        n_grazes=int(metrics["n_grazes"]),
+        n_subsequent_impacts=int(metrics["n_subsequent_impacts"]),
+        n_subsequent_episodes=int(metrics["n_subsequent_episodes"]),
+        subsequent_impacts=metrics["subsequent_impacts"],
+        crash_time_s=_nan_to_none(crash_t),
+        power_off_time_s=_nan_to_none(float(st[L.ST_POWER_OFF_T])),
+        crash_position_m=None if math.isnan(crash_t) else [float(c) for c in crash_pos],
+        max_penetration_m=max_pen,
+        bumper_model_valid=bool(max_pen <= setup.vehicle.valid_depth_m()),
+    )
+
+
+def _run_warnings(setup: RunSetup, episodes: RunEpisodes, st: np.ndarray) -> list[str]:
+    """What a run's record says is beyond its model: too deep, onsets missed, short
+    impacts, episodes dropped."""
+    warnings = []
+    rb = setup.vehicle.valid_depth_m()
     max_pen = float(st[L.ST_MAX_DELTA])
     if max_pen > rb:
         warnings.append(_too_deep(setup, episodes.table(), max_pen, rb))
@@ -93,104 +212,86 @@ def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray)
         warnings.append(
             f"{int(st[L.ST_EPISODES_DROPPED])} episodes beyond the buffer were not recorded"
         )
+    return warnings
 
-    summary: dict[str, Any] = {
-        "status": status,
-        "reason": reason,
-        "warnings": warnings,
-        "model": getattr(scenario, "model", None),
-        "model_options": setup.options.model_dump(),
-        "controller": getattr(scenario, "controller", None),
-        "vehicle": setup.vehicle.name,
-        "delta_init_m": _nan_to_none(metrics["delta_init_m"]),
-        "peak_force_n": _nan_to_none(metrics["peak_force_n"]),
-        "initial_impact_duration_s": _nan_to_none(metrics["initial_impact_duration_s"]),
-        "first_contact_s": _nan_to_none(onset_t),
-        "impact_speed_m_s": _nan_to_none(speed),
-        "heading_deg": getattr(scenario, "heading_deg", None),
-        "inclination_deg": getattr(scenario, "inclination_deg", None),
-        "impact_heading_deg": _nan_to_none(heading),
-        "impact_inclination_deg": _nan_to_none(incl),
-        "leading_bumpers": metrics["leading_bumpers"],
-        "aft_bumpers": metrics["aft_bumpers"],
-        "response_type": None
-        if status == "failed"
-        else classify_response(
-            metrics["leading_bumpers"], metrics["subsequent_impacts"], not math.isnan(crash_t)
-        ),
-        "n_episodes": int(metrics["n_episodes"]),
-        "n_grazes": int(metrics["n_grazes"]),
-        "n_subsequent_impacts": int(metrics["n_subsequent_impacts"]),
-        "n_subsequent_episodes": int(metrics["n_subsequent_episodes"]),
-        "subsequent_impacts": metrics["subsequent_impacts"],
-        "crash_time_s": _nan_to_none(crash_t),
-        "power_off_time_s": _nan_to_none(float(st[L.ST_POWER_OFF_T])),
-        "crash_position_m": None if math.isnan(crash_t) else [float(c) for c in crash_pos],
-        "max_penetration_m": max_pen,
-        "bumper_model_valid": bool(max_pen <= rb),
-        "t_start_s": float(setup.t0),
-        "t_final_s": float(st[L.ST_T_END]),
-        "references": {k: float(v) for k, v in setup.references.items()},
-        "quadimpact_version": __version__,
-    }
-    if setup.wall is not None:
-        d = setup.wall.point_m[0]
-        summary["wall_distance_m"] = d
-        summary["crash_distance_from_wall_m"] = (
-            None if math.isnan(crash_t) else float(d - crash_pos[0])
-        )
-        summary["approach"] = setup.approach
-    if isinstance(scenario, WallApproach):
-        summary["requested"] = {
-            "heading_deg": scenario.heading_deg,
-            "inclination_deg": scenario.inclination_deg,
-            "speed_m_s": scenario.speed_m_s,
-            "impact_time_s": scenario.impact_time_s,
-        }
-        if math.isnan(onset_t):
-            warnings.append("the vehicle never touched the wall")
-        else:
-            if abs(onset_t - scenario.impact_time_s) > ONSET_TIME_TOL_S:
-                warnings.append(
-                    f"first contact at {onset_t:.6f} s, "
-                    f"not at the requested {scenario.impact_time_s} s"
-                )
-            if abs(speed - scenario.speed_m_s) > SPEED_CHECK_TOL_M_S:
-                warnings.append(
-                    f"impact speed {speed:.6f} m/s differs from the requested {scenario.speed_m_s}"
-                )
-    final_state = setup.x0
-    if st[L.ST_N_OUT] > 0:
-        summary["attitude_excursion"] = excursion_deg(st)
-        final_state = st[L.ST_X_LAST : L.ST_X_LAST + L.NX]
-    summary["pre_impact"] = (
-        scenario.resolved_pre_impact() if getattr(scenario, "controller", None) == "recovery"
-        else None
-    )  # fmt: skip
-    summary["detection_threshold_m_s2"] = float(setup.scfg[L.SC_DET_THRESHOLD]) or None
-    summary.update(
-        recovery_metrics(
-            st,
-            None,  # the episodes' impacts and first obstacle contact are given
-            feat=setup.feat,
-            shapes=setup.shapes,
-            surface_names=setup.shape_names,
-            obstacle_names=obstacles,
-            final_state=np.asarray(final_state, dtype=float),
-            first_obstacle_contact=first_normal,
-            impacts=episodes.obstacle_impacts,
+
+def _wall_part(setup: RunSetup, st: np.ndarray) -> WallPart | None:
+    """The wall plane and the approach solve, for a run with a wall (None otherwise)."""
+    if setup.wall is None:
+        return None
+    d = setup.wall.point_m[0]
+    crash_t = float(st[L.ST_CRASH_T])
+    crash_x = float(st[L.ST_CRASH_X])
+    return WallPart(
+        wall_distance_m=d,
+        crash_distance_from_wall_m=None if math.isnan(crash_t) else float(d - crash_x),
+        # an empty table: no approach was solved (an impact trial against the wall)
+        approach=ApproachTable(**setup.approach) if setup.approach else {},
+    )
+
+
+def _wall_approach_request(
+    scenario: WallApproach, onset: _Onset, warnings: list[str]
+) -> RequestPart:
+    """What a wall approach asked for; a warning where the run did not reach it."""
+    if math.isnan(onset.t):
+        warnings.append("the vehicle never touched the wall")
+    else:
+        if abs(onset.t - scenario.impact_time_s) > ONSET_TIME_TOL_S:
+            warnings.append(
+                f"first contact at {onset.t:.6f} s, not at the requested {scenario.impact_time_s} s"
+            )
+        if abs(onset.speed - scenario.speed_m_s) > SPEED_CHECK_TOL_M_S:
+            warnings.append(
+                f"impact speed {onset.speed:.6f} m/s differs from the requested "
+                f"{scenario.speed_m_s}"
+            )
+    return RequestPart(
+        RequestedTable(
+            heading_deg=scenario.heading_deg,
+            inclination_deg=scenario.inclination_deg,
+            speed_m_s=scenario.speed_m_s,
+            impact_time_s=scenario.impact_time_s,
         )
     )
-    summary["final_altitude_m"] = _nan_to_none(-float(final_state[L.X_POS + 2]))
-    summary["first_contact_bumper"] = None
-    summary["first_contact_normal"] = None
-    if first_normal is not None:
-        summary["first_contact_bumper"] = int(first_normal[0])
-        summary["first_contact_normal"] = [float(c) for c in first_normal[1]]
-    summary.update(_estimation(setup, scenario, st))
-    rings = setup.vehicle.features is None
-    summary["outcome"] = describe_outcome(summary, None if rings else setup.feature_names)
-    return summary
+
+
+#: The summary part a scenario kind adds, by its ``kind`` (with the warnings it gives).
+KIND_PARTS: dict[str, Callable[[Any, _Onset, list[str]], RequestPart]] = {
+    "wall-approach": _wall_approach_request,
+}
+
+
+def _recovery_part(
+    setup: RunSetup,
+    scenario: Any,
+    st: np.ndarray,
+    episodes: RunEpisodes,
+    onset: _Onset,
+    final_state: np.ndarray,
+    obstacles: list[str],
+) -> RecoveryPart:
+    """Detection, the recovery stages and the run's end (docs/RECOVERY.md 6)."""
+    metrics = recovery_metrics(
+        st,
+        None,  # the episodes' impacts and first obstacle contact are given
+        feat=setup.feat,
+        shapes=setup.shapes,
+        surface_names=setup.shape_names,
+        obstacle_names=obstacles,
+        final_state=np.asarray(final_state, dtype=float),
+        first_obstacle_contact=onset.first_normal,
+        impacts=episodes.obstacle_impacts,
+    )
+    first = onset.first_normal
+    return RecoveryPart(
+        pre_impact=scenario.resolved_pre_impact() if scenario.controller == "recovery" else None,
+        detection_threshold_m_s2=float(setup.scfg[L.SC_DET_THRESHOLD]) or None,
+        final_altitude_m=_nan_to_none(-float(final_state[L.X_POS + 2])),
+        first_contact_bumper=None if first is None else int(first[0]),
+        first_contact_normal=None if first is None else [float(c) for c in first[1]],
+        **metrics,
+    )
 
 
 def excursion_deg(st: np.ndarray) -> dict[str, float]:
