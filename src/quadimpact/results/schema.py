@@ -84,6 +84,7 @@ _MODEL_OPTIONS = (
     _k("model_options__detection_tick_reference", "s", "", "recovery target at detection tick"),
     _k("model_options__contact_gate_m", "f", "m", "contact force gate on the CM distance (0: off)"),
     _k("model_options__pre_impact", "s", "", "recovery pre-impact rule of the model"),
+    _k("model_options__recovery_law", "s", "", "tuning of the staged recovery law"),
     _k("model_options__cut_step_motors", "j", "", "motors a power-off cuts at the next tick"),
     _k("model_options__bumper_force_scale", "j", "", "factor on each bumper's contact force"),
 )
