@@ -9,6 +9,9 @@ speeds until the detection.
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 from click.testing import CliRunner
@@ -18,8 +21,9 @@ from quadimpact.cli import cli
 from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.inputs.model import MODEL_VARIANTS, RECOVERY_LAWS
-from quadimpact.inputs.scenarios import load_scenario_file
+from quadimpact.inputs.scenarios import load_scenario_file, scenario_from_dict
 from quadimpact.simulation.setup import prepare
+from quadimpact.studies.pole.pole_study import PoleStudy, pitch_bands
 
 from helpers import run_cli
 
@@ -178,6 +182,39 @@ def test_the_run_command_takes_the_variant_and_single_parameters(tmp_path):
     assert bad.stderr.strip() == (
         "quadimpact: error: --param: level_test: must be one of 'tilt-error' or 'euler' (got 'x')"
     )
+
+
+# ------------------------------------------------------- a small grid, pinned
+GRID = json.loads((Path(__file__).parent / "data" / "pole_replica_grid.json").read_text())
+
+
+def test_the_pinned_grid_has_points_in_every_pitch_band():
+    bands = {pitch_bands(np.arange(0.0, 46.0))[int(abs(p["pitch_deg"]))] for p in GRID["points"]}
+    assert len(bands) == 9 and all(len(p) == 4 for p in GRID["points"])
+
+
+@pytest.mark.pinned
+@pytest.mark.parametrize(
+    "point", GRID["points"], ids=lambda p: f"{p['pitch_deg']:g}|{p['lateral_offset_m']:g}"
+)
+def test_small_grid_outcomes_are_pinned(point):
+    """Both laws at a few points of each pitch band, as the whole grid's reviewed run gave
+    them (its trials.parquet rows): the same numbers through simulate() on every machine."""
+    study = PoleStudy(model="pole-replica")
+    _, replica, default = study.arms()
+    for model, arm in (("pole-replica", replica), ("default", default)):
+        data = {**study.base(), **arm, "pitch_deg": point["pitch_deg"],
+                "lateral_offset_m": point["lateral_offset_m"]}  # fmt: skip
+        s = simulate(scenario_from_dict(data)).summary
+        want = point[model]
+        got = {
+            "success": 2.0 - s["final_altitude_m"] < 2.0,
+            "recovered": s["recovered"],
+            "t_stage4_s": s["t_stage4_s"],
+            "height_lost_m": 2.0 - s["final_altitude_m"],
+            "final_altitude_m": s["final_altitude_m"],
+        }
+        assert got == want, model
 
 
 def test_a_sweep_selects_the_variant_and_single_parameters(tmp_path):
