@@ -112,3 +112,100 @@ def test_tilted_vehicle_gets_a_rate_command_back_to_level():
     assert qey == pytest.approx(0.0, abs=1e-15)
     # thrust: m g cos(roll) (f_des . u)
     assert cmd[0] ** 2 == pytest.approx(9.81 * math.cos(roll), rel=1e-12)
+
+
+# ------------------------------------------------- the pole replica's switches
+def _tilt_inputs(level_test, q_tol=0.15, euler_tol=0.2, qe=(0.0, 0.0)):
+    """ctrl with the stage tests' switches, and mem with the previous tick's q_e."""
+    _, ctrl = _packed()
+    p = L.C_PARAMS
+    ctrl[p + CL.R_Q_TOL] = q_tol
+    ctrl[p + CL.R_LEVEL_TEST] = level_test
+    ctrl[p + CL.R_EULER_TOL] = euler_tol
+    mem = np.zeros(L.NMEM)
+    mem[CL.RM_QE_X], mem[CL.RM_QE_Y] = qe
+    return ctrl, mem
+
+
+def _step(stage, x, ctrl, mem, rates=(0.0, 0.0), w=0.0, rate_tol=2.0, w_tol=0.2):
+    """The stage after one tick's test, as recovery_step makes it."""
+    a, b, tol = R.stage_tilt(stage, x, ctrl, mem)
+    return R.next_stage(stage, a, b, rates[0], rates[1], w, tol, rate_tol, w_tol)
+
+
+@pytest.mark.parametrize(
+    ("roll", "pitch", "expected"),
+    [
+        (0.199, 0.0, 3),
+        (0.201, 0.0, 2),
+        (-0.199, 0.0, 3),
+        (-0.201, 0.0, 2),
+        (0.0, 0.199, 3),
+        (0.0, 0.201, 2),
+        (0.0, -0.199, 3),
+        (0.0, -0.201, 2),
+        (0.19, -0.19, 3),
+    ],
+)
+def test_euler_stage2_test_fires_at_its_threshold(roll, pitch, expected):
+    # a yaw of 2 rad changes nothing: the test reads the ZYX roll and pitch
+    ctrl, mem = _tilt_inputs(CL.LEVEL_EULER, qe=(0.9, 0.9))  # q_e would fail the old test
+    assert _step(2, _state(roll=roll, pitch=pitch, yaw=2.0), ctrl, mem) == expected
+
+
+def test_euler_stage2_test_reads_the_state_now_not_the_previous_tilt_error():
+    level = _state()
+    # the previous tick's tilt error passes, the attitude now does not: stays in stage 2
+    ctrl, mem = _tilt_inputs(CL.LEVEL_EULER, qe=(0.0, 0.0))
+    assert _step(2, _state(pitch=0.3), ctrl, mem) == 2
+    # and the other way round: moves on
+    ctrl, mem = _tilt_inputs(CL.LEVEL_EULER, qe=(0.5, 0.5))
+    assert _step(2, level, ctrl, mem) == 3
+    # the default test reads the previous tick's tilt error, whatever the attitude now
+    ctrl, mem = _tilt_inputs(CL.LEVEL_TILT_ERROR, qe=(0.5, 0.5))
+    assert _step(2, level, ctrl, mem) == 2
+    ctrl, mem = _tilt_inputs(CL.LEVEL_TILT_ERROR, qe=(0.1, -0.1))
+    assert _step(2, _state(pitch=0.3), ctrl, mem) == 3
+
+
+@pytest.mark.parametrize(
+    ("p", "q", "expected"), [(1.99, -1.99, 3), (2.01, 0.0, 2), (0.0, -2.01, 2)]
+)
+def test_euler_stage2_test_checks_the_rates(p, q, expected):
+    ctrl, mem = _tilt_inputs(CL.LEVEL_EULER)
+    assert _step(2, _state(roll=0.1), ctrl, mem, rates=(p, q)) == expected
+
+
+@pytest.mark.parametrize(
+    ("qe", "rates", "expected"),
+    [
+        ((0.149, -0.149), (1.99, -1.99), 2),
+        ((0.151, 0.0), (0.0, 0.0), 1),
+        ((0.0, -0.151), (0.0, 0.0), 1),
+        ((0.1, 0.1), (2.01, 0.0), 1),
+        ((0.1, 0.1), (0.0, -2.01), 1),
+    ],
+)
+def test_stage1_test_with_the_pole_tolerances(qe, rates, expected):
+    # stage 1 reads the previous tick's tilt error even with the Euler test on (stage 2 only),
+    # here against 0.15 and 2 rad/s; the attitude now does not matter
+    ctrl, mem = _tilt_inputs(CL.LEVEL_EULER, qe=qe)
+    assert _step(1, _state(roll=1.0, pitch=1.0), ctrl, mem, rates=rates) == expected
+
+
+@pytest.mark.parametrize(("w", "expected"), [(0.199, 4), (0.201, 3), (-1.0, 4)])
+def test_stage3_ends_below_the_pole_replicas_w(w, expected):
+    ctrl, mem = _tilt_inputs(CL.LEVEL_EULER)
+    assert _step(3, _state(), ctrl, mem, w=w) == expected
+
+
+def test_stage1_reference_a_mag_sets_the_tilt_away():
+    """a_ref = a_mag n: the target leans atan(a_mag / g) away from the wall (4.8: ~26 deg)."""
+    veh, ctrl = _packed()
+    ctrl[L.C_PARAMS + CL.R_A_MAG] = 4.8
+    normal = np.array([-1.0, 0.0, 0.0])
+    qex, qey = R.staged_law(1, True, _state(), np.zeros(3), normal, ctrl, veh, np.zeros(4))
+    tilt = math.atan2(4.8, 9.81)
+    assert math.degrees(tilt) == pytest.approx(26.07, abs=0.01)
+    assert qex == pytest.approx(0.0, abs=1e-15)
+    assert qey == pytest.approx(math.sin(tilt / 2), rel=1e-12)

@@ -26,6 +26,7 @@ DEFAULT_SWITCHES = {
     "detection_tick_reference": "tilt-away",
     "contact_gate_m": 0.0,
     "pre_impact": "scenario",
+    "recovery_law": "default",
     "cut_step_motors": (),
     "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
 }
@@ -40,6 +41,7 @@ REPLICA_SWITCHES = {
     "detection_tick_reference": "tilt-away",
     "contact_gate_m": 0.0,
     "pre_impact": "scenario",
+    "recovery_law": "default",
     "cut_step_motors": (),
     "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
 }
@@ -50,6 +52,13 @@ RECOVERY_REPLICA_SWITCHES = {
     "detection_tick_reference": "level",
     "contact_gate_m": 0.30,
     "pre_impact": "spin-down",
+}
+# the pole replica: the default physics, the retuned staged law and held rotors
+# (docs/VARIANTS.md 8)
+POLE_REPLICA_SWITCHES = {
+    **DEFAULT_SWITCHES,
+    "pre_impact": "hold",
+    "recovery_law": "pole-replica",
 }
 
 
@@ -128,7 +137,8 @@ def test_models_are_frozen_and_forbid_extras() -> None:
         ({"rotor_slew_limit_rad_s2": 0}, "rotor_slew_limit_rad_s2: must be > 0 (got 0)"),
         (
             {"model": "replica"},
-            "model: must be one of 'default', 'paper-replica' or 'recovery-replica'",
+            "model: must be one of 'default', 'paper-replica', 'recovery-replica' or "
+            "'pole-replica'",
         ),
         ({"controller": "pid"}, "controller: must be one of 'paper', 'cascade-pid', 'recovery'"),
         ({"rotor_mode": "lag"}, "rotor_mode: must be one of 'ideal' or 'first-order'"),
@@ -191,6 +201,7 @@ def test_variants_resolve_every_switch() -> None:
     assert MODEL_VARIANTS["default"] == DEFAULT_SWITCHES
     assert MODEL_VARIANTS["paper-replica"] == REPLICA_SWITCHES
     assert MODEL_VARIANTS["recovery-replica"] == RECOVERY_REPLICA_SWITCHES
+    assert MODEL_VARIANTS["pole-replica"] == POLE_REPLICA_SWITCHES
     assert resolve_model_options("default", None).model_dump() == DEFAULT_SWITCHES
     assert resolve_model_options("paper-replica", ModelOptions()).model_dump() == REPLICA_SWITCHES
     assert WallApproach(model="paper-replica").resolved_model_options().model_dump() == (

@@ -70,8 +70,9 @@ def cli() -> None:
     the authors' PID controller) with a physically consistent default model
     and a "paper-replica" variant that reproduces the authors' simulator;
     and what the paper was for: an IMU, impact detection and a staged
-    recovery controller (the Navi quadrotor, 'quadimpact recovery', and the
-    "recovery-replica" variant of the authors' later simulator).
+    recovery controller (the Navi quadrotor, 'quadimpact recovery', the
+    "recovery-replica" variant of the authors' later simulator, and the
+    "pole-replica" variant: their staged law as retuned for the pole study).
 
     Frames: inertial NED (X toward the wall, Y right, Z down; altitude = -Z),
     body FRD (x forward, y right, z down). Units: SI, angles in degrees.

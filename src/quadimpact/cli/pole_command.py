@@ -45,6 +45,14 @@ __all__ = ["pole"]
     "flying it until the detection.",
 )  # fmt: skip
 @click.option(
+    "--model", type=click.Choice(("default", "pole-replica")), default="default",
+    show_default=True,
+    help="Model variant of the recovery arm: default (docs/RECOVERY.md's staged law), or "
+    "pole-replica (the authors' retuned pole law, rotors held until the detection; the "
+    "default law's recovery is then flown beside it, a third arm, and the report puts the "
+    "two laws side by side).",
+)  # fmt: skip
+@click.option(
     "--radius", "radius_m", type=float, default=0.1, show_default=True, metavar="M",
     help="Radius of the pole (vertical, infinite, through the origin).",
 )  # fmt: skip
@@ -67,6 +75,7 @@ def pole(
     offset_max_m: float,
     offset_step_m: float,
     baseline: str,
+    model: str,
     radius_m: float,
     obstacle_file: Path | None,
     speed_m_s: float,
@@ -86,11 +95,17 @@ def pole(
     impact. Writes DIR/trials.parquet, the maps of height lost (crosses: 2 m
     or more, the authors' failure), success by pitch band with 95 % Wilson
     intervals, and DIR/report.md with the two side by side and where
-    recovery fails. Resumable like every sweep.
+    recovery fails. With --model pole-replica the recovery arm runs the
+    authors' retuned pole law (docs/VARIANTS.md) and the default law's
+    recovery is flown beside it: the report adds the two laws side by side,
+    by pitch band, and one point where only the replica succeeds, drawn under
+    each law. Resumable like every sweep (a study of another model needs
+    another folder).
 
     \b
     Examples:
       quadimpact pole --out results/pole
+      quadimpact pole --model pole-replica --out results/pole-replica
       quadimpact pole --pitch-step 5 --offset-step 0.05 --out results/pole-coarse
       quadimpact pole --obstacle box-corner.toml --out results/box
     """
@@ -107,6 +122,7 @@ def pole(
         offset_max_m=offset_max_m,
         offset_step_m=offset_step_m,
         baseline=baseline,
+        model=model,
         radius_m=radius_m,
         obstacle_file=None if obstacle_file is None else str(obstacle_file),
         speed_m_s=speed_m_s,
@@ -127,16 +143,21 @@ def pole(
         )  # fmt: skip
     arms = result.numbers["arms"]
     info = result.run_info
-    click.echo(
-        "\n".join(
-            [
-                f"grid      {result.numbers['n_points']} points x 2 controllers "
-                f"({info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']})",
-                f"baseline  {rate_text(arms['baseline']['success'])} lose < 2 m",
-                f"recovery  {rate_text(arms['recovery']['success'])} lose < 2 m",
-                f"table     {result.out_dir / 'trials.parquet'}",
-                f"report    {result.report}",
-                f"time      {result.elapsed_s:.1f} s",
-            ]
+    rows = [
+        f"grid      {result.numbers['n_points']} points x {len(arms)} controllers "
+        f"({info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']})",
+        f"baseline  {rate_text(arms['baseline']['success'])} lose < 2 m",
+        f"recovery  {rate_text(arms['recovery']['success'])} lose < 2 m"
+        + ("" if model == "default" else f" ({model})"),
+    ]
+    if "recovery-default" in arms:
+        rows.append(
+            f"          {rate_text(arms['recovery-default']['success'])} lose < 2 m "
+            "(the default law)"
         )
-    )
+    rows += [
+        f"table     {result.out_dir / 'trials.parquet'}",
+        f"report    {result.report}",
+        f"time      {result.elapsed_s:.1f} s",
+    ]
+    click.echo("\n".join(rows))

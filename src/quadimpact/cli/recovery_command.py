@@ -38,12 +38,17 @@ _STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimat
     "--seed", type=click.IntRange(min=0), metavar="S",
     help="Seed of the trials' conditions and of their IMU seeds. [default: 0]",
 )  # fmt: skip
-@click.option("--model", type=click.Choice(MODELS), help="Model variant. [default: default]")
+@click.option(
+    "--model", type=click.Choice(MODELS),
+    help="Model variant (docs/VARIANTS.md): the default model, the authors' recovery "
+    "simulator, or the default model with the authors' retuned pole law (rotors held until "
+    "the detection). [default: default]",
+)  # fmt: skip
 @click.option("--imu", type=click.Choice(IMUS), help="IMU preset. [default: ideal]")
 @click.option(
     "--pre-impact", "pre_impact", type=click.Choice(PRE_IMPACTS),
     help="Rotors before the detection: spin down at the slew limit, or hold. "
-    "[default: spin-down]",
+    "[default: spin-down; hold with --model pole-replica, the variant's own]",
 )  # fmt: skip
 @click.option(
     "--estimator", metavar="|".join(ESTIMATORS),

@@ -147,7 +147,8 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     type=MODEL,
     help="Model variant: 'default' is physically consistent; 'paper-replica' reproduces "
     "the authors' simulator, errors included, to match the published figures; "
-    "'recovery-replica' their later recovery simulator. [default: default]",
+    "'recovery-replica' their later recovery simulator; 'pole-replica' the default model "
+    "with the recovery law retuned as in their pole study. [default: default]",
 )
 @click.option(
     "--option",

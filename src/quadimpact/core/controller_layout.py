@@ -62,12 +62,17 @@ R_HOVER_GAINS = _params.slot("R_HOVER_GAINS", 5)  # K_p 1/s, K_v 1/s, v_max m/s,
 # K_psi 1/s (controllers/hover.py)
 R_HOVER_MODE = _params.slot("R_HOVER_MODE")  # HOLD_* below: which position stage 5 holds
 R_HOVER_SET = _params.slot("R_HOVER_SET", 3)  # m, the given set-point, inertial NED
+R_LEVEL_TEST = _params.slot("R_LEVEL_TEST")  # LEVEL_* below: the stage 2 -> 3 tilt test
+R_EULER_TOL = _params.slot("R_EULER_TOL")  # rad, |roll|, |pitch| tolerance of LEVEL_EULER
 N_RECOVERY_PARAMS = _params.end("N_RECOVERY_PARAMS")
 
 HOLD_ENTRY = 0  # the position estimate at stage 4's entry
 HOLD_STOP = 1  # brake first; hold the position estimate where the speed fell below 0.2 m/s
 HOLD_GIVEN = 2  # R_HOVER_SET
 HOLD_CAPTURE_M_S = 0.2
+
+LEVEL_TILT_ERROR = 0  # stage 2 -> 3 tests |q_e,x|, |q_e,y| < R_Q_TOL, as stage 1 -> 2
+LEVEL_EULER = 1  # stage 2 -> 3 tests the ZYX Euler |roll|, |pitch| < R_EULER_TOL
 
 PRE_NOMINAL = 0
 PRE_HOLD = 1

@@ -127,6 +127,13 @@ class RecoveryParams(BaseModel):
         0.3, gt=0, le=1, description="|q_e,x|, |q_e,y| below this end stages 1 and 2."
     )
     rate_tol_rad_s: Real = Field(0.5, gt=0, description="|p|, |q| below this end stages 1-2.")
+    level_test: Literal["tilt-error", "euler"] = Field(
+        "tilt-error",
+        description="Stage 2's tilt test: the tilt error as stage 1's, or ZYX Euler roll, pitch.",
+    )
+    euler_tol_rad: Real = Field(
+        0.2, gt=0, le=1.5, description="|roll|, |pitch| below this end stage 2 (euler test), rad."
+    )
     w_tol_m_s: Real = Field(0.3, description="Body z velocity below this ends stage 3, m/s.")
     hover: StrictBool = Field(
         True, description="Stage 5 after stage 4: return to hover, hold position and yaw."
@@ -281,6 +288,8 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block[CL.R_Q_TOL] = p.tilt_error_tol
     block[CL.R_RATE_TOL] = p.rate_tol_rad_s
     block[CL.R_W_TOL] = p.w_tol_m_s
+    block[CL.R_LEVEL_TEST] = CL.LEVEL_EULER if p.level_test == "euler" else CL.LEVEL_TILT_ERROR
+    block[CL.R_EULER_TOL] = p.euler_tol_rad
     level = ctx.options.detection_tick_reference == "level"
     block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
     block[CL.R_HOVER] = 1.0 if p.hover else 0.0

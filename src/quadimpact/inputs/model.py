@@ -1,5 +1,5 @@
 """Model options: the switches between the physically consistent model and the
-authors' simulators, and the three named model variants (docs/VARIANTS.md)."""
+authors' simulators, and the four named model variants (docs/VARIANTS.md)."""
 
 from __future__ import annotations
 
@@ -11,9 +11,16 @@ from pydantic import BaseModel, Field, StrictBool, ValidationError, field_valida
 from quadimpact.errors import InputError, input_error_from_validation
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec4
 
-__all__ = ["MODEL_VARIANTS", "ModelName", "ModelOptions", "resolve_model_options"]
+__all__ = [
+    "MODEL_VARIANTS",
+    "RECOVERY_LAWS",
+    "ModelName",
+    "ModelOptions",
+    "recovery_law_params",
+    "resolve_model_options",
+]
 
-ModelName = Literal["default", "paper-replica", "recovery-replica"]
+ModelName = Literal["default", "paper-replica", "recovery-replica", "pole-replica"]
 
 
 class ModelOptions(BaseModel):
@@ -25,7 +32,8 @@ class ModelOptions(BaseModel):
     ``paper-replica`` reproduces the code behind the paper's figures and
     ``recovery-replica`` the authors' later recovery simulator, errors
     included (docs/VARIANTS.md), so that published numbers can be checked and
-    each correction's effect seen on its own.
+    each correction's effect seen on its own; ``pole-replica`` is the default
+    model with the staged recovery law retuned as in the authors' pole study.
 
     Attributes
     ----------
@@ -79,10 +87,19 @@ class ModelOptions(BaseModel):
         within this distance of the surface (the authors' broad-phase test),
         so a bumper may already be ~16 mm deep when its force switches on; the
         gate crossing is a located event.
-    pre_impact : {"scenario", "spin-down"} or None
+    pre_impact : {"scenario", "spin-down", "hold"} or None
         ``"scenario"`` (default): the ``recovery`` controller's pre-impact
         behaviour is the scenario's ``pre_impact``. ``"spin-down"`` (recovery
         replica): always spin-down, as in the authors' Monte Carlo code.
+        ``"hold"`` (pole replica): always hold, the rotor speeds at their
+        trimmed values until the detection.
+    recovery_law : {"default", "pole-replica"} or None
+        The tuning of the ``recovery`` controller's staged law: the values its
+        parameters take when ``[controller_params]`` does not set them
+        (:data:`RECOVERY_LAWS`). ``"default"`` (every variant but the pole
+        replica): docs/RECOVERY.md's. ``"pole-replica"``: the authors' pole
+        branch (a_mag 4.8 m/s^2, stage 1 test 0.15 and 2 rad/s, stage 2's
+        Euler-angle test at 0.2 rad and 2 rad/s, stage 3 ends at w < 0.2 m/s).
     cut_step_motors : tuple of int or None
         Motors (1-4) that a power-off schedule cuts at the first control tick
         after its trigger, as a one-tick command step: the motor keeps its
@@ -131,8 +148,13 @@ class ModelOptions(BaseModel):
     contact_gate_m: Real | None = Field(
         None, ge=0, le=10, description="Contact forces only with the CM this close, m; 0: off."
     )
-    pre_impact: Literal["scenario", "spin-down"] | None = Field(
-        None, description="Recovery pre-impact behaviour: the scenario's, or spin-down."
+    pre_impact: Literal["scenario", "spin-down", "hold"] | None = Field(
+        None, description="Recovery pre-impact behaviour: the scenario's, spin-down or hold."
+    )
+    recovery_law: Literal["default", "pole-replica"] | None = Field(
+        None,
+        description="Staged recovery law's parameters not set in [controller_params]: "
+        "docs/RECOVERY.md's, or the authors' pole branch's.",
     )
     cut_step_motors: tuple[int, ...] | None = Field(
         None,
@@ -172,6 +194,7 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "tilt-away",
         "contact_gate_m": 0.0,
         "pre_impact": "scenario",
+        "recovery_law": "default",
         "cut_step_motors": (),
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
@@ -186,6 +209,7 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "tilt-away",
         "contact_gate_m": 0.0,
         "pre_impact": "scenario",
+        "recovery_law": "default",
         "cut_step_motors": (),
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
@@ -200,11 +224,55 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "level",
         "contact_gate_m": 0.30,
         "pre_impact": "spin-down",
+        "recovery_law": "default",
         "cut_step_motors": (),
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
 }
+# the pole replica: the default model with the authors' retuned pole law and held rotors
+MODEL_VARIANTS["pole-replica"] = {
+    **MODEL_VARIANTS["default"],
+    "pre_impact": "hold",
+    "recovery_law": "pole-replica",
+}
 """Every switch of :class:`ModelOptions` for each named model variant."""
+
+RECOVERY_LAWS: dict[str, dict[str, Any]] = {
+    "default": {},
+    "pole-replica": {
+        "a_mag_m_s2": 4.8,
+        "tilt_error_tol": 0.15,
+        "rate_tol_rad_s": 2.0,
+        "level_test": "euler",
+        "euler_tol_rad": 0.2,
+        "k_z_1_s": (0.0, 0.0, 10.0, 10.0),
+        "w_tol_m_s": 0.2,
+    },
+}
+"""The staged recovery law's tunings (switch ``recovery_law``): the ``recovery``
+controller's parameters (``RecoveryParams``) each sets; a parameter a tuning
+does not name keeps its own default (docs/RECOVERY.md 3.5, docs/VARIANTS.md 8)."""
+
+
+def recovery_law_params(law: str, given: Mapping[str, Any]) -> dict[str, Any]:
+    """The ``recovery`` controller's parameters under tuning ``law``.
+
+    Parameters
+    ----------
+    law : {"default", "pole-replica"}
+        The ``recovery_law`` switch.
+    given : mapping
+        The scenario's ``[controller_params]``; they win over the tuning.
+
+    Returns
+    -------
+    dict
+        The tuning's values (:data:`RECOVERY_LAWS`) with ``given`` on top.
+    """
+    tuning = RECOVERY_LAWS[law]
+    if not tuning:
+        return dict(given)
+    return {**tuning, **given}
 
 
 def resolve_model_options(
@@ -214,7 +282,7 @@ def resolve_model_options(
 
     Parameters
     ----------
-    model : {"default", "paper-replica", "recovery-replica"}
+    model : {"default", "paper-replica", "recovery-replica", "pole-replica"}
         The model variant.
     overrides : ModelOptions or mapping or None, optional
         Switches to change; ``None`` values (or missing keys) keep the variant's.

@@ -22,7 +22,12 @@ from quadimpact.inputs.controllers import (
     validate_params,
 )
 from quadimpact.inputs.estimators import estimator_entry, estimator_names, validate_estimator_params
-from quadimpact.inputs.model import ModelName, ModelOptions, resolve_model_options
+from quadimpact.inputs.model import (
+    ModelName,
+    ModelOptions,
+    recovery_law_params,
+    resolve_model_options,
+)
 from quadimpact.inputs.sensors import (
     SENSOR_PRESETS,
     DetectionSettings,
@@ -116,7 +121,7 @@ class RunSettings(BaseModel):
 
     Attributes
     ----------
-    model : {"default", "paper-replica", "recovery-replica"}
+    model : {"default", "paper-replica", "recovery-replica", "pole-replica"}
         Model variant (see :class:`ModelOptions`, docs/VARIANTS.md).
     model_options : ModelOptions
         Single switches overriding the variant; ``None`` fields keep it.
@@ -128,7 +133,10 @@ class RunSettings(BaseModel):
         behaviour then the staged recovery law after detection
         (docs/RECOVERY.md 3); or one registered by the user.
     controller_params : dict
-        The controller's own parameters (validated by its registry entry).
+        The controller's own parameters (validated by its registry entry); for
+        the ``recovery`` controller, those not given take the values of the
+        model's ``recovery_law`` switch (the pole replica's tuning), else their
+        defaults.
     pre_impact : {"nominal", "hold", "spin-down", "immediate"} or None
         The ``recovery`` controller's behaviour before detection; ``None``: the
         kind's default (``"nominal"``; ``"spin-down"`` for impact trials).
@@ -191,7 +199,8 @@ class RunSettings(BaseModel):
 
     model: ModelName = Field(
         "default",
-        description="Model variant: 'default' (physical), 'paper-replica' or 'recovery-replica'.",
+        description="Model variant: 'default' (physical), 'paper-replica', 'recovery-replica' "
+        "or 'pole-replica'.",
     )
     model_options: ModelOptions = Field(
         default_factory=ModelOptions, description="Switches overriding the model variant."
@@ -348,13 +357,25 @@ class RunSettings(BaseModel):
         return self
 
     def resolved_controller_params(self) -> BaseModel:
-        """The controller's parameters, validated, with its defaults filled in."""
+        """The controller's parameters, validated, with its defaults filled in.
+
+        For the ``recovery`` controller the parameters not given take the values
+        of the model's ``recovery_law`` switch first (``RECOVERY_LAWS``).
+        """
+        if self.controller == "recovery":
+            law = self.resolved_model_options().recovery_law
+            assert law is not None  # resolved: every switch set
+            return validate_params(
+                self.controller, recovery_law_params(law, self.controller_params)
+            )
         return validate_params(self.controller, self.controller_params)
 
     def resolved_pre_impact(self) -> str:
         """The recovery controller's pre-impact behaviour in force (model switch included)."""
-        if self.resolved_model_options().pre_impact == "spin-down":
-            return "spin-down"
+        forced = self.resolved_model_options().pre_impact
+        if forced != "scenario":
+            assert forced is not None  # resolved: every switch set
+            return forced
         if self.pre_impact is not None:
             return self.pre_impact
         return self._default_pre_impact

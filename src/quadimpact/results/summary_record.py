@@ -138,6 +138,7 @@ class ModelOptionsTable(Part):
     detection_tick_reference: str = metric("s", "", "recovery target at detection tick")
     contact_gate_m: float = metric("f", "m", "contact force gate on the CM distance (0: off)")
     pre_impact: str = metric("s", "", "recovery pre-impact rule of the model")
+    recovery_law: str = metric("s", "", "tuning of the staged recovery law")
     cut_step_motors: list = metric("j", "", "motors a power-off cuts at the next tick")
     bumper_force_scale: list = metric("j", "", "factor on each bumper's contact force")
 

@@ -101,3 +101,68 @@ def test_the_command(tmp_path):
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     assert "lose < 2 m" in result.output and (out / "report.md").is_file()
+
+
+# ------------------------------------------------------------ the pole replica
+REPLICA_SMALL = {
+    "pitch_max_deg": 40.0,
+    "pitch_step_deg": 40.0,
+    "offset_max_m": 0.1,
+    "offset_step_m": 0.1,
+}  # fmt: skip  (0, -40 deg x -0.1, 0, 0.1 m)
+
+
+def test_the_default_study_keeps_its_two_arms():
+    # the sweep of `quadimpact pole` as before the variant (an old folder resumes)
+    assert PoleStudy().arms() == [
+        {"controller": "paper"},
+        {"controller": "recovery", "pre_impact": "nominal", "nominal_controller": "paper"},
+    ]
+    assert PoleStudy().arm_names() == ("baseline", "recovery")
+    with pytest.raises(InputError, match="model: must be one of 'default', 'pole-replica'"):
+        PoleStudy(model="recovery-replica")
+
+
+def test_the_replica_study_flies_three_arms(tmp_path):
+    study = PoleStudy(model="pole-replica", **REPLICA_SMALL)
+    assert study.arm_names() == ("baseline", "recovery", "recovery-default")
+    base, replica, default = study.arms()
+    assert base == {"controller": "paper", "model": "default"}
+    assert replica["model"] == "pole-replica" and default["model"] == "default"
+    result = run_pole_study(study, tmp_path / "replica", workers=1)
+    plain = run_pole_study(PoleStudy(**REPLICA_SMALL), tmp_path / "default", workers=1)
+    t, d = result.table, plain.table
+    assert list(t["arm"][:3]) == ["baseline", "recovery", "recovery-default"] and len(t) == 18
+    assert list(t["model"][:3]) == ["default", "pole-replica", "default"]
+    assert set(t[t["arm"] == "recovery"]["pre_impact"]) == {"hold"}
+    # the baseline and the default law's arms are the default study's runs, number for number
+    skip = {"run_id", "model", "integrator__wall_time_s", "cost__kernel_cpu_s", "cost__total_cpu_s"}
+    cols = [c for c in d.columns if c not in skip]
+    for mine, theirs in (("baseline", "baseline"), ("recovery-default", "recovery")):
+        a = t[t["arm"] == mine][cols].reset_index(drop=True).assign(arm=theirs)
+        pd.testing.assert_frame_equal(a, d[d["arm"] == theirs][cols].reset_index(drop=True))
+    # the laws side by side: at -40 deg, 0.1 m off the centre line only the replica succeeds
+    laws = result.numbers["laws"]
+    both = t.pivot_table(index=["pitch_deg", "lateral_offset_m"], columns="arm", values="success")
+    only = both["recovery"].astype(bool) & ~both["recovery-default"].astype(bool)
+    assert laws["variant_only"] == int(only.sum()) >= 1 and laws["n"] == 6
+    ex = laws["example"]
+    assert only[(ex["pitch_deg"], ex["lateral_offset_m"])]
+    report = result.report.read_text()
+    assert "## The two laws side by side" in report and "`pole-replica` model variant" in report
+    for name in ("example_default_law.png", "example_pole_replica.png"):
+        assert (tmp_path / "replica" / name).is_file() and f"({name})" in report
+    assert "## The two laws" not in plain.report.read_text()
+
+
+def test_the_command_takes_the_model(tmp_path):
+    out = tmp_path / "cli"
+    result = CliRunner().invoke(
+        cli,
+        ["pole", "--model", "pole-replica", "--pitch-step", "45", "--offset-step", "0.35",
+         "--workers", "1", "--no-progress", "--out", str(out)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert "(pole-replica)" in result.output and "(the default law)" in result.output
+    bad = CliRunner().invoke(cli, ["pole", "--model", "paper-replica", "--out", str(out)])
+    assert bad.exit_code == 2 and "'paper-replica' is not one of" in bad.output

@@ -203,3 +203,19 @@ def test_a_script_that_imports_the_studies_costs_their_workers_no_pandas() -> No
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.split() == ["False", "True"]
+
+
+def test_the_pole_replica_holds_its_rotors_unless_told_otherwise() -> None:
+    # the variant's own pre-impact behaviour is the study's default: hold
+    study = RecoveryStudy(n=1, model="pole-replica")
+    assert study.pre_impact == "hold" and study.options()["pre_impact"] == "hold"
+    base = study.base()
+    assert base["model"] == "pole-replica" and base["pre_impact"] == "hold"
+    assert "model_options" not in base
+    # the law alone on the authors' trials: spin-down, the switch set to the scenario's
+    spun = RecoveryStudy(n=1, model="pole-replica", pre_impact="spin-down").base()
+    assert spun["pre_impact"] == "spin-down"
+    assert spun["model_options"] == {"pre_impact": "scenario"}
+    # the other models keep spin-down as the study's default, as before
+    assert RecoveryStudy(n=1).pre_impact == "spin-down"
+    assert RecoveryStudy(n=1, model="recovery-replica").pre_impact == "spin-down"

@@ -35,7 +35,9 @@ law is computed for the stage now in force):
 stage meaning             a_ref       k_z   leaves when
 ====  ==================  ==========  ====  =====================================
 1     impact detected     a_mag n     0     |q_e,x|, |q_e,y| < q_tol and |p|, |q| < rate_tol
-2     tilted away         0           0     the same test (now toward level)
+2     tilted away         0           0     the same test (now toward level), or with
+                                            ``R_LEVEL_TEST = LEVEL_EULER`` the ZYX Euler
+                                            |roll|, |pitch| < euler_tol and the same rates
 3     level               0           10    body z velocity w < w_tol
 4     recovered           0           10    stays (or 5 at the next tick)
 5     hover (optional)    position    --    stays (``hover.py``: holds the position
@@ -54,7 +56,8 @@ ideal estimator, the gyro minus the estimated bias otherwise), attitude,
 velocity and position come from the state estimate. Every gain, threshold,
 ``a_mag`` and ``k_z`` is a parameter (layout ``R_*`` below, at
 ``ctrl[C_PARAMS + ...]``); the recovery replica's "level target at the
-detection tick" is the switch ``R_FIRST_TICK_LEVEL``.
+detection tick" is the switch ``R_FIRST_TICK_LEVEL``, the pole replica's
+Euler-angle test of stage 2 the switch ``R_LEVEL_TEST`` (:func:`stage_tilt`).
 """
 
 import math
@@ -66,10 +69,12 @@ from quadimpact.core.controller_layout import (
     HOLD_CAPTURE_M_S,
     HOLD_GIVEN,
     HOLD_STOP,
+    LEVEL_EULER,
     PRE_HOLD,
     PRE_IMMEDIATE,
     PRE_NOMINAL,
     R_A_MAG,
+    R_EULER_TOL,
     R_FIRST_TICK_LEVEL,
     R_HOVER,
     R_HOVER_GAINS,
@@ -78,6 +83,7 @@ from quadimpact.core.controller_layout import (
     R_K_ATT,
     R_K_RATE,
     R_K_Z,
+    R_LEVEL_TEST,
     R_NOMINAL_KIND,
     R_PRE_IMPACT,
     R_Q_TOL,
@@ -118,7 +124,7 @@ from quadimpact.core.layout import (
     X_ROTOR,
     X_VEL,
 )
-from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.quaternion import euler_zyx, rotation_matrix
 
 
 @compiled
@@ -136,9 +142,11 @@ def next_stage(
 ) -> int:
     """The stage machine: the stage after this tick's test (at most one step up).
 
-    ``qe_x``, ``qe_y``: the previous tick's tilt error quaternion (body x, y);
-    ``p``, ``q``: body rates now (rad/s); ``w``: body z velocity now (m/s, down
-    positive); ``hover``: stage 5 follows stage 4 at the next tick.
+    ``qe_x``, ``qe_y``: the tilt the stage's test reads, ``q_tol`` its tolerance
+    (:func:`stage_tilt`: the previous tick's tilt error quaternion, body x and y,
+    or in stage 2 with the Euler test the roll and pitch now, rad); ``p``, ``q``:
+    body rates now (rad/s); ``w``: body z velocity now (m/s, down positive);
+    ``hover``: stage 5 follows stage 4 at the next tick.
     """
     if stage == STAGE_DETECTED or stage == STAGE_TILTED:
         if abs(qe_x) < q_tol and abs(qe_y) < q_tol and abs(p) < rate_tol and abs(q) < rate_tol:
@@ -151,6 +159,25 @@ def next_stage(
     if stage == STAGE_RECOVERED and hover:
         return STAGE_HOVER
     return stage
+
+
+@compiled
+def stage_tilt(
+    stage: int, x: np.ndarray, ctrl: np.ndarray, mem: np.ndarray
+) -> tuple[float, float, float]:
+    """The tilt that the stage test of ``stage`` reads, and its tolerance: ``(a, b, tol)``.
+
+    By default the previous tick's tilt error quaternion, body x and y parts
+    (``mem[RM_QE_X]``, ``mem[RM_QE_Y]``), against ``R_Q_TOL``. In stage 2 with
+    ``R_LEVEL_TEST = LEVEL_EULER`` (the pole replica): the ZYX Euler roll and
+    pitch (rad) of the state estimate ``x`` at this tick, against
+    ``R_EULER_TOL`` (rad).
+    """
+    p0 = C_PARAMS
+    if stage == STAGE_TILTED and int(ctrl[p0 + R_LEVEL_TEST]) == LEVEL_EULER:
+        roll, pitch, _ = euler_zyx(x[X_QUAT : X_QUAT + 4])
+        return roll, pitch, ctrl[p0 + R_EULER_TOL]
+    return mem[RM_QE_X], mem[RM_QE_Y], ctrl[p0 + R_Q_TOL]
 
 
 @allocating
@@ -373,14 +400,15 @@ def recovery_step(
         first_tick = False
         w_body = x[X_VEL + 2]
         before = stage
+        tilt_a, tilt_b, tilt_tol = stage_tilt(stage, x, ctrl, mem)
         stage = next_stage(
             stage,
-            mem[RM_QE_X],
-            mem[RM_QE_Y],
+            tilt_a,
+            tilt_b,
             meas[MS_W_HAT],
             meas[MS_W_HAT + 1],
             w_body,
-            ctrl[p0 + R_Q_TOL],
+            tilt_tol,
             ctrl[p0 + R_RATE_TOL],
             ctrl[p0 + R_W_TOL],
             ctrl[p0 + R_HOVER] > 0.5,

@@ -4,7 +4,11 @@
   m) over |pitch| (x, deg) and the sideways offset (y, m); a cross marks
   each trial that lost 2 m or more (a failure of the authors' criterion);
 * ``success_by_pitch.png``: the share of trials losing less than 2 m, by
-  pitch band, for both controllers, with 95 % Wilson intervals.
+  pitch band, for every controller, with 95 % Wilson intervals.
+
+A study of a variant (``pole-replica``) has three arms, the baseline, the
+variant's recovery and the default law's recovery: three panels and three
+series.
 """
 
 from __future__ import annotations
@@ -20,10 +24,23 @@ from matplotlib.figure import Figure
 from quadimpact.results.figures import new_figure, save_figure
 from quadimpact.studies.statistics import rate
 
-__all__ = ["FIGURES", "maps_figure", "success_by_pitch_figure", "write_figures"]
+__all__ = ["FIGURES", "arm_titles", "maps_figure", "success_by_pitch_figure", "write_figures"]
 
 FIGURES = ("maps.png", "success_by_pitch.png")
-TITLES = {"baseline": "without recovery (baseline)", "recovery": "with recovery"}
+TITLES = {
+    "baseline": "without recovery (baseline)",
+    "recovery": "with recovery",
+    "recovery-default": "with recovery, default law",
+}
+ARM_ORDER = tuple(TITLES)
+
+
+def arm_titles(model: str = "default") -> dict[str, str]:
+    """Each arm's title; the recovery arm of a variant says its variant."""
+    titles = dict(TITLES)
+    if model != "default":
+        titles["recovery"] = f"with recovery, {model}"
+    return titles
 
 
 def _cells(part: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -46,9 +63,10 @@ def _edges(values: np.ndarray) -> np.ndarray:
     return np.concatenate([[2 * values[0] - mid[0]], mid, [2 * values[-1] - mid[-1]]])
 
 
-def maps_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
+def maps_figure(table: pd.DataFrame, title: str | None = None, model: str = "default") -> Figure:
     """Height lost (colour) over |pitch| x offset, one panel per controller, failures crossed."""
-    arms = [a for a in ("baseline", "recovery") if (table["arm"] == a).any()]
+    arms = [a for a in ARM_ORDER if (table["arm"] == a).any()]
+    titles = arm_titles(model)
     fig = new_figure(5.2 * len(arms) + 1.2, 4.6)
     axes = fig.subplots(1, len(arms), sharey=True, squeeze=False)[0]
     finite = table["height_lost_m"].to_numpy(dtype=float)
@@ -65,7 +83,7 @@ def maps_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
         ax.plot(pitches[jj[bad]], offsets[ii[bad]], "x", color="white", markersize=2.5,
                 markeredgewidth=0.6, label="lost 2 m or more")  # fmt: skip
         share = ok.mean() if ok.size else float("nan")
-        ax.set_title(f"{TITLES[arm]}: {100 * share:.1f} % lose < 2 m", fontsize="medium")
+        ax.set_title(f"{titles[arm]}: {100 * share:.1f} % lose < 2 m", fontsize="medium")
         ax.set_xlabel("|pitch| toward the pole (deg)")
     axes[0].set_ylabel("offset from the pole's centre line (m)")
     if mesh is not None:
@@ -76,13 +94,17 @@ def maps_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     return fig
 
 
-def success_by_pitch_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
-    """Share of trials losing less than 2 m by pitch band, both controllers, Wilson intervals."""
+def success_by_pitch_figure(
+    table: pd.DataFrame, title: str | None = None, model: str = "default"
+) -> Figure:
+    """Share of trials losing less than 2 m by pitch band, every controller, Wilson intervals."""
     fig = new_figure(7.0, 3.8)
     ax = fig.add_subplot()
     bands = sorted(set(table["pitch_band"]), key=lambda b: float(b.split("-")[0]))
     x = np.arange(len(bands), dtype=float)
-    for k, arm in enumerate(a for a in ("baseline", "recovery") if (table["arm"] == a).any()):
+    arms = [a for a in ARM_ORDER if (table["arm"] == a).any()]
+    titles = arm_titles(model)
+    for k, arm in enumerate(arms):
         rates = []
         for band in bands:
             part = table[(table["arm"] == arm) & (table["pitch_band"] == band)]
@@ -90,8 +112,9 @@ def success_by_pitch_figure(table: pd.DataFrame, title: str | None = None) -> Fi
         v = np.array([r.value for r in rates])
         lo = v - np.array([r.low for r in rates])
         hi = np.array([r.high for r in rates]) - v
-        ax.errorbar(x + (k - 0.5) * 0.2, 100 * v, yerr=100 * np.vstack([lo, hi]), fmt="o",
-                    capsize=3, label=TITLES[arm])  # fmt: skip
+        ax.errorbar(x + (k - 0.5 * (len(arms) - 1)) * 0.2, 100 * v,
+                    yerr=100 * np.vstack([lo, hi]), fmt="o", capsize=3,
+                    label=titles[arm])  # fmt: skip
     ax.set_xticks(x, bands)
     ax.set_xlabel("|pitch| band (deg)")
     ax.set_ylabel("trials losing < 2 m (%)")
@@ -103,10 +126,15 @@ def success_by_pitch_figure(table: pd.DataFrame, title: str | None = None) -> Fi
     return fig
 
 
-def write_figures(table: pd.DataFrame, out_dir: str | os.PathLike[str]) -> list[Path]:
-    """Write :data:`FIGURES` into ``out_dir``; return their paths."""
+def write_figures(
+    table: pd.DataFrame, out_dir: str | os.PathLike[str], model: str = "default"
+) -> list[Path]:
+    """Write :data:`FIGURES` into ``out_dir``; return their paths.
+
+    ``model``: the recovery arm's model variant (its panels' titles).
+    """
     out = Path(out_dir)
     paths = [out / name for name in FIGURES]
-    save_figure(maps_figure(table), paths[0])
-    save_figure(success_by_pitch_figure(table), paths[1])
+    save_figure(maps_figure(table, model=model), paths[0])
+    save_figure(success_by_pitch_figure(table, model=model), paths[1])
     return paths

@@ -20,12 +20,45 @@ def _spread(s: dict[str, Any], unit: str, scale: float = 1.0, digits: int = 2) -
     )
 
 
+#: Column heads of the arms.
+HEADS = {
+    "baseline": "without recovery",
+    "recovery": "with recovery",
+    "recovery-default": "with recovery, default law",
+}
+
+
+def _model_text(st: dict[str, Any]) -> str:
+    """Which law the recovery arm ran (the study's model variant)."""
+    model = st.get("model", "default")
+    if model == "default":
+        return (
+            "The recovery arm runs the `default` model: the staged law of docs/RECOVERY.md "
+            "with its default parameters."
+        )
+    return (
+        f"The recovery arm runs the `{model}` model variant: the authors' retuned pole law "
+        "(stage 1 reference a_mag = 4.8 m/s², stage 1 test |q_e,x|, |q_e,y| < 0.15 and "
+        "|p|, |q| < 2 rad/s, stage 2 test on the ZYX Euler |roll|, |pitch| < 0.2 rad and "
+        "|p|, |q| < 2 rad/s, stage 3 ends at w < 0.2 m/s) and its pre-impact `hold`: the "
+        "rotor speeds stay at their trimmed values until the detection instead of flying the "
+        "baseline (docs/VARIANTS.md, docs/OBSTACLES.md). Beside it every point is flown by the "
+        "default law too (`with recovery, default law`: the recovery arm of `quadimpact pole` "
+        "without `--model`), so that the two laws compare point by point; the baseline arm is "
+        "the same in both studies."
+    )
+
+
 def render_report(description: dict[str, Any], numbers: dict[str, Any], figures: list[Path]) -> str:
     """The report's Markdown."""
     st = description["study"]
     grid = description["grid"]
     run = description["run"]
     arms = numbers["arms"]
+    names = list(arms)
+    heads = [HEADS[a] for a in names]
+    if st.get("model", "default") != "default":
+        heads[names.index("recovery")] = f"with recovery, {st['model']}"
     fl = numbers["failures"]
     obstacle = st["obstacles"][0]
     what = (
@@ -33,6 +66,11 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         if st.get("obstacle_file") is None
         else f"obstacle {obstacle.get('name')!r} ({obstacle.get('kind')}) of {st['obstacle_file']}"
     )
+    flown = "twice" if len(names) == 2 else "three times"
+
+    def row(label: str, cells: list[str]) -> str:
+        return f"| {label} | " + " | ".join(cells) + " |"
+
     lines = [
         "# The pole study",
         "",
@@ -43,11 +81,13 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         f"leans the top toward the pole) by {grid['lateral_offset_m']} sideways offsets "
         f"(+-{st['offset_max_m']:g} m every {st['offset_step_m']:g} m), friction "
         f"{st['friction_coefficient']:g}, {st['final_time_s']:g} s, no ground. Each point is "
-        f"flown twice: by the `{st['baseline']}` controller holding the initial attitude and "
+        f"flown {flown}: by the `{st['baseline']}` controller holding the initial attitude and "
         f"the altitude (the baseline, no recovery), and by the `recovery` controller flying "
         f"that same baseline until it detects the impact, then its staged law. Success: less "
         f"than 2 m of height lost over the run (altitude at the start minus at the end), the "
         f"authors' criterion.",
+        "",
+        _model_text(st),
         "",
         f"{run['n_runs']} runs ({run['n_ran']} run now in {run['sweep_s']:.1f} s, "
         f"{run['backend']}; {run['n_already_done']} done before); the whole study "
@@ -57,32 +97,35 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
             for h in description.get("sweeps", [])[: -1 if run["n_ran"] else None]
         ),
         "",
-        "## The two controllers",
+        "## The two controllers" if len(names) == 2 else "## The controllers",
         "",
-        "| | without recovery | with recovery |",
-        "|---|---|---|",
-        f"| lose less than 2 m (95 % Wilson) | {rate_text(arms['baseline']['success'])} | "
-        f"{rate_text(arms['recovery']['success'])} |",
-        f"| touched the obstacle | {arms['baseline']['contact']} | {arms['recovery']['contact']} |",
-        f"| impact detected | {arms['baseline']['detected']} | {arms['recovery']['detected']} |",
-        f"| recovered (stage 4) | - | {arms['recovery']['recovered']} |",
-        f"| median height lost | {arms['baseline']['height_lost_median_m']:.2f} m | "
-        f"{arms['recovery']['height_lost_median_m']:.2f} m |",
-        f"| failed runs | {arms['baseline']['failed_runs']} | {arms['recovery']['failed_runs']} |",
+        row("", heads),
+        "|---|" + "---|" * len(names),
+        row("lose less than 2 m (95 % Wilson)", [rate_text(arms[a]["success"]) for a in names]),
+        row("touched the obstacle", [str(arms[a]["contact"]) for a in names]),
+        row("impact detected", [str(arms[a]["detected"]) for a in names]),
+        row(
+            "recovered (stage 4)",
+            ["-" if a == "baseline" else str(arms[a]["recovered"]) for a in names],
+        ),
+        row("median height lost", [f"{arms[a]['height_lost_median_m']:.2f} m" for a in names]),
+        row("failed runs", [str(arms[a]["failed_runs"]) for a in names]),
         "",
         "## Success by pitch band",
         "",
-        "| abs(pitch) (deg) | without recovery | with recovery |",
-        "|---|---|---|",
+        row("abs(pitch) (deg)", heads),
+        "|---|" + "---|" * len(names),
     ]
     for band in numbers["bands"]:
-        lines.append(
-            f"| {band['band']} | {rate_text(band['baseline'])} | {rate_text(band['recovery'])} |"
-        )
+        lines.append(row(band["band"], [rate_text(band[a]) for a in names]))
+    examples = [p for p in figures if p.name.startswith("example_")]
+    if "laws" in numbers:
+        lines += ["", *_laws_section(numbers, st["model"], examples)]
     stage = fl["stage_reached"]
     lines += [
         "",
-        "## Where recovery fails, and why",
+        "## Where recovery fails, and why"
+        + ("" if st.get("model", "default") == "default" else f" (`{st['model']}`)"),
         "",
         f"Of the {fl['n_points']} grid points, recovery loses 2 m or more at "
         f"{fl['recovery_fails']}: at {fl['both_fail']} of them the baseline fails too, at "
@@ -111,19 +154,21 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         f" in the failures against "
         f"{_spread(fl['normal_error_deg_successes'], 'deg', digits=0)} in the successes.",
         "",
-        _explain(fl, arms),
+        _explain(fl, arms, tilt="about 26 deg" if st.get("model") == "pole-replica" else "45 deg"),
         "",
         "## Figures",
         "",
     ]
     for path in figures:
+        if path in examples:
+            continue
         lines.append(f"![{path.stem}]({path.as_posix()})")
         lines.append("")
     return "\n".join(lines)
 
 
-def _explain(fl: dict[str, Any], arms: dict[str, Any]) -> str:
-    """A paragraph reading the failure numbers."""
+def _explain(fl: dict[str, Any], arms: dict[str, Any], tilt: str = "45 deg") -> str:
+    """A paragraph reading the failure numbers (``tilt``: stage 1's tilt away, in words)."""
     parts = []
     stage = fl["stage_reached"]
     n = max(fl["recovery_fails"], 1)
@@ -141,7 +186,7 @@ def _explain(fl: dict[str, Any], arms: dict[str, Any]) -> str:
     if fl["impacts_after_detection"] >= 0.3 * n:
         parts.append(
             "Many hit the obstacle again and again after the detection: a pole is not a wall, "
-            "so tilting 45 deg away from the first contact's normal (the detector's estimate) "
+            f"so tilting {tilt} away from the first contact's normal (the detector's estimate) "
             "does not take the vehicle clear of it: the rotor arms swing around the pole and "
             "the body tumbles against it while it falls, and the staged law levels the vehicle "
             "(stage 4) only once it has slid off, metres lower."
@@ -158,3 +203,58 @@ def _explain(fl: dict[str, Any], arms: dict[str, Any]) -> str:
             "second impact, detection); see the maps for where they lie."
         )
     return " ".join(parts)
+
+
+def _where(w: dict[str, Any], who: str) -> str:
+    if not w["abs_pitch_deg"].get("n"):
+        return f"- Only {who} succeeds: nowhere."
+    return (
+        f"- Only {who} succeeds: {w['abs_pitch_deg']['n']} points, |pitch| "
+        f"{_spread(w['abs_pitch_deg'], 'deg', digits=0)}, |offset| "
+        f"{_spread(w['abs_offset_m'], 'm')}."
+    )
+
+
+def _laws_section(numbers: dict[str, Any], model: str, examples: list[Path]) -> list[str]:
+    """The two laws side by side: counts, by pitch band, where they differ, the example."""
+    laws = numbers["laws"]
+    arms = numbers["arms"]
+    var, dflt = arms["recovery"]["success"], arms["recovery-default"]["success"]
+    lines = [
+        "## The two laws side by side",
+        "",
+        f"Recovery loses less than 2 m at {rate_text(var)} of the points with `{model}` and "
+        f"at {rate_text(dflt)} with the default law. Point by point: both succeed at "
+        f"{laws['both']}, only `{model}` at {laws['variant_only']}, only the default law at "
+        f"{laws['default_only']}, neither at {laws['neither']}.",
+        "",
+        f"| abs(pitch) (deg) | default law | {model} | only {model} | only the default law |",
+        "|---|---|---|---|---|",
+    ]
+    by_band = {b["band"]: b for b in numbers["bands"]}
+    for band in laws["bands"]:
+        b = by_band[band["band"]]
+        lines.append(
+            f"| {band['band']} | {rate_text(b['recovery-default'])} | "
+            f"{rate_text(b['recovery'])} | {band['variant_only']} | {band['default_only']} |"
+        )
+    lines += [
+        "",
+        _where(laws["variant_only_where"], f"`{model}`"),
+        _where(laws["default_only_where"], "the default law"),
+    ]
+    ex = laws.get("example")
+    if ex is not None:
+        lost = ex["height_lost_m"]
+        lines += [
+            "",
+            f"An example where the default law fails and `{model}` does not (of those points, "
+            f"the one nearest their median |pitch| and offset): pitch {ex['pitch_deg']:g} deg, "
+            f"offset {ex['lateral_offset_m']:+.2f} m; the default law loses "
+            f"{lost['recovery-default']:.2f} m, `{model}` {lost['recovery']:.2f} m. Each run's "
+            "attitude, tilt, altitude and X, with the detection and each stage's entry marked:",
+            "",
+        ]
+        for path in examples:
+            lines += [f"![{path.stem}]({path.as_posix()})", ""]
+    return lines

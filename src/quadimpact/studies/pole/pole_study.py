@@ -10,12 +10,16 @@ writes into ``DIR``:
 
 * ``trials.parquet``: one row per trial and controller: the sweep's row
   (inputs, outcome, the recovery metrics, the first contact's bumper and
-  normal, ``final_altitude_m``) with ``arm`` (``"baseline"`` or
-  ``"recovery"``), ``pitch_deg``, ``abs_pitch_deg``, ``lateral_offset_m``,
+  normal, ``final_altitude_m``) with ``arm`` (``"baseline"``, ``"recovery"``
+  and, when the study's model is a variant of the staged law such as
+  ``pole-replica``, ``"recovery-default"``: the default law beside it),
+  ``pitch_deg``, ``abs_pitch_deg``, ``lateral_offset_m``,
   ``height_lost_m`` (altitude at the start minus at the end), ``success``
   (``height_lost_m`` below :data:`SUCCESS_LOSS_M`) and ``pitch_band``;
 * ``study.json``: what ran and the headline numbers;
-* the figures (:mod:`quadimpact.studies.pole.pole_figures`) and ``report.md``.
+* the figures (:mod:`quadimpact.studies.pole.pole_figures`), with a variant
+  the example point's runs under both laws
+  (:mod:`quadimpact.studies.pole.pole_laws`), and ``report.md``.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ import numpy as np
 
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
+from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
@@ -48,6 +53,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BASELINES",
+    "MODELS",
     "SUCCESS_LOSS_M",
     "PoleResult",
     "PoleStudy",
@@ -63,6 +69,11 @@ BASELINES = ("paper", "cascade-pid")
 #: Width of the pitch bands of the success table, deg.
 BAND_DEG = 5.0
 ARMS = ("baseline", "recovery")
+#: The default law's recovery arm, run beside the recovery arm of a variant.
+DEFAULT_LAW_ARM = "recovery-default"
+#: Model variants of the recovery arm (docs/VARIANTS.md): the default, or the authors'
+#: retuned pole law (docs/OBSTACLES.md 6.1).
+MODELS = ("default", "pole-replica")
 
 
 def _grid(start: float, stop: float, step: float, name: str) -> list[float]:
@@ -92,6 +103,11 @@ class PoleStudy:
     baseline : {"paper", "cascade-pid"}
         The controller without recovery, holding the initial attitude and the
         altitude; the recovery controller flies it until the detection.
+    model : {"default", "pole-replica"}
+        The model variant of the recovery arm. ``"pole-replica"``: the
+        authors' retuned law (its pre-impact ``hold`` included), with a third
+        arm, the default law's recovery (``"recovery-default"``), beside it;
+        the baseline arm is the same in both.
     radius_m : float
         The pole's radius (a vertical infinite cylinder through the origin), m.
     obstacle_file : str or None
@@ -112,6 +128,7 @@ class PoleStudy:
     offset_max_m: float = 0.35
     offset_step_m: float = 0.01
     baseline: str = "paper"
+    model: str = "default"
     radius_m: float = 0.1
     obstacle_file: str | None = None
     speed_m_s: float = 2.0
@@ -126,6 +143,9 @@ class PoleStudy:
         if self.baseline not in BASELINES:
             known = ", ".join(repr(b) for b in BASELINES)
             raise InputError(f"baseline: must be one of {known} (got {self.baseline!r})")
+        if self.model not in MODELS:
+            known = ", ".join(repr(m) for m in MODELS)
+            raise InputError(f"model: must be one of {known} (got {format_value(self.model)})")
         for name in ("pitch_max_deg", "offset_max_m"):
             if not getattr(self, name) >= 0:
                 raise InputError(f"{name}: must be >= 0 (got {getattr(self, name)!r})")
@@ -192,15 +212,31 @@ class PoleStudy:
             "yaw_deg": 0.0,
         }
 
+    def arm_names(self) -> tuple[str, ...]:
+        """The arms of each grid point, in run order (``trials.parquet``'s ``arm``)."""
+        return ARMS if self.model == "default" else (*ARMS, DEFAULT_LAW_ARM)
+
     def arms(self) -> list[dict[str, Any]]:
-        """The two controllers as sweep runs: the baseline, then recovery flying it."""
+        """The controllers as sweep runs: the baseline, then recovery flying it (in the
+        study's model), then, for a variant, the default law's recovery."""
+        recovery = {
+            "controller": "recovery",
+            "pre_impact": "nominal",
+            "nominal_controller": self.baseline,
+        }
+        if self.model == "default":
+            return [{"controller": self.baseline}, recovery]
+        # every arm names its model, and the variant's its pre-impact behaviour when the
+        # variant forces one, so that the table's ``model`` and ``pre_impact`` columns (the
+        # swept inputs', which take the place of the summary's) are the ones in force
+        forced = resolve_model_options(self.model).pre_impact
+        variant = {**recovery, "model": self.model}
+        if forced != "scenario":
+            variant["pre_impact"] = forced
         return [
-            {"controller": self.baseline},
-            {
-                "controller": "recovery",
-                "pre_impact": "nominal",
-                "nominal_controller": self.baseline,
-            },
+            {"controller": self.baseline, "model": "default"},
+            variant,
+            {**recovery, "model": "default"},
         ]
 
     def sweep_spec(self) -> SweepSpec:
@@ -246,7 +282,8 @@ def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
     import pandas as pd
 
     t = runs.sort_values("run_id").reset_index(drop=True)
-    t["arm"] = np.where(t["run_id"].to_numpy() % 2 == 0, ARMS[0], ARMS[1])
+    names = np.array(study.arm_names(), dtype=object)
+    t["arm"] = names[t["run_id"].to_numpy() % names.size]
     t["pitch_deg"] = t["pitch_deg"].astype(float)
     t["abs_pitch_deg"] = t["pitch_deg"].abs()
     t["lateral_offset_m"] = t["lateral_offset_m"].astype(float)
@@ -258,12 +295,21 @@ def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
     return t
 
 
+def table_arms(table: pd.DataFrame) -> tuple[str, ...]:
+    """The arms a trials table holds, in run order."""
+    present = set(table["arm"])
+    return tuple(a for a in (*ARMS, DEFAULT_LAW_ARM) if a in present)
+
+
 def summarise(table: pd.DataFrame) -> dict[str, Any]:
-    """The headline numbers: success per arm, per pitch band, and how recovery fails."""
+    """The headline numbers: success per arm, per pitch band, how recovery fails and, with
+    the default law's arm beside a variant's, where the two laws differ."""
     from quadimpact.studies.statistics import rate
 
-    out: dict[str, Any] = {"n_points": int(len(table) // 2), "arms": {}, "bands": []}
-    for arm in ARMS:
+    arms = table_arms(table)
+    n_points = int((table["arm"] == ARMS[0]).sum())
+    out: dict[str, Any] = {"n_points": n_points, "arms": {}, "bands": []}
+    for arm in arms:
         part = table[table["arm"] == arm]
         r = rate(int(part["success"].sum()), len(part))
         contact = part["first_contact_s"].notna()
@@ -278,17 +324,23 @@ def summarise(table: pd.DataFrame) -> dict[str, Any]:
     bands = sorted(set(table["pitch_band"]), key=lambda b: float(b.split("-")[0]))
     for band in bands:
         row: dict[str, Any] = {"band": band}
-        for arm in ARMS:
+        for arm in arms:
             part = table[(table["arm"] == arm) & (table["pitch_band"] == band)]
             row[arm] = asdict(rate(int(part["success"].sum()), len(part)))
         out["bands"].append(row)
     out["failures"] = failure_analysis(table)
+    if DEFAULT_LAW_ARM in arms:
+        from quadimpact.studies.pole.pole_laws import compare_laws
+
+        out["laws"] = compare_laws(table)
     return out
 
 
 def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
     """Where recovery fails and why: its failures against the baseline at the same point."""
     import pandas as pd
+
+    from quadimpact.studies.pole.pole_laws import spread
 
     base = table[table["arm"] == "baseline"].set_index(["pitch_deg", "lateral_offset_m"])
     rec = table[table["arm"] == "recovery"].set_index(["pitch_deg", "lateral_offset_m"])
@@ -299,18 +351,6 @@ def failure_analysis(table: pd.DataFrame) -> dict[str, Any]:
     stage = np.zeros(len(fail), dtype=int)
     for k in (1, 2, 3, 4):
         stage = np.where(fail[f"t_stage{k}_s"].notna().to_numpy(), k, stage)
-
-    def spread(values: pd.Series | np.ndarray) -> dict[str, float]:
-        v = np.asarray(values, dtype=float)
-        v = v[np.isfinite(v)]
-        if v.size == 0:
-            return {"n": 0}
-        return {
-            "n": int(v.size),
-            "min": float(v.min()),
-            "median": float(np.median(v)),
-            "max": float(v.max()),
-        }
 
     abs_pitch = np.abs(np.asarray(fail.index.get_level_values(0), dtype=float))
     offsets = np.asarray(fail.index.get_level_values(1), dtype=float)
@@ -371,6 +411,7 @@ FLAGS = {
     "vehicle": "--vehicle", "pitch_max_deg": "--pitch-max", "pitch_step_deg": "--pitch-step",
     "offset_max_m": "--offset-max", "offset_step_m": "--offset-step", "baseline": "--baseline",
     "radius_m": "--radius", "obstacles": "--obstacle", "speed_m_s": "--speed",
+    "model": "--model",
 }  # fmt: skip
 
 
@@ -417,14 +458,21 @@ def run_pole_study(
         import pandas as pd
 
         table = pd.read_parquet(out / TRIALS_PARQUET)
-        paths = [out / name for name in figures.FIGURES]
+        paths = [out / name for name in unchanged.get("figures") or figures.FIGURES]
         elapsed = time.perf_counter() - start
         return PoleResult(out, table, unchanged["numbers"], folder.report_path(), paths, info,
                           elapsed)  # fmt: skip
     table = pole_table(read_runs(out / SWEEP_DIR), study)
     atomic_write(out / TRIALS_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
     numbers = summarise(table)
-    paths = figures.write_figures(table, out)
+    paths = figures.write_figures(table, out, model=study.model)
+    example = numbers.get("laws", {}).get("example")
+    if example is not None:
+        from quadimpact.studies.pole.pole_laws import write_law_examples
+
+        paths += write_law_examples(
+            spec, example, out, altitude_m=study.altitude_m, model=study.model
+        )
     elapsed = time.perf_counter() - start
     run = describe_run(info)
     description = {
@@ -435,6 +483,7 @@ def run_pole_study(
         "sweeps": folder.sweep_history(run),
         "elapsed_s": elapsed,
         "numbers": numbers,
+        "figures": [str(p.relative_to(out)) for p in paths],
     }
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
     report_path = folder.finish(description, md)

@@ -103,14 +103,17 @@ class RecoveryStudy:
         Number of trials, >= 1.
     seed : int
         The study's seed, >= 0 (trial inputs and IMU seeds, :func:`sample_trials`).
-    model : {"default", "recovery-replica"}
+    model : {"default", "recovery-replica", "pole-replica"}
         Model variant (docs/VARIANTS.md).
     imu : {"ideal", "noisy", "impact"}
         IMU preset (docs/RECOVERY.md 1.4).
-    pre_impact : {"spin-down", "hold"}
-        The recovery controller's behaviour before the detection. The recovery
-        replica forces spin-down through its ``pre_impact`` switch; with
-        ``"hold"`` that switch is set to ``"scenario"``.
+    pre_impact : {"spin-down", "hold"} or None
+        The recovery controller's behaviour before the detection; ``None`` (the
+        default): the one the model variant forces (``"hold"`` in the pole
+        replica), else ``"spin-down"``, the authors' Monte Carlo; it is
+        resolved on construction. The recovery replica forces spin-down and
+        the pole replica hold through their ``pre_impact`` switch; with the
+        other behaviour given here that switch is set to ``"scenario"``.
     estimator : str
         The state estimator the controller and the detector read
         (docs/ESTIMATION.md): ``"ideal"`` (the default), ``"complementary"``,
@@ -133,7 +136,7 @@ class RecoveryStudy:
     seed: int = 0
     model: str = "default"
     imu: str = "ideal"
-    pre_impact: str = "spin-down"
+    pre_impact: str | None = None
     estimator: str = "ideal"
     sensors: str | None = None
     _vehicle_ref: str = field(init=False, repr=False, compare=False)
@@ -143,6 +146,11 @@ class RecoveryStudy:
         _check_int("seed", self.seed, 0)
         _check_choice("model", self.model, MODELS)
         _check_choice("imu", self.imu, IMUS)
+        if self.pre_impact is None:
+            forced = resolve_model_options(self.model).pre_impact
+            object.__setattr__(
+                self, "pre_impact", forced if forced in PRE_IMPACTS else PRE_IMPACTS[0]
+            )
         _check_choice("pre_impact", self.pre_impact, PRE_IMPACTS)
         if self.sensors is not None:
             _check_choice("sensors", self.sensors, SENSORS)
@@ -179,9 +187,8 @@ class RecoveryStudy:
         if self.sensors is not None:
             base["sensors"] = self.sensors
             del base["imu"]
-        if resolve_model_options(self.model).pre_impact == "spin-down" and (
-            self.pre_impact != "spin-down"
-        ):
+        forced = resolve_model_options(self.model).pre_impact
+        if forced != "scenario" and forced != self.pre_impact:
             base["model_options"] = {"pre_impact": "scenario"}
         slew = self.lent_slew_limit_rad_s2()
         if slew is not None:
