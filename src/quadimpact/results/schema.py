@@ -193,6 +193,12 @@ SUMMARY_KEYS: tuple[Key, ...] = (
     _k("pose_sensor", "b", "", "the run has a pose sensor"),
     *_ESTIMATION,
     _k("est_attitude_rms_run_deg", "f", "deg", "estimation: attitude error, RMS over the run"),
+    _k(
+        "est_attitude_rms_not_crash_deg",
+        "f",
+        "deg",
+        "estimation: attitude error, RMS over the run but the crash (pre and post)",
+    ),  # fmt: skip
     _k("outcome", "s", "", "one sentence on what the run did"),
     _k("integrator__steps", "i", "1", "accepted steps"),
     _k("integrator__rejected_steps", "i", "1", "rejected steps"),
