@@ -11,7 +11,7 @@ from quadimpact.errors import InputError
 
 __all__ = ["estimators"]
 
-_SWITCHES = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error")
+_SWITCHES = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error", "sensors")
 
 
 @click.command("estimators")
@@ -52,6 +52,11 @@ _SWITCHES = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error
     metavar="S", help="'authors-2016': hover before the waypoint flight, s.",
 )  # fmt: skip
 @click.option(
+    "--initial-bias", type=click.Choice(("true", "zero")), default=None,
+    help="The gyro bias estimate's start, whatever the initial error. [default: zero with "
+    "--initial-error authors, else the true bias]",
+)  # fmt: skip
+@click.option(
     "--seed", type=click.IntRange(0, 2**31 - 1), default=0, show_default=True,
     help="Seed of the trials' conditions and sensor draws.",
 )  # fmt: skip
@@ -64,6 +69,7 @@ def estimators(
     loop: str,
     back: tuple[str, ...],
     hover_s: float,
+    initial_bias: str | None,
     seed: int,
     workers: int | None,
     scheduler: str | None,
@@ -108,6 +114,7 @@ def estimators(
         seed=seed,
         back=tuple(dict.fromkeys(back)),
         approach=replace(Approach(), hover_s=hover_s),
+        initial_bias=initial_bias,
     )
     result = run_estimator_study(
         study, out, workers=workers, scheduler=scheduler, progress=not no_progress

@@ -55,6 +55,7 @@ from quadimpact.core.layout import (
     ES_POS,
     ES_Q,
     ES_T,
+    ES_T_IMPACT,
     ES_VEL,
     ES_W,
     EST_COMPLEMENTARY,
@@ -139,6 +140,7 @@ def init_estimate(m: Model, d: Data) -> None:
             true_bias = 0.0 if zero else m.scfg[SC_BIAS + 3 + r]
             est[ES_BIAS + r] = true_bias + e[EC_INIT_BIAS + r]
     est[ES_T] = np.nan
+    est[ES_T_IMPACT] = np.nan
     if int(e[EC_KIND]) == EST_EKF:
         ekf_init(m, d)
     elif int(e[EC_KIND]) == EST_EKF_ADDITIVE:

@@ -4,8 +4,9 @@ State ``x = (q, b)``: the attitude quaternion (body to inertial, scalar
 first) treated as a plain 4-vector, and the gyro bias; covariance ``P``
 (7 x 7, in ``est[ES_P]`` with the row stride ``N_EKF``).
 
-Prediction at each IMU sample (gyro ``w``, ``dt`` since the last sample),
-``w_hat = w - b_hat``::
+Prediction at each IMU sample, the first too (with ``dt = 0``; the update
+follows it, as in a loop of predict-then-update from the start), with the
+gyro ``w``, ``dt`` since the last sample, ``w_hat = w - b_hat``::
 
     q_hat <- q_hat + dt/2 Omega(w_hat) q_hat,  normalised     (q (x) (0, w_hat) dt/2)
     F     = [[F_qq, -dt/2 Xi(q_hat)], [0, I]]
@@ -15,7 +16,8 @@ with ``Omega(w) q = q (x) (0, w)`` and ``Xi(q) v = q (x) (0, v)``. The correct
 quaternion block is ``F_qq = I + dt/2 Omega(w_hat)``; the authors' code had
 ``F_qq = -dt/2 (I + Omega(w_hat))`` (``EC_AS_WRITTEN``), which is of order
 ``dt``: ``F P F^T`` all but vanishes, and the quaternion's covariance is in
-effect reset to the process noise at every step.
+effect reset to the process noise at every step (at the first sample, where
+``dt = 0``, to nothing: ``P0``'s quaternion part never reaches an update).
 
 Update with the raw accelerometer and magnetometer readings, stacked as
 ``z = (f, m)`` against ``h(q) = (C(q)^T (0, 0, -g), C(q)^T m_I)``
@@ -180,29 +182,29 @@ def additive_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> No
     w = meas[MS_IMU_W : MS_IMU_W + 3]
     f = meas[MS_IMU_F : MS_IMU_F + 3]
     wh = (w[0] - est[ES_BIAS], w[1] - est[ES_BIAS + 1], w[2] - est[ES_BIAS + 2])
-    if dt > 0.0:
-        _transition(F, q, wh, dt, ecfg[EC_AS_WRITTEN] > 0.5)
-        q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
-        hdt = 0.5 * dt
-        q[0] = q0 + hdt * (-q1 * wh[0] - q2 * wh[1] - q3 * wh[2])
-        q[1] = q1 + hdt * (q0 * wh[0] + q2 * wh[2] - q3 * wh[1])
-        q[2] = q2 + hdt * (q0 * wh[1] - q1 * wh[2] + q3 * wh[0])
-        q[3] = q3 + hdt * (q0 * wh[2] + q1 * wh[1] - q2 * wh[0])
-        _normalise(q)
-        for i in range(n):  # T = F P
-            for j in range(n):
-                s = 0.0
-                for k in range(n):
-                    s += F[i, k] * P[k, j]
-                T[i, j] = s
-        for i in range(n):  # P = T F^T + Q
-            for j in range(n):
-                s = 0.0
-                for k in range(n):
-                    s += T[i, k] * F[j, k]
-                P[i, j] = s
-        for k in range(n):
-            P[k, k] += dt * (ecfg[EC_Q_QUAT] if k < 4 else ecfg[EC_Q_BIAS])
+    # every sample, the first (dt = 0) too: predict, then update
+    _transition(F, q, wh, dt, ecfg[EC_AS_WRITTEN] > 0.5)
+    q0, q1, q2, q3 = q[0], q[1], q[2], q[3]
+    hdt = 0.5 * dt
+    q[0] = q0 + hdt * (-q1 * wh[0] - q2 * wh[1] - q3 * wh[2])
+    q[1] = q1 + hdt * (q0 * wh[0] + q2 * wh[2] - q3 * wh[1])
+    q[2] = q2 + hdt * (q0 * wh[1] - q1 * wh[2] + q3 * wh[0])
+    q[3] = q3 + hdt * (q0 * wh[2] + q1 * wh[1] - q2 * wh[0])
+    _normalise(q)
+    for i in range(n):  # T = F P
+        for j in range(n):
+            s = 0.0
+            for k in range(n):
+                s += F[i, k] * P[k, j]
+            T[i, j] = s
+    for i in range(n):  # P = T F^T + Q
+        for j in range(n):
+            s = 0.0
+            for k in range(n):
+                s += T[i, k] * F[j, k]
+            P[i, j] = s
+    for k in range(n):
+        P[k, k] += dt * (ecfg[EC_Q_QUAT] if k < 4 else ecfg[EC_Q_BIAS])
     dx = T[6]  # the correction (T's last row; T[0] is the update's scratch)
     dx[:] = 0.0
     fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])

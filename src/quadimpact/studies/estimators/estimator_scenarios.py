@@ -96,12 +96,17 @@ def _uniform(seed: int, key: int, index: int, lo: float, hi: float) -> float:
     return float(lo + (hi - lo) * rng.random())
 
 
-SWITCHES: tuple[str, ...] = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error")
+SWITCHES: tuple[str, ...] = (
+    "flight", "gain", "rate", "impact_noise", "in_loop", "initial_error", "sensors",
+)  # fmt: skip
 """The replica's parts, in the order the study sets them back to quadimpact's trial:
 the flight before the wall (waypoint flight -> the impact trial's 0.32-m spin-down
 start), the CF's gain (the authors' raw form -> quadimpact's unit form), the sensors'
 rate (100 Hz -> every control tick, 200 Hz), the impact noise (replacing -> added),
-the estimators (observers -> in the loop), the initial errors (as asked -> none)."""
+the estimators (observers -> in the loop), the initial errors (as asked -> none), the
+rest of the sensor model (their IMU and magnetometer -> the ``impact`` sensors: no
+magnetometer, biases of 0.05 m/s^2, saturation, a gyro bias walk, the IMU at the
+vehicle's IMU position)."""
 
 
 def trial_scenario(
@@ -153,13 +158,19 @@ def trial_scenario(
             **a.extra,
         }
     base["end_after_recovery_s"] = a.after_recovery_s
-    base["sensors"] = "authors-2016"
     base["estimate_in_loop"] = "in_loop" in back
-    imu: dict[str, Any] = {"preset": "authors-2016", "rate_hz": 100.0, "position": "cm"}
+    if "sensors" in back:
+        base["sensors"] = "impact"
+        imu: dict[str, Any] = {"preset": "impact", "rate_hz": 100.0}
+        if "impact_noise" not in back:
+            imu["impact_disturbance"] = {"mode": "replace"}
+    else:
+        base["sensors"] = "authors-2016"
+        imu = {"preset": "authors-2016", "rate_hz": 100.0, "position": "cm"}
+        if "impact_noise" in back:
+            imu["impact_disturbance"] = {"mode": "add"}
     if "rate" in back:
         imu.pop("rate_hz")
-    if "impact_noise" in back:
-        imu["impact_disturbance"] = {"mode": "add"}
     base["imu"] = imu
     base["seed"] = int(seed) * 1_000_003 + int(index)
     return base
@@ -180,21 +191,29 @@ def _impact_trial(index: int, seed: int) -> dict[str, Any]:
 
 
 def estimator_rows(
-    scenario: str, initial_error: str, back: frozenset[str] = frozenset()
+    scenario: str,
+    initial_error: str,
+    back: frozenset[str] = frozenset(),
+    initial_bias: str | None = None,
 ) -> list[tuple[str, str, dict[str, Any]]]:
     """The study's estimators with their parameters for a scenario and initial error.
 
     ``initial_error = "authors"``: ZYX Euler errors N(0, (2, 2, 5) deg) and the gyro
-    bias estimate 0 (``ideal`` has none). ``gain`` in ``back``: the CF row in
-    quadimpact's unit form.
+    bias estimate 0 (``ideal`` has none). ``initial_bias``: ``"true"`` or ``"zero"``
+    whatever the initial error (None: ``zero`` with the authors' errors, else
+    ``true``). ``gain`` in ``back``: the CF row in quadimpact's unit form.
     """
     rows = []
+    authors = initial_error == "authors" and "initial_error" not in back
     for label, name, params in ESTIMATORS:
         p = dict(params)
         if label == "cf" and "gain" in back:
             p.pop("form")
-        if initial_error == "authors" and name != "ideal" and "initial_error" not in back:
-            p["initial_euler_error_deg"] = [2.0, 2.0, 5.0]
-            p["initial_bias"] = "zero"
+        if name != "ideal":
+            if authors:
+                p["initial_euler_error_deg"] = [2.0, 2.0, 5.0]
+            bias = initial_bias or ("zero" if authors else "true")
+            if bias != "true":
+                p["initial_bias"] = bias
         rows.append((label, name, p))
     return rows

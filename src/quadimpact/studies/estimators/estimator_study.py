@@ -73,13 +73,18 @@ class EstimatorStudy:
         deg), the gyro bias estimate 0).
     loop : {"default", "in", "out"}
         The estimate in the loop or an observer; ``default``: in for ``impact``,
-        out for ``authors-2016``.
+        out for ``authors-2016``. In the loop, the ``authors-2016`` flight has a
+        position sensor (motion capture, position only: the waypoint flight is
+        flown on the position estimate).
     seed : int
         Seed of the trials' conditions and sensor draws.
     back : tuple of str
         Parts of the replica set back to quadimpact's trial (``authors-2016``).
     approach : Approach
         The authors' flight before the wall (hover time, position loop).
+    initial_bias : {"true", "zero"} or None
+        The gyro bias estimate's start; None: 0 with the authors' initial errors,
+        else the true bias.
     """
 
     scenario: str = "impact"
@@ -89,12 +94,14 @@ class EstimatorStudy:
     seed: int = 0
     back: tuple[str, ...] = ()
     approach: Approach = field(default_factory=Approach)
+    initial_bias: str | None = None
 
     def __post_init__(self) -> None:
         for name, value, known in (
             ("scenario", self.scenario, SCENARIOS),
             ("initial_error", self.initial_error, INITIAL_ERRORS),
             ("loop", self.loop, LOOPS),
+            ("initial_bias", self.initial_bias, (None, "true", "zero")),
         ):
             if value not in known:
                 choices = ", ".join(repr(k) for k in known)
@@ -117,7 +124,9 @@ class EstimatorStudy:
 
     def rows(self) -> list[tuple[str, str, dict[str, Any]]]:
         """(label, estimator, parameters) of each estimator."""
-        return estimator_rows(self.scenario, self.initial_error, frozenset(self.back))
+        return estimator_rows(
+            self.scenario, self.initial_error, frozenset(self.back), self.initial_bias
+        )
 
     def scenario_dict(self, index: int) -> dict[str, Any]:
         """Trial ``index``'s scenario mapping (no estimator yet)."""
@@ -126,6 +135,10 @@ class EstimatorStudy:
             back=frozenset(self.back),
         )  # fmt: skip
         d["estimate_in_loop"] = self.in_loop
+        if self.in_loop and d["kind"] == "flight":
+            # the waypoint flight is flown on the estimate: it needs a position sensor
+            # (motion capture, position only), or the integrated position drifts
+            d["pose_sensor"] = {"attitude": False}
         return d
 
     def sweep_spec(self) -> SweepSpec:
