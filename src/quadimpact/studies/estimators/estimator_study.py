@@ -189,17 +189,16 @@ def summarise(table: pd.DataFrame, study: EstimatorStudy) -> list[dict[str, Any]
         rest = part["est_attitude_rms_not_crash_deg"].to_numpy(dtype=float)[ok]
         rest = rest[np.isfinite(rest)]
         n = int(crash.size)
+        sd = float(crash.std(ddof=1)) if n > 1 else math.nan
         row: dict[str, Any] = {
             "estimator": label,
-            "registered_as": name,
             "crash_rms_mean_deg": float(crash.mean()) if n else math.nan,
-            "crash_rms_mean_ci95_deg": 1.96 * float(crash.std(ddof=1)) / math.sqrt(n)
-            if n > 1
-            else math.nan,
             "crash_rms_median_deg": float(np.median(crash)) if n else math.nan,
             "crash_rms_p90_deg": float(np.quantile(crash, 0.9)) if n else math.nan,
-            "crash_rms_sd_deg": float(crash.std(ddof=1)) if n > 1 else math.nan,
+            "crash_rms_sd_deg": sd,
             "not_crash_rms_mean_deg": float(rest.mean()) if rest.size else math.nan,
+            "crash_rms_mean_ci95_deg": 1.96 * sd / math.sqrt(n) if n > 1 else math.nan,
+            "registered_as": name,
             "trials": int(len(part)),
             "trials_counted": n,
             "no_contact": int(part["first_contact_s"].isna().sum()),
