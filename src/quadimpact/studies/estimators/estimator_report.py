@@ -1,4 +1,8 @@
-"""The estimator study's figures and ``report.md`` (``quadimpact estimators``)."""
+"""The estimator study's figures and ``report.md`` (``quadimpact estimators``).
+
+``study`` is an :class:`~quadimpact.studies.estimators.estimator_study.EstimatorStudy`
+(not imported here: the study imports this module).
+"""
 
 from __future__ import annotations
 
@@ -11,8 +15,11 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.results.figures import new_figure, save_figure
-from quadimpact.studies.estimators.estimator_scenarios import AUTHORS_2016, AUTHORS_ROWS
-from quadimpact.studies.estimators.estimator_study import CURVE_TRIALS, EstimatorStudy
+from quadimpact.studies.estimators.estimator_scenarios import (
+    AUTHORS_2016,
+    AUTHORS_ROWS,
+    CURVE_TRIALS,
+)
 
 __all__ = ["render_report", "write_figures"]
 
@@ -22,7 +29,7 @@ DISTRIBUTION_PNG = "crash_error_per_trial.png"
 
 def write_figures(
     table: pd.DataFrame,
-    study: EstimatorStudy,
+    study: Any,
     grid: np.ndarray,
     curves: dict[str, np.ndarray],
     out_dir: str | os.PathLike[str],
@@ -68,7 +75,7 @@ def _f(x: Any, digits: int = 2) -> str:
 
 
 def render_report(
-    study: EstimatorStudy, rows: list[dict[str, Any]], figures: list[Path], run: dict[str, Any]
+    study: Any, rows: list[dict[str, Any]], figures: list[Path], run: dict[str, Any]
 ) -> str:
     """``report.md``: the table with the authors' figures beside it, the figures."""
     authors = AUTHORS_2016[study.initial_error] if study.scenario == "authors-2016" else {}

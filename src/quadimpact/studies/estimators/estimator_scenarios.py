@@ -17,7 +17,7 @@ quadimpact's own trial on its own (``why they differ``).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -43,6 +43,8 @@ AUTHORS_2016 = {
     },
 }
 SCENARIOS = ("impact", "authors-2016")
+#: Trials whose error over time the report's figure averages.
+CURVE_TRIALS = 20
 INITIAL_ERRORS = ("none", "authors")
 
 #: The estimators of the study: (row label, registered estimator, its parameters).
@@ -87,7 +89,6 @@ class Approach:
     tilt_max_deg: float = 30.0
     altitude_m: float = 5.0
     after_recovery_s: float = 5.0
-    extra: dict[str, Any] = field(default_factory=dict)
 
 
 def _uniform(seed: int, key: int, index: int, lo: float, hi: float) -> float:
@@ -155,7 +156,6 @@ def trial_scenario(
                 "v_max_m_s": a.v_max_m_s,
                 "tilt_max_deg": a.tilt_max_deg,
             },
-            **a.extra,
         }
     base["end_after_recovery_s"] = a.after_recovery_s
     base["estimate_in_loop"] = "in_loop" in back

@@ -36,6 +36,7 @@ from quadimpact.errors import InputError
 from quadimpact.results.files import atomic_write
 from quadimpact.results.study_files import sweep_history, write_report, write_study_json
 from quadimpact.studies.estimators.estimator_scenarios import (
+    CURVE_TRIALS,
     INITIAL_ERRORS,
     SCENARIOS,
     SWITCHES,
@@ -54,8 +55,6 @@ SWEEP_DIR = "sweep"
 TRIALS_PARQUET = "trials.parquet"
 ESTIMATORS_CSV = "estimators.csv"
 LOOPS = ("default", "in", "out")
-#: Trials whose error over time the report's figure averages.
-CURVE_TRIALS = 20
 
 
 @dataclass(frozen=True)
