@@ -5,6 +5,8 @@
 * :mod:`~quadimpact.cli.reproduce_command`: ``quadimpact reproduce``;
 * :mod:`~quadimpact.cli.experiments_command`: ``quadimpact experiments``;
 * :mod:`~quadimpact.cli.recovery_command`: ``quadimpact recovery``;
+* :mod:`~quadimpact.cli.pole_command`: ``quadimpact pole``;
+* :mod:`~quadimpact.cli.estimators_command`: ``quadimpact estimators``;
 * :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
 
@@ -26,6 +28,7 @@ from typing import Any
 
 import click
 
+from quadimpact.cli.estimators_command import estimators
 from quadimpact.cli.experiments_command import experiments
 from quadimpact.cli.pole_command import pole
 from quadimpact.cli.recovery_command import recovery
@@ -86,7 +89,9 @@ def cli() -> None:
 
 
 # ---- the commands, each in its own module: one registration line each ----
-for _command in (run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole):
+for _command in (
+    run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole, estimators,
+):  # fmt: skip
     cli.add_command(_command)
 
 

@@ -118,6 +118,7 @@ class EstimatorKind(IntEnum):
     IDEAL = 0  # the true state (and the gyro as measured): every result as before estimators
     COMPLEMENTARY = 1  # Mahony-type nonlinear complementary filter
     EKF = 2  # multiplicative (error-state) extended Kalman filter
+    EKF_ADDITIVE = 3  # the authors' 7-state additive-quaternion EKF (ekf_additive.py)
     USER = 99  # a plug-in compiled into its own loop (core/kernel.py, make_kernel)
 
 
@@ -165,6 +166,7 @@ CTRL_USER = int(ControllerKind.USER)
 EST_IDEAL = int(EstimatorKind.IDEAL)
 EST_COMPLEMENTARY = int(EstimatorKind.COMPLEMENTARY)
 EST_EKF = int(EstimatorKind.EKF)
+EST_EKF_ADDITIVE = int(EstimatorKind.EKF_ADDITIVE)
 EST_USER = int(EstimatorKind.USER)
 ROTOR_IDEAL = int(RotorMode.IDEAL)
 ROTOR_FIRST_ORDER = int(RotorMode.FIRST_ORDER)
@@ -278,6 +280,8 @@ O_SPINUP_PAPER = _opt.slot("O_SPINUP_PAPER")  # 1: spin-up reaction -Jr sum Omeg
 O_CONTACT_GATE = _opt.slot("O_CONTACT_GATE")  # m; > 0: forces only while the CM is this close
 O_CUT_STEP_MOTORS = _opt.slot("O_CUT_STEP_MOTORS")  # bit j: motor j+1 cut at the first tick
 #   after the power-off trigger as a one-tick command step (actuators.cut_step)
+O_END_AFTER_RECOVERY = _opt.slot("O_END_AFTER_RECOVERY")  # s; > 0: the run ends this long
+#   after the entry into stage 4 (recovered)
 NOPT = _opt.end("NOPT")
 
 # ---- controller ctrl (NCTRL): a common head, then NPARAM slots that each
@@ -293,6 +297,11 @@ C_Z_REF = _ctrl.slot("C_Z_REF", 3)  # the reference attitude's body z axis, iner
 C_ALLOC_INV = _ctrl.slot("C_ALLOC_INV", 16)  # inverse allocation matrix, row-major
 C_OMEGA_MIN = _ctrl.slot("C_OMEGA_MIN")  # rad/s, the vehicle's rotor speed range
 C_OMEGA_MAX = _ctrl.slot("C_OMEGA_MAX")
+C_WAYPOINT_ON = _ctrl.slot("C_WAYPOINT_ON")  # 1: cascade-pid's position loop (a waypoint flight)
+C_HOLD_POS = _ctrl.slot("C_HOLD_POS", 3)  # m, inertial NED: the position held before C_WAYPOINT_T
+C_WAYPOINT = _ctrl.slot("C_WAYPOINT", 3)  # m, inertial NED: the waypoint (X, Y; Z is C_H_REF's)
+C_WAYPOINT_T = _ctrl.slot("C_WAYPOINT_T")  # s, when the waypoint replaces the held position
+C_POS_GAINS = _ctrl.slot("C_POS_GAINS", 4)  # K_p 1/s, K_v 1/s, v_max m/s, tilt_max rad
 NPARAM = 64
 C_PARAMS = _ctrl.slot("C_PARAMS", NPARAM)  # the controller's own parameters
 NCTRL = _ctrl.end("NCTRL")
@@ -327,6 +336,9 @@ SC_POSE_NOISE_P = _scfg.slot("SC_POSE_NOISE_P")  # position white-noise std per 
 SC_POSE_ATT = _scfg.slot("SC_POSE_ATT")  # 1: it measures the attitude too
 SC_POSE_NOISE_A = _scfg.slot("SC_POSE_NOISE_A")  # attitude noise std per axis (rot. vector), rad
 SC_POSE_LAG = _scfg.slot("SC_POSE_LAG")  # latency, IMU samples (< MAX_POSE_LAG)
+SC_IMPACT_REPLACE = _scfg.slot("SC_IMPACT_REPLACE")  # 1: the impact noise replaces the nominal
+#   noise while it is the larger, restarting at each onset (the authors' model); 0: added
+SC_MAG_BIAS = _scfg.slot("SC_MAG_BIAS", 3)  # magnetometer static bias, body (drawn per run)
 NSCFG = _scfg.end("NSCFG")
 MAX_POSE_LAG = 64  # IMU samples
 MAX_AVERAGE_WINDOW = 64  # samples
@@ -364,6 +376,23 @@ EC_SIG_POS = _ecfg.slot("EC_SIG_POS")  # EKF: pose position noise, m
 EC_SIG_ATT = _ecfg.slot("EC_SIG_ATT")  # EKF: pose attitude noise, rad
 EC_P0 = _ecfg.slot("EC_P0", 4)  # EKF initial std: attitude rad, bias rad/s, velocity m/s, pos m
 EC_NAV = _ecfg.slot("EC_NAV")  # EKF: 1: velocity and position are filter states (pose sensor)
+EC_OBSERVER = _ecfg.slot("EC_OBSERVER")  # 1: out of the loop (controller, detector read the truth)
+EC_INIT_EULER = _ecfg.slot("EC_INIT_EULER", 3)  # initial ZYX Euler errors (roll, pitch, yaw), rad
+EC_INIT_BIAS_ZERO = _ecfg.slot("EC_INIT_BIAS_ZERO")  # 1: the gyro bias estimate starts at 0
+EC_CF_RAW = _ecfg.slot("EC_CF_RAW")  # complementary: 1: the authors' form on raw vectors
+EC_K_BIAS_MAG = _ecfg.slot("EC_K_BIAS_MAG")  # complementary, raw form: bias gain of the mag. term
+EC_AS_WRITTEN = _ecfg.slot("EC_AS_WRITTEN")  # additive EKF: 1: the transition -dt/2 (I + Omega)
+EC_R_ACC = _ecfg.slot("EC_R_ACC")  # additive EKF: accelerometer noise variance, (m/s^2)^2
+EC_R_MAG = _ecfg.slot("EC_R_MAG")  # additive EKF: magnetometer noise variance (field units^2)
+EC_Q_QUAT = _ecfg.slot("EC_Q_QUAT")  # additive EKF: quaternion process noise per second
+EC_Q_BIAS = _ecfg.slot("EC_Q_BIAS")  # additive EKF: bias process noise per second, (rad/s)^2
+EC_P0_QUAT = _ecfg.slot("EC_P0_QUAT")  # additive EKF: initial quaternion variance
+EC_P0_BIAS = _ecfg.slot("EC_P0_BIAS")  # additive EKF: initial bias variance, (rad/s)^2
+EC_IMPACT_W = _ecfg.slot("EC_IMPACT_W")  # EKF: the IMU's impact disturbance, gyro g0, rad/s
+EC_IMPACT_F = _ecfg.slot("EC_IMPACT_F")  # EKF: ... accelerometer a0, m/s^2
+EC_IMPACT_TAU = _ecfg.slot("EC_IMPACT_TAU")  # EKF: ... time constant, s (<= 0: not modelled)
+EC_IMPACT_REPLACE = _ecfg.slot("EC_IMPACT_REPLACE")  # EKF: 1: it replaces the nominal noise
+EC_IMPACT_THRESHOLD = _ecfg.slot("EC_IMPACT_THRESHOLD")  # EKF: |(f_x, f_y)| marking an impact
 N_USER_ECFG = 16
 EC_USER = _ecfg.slot("EC_USER", N_USER_ECFG)  # a plug-in estimator's parameters
 NECFG = _ecfg.end("NECFG")
@@ -491,6 +520,7 @@ ES_GATED = _est.slot("ES_GATED")  # 1: the accelerometer correction was gated at
 N_EKF = 12  # error state: attitude (3), gyro bias (3), velocity (3), position (3)
 ES_P = _est.slot("ES_P", N_EKF * N_EKF)  # EKF error covariance, row-major
 ES_SCRATCH = _est.slot("ES_SCRATCH", 4)  # a quaternion's worth of scratch (EKF prediction)
+ES_T_IMPACT = _est.slot("ES_T_IMPACT")  # s, the EKF's latest impact sample (NaN: none)
 N_USER_EST = 32
 ES_USER = _est.slot("ES_USER", N_USER_EST)  # a plug-in estimator's own state
 NEST = _est.end("NEST")

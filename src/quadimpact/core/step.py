@@ -71,6 +71,7 @@ from quadimpact.core.layout import (
     O_CRASH_ALTITUDE,
     O_CRASH_RULE,
     O_DT_CONTROL,
+    O_END_AFTER_RECOVERY,
     O_H_MAX,
     O_POWER_OFF_T,
     O_ROTOR_MODE,
@@ -112,6 +113,7 @@ from quadimpact.core.recording import record_crash, write_sample
 from quadimpact.core.records import Data, Model, Output, Work, new_work
 from quadimpact.core.sensing import sample_at
 
+STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
 controller_step = builtin_step  # rebound by run.make_kernel for plug-in controllers
 
 
@@ -194,6 +196,16 @@ def _crash_at_tick(t: float, m: Model, d: Data, o: Output) -> bool:
 
 
 @compiled
+def _ended_after_recovery(t: float, m: Model, o: Output) -> bool:
+    """Whether the run ends at the tick ``t`` (s): ``O_END_AFTER_RECOVERY`` after stage 4."""
+    delay = m.opts[O_END_AFTER_RECOVERY]
+    if not delay > 0.0:
+        return False
+    t4 = o.stats[ST_STAGE_T + STAGE_RECOVERED]
+    return not np.isnan(t4) and t >= t4 + delay - 1e-9
+
+
+@compiled
 def _command(t: float, m: Model, d: Data, o: Output, w: Work) -> None:
     """The tick's rotor command into ``w.cmd``: the controller's, or the external one.
 
@@ -231,6 +243,9 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
         return
     t_next = min(t0 + (k + 1) * dt_c, tf)
     normalise_quaternion(d.x, X_QUAT)
+    if _ended_after_recovery(t_k, m, o):
+        ls[LS_DONE] = 1.0
+        return
     if _crash_at_tick(t_k, m, d, o):
         ls[LS_DONE] = 1.0
         return

@@ -177,7 +177,8 @@ class TrialDistribution:
     estimator_params : mapping
         Its parameters.
     sensors : str or None
-        A preset of sensors (``"ideal"``, ``"noisy"``, ``"impact"``, ``"indoor"``);
+        A preset of sensors (``"ideal"``, ``"noisy"``, ``"impact"``, ``"indoor"``,
+        ``"authors-2016"``);
         it replaces the IMU preset choice.
     overrides : mapping
         Any other :class:`~quadimpact.inputs.scenarios.ImpactTrial` field

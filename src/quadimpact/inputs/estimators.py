@@ -11,7 +11,9 @@ and may set its parameters (``[estimator_params]``). Built in:
 * ``complementary``: a Mahony-type nonlinear complementary filter
   (:class:`ComplementaryParams`);
 * ``ekf``: a multiplicative error-state extended Kalman filter
-  (:class:`EkfParams`).
+  (:class:`EkfParams`);
+* ``ekf-additive``: the authors' 7-state EKF on an additive quaternion, with
+  its transition matrix as written or correct (:class:`AdditiveEkfParams`).
 
 A user's compiled estimator plugs in like a controller:
 ``register_estimator(name, step=..., params=..., pack=...)`` (the step's
@@ -28,13 +30,14 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field
+from pydantic import BaseModel, Field, field_validator
 
 from quadimpact.core import layout as L
 from quadimpact.inputs.registry import Registry
-from quadimpact.inputs.types import MODEL_CONFIG, Real
+from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
 
 __all__ = [
+    "AdditiveEkfParams",
     "ComplementaryParams",
     "EkfParams",
     "EstimatorContext",
@@ -78,6 +81,21 @@ class EstimatorParams(BaseModel):
     initial_velocity_error_m_s: Real = Field(0.0, ge=0, description="Std per axis, m/s.")
     initial_position_error_m: Real = Field(0.0, ge=0, description="Std per axis, m.")
     initial_bias_error_rad_s: Real = Field(0.0, ge=0, description="Std per axis, rad/s.")
+    initial_euler_error_deg: Vec3 = Field(
+        (0.0, 0.0, 0.0),
+        description="Std of ZYX Euler-angle errors (roll, pitch, yaw), deg (the authors' "
+        "study: 2, 2, 5).",
+    )
+    initial_bias: Literal["true", "zero"] = Field(
+        "true", description="The gyro bias estimate starts at the true bias or at 0."
+    )
+
+    @field_validator("initial_euler_error_deg")
+    @classmethod
+    def _non_negative(cls, value: tuple[float, float, float]) -> tuple[float, float, float]:
+        if min(value) < 0:
+            raise ValueError("standard deviations must be >= 0")
+        return value
 
 
 class ComplementaryParams(EstimatorParams):
@@ -92,6 +110,16 @@ class ComplementaryParams(EstimatorParams):
     )
     k_pose_velocity_1_s: Real = Field(
         0.5, ge=0, description="Pose: velocity gain per measurement, 1/s."
+    )
+    form: Literal["unit", "raw"] = Field(
+        "unit",
+        description="'unit': the gains above on unit vectors; 'raw': the authors' explicit "
+        "filter on raw vectors with raw_gains.",
+    )
+    raw_gains: Vec4 = Field(
+        (0.1, 0.5, 1.0, 0.05),
+        description="form = 'raw': k_p, accelerometer weight, magnetometer weight, k_I "
+        "(the authors' 2016 study).",
     )
 
 
@@ -146,6 +174,36 @@ class EkfParams(EstimatorParams):
     initial_position_std_m: Real | None = Field(
         None, gt=0, description="m (with a pose sensor); None: the initial error's, >= 0.01."
     )
+    impact_noise: Literal["sensor", "none"] = Field(
+        "sensor",
+        description="'sensor': the IMU's impact disturbance (when it has one) in the gyro and "
+        "accelerometer noise after each impact the filter sees; 'none': not modelled.",
+    )
+    impact_threshold_g: Real = Field(
+        0.5, gt=0, description="|(f_x, f_y)| that marks an impact for the noise model, in g."
+    )
+
+
+class AdditiveEkfParams(EstimatorParams):
+    """The authors' 7-state EKF (an additive quaternion and the gyro bias).
+
+    Defaults: their 2016 study's figures, as matrix entries (variances):
+    measurement noise ``diag(1, 1, 1, 7e-4, 7e-4, 7e-4)``, process noise
+    ``dt diag(1.8e-3 I4, 1e-3 I3)``, ``P0 = diag(0.1 I4, 1e-4 I3)``, the
+    accelerometer gate 0.5 m/s^2. ``transition``: ``"correct"``
+    (``I + dt/2 Omega``) or ``"as-written"`` (their code's ``-dt/2 (I + Omega)``).
+    """
+
+    transition: Literal["correct", "as-written"] = Field(
+        "correct", description="The quaternion block of the transition matrix."
+    )
+    accel_variance: Real = Field(1.0, gt=0, description="Accelerometer noise variance.")
+    magnetometer_variance: Real = Field(7e-4, gt=0, description="Magnetometer noise variance.")
+    quaternion_process: Real = Field(1.8e-3, ge=0, description="Quaternion process noise / s.")
+    bias_process: Real = Field(1e-3, ge=0, description="Bias process noise / s, (rad/s)^2.")
+    initial_quaternion_variance: Real = Field(0.1, gt=0, description="P0, quaternion.")
+    initial_bias_variance: Real = Field(1e-4, gt=0, description="P0, bias, (rad/s)^2.")
+    gate_m_s2: Real = Field(0.5, ge=0, description="Skip the accelerometer while ||f|-g| > this.")
 
 
 class _NoParams(BaseModel):
@@ -209,6 +267,27 @@ def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     e[L.EC_GATE] = p.gate_m_s2
     e[L.EC_K_POS] = p.k_pose_position
     e[L.EC_K_VEL] = p.k_pose_velocity_1_s
+    if p.form == "raw":
+        k_p, w_a, w_m, k_i = p.raw_gains
+        e[L.EC_CF_RAW] = 1.0
+        e[L.EC_K_ACC] = 0.5 * k_p * w_a
+        e[L.EC_K_MAG] = 0.5 * k_p * w_m
+        e[L.EC_K_BIAS] = 0.5 * k_i * w_a
+        e[L.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
+    return e
+
+
+def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: AdditiveEkfParams = params  # type: ignore[assignment]
+    e = np.zeros(L.NECFG)
+    e[L.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
+    e[L.EC_R_ACC] = p.accel_variance
+    e[L.EC_R_MAG] = p.magnetometer_variance
+    e[L.EC_Q_QUAT] = p.quaternion_process
+    e[L.EC_Q_BIAS] = p.bias_process
+    e[L.EC_P0_QUAT] = p.initial_quaternion_variance
+    e[L.EC_P0_BIAS] = p.initial_bias_variance
+    e[L.EC_GATE] = p.gate_m_s2
     return e
 
 
@@ -247,10 +326,18 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
     e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
     e[L.EC_NAV] = 1.0 if pose is not None else 0.0
+    dist = imu.impact_disturbance
+    if p.impact_noise == "sensor" and dist is not None:
+        e[L.EC_IMPACT_W] = dist.gyro_rad_s
+        e[L.EC_IMPACT_F] = dist.accel_m_s2
+        e[L.EC_IMPACT_TAU] = dist.time_constant_s
+        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
+        g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
+        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
     return e
 
 
-BUILTIN = ("ideal", "complementary", "ekf")
+BUILTIN = ("ideal", "complementary", "ekf", "ekf-additive")
 _REGISTRY: Registry[EstimatorEntry] = Registry(
     "estimator",
     BUILTIN,
@@ -339,4 +426,11 @@ register_estimator(
     params=EkfParams,
     pack=_pack_ekf,
     description="multiplicative error-state EKF: attitude, gyro bias (+ velocity, position)",
+)
+register_estimator(
+    "ekf-additive",
+    kind=L.EST_EKF_ADDITIVE,
+    params=AdditiveEkfParams,
+    pack=_pack_additive,
+    description="the authors' 7-state EKF on an additive quaternion (their 2016 study)",
 )

@@ -13,7 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any, ClassVar, Literal
 
-from pydantic import BaseModel, Field, field_validator, model_validator
+from pydantic import BaseModel, Field, StrictBool, field_validator, model_validator
 
 from quadimpact.errors import InputError, near_miss
 from quadimpact.inputs.controllers import (
@@ -292,7 +292,7 @@ class RunSettings(BaseModel):
 
     magnetometer: Magnetometer | None = Field(None, description="A magnetometer (None: none).")
     pose_sensor: PoseSensor | None = Field(None, description="A pose sensor (None: none).")
-    sensors: Literal["ideal", "noisy", "impact", "indoor"] | None = Field(
+    sensors: Literal["ideal", "noisy", "impact", "indoor", "authors-2016"] | None = Field(
         None, description="A preset of sensors (imu, magnetometer, pose_sensor not set)."
     )
     estimator: str = Field(
@@ -300,6 +300,14 @@ class RunSettings(BaseModel):
     )
     estimator_params: dict[str, Any] = Field(
         default_factory=dict, description="The estimator's own parameters."
+    )
+    estimate_in_loop: StrictBool = Field(
+        True,
+        description="The controller and the detector read the estimate; false: the "
+        "estimator is an observer (computed and scored, the loop reads the true state).",
+    )
+    end_after_recovery_s: Real | None = Field(
+        None, gt=0, description="End the run this long after the entry into stage 4, s."
     )
 
     @model_validator(mode="before")

@@ -62,6 +62,7 @@ from quadimpact.errors import InputError, format_value, input_error_from_validat
 from quadimpact.inputs.run_settings import PowerOff, RunSettings, check_before_final, check_euler
 from quadimpact.inputs.toml_files import locate_vehicle, read_toml_file
 from quadimpact.inputs.types import Real, Vec3, Vec4
+from quadimpact.inputs.waypoint import Waypoint
 from quadimpact.inputs.world import Plane
 
 __all__ = [
@@ -178,6 +179,12 @@ class FlightScenario(RunSettings):
         Contact planes (walls, ceilings...); names must be unique.
     start_time_s : float
         Initial time, s, >= 0 and < ``final_time_s``.
+    waypoint : Waypoint or None
+        A flight toward a waypoint (:class:`~quadimpact.inputs.waypoint.Waypoint`):
+        the ``cascade-pid`` controller's position loop holds the start position,
+        then flies there; with the ``cascade-pid`` controller, or ``recovery``
+        flying it before the impact (``pre_impact = "nominal"``,
+        ``nominal_controller = "cascade-pid"``).
     """
 
     kind: Literal["flight"] = Field("flight", description="Scenario kind tag.")
@@ -204,6 +211,7 @@ class FlightScenario(RunSettings):
     )
     surfaces: tuple[Plane, ...] = Field((), description="Contact planes.")
     start_time_s: Real = Field(0.0, ge=0, description="Initial time, s.")
+    waypoint: Waypoint | None = Field(None, description="A flight toward a waypoint.")
 
     @field_validator("position_m")
     @classmethod
@@ -236,6 +244,17 @@ class FlightScenario(RunSettings):
     @model_validator(mode="after")
     def _start_before_end(self) -> FlightScenario:
         check_before_final(self, "start_time_s")
+        if self.waypoint is not None:
+            flies = self.controller == "cascade-pid" or (
+                self.controller == "recovery"
+                and self.resolved_pre_impact() == "nominal"
+                and self.nominal_controller == "cascade-pid"
+            )
+            if not flies:
+                raise ValueError(
+                    "waypoint: needs controller = 'cascade-pid', or 'recovery' with "
+                    "pre_impact = 'nominal' and nominal_controller = 'cascade-pid'"
+                )
         return self
 
 

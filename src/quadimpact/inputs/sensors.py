@@ -61,6 +61,9 @@ class ImpactDisturbance(BaseModel):
     ``accel_m_s2 exp(-(t - t_c)/time_constant_s)`` on each accelerometer axis
     and ``gyro_rad_s exp(-(t - t_c)/time_constant_s)`` on each gyro axis, added
     to the nominal noise (before saturation). Defaults: the authors' values.
+    With ``mode = "replace"`` (their 2016 estimator study) the noise of the
+    latest onset alone (a new contact restarts it) takes the place of the
+    nominal noise on each axis until it decays below it.
     """
 
     model_config = MODEL_CONFIG
@@ -68,20 +71,30 @@ class ImpactDisturbance(BaseModel):
     accel_m_s2: Real = Field(14.0, ge=0, description="Accelerometer amplitude a0, m/s^2.")
     gyro_rad_s: Real = Field(0.1, ge=0, description="Gyro amplitude g0, rad/s.")
     time_constant_s: Real = Field(0.4, gt=0, description="Decay time constant tau, s.")
+    mode: Literal["add", "replace"] = Field(
+        "add",
+        description="'add': each onset's noise added to the nominal noise (variances of "
+        "several onsets add); 'replace': the latest onset's noise replaces the nominal noise "
+        "while it is the larger (the authors' 2016 study).",
+    )
 
 
 class Magnetometer(BaseModel):
     """A magnetometer sampled with the IMU: the unit Earth field in body axes, with noise.
 
     The field ``m_I`` points to magnetic north (+X) and dips ``dip_deg`` below
-    the horizon (down positive, NED). Without a magnetometer yaw is
-    unobservable and an estimator's heading drifts with the gyro bias.
+    the horizon (down positive, NED), of length ``norm`` (1: a unit field);
+    a static bias of standard deviation ``bias`` per axis is drawn once per
+    run. Without a magnetometer yaw is unobservable and an estimator's heading
+    drifts with the gyro bias.
     """
 
     model_config = MODEL_CONFIG
 
     dip_deg: Real = Field(60.0, ge=-90, le=90, description="Dip of the field, deg (down +).")
     noise: Real = Field(7e-3, ge=0, description="White-noise std per axis, unit field.")
+    norm: Real = Field(1.0, gt=0, le=10, description="Length of the field (1: unit).")
+    bias: Real = Field(0.0, ge=0, description="Std of the static bias per axis (per run).")
 
 
 class PoseSensor(BaseModel):
@@ -125,11 +138,23 @@ IMU_PRESETS: dict[str, dict[str, float | None]] = {
 # the noisy IMU through impacts: its structure rings after each contact (the
 # authors' disturbance) and its gyro bias wanders (1e-4 rad/s/sqrt(s))
 IMU_PRESETS["impact"] = dict(IMU_PRESETS["noisy"])
+# the authors' 2016 estimator study: the noisy IMU's noise, static biases drawn with
+# 0.1 m/s^2 and 0.01 rad/s, no saturation
+IMU_PRESETS["authors-2016"] = {
+    **IMU_PRESETS["noisy"],
+    "accel_bias_m_s2": 0.1,
+    "accel_range_m_s2": None,
+    "gyro_range_rad_s": None,
+}
 """The IMU presets; a field set in ``[imu]`` overrides its preset's value."""
 IMU_EXTRAS: dict[str, dict[str, Any]] = {
     "ideal": {"impact_disturbance": None, "gyro_bias_walk_rad_s_sqrt_s": 0.0},
     "noisy": {"impact_disturbance": None, "gyro_bias_walk_rad_s_sqrt_s": 0.0},
     "impact": {"impact_disturbance": {}, "gyro_bias_walk_rad_s_sqrt_s": 1e-4},
+    "authors-2016": {
+        "impact_disturbance": {"mode": "replace"},
+        "gyro_bias_walk_rad_s_sqrt_s": 0.0,
+    },
 }
 """Each IMU preset's impact disturbance (None: off; a table: its settings) and bias walk."""
 
@@ -138,6 +163,11 @@ SENSOR_PRESETS: dict[str, dict[str, Any]] = {
     "noisy": {"imu": "noisy"},
     "impact": {"imu": "impact"},
     "indoor": {"imu": "impact", "magnetometer": {}, "pose_sensor": {}},
+    # the authors' 2016 estimator study: 100 Hz at the CM, their magnetometer
+    "authors-2016": {
+        "imu": {"preset": "authors-2016", "rate_hz": 100.0, "position": "cm"},
+        "magnetometer": {"dip_deg": 71.9, "norm": 0.99, "noise": 7e-4, "bias": 1e-3},
+    },
 }
 """Realistic combinations of sensors (a scenario's ``sensors``): the IMU preset and the
 optional sensors (``{}``: present with their defaults). Fields a scenario sets itself
@@ -182,10 +212,13 @@ class ImuSettings(BaseModel):
 
     Attributes
     ----------
-    preset : {"ideal", "noisy", "impact"}
+    preset : {"ideal", "noisy", "impact", "authors-2016"}
         Starting values (:data:`IMU_PRESETS`); the fields below override them.
         ``"impact"``: the noisy IMU with the impact disturbance and a gyro
-        bias random walk of 1e-4 rad/s/sqrt(s).
+        bias random walk of 1e-4 rad/s/sqrt(s); ``"authors-2016"``: the
+        authors' estimator study (the noisy IMU's noise, biases of 0.1 m/s^2
+        and 0.01 rad/s, no saturation, the impact disturbance replacing the
+        nominal noise).
     rate_hz : float or None
         Sample rate, Hz; ``None``: every control tick (200 Hz). Higher rates
         sample between the ticks from the integrator's dense output.
@@ -214,7 +247,9 @@ class ImuSettings(BaseModel):
 
     model_config = MODEL_CONFIG
 
-    preset: Literal["ideal", "noisy", "impact"] = Field("ideal", description="Starting values.")
+    preset: Literal["ideal", "noisy", "impact", "authors-2016"] = Field(
+        "ideal", description="Starting values."
+    )
     rate_hz: Real | None = Field(
         None, gt=0, le=100000, description="Sample rate, Hz; None: every control tick."
     )

@@ -380,6 +380,16 @@ EstimationPart = make_dataclass(
             float,
             metric("f", "deg", "estimation: attitude error, RMS over the whole run"),
         ),
+        (
+            "est_attitude_rms_not_crash_deg",
+            float,
+            metric(
+                "f",
+                "deg",
+                "estimation: attitude error, RMS over the run but the crash (the pre and post "
+                "phases together)",
+            ),
+        ),
     ],
     bases=(Part,),
     namespace={

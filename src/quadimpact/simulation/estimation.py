@@ -12,7 +12,9 @@ PCG64 seeded with the run's seed): the added sensors draw from the stream
 standard normal numbers per IMU sample, only when one of them needs noise;
 the initial estimate's error from ``SeedSequence(seed, spawn_key=(INIT_STREAM,))``
 (twelve numbers: attitude, velocity, position, gyro bias), only when it is
-asked for.
+asked for; the initial estimate's Euler-angle errors and the magnetometer's
+static bias from ``SeedSequence(seed, spawn_key=(EXTRA_STREAM,))`` (six
+numbers), only when one of them is asked for.
 So a run's table is the same on one core or a cluster, and adding a sensor
 does not change the IMU's noise.
 """
@@ -38,6 +40,7 @@ __all__ = ["Estimation", "draw_estimation", "pack_estimation"]
 
 SENSOR_STREAM = 1
 INIT_STREAM = 2
+EXTRA_STREAM = 3
 
 
 @dataclass
@@ -61,6 +64,9 @@ class Estimation:
     initial_std: np.ndarray | None = None
     """Standard deviations of the initial estimate's error (rad, m/s, m, rad/s, 3 each),
     None when no error is asked for."""
+    extra_std: np.ndarray | None = None
+    """Standard deviations of the initial Euler-angle errors (rad, 3) and of the
+    magnetometer's static bias (3), None when neither is asked for."""
 
 
 def _stream(seed: int, key: int) -> np.random.Generator:
@@ -77,12 +83,16 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
         scfg[L.SC_IMPACT_F] = dist.accel_m_s2
         scfg[L.SC_IMPACT_W] = dist.gyro_rad_s
         scfg[L.SC_IMPACT_TAU] = dist.time_constant_s
+        scfg[L.SC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
     scfg[L.SC_BIAS_WALK] = imu.gyro_bias_walk_rad_s_sqrt_s
     mag = s.magnetometer
     if mag is not None:
         dip = math.radians(mag.dip_deg)
         scfg[L.SC_MAG] = 1.0
-        scfg[L.SC_MAG_FIELD : L.SC_MAG_FIELD + 3] = (math.cos(dip), 0.0, math.sin(dip))
+        field = (math.cos(dip), 0.0, math.sin(dip))
+        if mag.norm != 1.0:
+            field = tuple(mag.norm * c for c in field)
+        scfg[L.SC_MAG_FIELD : L.SC_MAG_FIELD + 3] = field
         scfg[L.SC_MAG_NOISE] = mag.noise
     pose = s.pose_sensor
     if pose is not None:
@@ -108,7 +118,14 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
     if ecfg.shape != (L.NECFG,):
         raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
     ecfg[L.EC_KIND] = entry.kind
+    ecfg[L.EC_OBSERVER] = 0.0 if s.estimate_in_loop else 1.0
     initial_std = None
+    extra = np.zeros(6)
+    if mag is not None:
+        extra[3:] = mag.bias
+    if isinstance(params, EstimatorParams) and entry.kind != L.EST_IDEAL:
+        extra[:3] = np.radians(params.initial_euler_error_deg)
+        ecfg[L.EC_INIT_BIAS_ZERO] = 1.0 if params.initial_bias == "zero" else 0.0
     if isinstance(params, EstimatorParams) and entry.kind != L.EST_IDEAL:
         std = np.repeat(
             [
@@ -137,11 +154,17 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
         noisy=noisy,
         entry=entry,
         initial_std=initial_std,
+        extra_std=extra if np.any(extra > 0.0) else None,
     )
 
 
-def draw_estimation(est: Estimation, seed: int, n_imu: int) -> tuple[np.ndarray, np.ndarray]:
+def draw_estimation(
+    est: Estimation, seed: int, n_imu: int, scfg: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     """A run's ``ecfg`` (with its initial estimate's error) and ``snoise``, from its seed.
+
+    ``scfg``: the run's sensor settings, which get the magnetometer's static
+    bias in place (when it has one).
 
     The added sensors draw ``(n_imu, NSN)`` standard normal numbers from the
     stream ``SENSOR_STREAM`` when one of them needs noise; the initial
@@ -160,4 +183,10 @@ def draw_estimation(est: Estimation, seed: int, n_imu: int) -> tuple[np.ndarray,
         ecfg[L.EC_INIT_VEL : L.EC_INIT_VEL + 3] = draws[3:6]
         ecfg[L.EC_INIT_POS : L.EC_INIT_POS + 3] = draws[6:9]
         ecfg[L.EC_INIT_BIAS : L.EC_INIT_BIAS + 3] = draws[9:12]
+    if est.extra_std is not None:
+        ecfg = ecfg.copy() if ecfg is est.ecfg else ecfg
+        draws = _stream(seed, EXTRA_STREAM).standard_normal(6) * est.extra_std
+        ecfg[L.EC_INIT_EULER : L.EC_INIT_EULER + 3] = draws[0:3]
+        if scfg is not None:
+            scfg[L.SC_MAG_BIAS : L.SC_MAG_BIAS + 3] = draws[3:6]
     return ecfg, snoise

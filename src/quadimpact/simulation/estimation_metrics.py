@@ -8,7 +8,9 @@ position error (``|p_hat - p|``, m), in three phases: ``pre`` (before the
 first contact with an obstacle), ``crash`` (from it to the entry into stage 4
 of the recovery controller, or to the end), ``post`` (after stage 4). This
 module turns the sums into the RMS and the maximum of each (``None`` for a
-phase without samples), and the attitude error's RMS over the whole run.
+phase without samples), the attitude error's RMS over the whole run and over
+the run but the crash (``not_crash``: the pre and post phases together, the
+authors' "not-crash" figure).
 """
 
 from __future__ import annotations
@@ -51,4 +53,9 @@ def estimation_metrics(st: np.ndarray) -> dict[str, Any]:
     sq = sum(sums[3 * p] for p in range(L.N_PHASES))
     n = sum(sums[3 * p + 2] for p in range(L.N_PHASES))
     out["est_attitude_rms_run_deg"] = math.sqrt(sq / n) if n > 0 and math.isfinite(sq) else None
+    sq = sums[0] + sums[6]  # the attitude's pre and post phases (the rest of the run)
+    n = sums[2] + sums[8]
+    out["est_attitude_rms_not_crash_deg"] = (
+        math.sqrt(sq / n) if n > 0 and math.isfinite(sq) else None
+    )
     return out

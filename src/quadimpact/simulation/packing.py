@@ -5,6 +5,7 @@ Slots are named in ``quadimpact.core.layout``. Nothing here integrates.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -342,6 +343,21 @@ def set_references(ctrl: np.ndarray, refs: Mapping[str, float]) -> None:
     ctrl[L.C_THETA_REF] = refs["pitch_rad"]
     ctrl[L.C_PSI_REF] = refs["yaw_rad"]
     ctrl[L.C_Z_REF : L.C_Z_REF + 3] = reference_z_axis(refs)
+
+
+def pack_waypoint(ctrl: np.ndarray, waypoint: Any, start_m: Any) -> None:
+    """The waypoint flight's slots of a ``C_*`` vector, in place (``waypoint``: a
+    :class:`~quadimpact.inputs.waypoint.Waypoint`; ``start_m``: the position held first)."""
+    ctrl[L.C_WAYPOINT_ON] = 1.0
+    ctrl[L.C_HOLD_POS : L.C_HOLD_POS + 3] = start_m
+    ctrl[L.C_WAYPOINT : L.C_WAYPOINT + 3] = (waypoint.x_m, waypoint.y_m, 0.0)
+    ctrl[L.C_WAYPOINT_T] = waypoint.time_s
+    ctrl[L.C_POS_GAINS : L.C_POS_GAINS + 4] = (
+        waypoint.kp_1_s,
+        waypoint.kv_1_s,
+        waypoint.v_max_m_s,
+        math.radians(waypoint.tilt_max_deg),
+    )
 
 
 def reference_z_axis(refs: Mapping[str, float]) -> np.ndarray:

@@ -48,6 +48,7 @@ from quadimpact.simulation.packing import (
     pack_sensors,
     pack_surfaces,
     pack_vehicle,
+    pack_waypoint,
     schedule_rates,
     set_references,
     trim_rotor_speeds,
@@ -233,6 +234,8 @@ def _packed_options(
     if s.power_off is not None:
         trigger = s.power_off.trigger
         opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
+    if s.end_after_recovery_s is not None:
+        opts[L.O_END_AFTER_RECOVERY] = float(s.end_after_recovery_s)
     return opts
 
 
@@ -352,7 +355,7 @@ def _for_run(
     base = shared.setup
     scfg = base.scfg.copy()
     noise = draw_imu_noise(shared.imu, s.seed, base.n_imu, scfg)
-    ecfg, snoise = draw_estimation(shared.est, s.seed, base.n_imu)
+    ecfg, snoise = draw_estimation(shared.est, s.seed, base.n_imu, scfg)
     ctrl = base.ctrl.copy()
     set_references(ctrl, refs)
     # dataclasses.replace without its checks (a plain dataclass, every field set in
@@ -401,7 +404,10 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
     }
     surfaces = [*s.surfaces, *s.obstacles, *_ground(s)]
     duration = s.final_time_s - s.start_time_s
-    return _for_run(_shared(s, v, o, surfaces, duration), s, refs, x0=x0, t0=float(s.start_time_s))
+    run = _for_run(_shared(s, v, o, surfaces, duration), s, refs, x0=x0, t0=float(s.start_time_s))
+    if s.waypoint is not None:
+        pack_waypoint(run.ctrl, s.waypoint, s.position_m)
+    return run
 
 
 # --------------------------------------------------------------- wall approach

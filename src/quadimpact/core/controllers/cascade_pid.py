@@ -41,6 +41,7 @@ from quadimpact.core.controllers.common import (
     attitude_altitude,
     linearised_torques,
 )
+from quadimpact.core.controllers.waypoint import waypoint_references
 from quadimpact.core.layout import (
     C_H_REF,
     C_OMEGA_MAX,
@@ -49,6 +50,7 @@ from quadimpact.core.layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
+    C_WAYPOINT_ON,
     MS_X,
     N_ROTORS,
     NX,
@@ -136,8 +138,12 @@ def cascade_pid_step(
     thrust = veh[V_MASS] * (veh[V_GRAVITY] + acc) * fade
     e_psi = wrap_pi(ctrl[C_PSI_REF] - yaw)
     r_des = _pid(e_psi, M_E_PSI, M_I_PSI, mem, g, G_HEADING, dt, started, integrate, True)
-    e_phi = wrap_pi(ctrl[C_PHI_REF] - roll)
-    e_theta = ctrl[C_THETA_REF] - pitch
+    phi_ref = ctrl[C_PHI_REF]
+    theta_ref = ctrl[C_THETA_REF]
+    if ctrl[C_WAYPOINT_ON] > 0.5:
+        phi_ref, theta_ref = waypoint_references(t, x, yaw, ctrl, veh[V_GRAVITY])
+    e_phi = wrap_pi(phi_ref - roll)
+    e_theta = theta_ref - pitch
     a_phi = _pid(e_phi, M_E_PHI, M_I_PHI, mem, g, G_ATT, dt, started, integrate, True)
     a_theta = _pid(e_theta, M_E_THETA, M_I_THETA, mem, g, G_ATT, dt, started, integrate, False)
     a_r = _pid(

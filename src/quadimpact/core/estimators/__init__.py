@@ -14,13 +14,18 @@ The estimator is chosen by ``ecfg[EC_KIND]`` (``EST_*``):
   before estimators existed, bit for bit;
 * ``complementary`` (``complementary.py``): a Mahony-type filter on the attitude;
 * ``ekf`` (``ekf.py``): a multiplicative error-state Kalman filter;
+* ``ekf-additive`` (``ekf_additive.py``): the authors' 7-state EKF on an
+  additive quaternion;
 * a plug-in (``EST_USER``): a compiled step bound in place of
   :func:`plugin_estimator` by ``core.run.make_kernel(estimator=...)``.
 
 The stage runs at each IMU sample, after the IMU, the magnetometer and the
 pose sensor have written their readings into the measurement record and
 before the detector (:func:`estimate_sample`); at each control tick
-:func:`at_tick` writes the latest estimate for the controller. The initial
+:func:`at_tick` writes the latest estimate for the controller. Out of the
+loop (``ecfg[EC_OBSERVER]``, an observer) the estimate is computed and
+scored all the same, but the controller and the detector read what the
+ideal estimator gives them (the true state, the gyro as measured). The initial
 estimate is the true initial state plus the seeded error of ``ecfg``,
 and the gyro's bias (:func:`init_estimate`). Rotor speeds in the state estimate are the true
 ones (the motor controllers measure them).
@@ -34,22 +39,28 @@ from numba import njit
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.estimators.complementary import complementary_sample
 from quadimpact.core.estimators.ekf import ekf_init, ekf_sample
+from quadimpact.core.estimators.ekf_additive import additive_init, additive_sample
 from quadimpact.core.estimators.estimate_errors import record_estimate
 from quadimpact.core.layout import (
     EC_INIT_ATT,
     EC_INIT_BIAS,
+    EC_INIT_BIAS_ZERO,
+    EC_INIT_EULER,
     EC_INIT_POS,
     EC_INIT_VEL,
     EC_KIND,
+    EC_OBSERVER,
     ES_BIAS,
     ES_N,
     ES_POS,
     ES_Q,
     ES_T,
+    ES_T_IMPACT,
     ES_VEL,
     ES_W,
     EST_COMPLEMENTARY,
     EST_EKF,
+    EST_EKF_ADDITIVE,
     EST_IDEAL,
     MS_BIAS_HAT,
     MS_IMU_W,
@@ -62,6 +73,7 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_VEL,
 )
+from quadimpact.core.quaternion import euler_zyx
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.sensors.measurement import measure
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
@@ -120,12 +132,35 @@ def init_estimate(m: Model, d: Data) -> None:
         est[ES_POS + r] = x[X_POS + r] + e[EC_INIT_POS + r]
         est[ES_W + r] = x[X_OMEGA + r]
     rotate_by(est[ES_Q : ES_Q + 4], e[EC_INIT_ATT], e[EC_INIT_ATT + 1], e[EC_INIT_ATT + 2])
+    if e[EC_INIT_EULER] != 0.0 or e[EC_INIT_EULER + 1] != 0.0 or e[EC_INIT_EULER + 2] != 0.0:
+        _add_euler(est[ES_Q : ES_Q + 4], e[EC_INIT_EULER : EC_INIT_EULER + 3])
     if int(e[EC_KIND]) != EST_IDEAL:
+        zero = e[EC_INIT_BIAS_ZERO] > 0.5
         for r in range(3):
-            est[ES_BIAS + r] = m.scfg[SC_BIAS + 3 + r] + e[EC_INIT_BIAS + r]
+            true_bias = 0.0 if zero else m.scfg[SC_BIAS + 3 + r]
+            est[ES_BIAS + r] = true_bias + e[EC_INIT_BIAS + r]
     est[ES_T] = np.nan
+    est[ES_T_IMPACT] = np.nan
     if int(e[EC_KIND]) == EST_EKF:
         ekf_init(m, d)
+    elif int(e[EC_KIND]) == EST_EKF_ADDITIVE:
+        additive_init(m, d)
+
+
+@compiled
+def _add_euler(q: np.ndarray, de: np.ndarray) -> None:
+    """``q`` (in place) with its ZYX Euler angles increased by ``de`` (roll, pitch, yaw; rad)."""
+    roll, pitch, yaw = euler_zyx(q)
+    hr = 0.5 * (roll + de[0])
+    hp = 0.5 * (pitch + de[1])
+    hy = 0.5 * (yaw + de[2])
+    cr, sr = math.cos(hr), math.sin(hr)
+    cp, sp = math.cos(hp), math.sin(hp)
+    cy, sy = math.cos(hy), math.sin(hy)
+    q[0] = cr * cp * cy + sr * sp * sy
+    q[1] = sr * cp * cy - cr * sp * sy
+    q[2] = cr * sp * cy + sr * cp * sy
+    q[3] = cr * cp * sy - sr * sp * cy
 
 
 @compiled
@@ -147,6 +182,8 @@ def estimate_sample(
         complementary_sample(t, dt, m, d, w.C_hat)
     elif kind == EST_EKF:
         ekf_sample(t, dt, m, d, w.C_hat)
+    elif kind == EST_EKF_ADDITIVE:
+        additive_sample(t, dt, m, d, w.C_hat)
     else:
         plugin_estimator(t, dt, d.meas, m.ecfg, est)
     if kind != EST_IDEAL:
@@ -163,10 +200,10 @@ def attitude_at_sample(
     """The estimated body-to-inertial rotation at the IMU sample ``t`` (s), 3x3.
 
     ``xs`` is the true state there and ``C`` its rotation: the ideal
-    estimator's answer. Others: the estimate after the sample
-    (:func:`estimate_sample` left it in ``w.C_hat``).
+    estimator's answer, and an observer's (out of the loop). Others: the
+    estimate after the sample (:func:`estimate_sample` left it in ``w.C_hat``).
     """
-    if int(m.ecfg[EC_KIND]) == EST_IDEAL:
+    if int(m.ecfg[EC_KIND]) == EST_IDEAL or m.ecfg[EC_OBSERVER] > 0.5:
         return C
     return w.C_hat
 
@@ -178,9 +215,10 @@ def write_estimate(t: float, x: np.ndarray, m: Model, d: Data, meas: np.ndarray)
     ``x``: the true state (quaternion renormalised), which the ideal estimator
     writes as it is; with it the estimated rates are the gyro as measured.
     Others write their estimate (velocity in body axes of the estimated
-    attitude; the true rotor speeds).
+    attitude; the true rotor speeds), unless out of the loop (an observer:
+    what the ideal estimator writes).
     """
-    if int(m.ecfg[EC_KIND]) == EST_IDEAL:
+    if int(m.ecfg[EC_KIND]) == EST_IDEAL or m.ecfg[EC_OBSERVER] > 0.5:
         measure(t, x, meas)
         for a in range(3):
             meas[MS_W_HAT + a] = meas[MS_IMU_W + a]

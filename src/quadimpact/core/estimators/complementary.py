@@ -23,6 +23,15 @@ At each IMU sample (gyro ``w``, specific force ``f``, period ``dt``):
   ``q_hat <- q_hat (x) exp(k_pos phi)`` (``phi`` the rotation from the
   estimate to the measured attitude).
 
+The authors' explicit form (``EC_CF_RAW``, Mahony's explicit complementary
+filter as their 2016 study wrote it) works on the raw, unnormalised vectors:
+``e_a = f x (-g C_pred^T e_Z)`` and ``e_m = m x (C_pred^T m_I)`` (the whole
+field, so the magnetometer corrects the inclination too, and alone while the
+accelerometer is gated), the correction ``k_p (w_a e_a + w_m e_m) / 2`` and the
+bias rate ``-k_I (w_a e_a + w_m e_m) / 2``; ``ecfg`` holds the products
+(``EC_K_ACC = k_p w_a / 2``, ``EC_K_MAG = k_p w_m / 2``,
+``EC_K_BIAS = k_I w_a / 2``, ``EC_K_BIAS_MAG = k_I w_m / 2``).
+
 The estimated rates given to the controllers are ``w - b_hat``. Gains
 (``ecfg``): ``k_acc`` (``EC_K_ACC``, default 0.25 1/s), ``k_mag`` (0.15 1/s),
 ``k_I`` (``EC_K_BIAS``, 0.25 1/s^2), the gate (1 m/s^2): the authors'
@@ -40,9 +49,11 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.layout import (
+    EC_CF_RAW,
     EC_GATE,
     EC_K_ACC,
     EC_K_BIAS,
+    EC_K_BIAS_MAG,
     EC_K_MAG,
     EC_K_POS,
     EC_K_VEL,
@@ -58,6 +69,7 @@ from quadimpact.core.layout import (
     MS_MAG_T,
     MS_POSE,
     MS_POSE_T,
+    SC_MAG_FIELD,
     SC_POSE_ATT,
     V_GRAVITY,
 )
@@ -96,7 +108,9 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
     mz = 0.0
     fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
     est[ES_GATED] = 1.0
-    if fn > 0.0 and abs(fn - g) <= ecfg[EC_GATE]:
+    if ecfg[EC_CF_RAW] > 0.5:
+        ex, ey, ez, mx, my, mz = _raw_errors(t, fn, g, C, m, d)
+    elif fn > 0.0 and abs(fn - g) <= ecfg[EC_GATE]:
         est[ES_GATED] = 0.0
         ax = f[0] / fn
         ay = f[1] / fn
@@ -107,7 +121,7 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
         ex = ay * vz - az * vy
         ey = az * vx - ax * vz
         ez = ax * vy - ay * vx
-    if meas[MS_MAG_T] == t:
+    if meas[MS_MAG_T] == t and ecfg[EC_CF_RAW] < 0.5:
         mm = meas[MS_MAG : MS_MAG + 3]
         nn = math.sqrt(mm[0] * mm[0] + mm[1] * mm[1] + mm[2] * mm[2])
         if nn > 0.0:
@@ -124,10 +138,77 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
             mx = uy * wz - uz * wy
             my = uz * wx - ux * wz
             mz = ux * wy - uy * wx
+    _correct(t, dt, (p0, p1, p2, p3), (ex, ey, ez), (mx, my, mz), m, d, C)
+
+
+@compiled
+def _raw_errors(
+    t: float, fn: float, g: float, C: np.ndarray, m: Model, d: Data
+) -> tuple[float, float, float, float, float, float]:
+    """The authors' explicit form: the errors ``e_a``, ``e_m`` on the raw vectors."""
+    ecfg = m.ecfg
+    est = d.est
+    meas = d.meas
+    f = meas[MS_IMU_F : MS_IMU_F + 3]
+    ex = 0.0
+    ey = 0.0
+    ez = 0.0
+    mx = 0.0
+    my = 0.0
+    mz = 0.0
+    if abs(fn - g) <= ecfg[EC_GATE]:
+        est[ES_GATED] = 0.0
+        vx = -g * C[2, 0]
+        vy = -g * C[2, 1]
+        vz = -g * C[2, 2]
+        ex = f[1] * vz - f[2] * vy
+        ey = f[2] * vx - f[0] * vz
+        ez = f[0] * vy - f[1] * vx
+    if meas[MS_MAG_T] == t:
+        mm = meas[MS_MAG : MS_MAG + 3]
+        mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
+        wx = C[0, 0] * mi[0] + C[1, 0] * mi[1] + C[2, 0] * mi[2]
+        wy = C[0, 1] * mi[0] + C[1, 1] * mi[1] + C[2, 1] * mi[2]
+        wz = C[0, 2] * mi[0] + C[1, 2] * mi[1] + C[2, 2] * mi[2]
+        mx = mm[1] * wz - mm[2] * wy
+        my = mm[2] * wx - mm[0] * wz
+        mz = mm[0] * wy - mm[1] * wx
+    return ex, ey, ez, mx, my, mz
+
+
+@compiled
+def _correct(
+    t: float,
+    dt: float,
+    prior: tuple[float, float, float, float],
+    e_a: tuple[float, float, float],
+    e_m: tuple[float, float, float],
+    m: Model,
+    d: Data,
+    C: np.ndarray,
+) -> None:
+    """The bias and attitude updates from the ``prior`` attitude with the errors ``e_a``
+    (accelerometer) and ``e_m`` (magnetometer); then navigation and the pose sensor."""
+    ecfg = m.ecfg
+    est = d.est
+    meas = d.meas
+    g = m.veh[V_GRAVITY]
+    q = est[ES_Q : ES_Q + 4]
+    w = meas[MS_IMU_W : MS_IMU_W + 3]
+    f = meas[MS_IMU_F : MS_IMU_F + 3]
+    p0, p1, p2, p3 = prior
+    ex, ey, ez = e_a
+    mx, my, mz = e_m
     k_i = ecfg[EC_K_BIAS]
-    est[ES_BIAS] -= k_i * (ex + mx) * dt
-    est[ES_BIAS + 1] -= k_i * (ey + my) * dt
-    est[ES_BIAS + 2] -= k_i * (ez + mz) * dt
+    if ecfg[EC_CF_RAW] > 0.5:
+        k_im = ecfg[EC_K_BIAS_MAG]
+        est[ES_BIAS] -= (k_i * ex + k_im * mx) * dt
+        est[ES_BIAS + 1] -= (k_i * ey + k_im * my) * dt
+        est[ES_BIAS + 2] -= (k_i * ez + k_im * mz) * dt
+    else:
+        est[ES_BIAS] -= k_i * (ex + mx) * dt
+        est[ES_BIAS + 1] -= k_i * (ey + my) * dt
+        est[ES_BIAS + 2] -= k_i * (ez + mz) * dt
     ka = ecfg[EC_K_ACC]
     km = ecfg[EC_K_MAG]
     for a in range(3):

@@ -32,6 +32,19 @@ Updates, each a 3-row Kalman update in Joseph form followed by the injection
 * pose position, ``p_m = p``: ``H_p = I``; pose attitude, the rotation vector
   from the estimate to the measured attitude: ``H_theta = I``.
 
+The IMU's impact disturbance (when the sensors have one and ``EC_IMPACT_TAU >
+0``): from each sample whose body-horizontal specific force reaches
+``EC_IMPACT_THRESHOLD`` (an impact, by the detector's rule; each such sample
+restarts it), the gyro's noise in the prediction and the accelerometer's in the
+gravity measurement grow by the disturbance, ``g0 exp(-(t - t_i)/tau)`` and
+``a0 exp(-(t - t_i)/tau)`` (their variances added, or the larger taken when the
+disturbance replaces the nominal noise). Without it the filter believes its
+gyro through the impact and explains the disturbance's attitude increments,
+which a precise magnetometer sees, as a gyro bias; the bias error's part
+along the field, which the magnetometer cannot see, then turns the estimate
+about the field's direction, an error only the (de-weighted) accelerometer
+can remove (docs/ESTIMATION.md 8.4).
+
 The reset's second-order term (``P <- G P G^T``, ``G = I - [dtheta/2 x]``) is
 neglected. All noise figures are parameters (``ecfg``); by default they are
 the sensors' own (with floors, so an ideal IMU does not make ``P`` singular).
@@ -47,6 +60,11 @@ from quadimpact.core.layout import (
     EC_DEWEIGHT,
     EC_GATE,
     EC_GATE_MODE,
+    EC_IMPACT_F,
+    EC_IMPACT_REPLACE,
+    EC_IMPACT_TAU,
+    EC_IMPACT_THRESHOLD,
+    EC_IMPACT_W,
     EC_NAV,
     EC_P0,
     EC_SIG_ACC,
@@ -62,6 +80,7 @@ from quadimpact.core.layout import (
     ES_POS,
     ES_Q,
     ES_SCRATCH,
+    ES_T_IMPACT,
     ES_VEL,
     ES_W,
     GATE_DEWEIGHT,
@@ -164,11 +183,37 @@ def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: floa
 
 
 @compiled
+def _with_impact(sigma: float, amplitude: float, factor: float, replace: bool) -> float:
+    """A noise's standard deviation with the impact disturbance ``amplitude * factor``."""
+    extra = amplitude * factor
+    if replace:
+        return max(sigma, extra)
+    return math.sqrt(sigma * sigma + extra * extra)
+
+
+@compiled
+def impact_noise_factor(t: float, f: np.ndarray, ecfg: np.ndarray, est: np.ndarray) -> float:
+    """The IMU's impact disturbance at the sample ``t`` (s) per unit amplitude, as the
+    filter sees it: 0 unless modelled (``EC_IMPACT_TAU``) and an impact seen, else
+    ``exp(-(t - t_i)/tau)`` from the latest sample ``t_i`` whose ``|(f_x, f_y)|``
+    reached ``EC_IMPACT_THRESHOLD`` (this one included)."""
+    tau = ecfg[EC_IMPACT_TAU]
+    if not tau > 0.0:
+        return 0.0
+    if math.sqrt(f[0] * f[0] + f[1] * f[1]) >= ecfg[EC_IMPACT_THRESHOLD]:
+        est[ES_T_IMPACT] = t
+    if np.isnan(est[ES_T_IMPACT]):
+        return 0.0
+    return math.exp(-(t - est[ES_T_IMPACT]) / tau)
+
+
+@compiled
 def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.ndarray,
-                f: np.ndarray, dt: float, C: np.ndarray) -> None:  # fmt: skip
+                f: np.ndarray, dt: float, C: np.ndarray, impact: float) -> None:  # fmt: skip
     """The prediction over ``dt`` (s): the attitude and the covariance ``W[0]``.
 
-    ``C``: the estimate's rotation before; ``W[1..3]``: scratch.
+    ``C``: the estimate's rotation before; ``W[1..3]``: scratch; ``impact``: the
+    impact disturbance's factor (:func:`impact_noise_factor`).
     """
     P, T1, Phi = W[0], W[1], W[3]
     wx = w[0] - est[ES_BIAS]
@@ -199,13 +244,18 @@ def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.
             Phi[9 + i, 6 + i] = dt
     _mul(W, 3, 0, 1, n, n, n, False)
     _mul(W, 1, 3, 0, n, n, n, True)
+    replace = ecfg[EC_IMPACT_REPLACE] > 0.5
     sg = ecfg[EC_SIG_GYRO] * dt
+    if impact > 0.0:
+        sg = _with_impact(ecfg[EC_SIG_GYRO], ecfg[EC_IMPACT_W], impact, replace) * dt
     sb = ecfg[EC_SIG_WALK]
     for k in range(3):
         P[k, k] += sg * sg
         P[3 + k, 3 + k] += sb * sb * dt
     if n == N_EKF:
         sa = ecfg[EC_SIG_ACC] * dt
+        if impact > 0.0:
+            sa = _with_impact(ecfg[EC_SIG_ACC], ecfg[EC_IMPACT_F], impact, replace) * dt
         for k in range(3):
             P[6 + k, 6 + k] += sa * sa
     rotate_by(est[ES_Q : ES_Q + 4], wx * dt, wy * dt, wz * dt)
@@ -233,8 +283,9 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     w = meas[MS_IMU_W : MS_IMU_W + 3]
     q = est[ES_Q : ES_Q + 4]
     dcm(q, C)
+    impact = impact_noise_factor(t, f, ecfg, est)
     if dt > 0.0:
-        ekf_predict(est, W, n, ecfg, w, f, dt, C)
+        ekf_predict(est, W, n, ecfg, w, f, dt, C, impact)
         dcm(q, C)
         integrate_navigation(est, C, f, g, dt)
     H = W[4]
@@ -244,6 +295,10 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     excess = abs(fn - g)
     gate = ecfg[EC_GATE]
     r = ecfg[EC_SIG_GRAV] ** 2
+    if impact > 0.0:
+        sa = ecfg[EC_SIG_ACC]
+        extra = _with_impact(sa, ecfg[EC_IMPACT_F], impact, ecfg[EC_IMPACT_REPLACE] > 0.5)
+        r += extra * extra - sa * sa
     use = excess <= gate
     if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
         use = True

@@ -14,6 +14,11 @@ several onsets are independent, so their variances add: the loop keeps
 (``ST_IMPACT_V``, ``ST_IMPACT_T``), and a sample at ``t`` has the standard
 deviations ``a0 f``, ``g0 f`` with ``f = sqrt(V) exp(-(t - T)/tau)``
 (:func:`impact_factor`).
+
+The authors' model (``SC_IMPACT_REPLACE``, the ``replace`` mode): the noise of
+the latest onset alone, ``exp(-(t - T)/tau)`` per unit amplitude (a new contact
+restarts it), and it *replaces* the nominal noise on an axis while its standard
+deviation exceeds the nominal one (``imu.py``).
 """
 
 import math
@@ -39,9 +44,15 @@ def impact_onset(t: float, scfg: np.ndarray, stats: np.ndarray) -> None:
 
 
 @compiled
-def impact_factor(t: float, tau: float, stats: np.ndarray) -> float:
-    """The disturbance's standard deviation at ``t`` (s) per unit amplitude (0: none yet)."""
+def impact_factor(t: float, tau: float, stats: np.ndarray, restart: bool) -> float:
+    """The disturbance's standard deviation at ``t`` (s) per unit amplitude (0: none yet).
+
+    ``restart``: the latest onset's alone (the ``replace`` mode), else the
+    onsets' variances summed.
+    """
     last = stats[ST_IMPACT_T]
     if np.isnan(last) or t < last:
         return 0.0
+    if restart:
+        return math.exp(-(t - last) / tau)
     return math.sqrt(stats[ST_IMPACT_V]) * math.exp(-(t - last) / tau)

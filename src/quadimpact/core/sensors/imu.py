@@ -27,7 +27,9 @@ analogue range clips before its digital filter.
 Two options add to the chain, each off unless configured: the impact
 disturbance (``disturbance.py``: extra white noise after each contact onset,
 decaying with a time constant, drawn from ``snoise[i, SN_IMPACT...]``) is
-added to the true value, and the gyro bias random walk (``SS_WALK``, its
+added to the true value (or, in the authors' ``replace`` mode, takes the
+place of the nominal noise on an axis while its standard deviation is the
+larger), and the gyro bias random walk (``SS_WALK``, its
 increments ``sigma sqrt(1/rate) snoise[i, SN_WALK...]``) to the gyro's
 constant bias. With both off the chain is the same arithmetic as without them.
 """
@@ -54,6 +56,7 @@ from quadimpact.core.layout import (
     SC_FILTER,
     SC_FILTER_PARAM,
     SC_IMPACT_F,
+    SC_IMPACT_REPLACE,
     SC_IMPACT_TAU,
     SC_IMPACT_W,
     SC_NOISE_F,
@@ -163,8 +166,9 @@ def imu_sample(
     snoise = m.snoise
     has_extra = i < snoise.shape[0]
     factor = 0.0
+    replace = scfg[SC_IMPACT_REPLACE] > 0.5
     if scfg[SC_IMPACT_TAU] > 0.0 and has_extra:
-        factor = impact_factor(t, scfg[SC_IMPACT_TAU], o.stats)
+        factor = impact_factor(t, scfg[SC_IMPACT_TAU], o.stats, replace)
     walk = scfg[SC_BIAS_WALK] > 0.0 and has_extra
     if walk and i > 0:
         step = scfg[SC_BIAS_WALK] * math.sqrt(dt)
@@ -177,7 +181,11 @@ def imu_sample(
         value = true[a]
         if factor > 0.0:
             amplitude = scfg[SC_IMPACT_F] if a < 3 else scfg[SC_IMPACT_W]
-            value += amplitude * factor * snoise[i, SN_IMPACT + a]
+            if not replace:
+                value += amplitude * factor * snoise[i, SN_IMPACT + a]
+            elif amplitude * factor > sigma:
+                sigma = amplitude * factor  # the impact noise replaces the nominal one
+                z = snoise[i, SN_IMPACT + a]
         bias = scfg[SC_BIAS + a]
         if walk and a >= 3:
             bias += sst[SS_WALK + a - 3]

@@ -1,8 +1,10 @@
 """The magnetometer: the Earth's field in body axes, sampled with the IMU.
 
-It reads ``m_B = C^T m_I + noise``, with ``m_I`` the unit Earth field in
+It reads ``m_B = C^T m_I + bias + noise``, with ``m_I`` the Earth field in
 inertial NED (``scfg[SC_MAG_FIELD]``: magnetic north along +X, dipping
-below the horizon by the dip angle, down positive) and white noise of
+below the horizon by the dip angle, down positive; unit length unless a norm
+is given), a static bias drawn once per run (``scfg[SC_MAG_BIAS]``, body
+axes) and white noise of
 standard deviation ``scfg[SC_MAG_NOISE]`` per axis (in units of the field),
 drawn from ``snoise[i, SN_MAG...]``. Without it yaw is unobservable: an
 estimator's heading drifts with the gyro bias.
@@ -18,6 +20,7 @@ from quadimpact.core.layout import (
     MS_MAG,
     MS_MAG_T,
     SC_MAG,
+    SC_MAG_BIAS,
     SC_MAG_FIELD,
     SC_MAG_NOISE,
     SN_MAG,
@@ -48,7 +51,7 @@ def magnetometer_sample(t: float, C: np.ndarray, m: Model, d: Data, o: Output) -
             C[0, a] * scfg[SC_MAG_FIELD]
             + C[1, a] * scfg[SC_MAG_FIELD + 1]
             + C[2, a] * scfg[SC_MAG_FIELD + 2]
-        )
+        ) + scfg[SC_MAG_BIAS + a]
         if noisy:
             v += sigma * m.snoise[i, SN_MAG + a]
         d.meas[MS_MAG + a] = v

@@ -28,10 +28,10 @@ DEFAULT_N = 10_000
 #: Model variants of the study (docs/VARIANTS.md).
 MODELS = ("default", "recovery-replica", "pole-replica")
 #: IMU presets (``quadimpact.inputs.sensors.IMU_PRESETS``).
-IMUS = ("ideal", "noisy", "impact")
+IMUS = ("ideal", "noisy", "impact", "authors-2016")
 #: Presets of sensors (``quadimpact.inputs.sensors.SENSOR_PRESETS``).
-SENSORS = ("ideal", "noisy", "impact", "indoor")
+SENSORS = ("ideal", "noisy", "impact", "indoor", "authors-2016")
 #: Built-in state estimators (``quadimpact.inputs.estimators``; a registered one is accepted too).
-ESTIMATORS = ("ideal", "complementary", "ekf")
+ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive")
 #: Pre-impact behaviours of the recovery controller in the study.
 PRE_IMPACTS = ("spin-down", "hold")
