@@ -22,7 +22,7 @@ Run: ``python benchmarks/bench_recovery.py [--n 10000] [--n-variants 2000]
    trials as above): the Spiri (with the Navi's slew limit), the ``noisy``
    IMU and the ``hold`` pre-impact behaviour, each in both model variants.
 3. **Friction regularisation check**: the contact law regularises Coulomb
-   friction with ``v_reg`` (``quadimpact.simulation.packing.FRICTION_V_REG_M_S``,
+   friction with ``v_reg`` (``quadimpact.packing.constants.FRICTION_V_REG_M_S``,
    kernel slot ``O_V_REG``). The first ``--n-friction`` trials (default
    1,000) are run with v_reg = 1e-2 (the default), 3e-3, 1e-3 and 1e-4 m/s
    in both variants (the packed option changed on the prepared run:
@@ -153,7 +153,7 @@ def friction_check(n: int, workers: int) -> dict[str, Any]:
     import numpy as np
     import pandas as pd
 
-    from quadimpact.simulation.packing import FRICTION_V_REG_M_S
+    from quadimpact.packing.constants import FRICTION_V_REG_M_S
     from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 
     assert FRICTION_V_REG_M_S == V_REGS[0], "the default v_reg is the first of V_REGS"

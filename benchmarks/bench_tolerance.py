@@ -12,7 +12,7 @@ model variants and rtol = 1e-5 ... 1e-11 with atol = rtol / 100 it prints
   ``--repeat`` calls of ``core.run.execute`` on the prepared setup).
 
 The tolerances apply to the approach shooting runs as well as the main run.
-The row of the current defaults (``quadimpact.simulation.packing.DEFAULT_RTOL`` /
+The row of the current defaults (``quadimpact.packing.constants.DEFAULT_RTOL`` /
 ``DEFAULT_ATOL``) is marked with ``*``; if the defaults are not on the grid
 they get a row of their own.
 """
@@ -29,7 +29,7 @@ from pathlib import Path
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core.kernel import execute
-from quadimpact.simulation.packing import DEFAULT_ATOL, DEFAULT_RTOL
+from quadimpact.packing.constants import DEFAULT_ATOL, DEFAULT_RTOL
 from quadimpact.simulation.setup import prepare
 
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}

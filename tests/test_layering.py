@@ -40,6 +40,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
         ),
     ),
     ("inputs", ("quadimpact.inputs",)),
+    ("packing", ("quadimpact.packing",)),
     ("results", ("quadimpact.results",)),
     ("simulation", ("quadimpact.simulation",)),
     ("sweep, viz, envs", ("quadimpact.sweep", "quadimpact.viz", "quadimpact.envs")),

@@ -19,8 +19,9 @@ from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
 from quadimpact.inputs.world import Plane
+from quadimpact.packing.vehicle import pack_features
+from quadimpact.packing.world import pack_surfaces
 from quadimpact.rotations import quat_to_matrix
-from quadimpact.simulation.packing import pack_features, pack_surfaces
 
 STATE_COLS = [
     "x_m", "y_m", "z_m", "u_m_s", "v_m_s", "w_m_s", "q0", "q1", "q2", "q3",

@@ -15,8 +15,9 @@ from quadimpact.experiments.crashes import (
     scenario_file,
 )
 from quadimpact.inputs.model import resolve_model_options
+from quadimpact.packing.constants import RPM
+from quadimpact.packing.vehicle import pack_vehicle
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
-from quadimpact.simulation.packing import RPM, pack_vehicle
 
 KEYS = ("crash_rule", "cut_step_motors", "bumper_force_scale")
 

@@ -39,8 +39,8 @@ from quadimpact.inputs.controllers import (
     unregister_controller,
 )
 from quadimpact.inputs.scenarios import scenario_from_dict
-from quadimpact.simulation.packing import trim_rotor_speeds
 from quadimpact.simulation.setup import prepare
+from quadimpact.simulation.trim import trim_rotor_speeds
 from quadimpact.sweep import run_sweep
 
 pytestmark = pytest.mark.slow  # one plug-in kernel compiled for the module (~15 s)

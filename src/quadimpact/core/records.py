@@ -28,7 +28,7 @@ records stacked along a first axis (the learning environments' batches).
 
 Adding a per-run array is one field here (and in its factory and row
 function, all in this file), the stage that uses it, and its packing in
-``simulation/packing.py``.
+``packing/``.
 """
 
 from __future__ import annotations

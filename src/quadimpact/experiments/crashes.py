@@ -195,7 +195,7 @@ def crash_run_changes(number: int, base: WallApproach, switches: Iterable[str]) 
     contact (a zero rate in its first segment: crashes 2-7); crash 1's motor 2
     runs, except with :data:`HAND_MODIFICATION`.
     """
-    from quadimpact.simulation.packing import RPM
+    from quadimpact.packing.constants import RPM
 
     switches = set(switches)
     unknown = switches - set(REPLICA_CRASH_SWITCHES) - {HAND_MODIFICATION}

@@ -188,8 +188,10 @@ class ControllerEntry:
         ``ctrl[C_KIND]``: a built-in ``CTRL_*`` id, or ``CTRL_USER`` for a plug-in.
     params : type of pydantic.BaseModel
         Its parameters (``[controller_params]``), with defaults.
-    pack : callable
-        ``pack(params, context) -> ndarray (NPARAM,)``: the parameter block.
+    pack : callable or None
+        ``pack(params, context) -> ndarray (NPARAM,)``: the parameter block;
+        ``None``: a built-in's packer (``quadimpact.packing.controller``), or
+        for a plug-in the default packing (the fields in order, :func:`param_slots`).
     step : callable or None
         The compiled step of a plug-in (``None`` for built-ins).
     description : str
@@ -199,7 +201,7 @@ class ControllerEntry:
     name: str
     kind: int
     params: type[BaseModel]
-    pack: Callable[[BaseModel, PackContext], np.ndarray]
+    pack: Callable[[BaseModel, PackContext], np.ndarray] | None
     step: Callable | None = None
     description: str = ""
     kernel_cache: dict = field(default_factory=dict, compare=False, repr=False)
@@ -249,63 +251,14 @@ def param_index(params: type[BaseModel], name: str) -> int:
     return param_slots(params)[name][0]
 
 
-def _pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
-    """The default packing: the model's fields in order (:func:`param_slots`)."""
-    block = np.zeros(L.NPARAM)
-    for name, (offset, width) in param_slots(type(params)).items():
-        value = getattr(params, name)
-        block[offset : offset + width] = np.asarray(value, dtype=float).reshape(width)
-    return block
-
-
-def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
-    block = np.zeros(L.NPARAM)
-    block[CL.P_GAINS : CL.P_GAINS + 15] = params.gains()
-    block[CL.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
-    return block
-
-
-_PRE_IMPACT = {
+PRE_IMPACT_KINDS = {
     "nominal": CL.PRE_NOMINAL,
     "hold": CL.PRE_HOLD,
     "spin-down": CL.PRE_SPIN_DOWN,
     "immediate": CL.PRE_IMMEDIATE,
 }
-PRE_IMPACT_CHOICES: tuple[str, ...] = tuple(_PRE_IMPACT)
+PRE_IMPACT_CHOICES: tuple[str, ...] = tuple(PRE_IMPACT_KINDS)
 """The recovery controller's pre-impact behaviours."""
-
-
-def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
-    nominal = controller_entry(ctx.nominal_controller)
-    block = _pack_pid(nominal.params(), ctx)
-    p: RecoveryParams = params  # type: ignore[assignment]
-    block[CL.R_NOMINAL_KIND] = nominal.kind
-    block[CL.R_PRE_IMPACT] = _PRE_IMPACT[ctx.pre_impact]
-    block[CL.R_K_ATT] = p.k_att_1_s
-    block[CL.R_K_RATE : CL.R_K_RATE + 3] = p.k_rate_1_s
-    block[CL.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
-    block[CL.R_K_Z : CL.R_K_Z + 4] = p.k_z_1_s
-    block[CL.R_Q_TOL] = p.tilt_error_tol
-    block[CL.R_RATE_TOL] = p.rate_tol_rad_s
-    block[CL.R_W_TOL] = p.w_tol_m_s
-    block[CL.R_LEVEL_TEST] = CL.LEVEL_EULER if p.level_test == "euler" else CL.LEVEL_TILT_ERROR
-    block[CL.R_EULER_TOL] = p.euler_tol_rad
-    level = ctx.options.detection_tick_reference == "level"
-    block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
-    block[CL.R_HOVER] = 1.0 if p.hover else 0.0
-    a_max = 0.5 * ctx.vehicle.gravity_m_s2 if p.hover_a_max_m_s2 is None else p.hover_a_max_m_s2
-    block[CL.R_HOVER_GAINS : CL.R_HOVER_GAINS + 5] = (
-        p.hover_kp_1_s,
-        p.hover_kv_1_s,
-        p.hover_v_max_m_s,
-        a_max,
-        p.hover_k_yaw_1_s,
-    )
-    block[CL.R_HOVER_MODE] = CL.HOLD_STOP if p.hover_hold == "stop" else CL.HOLD_ENTRY
-    if p.hover_set_point_m is not None:
-        block[CL.R_HOVER_MODE] = CL.HOLD_GIVEN
-        block[CL.R_HOVER_SET : CL.R_HOVER_SET + 3] = p.hover_set_point_m
-    return block
 
 
 _REGISTRY: Registry[ControllerEntry] = Registry(
@@ -314,7 +267,7 @@ _REGISTRY: Registry[ControllerEntry] = Registry(
     entry_type=ControllerEntry,
     user_kind=L.CTRL_USER,
     no_params=_NoParams,
-    empty_pack=_pack_fields,
+    empty_pack=None,
 )
 
 
@@ -354,7 +307,7 @@ def register_controller(
     -------
     ControllerEntry
     """
-    if pack is None and params is not None:
+    if pack is None and params is not None and kind is None:
         param_slots(params)  # the default packing can pack it (TypeError now, not at a run)
     return _REGISTRY.register(
         name, step, params=params, pack=pack, kind=kind, description=description, replace=replace
@@ -391,20 +344,17 @@ register_controller(
     "paper",
     kind=L.CTRL_PAPER,
     params=PaperParams,
-    pack=_pack_pid,
     description="the authors' discrete PID as they ran it (quirks included)",
 )
 register_controller(
     "cascade-pid",
     kind=L.CTRL_CASCADE_PID,
     params=CascadePidParams,
-    pack=_pack_pid,
     description="the same loops with running integrals, anti-windup and rotor limits",
 )
 register_controller(
     "recovery",
     kind=L.CTRL_RECOVERY,
     params=RecoveryParams,
-    pack=_pack_recovery,
     description="pre-impact behaviour, then the staged recovery law after detection",
 )

@@ -24,7 +24,6 @@ process.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -236,9 +235,10 @@ class EstimatorEntry:
         ``ecfg[EC_KIND]``: a built-in ``EST_*`` id, or ``EST_USER`` for a plug-in.
     params : type of pydantic.BaseModel
         Its parameters (``[estimator_params]``), with defaults.
-    pack : callable
+    pack : callable or None
         ``pack(params, context) -> ndarray (NECFG,)``: its settings (the kind and
-        the initial error are filled in by the caller).
+        the initial error are filled in by the caller); ``None`` for a built-in,
+        whose packer is in ``quadimpact.packing.estimation``.
     step : callable or None
         The compiled step of a plug-in (``None`` for built-ins).
     description : str
@@ -248,7 +248,7 @@ class EstimatorEntry:
     name: str
     kind: int
     params: type[BaseModel]
-    pack: Callable[[BaseModel, EstimatorContext], np.ndarray]
+    pack: Callable[[BaseModel, EstimatorContext], np.ndarray] | None
     step: Callable | None = None
     description: str = ""
     kernel_cache: dict = field(default_factory=dict, compare=False, repr=False)
@@ -256,85 +256,6 @@ class EstimatorEntry:
 
 def _empty(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     return np.zeros(L.NECFG)
-
-
-def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    p: ComplementaryParams = params  # type: ignore[assignment]
-    e = np.zeros(L.NECFG)
-    e[L.EC_K_ACC] = p.k_acc_1_s
-    e[L.EC_K_MAG] = p.k_mag_1_s
-    e[L.EC_K_BIAS] = p.k_bias_1_s2
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_K_POS] = p.k_pose_position
-    e[L.EC_K_VEL] = p.k_pose_velocity_1_s
-    if p.form == "raw":
-        k_p, w_a, w_m, k_i = p.raw_gains
-        e[L.EC_CF_RAW] = 1.0
-        e[L.EC_K_ACC] = 0.5 * k_p * w_a
-        e[L.EC_K_MAG] = 0.5 * k_p * w_m
-        e[L.EC_K_BIAS] = 0.5 * k_i * w_a
-        e[L.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
-    return e
-
-
-def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    p: AdditiveEkfParams = params  # type: ignore[assignment]
-    e = np.zeros(L.NECFG)
-    e[L.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
-    e[L.EC_R_ACC] = p.accel_variance
-    e[L.EC_R_MAG] = p.magnetometer_variance
-    e[L.EC_Q_QUAT] = p.quaternion_process
-    e[L.EC_Q_BIAS] = p.bias_process
-    e[L.EC_P0_QUAT] = p.initial_quaternion_variance
-    e[L.EC_P0_BIAS] = p.initial_bias_variance
-    e[L.EC_GATE] = p.gate_m_s2
-    return e
-
-
-def _or(value: float | None, default: float, floor: float) -> float:
-    return float(value) if value is not None else max(float(default), floor)
-
-
-def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    p: EkfParams = params  # type: ignore[assignment]
-    imu = ctx.imu
-    mag = ctx.magnetometer
-    pose = ctx.pose_sensor
-    e = np.zeros(L.NECFG)
-    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
-    e[L.EC_SIG_WALK] = _or(
-        p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
-    )
-    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
-    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
-    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
-    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
-    e[L.EC_SIG_POS] = _or(
-        p.pose_position_noise_m, pose.position_noise_m if pose else 0.0, POSITION_NOISE_FLOOR
-    )
-    att = p.pose_attitude_noise_deg
-    e[L.EC_SIG_ATT] = math.radians(
-        _or(att, pose.attitude_noise_deg if pose else 0.0, ATTITUDE_NOISE_FLOOR_DEG)
-    )
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
-    e[L.EC_DEWEIGHT] = p.deweight
-    e[L.EC_P0] = math.radians(
-        _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
-    )
-    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
-    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
-    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
-    e[L.EC_NAV] = 1.0 if pose is not None else 0.0
-    dist = imu.impact_disturbance
-    if p.impact_noise == "sensor" and dist is not None:
-        e[L.EC_IMPACT_W] = dist.gyro_rad_s
-        e[L.EC_IMPACT_F] = dist.accel_m_s2
-        e[L.EC_IMPACT_TAU] = dist.time_constant_s
-        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
-        g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
-        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
-    return e
 
 
 BUILTIN = ("ideal", "complementary", "ekf", "ekf-additive")
@@ -417,20 +338,17 @@ register_estimator(
     "complementary",
     kind=L.EST_COMPLEMENTARY,
     params=ComplementaryParams,
-    pack=_pack_complementary,
     description="Mahony-type complementary filter with the accelerometer gate",
 )
 register_estimator(
     "ekf",
     kind=L.EST_EKF,
     params=EkfParams,
-    pack=_pack_ekf,
     description="multiplicative error-state EKF: attitude, gyro bias (+ velocity, position)",
 )
 register_estimator(
     "ekf-additive",
     kind=L.EST_EKF_ADDITIVE,
     params=AdditiveEkfParams,
-    pack=_pack_additive,
     description="the authors' 7-state EKF on an additive quaternion (their 2016 study)",
 )

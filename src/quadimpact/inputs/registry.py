@@ -57,8 +57,11 @@ class Registry(Generic[E]):
         The ``kind`` of a plug-in (its compiled step is called by the loop).
     no_params : type of pydantic.BaseModel
         The parameters of an entry registered without any.
-    empty_pack : callable
-        The packing of an entry registered without one (zeros).
+    empty_pack : callable or None
+        The packing of a plug-in registered without one (``None``: the packing
+        layer's default). A built-in (registered with its ``kind``) keeps
+        ``pack=None``: its packer lives in ``quadimpact.packing``, which the
+        input layer does not import.
     """
 
     def __init__(
@@ -69,7 +72,7 @@ class Registry(Generic[E]):
         entry_type: type[E],
         user_kind: int,
         no_params: type[BaseModel],
-        empty_pack: Callable[..., Any],
+        empty_pack: Callable[..., Any] | None,
     ) -> None:
         self.what = what
         self.builtins = tuple(builtins)
@@ -96,7 +99,7 @@ class Registry(Generic[E]):
             name=name,
             kind=self.user_kind if kind is None else int(kind),
             params=params or self.no_params,
-            pack=pack or self.empty_pack,
+            pack=pack if pack is not None or kind is not None else self.empty_pack,
             step=step,
             description=description,
         )

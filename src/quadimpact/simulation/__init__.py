@@ -1,6 +1,7 @@
 """One run, Python side: inputs to packed arrays, the compiled loop, tables and summary.
 
-* :mod:`~quadimpact.simulation.packing`: validated inputs -> the kernel's flat arrays;
+* (the blocks themselves are packed by :mod:`quadimpact.packing`, one module each);
+* :mod:`~quadimpact.simulation.trim`: the rotor speeds of a thrust without torque;
 * :mod:`~quadimpact.simulation.approach`: the wall approach's attitude and shooting;
 * :mod:`~quadimpact.simulation.setup`: :class:`RunSetup`, ``prepare(scenario)``;
 * :mod:`~quadimpact.simulation.tables`: raw kernel arrays -> episodes and time series;
@@ -12,7 +13,7 @@
   one control interval at a time from Python.
 
 Its public names are imported on first use, so that a part of it (the
-packing, the checks of a scenario) can be imported without the whole
+checks of a scenario) can be imported without the whole
 simulator: the command line checks its inputs before loading the kernel.
 """
 

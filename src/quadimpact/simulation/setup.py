@@ -33,31 +33,21 @@ from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
+from quadimpact.packing.constants import CONTROL_RATE_HZ
+from quadimpact.packing.controller import pack_controller, pack_waypoint, set_references
+from quadimpact.packing.estimation import draw_estimation, pack_estimation
+from quadimpact.packing.options import pack_run_options, pack_schedule, slew_limit_rad_s2
+from quadimpact.packing.sensors import draw_imu_noise, pack_sensors
+from quadimpact.packing.vehicle import pack_features, pack_vehicle
+from quadimpact.packing.world import pack_surfaces
 from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_imu, check_prepared, check_scenario_type
-from quadimpact.simulation.estimation import draw_estimation, pack_estimation
-from quadimpact.simulation.packing import (
-    CONTROL_RATE_HZ,
-    RPM,
-    draw_imu_noise,
-    pack_controller,
-    pack_features,
-    pack_options,
-    pack_sensors,
-    pack_surfaces,
-    pack_vehicle,
-    pack_waypoint,
-    schedule_rates,
-    set_references,
-    trim_rotor_speeds,
-)
 from quadimpact.simulation.sharing import SharedSetup, kept_shared
+from quadimpact.simulation.trim import trim_rotor_speeds
 
 __all__ = ["RunSetup", "prepare", "prepare_flight", "prepare_impact_trial", "prepare_wall_approach"]
-
-PAPER_CRASH_ALTITUDE_M = -0.3  # docs/VARIANTS.md 4.5
 
 
 @dataclass
@@ -190,69 +180,6 @@ def _initial_speeds(
     return trim_rotor_speeds(v, weight / (math.cos(roll) * math.cos(pitch)), yaw_paper)
 
 
-def _slew_limit_rad_s2(s: RunSettings, v: Vehicle) -> float | None:
-    if s.rotor_slew_limit_rad_s2 == "vehicle":
-        if v.rotor_slew_limit_rpm_per_s is None:
-            return None
-        return v.rotor_slew_limit_rpm_per_s * RPM
-    return s.rotor_slew_limit_rad_s2
-
-
-def _packed_options(
-    s: RunSettings, o: ModelOptions, v: Vehicle, duration_s: float, *, free: bool = False
-) -> np.ndarray:
-    if free:
-        crash_rule, level, stop = L.CRASH_NONE, 0.0, False
-    elif s.ground in ("contact", "none"):
-        crash_rule, level, stop = L.CRASH_NONE, 0.0, False
-    elif o.crash_rule == "paper-ticks":
-        crash_rule, level, stop = L.CRASH_PAPER_TICKS, PAPER_CRASH_ALTITUDE_M, True
-    elif o.crash_rule == "ground-ticks":
-        crash_rule, level, stop = L.CRASH_PAPER_TICKS, 0.0, True
-    else:
-        crash_rule, level, stop = L.CRASH_CM_GROUND, 0.0, True
-    limits = None
-    if s.rotor_speed_limits_rpm is not None:
-        lo, hi = s.rotor_speed_limits_rpm
-        limits = (lo * RPM, hi * RPM)
-    opts = pack_options(
-        yaw_paper=o.yaw_reaction == "paper",
-        spinup_paper=o.spinup_reaction == "paper",
-        contact_gate_m=float(o.contact_gate_m),
-        bumper1_yaw_twice=bool(o.bumper1_yaw_twice),
-        crash_rule=crash_rule,
-        crash_altitude_m=level,
-        stop_on_crash=stop,
-        first_order_rotors=s.rotor_mode == "first-order",
-        omega_limits_rad_s=limits,
-        slew_limit_rad_s2=_slew_limit_rad_s2(s, v),
-        rtol=s.rtol,
-        atol=s.atol,
-        duration_s=duration_s,
-        cut_step_motors=o.cut_step_motors,
-    )
-    if s.power_off is not None:
-        trigger = s.power_off.trigger
-        opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
-    if s.end_after_recovery_s is not None:
-        opts[L.O_END_AFTER_RECOVERY] = float(s.end_after_recovery_s)
-    return opts
-
-
-def _schedule(s: RunSettings) -> dict[str, np.ndarray]:
-    """The power-off schedule as the kernel's arrays (s; rad/s^2; stall flags)."""
-    if s.power_off is None:
-        return {}
-    stop = np.zeros(4)
-    for m in s.power_off.stopped_motors:
-        stop[m - 1] = 1.0
-    return {
-        "sched_t": np.asarray(s.power_off.segment_start_s, dtype=float),
-        "sched_rate": schedule_rates(s.power_off.rates_rpm_per_s, s.power_off.zero_rate),
-        "sched_stop": stop,
-    }
-
-
 def _ground(s: RunSettings) -> list[Plane]:
     if s.ground == "contact":
         return [GROUND]
@@ -301,7 +228,7 @@ def _shared(
         "pre_impact": context.pre_impact,
         "nominal_controller": s.nominal_controller,
         "imu": imu.model_dump(mode="json"),
-        "rotor_slew_limit_rad_s2": _slew_limit_rad_s2(s, v),
+        "rotor_slew_limit_rad_s2": slew_limit_rad_s2(s, v),
         **(est.resolved or {}),
     }
     setup = RunSetup(
@@ -311,7 +238,7 @@ def _shared(
         veh=pack_vehicle(v),
         feat=pack_features(v, s.friction_coefficient, o.bumper_force_scale),
         shapes=pack_surfaces(surfaces),
-        opts=_packed_options(s, o, v, duration_s),
+        opts=pack_run_options(s, o, v, duration_s),
         ctrl=pack_controller(entry, params, context, yaw_paper),
         feature_names=v.feature_names(),
         shape_names=tuple(x.name for x in surfaces),
@@ -329,7 +256,7 @@ def _shared(
         controller=s.controller,
         kernel=_kernel(entry, est.step),
         resolved=resolved,
-        **_schedule(s),
+        **pack_schedule(s),
     )
     setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())
     if s.controller == "recovery" and context.pre_impact == "spin-down":
@@ -430,7 +357,7 @@ def prepare_wall_approach(s: WallApproach, kernel: Kernel | None = None) -> RunS
     clock = CpuClock()
     setup.x0, setup.t0, setup.approach = solve_approach(
         run=setup.model(),
-        free_opts=_packed_options(s, o, v, float(s.impact_time_s), free=True),
+        free_opts=pack_run_options(s, o, v, float(s.impact_time_s), free=True),
         wall=setup.shapes[:1],  # the wall is the first surface
         q=euler_zyx_to_quat(roll, pitch, yaw),
         rotors=_initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper"),

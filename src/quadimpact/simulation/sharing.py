@@ -25,7 +25,7 @@ from quadimpact.inputs.estimators import estimator_entry
 if TYPE_CHECKING:
     from quadimpact.inputs.scenarios import ImpactTrial, WallApproach
     from quadimpact.inputs.sensors import ResolvedImu
-    from quadimpact.simulation.estimation import Estimation
+    from quadimpact.packing.estimation import Estimation
 
 __all__ = [
     "KEPT_LIMIT",

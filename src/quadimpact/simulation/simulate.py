@@ -15,10 +15,11 @@ from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
+from quadimpact.packing.vehicle import feature_records
+from quadimpact.packing.world import surface_records
 from quadimpact.results.costs import cpu_time
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.impacts import run_episodes
-from quadimpact.simulation.packing import feature_records, surface_records
 from quadimpact.simulation.setup import RunSetup, prepare
 from quadimpact.simulation.summary import build_summary
 from quadimpact.simulation.tables import (
@@ -113,9 +114,9 @@ def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
         (:attr:`RunSetup.resolved`); ``vehicle``: every field of the vehicle
         with its overrides applied (body FRD, SI); ``surfaces``: every contact
         surface as packed for the kernel (the ground of ``ground = "contact"``
-        included; :func:`~quadimpact.simulation.packing.surface_records`);
+        included; :func:`~quadimpact.packing.world.surface_records`);
         ``features``: the vehicle's contact features as packed
-        (:func:`~quadimpact.simulation.packing.feature_records`).
+        (:func:`~quadimpact.packing.vehicle.feature_records`).
     """
     return {
         "scenario": scenario.model_dump(mode="json") if hasattr(scenario, "model_dump") else None,

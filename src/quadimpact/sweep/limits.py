@@ -95,7 +95,7 @@ class RunLimits:
         self.outside_s = max(self.outside_s, cost.wall_s - cost.kernel_s)
 
     def _estimate(self, item: Item) -> float:
-        from quadimpact.simulation.packing import MAX_STEPS_PER_S
+        from quadimpact.packing.constants import MAX_STEPS_PER_S
 
         step = PRIOR_STEP_S if self.step_s is None else self.step_s
         return MARGIN * (MAX_STEPS_PER_S * final_time_s(item[1]) * step + self.outside_s)

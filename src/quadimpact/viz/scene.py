@@ -43,8 +43,8 @@ import pandas as pd
 from quadimpact.core import layout as L
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
+from quadimpact.packing.world import pack_surface_records, pack_surfaces
 from quadimpact.rotations import quat_to_matrix, unwrap_deg
-from quadimpact.simulation.packing import pack_surface_records, pack_surfaces
 from quadimpact.viz.camera import Camera
 
 # the vehicle and the world as drawn, each in its module; here too, with the scene
@@ -103,7 +103,7 @@ def contact_points(
     drawing : VehicleDrawing
         The vehicle.
     surf : numpy.ndarray
-        Packed surfaces (:func:`quadimpact.simulation.packing.pack_surfaces`).
+        Packed surfaces (:func:`quadimpact.packing.world.pack_surfaces`).
 
     Returns
     -------

@@ -11,7 +11,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from quadimpact.errors import InputError
-from quadimpact.simulation.packing import RPM
+from quadimpact.packing.constants import RPM
 from quadimpact.studies.recovery import recovery_analysis as analysis
 from quadimpact.studies.recovery.recovery_study import RecoveryStudy, run_study, sample_trials
 from quadimpact.studies.statistics import percent, wilson_interval

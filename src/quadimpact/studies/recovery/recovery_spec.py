@@ -16,7 +16,7 @@ from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
-from quadimpact.simulation.packing import RPM
+from quadimpact.packing.constants import RPM
 from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS
 
 if TYPE_CHECKING:

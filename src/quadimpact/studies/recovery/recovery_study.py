@@ -39,9 +39,9 @@ from typing import TYPE_CHECKING, Any
 from quadimpact import __version__
 from quadimpact.errors import InputError
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
+from quadimpact.packing.constants import CONTROL_RATE_HZ, RPM
 from quadimpact.results.costs import cost_ratio
 from quadimpact.results.files import atomic_write
-from quadimpact.simulation.packing import CONTROL_RATE_HZ, RPM
 from quadimpact.studies.recovery.recovery_spec import (  # noqa: F401  (the spec, here too)
     DISTRIBUTION,
     SLEW_DONOR,

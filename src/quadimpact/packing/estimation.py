@@ -6,7 +6,7 @@ sensor: layout ``SC_*``) and packs the estimator (``ecfg``, layout ``EC_*``);
 :func:`draw_estimation` makes a run's random part from its seed: the added
 sensors' noise (``snoise``, layout ``SN_*``) and the estimator's initial error.
 
-Random draws never touch the IMU's own (``packing.pack_sensors``: NumPy's
+Random draws never touch the IMU's own (``packing.sensors.pack_sensors``: NumPy's
 PCG64 seeded with the run's seed): the added sensors draw from the stream
 ``SeedSequence(seed, spawn_key=(SENSOR_STREAM,))``, one row of ``NSN``
 standard normal numbers per IMU sample, only when one of them needs noise;
@@ -26,9 +26,22 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from pydantic import BaseModel
 
 from quadimpact.core import layout as L
 from quadimpact.inputs.estimators import (
+    ACCEL_NOISE_FLOOR,
+    ATTITUDE_NOISE_FLOOR_DEG,
+    BIAS_STD_FLOOR,
+    GRAVITY_NOISE_FLOOR,
+    GYRO_NOISE_FLOOR,
+    INITIAL_ATTITUDE_STD_DEG,
+    MAG_NOISE_FLOOR,
+    POSITION_NOISE_FLOOR,
+    WALK_FLOOR,
+    AdditiveEkfParams,
+    ComplementaryParams,
+    EkfParams,
     EstimatorContext,
     EstimatorParams,
     estimator_entry,
@@ -36,7 +49,7 @@ from quadimpact.inputs.estimators import (
 )
 from quadimpact.inputs.sensors import ResolvedImu
 
-__all__ = ["Estimation", "draw_estimation", "pack_estimation"]
+__all__ = ["BUILTIN_PACKERS", "Estimation", "draw_estimation", "pack_estimation"]
 
 SENSOR_STREAM = 1
 INIT_STREAM = 2
@@ -67,6 +80,97 @@ class Estimation:
     extra_std: np.ndarray | None = None
     """Standard deviations of the initial Euler-angle errors (rad, 3) and of the
     magnetometer's static bias (3), None when neither is asked for."""
+
+
+def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: ComplementaryParams = params  # type: ignore[assignment]
+    e = np.zeros(L.NECFG)
+    e[L.EC_K_ACC] = p.k_acc_1_s
+    e[L.EC_K_MAG] = p.k_mag_1_s
+    e[L.EC_K_BIAS] = p.k_bias_1_s2
+    e[L.EC_GATE] = p.gate_m_s2
+    e[L.EC_K_POS] = p.k_pose_position
+    e[L.EC_K_VEL] = p.k_pose_velocity_1_s
+    if p.form == "raw":
+        k_p, w_a, w_m, k_i = p.raw_gains
+        e[L.EC_CF_RAW] = 1.0
+        e[L.EC_K_ACC] = 0.5 * k_p * w_a
+        e[L.EC_K_MAG] = 0.5 * k_p * w_m
+        e[L.EC_K_BIAS] = 0.5 * k_i * w_a
+        e[L.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
+    return e
+
+
+def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: AdditiveEkfParams = params  # type: ignore[assignment]
+    e = np.zeros(L.NECFG)
+    e[L.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
+    e[L.EC_R_ACC] = p.accel_variance
+    e[L.EC_R_MAG] = p.magnetometer_variance
+    e[L.EC_Q_QUAT] = p.quaternion_process
+    e[L.EC_Q_BIAS] = p.bias_process
+    e[L.EC_P0_QUAT] = p.initial_quaternion_variance
+    e[L.EC_P0_BIAS] = p.initial_bias_variance
+    e[L.EC_GATE] = p.gate_m_s2
+    return e
+
+
+def _or(value: float | None, default: float, floor: float) -> float:
+    return float(value) if value is not None else max(float(default), floor)
+
+
+def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: EkfParams = params  # type: ignore[assignment]
+    imu = ctx.imu
+    mag = ctx.magnetometer
+    pose = ctx.pose_sensor
+    e = np.zeros(L.NECFG)
+    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
+    e[L.EC_SIG_WALK] = _or(
+        p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
+    )
+    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
+    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
+    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
+    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
+    e[L.EC_SIG_POS] = _or(
+        p.pose_position_noise_m, pose.position_noise_m if pose else 0.0, POSITION_NOISE_FLOOR
+    )
+    att = p.pose_attitude_noise_deg
+    e[L.EC_SIG_ATT] = math.radians(
+        _or(att, pose.attitude_noise_deg if pose else 0.0, ATTITUDE_NOISE_FLOOR_DEG)
+    )
+    e[L.EC_GATE] = p.gate_m_s2
+    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
+    e[L.EC_DEWEIGHT] = p.deweight
+    e[L.EC_P0] = math.radians(
+        _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
+    )
+    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
+    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
+    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
+    e[L.EC_NAV] = 1.0 if pose is not None else 0.0
+    dist = imu.impact_disturbance
+    if p.impact_noise == "sensor" and dist is not None:
+        e[L.EC_IMPACT_W] = dist.gyro_rad_s
+        e[L.EC_IMPACT_F] = dist.accel_m_s2
+        e[L.EC_IMPACT_TAU] = dist.time_constant_s
+        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
+        g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
+        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
+    return e
+
+
+def _zeros(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    return np.zeros(L.NECFG)
+
+
+#: The built-in estimators' packers, by kind (a plug-in's is its registry entry's).
+BUILTIN_PACKERS = {
+    L.EST_COMPLEMENTARY: _pack_complementary,
+    L.EST_EKF: _pack_ekf,
+    L.EST_EKF_ADDITIVE: _pack_additive,
+}
 
 
 def _stream(seed: int, key: int) -> np.random.Generator:
@@ -114,7 +218,8 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
     entry = estimator_entry(s.estimator)
     params = s.resolved_estimator_params()
     context = EstimatorContext(imu=imu, magnetometer=mag, pose_sensor=pose, vehicle=vehicle)
-    ecfg = np.array(entry.pack(params, context), dtype=float)
+    pack = entry.pack if entry.pack is not None else BUILTIN_PACKERS.get(entry.kind, _zeros)
+    ecfg = np.array(pack(params, context), dtype=float)
     if ecfg.shape != (L.NECFG,):
         raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
     ecfg[L.EC_KIND] = entry.kind

@@ -1,0 +1,159 @@
+"""The controller's block: ``ctrl`` (``C_*``: the kind, the references, the inverse
+allocation, the rotor range, the controller's own parameters; a waypoint flight's slots)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel
+
+from quadimpact.core import controller_layout as CL
+from quadimpact.core import layout as L
+from quadimpact.inputs.controllers import (
+    PRE_IMPACT_KINDS,
+    ControllerEntry,
+    PackContext,
+    RecoveryParams,
+    controller_entry,
+    param_slots,
+)
+from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.linalg import inverse
+from quadimpact.packing.constants import RPM
+from quadimpact.packing.vehicle import allocation_matrix, vehicle_memo
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
+
+__all__ = [
+    "BUILTIN_PACKERS",
+    "pack_controller",
+    "pack_fields",
+    "pack_waypoint",
+    "reference_z_axis",
+    "set_references",
+]
+
+
+def pack_controller(
+    entry: ControllerEntry,
+    params: object,
+    context: PackContext,
+    yaw_paper: bool,
+) -> np.ndarray:
+    """Controller settings as the ``C_*`` vector, references 0 (a run's: :func:`set_references`).
+
+    The common head (kind, inverse allocation, the vehicle's rotor range)
+    and the controller's parameter block (its registry entry's packer).
+    """
+    v: Vehicle = context.vehicle
+    ctrl = np.zeros(L.NCTRL)
+    ctrl[L.C_KIND] = entry.kind
+    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = vehicle_memo(
+        f"alloc-inv-{yaw_paper}", v, lambda: inverse(allocation_matrix(v, yaw_paper)).ravel()
+    )
+    lo, hi = v.rotor_speed_range_rpm
+    ctrl[L.C_OMEGA_MIN] = lo * RPM
+    ctrl[L.C_OMEGA_MAX] = hi * RPM
+    pack = entry.pack or BUILTIN_PACKERS.get(entry.kind, pack_fields)
+    block = np.asarray(pack(params, context), dtype=float)
+    if block.shape != (L.NPARAM,):
+        raise ValueError(f"controller {entry.name!r}: its packer must return {L.NPARAM} numbers")
+    ctrl[L.C_PARAMS : L.C_PARAMS + L.NPARAM] = block
+    return ctrl
+
+
+def set_references(ctrl: np.ndarray, refs: Mapping[str, float]) -> None:
+    """Write the references into a ``C_*`` vector, in place (m and rad).
+
+    ``refs`` holds ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``;
+    the only slots of the controller's vector that depend on them (with the
+    reference's body z axis, :func:`reference_z_axis`).
+    """
+    ctrl[L.C_H_REF] = refs["altitude_m"]
+    ctrl[L.C_PHI_REF] = refs["roll_rad"]
+    ctrl[L.C_THETA_REF] = refs["pitch_rad"]
+    ctrl[L.C_PSI_REF] = refs["yaw_rad"]
+    ctrl[L.C_Z_REF : L.C_Z_REF + 3] = reference_z_axis(refs)
+
+
+def pack_waypoint(ctrl: np.ndarray, waypoint: Any, start_m: Any) -> None:
+    """The waypoint flight's slots of a ``C_*`` vector, in place (``waypoint``: a
+    :class:`~quadimpact.inputs.waypoint.Waypoint`; ``start_m``: the position held first)."""
+    ctrl[L.C_WAYPOINT_ON] = 1.0
+    ctrl[L.C_HOLD_POS : L.C_HOLD_POS + 3] = start_m
+    ctrl[L.C_WAYPOINT : L.C_WAYPOINT + 3] = (waypoint.x_m, waypoint.y_m, 0.0)
+    ctrl[L.C_WAYPOINT_T] = waypoint.time_s
+    ctrl[L.C_POS_GAINS : L.C_POS_GAINS + 4] = (
+        waypoint.kp_1_s,
+        waypoint.kv_1_s,
+        waypoint.v_max_m_s,
+        math.radians(waypoint.tilt_max_deg),
+    )
+
+
+def reference_z_axis(refs: Mapping[str, float]) -> np.ndarray:
+    """The reference attitude's body z axis in inertial axes (NED, unit): the third column
+    of ``C`` of the ZYX attitude (``roll_rad``, ``pitch_rad``, ``yaw_rad``), from which the
+    summary's tilt is measured."""
+    q = euler_zyx_to_quat(refs["roll_rad"], refs["pitch_rad"], refs["yaw_rad"])
+    return quat_to_matrix(q)[:, 2]
+
+
+def pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    """The default packing: the model's fields in order (:func:`param_slots`)."""
+    block = np.zeros(L.NPARAM)
+    for name, (offset, width) in param_slots(type(params)).items():
+        value = getattr(params, name)
+        block[offset : offset + width] = np.asarray(value, dtype=float).reshape(width)
+    return block
+
+
+def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    block = np.zeros(L.NPARAM)
+    block[CL.P_GAINS : CL.P_GAINS + 15] = params.gains()
+    block[CL.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
+    return block
+
+
+def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
+    nominal = controller_entry(ctx.nominal_controller)
+    block = _pack_pid(nominal.params(), ctx)
+    p: RecoveryParams = params  # type: ignore[assignment]
+    block[CL.R_NOMINAL_KIND] = nominal.kind
+    block[CL.R_PRE_IMPACT] = PRE_IMPACT_KINDS[ctx.pre_impact]
+    block[CL.R_K_ATT] = p.k_att_1_s
+    block[CL.R_K_RATE : CL.R_K_RATE + 3] = p.k_rate_1_s
+    block[CL.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
+    block[CL.R_K_Z : CL.R_K_Z + 4] = p.k_z_1_s
+    block[CL.R_Q_TOL] = p.tilt_error_tol
+    block[CL.R_RATE_TOL] = p.rate_tol_rad_s
+    block[CL.R_W_TOL] = p.w_tol_m_s
+    block[CL.R_LEVEL_TEST] = CL.LEVEL_EULER if p.level_test == "euler" else CL.LEVEL_TILT_ERROR
+    block[CL.R_EULER_TOL] = p.euler_tol_rad
+    level = ctx.options.detection_tick_reference == "level"
+    block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
+    block[CL.R_HOVER] = 1.0 if p.hover else 0.0
+    a_max = 0.5 * ctx.vehicle.gravity_m_s2 if p.hover_a_max_m_s2 is None else p.hover_a_max_m_s2
+    block[CL.R_HOVER_GAINS : CL.R_HOVER_GAINS + 5] = (
+        p.hover_kp_1_s,
+        p.hover_kv_1_s,
+        p.hover_v_max_m_s,
+        a_max,
+        p.hover_k_yaw_1_s,
+    )
+    block[CL.R_HOVER_MODE] = CL.HOLD_STOP if p.hover_hold == "stop" else CL.HOLD_ENTRY
+    if p.hover_set_point_m is not None:
+        block[CL.R_HOVER_MODE] = CL.HOLD_GIVEN
+        block[CL.R_HOVER_SET : CL.R_HOVER_SET + 3] = p.hover_set_point_m
+    return block
+
+
+#: The built-in controllers' packers, by kind (a plug-in's is its registry entry's, else
+#: :func:`pack_fields`).
+BUILTIN_PACKERS = {
+    L.CTRL_PAPER: _pack_pid,
+    L.CTRL_CASCADE_PID: _pack_pid,
+    L.CTRL_RECOVERY: _pack_recovery,
+}

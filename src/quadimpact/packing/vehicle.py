@@ -1,0 +1,154 @@
+"""The vehicle's blocks: ``veh`` (``V_*``: mass, inertia, rotors) and ``feat`` (``F_*``: its
+contact features, body frame), packed once per vehicle object; the allocation matrix."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+import numpy as np
+
+from quadimpact.core import layout as L
+from quadimpact.errors import InputError
+from quadimpact.inputs.features import ContactFeature
+from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.linalg import inverse
+
+__all__ = [
+    "FEATURE_KINDS",
+    "allocation_matrix",
+    "feature_records",
+    "pack_features",
+    "pack_vehicle",
+    "vehicle_memo",
+    "vehicle_memo_value",
+]
+
+_PACKED: dict[tuple[int, str], tuple[Vehicle, Any]] = {}
+
+_PACKED_LIMIT = 128
+
+
+def vehicle_memo(kind: str, v: Vehicle, make: Any) -> np.ndarray:
+    """A copy of ``make()`` computed once per (frozen) vehicle object and kind."""
+    return vehicle_memo_value(kind, v, make).copy()
+
+
+def vehicle_memo_value(kind: str, v: Vehicle, make: Any) -> Any:
+    """``make()`` computed once per (frozen) vehicle object and kind (not copied: immutable)."""
+    key = (id(v), kind)
+    hit = _PACKED.get(key)
+    if hit is None or hit[0] is not v:
+        if len(_PACKED) >= _PACKED_LIMIT:
+            _PACKED.pop(next(iter(_PACKED)))
+        hit = (v, make())  # holds v, so its id stays its own
+        _PACKED[key] = hit
+    return hit[1]
+
+
+def pack_vehicle(v: Vehicle) -> np.ndarray:
+    """Vehicle parameters as the ``V_*`` vector (SI, body frame); computed once per vehicle."""
+    return vehicle_memo("veh", v, lambda: _pack_vehicle(v))
+
+
+def _pack_vehicle(v: Vehicle) -> np.ndarray:
+    veh = np.zeros(L.NVEH)
+    inertia = v.inertia
+    veh[L.V_MASS] = v.mass_kg
+    veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
+    veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = inverse(inertia).ravel()
+    veh[L.V_ROTOR_POS : L.V_ROTOR_POS + 12] = v.rotor_positions.ravel()
+    veh[L.V_SPIN : L.V_SPIN + 4] = v.spins
+    veh[L.V_KT] = v.thrust_coefficient
+    veh[L.V_DT] = v.drag_torque_coefficient
+    veh[L.V_JR] = v.rotor_inertia_kg_m2
+    veh[L.V_GRAVITY] = v.gravity_m_s2
+    veh[L.V_TAU_M] = v.motor_time_constant_s
+    return veh
+
+
+#: Feature kinds by their names in vehicle data (``core.layout.FeatureKind``).
+FEATURE_KINDS: dict[str, int] = {
+    "ring": L.FEAT_RING,
+    "sphere": L.FEAT_SPHERE,
+    "point": L.FEAT_POINT,
+}
+
+
+def pack_features(
+    v: Vehicle, friction_coefficient: float, force_scale: Sequence[float] | None = None
+) -> np.ndarray:
+    """The vehicle's contact features as an (n, NFEAT) array (body frame, SI).
+
+    ``friction_coefficient``: the scenario's, for the features that set none.
+    ``force_scale``: a factor on each feature's normal force, in the
+    vehicle's feature order (the model switch ``bumper_force_scale``: bumpers
+    1-4 of a four-ring vehicle); None or all ones: the contact law itself.
+    """
+    feat = vehicle_memo("feat", v, lambda: _pack_features(v.contact_features()))
+    feat[np.isnan(feat[:, L.F_MU]), L.F_MU] = friction_coefficient
+    if force_scale is not None and any(f != 1.0 for f in force_scale):
+        if len(force_scale) != feat.shape[0]:
+            raise InputError(
+                f"bumper_force_scale: {len(force_scale)} factors for the {feat.shape[0]} contact "
+                "features of this vehicle"
+            )
+        feat[:, L.F_FORCE_SCALE] = force_scale
+    return feat
+
+
+def _pack_features(features: Sequence[ContactFeature]) -> np.ndarray:
+    feat = np.zeros((len(features), L.NFEAT))
+    for i, f in enumerate(features):
+        feat[i, L.F_KIND] = FEATURE_KINDS[f.kind]
+        feat[i, L.F_CENTRE : L.F_CENTRE + 3] = f.centre_m
+        feat[i, L.F_NORMAL : L.F_NORMAL + 3] = f.normal
+        feat[i, L.F_RADIUS] = f.radius_m
+        feat[i, L.F_K] = f.stiffness
+        feat[i, L.F_N] = f.exponent
+        feat[i, L.F_E] = f.restitution
+        feat[i, L.F_MU] = np.nan if f.friction_coefficient is None else f.friction_coefficient
+        feat[i, L.F_FORCE_SCALE] = 1.0
+    return feat
+
+
+def feature_records(feat: np.ndarray, names: Sequence[str]) -> list[dict[str, Any]]:
+    """The packed contact features as plain data (``scenario.json``), body FRD, SI.
+
+    Per feature: ``name``, ``kind`` (ring, sphere, point), ``centre_m``,
+    ``normal`` (rings), ``radius_m``, ``stiffness``, ``exponent``,
+    ``restitution``, ``friction_coefficient`` (the one in force).
+    """
+    kinds = {v: k for k, v in FEATURE_KINDS.items()}
+    out = []
+    for name, row in zip(names, feat, strict=True):
+        kind = kinds[int(row[L.F_KIND])]
+        rec: dict[str, Any] = {
+            "name": str(name),
+            "kind": kind,
+            "centre_m": [float(c) for c in row[L.F_CENTRE : L.F_CENTRE + 3]],
+        }
+        if kind == "ring":
+            rec["normal"] = [float(c) for c in row[L.F_NORMAL : L.F_NORMAL + 3]]
+        if kind != "point":
+            rec["radius_m"] = float(row[L.F_RADIUS])
+        rec.update(
+            stiffness=float(row[L.F_K]),
+            exponent=float(row[L.F_N]),
+            restitution=float(row[L.F_E]),
+            friction_coefficient=float(row[L.F_MU]),
+        )
+        out.append(rec)
+    return out
+
+
+def allocation_matrix(v: Vehicle, yaw_paper: bool) -> np.ndarray:
+    """``A`` with ``[T, tau_x, tau_y, tau_z] = A [Omega_1^2 .. Omega_4^2]`` (docs/MODEL.md 6.1).
+
+    Rows: ``kt``, ``-kt y_j``, ``kt x_j`` and the yaw row of the rotor-torque
+    model in use: ``-s_j dt`` (physical) or ``+s_j dt`` (paper replica).
+    """
+    kt = v.thrust_coefficient
+    r = v.rotor_positions
+    yaw = v.drag_torque_coefficient * v.spins * (1.0 if yaw_paper else -1.0)
+    return np.vstack([np.full(4, kt), -kt * r[:, 1], kt * r[:, 0], yaw])

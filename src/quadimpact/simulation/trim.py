@@ -1,0 +1,20 @@
+"""Trimmed rotor speeds: the ones that give a thrust and no torque (the resolve step)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.linalg import lu_factor, lu_solve
+from quadimpact.packing.vehicle import allocation_matrix, vehicle_memo_value
+
+__all__ = ["trim_rotor_speeds"]
+
+
+def trim_rotor_speeds(v: Vehicle, thrust_n: float, yaw_paper: bool) -> np.ndarray:
+    """Rotor speeds (rad/s) giving total thrust ``thrust_n`` (N) and zero torques."""
+    lu = vehicle_memo_value(
+        f"alloc-lu-{yaw_paper}", v, lambda: lu_factor(allocation_matrix(v, yaw_paper))
+    )
+    w2 = lu_solve(lu, [thrust_n, 0.0, 0.0, 0.0])  # = solve(A, b), A eliminated once per vehicle
+    return np.sqrt(np.maximum(w2, 0.0))  # np.clip's bits (the -0.0 and NaN cases too), faster
