@@ -163,25 +163,14 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
         notes.append("no motion capture of the impact (or no wall plane): contacts not observable")
         return LogResponse("unknown", crashed=crashed_motors, notes=tuple(notes))
     t = pose["t_s"].to_numpy()
-    post = t >= t0 - 0.02
-    if not post.any():
-        notes.append("motion capture ends before the impact")
+    tracked = _tracked_after_impact(t, t0)
+    if isinstance(tracked, str):
+        notes.append(tracked)
         return LogResponse("unknown", crashed=crashed_motors, notes=tuple(notes))
-    idx = np.flatnonzero(post)
+    idx, observed_to_end = tracked
     tp = t[idx]
-    gaps = np.flatnonzero(np.diff(tp) > MOCAP_GAP_S)
-    end = int(gaps[0]) + 1 if gaps.size else len(idx)
-    if tp[0] > t0 + MOCAP_GAP_S:
-        notes.append(f"motion capture resumes only {tp[0] - t0:.3f} s after the impact")
-        return LogResponse("unknown", crashed=crashed_motors, notes=tuple(notes))
-    idx, tp = idx[:end], tp[:end]
     tracked_until = float(tp[-1])
-    q = pose[["q0", "q1", "q2", "q3"]].to_numpy()[idx]
-    C = quat_to_matrix(q)
-    reach = bumper_rim_extent(C, np.array([1.0, 0.0, 0.0]))
-    rim = pose["x_m"].to_numpy()[idx][:, None] + reach  # (n, 4)
-    touching = rim >= wall - contact_tol_m
-    separated = (rim < wall - SEPARATION_M).all(axis=1)
+    touching, separated = _rims_at_wall(pose, idx, wall, contact_tol_m)
     impacts = _rim_impacts(touching, separated)
     if not impacts:
         pi = log.pre_impact()
@@ -193,7 +182,6 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
     subsequent = tuple(tuple(i) for i in impacts[1:])
     landing = _landing(pose["altitude_m"].to_numpy()[idx], tp, crashed_motors)
     crashed: bool | None = True if landing is not None else None
-    observed_to_end = end == len(np.flatnonzero(post)) and tracked_until >= t[-1] - 1e-9
     if landing is None:
         if crashed_motors:
             notes.append(f"motion capture lost at {tracked_until - t0:+.3f} s after the "
@@ -222,6 +210,35 @@ def log_response(log: FlightLog, *, contact_tol_m: float = CONTACT_TOL_M) -> Log
     return LogResponse(kind, crashed=crashed, landing_time_s=landing, leading_bumpers=leading,
                        subsequent_impacts=subsequent, tracked_until_s=tracked_until,
                        notes=tuple(notes))  # fmt: skip
+
+
+def _tracked_after_impact(t: np.ndarray, t0: float) -> tuple[np.ndarray, bool] | str:
+    """The motion-capture samples (indices into the times ``t``, s) tracked without a gap
+    over :data:`MOCAP_GAP_S` from the impact ``t0`` (s; from 20 ms before it), and whether
+    they reach the log's end; or, where the tracking does not cover the impact, why not."""
+    post = t >= t0 - 0.02
+    if not post.any():
+        return "motion capture ends before the impact"
+    idx = np.flatnonzero(post)
+    tp = t[idx]
+    gaps = np.flatnonzero(np.diff(tp) > MOCAP_GAP_S)
+    end = int(gaps[0]) + 1 if gaps.size else len(idx)
+    if tp[0] > t0 + MOCAP_GAP_S:
+        return f"motion capture resumes only {tp[0] - t0:.3f} s after the impact"
+    return idx[:end], end == len(idx) and float(tp[end - 1]) >= t[-1] - 1e-9
+
+
+def _rims_at_wall(
+    pose: pd.DataFrame, idx: np.ndarray, wall: float, contact_tol_m: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """At the pose samples ``idx``: which bumper rims touch the wall plane ``X = wall``
+    (m; within ``contact_tol_m``), (n, 4), and whether every rim is separated from it
+    (farther than :data:`SEPARATION_M`), (n,)."""
+    q = pose[["q0", "q1", "q2", "q3"]].to_numpy()[idx]
+    C = quat_to_matrix(q)
+    reach = bumper_rim_extent(C, np.array([1.0, 0.0, 0.0]))
+    rim = pose["x_m"].to_numpy()[idx][:, None] + reach  # (n, 4)
+    return rim >= wall - contact_tol_m, (rim < wall - SEPARATION_M).all(axis=1)
 
 
 def _rim_impacts(touching: np.ndarray, separated: np.ndarray) -> list[list[int]]:
@@ -474,23 +491,8 @@ def compare(
 
     sim = _sim_on_tau(ts, t_impact_sim)
     quats = ["q0", "q1", "q2", "q3"]
-    pose = log.pose().copy()
-    pose.insert(0, "tau_s", pose["t_s"].to_numpy(dtype=float) - t_log0)
+    pose = _log_pose_on_tau(log, t_log0, sim, notes)
     have_quats = all(c in sim for c in quats) and all(c in pose for c in quats)
-    if "yaw_deg" in sim and "yaw_deg" in pose and len(pose):
-        y_sim0 = float(np.interp(0.0, sim["tau_s"], sim["yaw_deg"]))
-        k0 = int(np.argmin(np.abs(pose["tau_s"].to_numpy())))
-        dyaw = float(wrap_angle_deg(np.array(y_sim0 - pose["yaw_deg"].iloc[k0])))
-        if abs(dyaw) > 90.0:
-            notes.append(
-                f"headings at the impact differ by {dyaw:.0f} deg: the log approaches "
-                "rear-first and the run front-first (or the reverse); read the log with "
-                "front_first=True to compare like with like"
-            )
-    for _, col, wrapped in GROUPS["attitude"][1]:
-        if wrapped and col in sim and col in pose and len(pose):
-            pose[col] = _unwrap_onto(pose["tau_s"].to_numpy(), pose[col].to_numpy(dtype=float),
-                                     float(np.interp(0.0, sim["tau_s"], sim[col])))  # fmt: skip
     motors = log.motors().copy()
     motors.insert(0, "tau_s", motors["t_s"].to_numpy(dtype=float) - t_log0)
 
@@ -525,6 +527,32 @@ def _sim_on_tau(ts: pd.DataFrame, t_impact_sim: float) -> pd.DataFrame:
         if c in ts:
             sim[c] = ts[c].to_numpy(dtype=float)
     return sim
+
+
+def _log_pose_on_tau(
+    log: FlightLog, t_log0: float, sim: pd.DataFrame, notes: list[str]
+) -> pd.DataFrame:
+    """The log's pose on the time since its impact ``t_log0`` (s, column ``tau_s``), roll
+    and yaw unwrapped onto the run's branch at the impact (``sim``: the run on its own
+    ``tau_s``); a note added to ``notes`` when the headings at the impact are more than
+    90 deg apart (one approaches rear first, the other front first)."""
+    pose = log.pose().copy()
+    pose.insert(0, "tau_s", pose["t_s"].to_numpy(dtype=float) - t_log0)
+    if "yaw_deg" in sim and "yaw_deg" in pose and len(pose):
+        y_sim0 = float(np.interp(0.0, sim["tau_s"], sim["yaw_deg"]))
+        k0 = int(np.argmin(np.abs(pose["tau_s"].to_numpy())))
+        dyaw = float(wrap_angle_deg(np.array(y_sim0 - pose["yaw_deg"].iloc[k0])))
+        if abs(dyaw) > 90.0:
+            notes.append(
+                f"headings at the impact differ by {dyaw:.0f} deg: the log approaches "
+                "rear-first and the run front-first (or the reverse); read the log with "
+                "front_first=True to compare like with like"
+            )
+    for _, col, wrapped in GROUPS["attitude"][1]:
+        if wrapped and col in sim and col in pose and len(pose):
+            pose[col] = _unwrap_onto(pose["tau_s"].to_numpy(), pose[col].to_numpy(dtype=float),
+                                     float(np.interp(0.0, sim["tau_s"], sim[col])))  # fmt: skip
+    return pose
 
 
 def _displacements_since_impact(sim: pd.DataFrame, pose: pd.DataFrame, notes: list[str]) -> None:

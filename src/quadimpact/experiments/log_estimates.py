@@ -384,6 +384,85 @@ def _unobserved_contact(
     )
 
 
+def _no_estimate(impact_s: float, method: str, notes: list[str]) -> PreImpact:
+    """Pre-impact conditions that could not be estimated: every quantity NaN, the time the
+    on-board impact ``impact_s`` (s), with the contact's ``method`` and the ``notes``."""
+    nan = math.nan
+    return PreImpact(nan, nan, nan, nan, nan, nan, nan, time_s=impact_s,
+                     method=method, notes=tuple(notes))  # fmt: skip
+
+
+def _contact_time_uncertainty(t: np.ndarray, last: int, tc: float, observed: bool) -> float:
+    """The contact time's uncertainty (s): half the local sample interval of the
+    motion-capture times ``t`` around ``last`` (the last sample before the contact ``tc``)
+    when the contact was ``observed``, else the span extrapolated past ``last``; at least
+    0.01 s where neither is known."""
+    if observed:
+        local = np.diff(t[max(last - 3, 0) : last + 2])
+        return 0.5 * float(np.median(local)) if local.size else 0.01
+    return max(tc - t[last], 0.01)
+
+
+def _velocity_at_contact(
+    t: np.ndarray, p: np.ndarray, pre: np.ndarray, tc: float, dtc: float
+) -> tuple[np.ndarray, np.ndarray, float]:
+    """Velocity (m/s) and acceleration (m/s^2) at the contact ``tc`` (NED; quadratic fits of
+    the positions ``p`` over :data:`FIT_WINDOW_S` of the samples ``pre`` before it), and the
+    approach speed's uncertainty (m/s): the fit's standard error, half the spread over
+    :data:`FIT_WINDOWS_SPREAD_S` and the acceleration times the contact time's uncertainty
+    ``dtc`` (s)."""
+
+    def fit(window: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return _velocity_fit(t[pre & (t >= tc - window)] - tc, p[pre & (t >= tc - window)])
+
+    vel, acc, var = fit(FIT_WINDOW_S)
+    spread = [fit(w)[0][0] for w in FIT_WINDOWS_SPREAD_S
+              if (pre & (t >= tc - w)).sum() >= 6]  # fmt: skip
+    sp = float(np.ptp(spread + [vel[0]]) / 2.0) if spread else 0.0
+    return vel, acc, math.sqrt(var[0] + sp**2 + (acc[0] * dtc) ** 2)
+
+
+def _wall_at_contact(
+    mc: dict[str, np.ndarray],
+    last: int,
+    tc: float,
+    speed: float,
+    contact: dict[str, Any],
+    wall_x_default: float,
+    notes: list[str],
+) -> tuple[int, float]:
+    """The leading bumper (1-based) and the wall plane's X (m, NED) at the contact ``tc``:
+    the last motion-capture sample before it (index ``last``) moved to ``tc`` at the
+    approach ``speed`` (m/s) plus the bumpers' reach when the contact was observed (a note
+    added to ``notes`` when that is over 5 cm from the set's ``wall_x_default``), the set's
+    ``wall_x_default`` when extrapolated, NaN when placed by the clock offset."""
+    t, p, C = mc["t"], mc["p"], mc["C"]
+    reach = bumper_rim_extent(C[last][None], np.array([1.0, 0.0, 0.0]))[0]
+    x_c = float(p[last, 0] + speed * (tc - t[last]))
+    lead = int(np.argmax(reach)) + 1
+    wall_x = x_c + float(reach.max()) if contact["observed"] else wall_x_default
+    if contact["method"] == "clock-offset":
+        wall_x = math.nan
+    if contact["observed"] and abs(wall_x - wall_x_default) > 0.05:
+        notes.append(
+            f"leading rim at the contact at X = {wall_x:.3f} m, "
+            f"{wall_x - wall_x_default:+.3f} m from the set's wall plane"
+        )
+    return lead, wall_x
+
+
+def _attitude_samples(
+    t: np.ndarray, C: np.ndarray, pre: np.ndarray, tc: float, last: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """The attitude samples (their times in s relative to the contact ``tc``, and ``C``
+    body -> NED) over :data:`ATTITUDE_WINDOW_S` before ``tc`` among those ``pre`` before
+    it; over the window before the last sample ``last`` if that holds fewer than 3."""
+    sa = pre & (t >= tc - ATTITUDE_WINDOW_S)
+    if sa.sum() < 3:
+        sa = pre & (t >= t[last] - ATTITUDE_WINDOW_S)
+    return t[sa] - tc, C[sa]
+
+
 def estimate_pre_impact(
     mocap: dict[str, np.ndarray] | None,
     contact: dict[str, Any],
@@ -414,57 +493,27 @@ def estimate_pre_impact(
     """
     c = contact
     notes = list(c["notes"])
-    nan = math.nan
-    mc = mocap
-    if mc is None or not math.isfinite(c["t_mocap"]):
-        return PreImpact(nan, nan, nan, nan, nan, nan, nan, time_s=impact_s,
-                         method=c["method"], notes=tuple(notes))  # fmt: skip
-    t, p, C = mc["t"], mc["p"], mc["C"]
+    if mocap is None or not math.isfinite(c["t_mocap"]):
+        return _no_estimate(impact_s, c["method"], notes)
+    t, p, C = mocap["t"], mocap["p"], mocap["C"]
     tc = float(c["t_mocap"])
     pre = t < tc
     last = int(np.flatnonzero(pre)[-1])
-    # contact-time uncertainty
-    if c["observed"]:
-        local = np.diff(t[max(last - 3, 0) : last + 2])
-        dtc = 0.5 * float(np.median(local)) if local.size else 0.01
-    else:
-        dtc = max(tc - t[last], 0.01)
-
-    def fit(window: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        return _velocity_fit(t[pre & (t >= tc - window)] - tc, p[pre & (t >= tc - window)])
-
+    dtc = _contact_time_uncertainty(t, last, tc, bool(c["observed"]))
     n_fit = int((pre & (t >= tc - FIT_WINDOW_S)).sum())
     if n_fit < 6:
         notes.append(f"only {n_fit} samples in the fit window: no estimate")
-        return PreImpact(nan, nan, nan, nan, nan, nan, nan, time_s=impact_s,
-                         method=c["method"], notes=tuple(notes))  # fmt: skip
-    vel, acc, var = fit(FIT_WINDOW_S)
-    spread = [fit(w)[0][0] for w in FIT_WINDOWS_SPREAD_S
-              if (pre & (t >= tc - w)).sum() >= 6]  # fmt: skip
-    sp = float(np.ptp(spread + [vel[0]]) / 2.0) if spread else 0.0
-    u_speed = math.sqrt(var[0] + sp**2 + (acc[0] * dtc) ** 2)
+        return _no_estimate(impact_s, c["method"], notes)
+    vel, acc, u_speed = _velocity_at_contact(t, p, pre, tc, dtc)
     speed_lookback = float(vel[0] - acc[0] * LOOKBACK_S)
     # altitude at t_c from the same fit
     s = pre & (t >= tc - FIT_WINDOW_S)
-    cz, _ = polyfit_at(t[s] - tc, p[s, 2], 2)
-    altitude = float(-cz[-1])
-
-    # attitude
-    sa = pre & (t >= tc - ATTITUDE_WINDOW_S)
-    if sa.sum() < 3:
-        sa = pre & (t >= t[last] - ATTITUDE_WINDOW_S)
-    ang, unc = _attitude_at(t[sa] - tc, C[sa], dtc)
+    altitude = float(-polyfit_at(t[s] - tc, p[s, 2], 2)[0][-1])
+    ang, unc = _attitude_at(*_attitude_samples(t, C, pre, tc, last), dtc)
     heading = float(wrap_angle_deg(ang["yaw_deg"]))
     rear = abs(heading) > 90.0
     equiv = float(wrap_angle_deg(heading - 180.0)) if rear else heading
-    # leading bumper and wall plane at the contact (the last sample before it,
-    # moved to t_c with the fitted velocity)
-    reach = bumper_rim_extent(C[last][None], np.array([1.0, 0.0, 0.0]))[0]
-    x_c = float(p[last, 0] + vel[0] * (tc - t[last]))
-    lead = int(np.argmax(reach)) + 1
-    wall_x = x_c + float(reach.max()) if c["observed"] else wall_x_default
-    if c["method"] == "clock-offset":
-        wall_x = math.nan
+    lead, wall_x = _wall_at_contact(mocap, last, tc, float(vel[0]), c, wall_x_default, notes)
     unc.update(
         speed_m_s=u_speed,
         heading_deg=unc["yaw_deg"],
@@ -472,11 +521,6 @@ def estimate_pre_impact(
         altitude_m=math.sqrt(0.005**2 + (vel[2] * dtc) ** 2),
         time_s=dtc,
     )
-    if c["observed"] and abs(wall_x - wall_x_default) > 0.05:
-        notes.append(
-            f"leading rim at the contact at X = {wall_x:.3f} m, "
-            f"{wall_x - wall_x_default:+.3f} m from the set's wall plane"
-        )
     return PreImpact(
         heading_deg=heading,
         speed_m_s=float(vel[0]),

@@ -173,13 +173,7 @@ def solve_approach(
         noise=np.zeros((0, 6)),
         t_out=np.array([float(impact_time_s)]),
     )
-    ap = np.zeros(L.NAP)
-    ap[L.AP_TC] = impact_time_s
-    ap[L.AP_VC] = speed_m_s
-    ap[L.AP_LATE_RULE] = 1.0 if late_start else 0.0
-    ap[L.AP_START : L.AP_START + 3] = start
-    ap[L.AP_Q : L.AP_Q + 4] = q
-    ap[L.AP_ROTORS : L.AP_ROTORS + L.N_ROTORS] = rotors
+    ap = _shooting_inputs(q, rotors, start, impact_time_s, speed_m_s, late_start)
     solve = (kernel or BUILTIN).approach
     args = (free, new_output(free, 0, 1), wall, pair_table(run.feat, wall), ap)
     if clock is None:
@@ -187,6 +181,29 @@ def solve_approach(
     else:
         with clock:
             solve(*args)
+    return _shooting_result(ap)
+
+
+def _shooting_inputs(
+    q: np.ndarray, rotors: np.ndarray, start: np.ndarray, tc: float, vc: float, late: bool
+) -> np.ndarray:
+    """The shooting's record (layout ``AP_*``) before the call: ``T_c`` (``tc``, s),
+    ``V_c`` (``vc``, m/s), the late-start rule (``late``), the start position before the X
+    shift (inertial NED, m), the attitude held ``q`` and the initial rotor speeds."""
+    ap = np.zeros(L.NAP)
+    ap[L.AP_TC] = tc
+    ap[L.AP_VC] = vc
+    ap[L.AP_LATE_RULE] = 1.0 if late else 0.0
+    ap[L.AP_START : L.AP_START + 3] = start
+    ap[L.AP_Q : L.AP_Q + 4] = q
+    ap[L.AP_ROTORS : L.AP_ROTORS + L.N_ROTORS] = rotors
+    return ap
+
+
+def _shooting_result(ap: np.ndarray) -> tuple[np.ndarray, float, dict[str, Any]]:
+    """What the shooting found in its record ``ap`` (layout ``AP_*``): the initial state,
+    the start time (s) and the summary's ``approach`` (:func:`solve_approach`); a failed
+    run (``RuntimeError``) or no late start reaching the speed (``ValueError``) raised."""
     status = int(ap[L.AP_STATUS])
     if status == L.APPROACH_RUN_FAILED:
         reason = L.REASON_TEXT.get(int(ap[L.AP_REASON]), "") or "no state sampled at T_c"

@@ -27,6 +27,7 @@ import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -317,34 +318,17 @@ def write_animation(
     out.mkdir(parents=True, exist_ok=True)
     fig = AnimationFigure(scene, camera or DEFAULT_ANIMATION_CAMERA, w, h, t0, t1, slow)
 
-    gif_frames = []
+    gif_frames: list[Any] | None = [] if gif else None
     gif_step = max(1, int(round(fps / gif_fps))) if gif else 0
-
-    def render(movie: Path | None) -> None:
-        """Draw every frame: into the movie (when given) and the GIF's frames."""
-        writer = None if movie is None else _movie_writer(movie, (w, h), fps)
-        sent = 0
-        try:
-            for k, t in enumerate(times):
-                pixels = fig.render_rgba(float(t))
-                if writer is not None:
-                    writer.send(pixels)  # written to ffmpeg's pipe from the canvas's memory
-                    sent += 1
-                if gif and k % gif_step == 0:
-                    gif_frames.append(_gif_frame(pixels[:, :, :3], gif_width))
-                if progress is not None:
-                    progress(k + 1, len(times))
-        finally:
-            if writer is not None:
-                _close_movie(writer, sent)
-
+    render = partial(_render_frames, fig, times, fps=fps, gif_frames=gif_frames,
+                     gif_step=gif_step, gif_width=gif_width, progress=progress)  # fmt: skip
     mp4_path = out / ANIMATION_MP4
     if mp4:
         atomic_write(mp4_path, render, suffix=".mp4")  # ffmpeg reads the format from the name
     else:
         render(None)
     gif_path = None
-    if gif:
+    if gif_frames is not None:
         gif_path = _write_gif(out / ANIMATION_GIF, gif_frames, int(round(1000.0 * gif_step / fps)))
     return AnimationInfo(
         mp4=mp4_path if mp4 else None,
@@ -354,6 +338,38 @@ def write_animation(
         size=(w, h),
         seconds=time.perf_counter() - started,
     )
+
+
+def _render_frames(
+    fig: AnimationFigure,
+    times: np.ndarray,
+    movie: Path | None,
+    *,
+    fps: float,
+    gif_frames: list[Any] | None,
+    gif_step: int,
+    gif_width: int,
+    progress: Callable[[int, int], None] | None,
+) -> None:
+    """Draw ``fig`` at each of ``times`` (simulated s): into the movie ``movie`` (H.264 at
+    ``fps`` frames per second; None: no movie) and, every ``gif_step``-th frame scaled to
+    ``gif_width`` pixels, onto ``gif_frames`` (None: no GIF); ``progress(k, n)`` after
+    each frame."""
+    writer = None if movie is None else _movie_writer(movie, (fig.width, fig.height), fps)
+    sent = 0
+    try:
+        for k, t in enumerate(times):
+            pixels = fig.render_rgba(float(t))
+            if writer is not None:
+                writer.send(pixels)  # written to ffmpeg's pipe from the canvas's memory
+                sent += 1
+            if gif_frames is not None and k % gif_step == 0:
+                gif_frames.append(_gif_frame(pixels[:, :, :3], gif_width))
+            if progress is not None:
+                progress(k + 1, len(times))
+    finally:
+        if writer is not None:
+            _close_movie(writer, sent)
 
 
 def _movie_writer(movie: Path, size: tuple[int, int], fps: float) -> Any:

@@ -81,7 +81,32 @@ def render_report(
     conditions and their switch runs (:func:`table3_markdown`).
     """
     variants = list(dict.fromkeys(findings["variant"]))
-    switches = list(dict.fromkeys(ablation["switch"])) if not ablation.empty else []
+    lines = _findings_lines(findings, elapsed_s)
+    lines += _disagreement_lines(findings, ablation)
+    lines += _figure_lines(tables, variants)
+    if table3 is not None:
+        logs = table3.attrs.get("logs")
+        lines += ["## Table III: the seven real crashes", ""]
+        lines += [f"The {logs} (docs/EXPERIMENTS.md).", ""] if logs else []
+        lines += [table3_markdown(table3, table3_runs, table3_switches), ""]
+    if recovery is not None:
+        lines += [recovery_markdown(recovery, elapsed_s), ""]
+    if pole is not None:
+        lines += [pole_markdown(pole), ""]
+    if stage_times:
+        lines += _stage_time_lines(tables, recovery, elapsed_s, stage_times)
+    if piece_times:
+        lines += ["The pieces that ran on worker processes, each with its own wall time "
+                  "(they ran side by side, so these overlap):", "",
+                  "| piece | time (s) |", "|---|---|"]  # fmt: skip
+        lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in piece_times]
+        lines.append("")
+    return "\n".join(lines) + "\n"
+
+
+def _findings_lines(findings: pd.DataFrame, elapsed_s: float) -> list[str]:
+    """The report's title, what made it (``elapsed_s``: the study's wall time, s) and the
+    findings' table: the paper's claim, each paper variant's measure and verdict, the rule."""
     lines = [
         "# The paper's study, reproduced",
         "",
@@ -102,37 +127,51 @@ def render_report(
         rule = rep.loc[key, "rule"] if "rule" in rep.columns else ""
         lines.append(f"| {key} | {rep.loc[key, 'claim']} | {_cell(rep.loc[key])} | "
                      f"{_cell(dft.loc[key])} | {_md(rule)} |")  # fmt: skip
-    lines += ["", "## Where the variants disagree", ""]
+    return lines
+
+
+def _disagreement_lines(findings: pd.DataFrame, ablation: pd.DataFrame) -> list[str]:
+    """The section "Where the variants disagree": the findings whose verdicts differ
+    between the replica and the default and, from the ``ablation`` (one row per switch and
+    finding), each one's verdict and value without each switch and the switches that
+    explain it."""
+    rep = findings[findings["variant"] == "paper-replica"].set_index("key")
+    dft = findings[findings["variant"] == "default"].set_index("key")
+    switches = list(dict.fromkeys(ablation["switch"])) if not ablation.empty else []
+    lines = ["", "## Where the variants disagree", ""]
     differ = [k for k in rep.index if rep.loc[k, "verdict"] != dft.loc[k, "verdict"]]
     if not differ:
-        lines.append("The two variants reach the same verdict on every finding.")
-    elif ablation.empty:
-        lines.append("Differing findings: " + ", ".join(differ) + " (ablation not run).")
-    else:
-        lines += [
-            "The replica was rerun with one of its differences switched to the default's at a "
-            "time. A switch *explains* a finding when removing it alone turns the replica's "
-            "verdict into the default's.",
-            "",
-            "| finding | replica | default | "
-            + " | ".join(f"without `{s}`" for s in switches)
-            + " | explained by |",
-            "|---" * (len(switches) + 4) + "|",
-        ]
-        for key in differ:
-            row = ablation[ablation["key"] == key].set_index("switch")
-            target = dft.loc[key, "verdict"]
-            causes = [s for s in switches if row.loc[s, "verdict"] == target]
-            cells = " | ".join(
-                f"{row.loc[s, 'verdict']} ({row.loc[s, 'value']:.2f})" for s in switches
-            )
-            lines.append(
-                f"| {key} | {rep.loc[key, 'verdict']} ({rep.loc[key, 'value']:.2f}) | {target} "
-                f"({dft.loc[key, 'value']:.2f}) | {cells} | "
-                + (", ".join(f"`{c}`" for c in causes) or "no single switch (a combination)")
-                + " |"
-            )
-    lines += ["", "## Figure 4", ""]
+        return [*lines, "The two variants reach the same verdict on every finding."]
+    if ablation.empty:
+        return [*lines, "Differing findings: " + ", ".join(differ) + " (ablation not run)."]
+    lines += [
+        "The replica was rerun with one of its differences switched to the default's at a "
+        "time. A switch *explains* a finding when removing it alone turns the replica's "
+        "verdict into the default's.",
+        "",
+        "| finding | replica | default | "
+        + " | ".join(f"without `{s}`" for s in switches)
+        + " | explained by |",
+        "|---" * (len(switches) + 4) + "|",
+    ]
+    for key in differ:
+        row = ablation[ablation["key"] == key].set_index("switch")
+        target = dft.loc[key, "verdict"]
+        causes = [s for s in switches if row.loc[s, "verdict"] == target]
+        cells = " | ".join(f"{row.loc[s, 'verdict']} ({row.loc[s, 'value']:.2f})" for s in switches)
+        lines.append(
+            f"| {key} | {rep.loc[key, 'verdict']} ({rep.loc[key, 'value']:.2f}) | {target} "
+            f"({dft.loc[key, 'value']:.2f}) | {cells} | "
+            + (", ".join(f"`{c}`" for c in causes) or "no single switch (a combination)")
+            + " |"
+        )
+    return lines
+
+
+def _figure_lines(tables: dict[str, pd.DataFrame], variants: list[str]) -> list[str]:
+    """Figure 4, Table II (its picture, the count of each response type and the table) and
+    Figures 5 and 6 of the example run, for each of ``variants``."""
+    lines = ["", "## Figure 4", ""]
     for v in variants:
         lines.append(f"![Figure 4, {v}](fig4_{v}.png)")
     lines += ["", "## Table II", ""]
@@ -147,33 +186,29 @@ def render_report(
                   f"![Figure 6, {v}](example-{v}/fig6.png)",
                   f"![Snapshots after impact (the paper's Figure 8 times), {v}]"
                   f"(example-{v}/snapshots.png)", ""]  # fmt: skip
-    if table3 is not None:
-        logs = table3.attrs.get("logs")
-        lines += ["## Table III: the seven real crashes", ""]
-        lines += [f"The {logs} (docs/EXPERIMENTS.md).", ""] if logs else []
-        lines += [table3_markdown(table3, table3_runs, table3_switches), ""]
-    if recovery is not None:
-        lines += [recovery_markdown(recovery, elapsed_s), ""]
-    if pole is not None:
-        lines += [pole_markdown(pole), ""]
-    if stage_times:
-        lines += ["## Time per stage", "", "Wall time of each stage of this run.", "",
-                  "| stage | time (s) |", "|---|---|"]  # fmt: skip
-        lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in stage_times]
-        lines += [f"| whole study | {elapsed_s:.1f} |", ""]
-        costs = [("the Figure 4 sweeps and the ablations", cost_ratio(pd.concat(tables.values())))]
-        if recovery is not None and getattr(recovery, "cost", None):
-            costs.append(("the recovery trials and grids", recovery.cost))
-        lines += ["CPU time of the runs (the thread that ran each), whole and in the compiled "
-                  "loop (the physics):", "",
-                  *(f"- {what}: {cost_text(c)}." for what, c in costs), ""]  # fmt: skip
-    if piece_times:
-        lines += ["The pieces that ran on worker processes, each with its own wall time "
-                  "(they ran side by side, so these overlap):", "",
-                  "| piece | time (s) |", "|---|---|"]  # fmt: skip
-        lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in piece_times]
-        lines.append("")
-    return "\n".join(lines) + "\n"
+    return lines
+
+
+def _stage_time_lines(
+    tables: dict[str, pd.DataFrame],
+    recovery: Any,
+    elapsed_s: float,
+    stage_times: list[tuple[str, float]],
+) -> list[str]:
+    """The section "Time per stage": each stage's wall time and the whole study's (s),
+    then the CPU time of the Figure 4 sweeps' runs and, with ``recovery``, of its trials
+    and grids."""
+    lines = ["## Time per stage", "", "Wall time of each stage of this run.", "",
+             "| stage | time (s) |", "|---|---|"]  # fmt: skip
+    lines += [f"| {_md(name)} | {seconds:.1f} |" for name, seconds in stage_times]
+    lines += [f"| whole study | {elapsed_s:.1f} |", ""]
+    costs = [("the Figure 4 sweeps and the ablations", cost_ratio(pd.concat(tables.values())))]
+    if recovery is not None and getattr(recovery, "cost", None):
+        costs.append(("the recovery trials and grids", recovery.cost))
+    lines += ["CPU time of the runs (the thread that ran each), whole and in the compiled "
+              "loop (the physics):", "",
+              *(f"- {what}: {cost_text(c)}." for what, c in costs), ""]  # fmt: skip
+    return lines
 
 
 # ---------------------------------------------------------------- recovery

@@ -233,6 +233,125 @@ def _paper_task(kind: str, *args: Any) -> tuple[Any, float]:
     return _variant_task(*args) if kind == "variant" else crash_task(*args)
 
 
+def _paper_pieces(
+    out: Path,
+    options: dict[str, Any],
+    ablation: bool,
+    crashes: tuple[Path, dict[int, Any]] | None,
+) -> list[tuple[str, tuple[Any, ...]]]:
+    """The pieces of the paper's part, independent of each other, as (stage name, task of
+    :func:`_paper_task`): Figure 4 and the example run in each variant, with ``ablation``
+    the replica without each of its differences, with ``crashes`` (the experiments' folder
+    and the logs by crash number) the crashes of Table III. ``options``: the pieces' own
+    sweeps' options (workers, scheduler, progress)."""
+    from quadimpact.experiments.crashes import TABLE3
+    from quadimpact.studies.table3.crash_logs import LOG_SENSITIVITY_RUNS
+    from quadimpact.studies.table3.table3_study import SENSITIVITY_RUNS
+
+    pieces: list[tuple[str, tuple[Any, ...]]] = [
+        (f"Figure 4 sweep and the example run, {v}",
+         ("variant", v, {"model": v}, out, True, options))
+        for v in VARIANTS
+    ]  # fmt: skip
+    if ablation:
+        for k, switch in enumerate(SWITCHES, 1):
+            base = {"model": "paper-replica",
+                    "model_options": {switch: MODEL_VARIANTS["default"][switch]}}  # fmt: skip
+            task = ("variant", _ablation_name(switch), base, out, False, options)
+            pieces.append((f"ablation {k} of {len(SWITCHES)}: the replica without {switch}", task))
+    if crashes is not None:
+        exp_out, logs = crashes
+        pieces += [
+            (f"Table III: crash {c.number} of {len(TABLE3)}",
+             ("crash", c, logs[c.number], exp_out, SENSITIVITY_RUNS, LOG_SENSITIVITY_RUNS, options))
+            for c in TABLE3
+        ]  # fmt: skip
+    return pieces
+
+
+def _run_pieces(
+    pieces: list[tuple[str, tuple[Any, ...]]], processes: int, clock: StageClock, what: str
+) -> list[tuple[Any, float]]:
+    """Each piece's (value, wall time in s), in the order of ``pieces``: on ``processes``
+    worker processes (the crashes, the longest, first, so that the processes end together;
+    one stage of ``clock``, its pieces timed, ``what`` saying what they are) or one after
+    the other in this process (one stage each)."""
+    from quadimpact.sweep.tasks import run_tasks
+
+    if processes <= 1:
+        results = []
+        for name, task in pieces:
+            clock.start(name)
+            results.append(_paper_task(*task))
+        return results
+    order = sorted(range(len(pieces)), key=lambda i: pieces[i][1][0] != "crash")
+    clock.start(f"the paper's runs: {len(pieces)} pieces on {min(processes, len(pieces))} "
+                f"processes ({what})", n_pieces=len(pieces))  # fmt: skip
+
+    def done(k: int, result: tuple[Any, float]) -> None:
+        clock.piece(pieces[order[k]][0], result[1])
+
+    ran = run_tasks(_paper_task, [pieces[i][1] for i in order], processes, done)
+    return [r for _, r in sorted(zip(order, ran, strict=True))]
+
+
+def _sorted_results(
+    pieces: list[tuple[str, tuple[Any, ...]]], results: list[tuple[Any, float]]
+) -> tuple[dict[str, pd.DataFrame], dict[str, list[Finding]], pd.DataFrame, list[Any]]:
+    """The pieces' values by kind: the Figure 4 tables by sweep name (variants and
+    ablations), the findings by paper variant, the ablations' findings (one row per switch
+    and finding) and the crashes' rows, in order."""
+    tables: dict[str, pd.DataFrame] = {}
+    found: dict[str, list[Finding]] = {}
+    ablation_rows, crash_rows = [], []
+    for (_, task), (value, _seconds) in zip(pieces, results, strict=True):
+        if task[0] == "crash":
+            crash_rows.append(value)
+            continue
+        name, (table, fs) = task[1], value
+        tables[name] = table
+        if task[4]:  # a variant of the paper, not an ablation
+            found[name] = fs
+        else:
+            switch = name.removeprefix(_ablation_name(""))
+            ablation_rows += [{"switch": switch, **f.__dict__} for f in fs]
+    return tables, found, pd.DataFrame(ablation_rows), crash_rows
+
+
+def _finish_table3(
+    folder: StudyFolder, crash_rows: list[Any], data_dir: str | Path | None
+) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """Table III from the crashes' rows, written into the experiments' ``folder`` (then
+    finished), the source of its logs in its ``attrs["logs"]`` (said in the report); with
+    its runs and switch runs as written (``table3_runs``, ``table3_switches``)."""
+    from quadimpact.studies.table3.crash_logs import logs_source
+    from quadimpact.studies.table3.table3_study import write_table3
+
+    table3 = write_table3(crash_rows, folder.path)
+    folder.finish({"crashes": len(crash_rows)})
+    table3.attrs["logs"] = logs_source(data_dir)
+    runs, switches = (
+        pd.read_parquet(folder.path / f"{name}.parquet")
+        for name in ("table3_runs", "table3_switches")
+    )
+    return table3, runs, switches
+
+
+def _write_paper_tables(
+    out: Path, tables: dict[str, pd.DataFrame], findings: pd.DataFrame, ablation: pd.DataFrame
+) -> None:
+    """The tables behind the report (``fig4.parquet``, ``table2.parquet``,
+    ``findings.parquet``, ``ablation.parquet``) and each paper variant's Figure 4 and
+    Table II pictures, into ``out``."""
+    pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
+    table2(tables).to_parquet(out / "table2.parquet")
+    findings.to_parquet(out / "findings.parquet")
+    ablation.to_parquet(out / "ablation.parquet")
+    for variant in VARIANTS:
+        fig4_figure(tables[variant], variant).savefig(out / f"fig4_{variant}.png", dpi=120)
+        type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
+
+
 def reproduce(
     out_dir: str | Path,
     *,
@@ -251,19 +370,9 @@ def reproduce(
     their logs when ``data_dir`` (or the default data folder) holds them.
     With ``recovery``, "Beyond the paper: recovery" (:func:`recovery_part`).
     """
-    from quadimpact.experiments.crashes import TABLE3
-    from quadimpact.studies.table3.crash_logs import (
-        LOG_SENSITIVITY_RUNS,
-        check_data_dir,
-        logs_source,
-    )
-    from quadimpact.studies.table3.table3_study import (
-        SENSITIVITY_RUNS,
-        prepare_experiments,
-        write_table3,
-    )
+    from quadimpact.studies.table3.crash_logs import check_data_dir
+    from quadimpact.studies.table3.table3_study import prepare_experiments
     from quadimpact.sweep.runner import _resolve_workers
-    from quadimpact.sweep.tasks import run_tasks
 
     start = time.perf_counter()
     clock = StageClock(progress)
@@ -276,100 +385,34 @@ def reproduce(
     processes = 1 if scheduler is not None else _resolve_workers(workers)
     here = {"workers": workers, "scheduler": scheduler, "progress": progress}
     inside = {"workers": 1, "scheduler": None, "progress": False}  # a piece's own sweeps
-    options = inside if processes > 1 else here
-    # the pieces of the paper's part, independent of each other: (stage name, task)
-    pieces: list[tuple[str, tuple[Any, ...]]] = [
-        (f"Figure 4 sweep and the example run, {v}",
-         ("variant", v, {"model": v}, out, True, options))
-        for v in VARIANTS
-    ]  # fmt: skip
-    if ablation:
-        for k, switch in enumerate(SWITCHES, 1):
-            base = {"model": "paper-replica",
-                    "model_options": {switch: MODEL_VARIANTS["default"][switch]}}  # fmt: skip
-            task = ("variant", _ablation_name(switch), base, out, False, options)
-            pieces.append((f"ablation {k} of {len(SWITCHES)}: the replica without {switch}", task))
+    exp_folder, crashes = None, None
     if experiments:
         exp_folder, logs = prepare_experiments(out / "experiments", data_dir)
-        exp_out = exp_folder.path
-        pieces += [
-            (f"Table III: crash {c.number} of {len(TABLE3)}",
-             ("crash", c, logs[c.number], exp_out, SENSITIVITY_RUNS, LOG_SENSITIVITY_RUNS, options))
-            for c in TABLE3
-        ]  # fmt: skip
-    if processes > 1:
-        # the crashes first (the longest pieces): the processes end together
-        order = sorted(range(len(pieces)), key=lambda i: pieces[i][1][0] != "crash")
-        clock.start(f"the paper's runs: {len(pieces)} pieces on {min(processes, len(pieces))} "
-                    "processes (Figure 4 and the example in both variants"
-                    + (", the ablations" if ablation else "")
-                    + (", the crashes of Table III" if experiments else "") + ")",
-                    n_pieces=len(pieces))  # fmt: skip
-
-        def done(k: int, result: tuple[Any, float]) -> None:
-            clock.piece(pieces[order[k]][0], result[1])
-
-        ran = run_tasks(_paper_task, [pieces[i][1] for i in order], processes, done)
-        results = [r for _, r in sorted(zip(order, ran, strict=True))]
-    else:
-        results = []
-        for name, task in pieces:
-            clock.start(name)
-            results.append(_paper_task(*task))
-    tables: dict[str, pd.DataFrame] = {}
-    found: dict[str, list[Finding]] = {}
-    ablation_rows, crash_rows = [], []
-    for (_, task), (value, _seconds) in zip(pieces, results, strict=True):
-        if task[0] == "crash":
-            crash_rows.append(value)
-            continue
-        name, (table, fs) = task[1], value
-        tables[name] = table
-        if task[4]:  # a variant of the paper, not an ablation
-            found[name] = fs
-        else:
-            switch = name.removeprefix(_ablation_name(""))
-            ablation_rows += [{"switch": switch, **f.__dict__} for f in fs]
-    ablation_df = pd.DataFrame(ablation_rows)
+        crashes = (exp_folder.path, logs)
+    pieces = _paper_pieces(out, inside if processes > 1 else here, ablation, crashes)
+    what = ("Figure 4 and the example in both variants" + (", the ablations" if ablation else "")
+            + (", the crashes of Table III" if experiments else ""))  # fmt: skip
+    tables, found, ablation_df, crash_rows = _sorted_results(
+        pieces, _run_pieces(pieces, processes, clock, what)
+    )
     findings = findings_frame(found)
-    table3 = write_table3(crash_rows, exp_out) if experiments else None
-    if experiments:
-        exp_folder.finish({"crashes": len(crash_rows)})
-    if table3 is not None:
-        table3.attrs["logs"] = logs_source(data_dir)  # said in the report's Table III
-    table3_extras = [
-        pd.read_parquet(exp_out / f"{name}.parquet") if experiments else None
-        for name in ("table3_runs", "table3_switches")
-    ]
+    table3, table3_runs, table3_switches = (
+        _finish_table3(exp_folder, crash_rows, data_dir) if exp_folder is not None
+        else (None, None, None)
+    )  # fmt: skip
 
     part = recovery_part(out, tables, workers, scheduler, progress, clock) if recovery else None
     pole = pole_part(out, workers, scheduler, progress, clock) if recovery else None
 
     clock.start("figures, tables and the report")
-    # tables behind the report
-    pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
-    table2(tables).to_parquet(out / "table2.parquet")
-    findings.to_parquet(out / "findings.parquet")
-    ablation_df.to_parquet(out / "ablation.parquet")
-    for variant in VARIANTS:
-        fig4_figure(tables[variant], variant).savefig(out / f"fig4_{variant}.png", dpi=120)
-        type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
+    _write_paper_tables(out, tables, findings, ablation_df)
     clock.stop()
     elapsed = time.perf_counter() - start
     report = folder.finish(
         {"elapsed_s": elapsed},
         render_report(
-            tables,
-            findings,
-            ablation_df,
-            elapsed,
-            table3,
-            part,
-            clock.times,
-            clock.pieces,
-            pole=pole,
-            table3_runs=table3_extras[0],
-            table3_switches=table3_extras[1],
+            tables, findings, ablation_df, elapsed, table3, part, clock.times, clock.pieces,
+            pole=pole, table3_runs=table3_runs, table3_switches=table3_switches,
         ),
     )  # fmt: skip
     return StudyResult(

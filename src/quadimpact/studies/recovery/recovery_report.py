@@ -356,23 +356,31 @@ def render_report(
     ]  # fmt: skip
     ex = d.get("example")
     if ex is not None:
-        lines += [
-            "## Example trial",
-            "",
-            f"Trial {ex['run_id']}, the one nearest the median conditions (roll, pitch, yaw and "
-            f"speed, each scaled by its range): roll {ex['roll_deg']:.1f}°, pitch "
-            f"{ex['pitch_deg']:.1f}° (inclination {ex['inclination_deg']:.1f}°), yaw "
-            f"{ex['yaw_deg']:.1f}°, {ex['speed_m_s']:.2f} m/s, IMU seed {ex['seed']}. Its "
-            "result folder is `example/` (summary, time series, IMU samples, Figures 5-6); "
-            "the vertical lines mark the detection and the entry into each stage.",
-            "",
-        ]
-        if "example/recovery.png" in names:
-            lines += ["![Example trial](example/recovery.png)", ""]
-        extras = [f"[{label}]({p})" for p, label in (
-            ("example/viewer.html", "interactive viewer"),
-            ("example/animation.mp4", "animation"),
-        ) if p in names]  # fmt: skip
-        if extras:
-            lines += ["Also: " + ", ".join(extras) + ".", ""]
+        lines += _example_lines(ex, names)
     return "\n".join(lines) + "\n"
+
+
+def _example_lines(ex: dict[str, Any], names: set[str]) -> list[str]:
+    """The section "Example trial": the trial ``ex`` (its run id, roll, pitch, inclination
+    and yaw in deg, speed in m/s, IMU seed), and of its figure, viewer and animation those
+    among the files written, ``names`` (paths relative to the report)."""
+    lines = [
+        "## Example trial",
+        "",
+        f"Trial {ex['run_id']}, the one nearest the median conditions (roll, pitch, yaw and "
+        f"speed, each scaled by its range): roll {ex['roll_deg']:.1f}°, pitch "
+        f"{ex['pitch_deg']:.1f}° (inclination {ex['inclination_deg']:.1f}°), yaw "
+        f"{ex['yaw_deg']:.1f}°, {ex['speed_m_s']:.2f} m/s, IMU seed {ex['seed']}. Its "
+        "result folder is `example/` (summary, time series, IMU samples, Figures 5-6); "
+        "the vertical lines mark the detection and the entry into each stage.",
+        "",
+    ]
+    if "example/recovery.png" in names:
+        lines += ["![Example trial](example/recovery.png)", ""]
+    extras = [f"[{label}]({p})" for p, label in (
+        ("example/viewer.html", "interactive viewer"),
+        ("example/animation.mp4", "animation"),
+    ) if p in names]  # fmt: skip
+    if extras:
+        lines += ["Also: " + ", ".join(extras) + ".", ""]
+    return lines

@@ -367,10 +367,7 @@ def run_study(
         numbers = analysis.summarise(table)
         if info["n_ran"] == 0 and unchanged is not None and _drawn(unchanged, out, example):
             return _as_before(unchanged, table, numbers, folder, info, start)
-        description = describe(spec, study if isinstance(study, RecoveryStudy) else None, table)
-        description["run"] = describe_run(info)
-        description["sweeps"] = folder.sweep_history(description["run"])
-        description["cost"] = cost_ratio(table)
+        description = _run_description(spec, study, table, info, folder)
         paths, example_dir, warnings = _draw(spec, table, numbers, description, out,
                                              early, example, animation)  # fmt: skip
     except BaseException:
@@ -378,6 +375,22 @@ def run_study(
             early.cancel()
         raise
     return _finish(folder, description, table, numbers, paths, example_dir, info, start, warnings)
+
+
+def _run_description(
+    spec: SweepSpec,
+    study: RecoveryStudy | SweepSpec,
+    table: pd.DataFrame,
+    info: dict[str, Any],
+    folder: StudyFolder,
+) -> dict[str, Any]:
+    """What ran (:func:`describe`) with how it ran (the sweep's run information ``info``),
+    the folder's sweeps so far and the trials' CPU cost (``results.costs.cost_ratio``)."""
+    description = describe(spec, study if isinstance(study, RecoveryStudy) else None, table)
+    description["run"] = describe_run(info)
+    description["sweeps"] = folder.sweep_history(description["run"])
+    description["cost"] = cost_ratio(table)
+    return description
 
 
 def _draw(

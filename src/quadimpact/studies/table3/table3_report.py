@@ -209,35 +209,7 @@ def _nominal_markdown(table: pd.DataFrame) -> str:
         if r["type_ours"] == r["type_paper_experiment"] and verdict != "agrees":
             motion_notes.append(_motion_note(r, MOTION_RMS_DEG))
         if r["type_ours"] != r["type_paper_experiment"]:
-            key = f"share_{r['type_paper_experiment']}"
-            seen = r[key] if key in r and r[key] == r[key] else float("nan")
-            deep = (
-                f"; the bumpers deflect {r['max_penetration_mm']:.0f} mm, beyond their radius"
-                if has_log and r["max_penetration_mm"] > rb_mm
-                else ""
-            )
-            note = (
-                f"- Crash {r['crash']}: the experiment was type {r['type_paper_experiment']}, ours "
-                f"at the nominal conditions is {r['type_ours']} (the replica: "
-                f"{r['type_replica']}{deep}). Over the stated uncertainty type "
-                f"{r['type_paper_experiment']} occurs in {seen:.0%} of the runs ({dist})."
-            )
-            if has_log and isinstance(r["type_log_conditions"], str):
-                note += (
-                    f" The log puts the impact at V_c {r['log_speed_m_s']:.2f} m/s, ι "
-                    f"{r['log_inclination_deg']:.1f}° (roll {r['log_roll_deg']:.1f}°, pitch "
-                    f"{r['log_pitch_deg']:.1f}°); there ours is "
-                    f"{r['type_log_conditions']} ({_share_text(r, 'log_share_')} over the "
-                    "log's uncertainty)"
-                )
-                depth = r["log_max_penetration_mm"]
-                note += (
-                    f", but the bumpers deflect {depth:.0f} mm there, beyond their radius "
-                    "(the model's answer, not a prediction)."
-                    if depth > rb_mm
-                    else "."
-                )
-            notes.append(note)
+            notes.append(_type_note(r, dist, has_log, rb_mm))
     lines += ["", f"Verdict of each row: {VERDICT_RULE}."]
     if motion_notes:
         lines += ["", "Rows where our type is the experiment's but the motion is not:", "",
@@ -245,50 +217,96 @@ def _nominal_markdown(table: pd.DataFrame) -> str:
     if notes:
         lines += ["", "Rows where our type differs from the experiment's:", "", *notes]
     if has_log:
-        seen = table[table["type_log_conditions"].apply(lambda v: isinstance(v, str))]
-        dv = seen["log_speed_m_s"] - seen["speed_m_s"]
-        di = seen["log_inclination_deg"] - seen["inclination_deg"]
-        spread = (
-            f" Against Table III the logs' speeds differ by {dv.min():+.2f} to {dv.max():+.2f} "
-            f"m/s (stated ±0.01) and their inclinations by {di.min():+.1f} to {di.max():+.1f}°."
-            if len(seen)
-            else ""
-        )
-        lines += [
-            "",
-            "At the logs' own pre-impact estimates (motion capture at the observed contact; "
-            "docs/EXPERIMENTS.md explains why they differ from Table III). ψ is given as in "
-            "Table III above: the heading of the equivalent front-first approach (the "
-            "flights went into the wall rear first, at ψ − 180° in the log frame and in the "
-            f"scenario files).{spread}",
-            "",
-            "| crash | ψ (°) | V_c (m/s) | ι (°) | roll / pitch (°) | log's own type "
-            "| ours at the log's estimates | over their uncertainty (±2σ) "
-            "| attitude RMS 0-0.3 s (°) | deepest δ (mm) |",
-            "|---" * 10 + "|",
-        ]
-        for _, r in table.iterrows():
-            if not isinstance(r["type_log_conditions"], str):
-                why = "no log" if not isinstance(r["type_log"], str) else "contact not observed"
-                lines.append(f"| {r['crash']} | {why} | | | | {r['type_log'] or '–'} | | | | |")
-                continue
-            lines.append(
-                f"| {r['crash']} | {_deg(_front_first(r['log_heading_deg']))} "
-                f"| {r['log_speed_m_s']:.2f} "
-                f"| {_deg(r['log_inclination_deg'])} "
-                f"| {_deg(r['log_roll_deg'])} / {_deg(r['log_pitch_deg'])} | {r['type_log']} "
-                f"| {r['type_log_conditions']} | {_share_text(r, 'log_share_') or 'not run'} "
-                f"| {_deg(r['attitude_rms_log_conditions_deg_0_3s'])} "
-                f"| {_depth(r['log_max_penetration_mm'], rb_mm)} |"
-            )
-        lines += [
-            "",
-            f"† deeper than the bumper radius ({rb_mm:.0f} mm): the bumper model no longer "
-            "holds (the body itself would reach the wall), so these runs' types are the "
-            "model's, not a prediction (docs/MODEL_NOTES.md). The paper's bumper law is the "
-            "same, with the same limit.",
-        ]
+        lines += _log_conditions_lines(table, rb_mm)
     return "\n".join(lines)
+
+
+def _type_note(r: pd.Series, dist: str, has_log: bool, rb_mm: float) -> str:
+    """Why a row's type at the nominal conditions differs from the experiment's, from the
+    data: the replica's type, the share of the experiment's type over the stated
+    uncertainty (``dist``: every type's share, as text), and with ``has_log`` the log's
+    own conditions and our type there; a deflection beyond the bumper radius ``rb_mm``
+    (mm) is said."""
+    key = f"share_{r['type_paper_experiment']}"
+    seen = r[key] if key in r and r[key] == r[key] else float("nan")
+    deep = (
+        f"; the bumpers deflect {r['max_penetration_mm']:.0f} mm, beyond their radius"
+        if has_log and r["max_penetration_mm"] > rb_mm
+        else ""
+    )
+    note = (
+        f"- Crash {r['crash']}: the experiment was type {r['type_paper_experiment']}, ours "
+        f"at the nominal conditions is {r['type_ours']} (the replica: "
+        f"{r['type_replica']}{deep}). Over the stated uncertainty type "
+        f"{r['type_paper_experiment']} occurs in {seen:.0%} of the runs ({dist})."
+    )
+    if has_log and isinstance(r["type_log_conditions"], str):
+        note += (
+            f" The log puts the impact at V_c {r['log_speed_m_s']:.2f} m/s, ι "
+            f"{r['log_inclination_deg']:.1f}° (roll {r['log_roll_deg']:.1f}°, pitch "
+            f"{r['log_pitch_deg']:.1f}°); there ours is "
+            f"{r['type_log_conditions']} ({_share_text(r, 'log_share_')} over the "
+            "log's uncertainty)"
+        )
+        depth = r["log_max_penetration_mm"]
+        note += (
+            f", but the bumpers deflect {depth:.0f} mm there, beyond their radius "
+            "(the model's answer, not a prediction)."
+            if depth > rb_mm
+            else "."
+        )
+    return note
+
+
+def _log_conditions_lines(table: pd.DataFrame, rb_mm: float) -> list[str]:
+    """The runs at the logs' own pre-impact estimates: how far those are from Table III's
+    conditions (m/s, deg), then one row per crash (its conditions, the log's type, ours
+    and over the log's uncertainty, the attitude error in deg, the deepest deflection in
+    mm, marked beyond the bumper radius ``rb_mm``), and what the mark means."""
+    seen = table[table["type_log_conditions"].apply(lambda v: isinstance(v, str))]
+    dv = seen["log_speed_m_s"] - seen["speed_m_s"]
+    di = seen["log_inclination_deg"] - seen["inclination_deg"]
+    spread = (
+        f" Against Table III the logs' speeds differ by {dv.min():+.2f} to {dv.max():+.2f} "
+        f"m/s (stated ±0.01) and their inclinations by {di.min():+.1f} to {di.max():+.1f}°."
+        if len(seen)
+        else ""
+    )
+    lines = [
+        "",
+        "At the logs' own pre-impact estimates (motion capture at the observed contact; "
+        "docs/EXPERIMENTS.md explains why they differ from Table III). ψ is given as in "
+        "Table III above: the heading of the equivalent front-first approach (the "
+        "flights went into the wall rear first, at ψ − 180° in the log frame and in the "
+        f"scenario files).{spread}",
+        "",
+        "| crash | ψ (°) | V_c (m/s) | ι (°) | roll / pitch (°) | log's own type "
+        "| ours at the log's estimates | over their uncertainty (±2σ) "
+        "| attitude RMS 0-0.3 s (°) | deepest δ (mm) |",
+        "|---" * 10 + "|",
+    ]
+    for _, r in table.iterrows():
+        if not isinstance(r["type_log_conditions"], str):
+            why = "no log" if not isinstance(r["type_log"], str) else "contact not observed"
+            lines.append(f"| {r['crash']} | {why} | | | | {r['type_log'] or '–'} | | | | |")
+            continue
+        lines.append(
+            f"| {r['crash']} | {_deg(_front_first(r['log_heading_deg']))} "
+            f"| {r['log_speed_m_s']:.2f} "
+            f"| {_deg(r['log_inclination_deg'])} "
+            f"| {_deg(r['log_roll_deg'])} / {_deg(r['log_pitch_deg'])} | {r['type_log']} "
+            f"| {r['type_log_conditions']} | {_share_text(r, 'log_share_') or 'not run'} "
+            f"| {_deg(r['attitude_rms_log_conditions_deg_0_3s'])} "
+            f"| {_depth(r['log_max_penetration_mm'], rb_mm)} |"
+        )
+    lines += [
+        "",
+        f"† deeper than the bumper radius ({rb_mm:.0f} mm): the bumper model no longer "
+        "holds (the body itself would reach the wall), so these runs' types are the "
+        "model's, not a prediction (docs/MODEL_NOTES.md). The paper's bumper law is the "
+        "same, with the same limit.",
+    ]
+    return lines
 
 
 #: The report's names of the two variants of the crash runs.
@@ -343,23 +361,9 @@ def conditions_markdown(table: pd.DataFrame, runs: pd.DataFrame) -> str:
             f"{c} conditions: default {count[(c, 'default')]} of {n}, replica "
             f"{count[(c, 'paper-replica')]} of {n}" for c in ("nominal", "matched")) + ".",
         "",
-        "| crash | Table III: ψ (°) / V_c (m/s) / ι (°) | matched: ψ (°) / V_c (m/s) / roll, "
-        "pitch (°) (ι) | matched: altitude start → set-point (m) | at the contact, matched, "
-        "default: altitude (m), climb (m/s), drift (m/s) |",
-        "|---|---|---|---|---|",
     ]  # fmt: skip
     by = runs.set_index(["crash", "conditions", "model"])
-    for _, r in table.iterrows():
-        m = by.loc[(r["crash"], "matched", "default")]
-        lines.append(
-            f"| {r['crash']} | {r['heading_deg']:g} / {r['speed_m_s']:g} / "
-            f"{r['inclination_deg']:g} | {_front_first(r['matched_heading_deg']):g} / "
-            f"{r['matched_speed_m_s']:g} / {r['matched_roll_deg']:g}, "
-            f"{r['matched_pitch_deg']:g} ({r['matched_inclination_deg']:.1f}) "
-            f"| {r['matched_start_altitude_m']:g} → {r['matched_altitude_setpoint_m']:g} "
-            f"| {m['contact_altitude_m']:.2f}, {m['contact_climb_m_s']:+.2f}, "
-            f"{m['contact_drift_m_s']:+.2f} |"
-        )
+    lines += _matched_conditions_lines(table, by)
     lines += [
         "",
         "| crash | experiment | paper's simulation | "
@@ -372,7 +376,45 @@ def conditions_markdown(table: pd.DataFrame, runs: pd.DataFrame) -> str:
         lines.append(f"| {r['crash']} | {r['type_paper_experiment']} "
                      f"| {r['type_paper_simulation']} | {cells} |")  # fmt: skip
     lines.append("| matched | | | " + " | ".join(f"{count[k]} of {n}" for k in keys) + " |")
+    lines += _run_lines(runs)
     lines += [
+        "",
+        "The crash set holds no outputs of the authors' own simulations, so the distance "
+        "of these runs to theirs cannot be measured here; the flight logs are the reference.",
+    ]
+    return "\n".join(lines)
+
+
+def _matched_conditions_lines(table: pd.DataFrame, by: pd.DataFrame) -> list[str]:
+    """Each crash's conditions, Table III's and the matched ones (heading, speed, roll and
+    pitch in deg and m/s, the altitude's start and set-point in m), and where the matched
+    default run meets the wall (altitude in m, climb and drift in m/s); ``by``: the runs
+    indexed by crash, conditions and model."""
+    lines = [
+        "| crash | Table III: ψ (°) / V_c (m/s) / ι (°) | matched: ψ (°) / V_c (m/s) / roll, "
+        "pitch (°) (ι) | matched: altitude start → set-point (m) | at the contact, matched, "
+        "default: altitude (m), climb (m/s), drift (m/s) |",
+        "|---|---|---|---|---|",
+    ]
+    for _, r in table.iterrows():
+        m = by.loc[(r["crash"], "matched", "default")]
+        lines.append(
+            f"| {r['crash']} | {r['heading_deg']:g} / {r['speed_m_s']:g} / "
+            f"{r['inclination_deg']:g} | {_front_first(r['matched_heading_deg']):g} / "
+            f"{r['matched_speed_m_s']:g} / {r['matched_roll_deg']:g}, "
+            f"{r['matched_pitch_deg']:g} ({r['matched_inclination_deg']:.1f}) "
+            f"| {r['matched_start_altitude_m']:g} → {r['matched_altitude_setpoint_m']:g} "
+            f"| {m['contact_altitude_m']:.2f}, {m['contact_climb_m_s']:+.2f}, "
+            f"{m['contact_drift_m_s']:+.2f} |"
+        )
+    return lines
+
+
+def _run_lines(runs: pd.DataFrame) -> list[str]:
+    """One row per crash run (conditions, variant, type, the bumpers of each impact, the
+    deflections in mm, the crash time in s, the errors against the log in deg and mm), then
+    the types that hinge on a contact overlap or gap under :data:`CHAINING_NOTE_MS`."""
+    lines = [
         "",
         "Each run: the bumpers of the initial impact and of each later one, δ_init (the "
         "initial impact's deepest deflection), the first episode's peak (bumper 2, the "
@@ -402,12 +444,7 @@ def conditions_markdown(table: pd.DataFrame, runs: pd.DataFrame) -> str:
         lines += ["", f"Types that hinge on a contact overlap (or gap) of less than "
                   f"{CHAINING_NOTE_MS:g} ms (docs/STUDIES.md 2: an episode starting before "
                   "the impact in progress has ended is part of it):", "", *notes]  # fmt: skip
-    lines += [
-        "",
-        "The crash set holds no outputs of the authors' own simulations, so the distance "
-        "of these runs to theirs cannot be measured here; the flight logs are the reference.",
-    ]
-    return "\n".join(lines)
+    return lines
 
 
 def _chaining_note(r: pd.Series) -> str:

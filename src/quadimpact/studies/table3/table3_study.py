@@ -361,11 +361,52 @@ def crash_task(
     crash's rows of ``table3_runs.csv`` and ``table3_switches.csv`` (keys
     ``"runs"`` and ``"switches"``), which :func:`write_table3` takes out.
     """
-    from quadimpact.experiments.logs_compare import attitude_rms, compare_crash
+    from quadimpact.experiments.logs_compare import attitude_rms
 
     sweep_options = sweep_options or {"workers": 1, "scheduler": None, "progress": False}
     start = time.perf_counter()
     folder = out / f"crash_{crash.number}"
+    runs, records = _crash_runs(crash, log, folder)
+    shares: dict[str, float] = {f"share_{t}": math.nan for t in RESPONSE_TYPES}
+    if samples > 0:
+        sweep = run_sweep(
+            sensitivity_spec(crash, samples),
+            out / "sensitivity" / f"crash_{crash.number}",
+            **sweep_options,
+        )
+        shares = _shares(sweep, "share_")
+    nominal, comparison = runs[("nominal", "default")]
+    row = {
+        "crash": crash.number,
+        "heading_deg": crash.heading_deg,
+        "speed_m_s": crash.speed_m_s,
+        "inclination_deg": crash.inclination_deg,
+        "type_paper_experiment": crash.type_experiment,
+        "type_paper_simulation": crash.type_paper_simulation,
+        "type_ours": nominal.summary["response_type"],
+        "type_replica": runs[("nominal", "paper-replica")][0].summary["response_type"],
+        **shares,
+        "attitude_rms_deg_0_3s": attitude_rms(comparison),
+        "max_penetration_mm": 1e3 * nominal.summary["max_penetration_m"],
+        **_log_row(crash, log, folder, out, log_samples, sweep_options),
+        **_motion_changes(comparison),
+        **_matched_columns(crash, runs),
+    }
+    row["verdict"], row["verdict_reason"] = crash_verdict(row)
+    row["runs"] = records
+    row["switches"] = switch_records(crash, log, runs)
+    return row, time.perf_counter() - start
+
+
+def _crash_runs(
+    crash: Crash, log: SpiriMatLog | None, folder: Path
+) -> tuple[dict[tuple[str, str], Any], list[dict[str, Any]]]:
+    """The crash's runs at each set of conditions in each variant, each written to
+    ``folder/<conditions>-<model>`` with its comparison with the ``log`` (None without a
+    log): the (run, comparison) pairs by (conditions, model), and their rows of
+    ``table3_runs.csv`` (:func:`run_record`)."""
+    from quadimpact.experiments.logs_compare import compare_crash
+
     runs: dict[tuple[str, str], Any] = {}
     records = []
     for conditions in CONDITIONS:
@@ -383,35 +424,28 @@ def crash_task(
             )
             runs[(conditions, model)] = (r, c)
             records.append(run_record(crash, conditions, model, r, c))  # fmt: skip
-    shares: dict[str, float] = {f"share_{t}": math.nan for t in RESPONSE_TYPES}
-    if samples > 0:
-        sweep = run_sweep(
-            sensitivity_spec(crash, samples),
-            out / "sensitivity" / f"crash_{crash.number}",
-            **sweep_options,
-        )
-        shares = _shares(sweep, "share_")
-    nominal, comparison = runs[("nominal", "default")]
+    return runs, records
+
+
+def _motion_changes(comparison: Any) -> dict[str, float]:
+    """How much roll, pitch and yaw change (deg) over the first 0.3 s after the impact, in
+    the run and in the log (:data:`MOTION_COLUMNS`; NaN without a ``comparison``)."""
     motion = {c: math.nan for c in MOTION_COLUMNS}
     if comparison is not None:
         for angle, (sim, logged) in comparison.departures(0.3).items():
             motion[f"sim_{angle}_change_deg_0_3s"] = sim
             motion[f"log_{angle}_change_deg_0_3s"] = logged
+    return motion
+
+
+def _matched_columns(crash: Crash, runs: dict[tuple[str, str], Any]) -> dict[str, Any]:
+    """The crash's matched conditions (heading, speed, roll, pitch, inclination in deg and
+    m/s; the altitude's start and set-point in m) and its matched runs' types in both
+    variants and attitude error against the log (deg RMS over 0.3 s, default model)."""
+    from quadimpact.experiments.logs_compare import attitude_rms
+
     m = crash.matched
-    row = {
-        "crash": crash.number,
-        "heading_deg": crash.heading_deg,
-        "speed_m_s": crash.speed_m_s,
-        "inclination_deg": crash.inclination_deg,
-        "type_paper_experiment": crash.type_experiment,
-        "type_paper_simulation": crash.type_paper_simulation,
-        "type_ours": nominal.summary["response_type"],
-        "type_replica": runs[("nominal", "paper-replica")][0].summary["response_type"],
-        **shares,
-        "attitude_rms_deg_0_3s": attitude_rms(comparison),
-        "max_penetration_mm": 1e3 * nominal.summary["max_penetration_m"],
-        **_log_row(crash, log, folder, out, log_samples, sweep_options),
-        **motion,
+    return {
         "matched_heading_deg": m.heading_deg,
         "matched_speed_m_s": m.speed_m_s,
         "matched_roll_deg": m.roll_deg,
@@ -423,10 +457,6 @@ def crash_task(
         "type_matched_replica": runs[("matched", "paper-replica")][0].summary["response_type"],
         "attitude_rms_matched_deg_0_3s": attitude_rms(runs[("matched", "default")][1]),
     }
-    row["verdict"], row["verdict_reason"] = crash_verdict(row)
-    row["runs"] = records
-    row["switches"] = switch_records(crash, log, runs)
-    return row, time.perf_counter() - start
 
 
 def run_experiments(
