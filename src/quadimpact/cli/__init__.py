@@ -6,6 +6,7 @@
 * :mod:`~quadimpact.cli.experiments_command`: ``quadimpact experiments``;
 * :mod:`~quadimpact.cli.recovery_command`: ``quadimpact recovery``;
 * :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
+* :mod:`~quadimpact.cli.compile_command`: ``quadimpact compile``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
 
 Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
@@ -18,6 +19,7 @@ run`` exits with status 3 when the run failed numerically (its status is
 
 from __future__ import annotations
 
+import logging
 import os
 import sys
 import traceback
@@ -26,6 +28,7 @@ from typing import Any
 
 import click
 
+from quadimpact.cli.compile_command import compile_command
 from quadimpact.cli.experiments_command import experiments
 from quadimpact.cli.pole_command import pole
 from quadimpact.cli.recovery_command import recovery
@@ -85,7 +88,8 @@ def cli() -> None:
 
 
 # ---- the commands, each in its own module: one registration line each ----
-for _command in (run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole):
+_COMMANDS = (run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole)
+for _command in (*_COMMANDS, compile_command):
     cli.add_command(_command)
 
 
@@ -110,6 +114,20 @@ def _show_warning(
     )
 
 
+class _Notices(logging.Handler):
+    """The ``quadimpact`` logger's notices (a first run's compilation) as lines on stderr."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        click.echo(one_line(record.getMessage()), err=True)
+
+
+def _show_notices() -> None:
+    logger = logging.getLogger("quadimpact")
+    if not any(isinstance(h, _Notices) for h in logger.handlers):
+        logger.addHandler(_Notices(logging.WARNING))
+        logger.propagate = False
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``quadimpact`` command.
 
@@ -126,6 +144,7 @@ def main(argv: list[str] | None = None) -> None:
     debug = os.environ.get("QUADIMPACT_DEBUG", "") not in ("", "0")
     if not debug:
         warnings.showwarning = _show_warning
+    _show_notices()
     try:
         code = cli.main(args=argv, prog_name="quadimpact", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as exc:

@@ -8,7 +8,6 @@ from typing import Any
 import click
 
 from quadimpact.cli.options import (
-    announce_compilation,
     data_option,
     defaulted_option,
     out_option,
@@ -78,7 +77,6 @@ def experiments(
 
     if data is not None:
         check_data_dir(data)
-    announce_compilation()
     with stoppable(out):
         table = run_experiments(
             out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,

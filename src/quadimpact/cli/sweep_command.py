@@ -11,7 +11,6 @@ from pathlib import Path
 import click
 
 from quadimpact.cli.options import (
-    announce_compilation,
     file_argument,
     max_record_option,
     parallel_options,
@@ -142,7 +141,6 @@ def sweep(
             spec = spec.with_grid(extra)
     else:
         spec = SweepSpec(grid=extra, where="sweep")
-    announce_compilation()
     # once stopped by a signal, every later one is ignored until the program has ended
     with stoppable():
         info = run_sweep(

@@ -10,6 +10,7 @@ from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+from quadimpact.core import announce_compilation
 from quadimpact.errors import InputError, format_value
 from quadimpact.results.files import check_out_dir
 from quadimpact.sweep.backends import (
@@ -253,6 +254,8 @@ def run_sweep(
             n_todo = spec.n_runs - n_before
             backend = "none"
             if n_todo:
+                if client is None:  # here or the local workers: said before the progress bar
+                    announce_compilation()
                 writer = PartWriter(out / "parts", schema, last_part)
                 bar = Progress(spec.n_runs, n_before, enabled=progress)
 

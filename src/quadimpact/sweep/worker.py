@@ -207,6 +207,7 @@ def pool_worker(conn: Any) -> None:
     for signum in (signal.SIGTERM, WATCH_SIGNAL):
         if signum is not None:
             signal.signal(signum, signal.SIG_DFL)  # the fork server's handler is inherited
+    _quiet_compilation()
     with contextlib.suppress(Exception):
         warm_up()
     group: list[int] = [0]  # the size of the group running
@@ -234,6 +235,14 @@ def pool_worker(conn: Any) -> None:
         return
 
 
+def _quiet_compilation() -> None:
+    """No compilation notice from this worker process: the sweep or study it works for
+    gives it (``core.announce_compilation``) before handing runs to its workers."""
+    from quadimpact.core import silence_compilation_notice
+
+    silence_compilation_notice()
+
+
 def worker_info() -> dict[str, Any]:
     from quadimpact import __version__
 
@@ -255,6 +264,7 @@ def preload() -> None:
     # Ctrl-C reaches the whole process group; the sweep decides. Set before the
     # server records its "old" handlers, so its workers start ignoring it too.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _quiet_compilation()  # the sweep says it, once (this server's workers inherit it)
     tempdir = ""
     with contextlib.suppress(BaseException):
         tempdir = _follow_sweep()
