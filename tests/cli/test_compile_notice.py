@@ -20,6 +20,8 @@ import pytest
 import quadimpact.core as core
 from quadimpact.cli import main
 
+from helpers import cli_here
+
 NOTICE = "quadimpact: compiling the simulator (first use only"
 
 
@@ -50,16 +52,6 @@ def notices() -> Iterator[list[str]]:
     logger.removeHandler(keep)
 
 
-def cli(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str]:
-    """``quadimpact ARGS`` in this process: (exit status, stderr)."""
-    try:
-        main(list(args))
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    return code, capsys.readouterr().err
-
-
 INVALID = [
     ["run", "--speed", "50"],
     ["sweep", "--grid", "speed_m_s=0.5,50"],
@@ -75,7 +67,7 @@ def test_an_invalid_input_is_refused_before_any_compile_notice(
     args: list[str], cold_cache: Path, tmp_path: Path, monkeypatch, capsys
 ) -> None:
     monkeypatch.chdir(tmp_path)
-    code, err = cli(capsys, *args, "--out", "o")
+    code, err = cli_here(capsys, *args, "--out", "o")
     assert code == 2, err
     assert err.startswith("quadimpact: error: ") and "compiling" not in err, err
 
@@ -99,13 +91,13 @@ def test_a_sweep_says_it_compiles_once_before_its_runs_and_not_when_nothing_is_l
 ) -> None:
     monkeypatch.chdir(tmp_path)
     args = ["sweep", "--grid", "inclination_deg=0,5,10", "--workers", "1", "--no-plots"]
-    code, err = cli(capsys, *args, "--out", "o")
+    code, err = cli_here(capsys, *args, "--out", "o")
     assert code == 0, err
     lines = err.splitlines()
     assert sum(NOTICE in line for line in lines) == 1, err
     assert lines[0].startswith(NOTICE) and "`quadimpact compile`" in lines[0], err
     monkeypatch.setattr(core, "_checked", set())  # a new process, the same cold cache
-    code, err = cli(capsys, *args, "--out", "o")
+    code, err = cli_here(capsys, *args, "--out", "o")
     assert code == 0 and "compiling" not in err, err
 
 

@@ -85,6 +85,7 @@ def test_the_recovery_command_without_the_example_writes_no_example(tmp_path: Pa
     assert (out / "success_map.png").is_file()
     report = (out / "report.md").read_text()
     assert "## Example trial" not in report and "example/" not in report
+    assert "the example included" not in report and "(tables and figures included)" in report
 
 
 @pytest.mark.slow  # three processes, one with the example and its viewer
@@ -105,7 +106,7 @@ def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
                     "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
     assert again.returncode == 0 and "all done before, nothing to run" in again.stdout
     other = run_cli("recovery", "--n", "7", "--out", "r", "--workers", "1", cwd=tmp_path)
-    assert_input_error(other, "holds a different sweep")
+    assert_input_error(other, "r: holds the recovery study of n = 6 trials (--n 6), not 7")
 
 
 @pytest.mark.slow  # the study's example with its viewer

@@ -525,9 +525,9 @@ def check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
                     for k in ("base", "grid", "runs", "sample")
                     if (old.get("spec") or {}).get(k) != json.loads(canonical(spec.to_dict()))[k]
                 ]
-                detail = "its " + ", ".join(keys or ["spec"])
+                detail = " or ".join(keys or ["spec"])
             raise InputError(
-                f"{out}: holds a different sweep ({detail} differs, see sweep.json); "
+                f"{out}: holds a different sweep (not the same {detail}, see sweep.json); "
                 "use another output folder, or delete this one to start over"
             )
         return

@@ -96,7 +96,7 @@ def test_rerunning_resumes_and_gives_the_same_table(study_dir) -> None:
     resumed = run_study(RecoveryStudy(n=N, seed=5), out, workers=1, example=False)
     assert resumed.run_info["n_already_done"] == 10 and resumed.run_info["n_ran"] == N - 10
     assert_same_table(pd.read_parquet(out / "trials.parquet"), before)
-    with pytest.raises(InputError, match="holds a different sweep"):
+    with pytest.raises(InputError, match=r"holds a recovery study of other trials \(another"):
         run_study(RecoveryStudy(n=N, seed=6), out, workers=1, example=False)
 
 

@@ -204,6 +204,40 @@ class RecoveryResult:
     warnings: list[str] = field(default_factory=list)
 
 
+def _refuse_another_study(study: RecoveryStudy, spec: SweepSpec, out: Path) -> None:
+    """Refuse a folder holding the recovery study with another ``n``, ``seed`` or options,
+    saying which in the study's own terms (the sweep's check would only say "a different
+    sweep"). Nothing is said of a folder without a readable ``sweep/sweep.json``: the
+    sweep's own checks judge it."""
+    import json
+
+    from quadimpact.sweep.values import canonical
+
+    path = out / SWEEP_DIR / "sweep.json"
+    try:
+        old = json.loads(path.read_text(encoding="utf-8"))["spec"]
+        old_runs = list(old.get("runs") or [])
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        return
+    new = json.loads(canonical(spec.to_dict()))
+    if old == new:
+        return
+    advice = "use another output folder, or delete this one to start over"
+    if old.get("base") != new["base"] or not old_runs:
+        raise InputError(
+            f"{out}: holds a recovery study with other settings (vehicle, model, IMU, "
+            f"estimator, sensors or pre-impact behaviour; see {path}); {advice}"
+        )
+    k = min(len(old_runs), len(new["runs"]))
+    if old_runs[:k] == new["runs"][:k]:  # the first trials of a seed are the same for any n
+        raise InputError(
+            f"{out}: holds the recovery study of n = {len(old_runs)} trials (--n "
+            f"{len(old_runs)}), not {study.n}: give --n {len(old_runs)} to resume or finish "
+            f"it, or {advice}"
+        )
+    raise InputError(f"{out}: holds a recovery study of other trials (another --seed); {advice}")
+
+
 def _claim_folder(spec: SweepSpec, out: Path) -> None:
     """Refuse a folder or sweep base the study cannot use; mark the folder as a study's."""
     check_out_dir(out, "recovery", where="")
@@ -237,6 +271,7 @@ def run_trials(
         _check_trial_base(spec, spec.where)
     else:
         spec = study.sweep_spec()
+        _refuse_another_study(study, spec, out)
     info = run_sweep(
         spec, out / SWEEP_DIR, workers=workers, scheduler=scheduler, progress=progress,
         load=False, on_placed=on_placed,
@@ -291,6 +326,8 @@ def run_study(
     start = time.perf_counter()
     out = Path(out_dir)
     spec = study if isinstance(study, SweepSpec) else study.sweep_spec()
+    if isinstance(study, RecoveryStudy):
+        _refuse_another_study(study, spec, out)
     # the example trial depends on the trials' inputs only: it runs beside the trials
     # when they run on other processes (a pool or Dask), else after them, here. It
     # starts once the sweep has placed its runs (the default sweep measures the idle
