@@ -492,6 +492,15 @@ def consolidate(out: Path, schema: Any, n_runs: int) -> None:
         p.unlink(missing_ok=True)
 
 
+def finished_before(out: Path) -> bool:
+    """Whether ``out`` looks like a finished sweep: ``runs.parquet`` and no part (a guess,
+    for what to ready before the sweep starts; :func:`scan_done` checks)."""
+    parts = out / "parts"
+    return (out / "runs.parquet").is_file() and not (
+        parts.is_dir() and any(parts.glob("part-*.parquet"))
+    )
+
+
 def check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
     """Write sweep.json, or check that the folder holds this very sweep."""
     from quadimpact import __version__
