@@ -22,7 +22,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from quadimpact.errors import InputError
-from quadimpact.results.figures import new_figure, save_figure
+from quadimpact.results.figures import fit_title, legend_below, new_figure, save_figure
 from quadimpact.results.sweep_figures import (
     INVALID_LABEL,
     TYPE_COLOURS,
@@ -123,11 +123,15 @@ def plot_metric(
         if fv is not None:
             ax.set_title(field_value(facet, fv), fontsize=10)
         ax.grid(True, alpha=0.3)
-        if by is not None or marked:
-            ax.legend(fontsize=8)
     axes[0].set_ylabel(label)
+    if by is not None or marked:  # one legend below the panels: it covers no curve
+        entries = {}
+        for ax in axes:
+            for handle, text in zip(*ax.get_legend_handles_labels(), strict=True):
+                entries.setdefault(text, handle)
+        legend_below(fig, list(entries.values()), list(entries), fontsize=8)
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     if path is not None:
         save_figure(fig, path)
     return fig

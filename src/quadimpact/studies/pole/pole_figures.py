@@ -17,7 +17,7 @@ import pandas as pd
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import new_figure, save_figure
+from quadimpact.results.figures import fit_title, new_figure, save_figure
 from quadimpact.studies.recovery.recovery_analysis import rate
 
 __all__ = ["FIGURES", "maps_figure", "success_by_pitch_figure", "write_figures"]
@@ -72,7 +72,7 @@ def maps_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
         fig.colorbar(mesh, ax=list(axes), label="height lost over the run (m)", extend="max")
     axes[0].legend(loc="lower left", fontsize="small", framealpha=0.6)
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     return fig
 
 
@@ -99,7 +99,7 @@ def success_by_pitch_figure(table: pd.DataFrame, title: str | None = None) -> Fi
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best", fontsize="small")
     if title:
-        ax.set_title(title)
+        fit_title(ax, title)
     return fig
 
 
