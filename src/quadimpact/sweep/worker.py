@@ -207,8 +207,8 @@ def pool_worker(conn: Any) -> None:
     for signum in (signal.SIGTERM, WATCH_SIGNAL):
         if signum is not None:
             signal.signal(signum, signal.SIG_DFL)  # the fork server's handler is inherited
-    _quiet_compilation()
     with contextlib.suppress(Exception):
+        _quiet_compilation()
         warm_up()
     group: list[int] = [0]  # the size of the group running
 
@@ -264,13 +264,13 @@ def preload() -> None:
     # Ctrl-C reaches the whole process group; the sweep decides. Set before the
     # server records its "old" handlers, so its workers start ignoring it too.
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    _quiet_compilation()  # the sweep says it, once (this server's workers inherit it)
     tempdir = ""
     with contextlib.suppress(BaseException):
         tempdir = _follow_sweep()
     for var in SINGLE_THREAD_VARS:
         os.environ.setdefault(var, "1")
     with contextlib.suppress(BaseException):
+        _quiet_compilation()  # the sweep says it, once (this server's workers inherit it)
         warm_up()
         if tempdir:  # tell the sweep that workers now start ready
             open(os.path.join(tempdir, SERVER_READY), "w").close()
