@@ -38,6 +38,7 @@ from quadimpact.sweep.store import (
     PartWriter,
     check_folder,
     consolidate,
+    finished_before,
     folder_lock,
     read_runs,
     scan_done,
@@ -236,7 +237,8 @@ def run_sweep(
 
     try:
         with stop_signals() as stop, contextlib.ExitStack() as stack:
-            if workers is not None and n_workers > 1 and spec.n_runs > 1:
+            pool = workers is not None and n_workers > 1 and spec.n_runs > 1
+            if pool and not finished_before(out):
                 start_server(pool_context())  # it loads the kernel while the runs are checked
             if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
                 _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
