@@ -105,8 +105,11 @@ def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
     again = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",
                     "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
     assert again.returncode == 0 and "all done before, nothing to run" in again.stdout
-    other = run_cli("recovery", "--n", "7", "--out", "r", "--workers", "1", cwd=tmp_path)
+    other = run_cli("recovery", "--n", "7", "--seed", "1", "--out", "r", "--workers", "1",
+                    cwd=tmp_path)  # fmt: skip
     assert_input_error(other, "r: holds the recovery study of n = 6 trials (--n 6), not 7")
+    other = run_cli("recovery", "--n", "6", "--out", "r", "--workers", "1", cwd=tmp_path)
+    assert_input_error(other, "r: holds a recovery study of other trials (another --seed)")
 
 
 @pytest.mark.slow  # the study's example with its viewer
