@@ -7,7 +7,9 @@ same path under ``DIR_B`` must hold the same columns and rows, floats compared b
 their bits (NaN equal to NaN), except what a run costs (columns and keys named
 ``cost``, ``cpu``, ``wall`` or ``elapsed``: times, not results). Prints one line per
 file that differs (its first differing column or key) and a count; exits 1 when
-any differs or is missing.
+any differs or is missing. ``--only-common`` compares only the columns and keys
+both folders have (two versions, one of which added a summary key), and
+only the files both have (one run with the flight logs, one without).
 
 What it is for: checking that results do not depend on the machine, e.g.
 ``quadimpact reproduce`` once as is and once with NumPy's dispatch limited to
@@ -28,6 +30,8 @@ import numpy as np
 import pandas as pd
 
 TIMES = ("cost", "cpu", "wall", "elapsed", "quadimpact_version", "created")
+#: Set by ``--only-common``: compare only what both sides have.
+ONLY_COMMON = False
 
 
 def _is_time(name: str) -> bool:
@@ -48,6 +52,8 @@ def _json_diff(a: Any, b: Any, path: str = "") -> str | None:
             if _is_time(k):
                 continue
             if k not in a or k not in b:
+                if ONLY_COMMON:
+                    continue
                 return f"{path}{k}: only in one"
             d = _json_diff(a[k], b[k], f"{path}{k}.")
             if d:
@@ -66,7 +72,9 @@ def _json_diff(a: Any, b: Any, path: str = "") -> str | None:
 
 def _frame_diff(a: pd.DataFrame, b: pd.DataFrame) -> str | None:
     cols = [c for c in a.columns if not _is_time(str(c))]
-    if sorted(cols) != sorted(c for c in b.columns if not _is_time(str(c))):
+    if ONLY_COMMON:
+        cols = [c for c in cols if c in b.columns]
+    elif sorted(cols) != sorted(c for c in b.columns if not _is_time(str(c))):
         return "columns differ"
     if len(a) != len(b):
         return f"rows {len(a)} and {len(b)}"
@@ -88,6 +96,8 @@ def compare(first: Path, second: Path) -> int:
     for path in sorted(first.rglob("*")):
         rel = path.relative_to(first)
         other = second / rel
+        if ONLY_COMMON and not other.is_file():
+            continue
         if path.suffix == ".parquet":
             d = (
                 _frame_diff(pd.read_parquet(path), pd.read_parquet(other))
@@ -111,6 +121,10 @@ def compare(first: Path, second: Path) -> int:
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
+    args = sys.argv[1:]
+    if "--only-common" in args:
+        ONLY_COMMON = True
+        args.remove("--only-common")
+    if len(args) != 2:
         sys.exit(__doc__)
-    sys.exit(1 if compare(Path(sys.argv[1]), Path(sys.argv[2])) else 0)
+    sys.exit(1 if compare(Path(args[0]), Path(args[1])) else 0)

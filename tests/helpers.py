@@ -64,6 +64,26 @@ def run_cli(*args: str, cwd, timeout: float = 120, env: dict | None = None, umas
     )  # fmt: skip
 
 
+def cli_here(capsys, *args: str) -> tuple[int, str]:
+    """``quadimpact ARGS`` in this process (``quadimpact.cli.main``): (exit status, stderr).
+
+    Python's warning printer, which the command replaces, is put back after it.
+    """
+    import warnings
+
+    from quadimpact.cli import main
+
+    shown = warnings.showwarning
+    try:
+        main(list(args))
+        code = 0
+    except SystemExit as exc:
+        code = int(exc.code or 0)
+    finally:
+        warnings.showwarning = shown
+    return code, capsys.readouterr().err
+
+
 # ------------------------------------------------------------- processes
 def process_cpu_s(p: psutil.Process) -> float:
     """CPU time (user + system, s) a process has used; 0 when it is gone."""

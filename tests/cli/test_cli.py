@@ -508,27 +508,30 @@ def test_no_library_warnings_leak_from_the_drawing_commands(
     assert "Warning" not in proc.stderr and "frames have been written" not in proc.stderr
 
 
-def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch, capsys) -> None:
+def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch) -> None:
     """The compiled loop's cache index is looked for where Numba itself puts it."""
     from numba.core.caching import UserProvidedCacheLocator
 
     import quadimpact.core as core
-    from quadimpact.cli.options import announce_compilation
 
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(core, "_checked", set())
+    said: list[str] = []
     assert not core.cache_is_warm()
-    announce_compilation()
-    assert capsys.readouterr().err == (
-        "quadimpact: compiling the simulator (first run only: about 120 s of CPU on a 2-core "
-        "machine, more on a slower one) ...\n"
-    )
+    assert core.announce_compilation(say=said.append)
+    assert said == [
+        "quadimpact: compiling the simulator (first use only: about 120 s of CPU on a 2-core "
+        "machine, more on a slower one; Numba keeps it in its disk cache for every later "
+        "process, and `quadimpact compile` does it ahead of time) ..."
+    ]
     run_py = str(Path(core.__file__).parent / "kernel.py")
     where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
     where.mkdir(parents=True)
     (where / "kernel.run-44.py311.nbi").write_bytes(b"")
     assert core.cache_is_warm()
-    announce_compilation()
-    assert capsys.readouterr().err == ""
+    core._checked.clear()
+    assert not core.announce_compilation(say=said.append)
+    assert len(said) == 1
 
 
 def _refusals(cases: list[list[str]], modules: tuple[str, ...], cwd: Path) -> list[list[Any]]:

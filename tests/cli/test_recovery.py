@@ -85,6 +85,7 @@ def test_the_recovery_command_without_the_example_writes_no_example(tmp_path: Pa
     assert (out / "success_map.png").is_file()
     report = (out / "report.md").read_text()
     assert "## Example trial" not in report and "example/" not in report
+    assert "the example included" not in report and "(tables and figures included)" in report
 
 
 @pytest.mark.slow  # three processes, one with the example and its viewer
@@ -104,6 +105,9 @@ def test_the_recovery_command_runs_a_small_study(tmp_path: Path) -> None:
     again = run_cli("recovery", "--n", "6", "--seed", "1", "--out", "r", "--workers", "1",
                     "--no-animation", "--no-progress", cwd=tmp_path)  # fmt: skip
     assert again.returncode == 0 and "all done before, nothing to run" in again.stdout
+    other = run_cli("recovery", "--n", "7", "--seed", "1", "--out", "r", "--workers", "1",
+                    cwd=tmp_path)  # fmt: skip
+    assert_input_error(other, "holds a recovery study with other options (--n 6 there, 7 asked)")
     other = run_cli("recovery", "--n", "7", "--out", "r", "--workers", "1", cwd=tmp_path)
     assert_input_error(other, "holds a recovery study with other options (--n 6 there, 7 asked; "
                               "--seed 1 there, 0 asked)")  # fmt: skip

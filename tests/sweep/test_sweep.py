@@ -772,7 +772,8 @@ def test_cli_sweep(tmp_path):
     table = read_runs(tmp_path / "o")
     assert len(table) == 6 and table["final_time_s"].eq(1.0).all()
     plots = sorted(p.name for p in (tmp_path / "o" / "plots").iterdir())
-    assert plots == ["delta_init_m_vs_inclination_deg.png", "types_inclination_deg_heading_deg.png"]
+    assert plots == [".drawn.json", "delta_init_m_vs_inclination_deg.png",
+                     "types_inclination_deg_heading_deg.png"]  # fmt: skip
 
 
 @pytest.mark.parametrize(
@@ -835,10 +836,63 @@ def test_plots_say_what_they_show(serial_table):
         "heading ψ = 45 deg",
         "run deeper than the bumper radius (the bumper model does not hold)",
     ]
-    assert fig.get_suptitle() == fixed
+    assert fig.get_suptitle().replace("\n", " ") == fixed  # wrapped to the figure's width
     fig = plot_type_map(table, "inclination_deg", "heading_deg", title=fixed)
     names = [t.get_text() for t in fig.legends[0].get_texts()]
     assert "number: subsequent impacts" in names
     assert "run deeper than the bumper radius (the bumper model does not hold)" in names
     assert fig.axes[0].get_ylabel() == "heading ψ (deg)"
     assert sum(p.get_hatch() == "//" for p in fig.axes[0].patches) == 1
+
+
+def test_a_rerun_with_nothing_to_do_keeps_the_plots_drawn_from_the_same_table(tmp_path):
+    """No Matplotlib, no drawing: the plots drawn from this very table are kept (issue 46);
+    a table written again, or a plot gone, draws them again."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    args = ["sweep", "--grid", "inclination_deg=0,10", "--grid", "speed_m_s=0.5,1.0",
+            "--workers", "1", "--no-progress", "--out", "o"]  # fmt: skip
+    code = (
+        "import json, sys\n"
+        "from quadimpact.cli import main\n"
+        "try:\n"
+        f"    main({args!r})\n"
+        "except SystemExit as exc:\n"
+        "    assert not exc.code, exc.code\n"
+        "print(json.dumps('matplotlib' in sys.modules))\n"
+    )
+
+    def run() -> tuple[bool, str]:
+        proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                              cwd=tmp_path, timeout=120)  # fmt: skip
+        assert proc.returncode == 0, proc.stderr
+        *out, drew = proc.stdout.strip().splitlines()
+        return json.loads(drew), "\n".join(out)
+
+    def mtimes() -> dict[str, int]:
+        return {p.name: p.stat().st_mtime_ns for p in (tmp_path / "o" / "plots").glob("*.png")}
+
+    drew, out = run()
+    first = mtimes()
+    assert drew and sorted(first) == [
+        "delta_init_m_vs_inclination_deg.png", "types_inclination_deg_speed_m_s.png"
+    ]  # fmt: skip
+    drew, again = run()
+    assert not drew and mtimes() == first and again.splitlines()[-1] == out.splitlines()[-1]
+    assert "all done before, nothing to run" in again
+    # what draws them again: a table written anew, a plot gone
+    from quadimpact.sweep.plot_plan import drawn_plots
+
+    names = sorted(first)
+    assert drawn_plots(tmp_path / "o", names) == [tmp_path / "o" / "plots" / n for n in names]
+    table = tmp_path / "o" / "runs.parquet"
+    os.utime(table, ns=(table.stat().st_atime_ns, table.stat().st_mtime_ns + 1_000_000))
+    assert drawn_plots(tmp_path / "o", names) is None
+    drew, _ = run()
+    assert drew and all(mtimes()[name] > first[name] for name in first)
+    assert drawn_plots(tmp_path / "o", names) is not None
+    (tmp_path / "o" / "plots" / names[0]).unlink()
+    assert drawn_plots(tmp_path / "o", names) is None

@@ -8,6 +8,7 @@
 * :mod:`~quadimpact.cli.pole_command`: ``quadimpact pole``;
 * :mod:`~quadimpact.cli.estimators_command`: ``quadimpact estimators``;
 * :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
+* :mod:`~quadimpact.cli.compile_command`: ``quadimpact compile``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
 
 Heavy modules (pydantic, NumPy, the compiled core) are imported inside the
@@ -20,6 +21,7 @@ run`` exits with status 3 when the run failed numerically (its status is
 
 from __future__ import annotations
 
+import logging
 import os
 import sys
 import traceback
@@ -28,6 +30,7 @@ from typing import Any
 
 import click
 
+from quadimpact.cli.compile_command import compile_command
 from quadimpact.cli.estimators_command import estimators
 from quadimpact.cli.experiments_command import experiments
 from quadimpact.cli.pole_command import pole
@@ -89,9 +92,19 @@ def cli() -> None:
 
 
 # ---- the commands, each in its own module: one registration line each ----
-for _command in (
-    run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole, estimators,
-):  # fmt: skip
+_COMMANDS = (
+    run,
+    animate,
+    snapshots,
+    view,
+    sweep,
+    reproduce,
+    experiments,
+    recovery,
+    pole,
+    estimators,
+)
+for _command in (*_COMMANDS, compile_command):
     cli.add_command(_command)
 
 
@@ -116,6 +129,20 @@ def _show_warning(
     )
 
 
+class _Notices(logging.Handler):
+    """The ``quadimpact`` logger's notices (a first run's compilation) as lines on stderr."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        click.echo(one_line(record.getMessage()), err=True)
+
+
+def _show_notices() -> None:
+    logger = logging.getLogger("quadimpact")
+    if not any(isinstance(h, _Notices) for h in logger.handlers):
+        logger.addHandler(_Notices(logging.WARNING))
+        logger.propagate = False
+
+
 def main(argv: list[str] | None = None) -> None:
     """Entry point of the ``quadimpact`` command.
 
@@ -132,6 +159,7 @@ def main(argv: list[str] | None = None) -> None:
     debug = os.environ.get("QUADIMPACT_DEBUG", "") not in ("", "0")
     if not debug:
         warnings.showwarning = _show_warning
+    _show_notices()
     try:
         code = cli.main(args=argv, prog_name="quadimpact", standalone_mode=False)
     except click.exceptions.NoArgsIsHelpError as exc:

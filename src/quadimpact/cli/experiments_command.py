@@ -8,7 +8,6 @@ from typing import Any
 import click
 
 from quadimpact.cli.options import (
-    announce_compilation,
     data_option,
     defaulted_option,
     out_option,
@@ -79,7 +78,6 @@ def experiments(
     study_folder(out, samples, log_samples, where="--out").check()  # other options: refused
     if data is not None:
         check_data_dir(data)
-    announce_compilation()
     with stoppable(out):
         table = run_experiments(
             out, data_dir=data, samples=samples, log_samples=log_samples, workers=workers,

@@ -89,27 +89,6 @@ def max_record_option(help: str) -> Decorator:
     )
 
 
-#: What a first run takes to compile the simulator (measured on 2 cores with the
-#: estimators, obstacle shapes and features in the loop: about 120 s of CPU).
-COMPILE_SECONDS = 120
-
-
-def announce_compilation() -> None:
-    """Say on stderr, before a first run, that the simulator is being compiled.
-
-    On a fresh checkout (or after its sources changed) Numba's cache is cold and
-    the first simulation compiles the loop: tens of seconds of silence otherwise.
-    """
-    from quadimpact.core import cache_is_warm
-
-    if not cache_is_warm():
-        click.echo(
-            "quadimpact: compiling the simulator (first run only: about "
-            f"{COMPILE_SECONDS} s of CPU on a 2-core machine, more on a slower one) ...",
-            err=True,
-        )
-
-
 def check_scheduler(address: str, timeout_s: float = 5.0) -> None:
     """Refuse a Dask scheduler address that is malformed or (``tcp://``) not listening.
 

@@ -7,7 +7,6 @@ from pathlib import Path
 import click
 
 from quadimpact.cli.options import (
-    announce_compilation,
     data_option,
     out_option,
     parallel_options,
@@ -80,7 +79,6 @@ def reproduce(
     study_folder(out, where="--out", **parts).check()  # other parts: refused at once
     if data is not None and not no_experiments:
         check_data_dir(data)
-    announce_compilation()
 
     with stoppable(out):
         result = run_study(

@@ -12,7 +12,6 @@ import click
 from quadimpact.cli.options import (
     CONTROLLER,
     MODEL,
-    announce_compilation,
     file_argument,
     max_record_option,
     number_option,
@@ -267,7 +266,6 @@ def run(
     check_out_dir(out, "run")
     vehicle = built.build_vehicle()
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
-    announce_compilation()
 
     from quadimpact.simulation import simulate
 

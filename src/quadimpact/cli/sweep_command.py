@@ -11,7 +11,6 @@ from pathlib import Path
 import click
 
 from quadimpact.cli.options import (
-    announce_compilation,
     file_argument,
     max_record_option,
     parallel_options,
@@ -126,7 +125,9 @@ def sweep(
     extra = _parse_grid(grid)
     if sweep_file is None and not extra:
         raise InputError("sweep: give a sweep file or at least one --grid FIELD=VALUES")
-    if workers is not None and workers > 1:
+    from quadimpact.sweep.store import finished_before
+
+    if workers is not None and workers > 1 and not finished_before(out):
         from quadimpact.sweep.runner import warm_pool
 
         # N workers from the start (unless every run is done already): the fork server
@@ -142,7 +143,6 @@ def sweep(
             spec = spec.with_grid(extra)
     else:
         spec = SweepSpec(grid=extra, where="sweep")
-    announce_compilation()
     # once stopped by a signal, every later one is ignored until the program has ended
     with stoppable():
         info = run_sweep(
@@ -158,12 +158,19 @@ def sweep(
         )
     plots: list[Path] = []
     if not no_plots:
-        from quadimpact.sweep.plots import auto_plots
+        from quadimpact.sweep.plot_plan import drawn_plots, plot_plan
 
-        try:
-            plots = auto_plots(out, spec)
-        except Exception as exc:  # plots never lose the table
-            click.echo(f"quadimpact: warning: plots not written: {exc}", err=True)
+        names = plot_plan(spec)[1]
+        drawn = drawn_plots(out, names) if names else []
+        if drawn is not None:  # drawn before from this very table (a rerun): kept
+            plots = drawn
+        else:
+            from quadimpact.sweep.plots import auto_plots
+
+            try:
+                plots = auto_plots(out, spec)
+            except Exception as exc:  # plots never lose the table
+                click.echo(f"quadimpact: warning: plots not written: {exc}", err=True)
     click.echo(_report(out, plots, info))
 
 

@@ -235,9 +235,12 @@ def animate(
     """
     from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA
 
+    if start is not None and end is not None and end < start:
+        raise InputError(f"--start {start:g}, --end {end:g}: --end must not precede --start")
     wh = _parse_size(size)
     camera = _camera(DEFAULT_ANIMATION_CAMERA, **cam)
     scene = _scene(result_dir, vehicle)
+    _check_span(start, end, scene.t_start, scene.t_end)
     _need_ffmpeg()
     from quadimpact.viz.animation import write_animation
 
@@ -260,6 +263,15 @@ def animate(
         f"in {info.seconds:.1f} s",
         err=True,
     )
+
+
+def _check_span(start: float | None, end: float | None, t_start: float, t_end: float) -> None:
+    """Refuse a ``--start`` after the run's end or an ``--end`` before its start, s."""
+    span = f"the run spans {t_start:g} to {t_end:g} s"
+    if start is not None and start > t_end:
+        raise InputError(f"--start {start:g}: after the end of the run ({span})")
+    if end is not None and end < t_start:
+        raise InputError(f"--end {end:g}: before the start of the run ({span})")
 
 
 def _need_ffmpeg() -> None:

@@ -33,18 +33,23 @@ pipeline stage:
 Numba's on-disk cache checks only the file of each cached function, not the
 files of the functions it calls and inlines: an edited ``controllers/paper.py``
 would leave ``run.py``'s cached loop stale. ``ensure_fresh_cache`` (run on import)
-keeps a hash of all the core sources next to the cache and clears the core's
-cache files when it changes. ``cache_is_warm`` says whether a first run will
-compile (the command line announces it).
+keeps a hash of all the core sources (but this file, which compiles nothing) next
+to the cache and clears the core's cache files when it changes. ``cache_is_warm``
+says whether a first run will compile, and ``announce_compilation`` says so once
+per process, before the compilation starts (the Python entry points and the
+commands call it).
 """
 
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
+from collections.abc import Callable
 from pathlib import Path
 
-_HERE = Path(__file__).resolve().parent
+_THIS = Path(__file__).resolve()
+_HERE = _THIS.parent
 _STAMP = "quadimpact-core-sources.sha256"
 
 
@@ -66,18 +71,88 @@ def _cache_dirs() -> list[Path]:
     return [_numba_dir(p) for p in packages]
 
 
-def cache_is_warm() -> bool:
-    """Whether the compiled loop is in Numba's on-disk cache (else the first run compiles it).
+def cache_is_warm(*entries: str) -> bool:
+    """Whether compiled entry points are in Numba's on-disk cache (else their first use compiles).
 
-    Cheap: looks for the index file of ``kernel.run`` (no Numba import).
+    ``entries``: functions named by their module under ``quadimpact.core`` and
+    their name, ``"kernel.run"`` (the default: the run loop) or
+    ``"envs.stacked.step_batch"``. Cheap: looks for each one's index file
+    (no Numba import).
     """
-    return any(_numba_dir(_HERE).glob("kernel.run-*.nbi"))
+    for entry in entries or ("kernel.run",):
+        module, _, function = entry.rpartition(".")
+        *packages, stem = module.split(".")
+        if not any(_numba_dir(_HERE.joinpath(*packages)).glob(f"{stem}.{function}-*.nbi")):
+            return False
+    return True
+
+
+#: What compiles on first use: each part's entry points (:func:`cache_is_warm`), what it
+#: is in words and about how much CPU its compilation takes on a 2-core machine, s (the
+#: simulator: the loop with its estimators, obstacle shapes and features; the learning
+#: environments: their own loop, with the simulator's functions already in the cache).
+COMPILED_PARTS: dict[str, tuple[tuple[str, ...], str, int]] = {
+    "simulator": (("kernel.run",), "the simulator", 120),
+    "environments": (
+        ("envs.stacked.reset_slot", "envs.stacked.step_batch"),
+        "the learning environments' loop",
+        20,
+    ),
+}
+#: The parts a part's first use compiles: the environments run the simulator's functions.
+_NEEDS = {"simulator": ("simulator",), "environments": ("simulator", "environments")}
+#: The command that compiles every part ahead of time.
+WARM_COMMAND = "quadimpact compile"
+
+_checked: set[str] = set()  # the parts this process has looked at (said, or found warm)
+_log = logging.getLogger("quadimpact")
+
+
+def compilation_notice(parts: tuple[str, ...] = ("simulator",)) -> str:
+    """The one-line notice that ``parts`` (keys of :data:`COMPILED_PARTS`) are being compiled."""
+    what = " and ".join(COMPILED_PARTS[p][1] for p in parts)
+    seconds = sum(COMPILED_PARTS[p][2] for p in parts)
+    return (
+        f"quadimpact: compiling {what} (first use only: about {seconds} s of CPU on a 2-core "
+        f"machine, more on a slower one; Numba keeps it in its disk cache for every later "
+        f"process, and `{WARM_COMMAND}` does it ahead of time) ..."
+    )
+
+
+def announce_compilation(part: str = "simulator", say: Callable[[str], None] | None = None) -> bool:
+    """Say, once per process, that the first use of ``part`` compiles it; True if said.
+
+    Called before the first compiled call (``simulation.setup.prepare``, the
+    learning environments, a sweep or a study about to hand runs to worker
+    processes, which compile in their turn): it looks at the on-disk cache
+    (:func:`cache_is_warm`) once per part and process, and, if cold, gives
+    :func:`compilation_notice` to ``say`` (default: a warning of the
+    ``quadimpact`` logger, which Python prints on stderr when logging is not
+    configured). ``part``: a key of :data:`COMPILED_PARTS`.
+    """
+    todo = [p for p in _NEEDS[part] if p not in _checked]
+    if not todo:
+        return False
+    _checked.update(todo)
+    cold = tuple(p for p in todo if not cache_is_warm(*COMPILED_PARTS[p][0]))
+    if not cold:
+        return False
+    (say or _log.warning)(compilation_notice(cold))
+    return True
+
+
+def silence_compilation_notice() -> None:
+    """Never announce a compilation in this process (a worker: the process it works for
+    announces it)."""
+    _checked.update(COMPILED_PARTS)
 
 
 def ensure_fresh_cache() -> None:
     """Clear the core's Numba cache files if any core source changed since they were made."""
     digest = hashlib.sha256()
     for src in sorted(_HERE.rglob("*.py")):
+        if src == _THIS:  # this file compiles nothing: its notices may change freely
+            continue
         digest.update(str(src.relative_to(_HERE)).encode())
         digest.update(src.read_bytes())
     current = digest.hexdigest()

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.records import (
@@ -83,6 +84,7 @@ class Slots:
         record: bool,
         max_episodes: int = 256,
     ) -> None:
+        announce_compilation("environments")  # a first use compiles their loop
         self.n = int(n)
         self.trials = trials
         self.until_detection = until_detection

@@ -41,7 +41,7 @@ import os
 import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -52,6 +52,9 @@ from quadimpact.experiments.logs import FlightLog, PreImpact
 from quadimpact.linalg import norm
 from quadimpact.rotations import quat_to_matrix, unwrap_deg, wrap_angle_deg
 from quadimpact.simulation.response_types import classify_response
+
+if TYPE_CHECKING:  # Matplotlib only where a figure is drawn
+    from matplotlib.figure import Figure
 
 __all__ = [
     "CONTACT_TOL_M",
@@ -372,8 +375,14 @@ class Comparison:
         return out
 
     def plot(self, path: str | os.PathLike[str], title: str | None = None) -> Path:
-        """Side-by-side panels (sim lines, log markers) written as a PNG; returns the path."""
-        from quadimpact.results.figures import new_figure, save_figure
+        """:meth:`figure` written as a PNG; returns the path."""
+        from quadimpact.results.figures import save_figure
+
+        return save_figure(self.figure(title), path)
+
+    def figure(self, title: str | None = None) -> Figure:
+        """Side-by-side panels: the simulation's lines, the log's markers, the errors."""
+        from quadimpact.results.figures import fit_title, new_figure
 
         # fixed margins (no constrained layout: half the time of this 12-panel figure)
         margins = {"left": 0.06, "right": 0.98, "bottom": 0.05, "top": 0.94,
@@ -432,8 +441,8 @@ class Comparison:
         for note in self.notes:
             lines.append(textwrap.fill(note, 60))
         text.text(0.0, 1.0, "\n".join(lines), va="top", family="monospace", fontsize=8)
-        fig.suptitle(title or f"{self.name}: simulation vs log, aligned at impact")
-        return save_figure(fig, path)
+        fit_title(fig, title or f"{self.name}: simulation vs log, aligned at impact")
+        return fig
 
 
 def _sim_table(result_or_timeseries: Any) -> tuple[pd.DataFrame, float | None, str | None]:

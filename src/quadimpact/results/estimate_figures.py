@@ -19,7 +19,13 @@ from typing import Any
 import numpy as np
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import mark_stages, new_figure, save_figure, set_time_limits
+from quadimpact.results.figures import (
+    fit_title,
+    mark_stages,
+    new_figure,
+    save_figure,
+    set_time_limits,
+)
 from quadimpact.rotations import quat_to_euler_zyx
 
 __all__ = ["make_error_comparison", "make_estimate", "plot_estimate"]
@@ -48,7 +54,7 @@ def make_estimate(
         ax.plot(t, np.unwrap(euler_hat[:, k], period=360.0), color=color, linewidth=1.0,
                 linestyle="--", label=f"{name} (estimate)")  # fmt: skip
     ax.set_ylabel("Attitude (deg)")
-    ax.legend(loc="upper right", fontsize="small", ncols=3)
+    ax.legend(loc="best", fontsize="small", ncols=3)  # where it covers the least
     ax = axes[1]
     ax.plot(t, _col(imu, "attitude_error_deg"), color="black", linewidth=1.0)
     ax.set_ylabel("Attitude error (deg)")
@@ -67,7 +73,7 @@ def make_estimate(
                 linestyle="--", label=f"b_{axis} (estimate)")  # fmt: skip
     ax.set_ylabel("Gyro bias (rad/s)")
     ax.set_xlabel("Time (s)")
-    ax.legend(loc="upper right", fontsize="small", ncols=3)
+    ax.legend(loc="best", fontsize="small", ncols=3)  # where it covers the least
     for k, ax in enumerate(axes):
         mark_stages(ax, summary, label=k == 1)
         ax.grid(True, alpha=0.4)
@@ -75,7 +81,7 @@ def make_estimate(
     set_time_limits(axes[0], t)
     name = (summary or {}).get("estimator")
     head = f"Estimate ({name}) beside the truth" if name else "Estimate beside the truth"
-    fig.suptitle(f"{head}: {title}" if title else head)
+    fit_title(fig, f"{head}: {title}" if title else head)
     return fig
 
 
@@ -115,5 +121,5 @@ def make_error_comparison(
     ax.set_ylabel("Attitude error (deg)")
     ax.grid(True, alpha=0.4)
     ax.legend(loc="upper right", fontsize="small")
-    fig.suptitle(title or "Attitude error around the impact (dashed: stage 4)")
+    fit_title(fig, title or "Attitude error around the impact (dashed: stage 4)")
     return fig

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from quadimpact.results.files import atomic_write
 from quadimpact.rotations import unwrap_deg
@@ -38,6 +39,8 @@ __all__ = [
     "break_wraps",
     "unwrap_deg",
     "fig_margins",
+    "fit_title",
+    "legend_below",
     "make_fig5",
     "make_fig6",
     "new_figure",
@@ -137,6 +140,69 @@ def fig_margins(
     }
 
 
+#: Share of the figure's (or the axes') width a title may take before it is wrapped.
+TITLE_WIDTH = 0.96
+
+
+def _wrap_to_width(text: Text, width_px: float) -> int:
+    """Wrap a text artist at its spaces until no line is wider than ``width_px``; its lines.
+
+    A text that fits is left as it is (the same pixels as before); a single
+    word wider than the width stays whole.
+    """
+    import textwrap
+
+    renderer = text.get_figure(root=True).canvas.get_renderer()
+    whole = text.get_text()
+    wide = text.get_window_extent(renderer).width
+    if wide <= width_px or " " not in whole.strip():
+        return whole.count("\n") + 1
+    chars = max(8, int(max(map(len, whole.split("\n"))) * width_px / wide))
+    while True:  # each of its own lines wrapped alike
+        lines = [wrapped for line in whole.split("\n") for wrapped in textwrap.wrap(
+            line, chars, break_long_words=False, break_on_hyphens=False) or [""]]  # fmt: skip
+        text.set_text("\n".join(lines))
+        if text.get_window_extent(renderer).width <= width_px or chars <= 8:
+            return len(lines)
+        chars -= max(1, chars // 10)
+
+
+def fit_title(where: Figure | Any, title: str, **kwargs: Any) -> Text:
+    """A title that fits: the figure's (``suptitle``) or an axes' (``set_title``), wrapped.
+
+    ``where``: a figure or an axes; ``kwargs`` go to ``suptitle`` or
+    ``set_title``. A title wider than :data:`TITLE_WIDTH` of the figure (or
+    of the axes) is wrapped at its spaces onto more lines; a figure with
+    fixed margins (:func:`fig_margins`) then lowers its subplots' top by the
+    added lines, so that the title is neither cut at the canvas' sides nor
+    drawn over the panels (constrained layout makes the room itself).
+    """
+    fig = where if isinstance(where, Figure) else where.get_figure(root=True)
+    if isinstance(where, Figure):
+        text = fig.suptitle(title, **kwargs)
+        width = fig.bbox.width
+    else:
+        text = where.set_title(title, **kwargs)
+        width = where.get_position().width * fig.bbox.width
+    extra = _wrap_to_width(text, TITLE_WIDTH * width) - (title.count("\n") + 1)
+    if extra > 0 and fig.get_layout_engine() is None:
+        line_px = 1.2 * text.get_fontsize() * fig.dpi / 72.0
+        fig.subplots_adjust(top=fig.subplotpars.top - extra * line_px / fig.bbox.height)
+    return text
+
+
+def legend_below(fig: Figure, handles: list[Any], labels: list[str], **kwargs: Any) -> Any:
+    """One legend for the whole figure, below its panels (constrained layout makes the room),
+    in as many columns as fit the figure's width: it covers no data and is not cut."""
+    renderer = fig.canvas.get_renderer()
+    for ncols in range(len(labels), 0, -1):
+        legend = fig.legend(handles, labels, loc="outside lower center", ncols=ncols, **kwargs)
+        if ncols == 1 or legend.get_window_extent(renderer).width <= fig.bbox.width:
+            return legend
+        legend.remove()
+    return None
+
+
 def set_time_limits(ax: Any, t: Any) -> None:
     """The time axis from the first to the last finite sample (a run of one sample: as is)."""
     t = np.asarray(t, dtype=np.float64)
@@ -193,7 +259,7 @@ def make_fig5(ts: pd.DataFrame, title: str | None = None) -> Figure:
     ax.legend(loc="best")
     set_time_limits(ax, t)
     if title:
-        ax.set_title(title)
+        fit_title(ax, title)
     return fig
 
 
@@ -278,7 +344,7 @@ def make_fig6(
         ax.set_xlabel("Time (s)")
     set_time_limits(axes[0, 0], t)
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     return fig
 
 
@@ -393,7 +459,7 @@ def make_imu(
         compact_ticks(ax)
     set_time_limits(first, t)
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     return fig
 
 

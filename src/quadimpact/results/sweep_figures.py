@@ -24,7 +24,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch, Rectangle
 
 from quadimpact.errors import InputError
-from quadimpact.results.figures import new_figure, save_figure
+from quadimpact.results.figures import fit_title, new_figure, save_figure
 from quadimpact.results.files import split_unit
 
 if TYPE_CHECKING:  # pandas only where a table is drawn
@@ -297,7 +297,7 @@ def type_map_figure(
         fig.legend(handles=handles, loc="outside lower center", fontsize=8,
                    ncols=min(len(handles), 5 if width >= 9.0 else 2))  # fmt: skip
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     if path is not None:
         save_figure(fig, path)
     return fig

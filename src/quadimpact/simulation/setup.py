@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
 from quadimpact.core.kernel import Kernel, make_kernel
@@ -494,10 +495,12 @@ def prepare(
 
     ``kernel``: a run loop (``core.run.make_kernel``) in place of the one the
     scenario's controller and estimator select; a wall approach's shooting
-    runs fly with it too.
+    runs fly with it too. The first call in a process whose compiled loop is
+    not in Numba's disk cache says that it compiles (``core.announce_compilation``).
     """
     started = cpu_time()
     check_scenario_type(scenario)
+    announce_compilation()
     if isinstance(scenario, WallApproach):
         setup = prepare_wall_approach(scenario, kernel)
     elif isinstance(scenario, ImpactTrial):

@@ -15,7 +15,6 @@ pyplot state); with ``path`` they are also written as PNG (atomically).
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,7 +22,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from quadimpact.errors import InputError
-from quadimpact.results.figures import new_figure, save_figure
+from quadimpact.results.figures import fit_title, legend_below, new_figure, save_figure
 from quadimpact.results.sweep_figures import (
     INVALID_LABEL,
     TYPE_COLOURS,
@@ -36,15 +35,18 @@ from quadimpact.results.sweep_figures import (
     sorted_levels,
     type_map_figure,
 )
+from quadimpact.sweep.plot_plan import (  # noqa: F401  (here as before)
+    MAX_AUTO_RUNS,
+    choose_plot_fields,
+    plot_plan,
+    record_plots,
+)
 from quadimpact.sweep.store import read_runs
 
 __all__ = ["TYPE_COLORS", "plot_metric", "plot_type_map", "auto_plots"]
 
 TYPE_COLORS = TYPE_COLOURS
 """The type map's colours (:data:`quadimpact.results.sweep_figures.TYPE_COLOURS`)."""
-
-MAX_AUTO_RUNS = 50_000
-"""``auto_plots`` does nothing for larger sweeps (keep ``quadimpact sweep`` cheap)."""
 
 
 def plot_metric(
@@ -121,11 +123,15 @@ def plot_metric(
         if fv is not None:
             ax.set_title(field_value(facet, fv), fontsize=10)
         ax.grid(True, alpha=0.3)
-        if by is not None or marked:
-            ax.legend(fontsize=8)
     axes[0].set_ylabel(label)
+    if by is not None or marked:  # one legend below the panels: it covers no curve
+        entries = {}
+        for ax in axes:
+            for handle, text in zip(*ax.get_legend_handles_labels(), strict=True):
+                entries.setdefault(text, handle)
+        legend_below(fig, list(entries.values()), list(entries), fontsize=8)
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     if path is not None:
         save_figure(fig, path)
     return fig
@@ -146,33 +152,8 @@ def plot_type_map(
     return type_map_figure(table, x, y, facet, title=title, path=path)
 
 
-def choose_plot_fields(
-    columns: dict[str, str], grid: dict[str, Sequence[Any]]
-) -> tuple[str, str | None, str | None] | None:
-    """(x, by, facet) for the automatic plots of a grid, or None if not plottable.
-
-    ``x`` is the numeric varied field with the most values; with two other
-    varied fields, the one with fewer values (at most 4) makes the panels.
-    """
-    varying = [k for k, v in grid.items() if len(v) > 1]
-    numeric = [k for k in varying if columns.get(k) == "f"]
-    if not numeric or len(varying) > 3:
-        return None
-    x = max(numeric, key=lambda k: (len(grid[k]), -varying.index(k)))
-    rest = [k for k in varying if k != x]
-    by = facet = None
-    if len(rest) == 2:
-        facet = min(rest, key=lambda k: (len(grid[k]), rest.index(k)))
-        if len(grid[facet]) > 4:
-            return None
-        by = rest[0] if rest[1] == facet else rest[1]
-    elif len(rest) == 1:
-        by = rest[0]
-    return x, by, facet
-
-
 def auto_plots(out_dir: str | os.PathLike[str], spec: Any) -> list[Path]:
-    """The plots ``quadimpact sweep`` writes in ``DIR/plots`` for a grid sweep.
+    """The plots ``quadimpact sweep`` writes in ``DIR/plots`` for a grid sweep (drawn anew).
 
     For a grid (no runs list or sample) of one to three varied fields, at
     least one numeric (see :func:`choose_plot_fields`): ``delta_init_m``
@@ -184,12 +165,11 @@ def auto_plots(out_dir: str | os.PathLike[str], spec: Any) -> list[Path]:
     -------
     list of pathlib.Path
         The files written (none for other sweeps, or above
-        :data:`MAX_AUTO_RUNS` runs).
+        :data:`MAX_AUTO_RUNS` runs: :func:`~quadimpact.sweep.plot_plan.plot_plan`).
+        What they were drawn from is recorded in ``plots/.drawn.json``
+        (:func:`~quadimpact.sweep.plot_plan.drawn_plots`).
     """
-    drawn = spec.sample is not None or spec.trials is not None
-    if spec.runs or drawn or spec.n_runs > MAX_AUTO_RUNS:
-        return []
-    choice = choose_plot_fields(spec.columns, spec.grid)
+    choice, names = plot_plan(spec)
     if choice is None:
         return []
     x, by, facet = choice
@@ -198,15 +178,15 @@ def auto_plots(out_dir: str | os.PathLike[str], spec: Any) -> list[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     fixed = fixed_parameters(spec)
     written = []
-    if by is None or len(spec.grid[by]) <= 12:
-        path = folder / f"delta_init_m_vs_{x}.png"
-        title = f"Initial deflection δ_init; {fixed}"
-        plot_metric(table, x, "delta_init_m", by=by, facet=facet, path=path, title=title)
+    for name in names:
+        path = folder / name
+        if name.startswith("delta_init_m_vs_"):
+            title = f"Initial deflection δ_init; {fixed}"
+            plot_metric(table, x, "delta_init_m", by=by, facet=facet, path=path, title=title)
+        else:
+            plot_type_map(table, x, by, path=path, facet=facet, title=f"Response type; {fixed}")
         written.append(path)
-    if by is not None and len(spec.grid[by]) <= 200:
-        path = folder / f"types_{x}_{by}.png"
-        plot_type_map(table, x, by, path=path, facet=facet, title=f"Response type; {fixed}")
-        written.append(path)
+    record_plots(out_dir, written)
     return written
 
 

@@ -14,7 +14,10 @@ class Progress:
     """Runs done / total, rate and time left, on stderr.
 
     On a terminal one line is redrawn in place (at most 10 times a second);
-    otherwise at most five lines are printed (start, 25/50/75 % and the end).
+    otherwise at most five lines are printed (start, 25/50/75 % and the end;
+    a resumed sweep skips the marks it had passed before). The rate and the
+    time left count only the runs done since the bar started: until one is
+    done they are unknown (``--``), not zero.
     """
 
     def __init__(self, total: int, done: int = 0, enabled: bool = True, stream: Any = None):
@@ -25,7 +28,9 @@ class Progress:
         self.tty = bool(isatty and isatty())
         self.t0 = time.monotonic()
         self.last = 0.0
-        self.next_mark = 1
+        self.next_mark = 1  # the first of the 25/50/75 % marks not yet passed
+        while self.next_mark <= 3 and done * 4 >= self.next_mark * total:
+            self.next_mark += 1
         self.drawn = -1
         if self.enabled and self.tty:
             self._draw()
@@ -42,12 +47,13 @@ class Progress:
     def _line(self) -> str:
         elapsed = time.monotonic() - self.t0
         ran = self.done - self.start_done
-        rate = ran / elapsed if elapsed > 0 else 0.0
+        rate = ran / elapsed if elapsed > 0 and ran > 0 else math.nan
         left = (self.total - self.done) / rate if rate > 0 else math.nan
         eta = "--:--" if math.isnan(left) else _clock(left)
+        speed = "    --" if math.isnan(rate) else f"{rate:6.1f}"
         pct = 100.0 * self.done / self.total if self.total else 100.0
         return (
-            f"sweep {self.done}/{self.total} runs ({pct:3.0f}%)  {rate:6.1f} runs/s  "
+            f"sweep {self.done}/{self.total} runs ({pct:3.0f}%)  {speed} runs/s  "
             f"elapsed {_clock(elapsed)}  left {eta}"
         )
 

@@ -10,6 +10,7 @@ from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
+from quadimpact.core import announce_compilation
 from quadimpact.errors import InputError, format_value
 from quadimpact.results.files import check_out_dir
 from quadimpact.sweep.backends import (
@@ -37,6 +38,7 @@ from quadimpact.sweep.store import (
     PartWriter,
     check_folder,
     consolidate,
+    finished_before,
     folder_lock,
     read_runs,
     scan_done,
@@ -232,7 +234,8 @@ def run_sweep(
 
     try:
         with stop_signals() as stop, contextlib.ExitStack() as stack:
-            if workers is not None and n_workers > 1 and spec.n_runs > 1:
+            pool = workers is not None and n_workers > 1 and spec.n_runs > 1
+            if pool and not finished_before(out):
                 start_server(pool_context())  # it loads the kernel while the runs are checked
             if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
                 _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
@@ -250,6 +253,8 @@ def run_sweep(
             n_todo = spec.n_runs - n_before
             backend = "none"
             if n_todo:
+                if client is None:  # here or the local workers: said before the progress bar
+                    announce_compilation()
                 writer = PartWriter(out / "parts", schema, last_part)
                 bar = Progress(spec.n_runs, n_before, enabled=progress)
 

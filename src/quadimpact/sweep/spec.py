@@ -11,7 +11,7 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from quadimpact.errors import InputError, format_value
+from quadimpact.errors import InputError, format_value, short_path
 from quadimpact.inputs.toml_files import apply_overrides, locate_vehicle, read_toml_file
 from quadimpact.sweep.items import SweepBase
 from quadimpact.sweep.values import (
@@ -183,8 +183,9 @@ class SweepSpec:
         if base is None:
             return {}
         if isinstance(base, (str, os.PathLike)):
-            path = Path(base)
-            return plain(locate_vehicle(read_toml_file(path), path.parent))
+            path = Path(base)  # "study.toml: base: scenario.toml: file not found"
+            where = f"{self.where}: base: {short_path(path)}"
+            return plain(locate_vehicle(read_toml_file(path, where), path.parent))
         if not isinstance(base, Mapping):
             raise InputError(f"{self.where}: base: must be a table of scenario fields or a path")
         return plain(dict(base))

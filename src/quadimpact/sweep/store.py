@@ -492,6 +492,15 @@ def consolidate(out: Path, schema: Any, n_runs: int) -> None:
         p.unlink(missing_ok=True)
 
 
+def finished_before(out: Path) -> bool:
+    """Whether ``out`` looks like a finished sweep: ``runs.parquet`` and no part (a guess,
+    for what to ready before the sweep starts; :func:`scan_done` checks)."""
+    parts = out / "parts"
+    return (out / "runs.parquet").is_file() and not (
+        parts.is_dir() and any(parts.glob("part-*.parquet"))
+    )
+
+
 def check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
     """Write sweep.json, or check that the folder holds this very sweep."""
     from quadimpact import __version__
@@ -525,9 +534,9 @@ def check_folder(out: Path, spec: SweepSpec, schema: Any) -> None:
                     for k in ("base", "grid", "runs", "sample")
                     if (old.get("spec") or {}).get(k) != json.loads(canonical(spec.to_dict()))[k]
                 ]
-                detail = "its " + ", ".join(keys or ["spec"])
+                detail = " or ".join(keys or ["spec"])
             raise InputError(
-                f"{out}: holds a different sweep ({detail} differs, see sweep.json); "
+                f"{out}: holds a different sweep (not the same {detail}, see sweep.json); "
                 "use another output folder, or delete this one to start over"
             )
         return

@@ -30,6 +30,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
+from quadimpact.core import announce_compilation, silence_compilation_notice
 from quadimpact.sweep.interrupt import stop_signals
 from quadimpact.sweep.pool import WorkerError, pool_context, start_server
 from quadimpact.sweep.worker import set_parent_death_signal
@@ -45,6 +46,7 @@ def _start_task_worker() -> None:
         set_parent_death_signal(signal.SIGKILL)
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    silence_compilation_notice()  # run_tasks said it, once
 
 
 def _kill_workers(executor: ProcessPoolExecutor) -> None:
@@ -94,6 +96,7 @@ def run_tasks(
     _refuse_in_a_starting_worker()
     ctx = pool_context()
     start_server(ctx)
+    announce_compilation()  # the workers compile, silently: said here, once
     results: list[Any] = [None] * len(tasks)
     executor = ProcessPoolExecutor(
         max_workers=min(workers, len(tasks)), mp_context=ctx, initializer=_start_task_worker

@@ -208,6 +208,7 @@ def pool_worker(conn: Any) -> None:
         if signum is not None:
             signal.signal(signum, signal.SIG_DFL)  # the fork server's handler is inherited
     with contextlib.suppress(Exception):
+        _quiet_compilation()
         warm_up()
     group: list[int] = [0]  # the size of the group running
 
@@ -232,6 +233,14 @@ def pool_worker(conn: Any) -> None:
                     rows = []
     except (EOFError, OSError):  # the sweep is gone
         return
+
+
+def _quiet_compilation() -> None:
+    """No compilation notice from this worker process: the sweep or study it works for
+    gives it (``core.announce_compilation``) before handing runs to its workers."""
+    from quadimpact.core import silence_compilation_notice
+
+    silence_compilation_notice()
 
 
 def worker_info() -> dict[str, Any]:
@@ -261,6 +270,7 @@ def preload() -> None:
     for var in SINGLE_THREAD_VARS:
         os.environ.setdefault(var, "1")
     with contextlib.suppress(BaseException):
+        _quiet_compilation()  # the sweep says it, once (this server's workers inherit it)
         warm_up()
         if tempdir:  # tell the sweep that workers now start ready
             open(os.path.join(tempdir, SERVER_READY), "w").close()

@@ -37,7 +37,7 @@ from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import set_time_limits, stage_label
+from quadimpact.results.figures import fit_title, set_time_limits, stage_label
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.camera import DEFAULT_ANIMATION_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
@@ -60,6 +60,9 @@ ANIMATION_GIF = "animation.gif"
 
 
 _ATTITUDE_COLORS = {"roll": "#1b9e77", "pitch": "#d95f02", "yaw": "#7570b3"}
+#: From this movie height on (pixels) the plots' legends sit above their panels, over no
+#: curve; a smaller movie has no room there and keeps them in the panels' upper right.
+LEGENDS_ABOVE_PX = 360
 
 
 def frame_times(t0: float, t1: float, fps: float, slow: float = 1.0) -> np.ndarray:
@@ -113,7 +116,7 @@ class AnimationFigure:
         # the 3D axes' box aspect: its share of the figure width over the height
         aspect = (1.55 / 2.55) * self.width / self.height * 0.97
         self.view = SceneArtists(ax3d, scene, camera, aspect=aspect, linewidth=2.0)
-        fig.suptitle(scene.describe(), fontsize=11)
+        fit_title(fig, scene.describe(), fontsize=11)
         self.clock = ax3d.text(
             0.02,
             0.98,
@@ -155,7 +158,12 @@ class AnimationFigure:
             self.defl_live.append(ax_d.plot([], [], color=c, linewidth=1.6, label=f"bumper {j}")[0])
             self.defl_dots.append(ax_d.plot([], [], "o", color=c, markersize=4)[0])
         ax_d.set_ylabel("deflection (mm)")
-        ax_d.legend(loc="upper right", fontsize=8, ncol=2)
+        # the legends above their panels, where the movie is tall enough for them: the
+        # curves drawn as the clock runs then go under none
+        above = self.height >= LEGENDS_ABOVE_PX
+        where = {"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "borderaxespad": 0.2}
+        ax_d.legend(**(where if above else {"loc": "upper right"}), fontsize=8,
+                    ncol=4 if above else 2)  # fmt: skip
         ymax = max(1.0, float(np.nanmax(1e3 * scene.deltas)) * 1.1)
         ax_d.set_ylim(-0.03 * ymax, ymax)
 
@@ -172,7 +180,9 @@ class AnimationFigure:
             self.att_data.append((tb, yb))
         ax_a.set_ylabel("attitude (deg)")
         ax_a.set_xlabel("time (s)")
-        ax_a.legend(loc="upper right", fontsize=8, ncol=3)
+        above = self.height >= LEGENDS_ABOVE_PX
+        where = {"loc": "lower right", "bbox_to_anchor": (1.0, 1.0), "borderaxespad": 0.2}
+        ax_a.legend(**(where if above else {"loc": "upper right"}), fontsize=8, ncol=3)
 
     def _prepare_blitting(self, ax3d: Axes, ax_d: Axes, ax_a: Axes) -> None:
         """Mark what changes every frame; stamp what never does (the rest is the background)."""

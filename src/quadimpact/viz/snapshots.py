@@ -15,6 +15,7 @@ from pathlib import Path
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from quadimpact.results.figures import fit_title
 from quadimpact.results.files import atomic_write
 from quadimpact.viz.camera import DEFAULT_SNAPSHOT_CAMERA, Camera
 from quadimpact.viz.render import SceneArtists
@@ -115,7 +116,8 @@ def make_snapshots(
         ax.set_xlabel(f"{tau:.3f} s", fontsize=10)
     origin = "first contact" if scene.first_contact_s is not None else "start"
     head = title if title is not None else scene.describe()
-    fig.suptitle(
+    fit_title(
+        fig,
         f"{head}\ntime after {origin} (t = {scene.t_ref:.3f} s); camera az {cam.azimuth_deg:g}°, "
         f"el {cam.elevation_deg:g}°, {cam.span_m:g} m high",
         fontsize=9,

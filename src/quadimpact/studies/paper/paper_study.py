@@ -552,7 +552,7 @@ def fig4_figure(table: pd.DataFrame, variant: str) -> Figure:
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("δ_init (mm)")
     axes[-1].legend(title="V_c")
-    fig.suptitle(f"Figure 4, {variant}: maximum deflection at the initial impact")
+    figures.fit_title(fig, f"Figure 4, {variant}: maximum deflection at the initial impact")
     return fig
 
 

@@ -21,7 +21,7 @@ import pandas as pd
 from matplotlib.colors import Normalize
 from matplotlib.figure import Figure
 
-from quadimpact.results.figures import new_figure, save_figure
+from quadimpact.results.figures import fit_title, new_figure, save_figure
 from quadimpact.studies.statistics import rate
 
 __all__ = ["FIGURES", "arm_titles", "maps_figure", "success_by_pitch_figure", "write_figures"]
@@ -90,7 +90,7 @@ def maps_figure(table: pd.DataFrame, title: str | None = None, model: str = "def
         fig.colorbar(mesh, ax=list(axes), label="height lost over the run (m)", extend="max")
     axes[0].legend(loc="lower left", fontsize="small", framealpha=0.6)
     if title:
-        fig.suptitle(title)
+        fit_title(fig, title)
     return fig
 
 
@@ -122,7 +122,7 @@ def success_by_pitch_figure(
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best", fontsize="small")
     if title:
-        ax.set_title(title)
+        fit_title(ax, title)
     return fig
 
 

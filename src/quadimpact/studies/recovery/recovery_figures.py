@@ -31,6 +31,7 @@ from quadimpact.results.figures import (
     STAGE_NAMES,
     break_wraps,
     fig_margins,
+    fit_title,
     mark_stages,
     new_figure,
     save_figure,
@@ -90,7 +91,7 @@ def success_map_figure(table: pd.DataFrame, title: str | None = None) -> Figure:
     ax.set_xlabel("inclination toward the wall, -pitch (deg)")
     ax.set_ylabel("speed toward the wall (m/s)")
     fig.colorbar(mesh, ax=ax, label="success rate (recovered / valid trials)")
-    ax.set_title(title or "Success rate; cells: recovered / trials")
+    fit_title(ax, title or "Success rate; cells: recovered / trials")
     return fig
 
 
@@ -130,8 +131,8 @@ def success_by_bin_figure(numbers: dict[str, Any], title: str | None = None) -> 
     _rate_panel(right, numbers["by_speed"], "speed toward the wall (m/s)")
     left.legend(loc="lower left", fontsize=8)
     s = numbers["success"]
-    fig.suptitle(title or f"Success rate {s.value:.1%} "
-                 f"[{s.low:.1%}, {s.high:.1%}] over {s.n} trials")  # fmt: skip
+    fit_title(fig, title or f"Success rate {s.value:.1%} [{s.low:.1%}, {s.high:.1%}] over "
+              f"{s.n} trials")  # fmt: skip
     return fig
 
 
@@ -161,7 +162,7 @@ def compare_by_bin_figure(
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="lower left")
     if title:
-        ax.set_title(title)
+        fit_title(ax, title)
     return fig
 
 
@@ -188,7 +189,7 @@ def distributions_figure(table: pd.DataFrame, title: str | None = None) -> Figur
         for ax in (hist, ecdf):
             ax.grid(alpha=0.3)
     axes[0, 0].legend(fontsize=8)
-    fig.suptitle(title or f"Recovered trials ({len(good)}): detection to stage 4")
+    fit_title(fig, title or f"Recovered trials ({len(good)}): detection to stage 4")
     return fig
 
 
@@ -236,7 +237,7 @@ def example_figure(result: Any, title: str | None = None) -> Figure:
         reached = [STAGE_NAMES[k] for k in (1, 2, 3, 4) if (stage == k).any()]
         axes[1].set_title("stages: " + ", ".join(reached), fontsize=8)
         axes[0].set_xlim(float(t[0]), float(t[-1]))
-    fig.suptitle(title or "Example trial")
+    fit_title(fig, title or "Example trial")
     return fig
 
 

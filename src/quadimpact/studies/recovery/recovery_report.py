@@ -161,9 +161,10 @@ def _what_ran(d: dict[str, Any]) -> list[str]:
         ran += "; the trials were run " + ", ".join(
             f"{h['n_ran']} in {h['sweep_s']:.1f} s ({h['backend']})" for h in history
         )
+    included = "tables, figures and the example" if d.get("example") else "tables and figures"
     lines += [
         f"- **quadimpact** {d['quadimpact_version']}. **Wall time**: {ran}; the whole command "
-        f"{d['elapsed_s']:.1f} s (tables, figures and the example included).",
+        f"{d['elapsed_s']:.1f} s ({included} included).",
     ]
     if d.get("cost"):
         lines.append(f"- **Cost**: {cost_sentence(d['cost'])}")
