@@ -13,7 +13,7 @@ detection (``pre_impact = "nominal"``), friction 0.3, 3 s:
 * ``box corner``: a 0.4-m cube turned so that a corner points at the vehicle
   (``examples/box_corner.toml``'s box), 0.3 m before it, 2 cm off.
 
-For each: the kernel's wall time alone (``core.run.execute`` on a prepared
+For each: the kernel's wall time alone (``core.kernel.execute`` on a prepared
 run; median and min over ``--repeat`` calls, the three interleaved so that
 load changes hit them alike), steps, RHS evaluations and ns per RHS
 evaluation; then the ratios pole / wall and box corner / wall of the

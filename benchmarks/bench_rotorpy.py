@@ -13,7 +13,7 @@ each simulator's own vehicle and controller:
 * **quadimpact**: a :class:`~quadimpact.FlightScenario` of the Spiri with its
   ``paper`` controller at 200 Hz, no ground, no surfaces: ``simulate()`` (the
   summary and the tables) and the compiled kernel alone
-  (``core.run.execute`` of the prepared setup's model).
+  (``core.kernel.execute`` of the prepared setup's model).
 
 The two vehicles and controllers differ, so the ratio is one of tools, not of
 identical physics: the time each needs for 3 s of controlled flight. The best

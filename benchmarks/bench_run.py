@@ -4,7 +4,7 @@ Run: ``python benchmarks/bench_run.py [--repeat N] [--json PATH] [--no-cold]``
 (``make bench``). For the paper's example (psi = 45 deg, iota = 15 deg,
 V_c = 0.75 m/s, 3-s scenario) in both model variants it reports
 
-* kernel-only wall time: ``core.run.execute`` on a prepared ``RunSetup``
+* kernel-only wall time: ``core.kernel.execute`` on a prepared ``RunSetup``
   (median and min over ``--repeat`` calls, after one warm-up call);
 * full ``simulate()`` wall time (median; includes the approach shooting runs,
   the pandas tables and the summary);

@@ -30,7 +30,7 @@ measures (the targets of issue 21):
 
 The kernel sums of 1, 2 and 4 are measured in each round by a separate pass
 in one process for each checkout, in that checkout (``--kernel-from``: one
-checkout's passes for all): each run prepared, then ``core.run.BUILTIN.run``
+checkout's passes for all): each run prepared, then ``core.kernel.BUILTIN.run``
 into the output a sweep's run fills (``simulation.batch``: no rows, or rows
 without contact columns, as the checkout has it) timed with ``time.thread_time``; a
 wall approach's shooting runs timed the same way (or, where the approach solve is

@@ -7,7 +7,7 @@ process: to the compiled kernel's own time on the same runs. Measures:
 
 1. ``simulate()`` of the paper example (psi = 45 deg, iota = 15 deg,
    V_c = 0.75 m/s) in both model variants, warm, one core: its time / the
-   kernel-only time of its main run (``core.run.execute`` of the prepared
+   kernel-only time of its main run (``core.kernel.execute`` of the prepared
    setup's model). The approach's compiled shooting (``core/approach.py``:
    2 free-flight runs for a start at t = 0, about 11 for a late start) is
    kernel time too; it is reported apart.

@@ -9,7 +9,7 @@ model variants and rtol = 1e-5 ... 1e-11 with atol = rtol / 100 it prints
 * its relative error against a reference run at rtol = 1e-12, atol = 1e-14;
 * the crash time, the number of subsequent impacts;
 * accepted steps, right-hand-side evaluations and the kernel time (median of
-  ``--repeat`` calls of ``core.run.execute`` on the prepared setup).
+  ``--repeat`` calls of ``core.kernel.execute`` on the prepared setup).
 
 The tolerances apply to the approach shooting runs as well as the main run.
 The row of the current defaults (``quadimpact.packing.constants.DEFAULT_RTOL`` /

@@ -9,7 +9,7 @@ checkout's ``src`` (``PYTHONPATH``) with Numba's on-disk cache warm (a
 warm-up run first). Each round times, for the paper's example (psi = 45 deg,
 iota = 15 deg, V_c = 0.75 m/s) in both model variants:
 
-* the kernel alone (``core.run.execute`` on a prepared setup, without its
+* the kernel alone (``core.kernel.execute`` on a prepared setup, without its
   IMU; either checkout's API): median of ``--repeat`` calls;
 * the whole ``simulate()``: median of ``--repeat // 5`` calls;
 

@@ -64,15 +64,15 @@ def test_a_recovery_folder_names_the_study_it_holds(tmp_path: Path, monkeypatch,
     line = error_line(cli_here(capsys, "recovery", "--n", "3", "--seed", "3", "--out", "r",
                           "--workers", "1", "--no-example"))  # fmt: skip
     assert line == (
-        "quadimpact: error: r: holds the recovery study of n = 2 trials (--n 2), not 3: give "
-        "--n 2 to resume or finish it, or use another output folder, or delete this one to "
-        "start over"
+        "quadimpact: error: r: holds a recovery study with other options (--n 2 there, 3 "
+        "asked); use a new folder, or the same options to resume it"
     )
-    with pytest.raises(InputError, match=r"^r: holds the recovery study of n = 2 trials"):
+    with pytest.raises(InputError, match=r"^r: holds a recovery study with other options "
+                                         r"\(--n 2 there, 1 asked\)"):  # fmt: skip
         run_study(RecoveryStudy(n=1, seed=3), "r", workers=1, example=False)  # fewer too
-    with pytest.raises(InputError, match=r"^r: holds a recovery study of other trials \(another "):
+    with pytest.raises(InputError, match=r"\(--seed 3 there, 4 asked\)"):
         run_study(RecoveryStudy(n=2, seed=4), "r", workers=1, example=False)
-    with pytest.raises(InputError, match=r"^r: holds a recovery study with other settings"):
+    with pytest.raises(InputError, match=r"\(--vehicle 'navi' there, 'spiri' asked\)"):
         run_study(RecoveryStudy(n=2, seed=3, vehicle="spiri"), "r", workers=1, example=False)
 
 

@@ -19,8 +19,8 @@ from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
 from quadimpact.inputs.world import Plane
-from quadimpact.packing.vehicle import pack_features
-from quadimpact.packing.world import pack_surfaces
+from quadimpact.packing.vehicle_block import pack_features
+from quadimpact.packing.world_block import pack_surfaces
 from quadimpact.rotations import quat_to_matrix
 
 STATE_COLS = [

@@ -16,7 +16,7 @@ from quadimpact.experiments.crashes import (
 )
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.packing.constants import RPM
-from quadimpact.packing.vehicle import pack_vehicle
+from quadimpact.packing.vehicle_block import pack_vehicle
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
 KEYS = ("crash_rule", "cut_step_motors", "bumper_force_scale")

@@ -2,7 +2,7 @@
 
 A test estimator registered here through ``register_estimator(name, step=...,
 params=..., pack=...)`` alone is selected by name in a scenario; the run loop
-is compiled around its step (``core.run.make_kernel(estimator=...)``, once per
+is compiled around its step (``core.kernel.make_kernel(estimator=...)``, once per
 process), and the controller and the detector read its estimate. The
 plug-in integrates the gyro (minus a constant bias given as a parameter) and
 never corrects: on an impact trial with an ideal IMU it tracks the truth to

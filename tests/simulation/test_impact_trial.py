@@ -10,7 +10,7 @@ import pytest
 from quadimpact import ImpactTrial, load_scenario_file, simulate
 from quadimpact.core import layout as L
 from quadimpact.inputs.vehicle import load_vehicle
-from quadimpact.packing.vehicle import allocation_matrix
+from quadimpact.packing.vehicle_block import allocation_matrix
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 

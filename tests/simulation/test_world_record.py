@@ -16,7 +16,7 @@ from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.inputs.sensors import ImuSettings
 from quadimpact.inputs.vehicle import Vehicle
-from quadimpact.packing.world import pack_surface_records, surface_records
+from quadimpact.packing.world_block import pack_surface_records, surface_records
 from quadimpact.results.schema import SUMMARY_KEYS
 from quadimpact.simulation.setup import prepare
 

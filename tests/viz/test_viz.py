@@ -22,8 +22,8 @@ from quadimpact import WallApproach, load_vehicle, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
 from quadimpact.inputs.world import Plane
-from quadimpact.packing.vehicle import pack_features
-from quadimpact.packing.world import pack_surfaces
+from quadimpact.packing.vehicle_block import pack_features
+from quadimpact.packing.world_block import pack_surfaces
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 from quadimpact.viz.render import SceneArtists
 from quadimpact.viz.scene import Camera, Scene, VehicleDrawing, to_inertial

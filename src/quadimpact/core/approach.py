@@ -14,7 +14,7 @@ one free-flight run per evaluation.
 
 :func:`solve_approach` does all of it in one compiled call: the free-flight
 runs are the loop's own ``start`` and ``advance`` (so a plug-in kernel's
-copy, ``core.run.make_kernel``, shoots with the plug-in controller), the
+copy, ``core.kernel.make_kernel``, shoots with the plug-in controller), the
 depths the contact geometry's. It reads its inputs from and writes what it
 found to one array (``ap``, slots ``AP_*`` in ``core/layout.py``);
 ``quadimpact.simulation.approach`` packs it and reads it back.

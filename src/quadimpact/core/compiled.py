@@ -24,7 +24,7 @@ compilation; so every other compiled function of ``quadimpact.core`` uses one
 of the two (helpers inlined into their callers excepted), and none marked
 ``compiled`` returns an array (``tests/core/test_core_shape.py``). A user's
 plug-in (controller, sensor, estimator, geometry) is compiled with reference
-counting of its own by ``core.run.make_kernel``, so it may allocate.
+counting of its own by ``core.kernel.make_kernel``, so it may allocate.
 """
 
 from __future__ import annotations

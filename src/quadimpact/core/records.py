@@ -210,11 +210,27 @@ def new_work(n_pairs: int) -> Work:
     )
 
 
-def _f64(a: np.ndarray | None, empty: tuple[int, ...] = (0,)) -> np.ndarray:
-    """``a`` as contiguous float64 (zeros of shape ``empty`` when absent)."""
+#: The shapes of a :class:`Model`'s arrays when absent (zeros): the state at rest at the
+#: origin, no IMU, no power-off schedule, the ``ideal`` estimator, no added sensor.
+MODEL_ABSENT: dict[str, tuple[int, ...]] = {
+    "x0": (NX,),
+    "scfg": (NSCFG,),
+    "noise": (0, 6),
+    "sched_t": (0,),
+    "sched_rate": (0, N_ROTORS),
+    "sched_stop": (N_ROTORS,),
+    "t_out": (0,),
+    "ecfg": (NECFG,),
+    "snoise": (0, NSN),
+}
+
+
+def model_array(name: str, a: np.ndarray | None) -> np.ndarray:
+    """Field ``name`` of a :class:`Model` as the loop takes it: contiguous float64
+    (``pairs``: int64), zeros of its :data:`MODEL_ABSENT` shape when ``None``."""
     if a is None:
-        return np.zeros(empty)
-    return np.ascontiguousarray(a, dtype=np.float64)
+        return np.zeros(MODEL_ABSENT.get(name, (0,)))
+    return np.ascontiguousarray(a, dtype=np.int64 if name == "pairs" else np.float64)
 
 
 def model(
@@ -242,27 +258,22 @@ def model(
     ``pairs`` is the contact-pair table of ``feat`` and ``shapes``
     (``core.geometry.pair_table``); ``t0``, ``tf`` in s.
     """
+    arrays = {
+        "x0": x0, "veh": veh, "feat": feat, "shapes": shapes, "pairs": pairs, "opts": opts,
+        "ctrl": ctrl, "scfg": scfg, "noise": noise, "sched_t": sched_t,
+        "sched_rate": sched_rate, "sched_stop": sched_stop, "t_out": t_out, "ecfg": ecfg,
+        "snoise": snoise,
+    }  # fmt: skip
+    fields = {name: model_array(name, a) for name, a in arrays.items()}
+    return Model(span=model_span(t0, tf), **fields)
+
+
+def model_span(t0: float, tf: float) -> np.ndarray:
+    """A :class:`Model`'s ``span``: start and end time (s)."""
     span = np.zeros(NSPAN)
     span[SPAN_T0] = float(t0)
     span[SPAN_TF] = float(tf)
-    return Model(
-        x0=_f64(x0, (NX,)),
-        span=span,
-        veh=_f64(veh),
-        feat=_f64(feat),
-        shapes=_f64(shapes),
-        pairs=np.ascontiguousarray(pairs, dtype=np.int64),
-        opts=_f64(opts),
-        ctrl=_f64(ctrl),
-        scfg=_f64(scfg, (NSCFG,)),
-        noise=_f64(noise, (0, 6)),
-        sched_t=_f64(sched_t, (0,)),
-        sched_rate=_f64(sched_rate, (0, N_ROTORS)),
-        sched_stop=_f64(sched_stop, (N_ROTORS,)),
-        t_out=_f64(t_out, (0,)),
-        ecfg=_f64(ecfg, (NECFG,)),
-        snoise=_f64(snoise, (0, NSN)),
-    )
+    return span
 
 
 # ---------------------------------------------------------------- batches

@@ -6,7 +6,7 @@ estimator's update (``core/estimators``), the detector with the estimated
 attitude (``detection.py``), then a plug-in sensor. The run loop takes the
 samples on the dense output of each step (so a sample at a control tick
 precedes that tick's new command), at the times ``t0 + n / rate``. A plug-in
-sensor (``core.run.make_kernel(sensor=...)``) is sampled with the IMU and
+sensor (``core.kernel.make_kernel(sensor=...)``) is sampled with the IMU and
 writes the measurement record's user block.
 """
 
@@ -28,7 +28,7 @@ from quadimpact.core.sensors.pose import pose_sample
 def plugin_sensor(
     t: float, xs: np.ndarray, xd: np.ndarray, C: np.ndarray, m: Model, d: Data
 ) -> None:
-    """A plug-in sensor's sample (rebound by ``core.run.make_kernel``); none here.
+    """A plug-in sensor's sample (rebound by ``core.kernel.make_kernel``); none here.
 
     It reads the true state ``xs``, its derivative ``xd`` and rotation ``C`` at
     the IMU sample ``t`` (s) and writes its readings into the measurement

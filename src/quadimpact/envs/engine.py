@@ -63,7 +63,7 @@ class Slots:
     trials : TrialDistribution
         What a row's trial is drawn from (also sizes the arrays).
     par : numpy.ndarray
-        The packed environment parameters (``settings.pack_parameters``).
+        The packed environment parameters (``packing.episode_block.pack_episode``).
     until_detection : bool
         Detection mode: a reset runs the pre-impact behaviour until the
         detector fires.
@@ -137,7 +137,7 @@ class Slots:
 
     @property
     def ENV(self) -> np.ndarray:  # noqa: N802
-        """Each row's episode state (N, NB), layout ``core.batch.B_*``."""
+        """Each row's episode state (N, NB), layout ``core.envs.episode_layout.B_*``."""
         return self.E.state
 
     @property
@@ -157,7 +157,7 @@ class Slots:
 
     @property
     def par(self) -> np.ndarray:
-        """The packed environment parameters (``core.batch.EP_*``)."""
+        """The packed environment parameters (``core.envs.episode_layout.EP_*``)."""
         return self.E.par
 
     # ------------------------------------------------------------ trials

@@ -48,7 +48,7 @@ class RecoveryPolicy:
     tick measurement (what the built-in controller would see at that tick),
     with the policy's own controller memory (cleared when a row begins a new
     episode), and returns the action whose map gives exactly its rotor
-    commands where such an action exists (``core.batch.affine_inverse``); the
+    commands where such an action exists (``core.envs.actions.affine_inverse``); the
     few commands near the bottom of the rotor range that no float action
     maps to exactly are replaced by the nearest one and counted in the
     metrics' ``inexact_commands``. It reports its stage through the
@@ -81,7 +81,7 @@ class RecoveryPolicy:
         """The action(s) for the next step.
 
         In the ``estimate`` mode from ``observation`` alone (its values are the
-        estimator's output, recovered exactly: ``core.batch.measurement_from_estimate``);
+        estimator's output, recovered exactly: ``core.envs.stacked.measurement_from_estimate``);
         the controller's gains, the vehicle's constants and the rotor map are
         the policy's own configuration. Otherwise the observation is not needed.
         """

@@ -4,8 +4,9 @@
   authors' distribution of docs/RECOVERY.md section 5.1, the Navi);
 * :class:`RewardWeights`: the reward's terms and weights;
 * :class:`Envelope`: the limits whose crossing ends an episode as a failure;
-* :func:`pack_parameters`: all of it, with the action and observation modes,
-  as the compiled core's parameter vector (``core.batch.P_*``).
+* :func:`check_episode_options`: the action and observation modes and the
+  episode's options, checked (``packing.episode_block.pack_episode`` packs it
+  all as the compiled core's parameter vector).
 
 Units: SI, angles in degrees where a name says ``_deg``; frames inertial NED
 and body FRD (docs/MODEL.md section 1).
@@ -16,12 +17,12 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 
-from quadimpact.core.envs import stacked as B
 from quadimpact.inputs.scenarios import ImpactTrial
+from quadimpact.packing.episode_block import ACTION_MODES, OBSERVATION_MODES
 
 __all__ = [
     "ACTION_MODES",
@@ -29,13 +30,10 @@ __all__ = [
     "Envelope",
     "RewardWeights",
     "TrialDistribution",
+    "check_episode_options",
     "coerce",
-    "pack_parameters",
 ]
 
-ACTION_MODES = ("rotors", "ctbr")
-OBSERVATION_MODES = ("imu", "state", "estimate")
-CTBR_RATE_MAX_RAD_S = (32.0, 32.0, 8.0)  # powers of two: the scaling of a rate action is exact
 
 Range = float | tuple[float, float]
 
@@ -338,19 +336,24 @@ class Envelope:
             raise ValueError(f"max_tilt_deg: must be <= 180 (got {self.max_tilt_deg!r})")
 
 
-def pack_parameters(
+def check_episode_options(
     *,
-    action: Literal["rotors", "ctbr"],
-    observe: Literal["imu", "state", "estimate"],
-    rotor_floor: Literal["vehicle", "zero"],
-    reward: RewardWeights,
-    envelope: Envelope,
+    action: str,
+    observe: str,
+    rotor_floor: str,
     hold_s: float,
     end_on_recovery: bool,
     ground: bool,
-    dt_s: float = 0.005,
-) -> np.ndarray:
-    """The compiled environment's parameter vector (``core.batch.P_*``)."""
+) -> None:
+    """Refuse an environment's modes and episode options that are not allowed.
+
+    Raises
+    ------
+    ValueError
+        Naming the option and its rule: ``action`` not in :data:`ACTION_MODES`,
+        ``observe`` not in :data:`OBSERVATION_MODES`, ``rotor_floor`` not
+        ``"vehicle"`` or ``"zero"``, ``hold_s`` (s) not > 0, a flag not a bool.
+    """
     if action not in ACTION_MODES:
         raise ValueError(f"action: one of {ACTION_MODES} (got {action!r})")
     if observe not in OBSERVATION_MODES:
@@ -358,35 +361,5 @@ def pack_parameters(
     if rotor_floor not in ("vehicle", "zero"):
         raise ValueError(f"rotor_floor: 'vehicle' or 'zero' (got {rotor_floor!r})")
     _number("hold_s", hold_s, low=0.0, low_open=True)
-    end_on_recovery = _flag("end_on_recovery", end_on_recovery)
-    ground = _flag("ground", ground)
-    par = np.zeros(B.NPAR)
-    par[B.EP_ACTION] = B.ACT_CTBR if action == "ctbr" else B.ACT_ROTORS
-    par[B.EP_OBSERVE] = {"state": B.OBS_STATE, "estimate": B.OBS_ESTIMATE}.get(observe, B.OBS_IMU)
-    par[B.EP_ZERO_LOW] = 1.0 if rotor_floor == "zero" else 0.0
-    par[B.EP_RATE_MAX : B.EP_RATE_MAX + 3] = CTBR_RATE_MAX_RAD_S
-    par[B.EP_W_TILT] = reward.tilt
-    par[B.EP_W_RATE] = reward.rate
-    par[B.EP_W_VZ] = reward.vertical_speed
-    par[B.EP_W_HEIGHT] = reward.height_loss
-    par[B.EP_W_EFFORT] = reward.effort
-    par[B.EP_W_RECOVERY] = reward.recovery_bonus
-    par[B.EP_W_FAILURE] = reward.failure_penalty
-    par[B.EP_FAIL_REMAINING] = 1.0 if reward.failure_remaining else 0.0
-    par[B.EP_S_RATE] = reward.rate_scale_rad_s
-    par[B.EP_S_VZ] = reward.vertical_speed_scale_m_s
-    par[B.EP_S_HEIGHT] = reward.height_scale_m
-    par[B.EP_MAX_TILT_COS] = math.cos(math.radians(envelope.max_tilt_deg))
-    par[B.EP_MAX_DROP] = envelope.max_drop_m
-    par[B.EP_MAX_DIST] = envelope.max_distance_m
-    par[B.EP_MAX_RATE] = envelope.max_rate_rad_s
-    par[B.EP_HOLD_TICKS] = max(1.0, round(hold_s / dt_s))
-    par[B.EP_END_ON_RECOVERY] = 1.0 if end_on_recovery else 0.0
-    par[B.EP_GROUND] = 1.0 if ground else 0.0
-    par[B.EP_OBS_F] = 9.81
-    par[B.EP_OBS_W] = 10.0
-    par[B.EP_OBS_V] = 2.0
-    par[B.EP_OBS_T] = 1.0
-    par[B.EP_OBS_POS] = 1.0
-    par[B.EP_OBS_CLIP] = 10.0
-    return par
+    _flag("end_on_recovery", end_on_recovery)
+    _flag("ground", ground)

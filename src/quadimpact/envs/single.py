@@ -19,10 +19,11 @@ from quadimpact.envs.settings import (
     Envelope,
     RewardWeights,
     TrialDistribution,
+    check_episode_options,
     coerce,
-    pack_parameters,
 )
 from quadimpact.inputs.scenarios import ImpactTrial
+from quadimpact.packing.episode_block import pack_episode
 from quadimpact.results.result import SimulationResult
 
 __all__ = ["ImpactRecoveryEnv", "configure", "observation_dtype", "spaces_for"]
@@ -116,10 +117,10 @@ def configure(
     env.reward_weights = coerce(RewardWeights, reward, "reward")
     env.envelope = coerce(Envelope, envelope, "envelope")
     env.max_redraws = int(max_redraws)
-    par = pack_parameters(
-        action=action, observe=observe, rotor_floor=rotor_floor, reward=env.reward_weights,
-        envelope=env.envelope, hold_s=hold_s, end_on_recovery=end_on_recovery, ground=ground,
-    )  # fmt: skip
+    options = {"action": action, "observe": observe, "rotor_floor": rotor_floor,
+               "hold_s": hold_s, "end_on_recovery": end_on_recovery, "ground": ground}  # fmt: skip
+    check_episode_options(**options)
+    par = pack_episode(**options, reward=env.reward_weights, envelope=env.envelope)
     env._slots = Slots(
         n, env.trials, par, until_detection=start == "detection", ground=bool(ground),
         record=bool(record),

@@ -1,7 +1,7 @@
 """N impact-recovery trials stepped together in compiled code: :class:`BatchedImpactRecoveryEnv`.
 
 Each ``step`` advances every sub-environment one control period in one
-compiled call (``core.batch.step_batch``, a loop over the N trials' stacked
+compiled call (``core.envs.stacked.step_batch``, a loop over the N trials' stacked
 arrays); Python work is left for the ends of episodes (metrics, the next
 trial's packing). Sub-environment ``k`` is the single environment
 :class:`~quadimpact.envs.single.ImpactRecoveryEnv` seeded with ``seed + k``

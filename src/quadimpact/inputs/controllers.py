@@ -11,7 +11,7 @@ Built-in controllers (``paper``, ``cascade-pid``, ``recovery``) have a kind id
 that the cached kernel dispatches on. A controller registered with a ``step``
 (a Numba ``njit`` function ``step(t, meas, ctrl, mem, veh, dt, cmd)``, see
 ``quadimpact.core.controllers``) runs in a kernel compiled for it
-(``core.run.make_kernel``, once per process).
+(``core.kernel.make_kernel``, once per process).
 
 The registry lives in the process: a sweep's local worker processes see a
 plug-in only when the registration runs on import of the main script (or of
@@ -190,7 +190,7 @@ class ControllerEntry:
         Its parameters (``[controller_params]``), with defaults.
     pack : callable or None
         ``pack(params, context) -> ndarray (NPARAM,)``: the parameter block;
-        ``None``: a built-in's packer (``quadimpact.packing.controller``), or
+        ``None``: a built-in's packer (``quadimpact.packing.controller_block``), or
         for a plug-in the default packing (the fields in order, :func:`param_slots`).
     step : callable or None
         The compiled step of a plug-in (``None`` for built-ins).

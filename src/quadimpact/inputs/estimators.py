@@ -18,7 +18,7 @@ and may set its parameters (``[estimator_params]``). Built in:
 A user's compiled estimator plugs in like a controller:
 ``register_estimator(name, step=..., params=..., pack=...)`` (the step's
 interface in ``quadimpact.core.estimators.plugin_estimator``); the run loop is
-then compiled around it (``core.run.make_kernel(estimator=...)``) once per
+then compiled around it (``core.kernel.make_kernel(estimator=...)``) once per
 process.
 """
 
@@ -238,7 +238,7 @@ class EstimatorEntry:
     pack : callable or None
         ``pack(params, context) -> ndarray (NECFG,)``: its settings (the kind and
         the initial error are filled in by the caller); ``None`` for a built-in,
-        whose packer is in ``quadimpact.packing.estimation``.
+        whose packer is in ``quadimpact.packing.estimator_block``.
     step : callable or None
         The compiled step of a plug-in (``None`` for built-ins).
     description : str

@@ -3,17 +3,17 @@
 The kernel reads numbers from fixed slots (``core/layout.py``); this layer
 writes them. Each block has its module:
 
-* :mod:`.vehicle`: ``veh`` (mass, inertia, rotors) and ``feat`` (the contact
+* :mod:`.vehicle_block`: ``veh`` (mass, inertia, rotors) and ``feat`` (the contact
   features), packed once per vehicle object; the allocation matrix;
-* :mod:`.world`: ``shapes`` (planes, cylinders, boxes) and the packed shapes as
+* :mod:`.world_block`: ``shapes`` (planes, cylinders, boxes) and the packed shapes as
   plain data for ``scenario.json`` (and back);
-* :mod:`.controller`: ``ctrl`` (the controller's head, references, parameter
+* :mod:`.controller_block`: ``ctrl`` (the controller's head, references, parameter
   block, a waypoint flight's slots), a packer per built-in controller;
-* :mod:`.options`: ``opts`` (model switches, crash rule, integrator settings)
+* :mod:`.options_block`: ``opts`` (model switches, crash rule, integrator settings)
   and a power-off schedule's rates;
-* :mod:`.sensors`: ``scfg`` (the IMU, the impact detector) and the IMU's
+* :mod:`.sensor_block`: ``scfg`` (the IMU, the impact detector) and the IMU's
   seeded noise;
-* :mod:`.estimation`: the added sensors' slots and noise, ``ecfg`` (the
+* :mod:`.estimator_block`: the added sensors' slots and noise, ``ecfg`` (the
   estimator), a packer per built-in estimator;
 * :mod:`.constants`: the control rate, units and integrator defaults every
   block uses.

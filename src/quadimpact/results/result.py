@@ -317,7 +317,7 @@ class SimulationResult:
 #: The parts of ``scenario.json`` and the JSON kind each must have (absent: allowed).
 _WORLD_PARTS = {"scenario": (dict, type(None)), "resolved": (dict,), "vehicle": (dict,),
                 "surfaces": (list,)}  # fmt: skip
-#: The keys every surface record has, by kind (``packing.world.surface_records``).
+#: The keys every surface record has, by kind (``packing.world_block.surface_records``).
 _SURFACE_KEYS = ("name", "point_m", "normal", "is_ground", "kind")
 _SHAPE_KEYS = {
     "plane": _SURFACE_KEYS,

@@ -475,7 +475,7 @@ def attitude_excursion_deg(ts: Table, refs: Mapping[str, float]) -> dict[str, fl
     pitch_ref = float(refs["pitch_rad"])
     yaw_ref = float(refs["yaw_rad"])
     if all(has_column(ts, c) for c in ("q0", "q1", "q2", "q3")):
-        from quadimpact.packing.controller import reference_z_axis
+        from quadimpact.packing.controller_block import reference_z_axis
         from quadimpact.simulation.attitude import excursion_from_quaternions
 
         quat = np.ascontiguousarray(

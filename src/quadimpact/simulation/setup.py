@@ -16,7 +16,7 @@ differs between them, with the same functions: the same arrays, bit for bit.
 
 from __future__ import annotations
 
-import copy
+import dataclasses
 import math
 from dataclasses import dataclass, field
 from typing import Any
@@ -27,20 +27,16 @@ from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
 from quadimpact.core.kernel import Kernel, make_kernel
-from quadimpact.core.records import Model, model
+from quadimpact.core.records import Model, model_array, model_span
 from quadimpact.errors import InputError
-from quadimpact.inputs.controllers import PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
-from quadimpact.packing.constants import CONTROL_RATE_HZ
-from quadimpact.packing.controller import pack_controller, pack_waypoint, set_references
-from quadimpact.packing.estimation import draw_estimation, pack_estimation
-from quadimpact.packing.options import pack_run_options, pack_schedule, slew_limit_rad_s2
-from quadimpact.packing.sensors import draw_imu_noise, pack_sensors
-from quadimpact.packing.vehicle import pack_features, pack_vehicle
-from quadimpact.packing.world import pack_surfaces
+from quadimpact.packing.controller_block import pack_waypoint
+from quadimpact.packing.options_block import pack_run_options
+from quadimpact.packing.run_model import output_grid, pack_own, pack_shared
+from quadimpact.packing.world_block import pack_surfaces
 from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
@@ -48,42 +44,50 @@ from quadimpact.simulation.checks import check_imu, check_prepared, check_scenar
 from quadimpact.simulation.sharing import SharedSetup, kept_shared
 from quadimpact.simulation.trim import trim_rotor_speeds
 
-__all__ = ["RunSetup", "prepare", "prepare_flight", "prepare_impact_trial", "prepare_wall_approach"]
+__all__ = [
+    "MODEL_ARRAYS",
+    "RunSetup",
+    "prepare",
+    "prepare_flight",
+    "prepare_impact_trial",
+    "prepare_wall_approach",
+]
+
+
+#: The arrays of a run's :class:`~quadimpact.core.records.Model` that :meth:`RunSetup.model`
+#: may change (``t0`` and ``tf`` are its ``span``).
+MODEL_ARRAYS = (
+    "x0", "veh", "feat", "shapes", "pairs", "opts", "ctrl", "scfg", "noise", "sched_t",
+    "sched_rate", "sched_stop", "t_out", "ecfg", "snoise",
+)  # fmt: skip
 
 
 @dataclass
 class RunSetup:
-    """Everything the compiled loop takes, and what is needed to read its record.
+    """A packed run: the compiled loop's :class:`~quadimpact.core.records.Model` and what
+    is needed to read its record.
 
-    The packed arrays (layouts in ``core/layout.py``) become the run's
-    :class:`~quadimpact.core.records.Model` with :meth:`model`.
+    ``run`` holds every array the loop takes (layouts in ``core/layout.py``),
+    its output times and contact-pair table included; the other fields are
+    what the Python side reads: names, the validated vehicle and options, the
+    references, the approach, the warnings, the kernel, the costs. The arrays
+    are read through ``run`` or the read-only properties of the same names
+    (``setup.ctrl`` is ``setup.run.ctrl``); a changed run is :meth:`model`.
     """
 
-    x0: np.ndarray
-    t0: float
-    tf: float
-    veh: np.ndarray
-    feat: np.ndarray
-    shapes: np.ndarray
-    opts: np.ndarray
-    ctrl: np.ndarray
+    run: Model
+    """The packed run (SI; inertial NED, body FRD)."""
     feature_names: tuple[str, ...]
     shape_names: tuple[str, ...]
     references: dict[str, float]
     vehicle: Vehicle
     options: ModelOptions
     output_rate_hz: float
+    n_imu: int
+    """IMU samples the run's draws were made for."""
     wall: Plane | None = None
     approach: dict[str, Any] = field(default_factory=dict)
     warnings: list[str] = field(default_factory=list)
-    sched_t: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    sched_rate: np.ndarray = field(default_factory=lambda: np.zeros((0, 4)))
-    sched_stop: np.ndarray = field(default_factory=lambda: np.zeros(4))
-    scfg: np.ndarray = field(default_factory=lambda: np.zeros(L.NSCFG))
-    noise: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
-    n_imu: int = 0
-    ecfg: np.ndarray = field(default_factory=lambda: np.zeros(L.NECFG))
-    snoise: np.ndarray = field(default_factory=lambda: np.zeros((0, L.NSN)))
     estimator: str = "ideal"
     estimator_settings: str = ""
     controller: str = "paper"
@@ -92,10 +96,6 @@ class RunSetup:
     """What the scenario's settings resolved to, as plain data (``scenario.json``'s
     ``resolved``): the model variant and every switch, the controller and its
     parameters with defaults, the pre-impact behaviour, the IMU and the slew limit."""
-    kept_grid: tuple[tuple[float, float, float], np.ndarray] | None = None
-    """The output times kept for (``t0``, ``tf``, ``output_rate_hz``) (see :meth:`model`)."""
-    kept_pairs: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-    """``feat``, ``shapes`` and their pair table, kept (:meth:`keep_grid_and_pairs`)."""
     prepare_cpu_s: float = 0.0
     """CPU time of :func:`prepare` (this thread), s; the summary's ``cost`` adds it in."""
     kernel_cpu_s: float = 0.0
@@ -104,71 +104,56 @@ class RunSetup:
     def model(self, **changes: Any) -> Model:
         """The run as the compiled core's :class:`~quadimpact.core.records.Model`.
 
-        ``changes`` replace fields of the packed run (``x0``, ``t0``, ``tf``,
-        ``shapes``, ``opts``, ``t_out``...); the output times default to
-        :meth:`output_times` and the contact-pair table is built from the
-        features and shapes.
+        Without ``changes``, :attr:`run` itself. ``changes`` replace arrays of
+        it (:data:`MODEL_ARRAYS`) or its times (``t0``, ``tf``, s); ``None``
+        for a sensor's, the schedule's or the estimator's arrays means none.
+        The output times follow changed times and the contact-pair table
+        changed features or shapes, unless given.
         """
-        fields: dict[str, Any] = {
-            "x0": self.x0,
-            "t0": self.t0,
-            "tf": self.tf,
-            "veh": self.veh,
-            "feat": self.feat,
-            "shapes": self.shapes,
-            "opts": self.opts,
-            "ctrl": self.ctrl,
-            "scfg": self.scfg,
-            "noise": self.noise,
-            "sched_t": self.sched_t,
-            "sched_rate": self.sched_rate,
-            "sched_stop": self.sched_stop,
-            "ecfg": self.ecfg,
-            "snoise": self.snoise,
-        }
-        fields.update(changes)
-        if "t_out" not in fields:
-            fields["t_out"] = self._output_grid()
-        if fields["feat"] is self.feat and fields["shapes"] is self.shapes:
-            fields["pairs"] = self.pair_table()
-        else:
-            fields["pairs"] = pair_table(fields["feat"], fields["shapes"])
-        return model(**fields)
+        if not changes:
+            return self.run
+        t0 = float(changes.pop("t0", self.t0))
+        tf = float(changes.pop("tf", self.tf))
+        unknown = set(changes) - set(MODEL_ARRAYS)
+        if unknown:
+            raise TypeError(f"RunSetup.model: no array {sorted(unknown)}")
+        fields = {name: model_array(name, a) for name, a in changes.items()}
+        if (t0, tf) != (self.t0, self.tf):
+            fields["span"] = model_span(t0, tf)
+            if "t_out" not in fields:
+                fields["t_out"] = output_grid(t0, tf, self.output_rate_hz)
+        if "pairs" not in fields and ("feat" in fields or "shapes" in fields):
+            run = self.run
+            fields["pairs"] = pair_table(
+                fields.get("feat", run.feat), fields.get("shapes", run.shapes)
+            )
+        return self.run._replace(**fields)
+
+    def output_times(self) -> np.ndarray:
+        """The run's output grid (s): ``t0``, the multiples of 1/rate inside, ``tf``."""
+        return self.run.t_out
 
     def pair_table(self) -> np.ndarray:
         """The contact-pair table of the features and shapes (``core.geometry.pair_table``):
-        pair ``c = shape * n_features + feature``; the kept one where it is of these arrays."""
-        kept = self.kept_pairs
-        if kept is not None and kept[0] is self.feat and kept[1] is self.shapes:
-            return kept[2]
-        return pair_table(self.feat, self.shapes)
+        pair ``c = shape * n_features + feature``."""
+        return self.run.pairs
 
-    def keep_grid_and_pairs(self) -> None:
-        """Compute the output times and the pair table now and keep them (no run changes them).
-
-        Runs copied from this setup (the shared packing's runs, ``_for_run``)
-        share them while their times, features and shapes are
-        this setup's (checked in :meth:`model`): the same arrays, not recomputed.
-        """
-        self._output_grid()
-        self.kept_pairs = (self.feat, self.shapes, pair_table(self.feat, self.shapes))
-
-    def _output_grid(self) -> np.ndarray:
-        """:meth:`output_times`, kept with the times and rate it is of."""
-        key = (self.t0, self.tf, self.output_rate_hz)
-        kept = self.kept_grid
-        if kept is None or kept[0] != key:
-            kept = self.kept_grid = (key, self.output_times())
-        return kept[1]
-
-    def output_times(self) -> np.ndarray:
-        """Output grid: ``t0``, the multiples of 1/rate inside (t0, tf), and ``tf`` (s)."""
-        dt = 1.0 / self.output_rate_hz
-        k0 = math.floor(self.t0 / dt) + 1
-        k1 = math.ceil(self.tf / dt)
-        inner = np.arange(k0, k1) * dt
-        inner = inner[(inner > self.t0 + 1e-12) & (inner < self.tf - 1e-12)]
-        return np.concatenate([[self.t0], inner, [self.tf]])
+    # the run's arrays by name, read-only (a changed run is model(...))
+    t0 = property(lambda self: float(self.run.span[L.SPAN_T0]), doc="Start time, s.")
+    tf = property(lambda self: float(self.run.span[L.SPAN_TF]), doc="End time, s.")
+    x0 = property(lambda self: self.run.x0, doc="Initial state (``X_*``).")
+    veh = property(lambda self: self.run.veh, doc="Vehicle (``V_*``).")
+    feat = property(lambda self: self.run.feat, doc="Contact features (``F_*``), body frame.")
+    shapes = property(lambda self: self.run.shapes, doc="Shapes (``SH_*``), inertial frame.")
+    opts = property(lambda self: self.run.opts, doc="Options (``O_*``).")
+    ctrl = property(lambda self: self.run.ctrl, doc="Controller (``C_*``).")
+    scfg = property(lambda self: self.run.scfg, doc="Sensors (``SC_*``).")
+    noise = property(lambda self: self.run.noise, doc="The IMU's normal draws.")
+    sched_t = property(lambda self: self.run.sched_t, doc="Power-off segment starts, s.")
+    sched_rate = property(lambda self: self.run.sched_rate, doc="Power-off rates, rad/s^2.")
+    sched_stop = property(lambda self: self.run.sched_stop, doc="Motors stalled at the trigger.")
+    ecfg = property(lambda self: self.run.ecfg, doc="Estimator (``EC_*``).")
+    snoise = property(lambda self: self.run.snoise, doc="The added sensors' normal draws.")
 
 
 # ---------------------------------------------------------------- settings
@@ -209,66 +194,33 @@ def _shared(
     wall: Plane | None = None,
 ) -> SharedSetup:
     """The packing common to every scenario kind, without the run's state, references and draws."""
-    yaw_paper = o.yaw_reaction == "paper"
-    entry = controller_entry(s.controller)
-    context = PackContext(
-        vehicle=v,
-        options=o,
-        pre_impact=s.resolved_pre_impact(),
-        nominal_controller=s.nominal_controller,
-    )
-    imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
-    scfg, n_imu = pack_sensors(imu, s.detection, v, duration_s)
-    est = pack_estimation(s, imu, scfg, v)
-    params = s.resolved_controller_params()
-    resolved = {
-        "model": s.model,
-        "model_options": o.model_dump(mode="json"),
-        "controller": s.controller,
-        "controller_params": params.model_dump(mode="json"),
-        "pre_impact": context.pre_impact,
-        "nominal_controller": s.nominal_controller,
-        "imu": imu.model_dump(mode="json"),
-        "rotor_slew_limit_rad_s2": slew_limit_rad_s2(s, v),
-        **(est.resolved or {}),
-    }
+    packing = pack_shared(s, v, o, surfaces, duration_s)
+    est = packing.est
     setup = RunSetup(
-        x0=np.zeros(L.NX),
-        t0=0.0,
-        tf=float(s.final_time_s),
-        veh=pack_vehicle(v),
-        feat=pack_features(v, s.friction_coefficient, o.bumper_force_scale),
-        shapes=pack_surfaces(surfaces),
-        opts=pack_run_options(s, o, v, duration_s),
-        ctrl=pack_controller(entry, params, context, yaw_paper),
+        run=packing.model,
         feature_names=v.feature_names(),
         shape_names=tuple(x.name for x in surfaces),
         references={},
         vehicle=v,
         options=o,
         output_rate_hz=float(s.output_rate_hz),
+        n_imu=packing.n_imu,
         wall=wall,
-        scfg=scfg,
-        n_imu=n_imu,
-        ecfg=est.ecfg,
-        snoise=est.snoise,
         estimator=est.name,
         estimator_settings=est.settings,
         controller=s.controller,
-        kernel=_kernel(entry, est.step),
-        resolved=resolved,
-        **pack_schedule(s),
+        kernel=_kernel(packing.entry, est.step),
+        resolved=packing.resolved,
     )
     setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())
-    if s.controller == "recovery" and context.pre_impact == "spin-down":
+    if s.controller == "recovery" and packing.context.pre_impact == "spin-down":
         if setup.opts[L.O_SLEW_MAX] <= 0.0:
             setup.warnings.append(
                 f"no rotor slew limit (vehicle {v.name} has none): the pre-impact spin-down "
                 "stops the rotors at the first tick"
             )
     check_imu(setup)  # of the shared packing: no draw changes what it checks
-    setup.keep_grid_and_pairs()
-    return SharedSetup(setup=setup, imu=imu, est=est, entries=(entry, est.entry))
+    return SharedSetup(setup=setup, packing=packing, entries=(packing.entry, est.entry))
 
 
 def _for_run(
@@ -278,30 +230,18 @@ def _for_run(
 
     ``refs``: ``altitude_m``, ``roll_rad``, ``pitch_rad``, ``yaw_rad``;
     ``fields``: ``x0``, ``t0``. The shared arrays that no run changes
-    (vehicle, features, surfaces, options) are the same objects in every run.
+    (vehicle, features, surfaces, options, the pair table, and the output
+    times while ``t0`` is the shared one) are the same objects in every run.
     """
     base = shared.setup
-    scfg = base.scfg.copy()
-    noise = draw_imu_noise(shared.imu, s.seed, base.n_imu, scfg)
-    ecfg, snoise = draw_estimation(shared.est, s.seed, base.n_imu, scfg)
-    ctrl = base.ctrl.copy()
-    set_references(ctrl, refs)
-    # dataclasses.replace without its checks (a plain dataclass, every field set in
-    # __init__): a shallow copy with the run's fields in place, a sixth of its time
-    run = copy.copy(base)
-    run.__dict__.update(
+    return dataclasses.replace(
+        base,
+        run=base.model(**pack_own(shared.packing, s.seed, refs), **fields),
         references=refs,
-        ctrl=ctrl,
-        scfg=scfg,
-        noise=noise,
-        ecfg=ecfg,
-        snoise=snoise,
         warnings=list(base.warnings),
         approach={},
         resolved=dict(base.resolved),
-        **fields,
     )
-    return run
 
 
 # ------------------------------------------------------------- flight scenario
@@ -356,7 +296,7 @@ def prepare_wall_approach(s: WallApproach, kernel: Kernel | None = None) -> RunS
         setup.kernel = kernel
     h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
     clock = CpuClock()
-    setup.x0, setup.t0, setup.approach = solve_approach(
+    x0, t0, setup.approach = solve_approach(
         run=setup.model(),
         free_opts=pack_run_options(s, o, v, float(s.impact_time_s), free=True),
         wall=setup.shapes[:1],  # the wall is the first surface
@@ -369,6 +309,7 @@ def prepare_wall_approach(s: WallApproach, kernel: Kernel | None = None) -> RunS
         kernel=setup.kernel,
         clock=clock,
     )
+    setup.run = setup.model(x0=x0, t0=t0)
     setup.kernel_cpu_s = clock.total
     if setup.approach["late_start"]:
         setup.warnings.append(
@@ -493,7 +434,7 @@ def prepare(
 ) -> RunSetup:
     """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``).
 
-    ``kernel``: a run loop (``core.run.make_kernel``) in place of the one the
+    ``kernel``: a run loop (``core.kernel.make_kernel``) in place of the one the
     scenario's controller and estimator select; a wall approach's shooting
     runs fly with it too. The first call in a process whose compiled loop is
     not in Numba's disk cache says that it compiles (``core.announce_compilation``).

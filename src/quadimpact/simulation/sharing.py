@@ -24,8 +24,7 @@ from quadimpact.inputs.estimators import estimator_entry
 
 if TYPE_CHECKING:
     from quadimpact.inputs.scenarios import ImpactTrial, WallApproach
-    from quadimpact.inputs.sensors import ResolvedImu
-    from quadimpact.packing.estimation import Estimation
+    from quadimpact.packing.run_model import SharedPacking
 
 __all__ = [
     "KEPT_LIMIT",
@@ -50,8 +49,8 @@ class SharedSetup:
     setup: Any
     """The packed run (a ``simulation.setup.RunSetup``; not imported here, which
     ``setup.py`` imports) with ``x0`` 0, no references and no random draw."""
-    imu: ResolvedImu
-    est: Estimation
+    packing: SharedPacking
+    """The shared arrays and what a run's own part is packed from (``packing.run_model``)."""
     entries: tuple[Any, ...] = ()
     """The registry entries it was packed with (controller, estimator): a new
     registration under the same name packs again."""

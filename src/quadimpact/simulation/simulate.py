@@ -15,8 +15,8 @@ from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
-from quadimpact.packing.vehicle import feature_records
-from quadimpact.packing.world import surface_records
+from quadimpact.packing.vehicle_block import feature_records
+from quadimpact.packing.world_block import surface_records
 from quadimpact.results.costs import cpu_time
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.impacts import run_episodes
@@ -114,9 +114,9 @@ def world_record(setup: RunSetup, scenario: Any = None) -> dict[str, Any]:
         (:attr:`RunSetup.resolved`); ``vehicle``: every field of the vehicle
         with its overrides applied (body FRD, SI); ``surfaces``: every contact
         surface as packed for the kernel (the ground of ``ground = "contact"``
-        included; :func:`~quadimpact.packing.world.surface_records`);
+        included; :func:`~quadimpact.packing.world_block.surface_records`);
         ``features``: the vehicle's contact features as packed
-        (:func:`~quadimpact.packing.vehicle.feature_records`).
+        (:func:`~quadimpact.packing.vehicle_block.feature_records`).
     """
     return {
         "scenario": scenario.model_dump(mode="json") if hasattr(scenario, "model_dump") else None,
@@ -137,7 +137,7 @@ def analyse(
     kernel_cpu_s: float | None = None,
     since: float | None = None,
 ):
-    """Summary, tables and world record of a raw record (``core.run.RawRecord``) of ``setup``.
+    """Summary, tables and world record of a raw record (``core.records.RawRecord``) of ``setup``.
 
     The summary is computed from the raw arrays (no DataFrame; the impacts by
     one compiled pass over the episodes, ``simulation.impacts``); the result's

@@ -50,7 +50,7 @@ class Simulation:
     max_episodes : int, optional
         Size of the episode buffer.
     kernel : Kernel, optional
-        A run loop from ``core.run.make_kernel`` (plug-ins); default the
+        A run loop from ``core.kernel.make_kernel`` (plug-ins); default the
         registered controller's. A wall approach's shooting runs fly with it too.
 
     Attributes

@@ -6,7 +6,7 @@ import numpy as np
 
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.linalg import lu_factor, lu_solve
-from quadimpact.packing.vehicle import allocation_matrix, vehicle_memo_value
+from quadimpact.packing.vehicle_block import allocation_matrix, vehicle_memo_value
 
 __all__ = ["trim_rotor_speeds"]
 

@@ -43,7 +43,7 @@ import pandas as pd
 from quadimpact.core import layout as L
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
-from quadimpact.packing.world import pack_surface_records, pack_surfaces
+from quadimpact.packing.world_block import pack_surface_records, pack_surfaces
 from quadimpact.rotations import quat_to_matrix, unwrap_deg
 from quadimpact.viz.camera import Camera
 
@@ -103,7 +103,7 @@ def contact_points(
     drawing : VehicleDrawing
         The vehicle.
     surf : numpy.ndarray
-        Packed surfaces (:func:`quadimpact.packing.world.pack_surfaces`).
+        Packed surfaces (:func:`quadimpact.packing.world_block.pack_surfaces`).
 
     Returns
     -------

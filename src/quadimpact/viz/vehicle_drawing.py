@@ -19,7 +19,7 @@ from pydantic import ValidationError
 
 from quadimpact.errors import input_error_from_validation
 from quadimpact.inputs.vehicle import Vehicle, load_vehicle
-from quadimpact.packing.vehicle import pack_features
+from quadimpact.packing.vehicle_block import pack_features
 from quadimpact.viz.world_drawing import rim_points, world_part
 
 __all__ = [

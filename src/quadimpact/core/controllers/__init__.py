@@ -26,7 +26,7 @@ without loading this compiled code. A new built-in is its module, its blocks
 there, a branch below, and an entry in the Python-side registry
 (``quadimpact.inputs.controllers``); a controller that is not built in is
 registered there with its step (``register_controller(name, step=...)``),
-and runs in a loop compiled around it (``core.run.make_kernel``).
+and runs in a loop compiled around it (``core.kernel.make_kernel``).
 """
 
 import numpy as np

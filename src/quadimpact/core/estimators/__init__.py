@@ -17,7 +17,7 @@ The estimator is chosen by ``ecfg[EC_KIND]`` (``EST_*``):
 * ``ekf-additive`` (``ekf_additive.py``): the authors' 7-state EKF on an
   additive quaternion;
 * a plug-in (``EST_USER``): a compiled step bound in place of
-  :func:`plugin_estimator` by ``core.run.make_kernel(estimator=...)``.
+  :func:`plugin_estimator` by ``core.kernel.make_kernel(estimator=...)``.
 
 The stage runs at each IMU sample, after the IMU, the magnetometer and the
 pose sensor have written their readings into the measurement record and
@@ -81,7 +81,7 @@ from quadimpact.core.sensors.rotvec import dcm, rotate_by
 
 @njit(cache=True, inline="always")
 def plugin_estimator(t: float, dt: float, meas: np.ndarray, ecfg: np.ndarray, est: np.ndarray):
-    """A plug-in estimator's step (rebound by ``core.run.make_kernel``); none here.
+    """A plug-in estimator's step (rebound by ``core.kernel.make_kernel``); none here.
 
     At each IMU sample ``t`` (s), ``dt`` (s) after the previous one (0 at the
     first), it reads the measurement record ``meas`` (``MS_IMU_F``,

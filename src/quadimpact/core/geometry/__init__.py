@@ -44,7 +44,7 @@ in the shape's module; for a built-in, give it a ``GEOM_*`` id, a row in
 kind, a branch in :func:`shape_distance`); or register it at run time with
 :func:`register_geometry` (and :func:`register_shape_distance`): a run whose
 pairs use a registered row runs in a loop compiled around the registered
-functions (``core.run.make_kernel``), as a plug-in controller does.
+functions (``core.kernel.make_kernel``), as a plug-in controller does.
 """
 
 from __future__ import annotations
@@ -148,7 +148,7 @@ SHAPE_DISTANCES: dict[int, tuple[Callable, bool]] = {
 def plugin_contact(
     g: int, x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> ContactRecord:
-    """Registered rows (rebound by ``core.run.make_kernel``); none here: no contact."""
+    """Registered rows (rebound by ``core.kernel.make_kernel``); none here: no contact."""
     return no_contact()
 
 
@@ -193,7 +193,7 @@ def pair_depth(
 
 @njit(cache=True, inline="always")
 def plugin_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) -> float:
-    """Registered shape kinds (rebound by ``core.run.make_kernel``); none here."""
+    """Registered shape kinds (rebound by ``core.kernel.make_kernel``); none here."""
     return math.inf
 
 
@@ -293,7 +293,7 @@ def register_geometry(feature_kind: int, shape_kind: int, fn: Callable) -> int:
     """Add a row to the table: ``fn(x, C, feat, f, shapes, s) -> ContactRecord`` (``njit``).
 
     Returns its geometry id. A run whose pair table uses it runs in a loop
-    compiled around the registered rows (``core.run.make_kernel``; compiled
+    compiled around the registered rows (``core.kernel.make_kernel``; compiled
     once per process, not cached on disk).
     """
     if not hasattr(fn, "py_func"):

@@ -10,6 +10,6 @@
 A new sensor is a module here with a ``*_sample`` function called from the
 loop where the IMU's is (``step.py``'s ``_sample_sensors``), its configuration
 slots (a ``Block`` in ``layout.py``), its fields in the measurement record,
-and its packing (``packing/sensors.py``); docs/ARCHITECTURE.md has the
+and its packing (``packing/sensor_block.py``); docs/ARCHITECTURE.md has the
 recipe.
 """

@@ -23,7 +23,7 @@ from quadimpact.inputs.controllers import (
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.linalg import inverse
 from quadimpact.packing.constants import RPM
-from quadimpact.packing.vehicle import allocation_matrix, vehicle_memo
+from quadimpact.packing.vehicle_block import allocation_matrix, vehicle_memo
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
 __all__ = [

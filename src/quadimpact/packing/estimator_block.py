@@ -6,7 +6,7 @@ sensor: layout ``SC_*``) and packs the estimator (``ecfg``, layout ``EC_*``);
 :func:`draw_estimation` makes a run's random part from its seed: the added
 sensors' noise (``snoise``, layout ``SN_*``) and the estimator's initial error.
 
-Random draws never touch the IMU's own (``packing.sensors.pack_sensors``: NumPy's
+Random draws never touch the IMU's own (``packing.sensor_block.pack_sensors``: NumPy's
 PCG64 seeded with the run's seed): the added sensors draw from the stream
 ``SeedSequence(seed, spawn_key=(SENSOR_STREAM,))``, one row of ``NSN``
 standard normal numbers per IMU sample, only when one of them needs noise;
