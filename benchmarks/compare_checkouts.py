@@ -47,9 +47,13 @@ try:
     from quadimpact.simulation.setup import prepare
 except ImportError:
     from quadimpact.scenario import prepare
-from quadimpact.core.kernel import execute
+try:  # the layout since the architecture's step 2, or the one before it
+    from quadimpact.core.kernel import execute
+    from quadimpact.studies.recovery.recovery_study import RecoveryStudy
+except ImportError:
+    from quadimpact.core.run import execute
+    from quadimpact.recovery.study import RecoveryStudy
 from quadimpact.inputs.scenarios import scenario_from_dict
-from quadimpact.studies.recovery.recovery_study import RecoveryStudy
 from quadimpact.simulation.batch import BatchRunner
 repeat, trials = int(sys.argv[1]), int(sys.argv[2])
 

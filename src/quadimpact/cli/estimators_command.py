@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
+from quadimpact.cli.command_output import file_lines
 from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
-from quadimpact.errors import InputError
 
 __all__ = ["estimators"]
 
@@ -95,8 +96,6 @@ def estimators(
       quadimpact estimators --scenario authors-2016 --initial-error authors
       quadimpact estimators --scenario authors-2016 --back flight --back gain
     """
-    if scheduler is not None and workers is not None:
-        raise InputError("--workers and --scheduler: give one or the other")
     from dataclasses import replace
 
     from quadimpact.studies.estimators.estimator_scenarios import Approach
@@ -126,6 +125,13 @@ def estimators(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
             allow_large=allow_large,
         )  # fmt: skip
+    click.echo(_summary(result, n))
+
+
+def _summary(result: Any, n: int) -> str:
+    """The closing lines: the ``n`` trials by estimators and their runs (time in s), each
+    estimator's mean crash-phase and not-crash RMS attitude error (deg) and its recovered
+    share (%, where the estimate is in the loop), the table, the report and the time (s)."""
     info = result.run_info
     lines = [
         f"trials    {n} x {len(result.rows)} estimators ({info['n_ran']} run now in "
@@ -139,9 +145,5 @@ def estimators(
             f"{r['estimator']:<15} crash {r['crash_rms_mean_deg']:6.2f} deg (mean), "
             f"not-crash {r['not_crash_rms_mean_deg']:6.2f} deg{share}"
         )
-    lines += [
-        f"table     {result.out_dir / 'estimators.csv'}",
-        f"report    {result.report}",
-        f"time      {result.elapsed_s:.1f} s",
-    ]
-    click.echo("\n".join(lines))
+    lines += file_lines(result.out_dir / "estimators.csv", result.report, result.elapsed_s)
+    return "\n".join(lines)

@@ -3,9 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
+from quadimpact.cli.command_output import file_lines
 from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
 
@@ -112,7 +114,6 @@ def pole(
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
     from quadimpact.studies.pole.pole_study import PoleStudy, run_pole_study, study_folder
-    from quadimpact.studies.statistics import rate_text
     from quadimpact.sweep.values import check_size
 
     study = PoleStudy(
@@ -141,6 +142,14 @@ def pole(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,
             allow_large=allow_large,
         )  # fmt: skip
+    click.echo(_summary(result, model))
+
+
+def _summary(result: Any, model: str) -> str:
+    """The closing lines: the grid and its runs (time in s), each arm's share that loses
+    less than 2 m (95 % Wilson), the table, the report and the study's time (s)."""
+    from quadimpact.studies.statistics import rate_text
+
     arms = result.numbers["arms"]
     info = result.run_info
     rows = [
@@ -155,9 +164,5 @@ def pole(
             f"          {rate_text(arms['recovery-default']['success'])} lose < 2 m "
             "(the default law)"
         )
-    rows += [
-        f"table     {result.out_dir / 'trials.parquet'}",
-        f"report    {result.report}",
-        f"time      {result.elapsed_s:.1f} s",
-    ]
-    click.echo("\n".join(rows))
+    rows += file_lines(result.out_dir / "trials.parquet", result.report, result.elapsed_s)
+    return "\n".join(rows)

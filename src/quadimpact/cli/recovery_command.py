@@ -6,9 +6,11 @@ The study itself is :mod:`quadimpact.studies.recovery`.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
+from quadimpact.cli.command_output import ran_text
 from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
 from quadimpact.errors import InputError
 from quadimpact.studies.recovery import DEFAULT_N, ESTIMATORS, IMUS, MODELS, PRE_IMPACTS, SENSORS
@@ -120,37 +122,10 @@ def recovery(
     if n is not None:  # refused at once, before anything is planned or loaded
         check_size(n, allow_large, f"--n {n}")
     check_out_dir(out, "recovery")
-
-    if scheduler is not None and workers is not None:
-        raise InputError("--workers and --scheduler: give one or the other")
-    if imu is not None and sensors is not None:
-        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
     values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
     given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
-    study = None
-    if sweep_file is not None and given:
-        flag = "--" + next(iter(given)).replace("_", "-")
-        raise InputError(f"--sweep: the sweep file sets the trials; {flag} cannot be given with it")
-    if sweep_file is None:  # the options checked before anything heavy loads
-        from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
-
-        try:
-            study = RecoveryStudy(**given)
-        except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
-            field, sep, rest = str(exc).partition(":")
-            raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
-    from quadimpact.studies.study_folder import StudyFolder
-    from quadimpact.sweep.runner import warm_pool
-
-    # the pool's fork server imports the simulator and loads the kernel on another core
-    # while this process imports the study: the trials' pool and the example trial's
-    # process (docs/RECOVERY.md 8) then start from a warm server instead of waiting for it
-    # (not for a finished study of the same options: it has nothing left to run)
-    finished = study is not None and (
-        StudyFolder(out, "recovery", study.options()).finished_description() is not None
-    )
-    if not finished:
-        warm_pool(workers, scheduler)
+    study = _options_study(given, sweep_file)
+    _warm_unless_finished(study, out, workers, scheduler)
     from quadimpact.studies.recovery.recovery_study import run_study
 
     if sweep_file is not None:
@@ -169,6 +144,46 @@ def recovery(
     click.echo(_summary(result))
 
 
+def _options_study(given: dict[str, Any], sweep_file: Path | None) -> Any:
+    """The study of the options ``given`` (option -> value, those given), checked before
+    anything heavy loads; None with a sweep file, which sets the trials itself. Refused, in
+    one line naming the flag: --imu with --sensors, an option with --sweep, a bad value."""
+    if "imu" in given and "sensors" in given:
+        raise InputError("--imu and --sensors: give one or the other (a preset sets the IMU)")
+    if sweep_file is not None:
+        if given:
+            flag = "--" + next(iter(given)).replace("_", "-")
+            raise InputError(
+                f"--sweep: the sweep file sets the trials; {flag} cannot be given with it"
+            )
+        return None
+    from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
+
+    try:
+        return RecoveryStudy(**given)
+    except InputError as exc:  # "pre_impact: ..." -> "--pre-impact: ..." (the flag only)
+        field, sep, rest = str(exc).partition(":")
+        raise InputError(f"--{field.replace('_', '-')}{sep}{rest}") from None
+
+
+def _warm_unless_finished(
+    study: Any, out: Path, workers: int | None, scheduler: str | None
+) -> None:
+    """Start the pool's fork server (``sweep.runner.warm_pool``) unless ``out`` holds this
+    very study (``study``, None for a sweep file) finished: it has nothing left to run."""
+    from quadimpact.studies.study_folder import StudyFolder
+    from quadimpact.sweep.runner import warm_pool
+
+    # the pool's fork server imports the simulator and loads the kernel on another core
+    # while this process imports the study: the trials' pool and the example trial's
+    # process (docs/RECOVERY.md 8) then start from a warm server instead of waiting for it
+    finished = study is not None and (
+        StudyFolder(out, "recovery", study.options()).finished_description() is not None
+    )
+    if not finished:
+        warm_pool(workers, scheduler)
+
+
 def _summary(result) -> str:
     from quadimpact.results.costs import cost_text
     from quadimpact.studies.recovery.recovery_report import excluded_text
@@ -176,13 +191,8 @@ def _summary(result) -> str:
 
     info, numbers = result.run_info, result.numbers
     c = numbers["classes"]
-    if info["n_ran"] == 0:
-        ran = "all done before, nothing to run"
-    else:
-        before = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
-        ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{before}"
     rows = [
-        ("trials", f"{numbers['n']} ({ran})"),
+        ("trials", f"{numbers['n']} ({ran_text(info)})"),
         ("success", f"{rate_text(numbers['success'])} (recovered / valid trials, 95 % Wilson)"),
         ("excluded", excluded_text(numbers)),
         ("if detected", f"{rate_text(numbers['success_detected'])} (recovered / detected impacts)"),

@@ -47,6 +47,8 @@ _FLAGS: dict[str, tuple[str, str]] = {
     "imu": ("imu", "--imu"),
     "seed": ("seed", "--seed"),
 }
+#: Scenario field -> its flag as typed (in error messages).
+_FLAG_OF = {field: flag for field, flag in _FLAGS.values()}
 _WALL_ONLY = {
     "heading_deg",
     "inclination_deg",
@@ -357,31 +359,49 @@ def build_scenario(
     InputError
         Naming the file and field, or the flag, that is wrong.
     """
-    from pydantic import ValidationError
-
     from quadimpact.inputs.toml_files import apply_overrides, read_toml_file
 
     if scenario_path is not None:
         # a missing, unreadable or malformed file is said before the scenarios' import (1 s)
         read_toml_file(scenario_path)
-    from quadimpact.inputs.model import ModelOptions
-    from quadimpact.inputs.scenarios import _KINDS, load_scenario_file
+    from quadimpact.inputs.scenarios import _KINDS
 
-    data: dict[str, Any] = {}
-    if scenario_path is not None:
-        data = load_scenario_file(scenario_path).model_dump()
-        if kind is not None and data.get("kind", "wall-approach") != kind:
-            raise InputError(
-                f"--kind {kind}: {scenario_path} has kind = {data.get('kind')!r} (a file sets "
-                "its own kind; leave --kind out)"
-            )
-    elif kind is not None:
-        data = {"kind": kind}
+    data = _file_fields(scenario_path, kind)
     kind = data.get("kind", "wall-approach")
     cls = _KINDS[kind]
-
     given = {_FLAGS[key][0]: value for key, value in flags.items() if value is not None}
-    rename = {field: flag for field, flag in _FLAGS.values()}
+    _check_flags_apply(given, cls, kind, scenario_path)
+    parsed_params: dict[str, Any] = {}
+    if params:
+        parsed_params = _parse_options(params, "--param")
+        data["controller_params"] = {**(data.get("controller_params") or {}), **parsed_params}
+    if options:
+        data["model_options"] = {**(data.get("model_options") or {}), **_model_options(options)}
+    data = apply_overrides(data, given)
+    return _validated(cls, data, scenario_path, given, parsed_params)
+
+
+def _file_fields(scenario_path: Path | None, kind: str | None) -> dict[str, Any]:
+    """The scenario file's fields (validated, defaults filled in); without a file, only
+    ``--kind``'s (none without it). A file's kind other than ``--kind`` is refused."""
+    from quadimpact.inputs.scenarios import load_scenario_file
+
+    if scenario_path is None:
+        return {} if kind is None else {"kind": kind}
+    data = load_scenario_file(scenario_path).model_dump()
+    if kind is not None and data.get("kind", "wall-approach") != kind:
+        raise InputError(
+            f"--kind {kind}: {scenario_path} has kind = {data.get('kind')!r} (a file sets "
+            "its own kind; leave --kind out)"
+        )
+    return data
+
+
+def _check_flags_apply(
+    given: Mapping[str, Any], cls: Any, kind: str, scenario_path: Path | None
+) -> None:
+    """Refuse a flag (``given``: field -> value) whose field the scenario kind (``cls``) does
+    not have, naming the flag, the kind it applies to and where the kind came from."""
     for field in given:
         if field not in cls.model_fields:
             named = {"wall-approach": "a wall approach", "impact-trial": "an impact trial"}
@@ -393,35 +413,51 @@ def build_scenario(
                 rule = "applies to wall-approach scenarios only"
             else:
                 rule = "applies to impact trials only (--kind impact-trial, or a file's kind)"
-            raise InputError(f"{rename[field]}: {rule} ({where})")
-    parsed_params: dict[str, Any] = {}
-    if params:
-        parsed_params = _parse_options(params, "--param")
-        data["controller_params"] = {**(data.get("controller_params") or {}), **parsed_params}
-    if options:
-        parsed = _parse_options(options)
-        try:
-            ModelOptions.model_validate(parsed)
-        except ValidationError as exc:
-            raise input_error_from_validation(exc, "--option", model=ModelOptions) from None
-        data["model_options"] = {**(data.get("model_options") or {}), **parsed}
-    data = apply_overrides(data, given)
+            raise InputError(f"{_FLAG_OF[field]}: {rule} ({where})")
+
+
+def _model_options(options: tuple[str, ...]) -> dict[str, Any]:
+    """The ``--option NAME=VALUE`` model switches, each checked as a model option."""
+    from pydantic import ValidationError
+
+    from quadimpact.inputs.model import ModelOptions
+
+    parsed = _parse_options(options)
+    try:
+        ModelOptions.model_validate(parsed)
+    except ValidationError as exc:
+        raise input_error_from_validation(exc, "--option", model=ModelOptions) from None
+    return parsed
+
+
+def _validated(
+    cls: Any,
+    data: dict[str, Any],
+    scenario_path: Path | None,
+    given: Mapping[str, Any],
+    parsed_params: Mapping[str, Any],
+) -> Any:
+    """The scenario of kind ``cls`` from ``data``; an error names what is wrong as given: a
+    ``--param`` (of ``parsed_params``), the flag of a cross-field rule or of a field
+    (``given``: field -> value), else the file's field."""
+    from pydantic import ValidationError
+
     try:
         return cls.model_validate(data)
     except ValidationError as exc:
         loc = exc.errors()[0].get("loc", ())
         text = str(input_error_from_validation(exc, "", model=cls))
         name = text.removeprefix("controller_params.").partition(":")[0]
-        if params and text.startswith("controller_params.") and name in parsed_params:
+        if parsed_params and text.startswith("controller_params.") and name in parsed_params:
             raise InputError("--param: " + text.removeprefix("controller_params.")) from None
         if not loc and given:  # a cross-field rule (e.g. impact before final time)
             message = str(input_error_from_validation(exc))
             field = message.partition(":")[0]
             if field in given:
-                message = rename[field] + message[len(field) :]
+                message = _FLAG_OF[field] + message[len(field) :]
             raise InputError(message) from None
         if scenario_path is None or (loc and loc[0] in given):
-            raise input_error_from_validation(exc, "", rename=rename, model=cls) from None
+            raise input_error_from_validation(exc, "", rename=_FLAG_OF, model=cls) from None
         raise input_error_from_validation(exc, str(scenario_path), model=cls) from None
 
 

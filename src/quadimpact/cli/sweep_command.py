@@ -7,9 +7,11 @@ imported inside the command, so that ``quadimpact --help`` stays fast.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import click
 
+from quadimpact.cli.command_output import ran_text
 from quadimpact.cli.options import (
     file_argument,
     max_record_option,
@@ -119,30 +121,14 @@ def sweep(
     """
     from quadimpact.results.files import check_out_dir
 
-    if scheduler is not None and workers is not None:
-        raise InputError("--workers and --scheduler: give one or the other")
     check_out_dir(out, "sweep")
     extra = _parse_grid(grid)
     if sweep_file is None and not extra:
         raise InputError("sweep: give a sweep file or at least one --grid FIELD=VALUES")
-    from quadimpact.sweep.store import finished_before
+    _warm_up(out, workers, no_plots)
+    from quadimpact.sweep import run_sweep
 
-    if workers is not None and workers > 1 and not finished_before(out):
-        from quadimpact.sweep.runner import warm_pool
-
-        # N workers from the start (unless every run is done already): the fork server
-        # imports the simulator and loads the kernel on another core meanwhile
-        warm_pool(workers)
-        if not no_plots:  # and this process loads the plotting (Matplotlib) on this one
-            import quadimpact.sweep.plots  # noqa: F401
-    from quadimpact.sweep import SweepSpec, load_sweep_file, run_sweep
-
-    if sweep_file is not None:
-        spec = load_sweep_file(sweep_file)
-        if extra:
-            spec = spec.with_grid(extra)
-    else:
-        spec = SweepSpec(grid=extra, where="sweep")
+    spec = _sweep_spec(sweep_file, extra)
     # once stopped by a signal, every later one is ignored until the program has ended
     with stoppable():
         info = run_sweep(
@@ -156,22 +142,52 @@ def sweep(
             allow_large=allow_large,
             max_record_mb=max_record_mb,
         )
-    plots: list[Path] = []
-    if not no_plots:
-        from quadimpact.sweep.plot_plan import drawn_plots, plot_plan
-
-        names = plot_plan(spec)[1]
-        drawn = drawn_plots(out, names) if names else []
-        if drawn is not None:  # drawn before from this very table (a rerun): kept
-            plots = drawn
-        else:
-            from quadimpact.sweep.plots import auto_plots
-
-            try:
-                plots = auto_plots(out, spec)
-            except Exception as exc:  # plots never lose the table
-                click.echo(f"quadimpact: warning: plots not written: {exc}", err=True)
+    plots = [] if no_plots else _plots(out, spec)
     click.echo(_report(out, plots, info))
+
+
+def _warm_up(out: Path, workers: int | None, no_plots: bool) -> None:
+    """With N workers given (N > 1) and runs left in ``out``: start the pool's fork server
+    now, and load the plotting here meanwhile (unless ``no_plots``)."""
+    from quadimpact.sweep.store import finished_before
+
+    if workers is not None and workers > 1 and not finished_before(out):
+        from quadimpact.sweep.runner import warm_pool
+
+        # N workers from the start (unless every run is done already): the fork server
+        # imports the simulator and loads the kernel on another core meanwhile
+        warm_pool(workers)
+        if not no_plots:  # and this process loads the plotting (Matplotlib) on this one
+            import quadimpact.sweep.plots  # noqa: F401
+
+
+def _sweep_spec(sweep_file: Path | None, extra: dict[str, list]) -> Any:
+    """The sweep: the file's, its grid replaced or extended by the ``--grid`` fields
+    (``extra``); without a file, the default base over those fields."""
+    from quadimpact.sweep import SweepSpec, load_sweep_file
+
+    if sweep_file is None:
+        return SweepSpec(grid=extra, where="sweep")
+    spec = load_sweep_file(sweep_file)
+    return spec.with_grid(extra) if extra else spec
+
+
+def _plots(out: Path, spec: Any) -> list[Path]:
+    """The sweep's plots in ``out/plots`` (``sweep.plot_plan``): those drawn before from
+    this very table (a rerun) kept, else drawn now; a failure only warns (the table stays)."""
+    from quadimpact.sweep.plot_plan import drawn_plots, plot_plan
+
+    names = plot_plan(spec)[1]
+    drawn = drawn_plots(out, names) if names else []
+    if drawn is not None:  # drawn before from this very table (a rerun): kept
+        return drawn
+    from quadimpact.sweep.plots import auto_plots
+
+    try:
+        return auto_plots(out, spec)
+    except Exception as exc:  # plots never lose the table
+        click.echo(f"quadimpact: warning: plots not written: {exc}", err=True)
+        return []
 
 
 def _report(out: Path, plots: list[Path], info: dict) -> str:
@@ -189,14 +205,10 @@ def _report(out: Path, plots: list[Path], info: dict) -> str:
         f"{k} {int(status.get(k, 0))}" for k in ("completed", "crashed", "failed")
     )
     type_text = ", ".join(f"{k} {int(types.get(k, 0))}" for k in ("A", "B", "C", "D", "Other"))
-    if info["n_ran"] == 0:
-        ran = "all done before, nothing to run"
-    else:
-        resumed = f", {info['n_already_done']} done before" if info["n_already_done"] else ""
-        ran = f"{info['n_ran']} run now in {info['elapsed_s']:.1f} s, {info['backend']}{resumed}"
     lines = [
         f"runs    {n} ({int(status.get('failed', 0))} failed, "
-        f"{int(t['bumper_model_valid'].eq(False).sum())} deeper than the bumper radius; {ran})",
+        f"{int(t['bumper_model_valid'].eq(False).sum())} deeper than the bumper radius; "
+        f"{ran_text(info)})",
         f"status  {status_text}",
         f"types   {type_text}",
         f"cost    {cost_text(cost_ratio(t))}",

@@ -299,42 +299,8 @@ def make_fig6(
     fig = new_figure(10.0, 7.5, margins=fig_margins(10.0, 7.5, title, hspace=0.12, wspace=0.25))
     axes = fig.subplots(3, 2, sharex=True)
     t = np.asarray(ts["t_s"], dtype=np.float64)
-
-    def ref_value(key: str, scale: float = 1.0) -> float | None:
-        v = refs.get(key)
-        if v is None or not math.isfinite(float(v)):
-            return None
-        return float(v) * scale
-
-    left = (
-        ("x_m", "X (m)", wall_x_m, "wall"),
-        ("y_m", "Y (m)", None, None),
-        ("altitude_m", "Altitude (m)", ref_value("altitude_m"), "reference"),
-    )
-    for ax, (col, label, ref, ref_label) in zip(axes[:, 0], left, strict=True):
-        ax.plot(t, np.asarray(ts[col], dtype=np.float64), color="tab:blue", label="simulated")
-        if ref is not None and math.isfinite(ref):
-            ax.axhline(ref, label=ref_label, **_REF_STYLE)
-        ax.set_ylabel(label)
-
-    deg = 180.0 / math.pi
-    right = (
-        ("roll_deg", "Roll φ (deg)", ref_value("roll_rad", deg), True),
-        ("pitch_deg", "Pitch θ (deg)", ref_value("pitch_rad", deg), False),
-        ("yaw_deg", "Yaw ψ (deg)", ref_value("yaw_rad", deg), True),
-    )
-    for ax, (col, label, ref, wrapped) in zip(axes[:, 1], right, strict=True):
-        yy = np.asarray(ts[col], dtype=np.float64)
-        if wrapped:  # continuous through +-180 deg; the reference on the same branch
-            yy = unwrap_deg(yy)
-            first = yy[np.isfinite(yy)][:1]
-            if ref is not None and len(first):
-                ref += 360.0 * round((float(first[0]) - ref) / 360.0)
-        ax.plot(t, yy, color="tab:blue", label="simulated")
-        if ref is not None:
-            ax.axhline(ref, label="reference", **_REF_STYLE)
-        ax.set_ylabel(label)
-
+    _draw_positions(axes[:, 0], t, ts, refs, wall_x_m)
+    _draw_angles(axes[:, 1], t, ts, refs)
     for ax in axes.flat:
         ax.grid(True, alpha=0.4)
         compact_ticks(ax)
@@ -346,6 +312,55 @@ def make_fig6(
     if title:
         fit_title(fig, title)
     return fig
+
+
+def _reference(refs: Mapping[str, float], key: str, scale: float = 1.0) -> float | None:
+    """``refs[key]`` times ``scale``; None where it is missing, None or not finite."""
+    v = refs.get(key)
+    if v is None or not math.isfinite(float(v)):
+        return None
+    return float(v) * scale
+
+
+def _draw_positions(
+    axes: Any, t: np.ndarray, ts: pd.DataFrame, refs: Mapping[str, float], wall_x_m: float | None
+) -> None:
+    """Figure 6's left column on ``axes``: X with the wall plane (``wall_x_m``), Y, and
+    the altitude with its reference (``refs["altitude_m"]``), in m against ``t`` (s),
+    references dashed."""
+    left = (
+        ("x_m", "X (m)", wall_x_m, "wall"),
+        ("y_m", "Y (m)", None, None),
+        ("altitude_m", "Altitude (m)", _reference(refs, "altitude_m"), "reference"),
+    )
+    for ax, (col, label, ref, ref_label) in zip(axes, left, strict=True):
+        ax.plot(t, np.asarray(ts[col], dtype=np.float64), color="tab:blue", label="simulated")
+        if ref is not None and math.isfinite(ref):
+            ax.axhline(ref, label=ref_label, **_REF_STYLE)
+        ax.set_ylabel(label)
+
+
+def _draw_angles(axes: Any, t: np.ndarray, ts: pd.DataFrame, refs: Mapping[str, float]) -> None:
+    """Figure 6's right column on ``axes``: roll, pitch and yaw (ZYX Euler, deg) against
+    ``t`` (s), each with its reference (``refs``, rad) dashed; roll and yaw unwrapped
+    (:func:`unwrap_deg`), their references moved to the same branch."""
+    deg = 180.0 / math.pi
+    right = (
+        ("roll_deg", "Roll φ (deg)", _reference(refs, "roll_rad", deg), True),
+        ("pitch_deg", "Pitch θ (deg)", _reference(refs, "pitch_rad", deg), False),
+        ("yaw_deg", "Yaw ψ (deg)", _reference(refs, "yaw_rad", deg), True),
+    )
+    for ax, (col, label, ref, wrapped) in zip(axes, right, strict=True):
+        yy = np.asarray(ts[col], dtype=np.float64)
+        if wrapped:  # continuous through +-180 deg; the reference on the same branch
+            yy = unwrap_deg(yy)
+            first = yy[np.isfinite(yy)][:1]
+            if ref is not None and len(first):
+                ref += 360.0 * round((float(first[0]) - ref) / 360.0)
+        ax.plot(t, yy, color="tab:blue", label="simulated")
+        if ref is not None:
+            ax.axhline(ref, label="reference", **_REF_STYLE)
+        ax.set_ylabel(label)
 
 
 def plot_fig5(ts: pd.DataFrame, path: str | os.PathLike[str], title: str | None = None) -> Path:

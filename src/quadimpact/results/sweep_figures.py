@@ -16,6 +16,7 @@ import math
 import numbers
 import os
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -218,86 +219,144 @@ def type_map_figure(
     fig = new_figure(width, height + 0.6)
     cell_pt = 72.0 * min(cell_h, (width - 1.8) / max(1, len(xs)))
     axes = fig.subplots(len(panels), 1, squeeze=False)[:, 0]
-    cmap = ListedColormap([TYPE_COLOURS[t] for t in _TYPES])
-    col = {v: i for i, v in enumerate(xs)}
-    row = {v: i for i, v in enumerate(ys)}
-    present: set[str] = set()
-    show_text = len(xs) * len(ys) <= MAX_TEXT_CELLS
-    any_text = any_invalid = False
+    text_pt = cell_pt if len(xs) * len(ys) <= MAX_TEXT_CELLS else None
+    drawn = _Drawn(set())
     for ax, (fv, sub) in zip(axes, panels, strict=True):
-        kind = sub["response_type"].astype(object).where(sub["status"] != "failed", "failed")
-        import pandas as pd
-
-        cells = pd.DataFrame(
-            {
-                "x": sub[x].to_numpy(),
-                "y": sub[y].to_numpy(),
-                "t": kind.to_numpy(),
-                "n": _cell_texts(sub, label),
-                "bad": invalid_runs(sub).to_numpy(),
-            }
-        ).dropna(subset=["x", "y"])
-        grid = np.full((len(ys), len(xs)), np.nan)
-        for (xv, yv), g in cells.groupby(["x", "y"], sort=False):
-            t = _mode(g["t"])
-            if t is None or (isinstance(t, float) and math.isnan(t)) or t not in _TYPES:
-                continue
-            present.add(t)
-            grid[row[yv], col[xv]] = _TYPES.index(t)
-            if g["bad"].any():
-                any_invalid = True
-                ax.add_patch(Rectangle((col[xv] - 0.5, row[yv] - 0.5), 1.0, 1.0, fill=False,
-                                       hatch="//", edgecolor="0.25", linewidth=0.0,
-                                       zorder=3))  # fmt: skip
-            if show_text and t != "failed":
-                text = g.loc[g["t"] == t, "n"].iloc[0]
-                if text is not None:
-                    any_text = True
-                    # as large as the cell allows: height, and width for the text's length
-                    size = min(0.45 * cell_pt, 0.9 * cell_pt / (0.62 * max(1, len(str(text)))))
-                    ax.text(
-                        col[xv],
-                        row[yv],
-                        text,
-                        ha="center",
-                        va="center",
-                        fontsize=max(5.0, min(12.0, size)),
-                        color="white" if t in ("B", "D") else "black",
-                        zorder=4,
-                    ).set_in_layout(False)  # inside its cell: no margin to make room for
-        ax.pcolormesh(
-            np.arange(len(xs) + 1) - 0.5,
-            np.arange(len(ys) + 1) - 0.5,
-            np.ma.masked_invalid(grid),
-            cmap=cmap,
-            vmin=-0.5,
-            vmax=len(_TYPES) - 0.5,
-            edgecolors="white",
-            linewidth=0.5,
-        )
-        step = max(1, math.ceil(len(xs) / 21))
-        ax.set_xticks(range(0, len(xs), step), [format_level(v) for v in xs[::step]], fontsize=8)
-        ax.set_yticks(range(len(ys)), [format_level(v) for v in ys], fontsize=8)
-        ax.set_xlim(-0.5, len(xs) - 0.5)
-        ax.set_ylim(-0.5, len(ys) - 0.5)
+        grid = _fill_cells(ax, _panel_cells(sub, x, y, label), xs, ys, text_pt, drawn)
+        _draw_grid(ax, grid, xs, ys)
         ax.set_xlabel(field_label(x))
         ax.set_ylabel(field_label(y))
         if fv is not None:
             ax.set_title(field_value(facet, fv), fontsize=10)
-    handles = [Patch(color=TYPE_COLOURS[t], label=t) for t in _TYPES if t in present]
-    if any_text:
-        meaning = text_meaning or (
-            "number: subsequent impacts" if label is None else "cell text: the run's label"
-        )
-        handles.append(Patch(facecolor="white", edgecolor="0.6", label=meaning))
-    if any_invalid:
-        handles.append(Patch(facecolor="white", edgecolor="0.25", hatch="//",
-                             label=INVALID_LABEL))  # fmt: skip
-    if handles:
-        fig.legend(handles=handles, loc="outside lower center", fontsize=8,
-                   ncols=min(len(handles), 5 if width >= 9.0 else 2))  # fmt: skip
+    _type_map_legend(fig, drawn, label, text_meaning, width)
     if title:
         fit_title(fig, title)
     if path is not None:
         save_figure(fig, path)
     return fig
+
+
+@dataclass
+class _Drawn:
+    """What a type map's panels drew, for its legend: the response types of its cells
+    (``types``), whether a cell has text (``text``) and whether a cell holds a run deeper
+    than the bumper radius (``invalid``, hatched)."""
+
+    types: set[str]
+    text: bool = False
+    invalid: bool = False
+
+
+def _panel_cells(
+    sub: pd.DataFrame, x: str, y: str, label: Callable[[pd.Series], str] | None
+) -> pd.DataFrame:
+    """A panel's runs as cells: their ``x`` and ``y`` values (rows without either left
+    out), type (``"failed"`` for a failed run), text (:func:`_cell_texts`) and whether the
+    run is deeper than the bumper radius (``bad``)."""
+    import pandas as pd
+
+    kind = sub["response_type"].astype(object).where(sub["status"] != "failed", "failed")
+    return pd.DataFrame(
+        {
+            "x": sub[x].to_numpy(),
+            "y": sub[y].to_numpy(),
+            "t": kind.to_numpy(),
+            "n": _cell_texts(sub, label),
+            "bad": invalid_runs(sub).to_numpy(),
+        }
+    ).dropna(subset=["x", "y"])
+
+
+def _fill_cells(
+    ax: Any,
+    cells: pd.DataFrame,
+    xs: list[Any],
+    ys: list[Any],
+    text_pt: float | None,
+    drawn: _Drawn,
+) -> np.ndarray:
+    """Each cell's type (the most frequent of its runs) as its index in :data:`TYPE_COLOURS`
+    on a (len(ys), len(xs)) grid (NaN: no run, or none of a known type); a cell holding a
+    run deeper than the bumper radius is hatched on ``ax``, and a cell's text written when
+    ``text_pt`` (the cell's size, points) is given. What was drawn goes to ``drawn``."""
+    col = {v: i for i, v in enumerate(xs)}
+    row = {v: i for i, v in enumerate(ys)}
+    grid = np.full((len(ys), len(xs)), np.nan)
+    for (xv, yv), g in cells.groupby(["x", "y"], sort=False):
+        t = _mode(g["t"])
+        if t is None or (isinstance(t, float) and math.isnan(t)) or t not in _TYPES:
+            continue
+        drawn.types.add(t)
+        grid[row[yv], col[xv]] = _TYPES.index(t)
+        if g["bad"].any():
+            drawn.invalid = True
+            ax.add_patch(Rectangle((col[xv] - 0.5, row[yv] - 0.5), 1.0, 1.0, fill=False,
+                                   hatch="//", edgecolor="0.25", linewidth=0.0,
+                                   zorder=3))  # fmt: skip
+        if text_pt is not None and t != "failed":
+            text = g.loc[g["t"] == t, "n"].iloc[0]
+            if text is not None:
+                drawn.text = True
+                _write_cell_text(ax, col[xv], row[yv], text, t, text_pt)
+    return grid
+
+
+def _write_cell_text(ax: Any, i: int, j: int, text: str, kind: str, cell_pt: float) -> None:
+    """Write ``text`` in the cell of column ``i`` and row ``j`` (of type ``kind``): as large
+    as the cell (``cell_pt``, points) allows for its height and the text's length, 5 to 12
+    points, white on the dark types (B, D)."""
+    size = min(0.45 * cell_pt, 0.9 * cell_pt / (0.62 * max(1, len(str(text)))))
+    ax.text(
+        i,
+        j,
+        text,
+        ha="center",
+        va="center",
+        fontsize=max(5.0, min(12.0, size)),
+        color="white" if kind in ("B", "D") else "black",
+        zorder=4,
+    ).set_in_layout(False)  # inside its cell: no margin to make room for
+
+
+def _draw_grid(ax: Any, grid: np.ndarray, xs: list[Any], ys: list[Any]) -> None:
+    """Colour the cells of ``grid`` (:func:`_fill_cells`) on ``ax``, one colour per type,
+    and label the axes' ticks with the values ``xs`` (at most about 21 shown) and ``ys``."""
+    ax.pcolormesh(
+        np.arange(len(xs) + 1) - 0.5,
+        np.arange(len(ys) + 1) - 0.5,
+        np.ma.masked_invalid(grid),
+        cmap=ListedColormap([TYPE_COLOURS[t] for t in _TYPES]),
+        vmin=-0.5,
+        vmax=len(_TYPES) - 0.5,
+        edgecolors="white",
+        linewidth=0.5,
+    )
+    step = max(1, math.ceil(len(xs) / 21))
+    ax.set_xticks(range(0, len(xs), step), [format_level(v) for v in xs[::step]], fontsize=8)
+    ax.set_yticks(range(len(ys)), [format_level(v) for v in ys], fontsize=8)
+    ax.set_xlim(-0.5, len(xs) - 0.5)
+    ax.set_ylim(-0.5, len(ys) - 0.5)
+
+
+def _type_map_legend(
+    fig: Figure,
+    drawn: _Drawn,
+    label: Callable[[pd.Series], str] | None,
+    text_meaning: str | None,
+    width: float,
+) -> None:
+    """The legend below the panels: the types drawn, what a cell's text is (``text_meaning``,
+    else said from ``label``) and the hatch, those that appear; in up to 5 columns on a
+    figure at least 9 in wide (``width``), else 2."""
+    handles = [Patch(color=TYPE_COLOURS[t], label=t) for t in _TYPES if t in drawn.types]
+    if drawn.text:
+        meaning = text_meaning or (
+            "number: subsequent impacts" if label is None else "cell text: the run's label"
+        )
+        handles.append(Patch(facecolor="white", edgecolor="0.6", label=meaning))
+    if drawn.invalid:
+        handles.append(Patch(facecolor="white", edgecolor="0.25", hatch="//",
+                             label=INVALID_LABEL))  # fmt: skip
+    if handles:
+        fig.legend(handles=handles, loc="outside lower center", fontsize=8,
+                   ncols=min(len(handles), 5 if width >= 9.0 else 2))  # fmt: skip

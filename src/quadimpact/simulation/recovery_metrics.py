@@ -183,6 +183,34 @@ def recovery_metrics(
         :data:`RECOVERY_KEYS`; floats are ``None`` where undefined (no
         detection, stage not reached...), booleans and counts always set.
     """
+    out = _detection_metrics(st, final_state)
+    if not out["detected"]:
+        return out
+    t_detect = float(st[L.ST_T_DETECT])
+    first_contact = float(st[L.ST_ONSET_T])
+    if math.isfinite(first_contact) and not out["false_detection"]:
+        out["detection_latency_s"] = t_detect - first_contact
+        first = first_obstacle_contact
+        if isinstance(first, str):
+            first = first_contact_normal(st, episodes, feat, shapes, surface_names, obstacle_names)
+        out["normal_error_deg"] = _normal_error_deg(st, first)
+    out.update(_stage_travel(st))
+    if out["recovered"]:
+        out["time_to_recover_s"] = float(st[L.ST_STAGE_T + RECOVERED_STAGE]) - t_detect
+    t_hover = float(st[L.ST_T_HOVER])
+    if math.isfinite(t_hover):
+        out["time_to_hover_s"] = t_hover - t_detect
+    out["max_tilt_deg"] = math.degrees(math.acos(min(max(float(st[L.ST_MIN_TILT_COS]), -1.0), 1.0)))
+    out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
+    out["impacts_after_detection"] = _impacts_after(t_detect, episodes, obstacle_names, impacts)
+    return out
+
+
+def _detection_metrics(st: np.ndarray, final_state: np.ndarray) -> dict[str, Any]:
+    """The metrics set whether or not the impact was detected, every other key None: the
+    detection (detected, missed, false, how many, its time in s), the lowest altitude (m),
+    the final speed (m/s), the time each stage 1-5 was entered (s), whether it recovered,
+    and no impact after the detection (counted later where there was one)."""
     t_detect = float(st[L.ST_T_DETECT])
     detected = math.isfinite(t_detect)
     first_contact = float(st[L.ST_ONSET_T])
@@ -202,41 +230,51 @@ def recovery_metrics(
         out[f"t_stage{k}_s"] = _finite(stage_t[k])
     out["recovered"] = bool(math.isfinite(stage_t[RECOVERED_STAGE]))
     out["impacts_after_detection"] = 0
-    if not detected:
-        return out
+    return out
 
-    if contact and not false_detection:
-        out["detection_latency_s"] = t_detect - first_contact
-        first = first_obstacle_contact
-        if isinstance(first, str):
-            first = first_contact_normal(st, episodes, feat, shapes, surface_names, obstacle_names)
-        if first is not None:
-            n_true = first[1]
-            n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
-            if norm(n_est) > 0:
-                c = min(max(float(dot(n_est, n_true) / norm(n_true)), -1.0), 1.0)
-                out["normal_error_deg"] = math.degrees(math.acos(c))
+
+def _normal_error_deg(st: np.ndarray, first: tuple[int, np.ndarray] | None) -> float | None:
+    """The angle (deg) between the detector's normal estimate and the true normal of the
+    first contact with an obstacle (``first``: bumper, normal; inertial); None without a
+    contact or an estimate."""
+    if first is None:
+        return None
+    n_true = first[1]
+    n_est = st[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
+    if not norm(n_est) > 0:
+        return None
+    c = min(max(float(dot(n_est, n_true) / norm(n_true)), -1.0), 1.0)
+    return math.degrees(math.acos(c))
+
+
+def _stage_travel(st: np.ndarray) -> dict[str, float]:
+    """The height lost (altitude at the detection minus at the entry, m) and the horizontal
+    drift (m) from the detection to the entry into stages 2, 3 and 4 (keys
+    ``height_loss_stage2_m``... and ``height_loss_m`` for stage 4), those entered."""
+    travel: dict[str, float] = {}
     p_detect = st[L.ST_DETECT_X + L.X_POS : L.ST_DETECT_X + L.X_POS + 3]
     for k, name in ((2, "stage2"), (3, "stage3"), (4, None)):
-        if not math.isfinite(stage_t[k]):
+        if not math.isfinite(float(st[L.ST_STAGE_T + k])):
             continue
         p = st[L.ST_STAGE_X + 3 * k : L.ST_STAGE_X + 3 * k + 3]
         loss = -p_detect[2] - (-p[2])  # altitude at detection minus altitude at entry
         drift = math.hypot(p[0] - p_detect[0], p[1] - p_detect[1])
         suffix = f"_{name}" if name else ""
-        out[f"height_loss{suffix}_m"] = float(loss)
-        out[f"horizontal_drift{suffix}_m"] = float(drift)
-    if out["recovered"]:
-        out["time_to_recover_s"] = stage_t[RECOVERED_STAGE] - t_detect
-    t_hover = float(st[L.ST_T_HOVER])
-    if math.isfinite(t_hover):
-        out["time_to_hover_s"] = t_hover - t_detect
-    out["max_tilt_deg"] = math.degrees(math.acos(min(max(float(st[L.ST_MIN_TILT_COS]), -1.0), 1.0)))
-    out["max_rate_rad_s"] = float(st[L.ST_MAX_RATE])
-    # impacts (grazes excluded, obstacles only) that start after the detection
+        travel[f"height_loss{suffix}_m"] = float(loss)
+        travel[f"horizontal_drift{suffix}_m"] = float(drift)
+    return travel
+
+
+def _impacts_after(
+    t_detect: float,
+    episodes: Table | None,
+    obstacle_names: Sequence[str],
+    impacts: RunImpacts | None,
+) -> int:
+    """The impacts on the obstacles (grazes left out) that start after the detection at
+    ``t_detect`` (s): of ``impacts`` when given, else found from the ``episodes``."""
     if impacts is None and n_rows(episodes):
         others = sorted(set(episode_lists(episodes, ("surface",))["surface"]) - set(obstacle_names))
         impacts = impacts_of_table(episodes, others, GRAZE_IMPULSE_FRACTION)
     starts = impacts.start_s if impacts is not None else []
-    out["impacts_after_detection"] = sum(1 for t in starts if t > t_detect)
-    return out
+    return sum(1 for t in starts if t > t_detect)

@@ -94,27 +94,7 @@ def plot_metric(
     axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
     marked = False  # the mark of runs deeper than the bumper radius, in the legend once
     for ax, (fv, sub) in zip(axes, panels, strict=True):
-        groups = (
-            [(None, sub)]
-            if by is None
-            else [(v, sub[sub[by] == v]) for v in sorted_levels(sub[by])]
-        )
-        bad_x: list[Any] = []
-        bad_y: list[float] = []
-        for bv, g in groups:
-            g = g.sort_values(x)
-            y = pd.to_numeric(g[metric], errors="coerce").to_numpy(dtype=float) * scale
-            ax.plot(
-                g[x].to_numpy(),
-                y,
-                marker="o",
-                markersize=3,
-                linewidth=1.2,
-                label=None if bv is None else field_value(by, bv),
-            )
-            bad = invalid_runs(g).to_numpy()
-            bad_x.extend(g[x].to_numpy()[bad])
-            bad_y.extend(y[bad])
+        bad_x, bad_y = _draw_curves(ax, sub, x, metric, scale, by)
         if bad_x:  # after the curves: last in the legend
             ax.plot(bad_x, bad_y, "x", color="black", markersize=6, zorder=5,
                     label=INVALID_LABEL if not marked else None)  # fmt: skip
@@ -135,6 +115,35 @@ def plot_metric(
     if path is not None:
         save_figure(fig, path)
     return fig
+
+
+def _draw_curves(
+    ax: Any, sub: pd.DataFrame, x: str, metric: str, scale: float, by: str | None
+) -> tuple[list[Any], list[float]]:
+    """Draw a panel's curves on ``ax``: ``metric`` (times ``scale``, its unit as drawn)
+    against ``x``, one curve per value of ``by`` (one without it), failed runs as gaps.
+    Returns the points of the runs deeper than the bumper radius (``x`` values, drawn
+    metric), to be marked."""
+    groups = (
+        [(None, sub)] if by is None else [(v, sub[sub[by] == v]) for v in sorted_levels(sub[by])]
+    )
+    bad_x: list[Any] = []
+    bad_y: list[float] = []
+    for bv, g in groups:
+        g = g.sort_values(x)
+        y = pd.to_numeric(g[metric], errors="coerce").to_numpy(dtype=float) * scale
+        ax.plot(
+            g[x].to_numpy(),
+            y,
+            marker="o",
+            markersize=3,
+            linewidth=1.2,
+            label=None if bv is None else field_value(by, bv),
+        )
+        bad = invalid_runs(g).to_numpy()
+        bad_x.extend(g[x].to_numpy()[bad])
+        bad_y.extend(y[bad])
+    return bad_x, bad_y
 
 
 def plot_type_map(

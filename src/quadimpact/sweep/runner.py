@@ -21,7 +21,7 @@ from quadimpact.sweep.backends import (
     run_dask,
     run_serial,
 )
-from quadimpact.sweep.interrupt import SweepInterrupted, signal_name, stop_signals
+from quadimpact.sweep.interrupt import StopFlag, SweepInterrupted, signal_name, stop_signals
 from quadimpact.sweep.limits import RunLimits
 from quadimpact.sweep.pool import (
     WorkerError,
@@ -216,6 +216,28 @@ def run_sweep(
     """
     _refuse_in_a_starting_worker()
     start = time.perf_counter()
+    sweep = _checked_sweep(spec, out_dir, workers, scheduler, timeout, allow_large, on_placed)
+    n_before, backend = sweep.run(progress, max_record_mb)
+    info = _run_info(sweep.spec.n_runs, n_before, time.perf_counter() - start, backend, sweep.out)
+    if not load:
+        return info
+    table = read_runs(sweep.out)
+    table.attrs["sweep"] = info
+    return table
+
+
+def _checked_sweep(
+    spec: SweepSpec | Mapping[str, Any],
+    out_dir: str | os.PathLike[str],
+    workers: int | None,
+    scheduler: Any,
+    timeout: float | None,
+    allow_large: bool,
+    on_placed: Callable[[], None] | None,
+) -> _FolderSweep:
+    """:func:`run_sweep`'s arguments checked, before anything runs: the sweep (a mapping
+    read by :meth:`SweepSpec.from_dict`), ``workers`` or ``scheduler`` (not both; workers
+    capped), the ``timeout`` (s), the number of runs and the folder; the sweep to run."""
     if not isinstance(spec, SweepSpec):
         spec = SweepSpec.from_dict(spec)
     if scheduler is not None and workers is not None:
@@ -224,99 +246,158 @@ def run_sweep(
     limits = RunLimits(timeout)
     check_size(spec.n_runs, allow_large, spec.where)
     out = check_out_dir(Path(out_dir), "sweep", where="")
+    return _FolderSweep(spec, out, workers, n_workers, scheduler, limits, on_placed)
 
-    saved = 0  # finished runs in the folder, as far as known
-    pending = [on_placed] if on_placed is not None else []
 
-    def placed() -> None:
-        while pending:
-            pending.pop()()
-
-    try:
-        with stop_signals() as stop, contextlib.ExitStack() as stack:
-            pool = workers is not None and n_workers > 1 and spec.n_runs > 1
-            if pool and not finished_before(out):
-                start_server(pool_context())  # it loads the kernel while the runs are checked
-            if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
-                _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
-            spec.validate(max_record_mb=max_record_mb)
-            schema = schema_of(spec)
-            client, threads = (
-                stack.enter_context(dask_session(scheduler)) if scheduler is not None else (None, 0)
-            )
-            (out / "parts").mkdir(parents=True, exist_ok=True)
-            stack.enter_context(folder_lock(out))
-            check_folder(out, spec, schema)
-            done, last_part = scan_done(out, spec.n_runs, schema, lambda m: _note(f"warning: {m}"))
-            n_before = saved = int(done.sum())
-            todo = (i for i in range(spec.n_runs) if not done[i])
-            n_todo = spec.n_runs - n_before
-            backend = "none"
-            if n_todo:
-                if client is None:  # here or the local workers: said before the progress bar
-                    announce_compilation()
-                writer = PartWriter(out / "parts", schema, last_part)
-                bar = Progress(spec.n_runs, n_before, enabled=progress)
-
-                def sink(rows: list[dict[str, Any]]) -> None:
-                    writer.add(rows)
-                    if rows:
-                        bar.update(len(rows))
-
-                def note(message: str) -> None:
-                    _note(message, bar)
-
-                try:
-                    if client is not None:
-                        placed()
-                        backend = f"dask, {threads} threads"
-                        chunks = make_chunks(spec, todo, chunk_size(n_todo, threads))
-                        run_dask(client, chunks, sink, limits=limits, stop=stop, note=note)
-                    elif n_workers == 1 or n_todo == 1:
-                        backend = "serial"
-                        placed()
-                        run_serial(make_chunks(spec, todo, 16), sink)
-                    else:
-                        n_here = 0
-                        if workers is None:  # the default: a measured start here
-                            n_here, n_workers = _start_here(
-                                spec, todo, n_todo, sink, n_workers, placed
-                            )  # calls placed() once it has chosen
-                        placed()  # given workers: at once
-                        n_left = n_todo - n_here
-                        if n_left:
-                            n_workers = min(n_workers, n_left)
-                            chunks = make_chunks(spec, todo, chunk_size(n_left, n_workers))
-                            run_pool(chunks, n_workers, sink, limits=limits, stop=stop, note=note)
-                        backend = (
-                            "serial"
-                            if not n_left
-                            else f"{n_workers} processes"
-                            if not n_here
-                            else f"{n_workers} processes, the first {n_here} runs in this one"
-                        )
-                finally:
-                    writer.flush()  # also on Ctrl-C or an error: keep every finished run
-                    bar.close()
-                    saved = n_before + writer.rows_written
-            placed()  # nothing was left to run
-            consolidate(out, schema, spec.n_runs)
-    except (SweepInterrupted, WorkerError) as exc:
-        raise _stopped(exc, saved, spec.n_runs, out) from None
-
-    info = {
-        "n_runs": spec.n_runs,
+def _run_info(n_runs: int, n_before: int, elapsed_s: float, backend: str, out: Path) -> dict:
+    """What :func:`run_sweep` returns about the sweep (its table's ``attrs["sweep"]``): its
+    runs, those found done before and those run now, the time it took (s), where the runs
+    went (``backend``) and its folder."""
+    return {
+        "n_runs": n_runs,
         "n_already_done": n_before,
-        "n_ran": spec.n_runs - n_before,
-        "elapsed_s": time.perf_counter() - start,
+        "n_ran": n_runs - n_before,
+        "elapsed_s": elapsed_s,
         "backend": backend,
         "out_dir": str(out),
     }
-    if not load:
-        return info
-    table = read_runs(out)
-    table.attrs["sweep"] = info
-    return table
+
+
+class _FolderSweep:
+    """A sweep run into its folder (:func:`run_sweep`'s work once its arguments are checked).
+
+    ``workers`` as given (None: the default's measured start), ``n_workers``
+    the local processes resolved from it (1 with a Dask ``scheduler``),
+    ``limits`` the workers' time limits, ``on_placed`` called once where the
+    runs go is decided. ``saved`` is the finished runs in the folder as far as
+    known, said when the sweep stops.
+    """
+
+    def __init__(
+        self,
+        spec: SweepSpec,
+        out: Path,
+        workers: int | None,
+        n_workers: int,
+        scheduler: Any,
+        limits: RunLimits,
+        on_placed: Callable[[], None] | None,
+    ) -> None:
+        self.spec, self.out, self.workers, self.n_workers = spec, out, workers, n_workers
+        self.scheduler, self.limits = scheduler, limits
+        self._pending = [on_placed] if on_placed is not None else []
+        self.saved = 0
+        self.client: Any = None  # the Dask client (None: local), once the session is open
+        self.threads = 0
+
+    def placed(self) -> None:
+        """Call ``on_placed`` the first time only."""
+        while self._pending:
+            self._pending.pop()()
+
+    def run(self, progress: bool, max_record_mb: float | None) -> tuple[int, str]:
+        """Check the runs, lock the folder, run what is missing, merge ``runs.parquet``.
+
+        Returns the runs found done before and where the runs went (``"none"``:
+        nothing left to run). A stop (a signal, workers that could not start)
+        is raised again saying how many runs are saved (:func:`_stopped`).
+        """
+        spec, out = self.spec, self.out
+        try:
+            with stop_signals() as stop, contextlib.ExitStack() as stack:
+                schema = self._open(stack, progress, max_record_mb)
+                done, last_part = scan_done(
+                    out, spec.n_runs, schema, lambda m: _note(f"warning: {m}")
+                )
+                n_before = self.saved = int(done.sum())
+                backend = "none"
+                if n_before < spec.n_runs:
+                    todo = (i for i in range(spec.n_runs) if not done[i])
+                    writer = PartWriter(out / "parts", schema, last_part)
+                    backend = self._run_missing(todo, n_before, writer, stop, progress)
+                self.placed()  # nothing was left to run
+                consolidate(out, schema, spec.n_runs)
+        except (SweepInterrupted, WorkerError) as exc:
+            raise _stopped(exc, self.saved, spec.n_runs, out) from None
+        return n_before, backend
+
+    def _open(
+        self, stack: contextlib.ExitStack, progress: bool, max_record_mb: float | None
+    ) -> Any:
+        """Everything before the first run: the pool's server started early (given workers),
+        the runs checked (:meth:`SweepSpec.validate`), the Dask session opened, the folder
+        locked and checked to hold this sweep; returns the table's schema."""
+        spec, out = self.spec, self.out
+        pool = self.workers is not None and self.n_workers > 1 and spec.n_runs > 1
+        if pool and not finished_before(out):
+            start_server(pool_context())  # it loads the kernel while the runs are checked
+        if progress and spec.n_runs >= VALIDATION_NOTE_RUNS:
+            _note(f"checking the {spec.n_runs} runs of the sweep before any starts")
+        spec.validate(max_record_mb=max_record_mb)
+        schema = schema_of(spec)
+        if self.scheduler is not None:
+            self.client, self.threads = stack.enter_context(dask_session(self.scheduler))
+        (out / "parts").mkdir(parents=True, exist_ok=True)
+        stack.enter_context(folder_lock(out))
+        check_folder(out, spec, schema)
+        return schema
+
+    def _run_missing(
+        self, todo: Iterator[int], n_before: int, writer: PartWriter, stop: StopFlag, progress: bool
+    ) -> str:
+        """The runs not done yet (``todo``) run and written as parts by ``writer``, with the
+        progress bar; every finished run is kept, also on Ctrl-C or an error. Returns where
+        they went (:meth:`_place`)."""
+        if self.client is None:  # here or the local workers: said before the progress bar
+            announce_compilation()
+        bar = Progress(self.spec.n_runs, n_before, enabled=progress)
+
+        def sink(rows: list[dict[str, Any]]) -> None:
+            writer.add(rows)
+            if rows:
+                bar.update(len(rows))
+
+        try:
+            return self._place(todo, self.spec.n_runs - n_before, sink, stop, bar)
+        finally:
+            writer.flush()  # also on Ctrl-C or an error: keep every finished run
+            bar.close()
+            self.saved = n_before + writer.rows_written
+
+    def _place(
+        self, todo: Iterator[int], n_todo: int, sink: Sink, stop: StopFlag, bar: Progress
+    ) -> str:
+        """Run the ``n_todo`` runs of ``todo`` on Dask, in this process or on the local
+        pool (after the default's measured start, :func:`_start_here`); returns where they
+        went, in words (``backend``)."""
+        spec, limits = self.spec, self.limits
+
+        def note(message: str) -> None:
+            _note(message, bar)
+
+        if self.client is not None:
+            self.placed()
+            chunks = make_chunks(spec, todo, chunk_size(n_todo, self.threads))
+            run_dask(self.client, chunks, sink, limits=limits, stop=stop, note=note)
+            return f"dask, {self.threads} threads"
+        if self.n_workers == 1 or n_todo == 1:
+            self.placed()
+            run_serial(make_chunks(spec, todo, 16), sink)
+            return "serial"
+        n_here, n_workers = 0, self.n_workers
+        if self.workers is None:  # the default: a measured start here
+            n_here, n_workers = _start_here(spec, todo, n_todo, sink, n_workers, self.placed)
+        self.placed()  # given workers: at once
+        n_left = n_todo - n_here
+        if n_left:
+            n_workers = min(n_workers, n_left)
+            chunks = make_chunks(spec, todo, chunk_size(n_left, n_workers))
+            run_pool(chunks, n_workers, sink, limits=limits, stop=stop, note=note)
+        if not n_left:
+            return "serial"
+        if not n_here:
+            return f"{n_workers} processes"
+        return f"{n_workers} processes, the first {n_here} runs in this one"
 
 
 def _start_here(

@@ -87,34 +87,13 @@ class SweepSpec:
         *,
         where: str = "sweep",
     ) -> None:
-        from quadimpact.inputs.scenarios import _KINDS
-        from quadimpact.inputs.vehicle import Vehicle
-
         self.where = where
         self.base = self._read_base(base)
-        kind = self.base.get("kind", "wall-approach")
-        if not isinstance(kind, str) or kind not in _KINDS:
-            known = ", ".join(repr(k) for k in _KINDS)
-            raise InputError(
-                f"{where}: base: kind: must be one of {known} (got {format_value(kind)})"
-            )
-        self._scenario_fields = [f for f in _KINDS[kind].model_fields if f != "kind"]
-        self._vehicle_fields = [f for f in Vehicle.model_fields if f not in self._scenario_fields]
-        self._kind_name = kind
-
-        self.grid: dict[str, list[Any]] = {}
-        if grid is not None:
-            if not isinstance(grid, Mapping):
-                raise InputError(f"{where}: grid: must be a table of field = values")
-            for name, values in grid.items():
-                self._check_field(str(name), "grid")
-                self.grid[str(name)] = self._grid_values(str(name), values)
-
+        self._read_kind()
+        self.grid: dict[str, list[Any]] = self._read_grid(grid)
         if sum(x is not None for x in (runs, sample, trials)) > 1:
             raise InputError(f"{where}: give one of runs, sample and trials, not two")
-        self.runs: list[dict[str, Any]] | None = None
-        if runs is not None:
-            self.runs = self._read_runs(runs)
+        self.runs: list[dict[str, Any]] | None = None if runs is None else self._read_runs(runs)
         self.sample: dict[str, Any] | None = None
         if sample is not None:
             self.sample = self._read_sample(sample)
@@ -123,8 +102,50 @@ class SweepSpec:
             self.trials = self._read_trials(trials)
         if not self.grid and not self.runs and self.sample is None and self.trials is None:
             raise InputError(f"{where}: empty sweep: give a grid, runs, a sample or trials")
+        self.columns: dict[str, str] = self._column_kinds()
+        self._numbers_as_floats()
+        self._sizes = [len(v) for v in self.grid.values()]
+        self._inner = self._entries_per_point()
+        n = math.prod(self._sizes) * self._inner
+        if n > MAX_RUNS:
+            raise InputError(f"{where}: {n} runs, more than {MAX_RUNS}")
+        self.n_runs = n
+        self._drawn: dict[str, list[Any]] | None = None
+        self._derive = False  # set by validate(): runs copied from the validated base
 
-        # input columns, in order, and their kinds
+    def _read_kind(self) -> None:
+        """The base's scenario kind (default a wall approach; another refused) and the
+        fields a sweep may vary: that kind's scenario fields and the vehicle's others."""
+        from quadimpact.inputs.scenarios import _KINDS
+        from quadimpact.inputs.vehicle import Vehicle
+
+        kind = self.base.get("kind", "wall-approach")
+        if not isinstance(kind, str) or kind not in _KINDS:
+            known = ", ".join(repr(k) for k in _KINDS)
+            raise InputError(
+                f"{self.where}: base: kind: must be one of {known} (got {format_value(kind)})"
+            )
+        self._scenario_fields = [f for f in _KINDS[kind].model_fields if f != "kind"]
+        self._vehicle_fields = [f for f in Vehicle.model_fields if f not in self._scenario_fields]
+        self._kind_name = kind
+
+    def _read_grid(self, grid: Any) -> dict[str, list[Any]]:
+        """The grid's fields (each checked) and their values (:meth:`_grid_values`); empty
+        without a grid."""
+        read: dict[str, list[Any]] = {}
+        if grid is not None:
+            if not isinstance(grid, Mapping):
+                raise InputError(f"{self.where}: grid: must be a table of field = values")
+            for name, values in grid.items():
+                self._check_field(str(name), "grid")
+                read[str(name)] = self._grid_values(str(name), values)
+        return read
+
+    def _column_kinds(self) -> dict[str, str]:
+        """The input columns, in order, and their kinds (:func:`column_kind` of the values
+        each takes in the grid, the runs and a sample's choices; a drawn field's are
+        numbers, a trial's seed too: exact below 2**53). A field both in the grid and in the
+        runs, sample or trials is refused."""
         fields: dict[str, list[Any]] = {k: list(v) for k, v in self.grid.items()}
         for entry in self.runs or []:
             for k, v in entry.items():
@@ -145,10 +166,13 @@ class SweepSpec:
         for k in self.grid:
             if k in inner:
                 raise InputError(
-                    f"{where}: {k}: swept both in the grid and in runs, sample or trials"
+                    f"{self.where}: {k}: swept both in the grid and in runs, sample or trials"
                 )
-        self.columns: dict[str, str] = {k: column_kind(v) for k, v in fields.items()}
-        # numbers as floats (one type per column, so equal sweeps compare equal)
+        return {k: column_kind(v) for k, v in fields.items()}
+
+    def _numbers_as_floats(self) -> None:
+        """The numbers of the grid, the runs and a sample's choices as floats, in the
+        columns of numbers (one type per column, so that equal sweeps compare equal)."""
         for k, values in self.grid.items():
             if self.columns[k] == "f":
                 self.grid[k] = list(map(float, values))
@@ -161,22 +185,15 @@ class SweepSpec:
                 if self.columns[k] == "f":
                     self.sample["choices"][k] = [float(v) for v in values]
 
-        self._sizes = [len(v) for v in self.grid.values()]
-        self._inner = (
-            len(self.runs)
-            if self.runs
-            else self.sample["n"]
-            if self.sample
-            else self.trials["n"]
-            if self.trials
-            else 1
-        )
-        n = math.prod(self._sizes) * self._inner
-        if n > MAX_RUNS:
-            raise InputError(f"{where}: {n} runs, more than {MAX_RUNS}")
-        self.n_runs = n
-        self._drawn: dict[str, list[Any]] | None = None
-        self._derive = False  # set by validate(): runs copied from the validated base
+    def _entries_per_point(self) -> int:
+        """Runs per grid point: the runs listed, the sample's or the trials' ``n``, else 1."""
+        if self.runs:
+            return len(self.runs)
+        if self.sample:
+            return self.sample["n"]
+        if self.trials:
+            return self.trials["n"]
+        return 1
 
     # ------------------------------------------------------------ reading
     def _read_base(self, base: Any) -> dict[str, Any]:

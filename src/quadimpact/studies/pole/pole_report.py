@@ -52,26 +52,44 @@ def _model_text(st: dict[str, Any]) -> str:
 def render_report(description: dict[str, Any], numbers: dict[str, Any], figures: list[Path]) -> str:
     """The report's Markdown."""
     st = description["study"]
-    grid = description["grid"]
-    run = description["run"]
     arms = numbers["arms"]
     names = list(arms)
     heads = [HEADS[a] for a in names]
     if st.get("model", "default") != "default":
         heads[names.index("recovery")] = f"with recovery, {st['model']}"
-    fl = numbers["failures"]
+    lines = [*_setup_lines(description, len(names)), *_arms_lines(numbers, names, heads)]
+    examples = [p for p in figures if p.name.startswith("example_")]
+    if "laws" in numbers:
+        lines += ["", *_laws_section(numbers, st["model"], examples)]
+    lines += _failures_lines(numbers["failures"], arms, st)
+    for path in figures:
+        if path in examples:
+            continue
+        lines.append(f"![{path.stem}]({path.as_posix()})")
+        lines.append("")
+    return "\n".join(lines)
+
+
+def _row(label: str, cells: list[str]) -> str:
+    """A Markdown table row: ``label`` then the ``cells``."""
+    return f"| {label} | " + " | ".join(cells) + " |"
+
+
+def _setup_lines(description: dict[str, Any], n_arms: int) -> list[str]:
+    """The report's title and what was flown: the vehicle, its speed (m/s), the obstacle,
+    the grid of pitches (deg) by sideways offsets (m), the ``n_arms`` arms, the success
+    criterion, the recovery arm's law, and the runs with their times (s)."""
+    st = description["study"]
+    grid = description["grid"]
+    run = description["run"]
     obstacle = st["obstacles"][0]
     what = (
         f"a vertical pole of radius {obstacle['radius_m']:g} m through the origin"
         if st.get("obstacle_file") is None
         else f"obstacle {obstacle.get('name')!r} ({obstacle.get('kind')}) of {st['obstacle_file']}"
     )
-    flown = "twice" if len(names) == 2 else "three times"
-
-    def row(label: str, cells: list[str]) -> str:
-        return f"| {label} | " + " | ".join(cells) + " |"
-
-    lines = [
+    flown = "twice" if n_arms == 2 else "three times"
+    return [
         "# The pole study",
         "",
         f"The {st['vehicle']} flies at {st['speed_m_s']:g} m/s along +X toward {what}, "
@@ -97,32 +115,47 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
             for h in description.get("sweeps", [])[: -1 if run["n_ran"] else None]
         ),
         "",
+    ]
+
+
+def _arms_lines(numbers: dict[str, Any], names: list[str], heads: list[str]) -> list[str]:
+    """The arms side by side (columns ``heads`` of the arms ``names``): success (95 % Wilson),
+    contact, detection, recovery, median height lost (m) and failed runs; then success by
+    pitch band."""
+    arms = numbers["arms"]
+    lines = [
         "## The two controllers" if len(names) == 2 else "## The controllers",
         "",
-        row("", heads),
+        _row("", heads),
         "|---|" + "---|" * len(names),
-        row("lose less than 2 m (95 % Wilson)", [rate_text(arms[a]["success"]) for a in names]),
-        row("touched the obstacle", [str(arms[a]["contact"]) for a in names]),
-        row("impact detected", [str(arms[a]["detected"]) for a in names]),
-        row(
+        _row("lose less than 2 m (95 % Wilson)", [rate_text(arms[a]["success"]) for a in names]),
+        _row("touched the obstacle", [str(arms[a]["contact"]) for a in names]),
+        _row("impact detected", [str(arms[a]["detected"]) for a in names]),
+        _row(
             "recovered (stage 4)",
             ["-" if a == "baseline" else str(arms[a]["recovered"]) for a in names],
         ),
-        row("median height lost", [f"{arms[a]['height_lost_median_m']:.2f} m" for a in names]),
-        row("failed runs", [str(arms[a]["failed_runs"]) for a in names]),
+        _row("median height lost", [f"{arms[a]['height_lost_median_m']:.2f} m" for a in names]),
+        _row("failed runs", [str(arms[a]["failed_runs"]) for a in names]),
         "",
         "## Success by pitch band",
         "",
-        row("abs(pitch) (deg)", heads),
+        _row("abs(pitch) (deg)", heads),
         "|---|" + "---|" * len(names),
     ]
     for band in numbers["bands"]:
-        lines.append(row(band["band"], [rate_text(band[a]) for a in names]))
-    examples = [p for p in figures if p.name.startswith("example_")]
-    if "laws" in numbers:
-        lines += ["", *_laws_section(numbers, st["model"], examples)]
+        lines.append(_row(band["band"], [rate_text(band[a]) for a in names]))
+    return lines
+
+
+def _failures_lines(fl: dict[str, Any], arms: dict[str, Any], st: dict[str, Any]) -> list[str]:
+    """The section "Where recovery fails, and why" from the failure numbers ``fl``: where
+    (|pitch| in deg, |offset| in m), contact and detection, the stage reached, the largest
+    tilt (deg), the impacts after the detection, stage 4's time (s), the first contact's
+    normal and its estimate's error (deg), and a paragraph reading them; then the heading
+    of the figures."""
     stage = fl["stage_reached"]
-    lines += [
+    return [
         "",
         "## Where recovery fails, and why"
         + ("" if st.get("model", "default") == "default" else f" (`{st['model']}`)"),
@@ -159,12 +192,6 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         "## Figures",
         "",
     ]
-    for path in figures:
-        if path in examples:
-            continue
-        lines.append(f"![{path.stem}]({path.as_posix()})")
-        lines.append("")
-    return "\n".join(lines)
 
 
 def _explain(fl: dict[str, Any], arms: dict[str, Any], tilt: str = "45 deg") -> str:
