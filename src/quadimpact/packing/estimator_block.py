@@ -49,7 +49,13 @@ from quadimpact.inputs.estimators import (
 )
 from quadimpact.inputs.sensors import ResolvedImu
 
-__all__ = ["BUILTIN_PACKERS", "Estimation", "draw_estimation", "pack_estimation"]
+__all__ = [
+    "BUILTIN_PACKERS",
+    "Estimation",
+    "draw_estimation",
+    "pack_added_sensors",
+    "pack_estimation",
+]
 
 SENSOR_STREAM = 1
 INIT_STREAM = 2
@@ -177,10 +183,13 @@ def _stream(seed: int, key: int) -> np.random.Generator:
     return np.random.Generator(np.random.PCG64(np.random.SeedSequence(seed, spawn_key=(key,))))
 
 
-def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) -> Estimation:
-    """Fill ``scfg``'s added-sensor slots (in place) and pack the estimator (no random draw).
+def pack_added_sensors(s: Any, imu: ResolvedImu, scfg: np.ndarray) -> bool:
+    """Fill ``scfg``'s slots of the added sensors (in place); whether any of them is noisy.
 
-    ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU.
+    The IMU's impact disturbance (m/s^2, rad/s, s) and gyro bias random walk
+    (rad/s/sqrt(s)), the magnetometer (its field in the inertial frame from
+    its dip, deg) and the pose sensor (rate, Hz; noises, m and rad; latency
+    in IMU samples). Noisy: one of them draws random numbers (``snoise``).
     """
     dist = imu.impact_disturbance
     if dist is not None:
@@ -206,7 +215,7 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
         scfg[L.SC_POSE_ATT] = 1.0 if pose.attitude else 0.0
         scfg[L.SC_POSE_NOISE_A] = math.radians(pose.attitude_noise_deg)
         scfg[L.SC_POSE_LAG] = min(round(pose.latency_s * float(imu.rate_hz)), L.MAX_POSE_LAG - 1)
-    noisy = (
+    return (
         (dist is not None and (dist.accel_m_s2 > 0.0 or dist.gyro_rad_s > 0.0))
         or imu.gyro_bias_walk_rad_s_sqrt_s > 0.0
         or (mag is not None and mag.noise > 0.0)
@@ -215,23 +224,25 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
             and (pose.position_noise_m > 0.0 or (pose.attitude and pose.attitude_noise_deg > 0.0))
         )
     )
-    entry = estimator_entry(s.estimator)
-    params = s.resolved_estimator_params()
-    context = EstimatorContext(imu=imu, magnetometer=mag, pose_sensor=pose, vehicle=vehicle)
-    pack = entry.pack if entry.pack is not None else BUILTIN_PACKERS.get(entry.kind, _zeros)
-    ecfg = np.array(pack(params, context), dtype=float)
-    if ecfg.shape != (L.NECFG,):
-        raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
-    ecfg[L.EC_KIND] = entry.kind
-    ecfg[L.EC_OBSERVER] = 0.0 if s.estimate_in_loop else 1.0
-    initial_std = None
+
+
+def _initial_errors(
+    params: BaseModel, kind: int, mag: Any, ecfg: np.ndarray
+) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """The standard deviations of the initial estimate's error and of the extra draws.
+
+    Returns ``(initial_std, extra_std)``: twelve numbers (attitude, rad;
+    velocity, m/s; position, m; gyro bias, rad/s; three each) or ``None``
+    when all are zero; six (the initial Euler-angle errors, rad, and the
+    magnetometer's static bias) or ``None``. Sets ``ecfg[EC_INIT_BIAS_ZERO]``.
+    """
     extra = np.zeros(6)
     if mag is not None:
         extra[3:] = mag.bias
-    if isinstance(params, EstimatorParams) and entry.kind != L.EST_IDEAL:
+    initial_std = None
+    if isinstance(params, EstimatorParams) and kind != L.EST_IDEAL:
         extra[:3] = np.radians(params.initial_euler_error_deg)
         ecfg[L.EC_INIT_BIAS_ZERO] = 1.0 if params.initial_bias == "zero" else 0.0
-    if isinstance(params, EstimatorParams) and entry.kind != L.EST_IDEAL:
         std = np.repeat(
             [
                 math.radians(params.initial_attitude_error_deg),
@@ -243,6 +254,26 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
         )
         if np.any(std > 0.0):
             initial_std = std
+    return initial_std, extra if np.any(extra > 0.0) else None
+
+
+def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) -> Estimation:
+    """Fill ``scfg``'s added-sensor slots (in place) and pack the estimator (no random draw).
+
+    ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU.
+    """
+    noisy = pack_added_sensors(s, imu, scfg)
+    mag, pose = s.magnetometer, s.pose_sensor
+    entry = estimator_entry(s.estimator)
+    params = s.resolved_estimator_params()
+    context = EstimatorContext(imu=imu, magnetometer=mag, pose_sensor=pose, vehicle=vehicle)
+    pack = entry.pack if entry.pack is not None else BUILTIN_PACKERS.get(entry.kind, _zeros)
+    ecfg = np.array(pack(params, context), dtype=float)
+    if ecfg.shape != (L.NECFG,):
+        raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
+    ecfg[L.EC_KIND] = entry.kind
+    ecfg[L.EC_OBSERVER] = 0.0 if s.estimate_in_loop else 1.0
+    initial_std, extra_std = _initial_errors(params, entry.kind, mag, ecfg)
     return Estimation(
         ecfg=ecfg,
         snoise=np.zeros((0, L.NSN)),
@@ -259,7 +290,7 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
         noisy=noisy,
         entry=entry,
         initial_std=initial_std,
-        extra_std=extra if np.any(extra > 0.0) else None,
+        extra_std=extra_std,
     )
 
 

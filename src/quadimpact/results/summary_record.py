@@ -90,6 +90,19 @@ def table(part: type) -> Any:
     return field(default=None, metadata={"table": part})
 
 
+_LAYOUTS: dict[type, tuple[tuple[str, bool], ...]] = {}
+
+
+def _field_layout(cls: type) -> tuple[tuple[str, bool], ...]:
+    """A part class's fields in order, each with whether it is a nested table (a
+    :class:`Part`, or a mapping given as is), kept per class: every run's summary walks
+    them."""
+    layout = _LAYOUTS.get(cls)
+    if layout is None:
+        layout = _LAYOUTS[cls] = tuple((f.name, "table" in f.metadata) for f in fields(cls))
+    return layout
+
+
 class Part:
     """A part of the summary: a dataclass of :func:`metric` and :func:`table` fields."""
 
@@ -112,9 +125,9 @@ class Part:
     def to_dict(self) -> dict[str, Any]:
         """The part's keys and values, nested tables as dicts (a table left None stays None)."""
         out: dict[str, Any] = {}
-        for f in fields(self):
-            value = getattr(self, f.name)
-            out[f.name] = value.to_dict() if isinstance(value, Part) else value
+        for name, is_table in _field_layout(type(self)):
+            value = getattr(self, name)
+            out[name] = value.to_dict() if is_table and isinstance(value, Part) else value
         return out
 
     @classmethod
@@ -442,13 +455,15 @@ class Summary:
             part = getattr(self, name)
             if part is None:
                 continue
-            out.update({k: v for k, v in part.to_dict().items()
-                        if v is not None or not _is_table(part, k)})  # fmt: skip
+            for key, is_table in _field_layout(type(part)):
+                value = getattr(part, key)
+                if is_table:
+                    if value is None:
+                        continue
+                    if isinstance(value, Part):
+                        value = value.to_dict()
+                out[key] = value
         return out
-
-
-def _is_table(part: Part, name: str) -> bool:
-    return "table" in part.__dataclass_fields__[name].metadata
 
 
 Summary.PARTS = (
