@@ -21,13 +21,7 @@ from quadimpact.cli.options import (
     "results/experiments",
     "Output folder: table3.csv, one folder per crash, the sensitivity sweeps.",
 )
-@data_option(
-    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
-    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
-    "shared/data or ../shared/data under the working folder, else ../shared/data beside "
-    "the source checkout; without logs the comparisons with them are left out] The folder "
-    "used is printed."
-)
+@data_option
 @defaulted_option(
     "--samples",
     click.IntRange(min=0),

@@ -183,9 +183,16 @@ def result_dir_argument(command: Callable[..., Any]) -> Callable[..., Any]:
     )
 
 
-def data_option(help: str) -> Decorator:
-    """``--data FOLDER``: the crash set's flight data."""
-    return click.option("--data", type=click.Path(file_okay=False, path_type=Path), help=help)
+data_option: Decorator = click.option(
+    "--data",
+    type=click.Path(file_okay=False, path_type=Path),
+    help="Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
+    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
+    "shared/data or ../shared/data under the working folder, else ../shared/data beside "
+    "the source checkout; without logs the comparisons with them are left out] The folder "
+    "used is printed.",
+)
+"""``--data FOLDER``: the crash set's flight data (``experiments``, ``reproduce``)."""
 
 
 def out_option(default: str, help: str) -> Decorator:

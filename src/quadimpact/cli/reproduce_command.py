@@ -30,13 +30,7 @@ from quadimpact.cli.options import (
     help="Skip 'Beyond the paper: recovery' (the recovery Monte Carlo, the Figure 4 grid and "
     "the crashes with the recovery controller).",
 )
-@data_option(
-    "Folder of the crash set's data (spiri-crash-set-1/crash_N.mat); a folder given here "
-    "must hold the logs. [default: $QUADIMPACT_DATA when set (then only it), else "
-    "shared/data or ../shared/data under the working folder, else ../shared/data beside "
-    "the source checkout; without logs the comparisons with them are left out] The folder "
-    "used is printed."
-)
+@data_option
 @parallel_options
 def reproduce(
     out: Path,
