@@ -166,3 +166,42 @@ def test_the_command_takes_the_model(tmp_path):
     assert "(pole-replica)" in result.output and "(the default law)" in result.output
     bad = CliRunner().invoke(cli, ["pole", "--model", "paper-replica", "--out", str(out)])
     assert bad.exit_code == 2 and "'paper-replica' is not one of" in bad.output
+
+
+# ------------------------------------------------------------ sensors and estimator
+def test_the_ideal_sensors_keep_the_study_as_it_was():
+    """Without sensors the study's identity and sweep are those it had before the options
+    existed (an old folder resumes)."""
+    study = PoleStudy(**SMALL)
+    assert not {"estimator", "sensors", "seed"} & set(study.options())
+    assert study.sweep_spec().grid == {"pitch_deg": study.pitches(),
+                                       "lateral_offset_m": study.offsets()}  # fmt: skip
+
+
+def test_with_sensors_each_point_draws_its_own_noise():
+    study = PoleStudy(**SMALL, sensors="impact", estimator="ekf")
+    spec = study.sweep_spec()
+    assert spec.n_runs == 2 * 9 and (spec.base["sensors"], spec.base["estimator"]) == (
+        "impact", "ekf")  # fmt: skip
+    seeds = [spec.inputs(i)["seed"] for i in range(spec.n_runs)]
+    assert seeds[0::2] == seeds[1::2]  # both arms of a point share its seed
+    assert len(set(seeds[0::2])) == 9  # every point its own
+    assert seeds[0::2] == [float(s) for s in PoleStudy(**SMALL, sensors="impact").point_seeds()]
+    assert study.options()["sensors"] == "impact" and study.options()["seed"] == 0
+    with pytest.raises(InputError, match="sensors: must be one of"):
+        PoleStudy(sensors="perfect")
+
+
+def test_the_command_takes_the_estimator_and_sensors(tmp_path):
+    out = tmp_path / "ekf"
+    result = CliRunner().invoke(
+        cli,
+        ["pole", "--estimator", "ekf", "--sensors", "impact", "--pitch-step", "45",
+         "--offset-step", "0.35", "--workers", "1", "--no-progress", "--out", str(out)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    t = pd.read_parquet(out / "trials.parquet")
+    assert set(t["estimator"]) == {"ekf"} and set(t["sensors"]) == {"impact"}
+    assert "the `impact` sensors" in (out / "report.md").read_text()
+    bad = CliRunner().invoke(cli, ["pole", "--estimator", "nope", "--out", str(out)])
+    assert bad.exit_code != 0 and "--estimator: " in str(bad.exception)

@@ -28,6 +28,19 @@ HEADS = {
 }
 
 
+def _sensing_text(st: dict[str, Any]) -> str:
+    """What both arms sense: the preset of sensors and the estimator they read."""
+    sensors = st.get("sensors")
+    estimator = st.get("estimator", "ideal")
+    imu = "the ideal IMU" if sensors is None else f"the `{sensors}` sensors"
+    state = (
+        "the true state (the `ideal` estimator)"
+        if estimator == "ideal"
+        else f"the `{estimator}` estimator's estimate"
+    )
+    return f"Both arms sense with {imu} and fly on {state}."
+
+
 def _model_text(st: dict[str, Any]) -> str:
     """Which law the recovery arm ran (the study's model variant)."""
     model = st.get("model", "default")
@@ -85,7 +98,7 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         f"the altitude (the baseline, no recovery), and by the `recovery` controller flying "
         f"that same baseline until it detects the impact, then its staged law. Success: less "
         f"than 2 m of height lost over the run (altitude at the start minus at the end), the "
-        f"authors' criterion.",
+        f"authors' criterion. {_sensing_text(st)}",
         "",
         _model_text(st),
         "",
