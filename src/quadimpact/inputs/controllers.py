@@ -21,6 +21,7 @@ a module it imports), not under ``if __name__ == "__main__":``
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -135,6 +136,19 @@ class RecoveryParams(BaseModel):
         0.2, gt=0, le=1.5, description="|roll|, |pitch| below this end stage 2 (euler test), rad."
     )
     w_tol_m_s: Real = Field(0.3, description="Body z velocity below this ends stage 3, m/s.")
+    lean_cut_deg: Real | None = Field(
+        None,
+        ge=0,
+        le=90,
+        description="Stage 1 idles the rotors while the up axis leans toward the obstacle by "
+        "more than this, deg; None: never.",
+    )
+    lean_cut_force_m_s2: Real = Field(
+        0.0,
+        ge=0,
+        description="The lean cut also needs a body-horizontal specific force of at least "
+        "this (the contact still pushing), m/s^2; 0: whatever it is.",
+    )
     hover: StrictBool = Field(
         True, description="Stage 5 after stage 4: return to hover, hold position and yaw."
     )
@@ -290,6 +304,8 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block[CL.R_W_TOL] = p.w_tol_m_s
     block[CL.R_LEVEL_TEST] = CL.LEVEL_EULER if p.level_test == "euler" else CL.LEVEL_TILT_ERROR
     block[CL.R_EULER_TOL] = p.euler_tol_rad
+    block[CL.R_LEAN_CUT] = 2.0 if p.lean_cut_deg is None else math.sin(math.radians(p.lean_cut_deg))
+    block[CL.R_LEAN_FORCE] = p.lean_cut_force_m_s2
     level = ctx.options.detection_tick_reference == "level"
     block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
     block[CL.R_HOVER] = 1.0 if p.hover else 0.0
