@@ -137,7 +137,7 @@ def test_models_are_frozen_and_forbid_extras() -> None:
         ({"rotor_slew_limit_rad_s2": 0}, "rotor_slew_limit_rad_s2: must be > 0 (got 0)"),
         (
             {"model": "replica"},
-            "model: must be one of 'default', 'paper-replica', 'recovery-replica' or "
+            "model: must be one of 'default', 'classic', 'paper-replica', 'recovery-replica' or "
             "'pole-replica'",
         ),
         ({"controller": "pid"}, "controller: must be one of 'paper', 'cascade-pid', 'recovery'"),

@@ -7,6 +7,7 @@
 * :mod:`~quadimpact.cli.recovery_command`: ``quadimpact recovery``;
 * :mod:`~quadimpact.cli.pole_command`: ``quadimpact pole``;
 * :mod:`~quadimpact.cli.estimators_command`: ``quadimpact estimators``;
+* :mod:`~quadimpact.cli.benchmark_command`: ``quadimpact benchmark``;
 * :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
 
@@ -28,6 +29,7 @@ from typing import Any
 
 import click
 
+from quadimpact.cli.benchmark_command import benchmark
 from quadimpact.cli.estimators_command import estimators
 from quadimpact.cli.experiments_command import experiments
 from quadimpact.cli.pole_command import pole
@@ -91,6 +93,7 @@ def cli() -> None:
 # ---- the commands, each in its own module: one registration line each ----
 for _command in (
     run, animate, snapshots, view, sweep, reproduce, experiments, recovery, pole, estimators,
+    benchmark,
 ):  # fmt: skip
     cli.add_command(_command)
 

@@ -20,7 +20,7 @@ __all__ = [
     "resolve_model_options",
 ]
 
-ModelName = Literal["default", "paper-replica", "recovery-replica", "pole-replica"]
+ModelName = Literal["default", "classic", "paper-replica", "recovery-replica", "pole-replica"]
 
 
 class ModelOptions(BaseModel):
@@ -229,6 +229,9 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
 }
+# the previous default model: the default physics with the staged law quadimpact had as its
+# default before the benchmark's (issue #45), so that earlier numbers reproduce
+MODEL_VARIANTS["classic"] = {**MODEL_VARIANTS["default"], "recovery_law": "default"}
 # the pole replica: the default model with the authors' retuned pole law and held rotors
 MODEL_VARIANTS["pole-replica"] = {
     **MODEL_VARIANTS["default"],
