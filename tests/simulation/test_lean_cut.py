@@ -24,28 +24,33 @@ def _pitched(pitch_deg: float) -> np.ndarray:
     return x
 
 
-def _ctrl(**params) -> np.ndarray:
-    s = FlightScenario(controller="recovery", controller_params=params, ground="none")
+def _ctrl(model: str, **params) -> np.ndarray:
+    s = FlightScenario(controller="recovery", controller_params=params, ground="none",
+                       model=model)  # fmt: skip
     return prepare(s).ctrl
 
 
 @pytest.mark.parametrize(
-    ("pitch_deg", "force", "params", "cut"),
+    ("pitch_deg", "force", "model", "params", "cut"),
     [
-        (-40.0, 10.0, {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2}, True),
+        (-40.0, 10.0, "classic", {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2}, True),
         # leaning 40 deg into the wall (up axis toward +X, the normal -X): beyond 30, not 45
-        (-40.0, 10.0, {"lean_cut_deg": 45.0, "lean_cut_force_m_s2": G / 2}, False),
-        (40.0, 10.0, {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2}, False),  # away
-        (-40.0, 4.0, {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2}, False),  # no push
-        (-40.0, 0.0, {"lean_cut_deg": 30.0}, True),  # no force condition
-        (-89.0, 10.0, {}, False),  # off by default
+        (-40.0, 10.0, "classic", {"lean_cut_deg": 45.0, "lean_cut_force_m_s2": G / 2}, False),
+        (40.0, 10.0, "classic", {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2}, False),
+        (-40.0, 4.0, "classic", {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2}, False),
+        (-40.0, 0.0, "classic", {"lean_cut_deg": 30.0, "lean_cut_force_m_s2": 0.0}, True),
+        (-89.0, 10.0, "classic", {}, False),  # the classic law has none
+        # the default law: beyond 40 deg with g/4 of push
+        (-45.0, 10.0, "default", {}, True),
+        (-35.0, 10.0, "default", {}, False),
+        (-45.0, 2.0, "default", {}, False),
     ],
 )
-def test_the_cut_reads_the_lean_and_the_push(pitch_deg, force, params, cut):
+def test_the_cut_reads_the_lean_and_the_push(pitch_deg, force, model, params, cut):
     meas = np.zeros(L.NMEAS)
     meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (force * 0.6, force * 0.8, -G)  # |f_xy| = force
     normal = np.array([-1.0, 0.0, 0.0])  # out of a wall at +X
-    assert lean_cut(_pitched(pitch_deg), normal, meas, _ctrl(**params)) is cut
+    assert lean_cut(_pitched(pitch_deg), normal, meas, _ctrl(model, **params)) is cut
 
 
 def test_a_cut_stage_1_commands_idle_rotors_and_the_default_does_not():
@@ -56,6 +61,7 @@ def test_a_cut_stage_1_commands_idle_rotors_and_the_default_does_not():
     def first_commands(params):
         s = FlightScenario(vehicle="navi", position_m=(0, 0, -20), euler_deg=(0, -40, 0),
                            controller="recovery", pre_impact="hold", ground="none",
+                           model="classic",
                            controller_params={"hover": False, **params},
                            final_time_s=0.05)  # fmt: skip
         sim = Simulation(s)
@@ -65,7 +71,8 @@ def test_a_cut_stage_1_commands_idle_rotors_and_the_default_does_not():
         return ts[[f"omega_cmd{j}_rad_s" for j in (1, 2, 3, 4)]].to_numpy()[1]
 
     floor = 1000 * 2 * math.pi / 60
-    assert first_commands({"lean_cut_deg": 30.0}) == pytest.approx([floor] * 4, rel=1e-12)
+    cut = first_commands({"lean_cut_deg": 30.0, "lean_cut_force_m_s2": 0.0})
+    assert cut == pytest.approx([floor] * 4, rel=1e-12)
     pushed = first_commands({"lean_cut_deg": 30.0, "lean_cut_force_m_s2": G / 2})
     plain = first_commands({})
     assert np.array_equal(pushed, plain)  # free air: no push, no cut

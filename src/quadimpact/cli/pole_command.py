@@ -52,12 +52,13 @@ __all__ = ["pole"]
     "flying it until the detection.",
 )  # fmt: skip
 @click.option(
-    "--model", type=click.Choice(("default", "pole-replica")), default="default",
+    "--model", type=click.Choice(("default", "classic", "pole-replica")), default="default",
     show_default=True,
-    help="Model variant of the recovery arm: default (docs/RECOVERY.md's staged law), or "
-    "pole-replica (the authors' retuned pole law, rotors held until the detection; the "
-    "default law's recovery is then flown beside it, a third arm, and the report puts the "
-    "two laws side by side).",
+    help="Model variant of the recovery arm: default (docs/RECOVERY.md's staged law), classic "
+    "(the default law before the benchmark, issue #45: earlier numbers) or pole-replica (the "
+    "authors' retuned pole law, rotors held until the detection); with a variant the default "
+    "law's recovery is flown beside it, a third arm, and the report puts the two laws side "
+    "by side.",
 )  # fmt: skip
 @click.option(
     "--radius", "radius_m", type=float, default=0.1, show_default=True, metavar="M",

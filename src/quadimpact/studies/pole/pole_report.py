@@ -49,6 +49,16 @@ def _model_text(st: dict[str, Any]) -> str:
             "The recovery arm runs the `default` model: the staged law of docs/RECOVERY.md "
             "with its default parameters."
         )
+    if model == "classic":
+        return (
+            "The recovery arm runs the `classic` model variant: the staged law with the "
+            "values that were its defaults before the benchmark (issue #45: a_mag = g, a 45 "
+            "deg tilt away from the contact, stage 1 test |p|, |q| < 0.5 rad/s, no "
+            "vertical-velocity damping in stages 1-2, no lean cut; docs/VARIANTS.md 9). "
+            "Beside it every point is flown by the default law too (`with recovery, default "
+            "law`: the recovery arm of `quadimpact pole` without `--model`), so that the two "
+            "laws compare point by point; the baseline arm is the same in both studies."
+        )
     return (
         f"The recovery arm runs the `{model}` model variant: the authors' retuned pole law "
         "(stage 1 reference a_mag = 4.8 m/s², stage 1 test |q_e,x|, |q_e,y| < 0.15 and "
@@ -167,7 +177,7 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
         f" in the failures against "
         f"{_spread(fl['normal_error_deg_successes'], 'deg', digits=0)} in the successes.",
         "",
-        _explain(fl, arms, tilt="about 26 deg" if st.get("model") == "pole-replica" else "45 deg"),
+        _explain(fl, arms, tilt="45 deg" if st.get("model") == "classic" else "about 26 deg"),
         "",
         "## Figures",
         "",

@@ -74,7 +74,7 @@ ARMS = ("baseline", "recovery")
 DEFAULT_LAW_ARM = "recovery-default"
 #: Model variants of the recovery arm (docs/VARIANTS.md): the default, or the authors'
 #: retuned pole law (docs/OBSTACLES.md 6.1).
-MODELS = ("default", "pole-replica")
+MODELS = ("default", "classic", "pole-replica")
 
 
 def _grid(start: float, stop: float, step: float, name: str) -> list[float]:
@@ -165,8 +165,9 @@ class PoleStudy:
     baseline : {"paper", "cascade-pid"}
         The controller without recovery, holding the initial attitude and the
         altitude; the recovery controller flies it until the detection.
-    model : {"default", "pole-replica"}
-        The model variant of the recovery arm. ``"pole-replica"``: the
+    model : {"default", "classic", "pole-replica"}
+        The model variant of the recovery arm. ``"classic"``: the default law
+        before the benchmark (issue #45). ``"pole-replica"``: the
         authors' retuned law (its pre-impact ``hold`` included), with a third
         arm, the default law's recovery (``"recovery-default"``), beside it;
         the baseline arm is the same in both.
