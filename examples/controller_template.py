@@ -53,7 +53,8 @@ K_ATT = param_index(HoldParams, "k_attitude_1_s2")
 K_RATE = param_index(HoldParams, "k_rate_1_s")
 K_YAW = param_index(HoldParams, "k_yaw_1_s2")
 K_YAW_RATE = param_index(HoldParams, "k_yaw_rate_1_s")
-# Its own memory (``mem``, kept between ticks; slot 0 is reported as its stage).
+# Its own memory (``mem``, kept between ticks; its last slot, ``MEM_STAGE``, is reported
+# as its stage).
 MEM_INTEGRAL = 1  # the altitude error's integral, m s
 
 

@@ -26,7 +26,7 @@ DEFAULT_SWITCHES = {
     "detection_tick_reference": "tilt-away",
     "contact_gate_m": 0.0,
     "pre_impact": "scenario",
-    "recovery_law": "default",
+    "recovery_law": "lean-cut",  # the benchmark's law since issue #45 ("default" before)
     "cut_step_motors": (),
     "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
 }
@@ -52,7 +52,10 @@ RECOVERY_REPLICA_SWITCHES = {
     "detection_tick_reference": "level",
     "contact_gate_m": 0.30,
     "pre_impact": "spin-down",
+    "recovery_law": "default",  # the law that was the default's before issue #45, classic
 }
+# the previous default model: the default physics with the law it had before issue #45
+CLASSIC_SWITCHES = {**DEFAULT_SWITCHES, "recovery_law": "default"}
 # the pole replica: the default physics, the retuned staged law and held rotors
 # (docs/VARIANTS.md 8)
 POLE_REPLICA_SWITCHES = {
@@ -137,7 +140,7 @@ def test_models_are_frozen_and_forbid_extras() -> None:
         ({"rotor_slew_limit_rad_s2": 0}, "rotor_slew_limit_rad_s2: must be > 0 (got 0)"),
         (
             {"model": "replica"},
-            "model: must be one of 'default', 'paper-replica', 'recovery-replica' or "
+            "model: must be one of 'default', 'classic', 'paper-replica', 'recovery-replica' or "
             "'pole-replica'",
         ),
         ({"controller": "pid"}, "controller: must be one of 'paper', 'cascade-pid', 'recovery'"),
@@ -202,6 +205,7 @@ def test_variants_resolve_every_switch() -> None:
     assert MODEL_VARIANTS["paper-replica"] == REPLICA_SWITCHES
     assert MODEL_VARIANTS["recovery-replica"] == RECOVERY_REPLICA_SWITCHES
     assert MODEL_VARIANTS["pole-replica"] == POLE_REPLICA_SWITCHES
+    assert MODEL_VARIANTS["classic"] == CLASSIC_SWITCHES
     assert resolve_model_options("default", None).model_dump() == DEFAULT_SWITCHES
     assert resolve_model_options("paper-replica", ModelOptions()).model_dump() == REPLICA_SWITCHES
     assert WallApproach(model="paper-replica").resolved_model_options().model_dump() == (

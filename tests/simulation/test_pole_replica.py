@@ -20,7 +20,7 @@ from quadimpact import ImpactTrial, simulate
 from quadimpact.cli import cli
 from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
-from quadimpact.inputs.model import MODEL_VARIANTS, RECOVERY_LAWS
+from quadimpact.inputs.model import CLASSIC_LAW, MODEL_VARIANTS, RECOVERY_LAWS
 from quadimpact.inputs.scenarios import load_scenario_file, scenario_from_dict
 from quadimpact.simulation.setup import prepare
 from quadimpact.studies.pole.pole_study import PoleStudy, pitch_bands
@@ -36,8 +36,9 @@ POLE_TABLE = {
     CL.R_EULER_TOL: 0.2,
     CL.R_W_TOL: 0.2,
 }
-#: The default law (docs/RECOVERY.md 3.4) in the same slots (the Navi's g).
-DEFAULT_TABLE = {
+#: The default law before the benchmark (the ``classic`` variant) in the same slots (the
+#: Navi's g): the law these tests compared the pole law with before issue #45.
+CLASSIC_TABLE = {
     CL.R_A_MAG: 9.81,
     CL.R_Q_TOL: 0.3,
     CL.R_RATE_TOL: 0.5,
@@ -45,6 +46,8 @@ DEFAULT_TABLE = {
     CL.R_EULER_TOL: 0.2,
     CL.R_W_TOL: 0.3,
 }
+#: The default law since the benchmark (docs/RECOVERY.md 3.5), in the same slots.
+DEFAULT_TABLE = {**CLASSIC_TABLE, CL.R_A_MAG: 4.8, CL.R_RATE_TOL: 1.0}
 #: The pole trial of docs/OBSTACLES.md 3 at one point: the recovery arm.
 POLE = {
     "vehicle": "navi",
@@ -76,11 +79,18 @@ def test_the_variant_is_the_default_model_with_the_pole_law_and_hold():
     differ = {k for k in default if pole[k] != default[k]}
     assert differ == {"pre_impact", "recovery_law"}
     assert (pole["pre_impact"], pole["recovery_law"]) == ("hold", "pole-replica")
-    # every other variant keeps the default law
-    assert {v["recovery_law"] for k, v in MODEL_VARIANTS.items() if k != "pole-replica"} == {
-        "default"
-    }
-    assert RECOVERY_LAWS["default"] == {}
+    # the replicas and the classic variant keep the law that was the default before the
+    # benchmark (issue #45: the switch's value "default" then), the default model the new one
+    laws = {k: v["recovery_law"] for k, v in MODEL_VARIANTS.items() if k != "pole-replica"}
+    assert laws.pop("default") == "lean-cut" and set(laws.values()) == {"default"}
+    assert RECOVERY_LAWS["default"] == CLASSIC_LAW and RECOVERY_LAWS["lean-cut"] == {}
+    # the pole law is the classic law with the table's values
+    assert (
+        RECOVERY_LAWS["pole-replica"].items()
+        >= {
+            k: v for k, v in CLASSIC_LAW.items() if k not in ("a_mag_m_s2", "rate_tol_rad_s")
+        }.items()
+    )
 
 
 def test_the_variant_resolves_to_the_table():
@@ -92,8 +102,10 @@ def test_the_variant_resolves_to_the_table():
     assert c[CL.R_K_ATT] == 20.0 and tuple(c[CL.R_K_RATE : CL.R_K_RATE + 3]) == (20, 20, 2)
     # before the detection: hold, whatever the scenario says
     assert trial.resolved_pre_impact() == "hold" and _pre_impact(trial) == CL.PRE_HOLD
-    # the default model packs the default law (the Euler tolerance is packed, unused)
+    # the default model packs the default law (the Euler tolerance is packed, unused), the
+    # classic variant the law before the benchmark
     assert _slots(ImpactTrial(**POLE)) == DEFAULT_TABLE
+    assert _slots(ImpactTrial(model="classic", **POLE)) == CLASSIC_TABLE
 
 
 @pytest.mark.parametrize(
@@ -108,8 +120,10 @@ def test_the_variant_resolves_to_the_table():
     ],
 )
 def test_each_switch_on_its_own(params, changed):
-    """One parameter of the law in [controller_params] changes that slot alone."""
-    assert _slots(ImpactTrial(controller_params=params, **POLE)) == {**DEFAULT_TABLE, **changed}
+    """One parameter of the law in [controller_params] changes that slot alone (on the classic
+    law, which these tests compared with the pole law before issue #45)."""
+    trial = ImpactTrial(model="classic", controller_params=params, **POLE)
+    assert _slots(trial) == {**CLASSIC_TABLE, **changed}
 
 
 def test_given_parameters_win_over_the_variant_and_the_switches_mix():
@@ -120,8 +134,8 @@ def test_given_parameters_win_over_the_variant_and_the_switches_mix():
     law_only = ImpactTrial(model_options={"recovery_law": "pole-replica"}, **POLE)
     assert _slots(law_only) == POLE_TABLE and _pre_impact(law_only) == CL.PRE_NOMINAL
     # held rotors alone
-    hold_only = ImpactTrial(model_options={"pre_impact": "hold"}, **POLE)
-    assert _slots(hold_only) == DEFAULT_TABLE and _pre_impact(hold_only) == CL.PRE_HOLD
+    hold_only = ImpactTrial(model="classic", model_options={"pre_impact": "hold"}, **POLE)
+    assert _slots(hold_only) == CLASSIC_TABLE and _pre_impact(hold_only) == CL.PRE_HOLD
     # the variant with the scenario's pre-impact behaviour back
     nominal = ImpactTrial(model="pole-replica", model_options={"pre_impact": "scenario"}, **POLE)
     assert _slots(nominal) == POLE_TABLE and _pre_impact(nominal) == CL.PRE_NOMINAL
@@ -145,8 +159,8 @@ def test_a_scenario_file_selects_the_variant_or_a_single_switch(tmp_path):
                     'model = "pole-replica"\n')  # fmt: skip
     assert _slots(load_scenario_file(path)) == POLE_TABLE
     path.write_text('kind = "impact-trial"\nvehicle = "navi"\ncontroller = "recovery"\n'
-                    '[controller_params]\nlevel_test = "euler"\n')  # fmt: skip
-    assert _slots(load_scenario_file(path)) == {**DEFAULT_TABLE, CL.R_LEVEL_TEST: CL.LEVEL_EULER}
+                    'model = "classic"\n[controller_params]\nlevel_test = "euler"\n')  # fmt: skip
+    assert _slots(load_scenario_file(path)) == {**CLASSIC_TABLE, CL.R_LEVEL_TEST: CL.LEVEL_EULER}
 
 
 def test_hold_keeps_the_trimmed_speeds_until_the_detection():
@@ -199,10 +213,13 @@ def test_the_pinned_grid_has_points_in_every_pitch_band():
 )
 def test_small_grid_outcomes_are_pinned(point):
     """Both laws at a few points of each pitch band, as the whole grid's reviewed run gave
-    them (its trials.parquet rows): the same numbers through simulate() on every machine."""
+    them (its trials.parquet rows): the same numbers through simulate() on every machine.
+    The file's "default" is the default law of that run: the ``classic`` variant since the
+    benchmark's law became the default (issue #45), pinned under that name."""
     study = PoleStudy(model="pole-replica")
     _, replica, default = study.arms()
-    for model, arm in (("pole-replica", replica), ("default", default)):
+    classic = {**default, "model": "classic"}
+    for model, arm in (("pole-replica", replica), ("default", classic)):
         data = {**study.base(), **arm, "pitch_deg": point["pitch_deg"],
                 "lateral_offset_m": point["lateral_offset_m"]}  # fmt: skip
         s = simulate(scenario_from_dict(data)).summary
@@ -224,6 +241,6 @@ def test_a_sweep_selects_the_variant_and_single_parameters(tmp_path):
     runs = [{}, {"model": "pole-replica"}, {"controller_params": {"level_test": "euler"}}]
     run_sweep(SweepSpec(base=base, runs=runs, where="t"), tmp_path, workers=1, load=False)
     rows = read_runs(tmp_path).sort_values("run_id")
-    assert list(rows["model_options__recovery_law"]) == ["default", "pole-replica", "default"]
+    assert list(rows["model_options__recovery_law"]) == ["lean-cut", "pole-replica", "lean-cut"]
     assert list(rows["pre_impact"]) == ["nominal", "hold", "nominal"]
     assert list(rows["status"]) == ["completed"] * 3

@@ -21,12 +21,16 @@ def test_the_replica_is_this_set_of_switches():
     rep = MODEL_VARIANTS["recovery-replica"]
     default = MODEL_VARIANTS["default"]
     differ = {k for k in default if default[k] != rep[k]}
+    # and the staged law the default had before the benchmark (issue #45), the classic law
+    assert rep["recovery_law"] == MODEL_VARIANTS["classic"]["recovery_law"] == "default"
+    differ.discard("recovery_law")
     assert differ == {"yaw_reaction", "detection_tick_reference", "contact_gate_m", "pre_impact"}
     assert rep["spinup_reaction"] == "physical"  # the recovery code had the spin sign
     assert (rep["yaw_reaction"], rep["detection_tick_reference"], rep["contact_gate_m"],
             rep["pre_impact"]) == ("paper", "level", 0.30, "spin-down")  # fmt: skip
-    every = {**default, **{k: rep[k] for k in differ}}
-    assert resolve_model_options("default", {k: rep[k] for k in differ}).model_dump() == every
+    classic = MODEL_VARIANTS["classic"]
+    every = {**classic, **{k: rep[k] for k in differ}}
+    assert resolve_model_options("classic", {k: rep[k] for k in differ}).model_dump() == every
 
 
 @pytest.mark.parametrize(("drag", "spinup"), [(False, False), (True, False), (False, True),
@@ -68,7 +72,9 @@ def _run(**options):
 def test_level_target_at_the_detection_tick_only():
     # rotors held and no slew limit, so that the commands show the law itself; pitched 45 deg
     # toward the wall, so that stage 1 outlasts the detection tick (|q_e,y| = 0.38 > 0.3)
-    free = dict(TRIAL, pitch_deg=-45.0, pre_impact="hold", rotor_slew_limit_rad_s2=None)
+    # (the classic law: the default's lean cut would idle the rotors of both at this lean)
+    free = dict(TRIAL, pitch_deg=-45.0, pre_impact="hold", rotor_slew_limit_rad_s2=None,
+                model="classic")  # fmt: skip
     base = simulate(ImpactTrial(**free))
     level = simulate(ImpactTrial(**free, model_options={"detection_tick_reference": "level"}))
     t_d = base.summary["t_detect_s"]

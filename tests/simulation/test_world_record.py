@@ -12,7 +12,7 @@ import pytest
 from quadimpact import FlightScenario, Plane, Simulation, WallApproach, read_result, simulate
 from quadimpact.core import layout as L
 from quadimpact.inputs.controllers import RecoveryParams
-from quadimpact.inputs.model import resolve_model_options
+from quadimpact.inputs.model import recovery_law_params, resolve_model_options
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.inputs.sensors import ImuSettings
 from quadimpact.inputs.vehicle import Vehicle
@@ -69,7 +69,9 @@ def test_the_world_holds_the_whole_scenario_resolved(flight_result) -> None:
     assert r["model_options"] == options.model_dump(mode="json")  # tuples as JSON lists
     assert None not in r["model_options"].values() and r["model_options"]["contact_gate_m"] == 0
     assert r["controller"] == "recovery"
-    assert r["controller_params"] == RecoveryParams(k_att_1_s=15.0).model_dump(mode="json")
+    # the replica flies the classic law (its recovery_law switch, "default")
+    law = recovery_law_params(options.recovery_law, {"k_att_1_s": 15.0})
+    assert r["controller_params"] == RecoveryParams(**law).model_dump(mode="json")
     assert set(r["controller_params"]) == set(RecoveryParams.model_fields)
     # the replica forces spin-down whatever the scenario says (docs/VARIANTS.md)
     assert r["pre_impact"] == FLIGHT.resolved_pre_impact() == "spin-down"

@@ -7,6 +7,7 @@
 * :mod:`~quadimpact.cli.recovery_command`: ``quadimpact recovery``;
 * :mod:`~quadimpact.cli.pole_command`: ``quadimpact pole``;
 * :mod:`~quadimpact.cli.estimators_command`: ``quadimpact estimators``;
+* :mod:`~quadimpact.cli.benchmark_command`: ``quadimpact benchmark``;
 * :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
 * :mod:`~quadimpact.cli.compile_command`: ``quadimpact compile``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
@@ -30,6 +31,7 @@ from typing import Any
 
 import click
 
+from quadimpact.cli.benchmark_command import benchmark
 from quadimpact.cli.compile_command import compile_command
 from quadimpact.cli.estimators_command import estimators
 from quadimpact.cli.experiments_command import experiments
@@ -103,6 +105,7 @@ _COMMANDS = (
     recovery,
     pole,
     estimators,
+    benchmark,
 )
 for _command in (*_COMMANDS, compile_command):
     cli.add_command(_command)

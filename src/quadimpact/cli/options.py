@@ -25,6 +25,26 @@ def allow_large_option(command: Callable[..., Any]) -> Callable[..., Any]:
     )(command)
 
 
+SENSORS_HELP = (
+    "A preset of sensors: impact = the noisy IMU with the impact disturbance and a gyro bias "
+    "walk; indoor = impact + magnetometer + pose sensor."
+)
+
+
+def sensing_options(estimator_help: str, sensors_help: str = SENSORS_HELP) -> Decorator:
+    """Add ``--estimator NAME`` (a built-in or registered one) and ``--sensors PRESET``
+    (the studies' presets of sensors); both default to None (not given)."""
+    from quadimpact.studies.recovery import ESTIMATORS, SENSORS
+
+    def add(command: Callable[..., Any]) -> Callable[..., Any]:
+        command = click.option("--sensors", type=click.Choice(SENSORS), help=sensors_help)(command)
+        return click.option("--estimator", metavar="|".join(ESTIMATORS), help=estimator_help)(
+            command
+        )
+
+    return add
+
+
 def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``.
 

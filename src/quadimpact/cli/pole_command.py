@@ -8,7 +8,14 @@ from typing import Any
 import click
 
 from quadimpact.cli.command_output import file_lines
-from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
+from quadimpact.cli.options import (
+    SENSORS_HELP,
+    allow_large_option,
+    out_option,
+    parallel_options,
+    sensing_options,
+    stoppable,
+)
 from quadimpact.errors import InputError
 
 __all__ = ["pole"]
@@ -47,12 +54,13 @@ __all__ = ["pole"]
     "flying it until the detection.",
 )  # fmt: skip
 @click.option(
-    "--model", type=click.Choice(("default", "pole-replica")), default="default",
+    "--model", type=click.Choice(("default", "classic", "pole-replica")), default="default",
     show_default=True,
-    help="Model variant of the recovery arm: default (docs/RECOVERY.md's staged law), or "
-    "pole-replica (the authors' retuned pole law, rotors held until the detection; the "
-    "default law's recovery is then flown beside it, a third arm, and the report puts the "
-    "two laws side by side).",
+    help="Model variant of the recovery arm: default (docs/RECOVERY.md's staged law), classic "
+    "(the default law before the benchmark, issue #45: earlier numbers) or pole-replica (the "
+    "authors' retuned pole law, rotors held until the detection); with a variant the default "
+    "law's recovery is flown beside it, a third arm, and the report puts the two laws side "
+    "by side.",
 )  # fmt: skip
 @click.option(
     "--radius", "radius_m", type=float, default=0.1, show_default=True, metavar="M",
@@ -63,6 +71,11 @@ __all__ = ["pole"]
     metavar="FILE.toml",
     help="A TOML file with [[obstacles]] (the first is the target) instead of the pole.",
 )  # fmt: skip
+@sensing_options(
+    "State estimator both arms read (docs/ESTIMATION.md); a registered one is accepted too. "
+    "[default: ideal]",
+    SENSORS_HELP + " [default: the ideal IMU]",
+)
 @click.option(
     "--speed", "speed_m_s", type=float, default=2.0, show_default=True, metavar="M/S",
     help="Speed along +X.",
@@ -80,6 +93,8 @@ def pole(
     model: str,
     radius_m: float,
     obstacle_file: Path | None,
+    estimator: str | None,
+    sensors: str | None,
     speed_m_s: float,
     allow_large: bool,
     workers: int | None,
@@ -109,25 +124,33 @@ def pole(
       quadimpact pole --out results/pole
       quadimpact pole --model pole-replica --out results/pole-replica
       quadimpact pole --pitch-step 5 --offset-step 0.05 --out results/pole-coarse
+      quadimpact pole --estimator ekf --sensors impact --out results/pole-ekf
       quadimpact pole --obstacle box-corner.toml --out results/box
     """
     if scheduler is not None and workers is not None:
         raise InputError("--workers and --scheduler: give one or the other")
-    from quadimpact.studies.pole.pole_study import PoleStudy, run_pole_study, study_folder
+    from quadimpact.studies.pole.pole_study import FLAGS, PoleStudy, run_pole_study, study_folder
     from quadimpact.sweep.values import check_size
 
-    study = PoleStudy(
-        vehicle=vehicle,
-        pitch_max_deg=pitch_max_deg,
-        pitch_step_deg=pitch_step_deg,
-        offset_max_m=offset_max_m,
-        offset_step_m=offset_step_m,
-        baseline=baseline,
-        model=model,
-        radius_m=radius_m,
-        obstacle_file=None if obstacle_file is None else str(obstacle_file),
-        speed_m_s=speed_m_s,
-    )
+    try:
+        study = PoleStudy(
+            vehicle=vehicle,
+            pitch_max_deg=pitch_max_deg,
+            pitch_step_deg=pitch_step_deg,
+            offset_max_m=offset_max_m,
+            offset_step_m=offset_step_m,
+            baseline=baseline,
+            model=model,
+            radius_m=radius_m,
+            obstacle_file=None if obstacle_file is None else str(obstacle_file),
+            estimator=estimator or "ideal",
+            sensors=sensors,
+            speed_m_s=speed_m_s,
+        )
+    except InputError as exc:  # "estimator: ..." -> "--estimator: ..." (the flag only)
+        field, sep, rest = str(exc).partition(":")
+        flag = FLAGS.get(field)
+        raise InputError(f"{flag}{sep}{rest}" if flag else str(exc)) from None
     n_runs = 2 * len(study.pitches()) * len(study.offsets())
     check_size(n_runs, allow_large, f"--pitch-step {pitch_step_deg:g}, --offset-step "
                f"{offset_step_m:g}")  # fmt: skip

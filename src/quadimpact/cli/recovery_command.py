@@ -11,9 +11,16 @@ from typing import Any
 import click
 
 from quadimpact.cli.command_output import ran_text
-from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
+from quadimpact.cli.options import (
+    SENSORS_HELP,
+    allow_large_option,
+    out_option,
+    parallel_options,
+    sensing_options,
+    stoppable,
+)
 from quadimpact.errors import InputError
-from quadimpact.studies.recovery import DEFAULT_N, ESTIMATORS, IMUS, MODELS, PRE_IMPACTS, SENSORS
+from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS
 
 __all__ = ["recovery"]
 
@@ -52,16 +59,11 @@ _STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimat
     help="Rotors before the detection: spin down at the slew limit, or hold. "
     "[default: spin-down; hold with --model pole-replica, the variant's own]",
 )  # fmt: skip
-@click.option(
-    "--estimator", metavar="|".join(ESTIMATORS),
-    help="State estimator the controller and the detector read (docs/ESTIMATION.md); a "
+@sensing_options(
+    "State estimator the controller and the detector read (docs/ESTIMATION.md); a "
     "registered one is accepted too. [default: ideal]",
-)  # fmt: skip
-@click.option(
-    "--sensors", type=click.Choice(SENSORS),
-    help="A preset of sensors (replaces --imu): impact = the noisy IMU with the impact "
-    "disturbance and a gyro bias walk; indoor = impact + magnetometer + pose sensor.",
-)  # fmt: skip
+    SENSORS_HELP.replace("sensors:", "sensors (replaces --imu):"),
+)
 @click.option(
     "--sweep", "sweep_file", type=click.Path(dir_okay=False, path_type=Path),
     metavar="SWEEP.toml",

@@ -64,6 +64,10 @@ R_HOVER_MODE = _params.slot("R_HOVER_MODE")  # HOLD_* below: which position stag
 R_HOVER_SET = _params.slot("R_HOVER_SET", 3)  # m, the given set-point, inertial NED
 R_LEVEL_TEST = _params.slot("R_LEVEL_TEST")  # LEVEL_* below: the stage 2 -> 3 tilt test
 R_EULER_TOL = _params.slot("R_EULER_TOL")  # rad, |roll|, |pitch| tolerance of LEVEL_EULER
+R_LEAN_CUT = _params.slot("R_LEAN_CUT")  # sine of the lean into the obstacle beyond which
+# stage 1 idles its rotors (> 1: never; controllers/recovery.py's lean_cut)
+R_LEAN_FORCE = _params.slot("R_LEAN_FORCE")  # m/s^2, the cut also needs a body-horizontal
+# specific force at least this (the contact still pushing); 0: whatever it is
 N_RECOVERY_PARAMS = _params.end("N_RECOVERY_PARAMS")
 
 HOLD_ENTRY = 0  # the position estimate at stage 4's entry

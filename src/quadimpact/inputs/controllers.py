@@ -107,8 +107,13 @@ class CascadePidParams(PaperParams):
 class RecoveryParams(BaseModel):
     """Gains and thresholds of the ``recovery`` controller's staged law (docs/RECOVERY.md 3).
 
-    The pre-impact behaviour and the nominal controller are scenario fields
-    (``pre_impact``, ``nominal_controller``).
+    The defaults are the default law since the benchmark (issue #45,
+    docs/BENCHMARK.md 4): a push of 4.8 m/s^2 away from the contact, stage 1's
+    rate test at 1 rad/s, a vertical-velocity gain of 2.5 1/s in stages 1 and 2
+    and the lean cut at 40 deg with g/4 of push; the law before it is the
+    ``recovery_law = "default"`` tuning (:data:`quadimpact.inputs.model.CLASSIC_LAW`,
+    model variant ``classic``). The pre-impact behaviour and the nominal
+    controller are scenario fields (``pre_impact``, ``nominal_controller``).
     """
 
     model_config = MODEL_CONFIG
@@ -118,15 +123,15 @@ class RecoveryParams(BaseModel):
         (20.0, 20.0, 2.0), description="Rate error -> angular acceleration (p, q, r), 1/s."
     )
     a_mag_m_s2: Real | None = Field(
-        None, ge=0, description="Stage 1 push away from the wall, m/s^2; None: the vehicle's g."
+        4.8, ge=0, description="Stage 1 push away from the wall, m/s^2; None: the vehicle's g."
     )
     k_z_1_s: Vec4 = Field(
-        (0.0, 0.0, 10.0, 10.0), description="Vertical-velocity gain of stages 1-4, 1/s."
+        (2.5, 2.5, 10.0, 10.0), description="Vertical-velocity gain of stages 1-4, 1/s."
     )
     tilt_error_tol: Real = Field(
         0.3, gt=0, le=1, description="|q_e,x|, |q_e,y| below this end stages 1 and 2."
     )
-    rate_tol_rad_s: Real = Field(0.5, gt=0, description="|p|, |q| below this end stages 1-2.")
+    rate_tol_rad_s: Real = Field(1.0, gt=0, description="|p|, |q| below this end stages 1-2.")
     level_test: Literal["tilt-error", "euler"] = Field(
         "tilt-error",
         description="Stage 2's tilt test: the tilt error as stage 1's, or ZYX Euler roll, pitch.",
@@ -135,6 +140,19 @@ class RecoveryParams(BaseModel):
         0.2, gt=0, le=1.5, description="|roll|, |pitch| below this end stage 2 (euler test), rad."
     )
     w_tol_m_s: Real = Field(0.3, description="Body z velocity below this ends stage 3, m/s.")
+    lean_cut_deg: Real | None = Field(
+        40.0,
+        ge=0,
+        le=90,
+        description="Stage 1 idles the rotors while the up axis leans toward the obstacle by "
+        "more than this, deg; None: never.",
+    )
+    lean_cut_force_m_s2: Real = Field(
+        2.4525,
+        ge=0,
+        description="The lean cut also needs a body-horizontal specific force of at least "
+        "this (the contact still pushing), m/s^2; 0: whatever it is.",
+    )
     hover: StrictBool = Field(
         True, description="Stage 5 after stage 4: return to hover, hold position and yaw."
     )

@@ -13,6 +13,7 @@ from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec4
 
 __all__ = [
     "MODEL_VARIANTS",
+    "CLASSIC_LAW",
     "RECOVERY_LAWS",
     "ModelName",
     "ModelOptions",
@@ -20,7 +21,7 @@ __all__ = [
     "resolve_model_options",
 ]
 
-ModelName = Literal["default", "paper-replica", "recovery-replica", "pole-replica"]
+ModelName = Literal["default", "classic", "paper-replica", "recovery-replica", "pole-replica"]
 
 
 class ModelOptions(BaseModel):
@@ -93,13 +94,17 @@ class ModelOptions(BaseModel):
         replica): always spin-down, as in the authors' Monte Carlo code.
         ``"hold"`` (pole replica): always hold, the rotor speeds at their
         trimmed values until the detection.
-    recovery_law : {"default", "pole-replica"} or None
+    recovery_law : {"lean-cut", "default", "pole-replica"} or None
         The tuning of the ``recovery`` controller's staged law: the values its
         parameters take when ``[controller_params]`` does not set them
-        (:data:`RECOVERY_LAWS`). ``"default"`` (every variant but the pole
-        replica): docs/RECOVERY.md's. ``"pole-replica"``: the authors' pole
-        branch (a_mag 4.8 m/s^2, stage 1 test 0.15 and 2 rad/s, stage 2's
-        Euler-angle test at 0.2 rad and 2 rad/s, stage 3 ends at w < 0.2 m/s).
+        (:data:`RECOVERY_LAWS`). ``"lean-cut"`` (the default model, since the
+        benchmark, issue #45): the controller's own defaults (docs/RECOVERY.md
+        3.5). ``"default"`` (its name from before: the ``classic`` variant and
+        both replicas): the law that was the default until then
+        (:data:`CLASSIC_LAW`). ``"pole-replica"``: the authors' pole branch
+        (a_mag 4.8 m/s^2, stage 1 test 0.15 and 2 rad/s, stage 2's Euler-angle
+        test at 0.2 rad and 2 rad/s, stage 3 ends at w < 0.2 m/s) on the
+        classic law.
     cut_step_motors : tuple of int or None
         Motors (1-4) that a power-off schedule cuts at the first control tick
         after its trigger, as a one-tick command step: the motor keeps its
@@ -151,10 +156,11 @@ class ModelOptions(BaseModel):
     pre_impact: Literal["scenario", "spin-down", "hold"] | None = Field(
         None, description="Recovery pre-impact behaviour: the scenario's, spin-down or hold."
     )
-    recovery_law: Literal["default", "pole-replica"] | None = Field(
+    recovery_law: Literal["lean-cut", "default", "pole-replica"] | None = Field(
         None,
-        description="Staged recovery law's parameters not set in [controller_params]: "
-        "docs/RECOVERY.md's, or the authors' pole branch's.",
+        description="Staged recovery law's parameters not set in [controller_params]: the "
+        "default law's, the classic law's (named 'default' before issue #45), or the "
+        "authors' pole branch's.",
     )
     cut_step_motors: tuple[int, ...] | None = Field(
         None,
@@ -229,6 +235,11 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
 }
+# the previous default model: the default physics with the staged law quadimpact had as its
+# default before the benchmark's (issue #45), so that earlier numbers reproduce; the default
+# model flies the benchmark's law (the controller's own defaults)
+MODEL_VARIANTS["classic"] = dict(MODEL_VARIANTS["default"])
+MODEL_VARIANTS["default"]["recovery_law"] = "lean-cut"
 # the pole replica: the default model with the authors' retuned pole law and held rotors
 MODEL_VARIANTS["pole-replica"] = {
     **MODEL_VARIANTS["default"],
@@ -237,9 +248,21 @@ MODEL_VARIANTS["pole-replica"] = {
 }
 """Every switch of :class:`ModelOptions` for each named model variant."""
 
+CLASSIC_LAW: dict[str, Any] = {
+    "a_mag_m_s2": None,
+    "k_z_1_s": (0.0, 0.0, 10.0, 10.0),
+    "rate_tol_rad_s": 0.5,
+    "lean_cut_deg": None,
+    "lean_cut_force_m_s2": 0.0,
+}
+"""The staged law's values before issue #45 where they differ from today's defaults
+(docs/RECOVERY.md 3.5): the ``classic`` law of the ``classic`` variant and of the replicas."""
+
 RECOVERY_LAWS: dict[str, dict[str, Any]] = {
-    "default": {},
+    "lean-cut": {},
+    "default": CLASSIC_LAW,
     "pole-replica": {
+        **CLASSIC_LAW,
         "a_mag_m_s2": 4.8,
         "tilt_error_tol": 0.15,
         "rate_tol_rad_s": 2.0,
@@ -259,7 +282,7 @@ def recovery_law_params(law: str, given: Mapping[str, Any]) -> dict[str, Any]:
 
     Parameters
     ----------
-    law : {"default", "pole-replica"}
+    law : {"lean-cut", "default", "pole-replica"}
         The ``recovery_law`` switch.
     given : mapping
         The scenario's ``[controller_params]``; they win over the tuning.

@@ -132,6 +132,8 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block[CL.R_W_TOL] = p.w_tol_m_s
     block[CL.R_LEVEL_TEST] = CL.LEVEL_EULER if p.level_test == "euler" else CL.LEVEL_TILT_ERROR
     block[CL.R_EULER_TOL] = p.euler_tol_rad
+    block[CL.R_LEAN_CUT] = 2.0 if p.lean_cut_deg is None else math.sin(math.radians(p.lean_cut_deg))
+    block[CL.R_LEAN_FORCE] = p.lean_cut_force_m_s2
     level = ctx.options.detection_tick_reference == "level"
     block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
     block[CL.R_HOVER] = 1.0 if p.hover else 0.0

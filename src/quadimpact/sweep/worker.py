@@ -256,7 +256,8 @@ def preload() -> None:
     first (see ``pool.start_server``): it ignores Ctrl-C (as will the workers
     it forks), follows the sweep process (below), sets one thread per
     numerical library (before NumPy loads; nothing this package imports
-    before it loads NumPy), then :func:`warm_up`. Never
+    before it loads NumPy), then :func:`warm_up` and imports the plug-ins named in
+    ``QUADIMPACT_PLUGINS`` (:mod:`quadimpact.inputs.plugins`). Never
     raises: a worker that finds the kernel not loaded loads it itself, and a
     failing preload must not break the fork server (Ctrl-C during start-up
     included).
@@ -272,6 +273,12 @@ def preload() -> None:
     with contextlib.suppress(BaseException):
         _quiet_compilation()  # the sweep says it, once (this server's workers inherit it)
         warm_up()
+        # the plug-ins the sweep's process was given (--plugin): registered here, so in
+        # every worker forked from here (a failing one leaves them out: their runs say so)
+        with contextlib.suppress(BaseException):
+            from quadimpact.inputs.plugins import load_env_plugins
+
+            load_env_plugins()
         if tempdir:  # tell the sweep that workers now start ready
             open(os.path.join(tempdir, SERVER_READY), "w").close()
 

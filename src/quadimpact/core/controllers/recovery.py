@@ -83,6 +83,8 @@ from quadimpact.core.controller_layout import (
     R_K_ATT,
     R_K_RATE,
     R_K_Z,
+    R_LEAN_CUT,
+    R_LEAN_FORCE,
     R_LEVEL_TEST,
     R_NOMINAL_KIND,
     R_PRE_IMPACT,
@@ -112,6 +114,7 @@ from quadimpact.core.layout import (
     CTRL_CASCADE_PID,
     MEM_STAGE,
     MS_DETECTED,
+    MS_IMU_F,
     MS_NORMAL,
     MS_W_HAT,
     MS_X,
@@ -366,6 +369,34 @@ def staged_law(
 
 
 @compiled
+def lean_cut(x: np.ndarray, normal: np.ndarray, meas: np.ndarray, ctrl: np.ndarray) -> bool:
+    """Whether stage 1 idles its rotors at this tick (the lean cut, ``R_LEAN_*``).
+
+    It does while the up axis leans toward the obstacle by more than the cut's
+    angle (the up axis's component along ``-normal``, the opposite of the
+    wall-normal estimate, above ``R_LEAN_CUT``, the angle's sine; above 1:
+    never) and the body-horizontal specific force of the latest IMU sample is
+    at least ``R_LEAN_FORCE`` (m/s^2; 0: whatever it is): the contact still
+    pushes. ``x``: state estimate; ``normal``: inertial, unit, horizontal.
+    """
+    p0 = C_PARAMS
+    sin_cut = ctrl[p0 + R_LEAN_CUT]
+    if sin_cut > 1.0:
+        return False
+    f_min = ctrl[p0 + R_LEAN_FORCE]
+    if meas[MS_IMU_F] ** 2 + meas[MS_IMU_F + 1] ** 2 < f_min * f_min:
+        return False
+    q0 = x[X_QUAT]
+    q1 = x[X_QUAT + 1]
+    q2 = x[X_QUAT + 2]
+    q3 = x[X_QUAT + 3]
+    # u = -C e_z: minus the third column of the rotation matrix
+    ux = -2.0 * (q1 * q3 + q0 * q2)
+    uy = -2.0 * (q2 * q3 - q0 * q1)
+    return -(ux * normal[0] + uy * normal[1]) > sin_cut
+
+
+@compiled
 def recovery_step(
     t: float,
     meas: np.ndarray,
@@ -416,10 +447,15 @@ def recovery_step(
         if stage == STAGE_RECOVERED and before != STAGE_RECOVERED:
             hold_set_point(x, ctrl, mem)
     a_ref_on = not (first_tick and ctrl[p0 + R_FIRST_TICK_LEVEL] > 0.5)
+    normal = meas[MS_NORMAL : MS_NORMAL + 3]
     thrust, p_des, q_des, r_des, qex, qey = law_references(
-        stage, a_ref_on, x, meas[MS_NORMAL : MS_NORMAL + 3], ctrl, veh, mem
+        stage, a_ref_on, x, normal, ctrl, veh, mem
     )
-    rate_loop(thrust, p_des, q_des, r_des, meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd)
+    if stage == STAGE_DETECTED and lean_cut(x, normal, meas, ctrl):
+        for j in range(N_ROTORS):
+            cmd[j] = ctrl[C_OMEGA_MIN]
+    else:
+        rate_loop(thrust, p_des, q_des, r_des, meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd)
     mem[RM_QE_X] = qex
     mem[RM_QE_Y] = qey
     mem[MEM_STAGE] = stage

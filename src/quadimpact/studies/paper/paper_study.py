@@ -82,6 +82,7 @@ SWITCHES = tuple(
     k
     for k in MODEL_VARIANTS["default"]
     if MODEL_VARIANTS["default"][k] != MODEL_VARIANTS["paper-replica"][k]
+    and k != "recovery_law"  # the staged law's tuning: the paper's runs fly no recovery
 )  # the paper replica's six differences (its other switches are the default's)
 #: Trials of the Navi's recovery Monte Carlo in each variant (reduced from the study's 10,000).
 RECOVERY_N = 2_000

@@ -28,6 +28,19 @@ HEADS = {
 }
 
 
+def _sensing_text(st: dict[str, Any]) -> str:
+    """What both arms sense: the preset of sensors and the estimator they read."""
+    sensors = st.get("sensors")
+    estimator = st.get("estimator", "ideal")
+    imu = "the ideal IMU" if sensors is None else f"the `{sensors}` sensors"
+    state = (
+        "the true state (the `ideal` estimator)"
+        if estimator == "ideal"
+        else f"the `{estimator}` estimator's estimate"
+    )
+    return f"Both arms sense with {imu} and fly on {state}."
+
+
 def _model_text(st: dict[str, Any]) -> str:
     """Which law the recovery arm ran (the study's model variant)."""
     model = st.get("model", "default")
@@ -35,6 +48,16 @@ def _model_text(st: dict[str, Any]) -> str:
         return (
             "The recovery arm runs the `default` model: the staged law of docs/RECOVERY.md "
             "with its default parameters."
+        )
+    if model == "classic":
+        return (
+            "The recovery arm runs the `classic` model variant: the staged law with the "
+            "values that were its defaults before the benchmark (issue #45: a_mag = g, a 45 "
+            "deg tilt away from the contact, stage 1 test |p|, |q| < 0.5 rad/s, no "
+            "vertical-velocity damping in stages 1-2, no lean cut; docs/VARIANTS.md 9). "
+            "Beside it every point is flown by the default law too (`with recovery, default "
+            "law`: the recovery arm of `quadimpact pole` without `--model`), so that the two "
+            "laws compare point by point; the baseline arm is the same in both studies."
         )
     return (
         f"The recovery arm runs the `{model}` model variant: the authors' retuned pole law "
@@ -103,7 +126,7 @@ def _setup_lines(description: dict[str, Any], n_arms: int) -> list[str]:
         f"the altitude (the baseline, no recovery), and by the `recovery` controller flying "
         f"that same baseline until it detects the impact, then its staged law. Success: less "
         f"than 2 m of height lost over the run (altitude at the start minus at the end), the "
-        f"authors' criterion.",
+        f"authors' criterion. {_sensing_text(st)}",
         "",
         _model_text(st),
         "",
@@ -187,7 +210,7 @@ def _failures_lines(fl: dict[str, Any], arms: dict[str, Any], st: dict[str, Any]
         f" in the failures against "
         f"{_spread(fl['normal_error_deg_successes'], 'deg', digits=0)} in the successes.",
         "",
-        _explain(fl, arms, tilt="about 26 deg" if st.get("model") == "pole-replica" else "45 deg"),
+        _explain(fl, arms, tilt="45 deg" if st.get("model") == "classic" else "about 26 deg"),
         "",
         "## Figures",
         "",

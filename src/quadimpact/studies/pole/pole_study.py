@@ -28,6 +28,7 @@ import json
 import math
 import os
 import time
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -73,7 +74,7 @@ ARMS = ("baseline", "recovery")
 DEFAULT_LAW_ARM = "recovery-default"
 #: Model variants of the recovery arm (docs/VARIANTS.md): the default, or the authors'
 #: retuned pole law (docs/OBSTACLES.md 6.1).
-MODELS = ("default", "pole-replica")
+MODELS = ("default", "classic", "pole-replica")
 
 
 def _grid(start: float, stop: float, step: float, name: str) -> list[float]:
@@ -84,6 +85,67 @@ def _grid(start: float, stop: float, step: float, name: str) -> list[float]:
     if n < 1:
         raise InputError(f"{name}: empty range {start:g} to {stop:g}")
     return [round(start + k * step, 9) + 0.0 for k in range(n)]
+
+
+def recovery_arm(model: str | None, baseline: str = "paper") -> dict[str, Any]:
+    """The recovery controller flying ``baseline`` until the detection, as a sweep run.
+
+    ``model``: the run's model variant (None: the sweep's base's). A variant that
+    forces a pre-impact behaviour (the pole replica's ``hold``) has it named in the
+    run, so that the table's ``model`` and ``pre_impact`` columns (the swept
+    inputs', which take the place of the summary's) are the ones in force.
+    """
+    arm: dict[str, Any] = {
+        "controller": "recovery",
+        "pre_impact": "nominal",
+        "nominal_controller": baseline,
+    }
+    if model is None:
+        return arm
+    forced = resolve_model_options(model).pre_impact
+    if forced != "scenario":
+        arm["pre_impact"] = forced
+    arm["model"] = model
+    return arm
+
+
+def checked_obstacles(items: Any, where: str) -> list[dict[str, Any]]:
+    """``[[obstacles]]`` tables, each checked (:func:`quadimpact.inputs.world.obstacle_from`).
+
+    Raises
+    ------
+    InputError
+        No table, or a bad one (``<where>: obstacle 1 ('pole'): radius_m: ...``).
+    """
+    if isinstance(items, (str, Mapping)) or not isinstance(items, (list, tuple)) or not items:
+        raise InputError(f"{where}: must list at least one [[obstacles]] table")
+    out = []
+    for i, item in enumerate(items):
+        name = item.get("name") if isinstance(item, Mapping) else None
+        label = f"obstacle {i + 1}" + (f" ({name!r})" if isinstance(name, str) else "")
+        try:
+            obstacle_from(item, label)
+        except ValueError as exc:
+            raise InputError(f"{where}: {exc}") from None
+        out.append(dict(item))
+    return out
+
+
+def check_sensing(estimator: str, sensors: str | None) -> None:
+    """Refuse an unknown estimator or preset of sensors (one line naming the field).
+
+    Raises
+    ------
+    InputError
+        ``estimator: ...`` (an unregistered name) or ``sensors: must be one of ...``.
+    """
+    from quadimpact.inputs.estimators import estimator_entry
+    from quadimpact.inputs.sensors import SENSOR_PRESETS
+
+    estimator_entry(estimator)
+    if sensors is not None and sensors not in SENSOR_PRESETS:
+        known = ", ".join(repr(k) for k in SENSOR_PRESETS)
+        raise InputError(f"sensors: must be one of {known} (got {format_value(sensors)})")
 
 
 @dataclass(frozen=True)
@@ -103,8 +165,9 @@ class PoleStudy:
     baseline : {"paper", "cascade-pid"}
         The controller without recovery, holding the initial attitude and the
         altitude; the recovery controller flies it until the detection.
-    model : {"default", "pole-replica"}
-        The model variant of the recovery arm. ``"pole-replica"``: the
+    model : {"default", "classic", "pole-replica"}
+        The model variant of the recovery arm. ``"classic"``: the default law
+        before the benchmark (issue #45). ``"pole-replica"``: the
         authors' retuned law (its pre-impact ``hold`` included), with a third
         arm, the default law's recovery (``"recovery-default"``), beside it;
         the baseline arm is the same in both.
@@ -113,6 +176,20 @@ class PoleStudy:
     obstacle_file : str or None
         A TOML file with ``[[obstacles]]`` (the first is the target) instead of
         the pole.
+    obstacles : tuple of mappings or None
+        ``[[obstacles]]`` tables given directly (the first is the target)
+        instead of the pole; not with ``obstacle_file``.
+    estimator : str
+        The state estimator both arms read (docs/ESTIMATION.md): ``"ideal"``
+        (the default, the true state), ``"complementary"``, ``"ekf"`` or a
+        registered one.
+    sensors : str or None
+        A preset of sensors (docs/ESTIMATION.md: ``"ideal"``, ``"noisy"``,
+        ``"impact"``, ``"indoor"``, ``"authors-2016"``); ``None``: the ideal IMU.
+        With a preset, each grid point draws its sensors' noise from a seed of
+        its own (:meth:`point_seeds`), the same for every arm of the point.
+    seed : int
+        The seed of the points' own seeds (with ``sensors`` only), >= 0.
     speed_m_s, altitude_m, start_distance_m : float
         Speed along +X, initial altitude, CM distance from the obstacle's
         surface along +X at the start (0.3 m: X = -0.4 m for the pole).
@@ -131,6 +208,10 @@ class PoleStudy:
     model: str = "default"
     radius_m: float = 0.1
     obstacle_file: str | None = None
+    obstacles: tuple[Mapping[str, Any], ...] | None = None
+    estimator: str = "ideal"
+    sensors: str | None = None
+    seed: int = 0
     speed_m_s: float = 2.0
     altitude_m: float = 2.0
     start_distance_m: float = 0.3
@@ -151,6 +232,9 @@ class PoleStudy:
                 raise InputError(f"{name}: must be >= 0 (got {getattr(self, name)!r})")
         if not self.radius_m > 0:
             raise InputError(f"radius_m: must be > 0 (got {self.radius_m!r})")
+        check_sensing(self.estimator, self.sensors)
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int) or self.seed < 0:
+            raise InputError(f"seed: must be an integer >= 0 (got {format_value(self.seed)})")
         self.pitches()
         self.offsets()
         load_vehicle(self.vehicle)
@@ -161,6 +245,10 @@ class PoleStudy:
         object.__setattr__(self, "_obstacles", tuple(self._read_obstacles()))
 
     def _read_obstacles(self) -> list[dict[str, Any]]:
+        if self.obstacles is not None:
+            if self.obstacle_file is not None:
+                raise InputError("obstacles: give obstacle_file or obstacles, not both")
+            return checked_obstacles(self.obstacles, "obstacles")
         if self.obstacle_file is None:
             return [
                 {
@@ -173,19 +261,7 @@ class PoleStudy:
             ]
         where = str(self.obstacle_file)
         data = read_toml_file(Path(self.obstacle_file), where)
-        items = data.get("obstacles")
-        if not isinstance(items, list) or not items:
-            raise InputError(f"{where}: obstacles: must list at least one [[obstacles]] table")
-        out = []
-        for i, item in enumerate(items):
-            name = item.get("name") if isinstance(item, dict) else None
-            label = f"obstacle {i + 1}" + (f" ({name!r})" if isinstance(name, str) else "")
-            try:
-                obstacle_from(item, label)
-            except ValueError as exc:
-                raise InputError(f"{where}: obstacles: {exc}") from None
-            out.append(dict(item))
-        return out
+        return checked_obstacles(data.get("obstacles"), f"{where}: obstacles")
 
     def pitches(self) -> list[float]:
         """Pitch values, deg: 0, -step, ... down to ``-pitch_max_deg``."""
@@ -199,7 +275,13 @@ class PoleStudy:
 
     def base(self) -> dict[str, Any]:
         """The impact trial every run starts from (a scenario-file mapping)."""
+        sensing: dict[str, Any] = {}
+        if self.estimator != "ideal":
+            sensing["estimator"] = self.estimator
+        if self.sensors is not None:
+            sensing["sensors"] = self.sensors
         return {
+            **sensing,
             "kind": "impact-trial",
             "vehicle": self._vehicle_ref,
             "obstacles": [dict(o) for o in self._obstacles],
@@ -219,34 +301,40 @@ class PoleStudy:
     def arms(self) -> list[dict[str, Any]]:
         """The controllers as sweep runs: the baseline, then recovery flying it (in the
         study's model), then, for a variant, the default law's recovery."""
-        recovery = {
-            "controller": "recovery",
-            "pre_impact": "nominal",
-            "nominal_controller": self.baseline,
-        }
         if self.model == "default":
-            return [{"controller": self.baseline}, recovery]
-        # every arm names its model, and the variant's its pre-impact behaviour when the
-        # variant forces one, so that the table's ``model`` and ``pre_impact`` columns (the
-        # swept inputs', which take the place of the summary's) are the ones in force
-        forced = resolve_model_options(self.model).pre_impact
-        variant = {**recovery, "model": self.model}
-        if forced != "scenario":
-            variant["pre_impact"] = forced
+            return [{"controller": self.baseline}, recovery_arm(None, self.baseline)]
         return [
             {"controller": self.baseline, "model": "default"},
-            variant,
-            {**recovery, "model": "default"},
+            recovery_arm(self.model, self.baseline),
+            recovery_arm("default", self.baseline),
         ]
 
-    def sweep_spec(self) -> SweepSpec:
-        """The study as a sweep: pitch x offset grid, each point with both controllers."""
-        return SweepSpec(
-            base=self.base(),
-            grid={"pitch_deg": self.pitches(), "lateral_offset_m": self.offsets()},
-            runs=self.arms(),
-            where="pole",
-        )
+    def point_seeds(self) -> list[int]:
+        """Each grid point's seed (pitch-major, as the sweep's runs), from :attr:`seed` and
+        the point's index alone (:func:`quadimpact.sweep.trials.trial_draws`)."""
+        from quadimpact.sweep.trials import trial_draws
+
+        n = len(self.pitches()) * len(self.offsets())
+        return [int(trial_draws(self.seed, i, {}, "seed")["seed"]) for i in range(n)]
+
+    def sweep_spec(self, arms: list[dict[str, Any]] | None = None) -> SweepSpec:
+        """The study as a sweep: pitch x offset grid, each point with every arm.
+
+        ``arms`` (default :meth:`arms`): the runs of each point. With ``sensors``
+        the points are listed as runs, each with its own seed (:meth:`point_seeds`);
+        without, they are the sweep's grid (the same runs as before sensors existed).
+        """
+        arms = self.arms() if arms is None else arms
+        grid = {"pitch_deg": self.pitches(), "lateral_offset_m": self.offsets()}
+        if self.sensors is None:
+            return SweepSpec(base=self.base(), grid=grid, runs=arms, where="pole")
+        points = [(p, o) for p in grid["pitch_deg"] for o in grid["lateral_offset_m"]]
+        runs = [
+            {"pitch_deg": p, "lateral_offset_m": o, "seed": seed, **arm}
+            for (p, o), seed in zip(points, self.point_seeds(), strict=True)
+            for arm in arms
+        ]
+        return SweepSpec(base=self.base(), runs=runs, where="pole")
 
     def options(self) -> dict[str, Any]:
         """The options as plain data (``study.json``)."""
@@ -254,6 +342,13 @@ class PoleStudy:
         d.pop("_vehicle_ref", None)
         d.pop("_obstacles", None)
         d["obstacles"] = [dict(o) for o in self._obstacles]
+        # the sensing options only when set: a study of the ideal sensors keeps the identity
+        # it had before they existed (its folder resumes)
+        for name, unset in (("estimator", "ideal"), ("sensors", None)):
+            if d[name] == unset:
+                del d[name]
+        if self.sensors is None:
+            del d["seed"]  # the points' seeds draw nothing without sensors
         return d
 
 
@@ -279,7 +374,6 @@ def pitch_bands(abs_pitch: np.ndarray) -> list[str]:
 
 def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
     """``trials.parquet``: the sweep's rows and the study's columns (module docstring)."""
-    import pandas as pd
 
     t = runs.sort_values("run_id").reset_index(drop=True)
     names = np.array(study.arm_names(), dtype=object)
@@ -287,12 +381,20 @@ def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
     t["pitch_deg"] = t["pitch_deg"].astype(float)
     t["abs_pitch_deg"] = t["pitch_deg"].abs()
     t["lateral_offset_m"] = t["lateral_offset_m"].astype(float)
-    final = pd.to_numeric(t["final_altitude_m"], errors="coerce").astype(float)
-    t["height_lost_m"] = float(study.altitude_m) - final
-    lost = t["height_lost_m"].to_numpy(dtype=float)
-    t["success"] = np.isfinite(lost) & (lost < SUCCESS_LOSS_M) & (t["status"] != "failed")
+    t["height_lost_m"], t["success"] = height_lost(t, study.altitude_m)
     t["pitch_band"] = pitch_bands(t["abs_pitch_deg"].to_numpy())
     return t
+
+
+def height_lost(runs: pd.DataFrame, altitude_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Each run's height lost (m: the altitude at the start minus at the end) and success
+    (less than :data:`SUCCESS_LOSS_M` lost, the run not failed)."""
+    import pandas as pd
+
+    final = pd.to_numeric(runs["final_altitude_m"], errors="coerce").to_numpy(dtype=float)
+    lost = float(altitude_m) - final
+    ok = np.isfinite(lost) & (lost < SUCCESS_LOSS_M) & (runs["status"] != "failed").to_numpy()
+    return lost, ok
 
 
 def table_arms(table: pd.DataFrame) -> tuple[str, ...]:
@@ -411,7 +513,7 @@ FLAGS = {
     "vehicle": "--vehicle", "pitch_max_deg": "--pitch-max", "pitch_step_deg": "--pitch-step",
     "offset_max_m": "--offset-max", "offset_step_m": "--offset-step", "baseline": "--baseline",
     "radius_m": "--radius", "obstacles": "--obstacle", "speed_m_s": "--speed",
-    "model": "--model",
+    "model": "--model", "estimator": "--estimator", "sensors": "--sensors",
 }  # fmt: skip
 
 

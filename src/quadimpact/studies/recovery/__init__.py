@@ -26,7 +26,7 @@ __all__ = ["DEFAULT_N", "ESTIMATORS", "IMUS", "MODELS", "PRE_IMPACTS", "SENSORS"
 #: Trials of a study by default.
 DEFAULT_N = 10_000
 #: Model variants of the study (docs/VARIANTS.md).
-MODELS = ("default", "recovery-replica", "pole-replica")
+MODELS = ("default", "classic", "recovery-replica", "pole-replica")
 #: IMU presets (``quadimpact.inputs.sensors.IMU_PRESETS``).
 IMUS = ("ideal", "noisy", "impact", "authors-2016")
 #: Presets of sensors (``quadimpact.inputs.sensors.SENSOR_PRESETS``).

@@ -1,0 +1,1 @@
+"""The recovery benchmark (``quadimpact benchmark``, docs/BENCHMARK.md)."""

@@ -1,0 +1,293 @@
+"""The benchmark's report (``report.md``) and its figure (``leaderboard.png``).
+
+``study`` below is the :class:`~quadimpact.studies.benchmark.benchmark_study.BenchmarkStudy`
+(its ``subject``, ``tasks``, ``quick``, ``references``, ``limit``).
+
+Both are drawn from ``benchmark.csv``'s table and the cells' trials tables
+(``cells/<row>/<task>-<sensors>.parquet``), never from numbers typed in:
+
+* the **leaderboard**, one table per task: every row with each sensor set,
+  ranked by its success with the ``ideal`` sensors, with its 95 % Wilson
+  interval, what the ``impact`` sensors cost it, the times, the height lost,
+  the drift, the missed and false detections, the CPU time and where the line
+  comes from (run now, the cache, or the authors' publication);
+* the subject **against each reference**, trial by trial (the same trials):
+  the trials only one of the two succeeds on;
+* **where the subject fails**: success by inclination bin (the wall) or pitch
+  band (the grids);
+* **what ran**: each cell's source and time.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from quadimpact.studies.benchmark.suite import SENSOR_SETS, SUITE_VERSION, TASKS
+from quadimpact.studies.statistics import percent, rate, rate_text
+
+__all__ = ["FIGURES", "leaderboard_figure", "render_report", "write_figures"]
+
+FIGURES = ("leaderboard.png",)
+MARKERS = {"ideal": "o", "impact": "s"}
+
+
+def _ranked_rows(part: pd.DataFrame) -> list[str]:
+    """A task's rows, best first by the ``ideal`` success (a row without it last)."""
+    ideal = part[part["sensors"] == "ideal"].set_index("row")["success"]
+    rows = list(dict.fromkeys(part["row"]))
+    return sorted(rows, key=lambda r: -float(ideal.get(r, -1.0)))
+
+
+def _shown_success(line: pd.Series) -> bool:
+    """Whether a line's success means something: a row that never declares recovery has
+    none on the wall (its criterion is the declared stage 4)."""
+    return not (
+        line.get("task") == "wall"
+        and line.get("source") != "published"
+        and line.get("declares_recovery") is False
+    )
+
+
+def leaderboard_figure(table: pd.DataFrame, tasks: tuple[str, ...]) -> Any:
+    """Success with 95 % intervals, row by row, one panel per task."""
+    from quadimpact.results.figures import new_figure
+
+    n_rows = max(len(set(table[table["task"] == t]["row"])) for t in tasks)
+    fig = new_figure(4.2 * len(tasks), 0.9 + 0.42 * n_rows)
+    axes = fig.subplots(1, len(tasks), squeeze=False)[0]
+    for ax, name in zip(axes, tasks, strict=True):
+        part = table[table["task"] == name]
+        rows = _ranked_rows(part)
+        for y, row in enumerate(rows):
+            for k, sensors in enumerate(SENSOR_SETS):
+                line = part[(part["row"] == row) & (part["sensors"] == sensors)]
+                if line.empty or not _shown_success(line.iloc[0]):
+                    continue
+                s = line.iloc[0]
+                published = s["source"] == "published"
+                x = 100 * s["success"]
+                err = [[x - 100 * s["success_low"]], [100 * s["success_high"] - x]]
+                ax.errorbar(
+                    x, y + (0.15 if k else -0.15), xerr=err, capsize=2,
+                    fmt="*" if published else MARKERS[sensors],
+                    color="0.4" if published else f"C{k}",
+                    mfc="white" if sensors == "impact" else None,
+                    label=("published" if published else sensors) if y == 0 else None,
+                )  # fmt: skip
+        ax.set_yticks(range(len(rows)), rows)
+        ax.invert_yaxis()
+        ax.set_xlabel("success, % (95 % Wilson)")
+        ax.set_title(name)
+        ax.grid(axis="x", alpha=0.3)
+    handles = {}
+    for ax in axes:
+        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
+            handles.setdefault(label, h)
+    axes[-1].legend(handles.values(), handles.keys(), loc="lower left", fontsize="small")
+    fig.suptitle(f"quadimpact benchmark, suite {SUITE_VERSION}")
+    return fig
+
+
+def write_figures(table: pd.DataFrame, out: Path, study: Any) -> list[Path]:
+    """``leaderboard.png`` into ``out``."""
+    from quadimpact.results.figures import save_figure
+
+    return [save_figure(leaderboard_figure(table, study.tasks), out / FIGURES[0])]
+
+
+# ------------------------------------------------------------------- text
+def _pair(line: pd.Series, name: str, unit: str, digits: int) -> str:
+    a, b = line.get(f"{name}_p50_{unit}"), line.get(f"{name}_p90_{unit}")
+    if a is None or b is None or not (math.isfinite(a) and math.isfinite(b)):
+        return "–"
+    return f"{a:.{digits}f} / {b:.{digits}f}"
+
+
+def _success_text(line: pd.Series) -> str:
+    if not _shown_success(line):
+        return "– (declares no recovery)"
+    k, n = int(line["success_k"]), int(line["valid"])
+    return rate_text({"k": k, "n": n, "value": line["success"], "low": line["success_low"],
+                      "high": line["success_high"]})  # fmt: skip
+
+
+def _leaderboard(table: pd.DataFrame, name: str, subject: str) -> list[str]:
+    part = table[table["task"] == name]
+    lines = [
+        "| row | sensors | success [95 %] | impact − ideal (points) | time to recover p50 / p90 "
+        "(s) | hover reached; p50 / p90 (s) | height lost p50 / p90 (m) | drift p50 / p90 (m) "
+        "| missed / false detections | CPU per trial (ms) | source |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for row in _ranked_rows(part):
+        mine = part[part["row"] == row]
+        ideal = mine[mine["sensors"] == "ideal"]
+        for _, line in mine.iterrows():
+            label = f"**{row}**" if row == subject else row
+            if line["source"] == "published":
+                lines.append(f"| {label} | {line['sensors']} | {_success_text(line)} | | | | | "
+                             f"| | | published: {line['note']} |")  # fmt: skip
+                continue
+            gap = "–"
+            if line["sensors"] == "impact" and not ideal.empty and _shown_success(line):
+                gap = f"{100 * (line['success'] - ideal.iloc[0]['success']):+.1f}"
+            hover = percent(line["hover"])
+            lines.append(
+                f"| {label} | {line['sensors']} ({line['estimator']}) | {_success_text(line)} "
+                f"| {gap} | {_pair(line, 'recover', 's', 3)} | {hover}; "
+                f"{_pair(line, 'hover', 's', 2)} | {_pair(line, 'height_lost', 'm', 2)} | "
+                f"{_pair(line, 'drift', 'm', 2)} | {int(line['missed_detections'])} / "
+                f"{int(line['false_detections'])} | {line['cpu_ms_per_trial']:.1f} | "
+                f"{line['source']} |"
+            )
+    return lines
+
+
+def _cell(out: Path, row: str, task: str, sensors: str) -> pd.DataFrame | None:
+    path = out / "cells" / row / f"{task}-{sensors}.parquet"
+    return pd.read_parquet(path) if path.is_file() else None
+
+
+def _versus(out: Path, study: Any, table: pd.DataFrame) -> list[str]:
+    """The subject against each reference row, trial by trial."""
+    subject = study.subject.name
+    lines = [
+        "| task | sensors | reference | subject | reference's | only the subject | "
+        "only the reference | neither |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    rows = [r for r in dict.fromkeys(table["row"]) if r != subject]
+    for name in study.tasks:
+        for sensors in SENSOR_SETS:
+            mine = _cell(out, subject, name, sensors)
+            for ref in rows:
+                theirs = _cell(out, ref, name, sensors)
+                if mine is None or theirs is None or len(mine) != len(theirs):
+                    continue
+                a = (mine["success"] & mine["valid"]).to_numpy(dtype=bool)
+                b = (theirs["success"] & theirs["valid"]).to_numpy(dtype=bool)
+                lines.append(
+                    f"| {name} | {sensors} | {ref} | {percent(a.mean())} | {percent(b.mean())} "
+                    f"| {int((a & ~b).sum())} | {int((~a & b).sum())} | {int((~a & ~b).sum())} |"
+                )
+    return lines
+
+
+def _where_fails(out: Path, study: Any) -> list[str]:
+    """The subject's success by inclination bin (wall) or pitch band (grids), ideal sensors."""
+    from quadimpact.studies.pole.pole_study import pitch_bands
+    from quadimpact.studies.recovery.recovery_analysis import INCLINATION_BIN, binned
+
+    lines: list[str] = []
+    for name in study.tasks:
+        cols: dict[str, pd.DataFrame] = {}
+        for sensors in SENSOR_SETS:
+            t = _cell(out, study.subject.name, name, sensors)
+            if t is None:
+                continue
+            t = t[t["valid"].astype(bool)]
+            if name == "wall":
+                key = binned(t["inclination_deg"].astype(float), *INCLINATION_BIN).astype(str)
+            else:
+                key = pd.Series(pitch_bands(np.abs(t["pitch_deg"].to_numpy(dtype=float))),
+                                index=t.index)  # fmt: skip
+            cols[sensors] = t.assign(key=key.to_numpy())
+        if not cols:
+            continue
+        first = next(iter(cols.values()))
+        keys = list(dict.fromkeys(first["key"]))
+        if name != "wall":
+            keys.sort(key=lambda b: float(b.split("-")[0]))
+        what = "inclination toward the wall (deg)" if name == "wall" else "abs(pitch) (deg)"
+        lines += [f"**{name}**, by {what}:", "", "| bin | " + " | ".join(cols) + " |",
+                  "|---|" + "---|" * len(cols)]  # fmt: skip
+        for k in keys:
+            cells = []
+            for t in cols.values():
+                part = t[t["key"] == k]
+                cells.append(rate_text(rate(int(part["success"].sum()), len(part))))
+            lines.append(f"| {k} | " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines
+
+
+def render_report(
+    table: pd.DataFrame,
+    study: Any,
+    description: dict[str, Any],
+    out: Path,
+    figures: list[Path],
+) -> str:
+    """The report's Markdown (module docstring)."""
+    s = study.subject
+    d = s.describe()
+    params = json.loads(d["params"])
+    what = {
+        "controller": f"the controller `{s.controller}`"
+        + (f" in the model `{s.model}`" if s.controller == "recovery" else "")
+        + (f" with {params}" if params else ""),
+        "estimator": f"the estimator `{s.estimator}` (with the default law)",
+        "policy": f"the policy `{s.policy}`",
+    }[s.kind]
+    sizes = ", ".join(
+        f"{t} ({TASKS[t].size(study.quick):,} {'trials' if TASKS[t].kind == 'wall' else 'points'})"
+        for t in study.tasks
+    )
+    lines = [
+        f"# quadimpact benchmark: {s.name}",
+        "",
+        f"Suite {SUITE_VERSION}{' (quick)' if study.quick else ''}, quadimpact "
+        f"{description['quadimpact_version']}. Benchmarked: **{s.name}**, {what}; with the "
+        f"`impact` sensors it reads the `{s.estimator}` estimator. Tasks: {sizes}; each with "
+        "the `ideal` sensors (the true state) and with the `impact` sensors (noisy IMU, its "
+        "impact disturbance and bias walk) and a state estimator (docs/BENCHMARK.md).",
+        "",
+        "Success: " + "; ".join(f"{t}: {TASKS[t].success}" for t in study.tasks) + ". "
+        "Time to recover: the detection to the declared recovery (stage 4), of the "
+        "successes. Hover: the true CM speed below 0.2 m/s and the tilt below 5 deg for "
+        "0.5 s (the share of the valid trials that get there, and when). Height lost: "
+        "the altitude at the start minus at the end of the run, of the valid trials. "
+        "Drift: the detection to the declared recovery, horizontal, of the successes.",
+        "",
+        *(
+            [
+                f"**A smoke test, not a benchmark**: only the first {study.limit} trials or points "
+                "of each task flew.",
+                "",
+            ]
+            if study.limit is not None
+            else []
+        ),
+        "## Leaderboard",
+        "",
+        *[f"![leaderboard]({p})" for p in figures],
+        "",
+    ]
+    for name in study.tasks:
+        lines += [f"### {name}: {TASKS[name].title}", "", *_leaderboard(table, name, s.name), ""]
+    if study.references:
+        lines += [
+            f"## {s.name} against each reference, trial by trial",
+            "",
+            "The same trials flown by both: the trials only one of the two succeeds on.",
+            "",
+            *_versus(out, study, table),
+            "",
+        ]
+    lines += [f"## Where {s.name} fails", "", *_where_fails(out, study)]
+    lines += ["## What ran", "", "| row | task | sensors | source | sweep (s) | CPU (s) |",
+              "|---|---|---|---|---|---|"]  # fmt: skip
+    for c in description["cells"]:
+        sweep = "–" if c["sweep_s"] is None else f"{c['sweep_s']:.1f}"
+        lines.append(f"| {c['row']} | {c['task']} | {c['sensors']} | {c['source']} | {sweep} "
+                     f"| {c['cpu_s']:.1f} |")  # fmt: skip
+    lines += ["", f"The benchmark took {description['elapsed_s']:.1f} s of wall time this time "
+              "(cells read from the cache took none; their sweep times are those of the run "
+              "that computed them).", ""]  # fmt: skip
+    return "\n".join(lines)
