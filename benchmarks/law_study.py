@@ -109,7 +109,8 @@ CHOSEN = "r10"
 #: (its accelerometer and gyro impact disturbance, its bias walk) removed on its own, the
 #: law without its stage 5, and what added information would give (a pose sensor, with and
 #: without its attitude; the same IMU sampled at 1 kHz instead of every 200-Hz tick), and the
-#: detector firing on 3 consecutive samples instead of 1 (a later, less disturbed normal).
+#: detector firing on 3 consecutive samples instead of 1 (a later, less disturbed normal); the
+#: law without its lean cut.
 _IMPACT_IMU = {"sensors": "impact"}
 SENSINGS: dict[str, dict[str, Any]] = {
     "ideal": {},
@@ -140,6 +141,10 @@ SENSINGS: dict[str, dict[str, Any]] = {
         **_IMPACT_IMU, "detection": {"persistence": 3}},
     "impact, ekf, detection on 3 samples": {
         **_IMPACT_IMU, "estimator": "ekf", "detection": {"persistence": 3}},
+    "ideal, no lean cut": {"controller_params": {"lean_cut_deg": None}},
+    "impact, true state, no lean cut": {**_IMPACT_IMU, "controller_params": {"lean_cut_deg": None}},
+    "impact, ekf, no lean cut": {
+        **_IMPACT_IMU, "estimator": "ekf", "controller_params": {"lean_cut_deg": None}},
 }  # fmt: skip
 #: The sensing phase's paired differences: (what it measures, sensing a, sensing b), a - b.
 PARTS: list[tuple[str, str, str]] = [
@@ -164,6 +169,11 @@ PARTS: list[tuple[str, str, str]] = [
     ("detection on 3 samples, ekf", "impact, ekf, detection on 3 samples", "impact, ekf"),
     ("the gap with detection on 3 samples", "ideal, detection on 3 samples",
      "impact, ekf, detection on 3 samples"),
+    ("the lean cut, ideal", "ideal", "ideal, no lean cut"),
+    ("the impact IMU read as it is, true state, no lean cut", "ideal, no lean cut",
+     "impact, true state, no lean cut"),
+    ("the gap without the lean cut", "ideal, no lean cut", "impact, ekf, no lean cut"),
+    ("the lean cut, impact + ekf", "impact, ekf", "impact, ekf, no lean cut"),
 ]  # fmt: skip
 #: Wall trials of the sensing phase (seed 2, the authors' distribution).
 SENSING_WALL_N = 2_000
