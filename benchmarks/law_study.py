@@ -27,17 +27,20 @@ choice is never made on the trials it is then measured on.
   3,150 held-out points each.
 * ``sensors``: the :data:`N_SENSORS` best of the confirmation with the
   ``impact`` sensors and the EKF (the grids' points seeded from 1).
-* ``sensing``: why the ``impact`` sensors cost what they cost: the chosen
-  law (:data:`CHOSEN`) on the screen's steep held-out pole and edge points
-  with each part of the sensing on its own (:data:`SENSINGS`: the ideal
-  sensors; the ``impact`` sensors with the true state; the ``noisy`` IMU,
-  without the impact disturbance, and the EKF; the ``impact`` sensors and the
-  EKF; the ``indoor`` sensors, a pose sensor added, and the EKF).
+* ``sensing``: why the ``impact`` sensors cost what they cost (docs/BENCHMARK.md
+  6): the chosen law (:data:`CHOSEN`) on held-out trials, :data:`SENSING_WALL_N`
+  wall trials of seed 2 and the screen's steep pole and edge points, with each
+  part of the sensing on or off on its own (:data:`SENSINGS`), every sensing on
+  the same trials (the same noise); then the differences of :data:`PARTS`
+  trial by trial (paired), with 95 % intervals.
 
 Writes, in ``DIR``: each sweep (``<phase>/<set>/``: ``runs.parquet``, every
 run's row, kept), ``<phase>.csv`` (one row per candidate: its parameters, its
 success per set with 95 % Wilson intervals, and the estimates) and
-``candidates.json`` (the candidates, in order) and ``sensing.csv``. The rule
+``candidates.json`` (the candidates, in order), ``sensing.csv`` (each task and
+sensing: success with its 95 % Wilson interval, the post-impact velocity
+estimate's error, the normal estimate's error, the hover share, the height lost)
+and ``sensing_parts.csv`` (the paired differences). The rule
 of the choice: the confirmation's best mean success over the three tasks
 (ideal sensors), checked to be the best too by the mean over both sensor sets
 in the ``sensors`` phase; it was ``r10`` (:data:`CHOSEN`), the default law
@@ -48,6 +51,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import time
 from pathlib import Path
 from typing import Any
@@ -100,14 +104,79 @@ WALL_EASY_SHARE = 65.0 / 90.0
 STEEP_FROM_DEG = 24.5
 #: The law the study chose (docs/BENCHMARK.md 4): the default since issue #45.
 CHOSEN = "r10"
-#: The ``sensing`` phase's sensing, each as the scenario fields it sets.
+#: The ``sensing`` phase's sensings, each as the scenario fields it sets (``controller_params``
+#: merged into the chosen law's): the benchmark's two sets, each part of the ``impact`` IMU
+#: (its accelerometer and gyro impact disturbance, its bias walk) removed on its own, the
+#: law without its stage 5, and what added information would give (a pose sensor, with and
+#: without its attitude; the same IMU sampled at 1 kHz instead of every 200-Hz tick), and the
+#: detector firing on 3 consecutive samples instead of 1 (a later, less disturbed normal); the
+#: law without its lean cut.
+_IMPACT_IMU = {"sensors": "impact"}
 SENSINGS: dict[str, dict[str, Any]] = {
     "ideal": {},
-    "impact, true state": {"sensors": "impact"},
+    "impact, true state": _IMPACT_IMU,
+    "impact without accel disturbance, true state": {
+        **_IMPACT_IMU, "imu": {"preset": "impact", "impact_disturbance": {"accel_m_s2": 0.0}}},
     "noisy, ekf": {"sensors": "noisy", "estimator": "ekf"},
-    "impact, ekf": {"sensors": "impact", "estimator": "ekf"},
+    "impact, ekf": {**_IMPACT_IMU, "estimator": "ekf"},
+    "impact without accel disturbance, ekf": {
+        **_IMPACT_IMU, "estimator": "ekf",
+        "imu": {"preset": "impact", "impact_disturbance": {"accel_m_s2": 0.0}}},
+    "impact without gyro disturbance, ekf": {
+        **_IMPACT_IMU, "estimator": "ekf",
+        "imu": {"preset": "impact", "impact_disturbance": {"gyro_rad_s": 0.0}}},
+    "impact without bias walk, ekf": {
+        **_IMPACT_IMU, "estimator": "ekf",
+        "imu": {"preset": "impact", "gyro_bias_walk_rad_s_sqrt_s": 0.0}},
+    "impact, ekf, no stage 5": {
+        **_IMPACT_IMU, "estimator": "ekf", "controller_params": {"hover": False}},
     "indoor, ekf": {"sensors": "indoor", "estimator": "ekf"},
-}
+    "indoor position only, ekf": {
+        "sensors": "indoor", "estimator": "ekf", "pose_sensor": {"attitude": False}},
+    "impact at 1 kHz, true state": {**_IMPACT_IMU, "imu": {"preset": "impact", "rate_hz": 1000.0}},
+    "impact at 1 kHz, ekf": {
+        **_IMPACT_IMU, "estimator": "ekf", "imu": {"preset": "impact", "rate_hz": 1000.0}},
+    "ideal, detection on 3 samples": {"detection": {"persistence": 3}},
+    "impact, true state, detection on 3 samples": {
+        **_IMPACT_IMU, "detection": {"persistence": 3}},
+    "impact, ekf, detection on 3 samples": {
+        **_IMPACT_IMU, "estimator": "ekf", "detection": {"persistence": 3}},
+    "ideal, no lean cut": {"controller_params": {"lean_cut_deg": None}},
+    "impact, true state, no lean cut": {**_IMPACT_IMU, "controller_params": {"lean_cut_deg": None}},
+    "impact, ekf, no lean cut": {
+        **_IMPACT_IMU, "estimator": "ekf", "controller_params": {"lean_cut_deg": None}},
+}  # fmt: skip
+#: The sensing phase's paired differences: (what it measures, sensing a, sensing b), a - b.
+PARTS: list[tuple[str, str, str]] = [
+    ("the whole gap", "ideal", "impact, ekf"),
+    ("the impact IMU read as it is, true state", "ideal", "impact, true state"),
+    ("  of which the accelerometer's disturbance", "impact without accel disturbance, true state",
+     "impact, true state"),
+    ("the EKF's estimate with the impact IMU", "impact, true state", "impact, ekf"),
+    ("the EKF with the noisy IMU (no disturbance)", "ideal", "noisy, ekf"),
+    ("removing the accelerometer's disturbance", "impact without accel disturbance, ekf",
+     "impact, ekf"),
+    ("removing the gyro's disturbance", "impact without gyro disturbance, ekf", "impact, ekf"),
+    ("removing the bias walk", "impact without bias walk, ekf", "impact, ekf"),
+    ("stage 5 off (no position hold)", "impact, ekf, no stage 5", "impact, ekf"),
+    ("adding a pose sensor", "indoor, ekf", "impact, ekf"),
+    ("adding a position sensor only", "indoor position only, ekf", "impact, ekf"),
+    ("the IMU at 1 kHz, ekf", "impact at 1 kHz, ekf", "impact, ekf"),
+    ("the IMU at 1 kHz, true state", "impact at 1 kHz, true state", "impact, true state"),
+    ("detection on 3 samples, ideal", "ideal, detection on 3 samples", "ideal"),
+    ("detection on 3 samples, true state", "impact, true state, detection on 3 samples",
+     "impact, true state"),
+    ("detection on 3 samples, ekf", "impact, ekf, detection on 3 samples", "impact, ekf"),
+    ("the gap with detection on 3 samples", "ideal, detection on 3 samples",
+     "impact, ekf, detection on 3 samples"),
+    ("the lean cut, ideal", "ideal", "ideal, no lean cut"),
+    ("the impact IMU read as it is, true state, no lean cut", "ideal, no lean cut",
+     "impact, true state, no lean cut"),
+    ("the gap without the lean cut", "ideal, no lean cut", "impact, ekf, no lean cut"),
+    ("the lean cut, impact + ekf", "impact, ekf", "impact, ekf, no lean cut"),
+]  # fmt: skip
+#: Wall trials of the sensing phase (seed 2, the authors' distribution).
+SENSING_WALL_N = 2_000
 #: A run longer than this (s, in a worker) is stopped and counts as a failure.
 TIMEOUT_S = 120.0
 
@@ -251,37 +320,94 @@ def run_phase(phase: str, names: list[str], out: Path, workers: int) -> list[dic
     return rows
 
 
-def run_sensing(out: Path, workers: int) -> list[dict[str, Any]]:
-    """The chosen law on the steep held-out grid points with each sensing of :data:`SENSINGS`."""
+def sensing_spec(task: str, fields: dict[str, Any]) -> Any:
+    """The sensing phase's sweep of ``task`` with one sensing (``fields``, :data:`SENSINGS`)."""
     from quadimpact.studies.benchmark.suite import TASKS, sensor_set
-    from quadimpact.studies.statistics import rate
-    from quadimpact.sweep import SweepSpec, run_sweep
+    from quadimpact.studies.recovery.recovery_spec import DISTRIBUTION
+    from quadimpact.sweep import SweepSpec
     from quadimpact.sweep.trials import trial_draws
 
-    params = controller_params(candidates()[CHOSEN])
-    rows = []
-    for name in ("pole", "edge"):
-        study = TASKS[name].grid_study(True, sensor_set("ideal"))
-        arms = [{**study.arms()[1], "controller_params": params, **f} for f in SENSINGS.values()]
-        grid = held_out_grid(True)
-        points = [(p, o) for p in grid["pitch_deg"] for o in grid["lateral_offset_m"]]
-        runs = [
-            {"pitch_deg": p, "lateral_offset_m": o, **a,
-             "seed": trial_draws(1, i, {}, "seed")["seed"]}
-            for i, (p, o) in enumerate(points)
-            for a in arms
-        ]  # fmt: skip
-        spec = SweepSpec(base=study.base(), runs=runs, where=f"sensing {name}")
-        t = run_sweep(spec, out / "sensing" / name, workers=workers, timeout=TIMEOUT_S)
-        t = t.sort_values("run_id").reset_index(drop=True)
-        lost = 2.0 - t["final_altitude_m"].astype(float).to_numpy()
-        ok = np.isfinite(lost) & (lost < 2.0) & (t["status"] != "failed").to_numpy()
-        arm = t["run_id"].to_numpy() % len(arms)
-        for i, sensing in enumerate(SENSINGS):
-            r = rate(int(ok[arm == i].sum()), int((arm == i).sum()))
-            rows.append({"task": name, "sensing": sensing, "k": r.k, "n": r.n,
-                         "success": r.value, "low": r.low, "high": r.high})  # fmt: skip
-    return rows
+    law = controller_params(candidates()[CHOSEN])
+    fields = {**fields, "controller_params": {**law, **fields.get("controller_params", {})}}
+    if task == "wall":
+        base = TASKS["wall"].wall_study(True, sensor_set("ideal")).base()
+        if "sensors" in fields:  # the ideal study's own IMU gives way to the sensing's
+            base.pop("imu", None)
+        ranges = {k: list(v) for k, v in DISTRIBUTION.items()}
+        trials = {"n": SENSING_WALL_N, "seed": 2, "ranges": ranges, "seed_field": "seed"}
+        return SweepSpec(base={**base, **fields}, trials=trials, where="sensing wall")
+    study = TASKS[task].grid_study(True, sensor_set("ideal"))
+    grid = held_out_grid(True)
+    points = [(p, o) for p in grid["pitch_deg"] for o in grid["lateral_offset_m"]]
+    runs = [
+        {"pitch_deg": p, "lateral_offset_m": o, **study.arms()[1], **fields,
+         "seed": trial_draws(1, i, {}, "seed")["seed"]}
+        for i, (p, o) in enumerate(points)
+    ]  # fmt: skip
+    return SweepSpec(base=study.base(), runs=runs, where=f"sensing {task}")
+
+
+def sensing_outcomes(task: str, t: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per trial of a sensing sweep's table ``t`` (by run): success, validity, height lost (m)."""
+    from quadimpact.studies.recovery import recovery_analysis as analysis
+    from quadimpact.studies.recovery.recovery_spec import DISTRIBUTION
+    from quadimpact.sweep.trials import trial_draws
+
+    if task == "wall":
+        draws = [trial_draws(2, i, DISTRIBUTION, "seed") for i in range(len(t))]
+        for k in ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s"):
+            t[k] = [d[k] for d in draws]
+        t = analysis.add_derived(t)
+        lost = t["height_loss_m"].astype(float).to_numpy()
+        return analysis.success_mask(t), analysis.valid_mask(t), lost
+    lost = 2.0 - t["final_altitude_m"].astype(float).to_numpy()
+    ok = np.isfinite(lost) & (lost < 2.0) & (t["status"] != "failed").to_numpy()
+    return ok, np.ones(len(t), bool), lost
+
+
+def paired_difference(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    """The mean of ``a - b`` (0/1 outcomes of the same trials) with its 95 % normal interval."""
+    d = a.astype(float) - b.astype(float)
+    m = float(d.mean())
+    half = 1.959964 * float(d.std(ddof=1)) / math.sqrt(len(d))
+    return m, m - half, m + half
+
+
+def run_sensing(out: Path, workers: int) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """The chosen law on held-out trials with each sensing of :data:`SENSINGS`: one row per
+    task and sensing, and one per task and part of :data:`PARTS`."""
+    from quadimpact.studies.statistics import rate
+    from quadimpact.sweep import run_sweep
+
+    rows, parts = [], []
+    for task in ("wall", "pole", "edge"):
+        ok = {}
+        for k, (name, fields) in enumerate(SENSINGS.items()):
+            spec = sensing_spec(task, fields)
+            t = run_sweep(spec, out / "sensing" / task / f"s{k:02d}", workers=workers,
+                          timeout=TIMEOUT_S)  # fmt: skip
+            t = t.sort_values("run_id").reset_index(drop=True)
+            success, valid, lost = sensing_outcomes(task, t)
+            ok[name] = success & valid
+            r = rate(int(ok[name].sum()), int(valid.sum()))
+            speed_err = t["est_velocity_rms_post_m_s"].astype(float)
+            rows.append({
+                "task": task, "sensing": name, "k": r.k, "n": r.n, "success": r.value,
+                "low": r.low, "high": r.high,
+                "velocity_error_p50_m_s": float(speed_err.median()),
+                "normal_error_p50_deg": float(t["normal_error_deg"].astype(float).median()),
+                "hover": float(t["time_to_hover_s"].astype(float).notna().mean()),
+                "height_lost_p50_m": float(np.nanpercentile(lost, 50)),
+                "height_lost_p90_m": float(np.nanpercentile(lost, 90)),
+            })  # fmt: skip
+            print(f"sensing {task} {name}: {100 * r.value:.1f} %", flush=True)
+        for what, a, b in PARTS:
+            m, low, high = paired_difference(ok[a], ok[b])
+            parts.append({"task": task, "part": what.strip(), "a": a, "b": b,
+                          "points": 100 * m, "low": 100 * low, "high": 100 * high,
+                          "a_only": int((ok[a] & ~ok[b]).sum()),
+                          "b_only": int((ok[b] & ~ok[a]).sum())})  # fmt: skip
+    return rows, parts
 
 
 def _best(rows: list[dict[str, Any]], n: int) -> list[str]:
@@ -312,9 +438,10 @@ def main() -> None:
 
     for phase in phases:
         if phase == "sensing":
-            path = args.out / "sensing.csv"
-            pd.DataFrame(run_sensing(args.out, args.workers)).to_csv(path, index=False)
-            print(f"wrote {path}")
+            rows, parts = run_sensing(args.out, args.workers)
+            for name, table in (("sensing.csv", rows), ("sensing_parts.csv", parts)):
+                pd.DataFrame(table).to_csv(args.out / name, index=False)
+                print(f"wrote {args.out / name}")
             continue
         if phase == "screen":
             names = list(every)
