@@ -47,6 +47,8 @@ seed = 2
         (["--estimator", "kalman"], ["--estimator: must be one of 'ideal', 'complementary'"]),
         (["--sensors", "all"], ["'--sensors'", "'all' is not one of 'ideal', 'noisy'"]),
         (["--imu", "noisy", "--sensors", "impact"], ["--imu and --sensors: give one"]),
+        (["--policy", "none.npz"], ["--policy: none.npz: no such file"]),
+        (["--policy", "trials.toml"], ["--policy: trials.toml: not a .npz policy file"]),
     ],
 )
 def test_bad_arguments_exit_2_with_one_line(tmp_path: Path, args, fragments) -> None:
@@ -125,3 +127,39 @@ def test_the_recovery_command_takes_an_estimator_and_sensors(tmp_path: Path) -> 
     report = (tmp_path / "r" / "report.md").read_text()
     assert "## Estimation" in report and "Estimator: complementary; sensors: impact" in report
     assert (tmp_path / "r" / "example" / "estimate.png").is_file()
+
+
+def test_the_recovery_command_flies_a_policy_file_and_records_it(tmp_path: Path) -> None:
+    """--policy FILE: the trials fly the law with the file's residual; study.json names the
+    file and its weights' digest; a changed file is another study (refused in the folder)."""
+    import json
+
+    import numpy as np
+
+    from quadimpact.inputs.policy_file import initial_policy, save_policy
+
+    p = initial_policy(4, 0.3, 4.0, seed=2)
+    path = save_policy(p.with_vector(np.full(p.vector().size, 0.1)), tmp_path / "mine.npz")
+    args = ("recovery", "--n", "3", "--out", "r", "--workers", "1", "--no-example",
+            "--no-progress", "--sensors", "impact", "--estimator", "ekf")  # fmt: skip
+    law = run_cli(*args[:4], "law", *args[5:], cwd=tmp_path)
+    proc = run_cli(*args, "--policy", "mine.npz", cwd=tmp_path)
+    assert law.returncode == 0 and proc.returncode == 0, proc.stderr
+    study = json.loads((tmp_path / "r" / "study.json").read_text())["study"]
+    assert study["policy"] == str(path.resolve())
+    assert study["policy_sha256"] == load_sha(path)
+    assert "Learned policy" in (tmp_path / "r" / "report.md").read_text()
+    mine = pd.read_parquet(tmp_path / "r" / "trials.parquet")
+    theirs = pd.read_parquet(tmp_path / "law" / "trials.parquet")
+    for col in ("recovered", "height_loss_m", "time_to_recover_s", "time_to_hover_s"):
+        assert col in mine.columns
+    assert not mine["min_altitude_m"].equals(theirs["min_altitude_m"])  # the residual acts
+    save_policy(p, path)  # other weights, same file: another study
+    other = run_cli(*args, "--policy", "mine.npz", cwd=tmp_path)
+    assert_input_error(other, "holds a recovery study with other options", "--policy")
+
+
+def load_sha(path: Path) -> str:
+    from quadimpact.inputs.policy_file import load_policy
+
+    return load_policy(path).sha256

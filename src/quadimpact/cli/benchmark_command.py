@@ -120,9 +120,10 @@ def subject_from_options(
     "default law. [default: ekf]",
 )  # fmt: skip
 @click.option(
-    "--policy", metavar="NAME",
-    help="A policy of the learning environment registered for the benchmark "
-    "(quadimpact.studies.benchmark.subject.register_policy; none yet).",
+    "--policy", metavar="learned|FILE",
+    help="A learned policy flown by the recovery controller: learned = the residual on the "
+    "staged law shipped with quadimpact (docs/LEARNING.md 12), or a .npz policy file of your "
+    "own; or a policy registered with quadimpact.studies.benchmark.subject.register_policy.",
 )  # fmt: skip
 @click.option(
     "--plugin", "plugins", multiple=True, metavar="FILE.py|MODULE",
@@ -187,6 +188,7 @@ def benchmark(
       quadimpact benchmark --quick --model pole-replica --out results/bench-pole-law
       quadimpact benchmark --quick --param a_mag_m_s2=4.8 --out results/bench-amag
       quadimpact benchmark --quick --estimator complementary --out results/bench-cf
+      quadimpact benchmark --quick --policy learned --out results/bench-learned
       quadimpact benchmark --quick --plugin my_law.py --controller my-law --out results/mine
     """
     if scheduler is not None and workers is not None:

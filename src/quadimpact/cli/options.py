@@ -45,6 +45,17 @@ def sensing_options(estimator_help: str, sensors_help: str = SENSORS_HELP) -> De
     return add
 
 
+def policy_option(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Add ``--policy learned|FILE``: a learned residual on the recovery law (None: not given)."""
+    return click.option(
+        "--policy",
+        metavar="learned|FILE",
+        help="Fly the recovery law with a learned residual (docs/LEARNING.md 12): learned = "
+        "the policy shipped with quadimpact, or a .npz policy file of your own. The study "
+        "records the policy and its weights' SHA-256. [default: the law alone]",
+    )(command)
+
+
 def parallel_options(command: Callable[..., Any]) -> Callable[..., Any]:
     """Add ``--workers N``, ``--scheduler tcp://HOST:PORT`` and ``--no-progress``.
 

@@ -13,6 +13,7 @@ from quadimpact.cli.options import (
     allow_large_option,
     out_option,
     parallel_options,
+    policy_option,
     sensing_options,
     stoppable,
 )
@@ -76,6 +77,7 @@ __all__ = ["pole"]
     "[default: ideal]",
     SENSORS_HELP + " [default: the ideal IMU]",
 )
+@policy_option
 @click.option(
     "--speed", "speed_m_s", type=float, default=2.0, show_default=True, metavar="M/S",
     help="Speed along +X.",
@@ -95,6 +97,7 @@ def pole(
     obstacle_file: Path | None,
     estimator: str | None,
     sensors: str | None,
+    policy: str | None,
     speed_m_s: float,
     allow_large: bool,
     workers: int | None,
@@ -125,6 +128,7 @@ def pole(
       quadimpact pole --model pole-replica --out results/pole-replica
       quadimpact pole --pitch-step 5 --offset-step 0.05 --out results/pole-coarse
       quadimpact pole --estimator ekf --sensors impact --out results/pole-ekf
+      quadimpact pole --sensors impact --estimator ekf --policy learned --out results/pole-learned
       quadimpact pole --obstacle box-corner.toml --out results/box
     """
     if scheduler is not None and workers is not None:
@@ -146,6 +150,7 @@ def pole(
             estimator=estimator or "ideal",
             sensors=sensors,
             speed_m_s=speed_m_s,
+            policy=policy,
         )
     except InputError as exc:  # "estimator: ..." -> "--estimator: ..." (the flag only)
         field, sep, rest = str(exc).partition(":")

@@ -16,6 +16,7 @@ from quadimpact.cli.options import (
     allow_large_option,
     out_option,
     parallel_options,
+    policy_option,
     sensing_options,
     stoppable,
 )
@@ -24,7 +25,9 @@ from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS
 
 __all__ = ["recovery"]
 
-_STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimator", "sensors")
+_STUDY_OPTIONS = (
+    "vehicle", "n", "seed", "model", "imu", "pre_impact", "estimator", "sensors", "policy",
+)  # fmt: skip
 
 
 @click.command("recovery")
@@ -64,6 +67,7 @@ _STUDY_OPTIONS = ("vehicle", "n", "seed", "model", "imu", "pre_impact", "estimat
     "registered one is accepted too. [default: ideal]",
     SENSORS_HELP.replace("sensors:", "sensors (replaces --imu):"),
 )
+@policy_option
 @click.option(
     "--sweep", "sweep_file", type=click.Path(dir_okay=False, path_type=Path),
     metavar="SWEEP.toml",
@@ -87,6 +91,7 @@ def recovery(
     pre_impact: str | None,
     estimator: str | None,
     sensors: str | None,
+    policy: str | None,
     sweep_file: Path | None,
     no_animation: bool,
     no_example: bool,
@@ -116,6 +121,7 @@ def recovery(
       quadimpact recovery --out results/recovery
       quadimpact recovery --vehicle spiri --n 2000 --imu noisy --out results/spiri-noisy
       quadimpact recovery --estimator ekf --sensors impact --out results/ekf-impact
+      quadimpact recovery --sensors impact --estimator ekf --policy learned --out results/learned
       quadimpact recovery --sweep my-trials.toml --out results/mine
     """
     from quadimpact.results.files import check_out_dir
@@ -124,7 +130,7 @@ def recovery(
     if n is not None:  # refused at once, before anything is planned or loaded
         check_size(n, allow_large, f"--n {n}")
     check_out_dir(out, "recovery")
-    values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors)
+    values = (vehicle, n, seed, model, imu, pre_impact, estimator, sensors, policy)
     given = {k: v for k, v in zip(_STUDY_OPTIONS, values, strict=True) if v is not None}
     study = _options_study(given, sweep_file)
     _warm_unless_finished(study, out, workers, scheduler)

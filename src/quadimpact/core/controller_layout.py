@@ -7,7 +7,7 @@ blocks live at ``ctrl[C_PARAMS + ...]`` (capacity ``NPARAM``) and in the
 controller's memory ``mem`` (before ``MEM_STAGE``).
 """
 
-from quadimpact.core.layout import MEM_STAGE, NPARAM, Block
+from quadimpact.core.layout import MEM_STAGE, NPARAM, NPOLICY, Block
 
 # ---- PID (controllers/common.py)
 # The two PID controllers (paper, cascade-pid) and the recovery controller's
@@ -98,3 +98,13 @@ STAGE_TILTED = 2
 STAGE_LEVEL = 3
 STAGE_RECOVERED = 4
 STAGE_HOVER = 5
+
+# ---- a learned residual on the recovery law, at ctrl[C_POLICY:] (controllers/residual.py)
+PB_HIDDEN = 0  # hidden width (0: no policy)
+PB_THRUST_SCALE = 1  # s_T: the largest thrust correction as a fraction of m g
+PB_RATE_SCALE = 2  # s_w, rad/s: the largest roll and pitch rate-reference correction
+PB_WEIGHTS = 3  # W1 (nh x N_FEATURES, row-major), b1 (nh), W2 (N_OUTPUTS x nh), b2 from here
+N_FEATURES = 24  # what the network reads (residual.features)
+N_OUTPUTS = 3  # thrust, p_des, q_des corrections
+MAX_HIDDEN = 32  # the widest hidden layer a policy may have (fits in NPOLICY)
+assert PB_WEIGHTS + MAX_HIDDEN * (N_FEATURES + 1 + N_OUTPUTS) + N_OUTPUTS <= NPOLICY

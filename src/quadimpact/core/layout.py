@@ -304,6 +304,9 @@ C_WAYPOINT_T = _ctrl.slot("C_WAYPOINT_T")  # s, when the waypoint replaces the h
 C_POS_GAINS = _ctrl.slot("C_POS_GAINS", 4)  # K_p 1/s, K_v 1/s, v_max m/s, tilt_max rad
 NPARAM = 64
 C_PARAMS = _ctrl.slot("C_PARAMS", NPARAM)  # the controller's own parameters
+NPOLICY = 1024
+C_POLICY = _ctrl.slot("C_POLICY", NPOLICY)  # a learned residual on the recovery law (first
+#   slot: its hidden width, 0 = none; core/controllers/residual.py lays out the rest)
 NCTRL = _ctrl.end("NCTRL")
 
 # ---- sensors scfg (NSCFG): the IMU and the impact detector; noise, bias,

@@ -26,10 +26,11 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, StrictBool
+from pydantic import BaseModel, Field, StrictBool, field_validator
 
 from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.errors import InputError
 from quadimpact.inputs.registry import Registry
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
 
@@ -170,6 +171,25 @@ class RecoveryParams(BaseModel):
     hover_set_point_m: Vec3 | None = Field(
         None, description="Stage 5 position set-point (inertial NED, m); None: hover_hold's."
     )
+    policy: str | None = Field(
+        None,
+        description="A learned residual on the law after the detection: 'learned' (the policy "
+        "shipped with quadimpact) or a .npz policy file; None: the law alone.",
+    )
+
+    @field_validator("policy")
+    @classmethod
+    def _policy_file(cls, value: str | None) -> str | None:
+        if value is None:
+            return None
+        from quadimpact.inputs.policy_file import load_policy, policy_ref
+
+        try:
+            load_policy(value)
+        except InputError as exc:
+            # "policy: FILE: rule" -> "rule" (the error names the field and the value given)
+            raise ValueError(str(exc).removeprefix("policy: ").partition(": ")[2]) from None
+        return policy_ref(value)
 
 
 # ------------------------------------------------------------------ registry

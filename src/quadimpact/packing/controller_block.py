@@ -1,5 +1,6 @@
 """The controller's block: ``ctrl`` (``C_*``: the kind, the references, the inverse
-allocation, the rotor range, the controller's own parameters; a waypoint flight's slots)."""
+allocation, the rotor range, the controller's own parameters, a learned residual; a
+waypoint flight's slots)."""
 
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from quadimpact.inputs.controllers import (
     controller_entry,
     param_slots,
 )
+from quadimpact.inputs.policy_file import load_policy
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.linalg import inverse
 from quadimpact.packing.constants import RPM
@@ -31,6 +33,7 @@ __all__ = [
     "pack_controller",
     "pack_fields",
     "pack_waypoint",
+    "policy_block",
     "reference_z_axis",
     "set_references",
 ]
@@ -61,7 +64,19 @@ def pack_controller(
     if block.shape != (L.NPARAM,):
         raise ValueError(f"controller {entry.name!r}: its packer must return {L.NPARAM} numbers")
     ctrl[L.C_PARAMS : L.C_PARAMS + L.NPARAM] = block
+    policy = getattr(params, "policy", None) if entry.kind == L.CTRL_RECOVERY else None
+    if policy is not None:
+        ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY] = policy_block(policy)
     return ctrl
+
+
+def policy_block(policy: str) -> np.ndarray:
+    """The ``C_POLICY`` block of a learned residual (``learned`` or a ``.npz`` file), in
+    ``core/controllers/residual.py``'s layout, zero-padded to ``NPOLICY``."""
+    block = np.zeros(L.NPOLICY)
+    weights = load_policy(policy).block()
+    block[: weights.size] = weights
+    return block
 
 
 def set_references(ctrl: np.ndarray, refs: Mapping[str, float]) -> None:

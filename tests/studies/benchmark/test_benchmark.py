@@ -82,10 +82,30 @@ def test_rows_fly_their_own_controller_and_model():
     assert classic["model"] == "classic" and classic["pre_impact"] == "spin-down"
     mine = Subject("mine", params={"a_mag_m_s2": 4.8}).spec(TASKS["edge"], quick, ideal)
     assert mine.scenario_dict(0)["controller_params"] == {"a_mag_m_s2": 4.8}
-    with pytest.raises(InputError, match="--policy: unknown policy 'learned'"):
-        Subject("p", kind="policy", policy="learned")
+    with pytest.raises(InputError, match="--policy: .*none.npz: no such file"):
+        Subject("p", kind="policy", policy="none.npz")
     with pytest.raises(InputError, match="--model: must be one of"):
         Subject("m", model="nope")
+
+
+def test_a_residual_policy_row_flies_the_law_with_the_policy_in_its_model(tmp_path):
+    """--policy FILE: the recovery controller in the row's model with the file's residual,
+    the pre-impact behaviour of the law kept, compiled in the cached kernel; a user's file
+    is never cached (it may change under the same path), its digest is in the row."""
+    from quadimpact.inputs.policy_file import initial_policy, save_policy
+
+    path = save_policy(initial_policy(4, 0.3, 4.0, seed=1), tmp_path / "mine.npz")
+    quick, ideal = True, sensor_set("ideal")
+    row = Subject("mine", kind="policy", policy=str(path))
+    assert row.residual and row.law and not row.plugin and not row.cacheable
+    wall = row.spec(TASKS["wall"], quick, ideal).base
+    assert wall["controller"] == "recovery" and wall["pre_impact"] == "spin-down"
+    assert wall["controller_params"] == {"policy": str(path.resolve())}
+    pole = row.spec(TASKS["pole"], quick, ideal).scenario_dict(0)
+    assert pole["pre_impact"] == "nominal" and pole["controller_params"]["policy"]
+    replica = Subject("r", kind="policy", policy=str(path), model="pole-replica")
+    assert replica.spec(TASKS["pole"], quick, ideal).scenario_dict(0)["pre_impact"] == "hold"
+    assert row.describe()["policy"].startswith(f"{path.resolve()} (sha256 ")
 
 
 def test_cell_numbers_of_a_hand_made_table():

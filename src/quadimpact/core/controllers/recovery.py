@@ -58,6 +58,10 @@ velocity and position come from the state estimate. Every gain, threshold,
 ``ctrl[C_PARAMS + ...]``); the recovery replica's "level target at the
 detection tick" is the switch ``R_FIRST_TICK_LEVEL``, the pole replica's
 Euler-angle test of stage 2 the switch ``R_LEVEL_TEST`` (:func:`stage_tilt`).
+
+A learned residual (``ctrl[C_POLICY:]``, ``residual.py``) may correct the
+outer loop's thrust and roll and pitch rate references after the detection;
+with none (the default) the law is as above.
 """
 
 import math
@@ -70,6 +74,7 @@ from quadimpact.core.controller_layout import (
     HOLD_GIVEN,
     HOLD_STOP,
     LEVEL_EULER,
+    PB_HIDDEN,
     PRE_HOLD,
     PRE_IMMEDIATE,
     PRE_NOMINAL,
@@ -107,10 +112,12 @@ from quadimpact.core.controllers.cascade_pid import cascade_pid_step
 from quadimpact.core.controllers.common import allocate, linearised_torques
 from quadimpact.core.controllers.hover import hover_acceleration, yaw_of
 from quadimpact.core.controllers.paper import paper_step
+from quadimpact.core.controllers.residual import residual_references
 from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
     C_PARAMS,
+    C_POLICY,
     CTRL_CASCADE_PID,
     MEM_STAGE,
     MS_DETECTED,
@@ -451,6 +458,10 @@ def recovery_step(
     thrust, p_des, q_des, r_des, qex, qey = law_references(
         stage, a_ref_on, x, normal, ctrl, veh, mem
     )
+    if ctrl[C_POLICY + PB_HIDDEN] > 0.5:
+        thrust, p_des, q_des = residual_references(
+            t, stage, (thrust, p_des, q_des), meas, ctrl, veh
+        )
     if stage == STAGE_DETECTED and lean_cut(x, normal, meas, ctrl):
         for j in range(N_ROTORS):
             cmd[j] = ctrl[C_OMEGA_MIN]

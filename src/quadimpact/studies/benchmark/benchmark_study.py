@@ -181,7 +181,7 @@ def run_benchmark(
                 spec = row.spec(task, study.quick, sensor_set(sensors), study.limit)
                 key = cell_key(spec)
                 label = f"{row.name} {task.name}/{sensors}"
-                cached = None if row.plugin else store.get(key)
+                cached = store.get(key) if row.cacheable else None
                 if key in done:
                     table, facts = done[key]
                     source = facts["source"]
@@ -202,7 +202,7 @@ def run_benchmark(
                         "quadimpact_version": __version__, "code": code_digest(),
                         "suite_version": SUITE_VERSION,
                     }  # fmt: skip
-                    if not row.plugin:
+                    if row.cacheable:
                         where_from = {"row": row.name, "task": task.name, "sensors": sensors}
                         store.put(key, table, {**facts, **where_from, "quick": study.quick})
                 source = facts["source"]

@@ -72,12 +72,12 @@ KEPT = (
 
 @cache
 def code_digest() -> str:
-    """A digest of quadimpact's installed files (``*.py``, ``*.toml``, ``*.json``): the code
-    a cached cell was computed with (hex, 16 characters)."""
+    """A digest of quadimpact's installed files (``*.py``, ``*.toml``, ``*.json``, the shipped
+    policies' ``*.npz``): the code a cached cell was computed with (hex, 16 characters)."""
     root = Path(__file__).resolve().parents[2]
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*")):
-        if path.suffix in (".py", ".toml", ".json") and "__pycache__" not in path.parts:
+        if path.suffix in (".py", ".toml", ".json", ".npz") and "__pycache__" not in path.parts:
             digest.update(path.relative_to(root).as_posix().encode())
             digest.update(path.read_bytes())
     return digest.hexdigest()[:16]

@@ -2,9 +2,11 @@
 
 A :class:`Subject` is a controller (a built-in law or variant with its
 parameters, or a registered plug-in controller), the state estimator of the
-``impact`` sensor set (a built-in or a registered one), or, once one exists,
-a policy of the learning environment (:func:`register_policy`, the seam that
-issue #47's ``--policy learned`` fills). It turns each task and sensor set
+``impact`` sensor set (a built-in or a registered one), or a policy: a
+learned residual on the staged law (``learned``, the policy shipped with
+quadimpact, or a ``.npz`` policy file: docs/LEARNING.md 12), flown by the
+recovery controller in the compiled loop, or a policy registered with
+:func:`register_policy` (its own scenario fields). It turns each task and sensor set
 into the runs of a sweep: the wall task's trials
 (:meth:`Subject.wall_spec`) and a grid task's points (:meth:`Subject.grid_spec`),
 each with the subject's controller, model, parameters and estimator.
@@ -55,8 +57,8 @@ def register_policy(name: str, overrides: Callable[[], dict[str, Any]]) -> None:
 
     ``overrides()`` returns the scenario fields that fly it in the loop (its
     controller and parameters: a policy runs as a compiled controller, so
-    that the tasks' sweeps fly it like any other). No policy is registered
-    yet: issue #47 adds a learned one.
+    that the tasks' sweeps fly it like any other). A name not registered is
+    read as a residual policy (``learned`` or a ``.npz`` file).
     """
     _POLICIES[name] = overrides
 
@@ -82,7 +84,9 @@ class Subject:
     estimator : str
         The state estimator of the ``impact`` sensor set.
     policy : str or None
-        A registered policy (:func:`register_policy`) instead of a controller.
+        A policy: a learned residual on the recovery law (``learned`` or a
+        ``.npz`` file, recorded as the name or the file's absolute path), or one
+        registered with :func:`register_policy` instead of a controller.
     reference : bool
         A reference row (beside the subject, read from the cache when there).
     note : str
@@ -98,6 +102,7 @@ class Subject:
     policy: str | None = None
     reference: bool = False
     note: str = ""
+    _policy_sha256: str = field(default="", init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -105,22 +110,47 @@ class Subject:
         if self.model not in MODEL_VARIANTS:
             known = ", ".join(repr(m) for m in MODEL_VARIANTS)
             raise InputError(f"--model: must be one of {known} (got {self.model!r})")
-        if self.policy is not None and self.policy not in _POLICIES:
-            known = ", ".join(_POLICIES) or "none yet: issue #47 adds a learned one"
-            raise InputError(f"--policy: unknown policy {self.policy!r} (registered: {known})")
+        if self.residual:
+            from quadimpact.inputs.policy_file import checked_policy
+
+            try:
+                ref, sha = checked_policy(str(self.policy))
+            except InputError as exc:
+                raise InputError(f"--{exc}") from None
+            object.__setattr__(self, "policy", ref)
+            object.__setattr__(self, "_policy_sha256", sha)
         controller_entry(self.controller)
         estimator_entry(self.estimator)
         object.__setattr__(self, "params", json.loads(json.dumps(dict(self.params))))
 
     # ------------------------------------------------------------ describe
     @property
+    def residual(self) -> bool:
+        """Whether it flies a learned residual on the recovery law (not a registered policy)."""
+        return self.policy is not None and self.policy not in _POLICIES
+
+    @property
+    def law(self) -> bool:
+        """Whether the recovery controller flies it in the row's model (the staged law, with
+        or without a learned residual)."""
+        return self.controller == "recovery" and (self.policy is None or self.residual)
+
+    @property
     def plugin(self) -> bool:
         """Whether it flies a plug-in (compiled per process; never cached)."""
         return (
-            self.policy is not None
+            (self.policy is not None and not self.residual)
             or self.controller not in BUILTIN_CONTROLLERS
             or self.estimator not in BUILTIN_ESTIMATORS
         )
+
+    @property
+    def cacheable(self) -> bool:
+        """Whether its cells may be kept in and read from the cache: built-in code only, and a
+        residual policy only when shipped (a user's file may change under the same path)."""
+        from quadimpact.inputs.policy_file import SHIPPED_POLICIES
+
+        return not self.plugin and (not self.residual or self.policy in SHIPPED_POLICIES)
 
     @property
     def recovers(self) -> bool:
@@ -137,7 +167,11 @@ class Subject:
             "model": self.model,
             "params": json.dumps(self.params, sort_keys=True),
             "estimator": self.estimator,
-            "policy": self.policy or "",
+            "policy": (
+                f"{self.policy} (sha256 {self._policy_sha256[:12]})"
+                if self.residual
+                else self.policy or ""
+            ),
             "note": self.note,
         }
 
@@ -145,10 +179,12 @@ class Subject:
     def _fields(self) -> dict[str, Any]:
         """The scenario fields of its controller (its parameters, its policy's fields)."""
         fields: dict[str, Any] = {}
-        if self.policy is not None:
+        if self.policy is not None and not self.residual:
             fields.update(_POLICIES[self.policy]())
         else:
             fields["controller"] = self.controller
+        if self.residual:
+            fields["controller_params"] = {"policy": self.policy}
         if self.params:
             fields["controller_params"] = {**fields.get("controller_params", {}), **self.params}
         return fields
@@ -163,10 +199,10 @@ class Subject:
         from quadimpact.sweep import SweepSpec
 
         sensing = self._sensing(sensing)
-        model = self.model if self.controller == "recovery" and self.policy is None else "default"
+        model = self.model if self.law else "default"
         spec = task.wall_study(quick, sensing, model).sweep_spec()
         base = dict(spec.base)
-        if self.controller != "recovery" or self.policy is not None:
+        if not self.law:
             base.pop("pre_impact", None)  # a behaviour of the recovery controller only
         base.update(self._fields())
         return SweepSpec(base=base, trials=spec.trials, where=f"benchmark: {task.name}")
@@ -174,7 +210,7 @@ class Subject:
     def grid_spec(self, task: Task, quick: bool, sensing: SensorSet) -> SweepSpec:
         """A grid task's points flown by this row (the pole study's sweep, one arm)."""
         study = task.grid_study(quick, self._sensing(sensing))
-        if self.controller == "recovery" and self.policy is None:
+        if self.law:
             arm = recovery_arm(self.model, study.baseline)
         else:
             arm = {"model": self.model}

@@ -72,6 +72,17 @@ def _model_text(st: dict[str, Any]) -> str:
     )
 
 
+def _policy_text(st: dict[str, Any]) -> str:
+    """The learned residual the recovery arm flew with, if any (docs/LEARNING.md 12)."""
+    if st.get("policy") is None:
+        return ""
+    return (
+        f" The recovery arm's law flies with the learned policy `{st['policy']}` (weights' "
+        f"SHA-256 `{st.get('policy_sha256', '')[:16]}`...): a residual on its thrust and roll "
+        "and pitch rate references after the detection, from on-board quantities only."
+    )
+
+
 def render_report(description: dict[str, Any], numbers: dict[str, Any], figures: list[Path]) -> str:
     """The report's Markdown."""
     st = description["study"]
@@ -128,7 +139,7 @@ def _setup_lines(description: dict[str, Any], n_arms: int) -> list[str]:
         f"than 2 m of height lost over the run (altitude at the start minus at the end), the "
         f"authors' criterion. {_sensing_text(st)}",
         "",
-        _model_text(st),
+        _model_text(st) + _policy_text(st),
         "",
         f"{run['n_runs']} runs ({run['n_ran']} run now in {run['sweep_s']:.1f} s, "
         f"{run['backend']}; {run['n_already_done']} done before); the whole study "

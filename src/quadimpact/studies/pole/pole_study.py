@@ -38,6 +38,7 @@ import numpy as np
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.model import resolve_model_options
+from quadimpact.inputs.policy_file import checked_policy
 from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
@@ -197,6 +198,11 @@ class PoleStudy:
         Coulomb friction at the bumpers (0.3).
     final_time_s : float
         Length of a run, s.
+    policy : str or None
+        A learned residual on the recovery arm's law (docs/LEARNING.md 12):
+        ``"learned"`` (the policy shipped with quadimpact) or a ``.npz`` policy
+        file; ``None`` (the default): the law alone. The baseline arm (and a
+        variant's default-law arm) fly without it.
     """
 
     vehicle: str = "navi"
@@ -217,8 +223,10 @@ class PoleStudy:
     start_distance_m: float = 0.3
     friction_coefficient: float = 0.3
     final_time_s: float = 3.0
+    policy: str | None = None
     _vehicle_ref: str = field(init=False, repr=False, compare=False)
     _obstacles: tuple = field(init=False, repr=False, compare=False)
+    _policy_sha256: str = field(init=False, repr=False, compare=False, default="")
 
     def __post_init__(self) -> None:
         if self.baseline not in BASELINES:
@@ -243,6 +251,10 @@ class PoleStudy:
             ref = str(Path(ref).resolve())
         object.__setattr__(self, "_vehicle_ref", ref)
         object.__setattr__(self, "_obstacles", tuple(self._read_obstacles()))
+        if self.policy is not None:
+            ref, sha = checked_policy(str(self.policy))
+            object.__setattr__(self, "policy", ref)
+            object.__setattr__(self, "_policy_sha256", sha)
 
     def _read_obstacles(self) -> list[dict[str, Any]]:
         if self.obstacles is not None:
@@ -301,11 +313,14 @@ class PoleStudy:
     def arms(self) -> list[dict[str, Any]]:
         """The controllers as sweep runs: the baseline, then recovery flying it (in the
         study's model), then, for a variant, the default law's recovery."""
+        arm = recovery_arm(None if self.model == "default" else self.model, self.baseline)
+        if self.policy is not None:
+            arm["controller_params"] = {"policy": self.policy}
         if self.model == "default":
-            return [{"controller": self.baseline}, recovery_arm(None, self.baseline)]
+            return [{"controller": self.baseline}, arm]
         return [
             {"controller": self.baseline, "model": "default"},
-            recovery_arm(self.model, self.baseline),
+            arm,
             recovery_arm("default", self.baseline),
         ]
 
@@ -341,7 +356,12 @@ class PoleStudy:
         d = asdict(self)
         d.pop("_vehicle_ref", None)
         d.pop("_obstacles", None)
+        d.pop("_policy_sha256", None)
         d["obstacles"] = [dict(o) for o in self._obstacles]
+        if self.policy is None:  # as before policies existed: earlier study folders resume
+            del d["policy"]
+        else:
+            d["policy_sha256"] = self._policy_sha256
         # the sensing options only when set: a study of the ideal sensors keeps the identity
         # it had before they existed (its folder resumes)
         for name, unset in (("estimator", "ideal"), ("sensors", None)):
@@ -514,6 +534,7 @@ FLAGS = {
     "offset_max_m": "--offset-max", "offset_step_m": "--offset-step", "baseline": "--baseline",
     "radius_m": "--radius", "obstacles": "--obstacle", "speed_m_s": "--speed",
     "model": "--model", "estimator": "--estimator", "sensors": "--sensors",
+    "policy": "--policy", "policy_sha256": "--policy",
 }  # fmt: skip
 
 

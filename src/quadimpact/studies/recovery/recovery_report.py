@@ -91,6 +91,17 @@ def _values(v: Sequence[Any]) -> str:
     return ", ".join(one(x) for x in v)
 
 
+def _policy_lines(study: dict[str, Any] | None) -> list[str]:
+    """The learned residual the law flew with, if any (docs/LEARNING.md 12)."""
+    if not study or study.get("policy") is None:
+        return []
+    return [
+        f"- **Learned policy**: `{study['policy']}` (weights' SHA-256 "
+        f"`{study.get('policy_sha256', '')[:16]}`...): a residual on the staged law's thrust and "
+        "roll and pitch rate references after the detection, from on-board quantities only."
+    ]
+
+
 def _what_ran(d: dict[str, Any]) -> list[str]:
     study = d.get("study")
     imu = d["imu"]
@@ -131,6 +142,7 @@ def _what_ran(d: dict[str, Any]) -> list[str]:
         ),
         f"- **Model variant**: {_values(d['model'])}; controller {_values(d['controller'])}; "
         f"pre-impact behaviour {_values(d['pre_impact'])}.",
+        *_policy_lines(study),
         "- **Model switches** (as run): "
         + "; ".join(f"`{k}` = {_values(v)}" for k, v in d["model_options"].items())
         + ".",

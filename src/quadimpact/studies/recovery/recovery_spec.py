@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
+from quadimpact.inputs.policy_file import checked_policy
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.packing.constants import RPM
 from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS
@@ -122,6 +123,11 @@ class RecoveryStudy:
         A preset of sensors; it replaces ``imu`` (``None``: ``imu`` alone).
         The same seed gives the same trials (conditions and IMU seeds) with
         any estimator and sensors, so studies compare row by row.
+    policy : str or None
+        A learned residual on the recovery law (docs/LEARNING.md 12): ``"learned"``
+        (the policy shipped with quadimpact) or a ``.npz`` policy file; ``None``
+        (the default): the law alone. Recorded as the name or the file's absolute
+        path, with the weights' SHA-256 in :meth:`options`.
 
     Notes
     -----
@@ -139,10 +145,16 @@ class RecoveryStudy:
     pre_impact: str | None = None
     estimator: str = "ideal"
     sensors: str | None = None
+    policy: str | None = None
     _vehicle_ref: str = field(init=False, repr=False, compare=False)
+    _policy_sha256: str = field(init=False, repr=False, compare=False, default="")
 
     def __post_init__(self) -> None:
         _check_int("n", self.n, 1)
+        if self.policy is not None:
+            ref, sha = checked_policy(str(self.policy))
+            object.__setattr__(self, "policy", ref)
+            object.__setattr__(self, "_policy_sha256", sha)
         _check_int("seed", self.seed, 0)
         _check_choice("model", self.model, MODELS)
         _check_choice("imu", self.imu, IMUS)
@@ -193,6 +205,8 @@ class RecoveryStudy:
         slew = self.lent_slew_limit_rad_s2()
         if slew is not None:
             base["rotor_slew_limit_rad_s2"] = slew
+        if self.policy is not None:
+            base["controller_params"] = {"policy": self.policy}
         return base
 
     def sweep_spec(self) -> SweepSpec:
@@ -207,4 +221,9 @@ class RecoveryStudy:
         """The study's options as plain data (``study.json``)."""
         d = asdict(self)
         d.pop("_vehicle_ref", None)
+        d.pop("_policy_sha256", None)
+        if self.policy is None:  # as before policies existed: earlier study folders resume
+            d.pop("policy")
+        else:
+            d["policy_sha256"] = self._policy_sha256
         return d

@@ -226,7 +226,7 @@ class RecoveryResult:
 FLAGS = {
     "vehicle": "--vehicle", "n": "--n", "seed": "--seed", "model": "--model", "imu": "--imu",
     "pre_impact": "--pre-impact", "estimator": "--estimator", "sensors": "--sensors",
-    "sweep": "--sweep",
+    "sweep": "--sweep", "policy": "--policy", "policy_sha256": "--policy",
 }  # fmt: skip
 
 

@@ -1,0 +1,171 @@
+"""A learned residual on the recovery law: a small network that corrects the staged law.
+
+After the detection the ``recovery`` controller's outer loop gives a collective
+thrust ``T`` (N) and roll and pitch rate references ``p_des``, ``q_des``
+(rad/s). When ``ctrl[C_POLICY]`` holds a network (its first slot, the hidden
+width, > 0), :func:`residual_references` corrects them from on-board
+quantities only (the state estimate, the estimated rates, the accelerometer,
+the detector's wall normal and time, the law's stage)::
+
+    f  = features(...)                     24 numbers, each about unit size
+    h  = tanh(W1 f + b1)                   hidden layer (width nh <= MAX_HIDDEN, 32)
+    o  = tanh(W2 h + b2)                   3 outputs in (-1, 1)
+    T'     = max(0, T + s_T m g o_0)
+    p_des' = p_des + s_w o_1,   q_des' = q_des + s_w o_2
+
+so the correction is bounded by ``s_T`` times the hover thrust and ``s_w``
+rad/s whatever the weights, and a network whose ``W2`` and ``b2`` are zero
+flies the staged law exactly. Stage changes, the lean cut, the rate loop and
+the allocation are the law's.
+
+Features (body FRD axes; non-finite inputs read as 0):
+
+======  ==================================================================
+0-2     gravity's direction in body axes (from the estimated attitude)
+3-5     the wall-normal estimate in body axes (zero before it is known)
+6-8     estimated velocity, body axes, / 2 m/s
+9-11    estimated body rates / 8 rad/s
+12-14   the accelerometer's specific force, body axes, / 16 m/s^2
+15      time since the detecting sample, s, capped at 2
+16-20   the law's stage (1-5), one-hot
+21      the law's thrust / (m g) - 1
+22-23   the law's p_des, q_des / 8 rad/s
+======  ==================================================================
+
+The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, W1 (nh x 24,
+row-major), b1 (nh), W2 (3 x nh, row-major), b2 (3)]``. The weights come from
+a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy forward pass of
+the same network is ``PolicyWeights.outputs``. The block's layout (``PB_*``,
+``N_FEATURES``, ``MAX_HIDDEN``) is declared in ``core/controller_layout.py``.
+"""
+
+import math
+
+import numpy as np
+
+from quadimpact.core.compiled import allocating
+from quadimpact.core.controller_layout import (
+    N_FEATURES,
+    N_OUTPUTS,
+    PB_HIDDEN,
+    PB_RATE_SCALE,
+    PB_THRUST_SCALE,
+    PB_WEIGHTS,
+)
+from quadimpact.core.layout import (
+    C_POLICY,
+    MS_IMU_F,
+    MS_NORMAL,
+    MS_T_DETECT,
+    MS_W_HAT,
+    MS_X,
+    V_GRAVITY,
+    V_MASS,
+    X_QUAT,
+    X_VEL,
+)
+
+_V_SCALE_M_S = 2.0
+_W_SCALE_RAD_S = 8.0
+_F_SCALE_M_S2 = 16.0
+_T_CAP_S = 2.0
+
+
+@allocating
+def features(
+    t: float,
+    stage: int,
+    refs: tuple[float, float, float],
+    meas: np.ndarray,
+    veh: np.ndarray,
+) -> np.ndarray:
+    """The network's 24 input features (table above) at time ``t`` (s) in ``stage``.
+
+    ``refs``: the staged law's ``(thrust N, p_des rad/s, q_des rad/s)``; ``meas``:
+    the controller's measurement vector; ``veh``: the vehicle vector.
+    """
+    f = np.zeros(N_FEATURES)
+    x = meas[MS_X:]
+    q0 = x[X_QUAT]
+    q1 = x[X_QUAT + 1]
+    q2 = x[X_QUAT + 2]
+    q3 = x[X_QUAT + 3]
+    # rows of C^T (body <- inertial): C^T e_Z is the third row of C read as a column
+    f[0] = 2.0 * (q1 * q3 - q0 * q2)
+    f[1] = 2.0 * (q2 * q3 + q0 * q1)
+    f[2] = q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3
+    n0 = meas[MS_NORMAL]
+    n1 = meas[MS_NORMAL + 1]
+    n2 = meas[MS_NORMAL + 2]
+    # C^T n, body components of the inertial normal
+    f[3] = (
+        (q0 * q0 + q1 * q1 - q2 * q2 - q3 * q3) * n0
+        + 2.0 * (q1 * q2 + q0 * q3) * n1
+        + 2.0 * (q1 * q3 - q0 * q2) * n2
+    )
+    f[4] = (
+        2.0 * (q1 * q2 - q0 * q3) * n0
+        + (q0 * q0 - q1 * q1 + q2 * q2 - q3 * q3) * n1
+        + 2.0 * (q2 * q3 + q0 * q1) * n2
+    )
+    f[5] = (
+        2.0 * (q1 * q3 + q0 * q2) * n0
+        + 2.0 * (q2 * q3 - q0 * q1) * n1
+        + (q0 * q0 - q1 * q1 - q2 * q2 + q3 * q3) * n2
+    )
+    for k in range(3):
+        f[6 + k] = x[X_VEL + k] / _V_SCALE_M_S
+        f[9 + k] = meas[MS_W_HAT + k] / _W_SCALE_RAD_S
+        f[12 + k] = meas[MS_IMU_F + k] / _F_SCALE_M_S2
+    since = t - meas[MS_T_DETECT]
+    f[15] = min(max(since, 0.0), _T_CAP_S)
+    if 1 <= stage <= 5:
+        f[15 + stage] = 1.0
+    f[21] = refs[0] / (veh[V_MASS] * veh[V_GRAVITY]) - 1.0
+    f[22] = refs[1] / _W_SCALE_RAD_S
+    f[23] = refs[2] / _W_SCALE_RAD_S
+    for k in range(N_FEATURES):
+        if not math.isfinite(f[k]):
+            f[k] = 0.0
+    return f
+
+
+@allocating
+def residual_references(
+    t: float,
+    stage: int,
+    refs: tuple[float, float, float],
+    meas: np.ndarray,
+    ctrl: np.ndarray,
+    veh: np.ndarray,
+) -> tuple[float, float, float]:
+    """The law's ``refs = (thrust N, p_des rad/s, q_des rad/s)`` corrected by the network.
+
+    The network is the block at ``ctrl[C_POLICY:]`` (module docstring); the
+    result is ``(thrust, p_des, q_des)`` in the same units.
+    """
+    f = features(t, stage, refs, meas, veh)
+    b = C_POLICY
+    nh = int(ctrl[b + PB_HIDDEN])
+    w1 = b + PB_WEIGHTS
+    b1 = w1 + nh * N_FEATURES
+    w2 = b1 + nh
+    b2 = w2 + N_OUTPUTS * nh
+    o0 = ctrl[b2]
+    o1 = ctrl[b2 + 1]
+    o2 = ctrl[b2 + 2]
+    for j in range(nh):
+        a = ctrl[b1 + j]
+        row = w1 + j * N_FEATURES
+        for i in range(N_FEATURES):
+            a += ctrl[row + i] * f[i]
+        h = math.tanh(a)
+        o0 += ctrl[w2 + j] * h
+        o1 += ctrl[w2 + nh + j] * h
+        o2 += ctrl[w2 + 2 * nh + j] * h
+    thrust = refs[0] + ctrl[b + PB_THRUST_SCALE] * veh[V_MASS] * veh[V_GRAVITY] * math.tanh(o0)
+    if thrust < 0.0:
+        thrust = 0.0
+    p_des = refs[1] + ctrl[b + PB_RATE_SCALE] * math.tanh(o1)
+    q_des = refs[2] + ctrl[b + PB_RATE_SCALE] * math.tanh(o2)
+    return thrust, p_des, q_des

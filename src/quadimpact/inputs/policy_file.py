@@ -1,0 +1,242 @@
+"""Learned recovery policies: the residual network's weights in a ``.npz`` file.
+
+A policy file holds the arrays of the residual network that corrects the
+recovery law after the detection (``core/controllers/residual.py``, docs/LEARNING.md
+section 12)::
+
+    w1 (nh, 24)   b1 (nh,)   w2 (3, nh)   b2 (3,)
+    thrust_scale ()    the largest thrust correction, a fraction of m g
+    rate_scale_rad_s () the largest roll and pitch rate-reference correction, rad/s
+    meta ()            optional: a JSON text of how it was trained
+
+``--policy learned`` names the policy shipped with quadimpact
+(``inputs/policies/learned.npz``); any other value is a file path. Flying a
+policy needs NumPy only: the compiled loop evaluates the network itself, and
+:meth:`PolicyWeights.outputs` is the same network in NumPy.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from quadimpact.core.controller_layout import MAX_HIDDEN, N_FEATURES, N_OUTPUTS
+from quadimpact.errors import InputError, short_path
+
+__all__ = [
+    "SHIPPED_POLICIES",
+    "PolicyWeights",
+    "checked_policy",
+    "initial_policy",
+    "load_policy",
+    "policy_path",
+    "policy_ref",
+    "save_policy",
+]
+
+#: Policies shipped with quadimpact, by name: their files in ``inputs/policies/``.
+SHIPPED_POLICIES = {"learned": "learned.npz"}
+
+_POLICY_DIR = Path(__file__).parent / "policies"
+
+
+@dataclass(frozen=True)
+class PolicyWeights:
+    """A residual policy's weights (module docstring), with where they came from.
+
+    Attributes
+    ----------
+    w1, b1, w2, b2 : numpy.ndarray
+        The network's weights, shapes ``(nh, 24)``, ``(nh,)``, ``(3, nh)``, ``(3,)``.
+    thrust_scale : float
+        The largest thrust correction as a fraction of the hover thrust ``m g``.
+    rate_scale_rad_s : float
+        The largest roll and pitch rate-reference correction, rad/s.
+    meta : dict
+        How the weights were made (training script, seeds, ...), as saved.
+    sha256 : str
+        Digest of the weights (``vector()``'s bytes): the policy's identity.
+    path : str
+        The file read ("" for weights made in memory).
+    """
+
+    w1: np.ndarray
+    b1: np.ndarray
+    w2: np.ndarray
+    b2: np.ndarray
+    thrust_scale: float
+    rate_scale_rad_s: float
+    meta: dict = field(default_factory=dict)
+    sha256: str = ""
+    path: str = ""
+
+    @property
+    def hidden(self) -> int:
+        """Width of the hidden layer."""
+        return int(self.w1.shape[0])
+
+    def vector(self) -> np.ndarray:
+        """The weights as one vector ``[w1, b1, w2, b2]`` (row-major), the trainer's parameters."""
+        return np.concatenate([self.w1.ravel(), self.b1, self.w2.ravel(), self.b2])
+
+    def with_vector(self, theta: np.ndarray, **meta: Any) -> PolicyWeights:
+        """These weights replaced by ``theta`` (as :meth:`vector` lays them out)."""
+        nh = self.hidden
+        theta = np.asarray(theta, dtype=float)
+        a = nh * N_FEATURES
+        w1 = theta[:a].reshape(nh, N_FEATURES)
+        b1 = theta[a : a + nh]
+        w2 = theta[a + nh : a + nh + N_OUTPUTS * nh].reshape(N_OUTPUTS, nh)
+        b2 = theta[a + nh + N_OUTPUTS * nh :]
+        new = replace(self, w1=w1.copy(), b1=b1.copy(), w2=w2.copy(), b2=b2.copy(), path="")
+        return replace(new, meta={**self.meta, **meta}, sha256=_digest(new))
+
+    def outputs(self, features: np.ndarray) -> np.ndarray:
+        """The network's three outputs in (-1, 1) for ``features`` ``(..., 24)`` (NumPy only)."""
+        h = np.tanh(np.asarray(features, dtype=float) @ self.w1.T + self.b1)
+        return np.tanh(h @ self.w2.T + self.b2)
+
+    def block(self) -> np.ndarray:
+        """The compiled loop's block ``[nh, s_T, s_w, W1, b1, W2, b2]`` (residual.py)."""
+        head = np.array([self.hidden, self.thrust_scale, self.rate_scale_rad_s], dtype=float)
+        return np.concatenate([head, self.vector()])
+
+
+def _digest(p: PolicyWeights) -> str:
+    h = hashlib.sha256(np.ascontiguousarray(p.vector(), dtype="<f8").tobytes())
+    h.update(np.array([p.thrust_scale, p.rate_scale_rad_s], dtype="<f8").tobytes())
+    return h.hexdigest()
+
+
+def policy_path(name: str) -> Path:
+    """The file of policy ``name``: a shipped policy's (``learned``) or the path given."""
+    if name in SHIPPED_POLICIES:
+        return _POLICY_DIR / SHIPPED_POLICIES[name]
+    return Path(name).expanduser()
+
+
+def policy_ref(name: str) -> str:
+    """How a run records policy ``name``: a shipped name as is, a file as its absolute path."""
+    return name if name in SHIPPED_POLICIES else str(policy_path(name).resolve())
+
+
+def checked_policy(name: str) -> tuple[str, str]:
+    """A study's ``policy`` option checked: ``(policy_ref(name), sha256 of its weights)``.
+
+    Raises :class:`InputError` as :func:`load_policy`.
+    """
+    return policy_ref(name), load_policy(name).sha256
+
+
+def load_policy(name: str | Path) -> PolicyWeights:
+    """Read and check a policy file (``learned``: the shipped one; else a ``.npz`` path).
+
+    Raises
+    ------
+    InputError
+        One line naming the file and the rule broken: missing file, not a
+        ``.npz`` archive, a missing array, wrong shapes, non-finite numbers,
+        a hidden layer wider than ``MAX_HIDDEN``.
+    """
+    path = policy_path(str(name))
+    where = f"policy: {short_path(str(path))}"
+    if not path.is_file():
+        shipped = ", ".join(sorted(SHIPPED_POLICIES))
+        raise InputError(f"{where}: no such file (give a .npz policy file or one of: {shipped})")
+    try:
+        with np.load(path, allow_pickle=False) as npz:
+            arrays = {k: np.array(npz[k]) for k in npz.files}
+    except Exception as exc:  # noqa: BLE001 - any unreadable file is the same user error
+        raise InputError(f"{where}: not a .npz policy file ({type(exc).__name__})") from None
+    need = ("w1", "b1", "w2", "b2", "thrust_scale", "rate_scale_rad_s")
+    missing = [k for k in need if k not in arrays]
+    if missing:
+        raise InputError(f"{where}: missing array(s) {', '.join(missing)}")
+    try:
+        w = {k: np.asarray(arrays[k], dtype=float) for k in need}
+    except (TypeError, ValueError):
+        raise InputError(f"{where}: every array must be numeric") from None
+    nh = w["w1"].shape[0] if w["w1"].ndim == 2 else -1
+    shapes = {
+        "w1": (nh, N_FEATURES),
+        "b1": (nh,),
+        "w2": (N_OUTPUTS, nh),
+        "b2": (N_OUTPUTS,),
+        "thrust_scale": (),
+        "rate_scale_rad_s": (),
+    }
+    for k, shape in shapes.items():
+        if nh < 1 or w[k].shape != shape:
+            raise InputError(
+                f"{where}: {k}: must be {shape if nh >= 1 else '(nh, 24)'} with w1 (nh, 24), "
+                f"1 <= nh <= {MAX_HIDDEN} (got {w[k].shape})"
+            )
+    if nh > MAX_HIDDEN:
+        raise InputError(f"{where}: w1: hidden width must be <= {MAX_HIDDEN} (got {nh})")
+    for k in need:
+        if not np.all(np.isfinite(w[k])):
+            raise InputError(f"{where}: {k}: must be finite")
+    for k in ("thrust_scale", "rate_scale_rad_s"):
+        if float(w[k]) < 0:
+            raise InputError(f"{where}: {k}: must be >= 0 (got {float(w[k])})")
+    meta: dict = {}
+    if "meta" in arrays:
+        try:
+            meta = json.loads(str(arrays["meta"]))
+        except ValueError:
+            raise InputError(f"{where}: meta: must be a JSON text") from None
+    p = PolicyWeights(
+        w["w1"],
+        w["b1"],
+        w["w2"],
+        w["b2"],
+        float(w["thrust_scale"]),
+        float(w["rate_scale_rad_s"]),
+        meta=meta,
+        path=str(path),
+    )
+    return replace(p, sha256=_digest(p))
+
+
+def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
+    """Write ``policy`` as a ``.npz`` policy file (float64, its ``meta`` as JSON text)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp.npz")
+    np.savez(
+        tmp,
+        w1=policy.w1,
+        b1=policy.b1,
+        w2=policy.w2,
+        b2=policy.b2,
+        thrust_scale=np.float64(policy.thrust_scale),
+        rate_scale_rad_s=np.float64(policy.rate_scale_rad_s),
+        meta=np.array(json.dumps(policy.meta, sort_keys=True)),
+    )
+    tmp.replace(path)
+    return path
+
+
+def initial_policy(
+    hidden: int, thrust_scale: float, rate_scale_rad_s: float, seed: int
+) -> PolicyWeights:
+    """A new policy that flies the law exactly: random ``w1`` (scale 1/sqrt(24)), a zero
+    output layer (``seed``: of ``w1``'s draw; the scales as :class:`PolicyWeights`')."""
+    if not 1 <= hidden <= MAX_HIDDEN or not math.isfinite(thrust_scale):
+        raise InputError(f"policy: hidden: must be in 1..{MAX_HIDDEN} (got {hidden})")
+    rng = np.random.default_rng(seed)
+    p = PolicyWeights(
+        rng.normal(0.0, 1.0 / math.sqrt(N_FEATURES), (hidden, N_FEATURES)),
+        np.zeros(hidden),
+        np.zeros((N_OUTPUTS, hidden)),
+        np.zeros(N_OUTPUTS),
+        float(thrust_scale),
+        float(rate_scale_rad_s),
+    )
+    return replace(p, sha256=_digest(p))

@@ -1,0 +1,238 @@
+"""The learned residual on the recovery law: its features in the right frames, its network
+the same compiled as in NumPy, its correction bounded, zero weights flying the law exactly,
+its files checked, and the shipped policy flown with NumPy alone."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from quadimpact import ImpactTrial, simulate
+from quadimpact.core import controller_layout as CL
+from quadimpact.core import layout as L
+from quadimpact.core.controllers.residual import features, residual_references
+from quadimpact.errors import InputError
+from quadimpact.inputs.policy_file import (
+    PolicyWeights,
+    initial_policy,
+    load_policy,
+    policy_path,
+    save_policy,
+)
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
+
+NAVI_MASS_KG, G = 1.095, 9.81
+
+
+def _veh() -> np.ndarray:
+    veh = np.zeros(L.NVEH)
+    veh[L.V_MASS] = NAVI_MASS_KG
+    veh[L.V_GRAVITY] = G
+    return veh
+
+
+def _meas(q: np.ndarray, normal=(-1.0, 0.0, 0.0), t_detect: float = 0.1) -> np.ndarray:
+    meas = np.zeros(L.NMEAS)
+    meas[L.MS_X + L.X_QUAT : L.MS_X + L.X_QUAT + 4] = q
+    meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (1.0, -0.5, 0.25)
+    meas[L.MS_W_HAT : L.MS_W_HAT + 3] = (4.0, -2.0, 1.0)
+    meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (3.0, 0.0, -9.0)
+    meas[L.MS_NORMAL : L.MS_NORMAL + 3] = normal
+    meas[L.MS_T_DETECT] = t_detect
+    return meas
+
+
+def _random_policy(seed: int, hidden: int = 8, scale: float = 1.0) -> PolicyWeights:
+    p = initial_policy(hidden, 0.3, 4.0, seed)
+    rng = np.random.default_rng(seed + 1)
+    return p.with_vector(rng.normal(0.0, scale, p.vector().size))
+
+
+def _ctrl(p: PolicyWeights) -> np.ndarray:
+    ctrl = np.zeros(L.NCTRL)
+    block = p.block()
+    ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+    return ctrl
+
+
+@pytest.mark.parametrize(
+    "euler_deg", [(0.0, 0.0, 0.0), (30.0, -20.0, 75.0), (-100.0, 60.0, -150.0)]
+)
+def test_features_are_gravity_and_the_wall_normal_in_body_axes(euler_deg):
+    """Features 0-2 are C^T e_Z (gravity's direction in body FRD), 3-5 are C^T n."""
+    q = euler_zyx_to_quat(*np.radians(euler_deg))
+    c = quat_to_matrix(q)
+    n = np.array([-0.6, 0.8, 0.0])
+    f = features(0.3, 2, (10.0, 1.0, -2.0), _meas(q, n), _veh())
+    np.testing.assert_allclose(f[0:3], c.T @ np.array([0.0, 0.0, 1.0]), atol=1e-12)
+    np.testing.assert_allclose(f[3:6], c.T @ n, atol=1e-12)
+    assert math.isclose(f[15], 0.2, abs_tol=1e-12)  # time since detection, s
+    assert list(f[16:21]) == [0, 1, 0, 0, 0]  # stage 2, one-hot
+    assert math.isclose(f[21], 10.0 / (NAVI_MASS_KG * G) - 1.0)
+
+
+def test_features_read_non_finite_inputs_as_zero_and_cap_the_time():
+    q = np.array([1.0, 0.0, 0.0, 0.0])
+    meas = _meas(q, (math.nan, math.nan, math.nan), t_detect=math.nan)
+    f = features(5.0, 1, (math.inf, 0.0, 0.0), meas, _veh())
+    assert np.all(np.isfinite(f))
+    assert f[3] == f[4] == f[5] == f[15] == f[21] == 0.0
+    f = features(5.0, 1, (5.0, 0.0, 0.0), _meas(q, t_detect=1.0), _veh())
+    assert f[15] == 2.0  # capped at 2 s
+
+
+def test_the_compiled_network_is_the_numpy_network():
+    """residual_references (compiled) == PolicyWeights.outputs (NumPy) on the same features."""
+    rng = np.random.default_rng(3)
+    for k in range(20):
+        p = _random_policy(k, hidden=int(rng.integers(1, 33)))
+        q = euler_zyx_to_quat(*rng.uniform(-1.0, 1.0, 3))
+        meas = _meas(q, (-1.0, 0.0, 0.0))
+        refs = (float(rng.uniform(0, 20)), float(rng.normal()), float(rng.normal()))
+        stage = int(rng.integers(1, 6))
+        got = residual_references(0.5, stage, refs, meas, _ctrl(p), _veh())
+        o = p.outputs(features(0.5, stage, refs, meas, _veh()))
+        want = (
+            max(0.0, refs[0] + p.thrust_scale * NAVI_MASS_KG * G * o[0]),
+            refs[1] + p.rate_scale_rad_s * o[1],
+            refs[2] + p.rate_scale_rad_s * o[2],
+        )
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+def test_the_correction_is_bounded_whatever_the_weights():
+    """|dT| <= s_T m g and |dp|, |dq| <= s_w, even for weights of size 1000."""
+    q = np.array([1.0, 0.0, 0.0, 0.0])
+    for k in range(30):
+        p = _random_policy(k, scale=1000.0)
+        refs = (12.0, 0.5, -0.5)
+        t, pd, qd = residual_references(0.2, 1, refs, _meas(q), _ctrl(p), _veh())
+        assert abs(t - refs[0]) <= 0.3 * NAVI_MASS_KG * G + 1e-9 and t >= 0.0
+        assert abs(pd - refs[1]) <= 4.0 + 1e-12 and abs(qd - refs[2]) <= 4.0 + 1e-12
+
+
+def _trial(**fields) -> ImpactTrial:
+    return ImpactTrial(
+        vehicle="navi", speed_m_s=2.0, roll_deg=5.0, pitch_deg=-25.0, yaw_deg=10.0,
+        pre_impact="spin-down", sensors="impact", estimator="ekf", seed=11, final_time_s=2.5,
+        **fields,
+    )  # fmt: skip
+
+
+def test_a_policy_with_a_zero_output_layer_flies_the_law_bit_for_bit(tmp_path):
+    path = save_policy(initial_policy(16, 0.3, 4.0, seed=5), tmp_path / "zero.npz")
+    law = simulate(_trial())
+    res = simulate(_trial(controller_params={"policy": str(path)}))
+    assert law.summary["recovered"] and res.summary["detected"]
+    cols = [c for c in law.timeseries.columns if c != "wall_time_s"]
+    assert law.timeseries[cols].equals(res.timeseries[cols])
+
+
+def test_a_policy_changes_the_flight_only_after_the_detection(tmp_path):
+    """A strong random policy: the same flight up to the detection tick, another after."""
+    path = save_policy(_random_policy(9, hidden=16, scale=2.0), tmp_path / "p.npz")
+    law = simulate(_trial()).timeseries
+    res = simulate(_trial(controller_params={"policy": str(path)})).timeseries
+    stage = law["stage"].to_numpy()
+    before = stage == 0
+    cols = ["x_m", "y_m", "z_m", "q0", "q1", "q2", "q3"]
+    assert law.loc[before, cols].equals(res.loc[before, cols])
+    assert not law[cols].equals(res[cols])
+
+
+def test_packing_writes_the_files_block(tmp_path):
+    from quadimpact.simulation.setup import prepare
+
+    p = _random_policy(2)
+    path = save_policy(p, tmp_path / "p.npz")
+    ctrl = prepare(_trial(controller_params={"policy": str(path)})).ctrl
+    block = p.block()
+    np.testing.assert_array_equal(ctrl[L.C_POLICY : L.C_POLICY + block.size], block)
+    assert not ctrl[L.C_POLICY + block.size : L.C_POLICY + L.NPOLICY].any()
+    assert not prepare(_trial()).ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY].any()
+    assert int(ctrl[L.C_POLICY + CL.PB_HIDDEN]) == p.hidden
+
+
+def test_a_policy_file_round_trips_with_its_digest(tmp_path):
+    p = _random_policy(4).with_vector(_random_policy(4).vector(), note="x")
+    q = load_policy(save_policy(p, tmp_path / "p.npz"))
+    np.testing.assert_array_equal(q.vector(), p.vector())
+    assert q.sha256 == p.sha256 and len(q.sha256) == 64 and q.meta["note"] == "x"
+    assert _random_policy(5).sha256 != p.sha256
+
+
+@pytest.mark.parametrize(
+    ("arrays", "rule"),
+    [
+        ({"w1": np.zeros((4, 23))}, "w1: must be (4, 24)"),
+        ({"b2": np.zeros(2)}, "b2: must be (3,)"),
+        ({"w1": np.zeros((40, 24)), "b1": np.zeros(40), "w2": np.zeros((3, 40))}, "<= 32"),
+        ({"b1": np.full(4, np.nan)}, "b1: must be finite"),
+        ({"rate_scale_rad_s": np.float64(-1.0)}, "rate_scale_rad_s: must be >= 0"),
+        ({"w2": None}, "missing array(s) w2"),
+    ],
+)
+def test_a_bad_policy_file_is_a_one_line_error(tmp_path, arrays, rule):
+    good = {"w1": np.zeros((4, 24)), "b1": np.zeros(4), "w2": np.zeros((3, 4)),
+            "b2": np.zeros(3), "thrust_scale": np.float64(0.3),
+            "rate_scale_rad_s": np.float64(4.0)}  # fmt: skip
+    data = {**good, **arrays}
+    path = tmp_path / "bad.npz"
+    np.savez(path, **{k: v for k, v in data.items() if v is not None})
+    with pytest.raises(InputError, match=re.escape(rule)) as err:
+        load_policy(path)
+    assert "\n" not in str(err.value) and "bad.npz" in str(err.value)
+
+
+def test_a_missing_or_unreadable_policy_is_a_one_line_error(tmp_path):
+    with pytest.raises(InputError, match="no such file"):
+        load_policy(tmp_path / "none.npz")
+    (tmp_path / "text.npz").write_text("not an archive")
+    with pytest.raises(InputError, match="not a .npz policy file"):
+        load_policy(tmp_path / "text.npz")
+    from quadimpact.inputs.scenarios import scenario_from_dict
+
+    data = {"kind": "impact-trial", "controller_params": {"policy": str(tmp_path / "none.npz")}}
+    with pytest.raises(InputError, match="controller_params.policy: no such file") as err:
+        scenario_from_dict(data, where="trial.toml")
+    assert "\n" not in str(err.value)
+
+
+SHIPPED = policy_path("learned")
+
+
+@pytest.mark.skipif(not SHIPPED.is_file(), reason="no shipped policy (inputs/policies/learned.npz)")
+def test_the_shipped_policy_flies_seeded_trials_with_numpy_and_the_loop_only():
+    """In a fresh interpreter: the shipped weights load, fly five seeded wall trials, and
+    no deep-learning framework is imported; the NumPy network gives bounded outputs."""
+    code = """
+import json, sys
+import numpy as np
+from quadimpact import ImpactTrial, simulate
+from quadimpact.inputs.policy_file import load_policy
+p = load_policy("learned")
+out = p.outputs(np.zeros((2, 24)))
+rows = []
+for seed in range(5):
+    s = ImpactTrial(vehicle="navi", speed_m_s=2.0, pitch_deg=-30.0 + 10 * seed,
+                    pre_impact="spin-down", sensors="impact",
+                    estimator="ekf", seed=seed, controller_params={"policy": "learned"})
+    r = simulate(s).summary
+    rows.append([r["status"], r["detected"], r["recovered"], r["height_loss_m"]])
+print(json.dumps({"rows": rows, "hidden": p.hidden, "out": out.tolist(), "sha": p.sha256,
+                  "torch": "torch" in sys.modules, "jax": "jax" in sys.modules}))
+"""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr
+    got = json.loads(res.stdout.strip().splitlines()[-1])
+    assert not got["torch"] and not got["jax"]
+    assert len(got["rows"]) == 5 and all(r[0] != "failed" and r[1] for r in got["rows"])
+    assert sum(bool(r[2]) for r in got["rows"]) >= 3
+    assert np.all(np.abs(got["out"]) < 1.0) and len(got["sha"]) == 64
+    assert SHIPPED.stat().st_size < 2_000_000
