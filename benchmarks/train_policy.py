@@ -116,6 +116,34 @@ def _check(job: tuple[list[int], np.ndarray | None]) -> tuple[int, int]:
     return k, n
 
 
+def plot_curve(curve_csv: Path, png: Path) -> Path:
+    """The learning curve as a figure: the batch's mean score per generation and the check
+    set's success (the law's at generation 0), against training minutes."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    c = pd.read_csv(curve_csv)
+    fig, ax = plt.subplots(figsize=(7.0, 3.6), constrained_layout=True)
+    batch = c.dropna(subset=["batch_score"])
+    ax.plot(batch["generation"], batch["batch_score"].rolling(10, min_periods=1).mean(),
+            color="0.6", lw=1, label="training batch: mean score, 1 a success + 0.1 exp(-lost/m) (10-gen. mean)")  # fmt: skip
+    check = c.dropna(subset=["check_success"])
+    ax.plot(check["generation"], check["check_success"], "o-", color="C0", ms=3,
+            label="check set (600 trials): success")  # fmt: skip
+    ax.axhline(check["check_success"].iloc[0], color="C3", ls="--", lw=1,
+               label="the staged law on the check set")  # fmt: skip
+    ax.set_xlabel("generation (1,024 trials each)")
+    ax.set_ylabel("share")
+    ax.legend(fontsize=8, loc="lower right")
+    ax.grid(alpha=0.3)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png
+
+
 def main() -> None:
     from quadimpact.inputs.policy_file import initial_policy, save_policy
 
@@ -228,6 +256,7 @@ def main() -> None:
     }  # fmt: skip
     save_policy(pol.with_vector(best_theta, **meta), a.out / "policy.npz")
     (a.out / "train.json").write_text(json.dumps(meta, indent=1) + "\n")
+    plot_curve(curve_path, a.out / "curve.png")
     print(f"wrote {a.out / 'policy.npz'}: check {best:.4f} (law {law:.4f}), "
           f"{gen} generations, {runs} runs, {minutes:.1f} min", flush=True)  # fmt: skip
 

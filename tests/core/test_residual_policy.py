@@ -146,6 +146,36 @@ def test_a_policy_changes_the_flight_only_after_the_detection(tmp_path):
     assert not law[cols].equals(res[cols])
 
 
+@pytest.mark.parametrize(("stage", "acts"), [(1, True), (3, True), (5, False)])
+def test_the_residual_acts_until_the_recovery_and_leaves_the_hover_to_the_law(stage, acts):
+    """One tick of recovery_step in a stage, with and without a strong policy: the commands
+    differ in stages 1-4 and are the same in stage 5 (the law's return to hover)."""
+    from quadimpact.core import controller_layout as CL
+    from quadimpact.core.controllers.recovery import recovery_step
+    from quadimpact.simulation.setup import prepare
+
+    setup = prepare(_trial())
+    cmds = []
+    for policy in (None, _random_policy(7, hidden=16, scale=3.0)):
+        ctrl = setup.ctrl.copy()
+        if policy is not None:
+            block = policy.block()
+            ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+        meas = np.zeros(L.NMEAS)
+        meas[L.MS_X : L.MS_X + L.NX] = setup.x0
+        meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
+        meas[L.MS_DETECTED] = 1.0
+        meas[L.MS_T_DETECT] = 0.1
+        meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+        mem = np.zeros(L.NMEM)
+        mem[L.MEM_STAGE] = stage
+        mem[CL.RM_HOLD_SET] = 1.0
+        cmd = np.zeros(4)
+        recovery_step(0.3, meas, ctrl, mem, setup.veh, 0.005, cmd)
+        cmds.append(cmd)
+    assert (not np.array_equal(*cmds)) == acts
+
+
 def test_packing_writes_the_files_block(tmp_path):
     from quadimpact.simulation.setup import prepare
 

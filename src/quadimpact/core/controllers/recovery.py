@@ -60,8 +60,9 @@ detection tick" is the switch ``R_FIRST_TICK_LEVEL``, the pole replica's
 Euler-angle test of stage 2 the switch ``R_LEVEL_TEST`` (:func:`stage_tilt`).
 
 A learned residual (``ctrl[C_POLICY:]``, ``residual.py``) may correct the
-outer loop's thrust and roll and pitch rate references after the detection;
-with none (the default) the law is as above.
+outer loop's thrust and roll and pitch rate references from the detection to
+the recovery (stages 1-4; stage 5's hover is the law's); with none (the
+default) the law is as above.
 """
 
 import math
@@ -458,7 +459,7 @@ def recovery_step(
     thrust, p_des, q_des, r_des, qex, qey = law_references(
         stage, a_ref_on, x, normal, ctrl, veh, mem
     )
-    if ctrl[C_POLICY + PB_HIDDEN] > 0.5:
+    if stage <= STAGE_RECOVERED and ctrl[C_POLICY + PB_HIDDEN] > 0.5:
         thrust, p_des, q_des = residual_references(
             t, stage, (thrust, p_des, q_des), meas, ctrl, veh
         )

@@ -1,6 +1,7 @@
 """A learned residual on the recovery law: a small network that corrects the staged law.
 
-After the detection the ``recovery`` controller's outer loop gives a collective
+From the detection to the recovery (stages 1-4; stage 5, the return to hover,
+is the law's alone) the ``recovery`` controller's outer loop gives a collective
 thrust ``T`` (N) and roll and pitch rate references ``p_des``, ``q_des``
 (rad/s). When ``ctrl[C_POLICY]`` holds a network (its first slot, the hidden
 width, > 0), :func:`residual_references` corrects them from on-board
