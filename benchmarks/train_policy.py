@@ -128,8 +128,9 @@ def plot_curve(curve_csv: Path, png: Path) -> Path:
     c = pd.read_csv(curve_csv)
     fig, ax = plt.subplots(figsize=(7.0, 3.6), constrained_layout=True)
     batch = c.dropna(subset=["batch_score"])
-    ax.plot(batch["generation"], batch["batch_score"].rolling(10, min_periods=1).mean(),
-            color="0.6", lw=1, label="training batch: mean score, 1 a success + 0.1 exp(-lost/m) (10-gen. mean)")  # fmt: skip
+    label = "training batch: mean score, 1 a success + 0.1 exp(-lost/m) (10-gen. mean)"
+    score = batch["batch_score"].rolling(10, min_periods=1).mean()
+    ax.plot(batch["generation"], score, color="0.6", lw=1, label=label)
     check = c.dropna(subset=["check_success"])
     ax.plot(check["generation"], check["check_success"], "o-", color="C0", ms=3,
             label="check set (600 trials): success")  # fmt: skip
