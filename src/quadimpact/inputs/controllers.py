@@ -173,8 +173,9 @@ class RecoveryParams(BaseModel):
     )
     policy: str | None = Field(
         None,
-        description="A learned residual on the law after the detection: 'learned' (the policy "
-        "shipped with quadimpact) or a .npz policy file; None: the law alone.",
+        description="A learned residual on the law from the detection to the recovery: "
+        "'learned' (the policy shipped with quadimpact) or a .npz policy file; None: the law "
+        "alone.",
     )
 
     @field_validator("policy")

@@ -1,8 +1,8 @@
 """Learned recovery policies: the residual network's weights in a ``.npz`` file.
 
 A policy file holds the arrays of the residual network that corrects the
-recovery law after the detection (``core/controllers/residual.py``, docs/LEARNING.md
-section 12)::
+recovery law from the detection to the recovery (``core/controllers/residual.py``,
+docs/LEARNING.md section 12)::
 
     w1 (nh, 24)   b1 (nh,)   w2 (3, nh)   b2 (3,)
     thrust_scale ()    the largest thrust correction, a fraction of m g
