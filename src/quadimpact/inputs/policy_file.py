@@ -228,8 +228,11 @@ def initial_policy(
 ) -> PolicyWeights:
     """A new policy that flies the law exactly: random ``w1`` (scale 1/sqrt(24)), a zero
     output layer (``seed``: of ``w1``'s draw; the scales as :class:`PolicyWeights`')."""
-    if not 1 <= hidden <= MAX_HIDDEN or not math.isfinite(thrust_scale):
+    if not 1 <= hidden <= MAX_HIDDEN:
         raise InputError(f"policy: hidden: must be in 1..{MAX_HIDDEN} (got {hidden})")
+    for name, value in (("thrust_scale", thrust_scale), ("rate_scale_rad_s", rate_scale_rad_s)):
+        if not (math.isfinite(value) and value >= 0):
+            raise InputError(f"policy: {name}: must be finite and >= 0 (got {value})")
     rng = np.random.default_rng(seed)
     p = PolicyWeights(
         rng.normal(0.0, 1.0 / math.sqrt(N_FEATURES), (hidden, N_FEATURES)),
