@@ -28,6 +28,7 @@ import numpy as np
 
 from quadimpact.core.controller_layout import MAX_HIDDEN, N_FEATURES, N_OUTPUTS
 from quadimpact.errors import InputError, short_path
+from quadimpact.linalg import matvec
 
 __all__ = [
     "SHIPPED_POLICIES",
@@ -98,14 +99,27 @@ class PolicyWeights:
         return replace(new, meta={**self.meta, **meta}, sha256=_digest(new))
 
     def outputs(self, features: np.ndarray) -> np.ndarray:
-        """The network's three outputs in (-1, 1) for ``features`` ``(..., 24)`` (NumPy only)."""
-        h = np.tanh(np.asarray(features, dtype=float) @ self.w1.T + self.b1)
-        return np.tanh(h @ self.w2.T + self.b2)
+        """The network's three outputs in (-1, 1) for ``features`` ``(..., 24)`` (NumPy only).
+
+        The same arithmetic on every CPU (``quadimpact.linalg``'s sums in index order and
+        the C library's ``tanh``, as the compiled loop), not NumPy's vectorised kernels.
+        """
+        f = np.asarray(features, dtype=float)
+        h = _tanh(matvec(self.w1, f) + self.b1)
+        return _tanh(matvec(self.w2, h) + self.b2)
 
     def block(self) -> np.ndarray:
         """The compiled loop's block ``[nh, s_T, s_w, W1, b1, W2, b2]`` (residual.py)."""
         head = np.array([self.hidden, self.thrust_scale, self.rate_scale_rad_s], dtype=float)
         return np.concatenate([head, self.vector()])
+
+
+_tanh_object = np.frompyfunc(math.tanh, 1, 1)
+
+
+def _tanh(x: np.ndarray) -> np.ndarray:
+    """``tanh`` element by element with the C library's scalar function."""
+    return np.asarray(_tanh_object(x), dtype=float)
 
 
 def _digest(p: PolicyWeights) -> str:
