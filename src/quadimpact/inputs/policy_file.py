@@ -38,6 +38,7 @@ __all__ = [
     "load_policy",
     "policy_path",
     "policy_ref",
+    "record_policy",
     "save_policy",
 ]
 
@@ -146,6 +147,18 @@ def checked_policy(name: str) -> tuple[str, str]:
     Raises :class:`InputError` as :func:`load_policy`.
     """
     return policy_ref(name), load_policy(name).sha256
+
+
+def record_policy(options: dict[str, Any], sha256: str) -> dict[str, Any]:
+    """A study's options (``study.json``) with its policy recorded, in place: ``policy``
+    dropped when None (a study without one keeps the identity it had before policies
+    existed, so its folder resumes), else the weights' ``policy_sha256`` beside it."""
+    options.pop("_policy_sha256", None)
+    if options.get("policy") is None:
+        options.pop("policy", None)
+    else:
+        options["policy_sha256"] = sha256
+    return options
 
 
 def load_policy(name: str | Path) -> PolicyWeights:

@@ -38,7 +38,7 @@ import numpy as np
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.model import resolve_model_options
-from quadimpact.inputs.policy_file import checked_policy
+from quadimpact.inputs.policy_file import checked_policy, record_policy
 from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
@@ -356,12 +356,8 @@ class PoleStudy:
         d = asdict(self)
         d.pop("_vehicle_ref", None)
         d.pop("_obstacles", None)
-        d.pop("_policy_sha256", None)
+        record_policy(d, self._policy_sha256)
         d["obstacles"] = [dict(o) for o in self._obstacles]
-        if self.policy is None:  # as before policies existed: earlier study folders resume
-            del d["policy"]
-        else:
-            d["policy_sha256"] = self._policy_sha256
         # the sensing options only when set: a study of the ideal sensors keeps the identity
         # it had before they existed (its folder resumes)
         for name, unset in (("estimator", "ideal"), ("sensors", None)):

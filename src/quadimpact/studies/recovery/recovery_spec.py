@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING, Any
 from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
-from quadimpact.inputs.policy_file import checked_policy
+from quadimpact.inputs.policy_file import checked_policy, record_policy
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.packing.constants import RPM
 from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS
@@ -221,9 +221,5 @@ class RecoveryStudy:
         """The study's options as plain data (``study.json``)."""
         d = asdict(self)
         d.pop("_vehicle_ref", None)
-        d.pop("_policy_sha256", None)
-        if self.policy is None:  # as before policies existed: earlier study folders resume
-            d.pop("policy")
-        else:
-            d["policy_sha256"] = self._policy_sha256
+        record_policy(d, self._policy_sha256)
         return d
