@@ -130,6 +130,16 @@ def subject_from_options(
     help="Import this file or module first (repeatable): it registers a controller or an "
     "estimator, in this process and in the sweeps' worker processes.",
 )  # fmt: skip
+@click.option(
+    "--suite", "suite_version", default=None, metavar="VERSION",
+    help="The suite's version: 2 (the default: success is a held hover, sensor sets ideal and "
+    "lab) or 1 (the published criteria, sensor sets ideal and impact; its numbers unchanged).",
+)  # fmt: skip
+@click.option(
+    "--sensors", metavar="ideal,lab,...",
+    help="The sensor sets to fly, comma-separated: the suite's own by default; suite 2 also "
+    "flies impact (an IMU alone) when named.",
+)  # fmt: skip
 @click.option("--name", metavar="NAME", help="The benchmarked row's name in every output.")
 @click.option(
     "--no-references", is_flag=True,
@@ -154,6 +164,8 @@ def benchmark(
     estimator: str | None,
     policy: str | None,
     plugins: tuple[str, ...],
+    suite_version: str | None,
+    sensors: str | None,
     name: str | None,
     no_references: bool,
     cache: Path | None,
@@ -169,15 +181,19 @@ def benchmark(
     Monte Carlo of wall impacts (10,000 trials; --quick 1,000); pole, the
     authors' pole grid (3,266 points; --quick 240); edge, the same grid against
     the vertical edge of a 1 m x 1 m pillar; each with the ideal sensors and
-    with the impact sensors and a state estimator (ekf unless --estimator).
+    with the lab sensors (an IMU, a magnetometer, motion capture) and a state
+    estimator (ekf unless --estimator). Success (suite 2) is a held hover:
+    slow, level, not turning and touching nothing for 0.5 s, with less than
+    2 m of height lost and the ground untouched.
     The thing benchmarked (by default the default law) flies beside the
     reference rows (the default law, classic, recovery-replica, pole-replica,
     the baseline without recovery; read from the cache when computed before
     by this version) and the authors' published figures. Writes
     DIR/benchmark.csv (and .parquet): per row, task and sensor set the
-    success with its 95 % Wilson interval, the times to recover and to hover,
-    the height lost, the drift (p50, p90), missed and false detections and
-    the CPU time; DIR/report.md with the leaderboard; DIR/leaderboard.png.
+    success with its 95 % interval, its paired difference to the default row,
+    the published criterion, the time and distance to the hover, the height
+    lost (p50, p90), missed and false detections and the CPU time;
+    DIR/report.md with the leaderboard; DIR/leaderboard.png.
     The suite's version is in every output. Resumable and distributed like
     every sweep.
 
@@ -207,16 +223,19 @@ def benchmark(
         study_folder,
     )
     from quadimpact.studies.benchmark.cells import default_cache
-    from quadimpact.studies.benchmark.suite import parse_tasks
+    from quadimpact.studies.benchmark.suite import SUITE_VERSION, parse_sensor_sets, parse_tasks
 
     subject = subject_from_options(
         name=name, controller=controller, model=model,
         params=_parse_options(params, "--param") if params else None, estimator=estimator,
         policy=policy,
     )  # fmt: skip
+    version = suite_version or SUITE_VERSION
+    sets = None if sensors is None else parse_sensor_sets(sensors, version)
     study = BenchmarkStudy(
-        subject=subject, quick=quick, tasks=parse_tasks(tasks), references=not no_references
-    )
+        subject=subject, quick=quick, tasks=parse_tasks(tasks), references=not no_references,
+        suite=version, sensors=sets,
+    )  # fmt: skip
     study_folder(study, out).check()  # another benchmark, or other options: refused at once
     from quadimpact.sweep.runner import warm_pool
 
@@ -243,7 +262,7 @@ def _summary(result: Any) -> str:
         )
     n_run = sum(c["source"] == "run" for c in result.cells)
     return "\n".join([
-        f"benchmarked {result.cells[0]['row']}:",
+        f"benchmarked {result.cells[0]['row']} (suite {t['suite_version'].iloc[0]}):",
         *rows,
         f"cells     {len(result.cells)} ({n_run} run now, the others from the cache or shared)",
         f"table     {result.out_dir / 'benchmark.csv'}",

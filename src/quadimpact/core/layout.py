@@ -637,6 +637,12 @@ ST_HOVER_RUN_T = _st.slot("ST_HOVER_RUN_T")  # s, first tick of the hover condit
 ST_T_HOVER = _st.slot("ST_T_HOVER")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
 ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion (EX_*)
 ST_X_LAST = _st.slot("ST_X_LAST", NX)  # the state of the last output sample
+# the held hover of the benchmark's suite 2 (core/hover_tracking.py track_held_hover)
+ST_HELD_RUN_T = _st.slot("ST_HELD_RUN_T")  # s, first tick of the held-hover condition's run (NaN)
+ST_HELD_RUN_X = _st.slot("ST_HELD_RUN_X", 3)  # m, CM position at that tick, inertial
+ST_T_HELD = _st.slot("ST_T_HELD")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
+ST_HELD_X = _st.slot("ST_HELD_X", 3)  # m, CM position there (the hover point), inertial
+ST_LAST_ONSET_T = _st.slot("ST_LAST_ONSET_T")  # s, the latest contact onset, any shape (NaN)
 NSTAT = _st.end("NSTAT")
 
 

@@ -51,6 +51,7 @@ from quadimpact.core.layout import (
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
     ST_EXCURSION,
+    ST_LAST_ONSET_T,
     ST_MAX_RATE,
     ST_MIN_ALT,
     ST_MIN_TILT_COS,
@@ -156,6 +157,7 @@ def open_episode(c: int, t: float, gd: float, m: Model, d: Data, o: Output, w: W
     cs[c, CS_ACTIVE] = 1.0
     cs[c, CS_LAMBDA] = pair_damping(m, c, gd, m.opts[O_V_MIN])
     impact_onset(t, m.scfg, stats)  # the IMU's impact disturbance (off unless configured)
+    stats[ST_LAST_ONSET_T] = t
     n_ep = int(stats[ST_N_EPISODES])
     if n_ep < episodes.shape[0]:
         rotation_matrix(d.x[X_QUAT : X_QUAT + 4], w.C)

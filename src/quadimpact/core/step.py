@@ -8,7 +8,7 @@ Per control tick ``t_k = t0 + k dt`` (``dt = opts[O_DT_CONTROL]``, 5 ms),
 2. estimation: the state estimate into the measurement record
    (``estimators``; the IMU samples up to and including ``t_k`` are already in
    it, taken and filtered by the sensor stage ``sensors/stage.py`` during the
-   last interval); the time-to-hover test on the true state (``hover.py``);
+   last interval); the hover tests on the true state (``hover_tracking.py``);
 3. the controller (``controllers/``), or an external command set in
    ``ls[LS_EXT_CMD]`` (from Python, a learning agent...); its stage is recorded;
 4. actuators: limits, slew, the rotor inputs of the interval, then the
@@ -35,7 +35,7 @@ from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.controllers import builtin_step
 from quadimpact.core.estimators import at_tick, init_estimate
 from quadimpact.core.excursion import excursion_start
-from quadimpact.core.hover_tracking import track_hover
+from quadimpact.core.hover_tracking import track_held_hover, track_hover
 from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
 from quadimpact.core.layout import (
     C_PHI_REF,
@@ -85,8 +85,10 @@ from quadimpact.core.layout import (
     SS_NEXT_T,
     ST_CRASH_T,
     ST_EXCURSION,
+    ST_HELD_RUN_T,
     ST_HOVER_RUN_T,
     ST_IMPACT_T,
+    ST_LAST_ONSET_T,
     ST_MAX_DELTA,
     ST_MIN_ALT,
     ST_MIN_TILT_COS,
@@ -100,6 +102,7 @@ from quadimpact.core.layout import (
     ST_STATUS,
     ST_T_DETECT,
     ST_T_END,
+    ST_T_HELD,
     ST_T_HOVER,
     STATUS_COMPLETED,
     STATUS_CRASHED,
@@ -130,7 +133,7 @@ def start(m: Model, d: Data, o: Output) -> None:
     stats[:] = 0.0
     for i in (ST_CRASH_T, ST_ONSET_T, ST_POWER_OFF_T, ST_T_DETECT):
         stats[i] = np.nan
-    for i in (ST_IMPACT_T, ST_HOVER_RUN_T, ST_T_HOVER):
+    for i in (ST_IMPACT_T, ST_HOVER_RUN_T, ST_T_HOVER, ST_HELD_RUN_T, ST_T_HELD, ST_LAST_ONSET_T):
         stats[i] = np.nan
     stats[ST_STAGE_T : ST_STAGE_T + N_STAGES] = np.nan
     stats[ST_T_END] = t0
@@ -251,6 +254,7 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
         return
     at_tick(t_k, m, d)
     track_hover(t_k, d.x, o.stats)
+    track_held_hover(t_k, d.x, d.cs, o.stats)
     _command(t_k, m, d, o, w)
     apply_command(w.cmd, d.x, d.rin, m.opts, dt_c, ls[LS_PO_ACTIVE] > 0.5)
     cut_step(m, d)

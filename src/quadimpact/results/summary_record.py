@@ -325,6 +325,21 @@ class RecoveryPart(Part):
         "detection to the first tick from which the true speed < 0.2 m/s and tilt < 5° "
         "hold for 0.5 s",
     )
+    held_hover: bool = metric(
+        "b",
+        "",
+        "a held hover after the first obstacle contact: true speed < 0.2 m/s, tilt < 5°, "
+        "body rate < 20°/s and no contact, for 0.5 s (benchmark suite 2)",
+    )
+    time_to_held_hover_s: float = metric(
+        "f", "s", "first obstacle contact to the start of the held hover"
+    )
+    held_hover_distance_m: float = metric(
+        "f", "m", "horizontal distance from the CM at the first obstacle contact to the hover point"
+    )
+    touched_after_hover: bool = metric(
+        "b", "", "a contact began at or after the start of the held hover"
+    )
     height_loss_stage2_m: float = metric("f", "m", "altitude at detection minus at stage 2 entry")
     height_loss_stage3_m: float = metric("f", "m", "altitude at detection minus at stage 3 entry")
     height_loss_m: float = metric("f", "m", "altitude at detection minus at stage 4 entry")

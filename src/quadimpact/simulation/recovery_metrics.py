@@ -230,7 +230,35 @@ def _detection_metrics(st: np.ndarray, final_state: np.ndarray) -> dict[str, Any
         out[f"t_stage{k}_s"] = _finite(stage_t[k])
     out["recovered"] = bool(math.isfinite(stage_t[RECOVERED_STAGE]))
     out["impacts_after_detection"] = 0
+    out.update(held_hover_metrics(st))
     return out
+
+
+def held_hover_metrics(st: np.ndarray) -> dict[str, Any]:
+    """The held hover of the benchmark's suite 2 (``core/hover_tracking.py``) from the stats.
+
+    Returns
+    -------
+    dict
+        ``held_hover`` (bool), ``time_to_held_hover_s`` (s, from the first
+        obstacle contact), ``held_hover_distance_m`` (m, horizontal, from the CM
+        at the first obstacle contact to the hover point) and
+        ``touched_after_hover`` (bool: a contact onset at or after the hover's
+        start); the floats None without a held hover.
+    """
+    t_held = float(st[L.ST_T_HELD])
+    if not math.isfinite(t_held):
+        return {"held_hover": False, "time_to_held_hover_s": None,
+                "held_hover_distance_m": None, "touched_after_hover": False}  # fmt: skip
+    onset = st[L.ST_ONSET_X + L.X_POS : L.ST_ONSET_X + L.X_POS + 2]
+    held = st[L.ST_HELD_X : L.ST_HELD_X + 2]
+    last_onset = float(st[L.ST_LAST_ONSET_T])
+    return {
+        "held_hover": True,
+        "time_to_held_hover_s": t_held - float(st[L.ST_ONSET_T]),
+        "held_hover_distance_m": math.hypot(held[0] - onset[0], held[1] - onset[1]),
+        "touched_after_hover": bool(math.isfinite(last_onset) and last_onset >= t_held),
+    }
 
 
 def _normal_error_deg(st: np.ndarray, first: tuple[int, np.ndarray] | None) -> float | None:

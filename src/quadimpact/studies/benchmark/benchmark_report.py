@@ -22,75 +22,107 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
-from quadimpact.studies.benchmark.suite import SENSOR_SETS, SUITE_VERSION, TASKS
+from quadimpact.studies.benchmark.suite import SENSOR_SET_DEFS, TASKS
 from quadimpact.studies.statistics import percent, rate, rate_text
 
 __all__ = ["FIGURES", "leaderboard_figure", "render_report", "write_figures"]
 
 FIGURES = ("leaderboard.png",)
-MARKERS = {"ideal": "o", "impact": "s"}
+MARKERS = ("o", "s", "D", "^")  # by the sensor set's place in the suite's order
 
 
-def _ranked_rows(part: pd.DataFrame) -> list[str]:
-    """A task's rows, best first by the ``ideal`` success (a row without it last)."""
-    ideal = part[part["sensors"] == "ideal"].set_index("row")["success"]
+def _ranked_rows(part: pd.DataFrame, first: str = "ideal") -> list[str]:
+    """A task's rows, best first by the success with the sensor set ``first`` (a row
+    without it last)."""
+    lines = part[(part["sensors"] == first) & (part["source"] != "published")]
+    best = lines.set_index("row")["success"].fillna(-1.0)
     rows = list(dict.fromkeys(part["row"]))
-    return sorted(rows, key=lambda r: -float(ideal.get(r, -1.0)))
+    return sorted(rows, key=lambda r: -float(best.get(r, -1.0)))
 
 
 def _shown_success(line: pd.Series) -> bool:
     """Whether a line's success means something: a row that never declares recovery has
-    none on the wall (its criterion is the declared stage 4)."""
+    none on the wall in suite 1 (its criterion is the declared stage 4)."""
     return not (
-        line.get("task") == "wall"
+        str(line.get("suite_version")) == "1"
+        and line.get("task") == "wall"
         and line.get("source") != "published"
         and line.get("declares_recovery") is False
     )
 
 
-def leaderboard_figure(table: pd.DataFrame, tasks: tuple[str, ...]) -> Any:
-    """Success with 95 % intervals, row by row, one panel per task."""
+def leaderboard_figure(table: pd.DataFrame, study: Any) -> Any:
+    """Success with 95 % intervals, row by row, one panel per task.
+
+    The benchmarked row is shaded and named in bold; a row with no success says
+    why beside its axis; the legend sits below the panels, off the markers.
+    """
     from quadimpact.results.figures import new_figure
 
+    tasks, sets = study.tasks, study.sensor_sets()
+    held = study.definition.held_hover
     n_rows = max(len(set(table[table["task"] == t]["row"])) for t in tasks)
-    fig = new_figure(4.2 * len(tasks), 0.9 + 0.42 * n_rows)
+    fig = new_figure(4.4 * len(tasks), 1.6 + 0.42 * n_rows)
     axes = fig.subplots(1, len(tasks), squeeze=False)[0]
+    handles: dict[str, Any] = {}
     for ax, name in zip(axes, tasks, strict=True):
         part = table[table["task"] == name]
-        rows = _ranked_rows(part)
+        rows = _ranked_rows(part, sets[0])
         for y, row in enumerate(rows):
-            for k, sensors in enumerate(SENSOR_SETS):
-                line = part[(part["row"] == row) & (part["sensors"] == sensors)]
+            if row == study.subject.name:
+                ax.axhspan(y - 0.45, y + 0.45, color="C1", alpha=0.12, lw=0)
+            empty = True
+            for k, sensors in enumerate((*sets, "published")):
+                line = part[
+                    (part["row"] == row) & (part["sensors"] == sensors)
+                    & (part["source"] != "published")
+                ]  # fmt: skip
+                if sensors == "published":
+                    line = part[(part["row"] == row) & (part["source"] == "published")]
                 if line.empty or not _shown_success(line.iloc[0]):
                     continue
                 s = line.iloc[0]
                 published = s["source"] == "published"
-                x = 100 * s["success"]
-                err = [[x - 100 * s["success_low"]], [100 * s["success_high"] - x]]
-                ax.errorbar(
-                    x, y + (0.15 if k else -0.15), xerr=err, capsize=2,
-                    fmt="*" if published else MARKERS[sensors],
-                    color="0.4" if published else f"C{k}",
-                    mfc="white" if sensors == "impact" else None,
-                    label=("published" if published else sensors) if y == 0 else None,
+                key = "published_success" if published and held else "success"
+                x = 100 * s[key]
+                if not np.isfinite(x):
+                    continue
+                empty = empty and x == 0.0
+                err = [[x - 100 * s[f"{key}_low"]], [100 * s[f"{key}_high"] - x]]
+                dy = 0.0 if published else 0.3 * (k - (len(sets) - 1) / 2)
+                label = (
+                    ("published (their criterion)" if held else "published") if published
+                    else sensors
                 )  # fmt: skip
+                h = ax.errorbar(
+                    x, y + dy, xerr=err, capsize=2,
+                    fmt="*" if published else MARKERS[k % len(MARKERS)],
+                    color="0.4" if published else f"C{k}", mfc="white" if k else None,
+                )  # fmt: skip
+                handles.setdefault(label, h)
+            if empty and held:
+                ax.annotate("no held hover", (0.98, y), xycoords=("axes fraction", "data"),
+                            ha="right", va="center", fontsize="small", color="0.3")  # fmt: skip
         ax.set_yticks(range(len(rows)), rows)
+        for tick in ax.get_yticklabels():
+            if tick.get_text() == study.subject.name:
+                tick.set_fontweight("bold")
         ax.invert_yaxis()
-        ax.set_xlabel("success, % (95 % Wilson)")
+        ax.set_xlim(-2, 102)
+        ax.set_xlabel("success, % (95 % interval)")
         ax.set_title(name)
         ax.grid(axis="x", alpha=0.3)
-    handles = {}
-    for ax in axes:
-        for h, label in zip(*ax.get_legend_handles_labels(), strict=True):
-            handles.setdefault(label, h)
-    axes[-1].legend(handles.values(), handles.keys(), loc="lower left", fontsize="small")
-    fig.suptitle(f"quadimpact benchmark, suite {SUITE_VERSION}")
+    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=len(handles),
+               fontsize="small", frameon=False)  # fmt: skip
+    what = "a held hover" if held else "the published criteria"
+    fig.suptitle(f"quadimpact benchmark, suite {study.suite}: success is {what}")
     return fig
 
 
@@ -98,7 +130,7 @@ def write_figures(table: pd.DataFrame, out: Path, study: Any) -> list[Path]:
     """``leaderboard.png`` into ``out``."""
     from quadimpact.results.figures import save_figure
 
-    return [save_figure(leaderboard_figure(table, study.tasks), out / FIGURES[0])]
+    return [save_figure(leaderboard_figure(table, study), out / FIGURES[0])]
 
 
 # ------------------------------------------------------------------- text
@@ -117,7 +149,9 @@ def _success_text(line: pd.Series) -> str:
                       "high": line["success_high"]})  # fmt: skip
 
 
-def _leaderboard(table: pd.DataFrame, name: str, subject: str) -> list[str]:
+def _leaderboard(table: pd.DataFrame, name: str, subject: str, study: Any) -> list[str]:
+    if study.definition.held_hover:
+        return _held_leaderboard(table, name, subject, study)
     part = table[table["task"] == name]
     lines = [
         "| row | sensors | success [95 %] | impact − ideal (points) | time to recover p50 / p90 "
@@ -149,6 +183,74 @@ def _leaderboard(table: pd.DataFrame, name: str, subject: str) -> list[str]:
     return lines
 
 
+def _share_text(line: pd.Series, key: str) -> str:
+    value = line.get(key)
+    if value is None or not math.isfinite(float(value)):
+        return "–"
+    return f"{percent(value)} [{percent(line[f'{key}_low'])}, {percent(line[f'{key}_high'])}]"
+
+
+def _versus_default(line: pd.Series) -> str:
+    """The row minus the default, points, with its 95 % interval (and whether resolved)."""
+    d = line.get("vs_default")
+    if d is None or not math.isfinite(float(d)):
+        return "–"
+    mark = "" if bool(line.get("vs_default_resolved")) else " (not resolved)"
+    return f"{d:+.1f} [{line['vs_default_low']:+.1f}, {line['vs_default_high']:+.1f}]{mark}"
+
+
+def _held_leaderboard(table: pd.DataFrame, name: str, subject: str, study: Any) -> list[str]:
+    """Suite 2's table of a task: ranked by the success with the first sensor set."""
+    part = table[table["task"] == name]
+    lines = [
+        "| row | sensors | success [95 %] | − default, points [95 %] | published criterion "
+        "[95 %] | time to hover p50 / p90 (s) | distance to hover p50 / p90 (m) | height lost "
+        "p50 / p90 (m) | missed / false detections | excluded | CPU per trial (ms) | source |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for row in _ranked_rows(part, study.sensor_sets()[0]):
+        label = f"**{row}**" if row == subject else row
+        for _, line in part[part["row"] == row].iterrows():
+            if line["source"] == "published":
+                lines.append(f"| {label} | – | – | – | {_share_text(line, 'published_success')} "
+                             f"| | | | | | | published: {line['note']} |")  # fmt: skip
+                continue
+            success = _share_text(line, "success")
+            if int(line["success_k"]) == 0:
+                success += " (no held hover)"
+            lines.append(
+                f"| {label} | {line['sensors']} ({line['estimator']}) | {success} | "
+                f"{_versus_default(line)} | {_share_text(line, 'published_success')} | "
+                f"{_pair(line, 'hover', 's', 2)} | {_pair(line, 'hover_distance', 'm', 2)} | "
+                f"{_pair(line, 'height_lost', 'm', 2)} | {int(line['missed_detections'])} / "
+                f"{int(line['false_detections'])} | {int(line['excluded'])} | "
+                f"{line['cpu_ms_per_trial']:.1f} | {line['source']} |"
+            )
+    return lines
+
+
+def _resolution(table: pd.DataFrame) -> list[str]:
+    """What the suite resolves: per task and sensor set, the half-widths of the rows'
+    paired intervals to the default (the smallest difference it tells apart)."""
+    if "vs_default" not in table:
+        return []
+    part = table[table["vs_default"].notna()]
+    if part.empty:
+        return []
+    lines = [
+        "| task | sensors | trials | paired interval half-width, points: min / median / max "
+        "| differences resolved |",
+        "|---|---|---|---|---|",
+    ]
+    for (task, sensors), g in part.groupby(["task", "sensors"], sort=False):
+        half = (g["vs_default_high"] - g["vs_default_low"]).to_numpy(dtype=float) / 2
+        resolved = int(g["vs_default_resolved"].astype(bool).sum())
+        spread = f"{half.min():.1f} / {np.median(half):.1f} / {half.max():.1f}"
+        lines.append(f"| {task} | {sensors} | {int(g['valid'].max())} | {spread} | "
+                     f"{resolved} of {len(g)} |")  # fmt: skip
+    return lines
+
+
 def _cell(out: Path, row: str, task: str, sensors: str) -> pd.DataFrame | None:
     path = out / "cells" / row / f"{task}-{sensors}.parquet"
     return pd.read_parquet(path) if path.is_file() else None
@@ -164,7 +266,7 @@ def _versus(out: Path, study: Any, table: pd.DataFrame) -> list[str]:
     ]
     rows = [r for r in dict.fromkeys(table["row"]) if r != subject]
     for name in study.tasks:
-        for sensors in SENSOR_SETS:
+        for sensors in study.sensor_sets():
             mine = _cell(out, subject, name, sensors)
             for ref in rows:
                 theirs = _cell(out, ref, name, sensors)
@@ -179,15 +281,20 @@ def _versus(out: Path, study: Any, table: pd.DataFrame) -> list[str]:
     return lines
 
 
+def _bin_start(label: str) -> float:
+    """Where a bin starts, for sorting: ``"[-15, -5)"`` -> -15, ``"40-45"`` -> 40."""
+    match = re.match(r"[\[(]?\s*(-?\d+(?:\.\d+)?)", label)
+    return float(match.group(1)) if match else math.inf
+
+
 def _where_fails(out: Path, study: Any) -> list[str]:
     """The subject's success by inclination bin (wall) or pitch band (grids), ideal sensors."""
-    from quadimpact.studies.pole.pole_study import pitch_bands
-    from quadimpact.studies.recovery.recovery_analysis import INCLINATION_BIN, binned
+    from quadimpact.studies.trial_analysis import INCLINATION_BIN, binned, pitch_bands
 
     lines: list[str] = []
     for name in study.tasks:
         cols: dict[str, pd.DataFrame] = {}
-        for sensors in SENSOR_SETS:
+        for sensors in study.sensor_sets():
             t = _cell(out, study.subject.name, name, sensors)
             if t is None:
                 continue
@@ -201,9 +308,7 @@ def _where_fails(out: Path, study: Any) -> list[str]:
         if not cols:
             continue
         first = next(iter(cols.values()))
-        keys = list(dict.fromkeys(first["key"]))
-        if name != "wall":
-            keys.sort(key=lambda b: float(b.split("-")[0]))
+        keys = sorted(dict.fromkeys(first["key"]), key=_bin_start)
         what = "inclination toward the wall (deg)" if name == "wall" else "abs(pitch) (deg)"
         lines += [f"**{name}**, by {what}:", "", "| bin | " + " | ".join(cols) + " |",
                   "|---|" + "---|" * len(cols)]  # fmt: skip
@@ -239,21 +344,18 @@ def render_report(
         f"{t} ({TASKS[t].size(study.quick):,} {'trials' if TASKS[t].kind == 'wall' else 'points'})"
         for t in study.tasks
     )
+    suite = study.definition
+    sets = study.sensor_sets()
+    set_words = "; ".join(f"`{n}`: {SENSOR_SET_DEFS[n].title}" for n in sets)
     lines = [
         f"# quadimpact benchmark: {s.name}",
         "",
-        f"Suite {SUITE_VERSION}{' (quick)' if study.quick else ''}, quadimpact "
-        f"{description['quadimpact_version']}. Benchmarked: **{s.name}**, {what}; with the "
-        f"`impact` sensors it reads the `{s.estimator}` estimator. Tasks: {sizes}; each with "
-        "the `ideal` sensors (the true state) and with the `impact` sensors (noisy IMU, its "
-        "impact disturbance and bias walk) and a state estimator (docs/BENCHMARK.md).",
+        f"Suite {suite.version}{' (quick)' if study.quick else ''}, quadimpact "
+        f"{description['quadimpact_version']}. Benchmarked: **{s.name}**, {what}. Tasks: "
+        f"{sizes}. Sensor sets: {set_words}; the sets of real sensors read the "
+        f"`{s.estimator}` estimator (docs/BENCHMARK.md).",
         "",
-        "Success: " + "; ".join(f"{t}: {TASKS[t].success}" for t in study.tasks) + ". "
-        "Time to recover: the detection to the declared recovery (stage 4), of the "
-        "successes. Hover: the true CM speed below 0.2 m/s and the tilt below 5 deg for "
-        "0.5 s (the share of the valid trials that get there, and when). Height lost: "
-        "the altitude at the start minus at the end of the run, of the valid trials. "
-        "Drift: the detection to the declared recovery, horizontal, of the successes.",
+        *_criterion_words(study),
         "",
         *(
             [
@@ -270,7 +372,21 @@ def render_report(
         "",
     ]
     for name in study.tasks:
-        lines += [f"### {name}: {TASKS[name].title}", "", *_leaderboard(table, name, s.name), ""]
+        lines += [f"### {name}: {TASKS[name].title}", "",
+                  *_leaderboard(table, name, s.name, study), ""]  # fmt: skip
+    resolution = _resolution(table)
+    if resolution:
+        lines += [
+            "## What the suite resolves",
+            "",
+            "Each row's difference to the `default` row is paired: the same trials, flown by "
+            "both. Its 95 % interval is Newcombe's for paired shares. A difference whose "
+            "interval contains 0 is not resolved: the suite cannot tell the two rows apart. "
+            "The half-width of the intervals is the smallest difference this suite resolves.",
+            "",
+            *resolution,
+            "",
+        ]
     if study.references:
         lines += [
             f"## {s.name} against each reference, trial by trial",
@@ -291,3 +407,32 @@ def render_report(
               "(cells read from the cache took none; their sweep times are those of the run "
               "that computed them).", ""]  # fmt: skip
     return "\n".join(lines)
+
+
+def _criterion_words(study: Any) -> list[str]:
+    """The report's paragraph on what success means in the suite flown."""
+    suite = study.definition
+    if not suite.held_hover:
+        return [
+            "Success: " + "; ".join(f"{t}: {TASKS[t].success}" for t in study.tasks) + ". "
+            "Time to recover: the detection to the declared recovery (stage 4), of the "
+            "successes. Hover: the true CM speed below 0.2 m/s and the tilt below 5 deg for "
+            "0.5 s (the share of the valid trials that get there, and when). Height lost: "
+            "the altitude at the start minus at the end of the run, of the valid trials. "
+            "Drift: the detection to the declared recovery, horizontal, of the successes."
+        ]
+    from quadimpact.studies.benchmark.suite import HELD_HOVER_SUCCESS
+
+    words = [
+        f"Success, the same for every task: {HELD_HOVER_SUCCESS}. Each trial runs "
+        f"{suite.final_time_s:g} s, over a ground that ends it when touched. The published "
+        "criterion of each task is kept beside it, to set rows against the authors' figures. "
+        "Time to hover: from the first contact to the start of the held hover, of the "
+        "successes. Distance to hover: horizontal, from the CM at the first contact to the "
+        "hover point, of the successes. Height lost: the altitude at the start minus the "
+        "lowest, of the valid trials."
+    ]
+    unflown = [n for n in suite.extra_sensor_sets if n not in study.sensor_sets()]
+    if unflown:
+        words += ["", f"Not on this leaderboard: {suite.extra_note}."]
+    return words

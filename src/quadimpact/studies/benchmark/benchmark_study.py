@@ -43,7 +43,14 @@ from quadimpact.studies.benchmark.cells import (
     code_digest,
 )
 from quadimpact.studies.benchmark.subject import PUBLISHED, REFERENCES, Subject
-from quadimpact.studies.benchmark.suite import SENSOR_SETS, SUITE_VERSION, TASKS, sensor_set
+from quadimpact.studies.benchmark.suite import (
+    SUITE_VERSION,
+    TASKS,
+    Suite,
+    parse_sensor_sets,
+    sensor_set,
+    suite,
+)
 from quadimpact.studies.study_folder import StudyFolder, describe_run
 
 if TYPE_CHECKING:
@@ -74,6 +81,12 @@ class BenchmarkStudy:
     limit : int or None
         Only the first ``limit`` trials or points of each task: a smoke test,
         not a benchmark (every output says so).
+    suite : str
+        The suite's version (default the latest, :data:`SUITE_VERSION`): ``"1"``
+        counts the published criteria, ``"2"`` the held hover.
+    sensors : tuple of str or None
+        The sensor sets flown (None: the suite's own; an extra set of the
+        suite, such as suite 2's ``impact``, only when named).
     """
 
     subject: Subject = field(default_factory=lambda: Subject("default"))
@@ -81,8 +94,14 @@ class BenchmarkStudy:
     tasks: tuple[str, ...] = tuple(TASKS)
     references: bool = True
     limit: int | None = None
+    suite: str = SUITE_VERSION
+    sensors: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "suite", suite(self.suite).version)
+        if self.sensors is not None:
+            names = parse_sensor_sets(",".join(self.sensors), self.suite)
+            object.__setattr__(self, "sensors", names)
         if self.limit is not None and (isinstance(self.limit, bool) or self.limit < 1):
             raise InputError(f"limit: must be an integer >= 1 (got {self.limit!r})")
         if not self.tasks:
@@ -91,6 +110,15 @@ class BenchmarkStudy:
             if name not in TASKS:
                 raise InputError(f"--tasks: unknown task {name!r} (the suite's: "
                                  f"{', '.join(TASKS)})")  # fmt: skip
+
+    @property
+    def definition(self) -> Suite:
+        """The suite flown."""
+        return suite(self.suite)
+
+    def sensor_sets(self) -> tuple[str, ...]:
+        """The sensor sets flown, in table order."""
+        return self.sensors if self.sensors is not None else self.definition.sensor_sets
 
     def rows(self) -> list[Subject]:
         """The subject, then the reference rows (one the subject stands for is left out)."""
@@ -102,7 +130,8 @@ class BenchmarkStudy:
     def identity(self) -> dict[str, Any]:
         """What decides the benchmark's runs (``study.json``; a rerun resumes only the same)."""
         return {
-            "suite_version": SUITE_VERSION,
+            "suite_version": self.suite,
+            **({"sensors": list(self.sensors)} if self.sensors is not None else {}),
             "quick": self.quick,
             "tasks": list(self.tasks),
             "references": self.references,
@@ -124,7 +153,8 @@ class BenchmarkResult:
 
 
 _FLAGS = {"quick": "--quick", "tasks": "--tasks", "references": "--no-references",
-          "subject": "the thing benchmarked"}  # fmt: skip
+          "subject": "the thing benchmarked", "suite_version": "--suite",
+          "sensors": "--sensors"}  # fmt: skip
 
 
 def study_folder(study: BenchmarkStudy, out_dir: str | os.PathLike[str]) -> StudyFolder:
@@ -174,12 +204,14 @@ def run_benchmark(
     store = CellCache(cache)
     done: dict[str, tuple[pd.DataFrame, dict[str, Any]]] = {}  # by key: run or read once
     cells: list[dict[str, Any]] = []
+    tables: dict[tuple[str, str, str], pd.DataFrame] = {}  # by (row, task, sensors)
+    version = study.suite
     for row in study.rows():
         for task_name in study.tasks:
             task = TASKS[task_name]
-            for sensors in SENSOR_SETS:
-                spec = row.spec(task, study.quick, sensor_set(sensors), study.limit)
-                key = cell_key(spec)
+            for sensors in study.sensor_sets():
+                spec = row.spec(task, study.quick, sensor_set(sensors), study.limit, version)
+                key = cell_key(spec, version)
                 label = f"{row.name} {task.name}/{sensors}"
                 cached = store.get(key) if row.cacheable else None
                 if key in done:
@@ -196,11 +228,11 @@ def run_benchmark(
                         spec, where / "sweep", workers=workers, scheduler=scheduler,
                         progress=progress, load=False, allow_large=allow_large,
                     )  # fmt: skip
-                    table = cell_table(read_runs(where / "sweep"), spec, task)
+                    table = cell_table(read_runs(where / "sweep"), spec, task, version)
                     facts = {
                         "source": "run", "run": describe_run(info), "key": key,
                         "quadimpact_version": __version__, "code": code_digest(),
-                        "suite_version": SUITE_VERSION,
+                        "suite_version": version,
                     }  # fmt: skip
                     if row.cacheable:
                         where_from = {"row": row.name, "task": task.name, "sensors": sensors}
@@ -214,8 +246,11 @@ def run_benchmark(
                     **row.describe(), "task": task.name, "sensors": sensors,
                     "estimator": sensor_set(sensors, row.estimator).estimator,
                     "source": source, "sweep_s": facts.get("run", {}).get("sweep_s"),
-                    **cell_numbers(table),
+                    **cell_numbers(table, version),
                 })  # fmt: skip
+                tables[(row.name, task.name, sensors)] = table
+    if study.definition.held_hover:
+        add_paired_differences(cells, tables)
     table = _benchmark_table(cells, study)
     atomic_write(out / BENCHMARK_CSV, lambda tmp: table.to_csv(tmp, index=False))
     atomic_write(out / BENCHMARK_PARQUET, lambda tmp: table.to_parquet(tmp, index=False))
@@ -223,7 +258,7 @@ def run_benchmark(
     figures = report.write_figures(table, out, study)
     description = {
         "quadimpact_version": __version__,
-        "suite_version": SUITE_VERSION,
+        "suite_version": version,
         "identity": study.identity(),
         "elapsed_s": elapsed,
         "cells": [
@@ -236,25 +271,54 @@ def run_benchmark(
     return BenchmarkResult(out, table, report_path, figures, cells, elapsed)
 
 
+def add_paired_differences(
+    cells: list[dict[str, Any]], tables: dict[tuple[str, str, str], pd.DataFrame]
+) -> None:
+    """Each cell's paired difference of success to the ``default`` row's cell on the same
+    trials (:mod:`~quadimpact.studies.benchmark.paired`): ``vs_default`` (points of
+    success, the row minus the default), ``vs_default_low``, ``vs_default_high`` (its
+    95 % interval), ``vs_default_only_row``, ``vs_default_only_default`` and
+    ``vs_default_resolved``; none for the default row or without it."""
+    from quadimpact.studies.benchmark.paired import paired_difference
+
+    for cell in cells:
+        mine = tables.get((cell["row"], cell["task"], cell["sensors"]))
+        ref = tables.get(("default", cell["task"], cell["sensors"]))
+        if cell["row"] == "default" or mine is None or ref is None or len(mine) != len(ref):
+            continue
+        both = mine["valid"].to_numpy(dtype=bool) & ref["valid"].to_numpy(dtype=bool)
+        d = paired_difference(
+            mine["success"].to_numpy(dtype=bool)[both], ref["success"].to_numpy(dtype=bool)[both]
+        )
+        cell.update({
+            "vs_default": 100 * d.difference, "vs_default_low": 100 * d.low,
+            "vs_default_high": 100 * d.high, "vs_default_only_row": d.only_first,
+            "vs_default_only_default": d.only_second, "vs_default_resolved": d.resolved,
+        })  # fmt: skip
+
+
 def _benchmark_table(cells: list[dict[str, Any]], study: BenchmarkStudy) -> pd.DataFrame:
-    """``benchmark.csv``: the cells' lines, then the authors' published figures."""
+    """``benchmark.csv``: the cells' lines, then the authors' published figures (suite 2:
+    as ``published_success``, the criterion they were measured by)."""
     import pandas as pd
 
     from quadimpact.studies.statistics import rate
 
     lines = [dict(c) for c in cells]
+    held = study.definition.held_hover
     for p in PUBLISHED:
         if p.task not in study.tasks:
             continue
         r = rate(round(p.share * p.n), p.n)
+        key = "published_success" if held else "success"
         lines.append({
             "row": p.row, "role": "published", "kind": "controller", "task": p.task,
             "sensors": "ideal", "source": "published", "note": p.source, "trials": p.n,
-            "valid": p.n, "success_k": r.k, "success": p.share, "success_low": r.low,
-            "success_high": r.high,
+            "valid": p.n, f"{key}_k": r.k, key: p.share, f"{key}_low": r.low,
+            f"{key}_high": r.high,
         })  # fmt: skip
     table = pd.DataFrame(lines)
-    table.insert(0, "suite_version", SUITE_VERSION)
+    table.insert(0, "suite_version", study.suite)
     table.insert(1, "quadimpact_version", __version__)
     table.insert(2, "quick", study.quick)
     table.insert(3, "limit", study.limit)

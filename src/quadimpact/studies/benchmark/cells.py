@@ -3,19 +3,23 @@
 A cell is a sweep (:meth:`~quadimpact.studies.benchmark.subject.Subject.spec`)
 and, once run, its **trials table** (:func:`cell_table`: one row per trial or
 grid point, the columns every metric needs, the same for every task) and its
-**numbers** (:func:`cell_numbers`, docs/BENCHMARK.md 3):
+**numbers** (:func:`cell_numbers`, docs/BENCHMARK.md 3). Suite 2's
+(:func:`held_hover_numbers`):
 
-* ``success``: the task's criterion (the wall: recovery declared and never
-  below altitude 0, over the valid trials; a grid: less than 2 m lost), with
-  its 95 % Wilson interval;
-* the times to recover (the declared stage 4, of the successes) and to hover
-  (the true CM speed below 0.2 m/s and the tilt below 5 deg for 0.5 s, of the
-  trials that get there: whatever the controller declares), p50 and p90;
-* the height lost over the run (the altitude at the start minus at the end)
-  of the valid trials and the drift (detection to the declared stage 4) of the
-  successes, p50 and p90;
+* ``success``: a held hover (the true CM speed below 0.2 m/s, the tilt below
+  5 deg, the body rate below 20 deg/s and no contact, for 0.5 s, from the first
+  obstacle contact on) with less than 2 m of height lost, the ground never
+  touched and no contact after the hover began, over the valid trials, with its
+  95 % Wilson interval; ``published_success``: the task's published criterion;
+* the time from the first contact to the hover and the horizontal distance
+  from the first contact to the hover point, of the successes, p50 and p90;
+* the height lost (the altitude at the start minus the lowest) of the valid
+  trials, p50 and p90;
 * missed detections (a contact never detected), false detections (a detection
   before any contact), failed and excluded runs, and the CPU time.
+
+Suite 1's (:func:`published_numbers`) count the published criteria
+(docs/BENCHMARK.md 8).
 
 The cache (:class:`CellCache`) keeps the tables of cells that fly only
 built-in code, keyed by the suite's version, quadimpact's version, a digest of
@@ -40,7 +44,7 @@ import numpy as np
 
 from quadimpact import __version__
 from quadimpact.results.files import atomic_write
-from quadimpact.studies.benchmark.suite import SUITE_VERSION, Task
+from quadimpact.studies.benchmark.suite import SUITE_VERSION, Suite, Task, suite
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -59,7 +63,7 @@ __all__ = [
 
 #: Environment variable naming the cache folder (else the user's cache folder).
 CACHE_ENV = "QUADIMPACT_BENCHMARK_CACHE"
-#: The per-trial columns a cell keeps (those the sweep has).
+#: The per-trial columns a cell of suite 1 keeps (those the sweep has).
 KEPT = (
     "run_id", "status", "reason", "success", "valid", "recovered", "outcome_class",
     "roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "lateral_offset_m", "seed",
@@ -67,6 +71,11 @@ KEPT = (
     "min_altitude_m", "horizontal_drift_m", "detected", "not_detected", "false_detection",
     "t_stage1_s", "max_tilt_deg", "impacts_after_detection", "cost__kernel_cpu_s",
     "cost__total_cpu_s",
+)  # fmt: skip
+#: The per-trial columns a cell of suite 2 keeps: suite 1's, the held hover's and the crash.
+KEPT_HELD = (
+    *KEPT, "published_success", "held_hover", "time_to_held_hover_s", "held_hover_distance_m",
+    "touched_after_hover", "crash_time_s", "first_contact_s", "n_steps", "n_rejected_steps",
 )  # fmt: skip
 
 
@@ -83,11 +92,11 @@ def code_digest() -> str:
     return digest.hexdigest()[:16]
 
 
-def cell_key(spec: SweepSpec) -> str:
+def cell_key(spec: SweepSpec, version: str = SUITE_VERSION) -> str:
     """The cell's cache key: the suite's version, quadimpact's, its code, and the sweep."""
     text = json.dumps(
         {
-            "suite": SUITE_VERSION,
+            "suite": version,
             "quadimpact": __version__,
             "code": code_digest(),
             "sweep": spec.fingerprint(),
@@ -97,33 +106,64 @@ def cell_key(spec: SweepSpec) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
-def cell_table(runs: pd.DataFrame, spec: SweepSpec, task: Task) -> pd.DataFrame:
+def cell_table(
+    runs: pd.DataFrame, spec: SweepSpec, task: Task, version: str = SUITE_VERSION
+) -> pd.DataFrame:
     """The cell's trials table from its sweep's rows (see the module docstring).
 
     The wall's rows go through the recovery study's table (trial inputs,
     outcome classes, its success and validity); a grid's through the pole
-    study's criterion (:func:`~quadimpact.studies.pole.pole_study.height_lost`).
+    study's criterion (:func:`~quadimpact.studies.trial_analysis.height_lost`).
+    In suite 2 ``success`` is the held hover (:func:`held_hover_success`) and
+    the published criterion is kept as ``published_success``.
     """
     import pandas as pd
 
-    if task.kind == "wall":
-        from quadimpact.studies.recovery import recovery_analysis as analysis
-        from quadimpact.studies.recovery.recovery_study import trial_table
+    from quadimpact.studies import trial_analysis as analysis
 
-        t = trial_table(runs, spec)
+    altitude = float(spec.base.get("altitude_m", 5.0))
+    if task.kind == "wall":
+        t = analysis.wall_trial_table(runs, spec)
         t["success"] = analysis.success_mask(t)
         t["valid"] = analysis.valid_mask(t)
         t["outcome_class"] = t["outcome_class"].astype(str)
-        altitude = float(spec.base.get("altitude_m", 5.0))
         final = pd.to_numeric(t["final_altitude_m"], errors="coerce").to_numpy(dtype=float)
         t["height_lost_m"] = altitude - final
     else:
-        from quadimpact.studies.pole.pole_study import height_lost
-
         t = runs.sort_values("run_id").reset_index(drop=True)
-        t["height_lost_m"], t["success"] = height_lost(t, float(spec.base["altitude_m"]))
+        t["height_lost_m"], t["success"] = analysis.height_lost(t, altitude)
         t["valid"] = True
-    return t[[c for c in KEPT if c in t.columns]].copy()
+    if not suite(version).held_hover:
+        return t[[c for c in KEPT if c in t.columns]].copy()
+    t = t.rename(columns={"integrator__steps": "n_steps",
+                          "integrator__rejected_steps": "n_rejected_steps"})  # fmt: skip
+    crashed = pd.to_numeric(t["crash_time_s"], errors="coerce").notna().to_numpy()
+    t["published_success"] = t["success"].to_numpy(dtype=bool) & ~crashed  # the ground is there
+    t["valid"] = analysis.valid_mask(t) if task.kind == "wall" else analysis.model_valid(t)
+    lowest = pd.to_numeric(t["min_altitude_m"], errors="coerce").to_numpy(dtype=float)
+    t["height_lost_m"] = altitude - lowest
+    t["success"] = held_hover_success(t)
+    return t[[c for c in KEPT_HELD if c in t.columns]].copy()
+
+
+def held_hover_success(t: pd.DataFrame) -> np.ndarray:
+    """Suite 2's success of each trial (docs/BENCHMARK.md 1.2): valid, a held hover, less
+    than 2 m of height lost, the ground never touched (no crash) and no contact once the
+    hover began. ``t`` has ``valid``, ``held_hover``, ``touched_after_hover``,
+    ``height_lost_m`` (m: the start altitude minus the lowest) and ``crash_time_s``."""
+    import pandas as pd
+
+    from quadimpact.studies.trial_analysis import SUCCESS_LOSS_M
+
+    lost = pd.to_numeric(t["height_lost_m"], errors="coerce").to_numpy(dtype=float)
+    crashed = pd.to_numeric(t["crash_time_s"], errors="coerce").notna().to_numpy()
+    return (
+        _flag(t, "valid")
+        & _flag(t, "held_hover")
+        & ~_flag(t, "touched_after_hover")
+        & (lost < SUCCESS_LOSS_M)
+        & ~crashed
+    )
 
 
 def _flag(t: pd.DataFrame, column: str) -> np.ndarray:
@@ -135,14 +175,75 @@ def _flag(t: pd.DataFrame, column: str) -> np.ndarray:
 def _spread(values: Any) -> tuple[float, float]:
     import pandas as pd
 
-    from quadimpact.studies.recovery.recovery_analysis import quantiles
+    from quadimpact.studies.trial_analysis import quantiles
 
     q = quantiles(pd.Series(np.asarray(values, dtype=float)))
     return q["median"], q["p90"]
 
 
-def cell_numbers(t: pd.DataFrame) -> dict[str, Any]:
-    """A cell's numbers (module docstring) from its trials table."""
+def _numbers(t: pd.DataFrame, name: str, mask: np.ndarray, valid: np.ndarray) -> dict[str, Any]:
+    """``name``, ``name_k``, ``name_low``, ``name_high``: the share of ``mask`` in ``valid``."""
+    from quadimpact.studies.statistics import rate
+
+    r = rate(int((mask & valid).sum()), int(valid.sum()))
+    return {f"{name}_k": r.k, name: r.value, f"{name}_low": r.low, f"{name}_high": r.high}
+
+
+def _common(t: pd.DataFrame, valid: np.ndarray) -> dict[str, Any]:
+    """The counts every suite reports: trials, validity, failures, detections, CPU."""
+    from quadimpact.results.costs import cost_ratio
+
+    cost = cost_ratio(t[t["status"] != "failed"])
+    return {
+        "trials": int(len(t)),
+        "valid": int(valid.sum()),
+        "excluded": int((~valid).sum()),
+        "failed_runs": int((t["status"] == "failed").sum()),
+        "missed_detections": int((_flag(t, "not_detected") & valid).sum()),
+        "false_detections": int((_flag(t, "false_detection") & valid).sum()),
+        "cpu_s": float(cost["total_cpu_s"]),
+        "cpu_ms_per_trial": 1e3 * cost["total_cpu_s"] / cost["runs"] if cost["runs"] else math.nan,
+    }
+
+
+def cell_numbers(t: pd.DataFrame, version: str = SUITE_VERSION) -> dict[str, Any]:
+    """A cell's numbers (module docstring) from its trials table, as suite ``version`` counts."""
+    s: Suite = suite(version)
+    return held_hover_numbers(t) if s.held_hover else published_numbers(t)
+
+
+def held_hover_numbers(t: pd.DataFrame) -> dict[str, Any]:
+    """Suite 2's numbers of a cell (module docstring)."""
+    import pandas as pd
+
+    valid = _flag(t, "valid")
+    success = _flag(t, "success") & valid
+    out: dict[str, Any] = {
+        **_common(t, valid),
+        **_numbers(t, "success", success, valid),
+        **_numbers(t, "published_success", _flag(t, "published_success"), valid),
+        **_numbers(t, "hover", _flag(t, "held_hover"), valid),
+        "declares_recovery": bool(pd.to_numeric(t["t_stage1_s"], errors="coerce").notna().any())
+        if "t_stage1_s" in t
+        else False,
+    }
+    num = {
+        c: pd.to_numeric(t[c], errors="coerce").to_numpy(dtype=float)
+        for c in ("time_to_held_hover_s", "held_hover_distance_m", "height_lost_m")
+    }
+    spreads = {
+        "hover_s": num["time_to_held_hover_s"][success],
+        "hover_distance_m": num["held_hover_distance_m"][success],
+        "height_lost_m": num["height_lost_m"][valid],
+    }
+    for name, values in spreads.items():
+        stem, unit = name.rsplit("_", 1)
+        out[f"{stem}_p50_{unit}"], out[f"{stem}_p90_{unit}"] = _spread(values)
+    return out
+
+
+def published_numbers(t: pd.DataFrame) -> dict[str, Any]:
+    """Suite 1's numbers of a cell: the published criteria (docs/BENCHMARK.md 8)."""
     import pandas as pd
 
     from quadimpact.results.costs import cost_ratio

@@ -28,8 +28,14 @@ from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import controller_entry
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import MODEL_VARIANTS
-from quadimpact.studies.benchmark.suite import DEFAULT_ESTIMATOR, SensorSet, Task
-from quadimpact.studies.pole.pole_study import recovery_arm
+from quadimpact.studies.benchmark.suite import (
+    DEFAULT_ESTIMATOR,
+    SUITE_VERSION,
+    SensorSet,
+    Task,
+    suite,
+)
+from quadimpact.studies.trial_analysis import recovery_arm
 
 if TYPE_CHECKING:
     from quadimpact.sweep import SweepSpec
@@ -82,7 +88,7 @@ class Subject:
     params : mapping
         The controller's ``[controller_params]`` (JSON-able).
     estimator : str
-        The state estimator of the ``impact`` sensor set.
+        The state estimator of every sensor set of real sensors (``impact``, ``lab``).
     policy : str or None
         A policy: a learned residual on the recovery law (``learned`` or a
         ``.npz`` file, recorded as the name or the file's absolute path), or one
@@ -190,8 +196,9 @@ class Subject:
         return fields
 
     def _sensing(self, sensing: SensorSet) -> SensorSet:
-        if sensing.name == "impact":
-            return SensorSet(sensing.name, sensing.sensors, self.estimator)
+        """The set as this row flies it: its own estimator for a set of real sensors."""
+        if sensing.sensors is not None:
+            return SensorSet(sensing.name, sensing.sensors, self.estimator, sensing.title)
         return sensing
 
     def wall_spec(self, task: Task, quick: bool, sensing: SensorSet) -> SweepSpec:
@@ -220,16 +227,32 @@ class Subject:
         return spec
 
     def spec(
-        self, task: Task, quick: bool, sensing: SensorSet, limit: int | None = None
+        self,
+        task: Task,
+        quick: bool,
+        sensing: SensorSet,
+        limit: int | None = None,
+        version: str = SUITE_VERSION,
     ) -> SweepSpec:
-        """The sweep of one task and sensor set; ``limit``: only its first runs (a smoke
-        test's: the same runs as the task's first, listed)."""
+        """The sweep of one task and sensor set in the suite ``version``; ``limit``: only
+        its first runs (a smoke test's: the same runs as the task's first, listed).
+
+        Suite 2 flies every trial for the suite's run length with the ground as a
+        contact surface whose first touch ends the run (``ground = "crash"``).
+        """
         from quadimpact.sweep import SweepSpec
 
         if task.kind == "wall":
             spec = self.wall_spec(task, quick, sensing)
         else:
             spec = self.grid_spec(task, quick, sensing)
+        s = suite(version)
+        if s.held_hover:
+            base = {**spec.base, "final_time_s": s.final_time_s, "ground": "crash"}
+            spec = SweepSpec(
+                base=base, grid=spec.grid or None, runs=spec.runs, trials=spec.trials,
+                where=spec.where,
+            )  # fmt: skip
         if limit is None or limit >= spec.n_runs:
             return spec
         runs = [spec.inputs(i) for i in range(limit)]

@@ -37,13 +37,18 @@ import numpy as np
 
 from quadimpact import __version__
 from quadimpact.errors import InputError, format_value
-from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.policy_file import checked_policy, record_policy
 from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
 from quadimpact.results.files import atomic_write
 from quadimpact.studies.study_folder import SWEEP_DIR, TRIALS_PARQUET, StudyFolder, describe_run
+from quadimpact.studies.trial_analysis import (  # the analysis the studies share, here too
+    SUCCESS_LOSS_M,
+    height_lost,
+    pitch_bands,
+    recovery_arm,
+)
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 from quadimpact.sweep.values import check_size
 
@@ -64,12 +69,8 @@ __all__ = [
     "summarise",
 ]
 
-#: Height lost over the run below which a trial is a success (the authors' criterion), m.
-SUCCESS_LOSS_M = 2.0
 #: Baseline controllers (the recovery controller flies the same until it detects).
 BASELINES = ("paper", "cascade-pid")
-#: Width of the pitch bands of the success table, deg.
-BAND_DEG = 5.0
 ARMS = ("baseline", "recovery")
 #: The default law's recovery arm, run beside the recovery arm of a variant.
 DEFAULT_LAW_ARM = "recovery-default"
@@ -86,28 +87,6 @@ def _grid(start: float, stop: float, step: float, name: str) -> list[float]:
     if n < 1:
         raise InputError(f"{name}: empty range {start:g} to {stop:g}")
     return [round(start + k * step, 9) + 0.0 for k in range(n)]
-
-
-def recovery_arm(model: str | None, baseline: str = "paper") -> dict[str, Any]:
-    """The recovery controller flying ``baseline`` until the detection, as a sweep run.
-
-    ``model``: the run's model variant (None: the sweep's base's). A variant that
-    forces a pre-impact behaviour (the pole replica's ``hold``) has it named in the
-    run, so that the table's ``model`` and ``pre_impact`` columns (the swept
-    inputs', which take the place of the summary's) are the ones in force.
-    """
-    arm: dict[str, Any] = {
-        "controller": "recovery",
-        "pre_impact": "nominal",
-        "nominal_controller": baseline,
-    }
-    if model is None:
-        return arm
-    forced = resolve_model_options(model).pre_impact
-    if forced != "scenario":
-        arm["pre_impact"] = forced
-    arm["model"] = model
-    return arm
 
 
 def checked_obstacles(items: Any, where: str) -> list[dict[str, Any]]:
@@ -369,23 +348,6 @@ class PoleStudy:
 
 
 # ------------------------------------------------------------------- tables
-def pitch_bands(abs_pitch: np.ndarray) -> list[str]:
-    """Each |pitch|'s band of :data:`BAND_DEG` (0-4, 5-9, ...), labelled by the values in it.
-
-    The largest |pitch| joins the band below when it would be alone in its own
-    (the authors' 45 deg joins 40-44: 40-45).
-    """
-    a = np.asarray(abs_pitch, dtype=float)
-    idx = np.floor(a / BAND_DEG + 1e-9).astype(int)
-    top = int(idx.max()) if idx.size else 0
-    if top > 0 and np.unique(a[idx == top]).size == 1:
-        idx[idx == top] = top - 1
-    labels = {}
-    for k in np.unique(idx):
-        values = a[idx == k]
-        lo, hi = float(values.min()), float(values.max())
-        labels[k] = f"{lo:g}-{hi:g}" if hi > lo else f"{lo:g}"
-    return [labels[k] for k in idx]
 
 
 def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
@@ -400,17 +362,6 @@ def pole_table(runs: pd.DataFrame, study: PoleStudy) -> pd.DataFrame:
     t["height_lost_m"], t["success"] = height_lost(t, study.altitude_m)
     t["pitch_band"] = pitch_bands(t["abs_pitch_deg"].to_numpy())
     return t
-
-
-def height_lost(runs: pd.DataFrame, altitude_m: float) -> tuple[np.ndarray, np.ndarray]:
-    """Each run's height lost (m: the altitude at the start minus at the end) and success
-    (less than :data:`SUCCESS_LOSS_M` lost, the run not failed)."""
-    import pandas as pd
-
-    final = pd.to_numeric(runs["final_altitude_m"], errors="coerce").to_numpy(dtype=float)
-    lost = float(altitude_m) - final
-    ok = np.isfinite(lost) & (lost < SUCCESS_LOSS_M) & (runs["status"] != "failed").to_numpy()
-    return lost, ok
 
 
 def table_arms(table: pd.DataFrame) -> tuple[str, ...]:

@@ -20,7 +20,9 @@ writes ``trials.parquet``, the figures and ``report.md``.
   motor power-off).
 """
 
-__all__ = ["DEFAULT_N", "ESTIMATORS", "IMUS", "MODELS", "PRE_IMPACTS", "SENSORS"]
+__all__ = [
+    "DEFAULT_N", "ESTIMATORS", "IMUS", "MODELS", "PRE_IMPACTS", "SENSORS", "RecoveryStudy",
+]  # fmt: skip
 
 # The study's choices, here so that the command line needs nothing heavy.
 #: Trials of a study by default.
@@ -35,3 +37,6 @@ SENSORS = ("ideal", "noisy", "impact", "indoor", "authors-2016")
 ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive")
 #: Pre-impact behaviours of the recovery controller in the study.
 PRE_IMPACTS = ("spin-down", "hold")
+
+# the study's spec, for the benchmark (after the constants it reads)
+from quadimpact.studies.recovery.recovery_spec import RecoveryStudy  # noqa: E402

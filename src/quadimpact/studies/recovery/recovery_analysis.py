@@ -53,6 +53,21 @@ import pandas as pd
 
 from quadimpact.studies.recovery.estimation_numbers import estimation_numbers
 from quadimpact.studies.statistics import rate
+from quadimpact.studies.trial_analysis import (  # the analysis the studies share, here too
+    BELOW_GROUND,
+    EXCLUDED_CLASSES,
+    INCLINATION_BIN,
+    OUTCOME_CLASSES,
+    SPEED_BIN,
+    _flag,
+    add_derived,
+    bin_edges,
+    binned,
+    outcome_class,
+    quantiles,
+    success_mask,
+    valid_mask,
+)
 
 __all__ = [
     "BELOW_GROUND",
@@ -74,25 +89,6 @@ __all__ = [
     "valid_mask",
 ]
 
-#: (width, offset) of the inclination bins, deg: edges at offset + k width.
-INCLINATION_BIN = (10.0, 5.0)
-#: (width, offset) of the speed bins, m/s.
-SPEED_BIN = (0.25, 0.0)
-#: The class of a trial that recovered but went below altitude 0 (not a success).
-BELOW_GROUND = "recovered below ground level"
-OUTCOME_CLASSES = (
-    "recovered",
-    BELOW_GROUND,
-    "not recovered",
-    "not detected",
-    "false detection",
-    "no contact",
-    "invalid: bumper model exceeded",
-    "invalid: started in contact",
-    "failed",
-)
-#: Classes left out of the rates (they say nothing of the recovery).
-EXCLUDED_CLASSES = ("invalid: started in contact", "invalid: bumper model exceeded", "failed")
 #: Tilt beyond which a vehicle has turned over (its up axis points down), deg.
 FLIP_DEG = 90.0
 #: The trial conditions, for the example trial (nearest the medians of these).
@@ -100,101 +96,9 @@ CONDITIONS = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s")
 
 
 # ------------------------------------------------------------------- bins
-def bin_edges(values: Iterable[float], width: float, offset: float = 0.0) -> np.ndarray:
-    """Edges ``offset + k width`` covering every finite value (at least one bin)."""
-    v = np.asarray(list(values) if not isinstance(values, np.ndarray) else values, float)
-    v = v[np.isfinite(v)]
-    if v.size == 0:
-        return np.array([offset, offset + width])
-    lo = math.floor(round((v.min() - offset) / width, 9))
-    hi = math.ceil(round((v.max() - offset) / width, 9))
-    hi = max(hi, lo + 1)
-    return offset + width * np.arange(lo, hi + 1, dtype=float)
-
-
-def _edge(x: float) -> str:
-    return f"{x:g}" if abs(x) > 1e-12 else "0"
-
-
-def binned(values: pd.Series, width: float, offset: float = 0.0) -> pd.Series:
-    """Each value's bin label (``"[lo, hi)"``, the last ``"[lo, hi]"``), ordered categories."""
-    v = values.to_numpy(dtype=float)
-    edges = bin_edges(v, width, offset)
-    n_bins = len(edges) - 1
-    labels = [
-        f"[{_edge(a)}, {_edge(b)}{']' if i == n_bins - 1 else ')'}"
-        for i, (a, b) in enumerate(zip(edges[:-1], edges[1:], strict=True))
-    ]
-    index = np.searchsorted(edges, v, side="right") - 1
-    index = np.clip(index, 0, n_bins - 1)
-    codes = np.where(np.isfinite(v), index, -1)
-    cat = pd.Categorical.from_codes(codes, categories=labels, ordered=True)
-    return pd.Series(cat, index=values.index)
 
 
 # --------------------------------------------------------------- outcomes
-def _flag(table: pd.DataFrame, column: str) -> np.ndarray:
-    """A nullable boolean column as a plain array (null: False)."""
-    return table[column].fillna(False).to_numpy(dtype=bool)
-
-
-def outcome_class(table: pd.DataFrame) -> pd.Series:
-    """Each trial's class (:data:`OUTCOME_CLASSES`, see the module docstring)."""
-    from quadimpact.simulation.checks import STARTED_IN_CONTACT
-
-    failed = (table["status"] == "failed").to_numpy()
-    reason = (
-        table["reason"].fillna("").astype(str) if "reason" in table
-        else pd.Series("", index=table.index)
-    )  # fmt: skip
-    in_contact = failed & reason.str.contains(STARTED_IN_CONTACT, regex=False).to_numpy()
-    too_deep = (
-        (table["bumper_model_valid"] == False).fillna(False).to_numpy(dtype=bool)  # noqa: E712
-        if "bumper_model_valid" in table
-        else np.zeros(len(table), dtype=bool)
-    )
-    false = _flag(table, "false_detection")
-    missed = _flag(table, "not_detected")
-    detected = _flag(table, "detected")
-    recovered = _flag(table, "recovered")
-    below = _below_ground(table)
-    classes = np.select(
-        [in_contact, failed, too_deep, false, missed, ~detected, recovered & below, recovered],
-        ["invalid: started in contact", "failed", "invalid: bumper model exceeded",
-         "false detection", "not detected", "no contact", BELOW_GROUND, "recovered"],
-        default="not recovered",
-    )  # fmt: skip
-    return pd.Series(
-        pd.Categorical(classes, categories=OUTCOME_CLASSES), index=table.index, name="outcome"
-    )
-
-
-def _below_ground(table: pd.DataFrame) -> np.ndarray:
-    """Trials whose altitude went below 0 (the level the start altitude is measured from)."""
-    if "min_altitude_m" not in table:
-        return np.zeros(len(table), dtype=bool)
-    return (table["min_altitude_m"].astype(float) < 0.0).fillna(False).to_numpy(dtype=bool)
-
-
-def valid_mask(table: pd.DataFrame) -> np.ndarray:
-    """The trials the rates count: not of an :data:`EXCLUDED_CLASSES` class."""
-    return ~table["outcome_class"].astype(str).isin(EXCLUDED_CLASSES).to_numpy()
-
-
-def success_mask(table: pd.DataFrame) -> np.ndarray:
-    """The successes: valid, stage 4 reached (``recovered``), never below altitude 0."""
-    cls = table["outcome_class"].astype(str).to_numpy()
-    return _flag(table, "recovered") & valid_mask(table) & (cls != BELOW_GROUND)
-
-
-def add_derived(table: pd.DataFrame) -> pd.DataFrame:
-    """The table with ``inclination_deg`` (= -pitch), its bin, the speed bin and the class."""
-    t = table.copy()
-    t["inclination_deg"] = -t["pitch_deg"].astype(float)
-    t["inclination_bin"] = binned(t["inclination_deg"], *INCLINATION_BIN)
-    t["speed_bin"] = binned(t["speed_m_s"].astype(float), *SPEED_BIN)
-    t["outcome_class"] = outcome_class(t)
-    return t
 
 
 # ----------------------------------------------------------------- numbers
@@ -226,21 +130,6 @@ def rate_by(table: pd.DataFrame, column: str) -> pd.DataFrame:
             "excluded": len(group) - n_valid,
         })  # fmt: skip
     return pd.DataFrame(rows)
-
-
-def quantiles(values: pd.Series) -> dict[str, float]:
-    """Count, median, 90th percentile, min and max of the finite values (NaN when none)."""
-    v = values.to_numpy(dtype=float)
-    v = v[np.isfinite(v)]
-    if v.size == 0:
-        return {"n": 0, "median": math.nan, "p90": math.nan, "min": math.nan, "max": math.nan}
-    return {
-        "n": int(v.size),
-        "median": float(np.median(v)),
-        "p90": float(np.quantile(v, 0.9)),
-        "min": float(v.min()),
-        "max": float(v.max()),
-    }
 
 
 def _stage_reached(table: pd.DataFrame) -> np.ndarray:

@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING, Any
 
 from quadimpact import __version__
 from quadimpact.errors import InputError
-from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
+from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.packing.constants import CONTROL_RATE_HZ, RPM
 from quadimpact.results.costs import cost_ratio
 from quadimpact.results.files import atomic_write
@@ -55,6 +55,7 @@ from quadimpact.studies.study_folder import (
     StudyFolder,
     describe_run,
 )
+from quadimpact.studies.trial_analysis import trial_inputs, trial_table  # shared, here too
 from quadimpact.sweep import SweepSpec, read_runs, run_sweep
 from quadimpact.sweep.values import check_size
 
@@ -80,47 +81,6 @@ __all__ = [
 
 
 # ------------------------------------------------------------------- tables
-_TRIAL_DEFAULTS = {name: ImpactTrial.model_fields[name].default for name in TRIAL_FIELDS}
-
-
-def trial_inputs(spec: SweepSpec, runs: pd.DataFrame | None = None) -> pd.DataFrame:
-    """Roll, pitch, yaw (deg), speed (m/s) and IMU seed of every run of a sweep.
-
-    From each run's swept value (its input column in ``runs``, the sweep's
-    table, when given), else the base scenario's, else the impact trial's
-    default. Indexed by ``run_id``; without ``runs``, each run's inputs are
-    computed from the spec (slower: a million trials take seconds).
-    """
-    import numpy as np
-    import pandas as pd
-
-    index = pd.RangeIndex(spec.n_runs, name="run_id")
-    if runs is None:
-        rows = [spec.inputs(run_id) for run_id in range(spec.n_runs)]
-        runs = pd.DataFrame({name: [r.get(name) for r in rows] for name in spec.columns})
-        runs["run_id"] = np.arange(spec.n_runs)
-    by_id = runs.set_index("run_id").reindex(index)
-    frame = pd.DataFrame(index=index)
-    for name in TRIAL_FIELDS:
-        fallback = float(spec.base.get(name, _TRIAL_DEFAULTS[name]))
-        if name in spec.columns:
-            values = pd.to_numeric(by_id[name], errors="coerce").to_numpy(dtype=float)
-            frame[name] = np.where(np.isnan(values), fallback, values)
-        else:
-            frame[name] = np.full(spec.n_runs, fallback)
-    frame["seed"] = frame["seed"].astype("int64")
-    return frame
-
-
-def trial_table(runs: pd.DataFrame, spec: SweepSpec) -> pd.DataFrame:
-    """``trials.parquet``: the sweep's rows, the trial inputs and the derived columns."""
-    from quadimpact.studies.recovery import recovery_analysis as analysis
-
-    table = runs.sort_values("run_id").reset_index(drop=True)
-    inputs = trial_inputs(spec, table).reindex(table["run_id"].to_numpy())
-    for name in TRIAL_FIELDS:
-        table[name] = inputs[name].to_numpy()
-    return analysis.add_derived(table)
 
 
 def _first_runs(spec: SweepSpec, n: int) -> SweepSpec:
