@@ -42,12 +42,17 @@ def test_the_suite_sizes():
 def test_the_wall_task_is_the_recovery_studys_trials():
     from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
 
-    spec = Subject("default").spec(TASKS["wall"], True, sensor_set("ideal"))
+    spec = Subject("default").spec(TASKS["wall"], True, sensor_set("ideal"), version="1")
     theirs = RecoveryStudy(n=1_000).sweep_spec()
     assert spec.n_runs == 1_000 and spec.trials == theirs.trials
     assert spec.base == theirs.base
-    impact = Subject("default").spec(TASKS["wall"], True, sensor_set("impact"))
+    impact = Subject("default").spec(TASKS["wall"], True, sensor_set("impact"), version="1")
     assert (impact.base["sensors"], impact.base["estimator"]) == ("impact", "ekf")
+    # suite 2: the same trials, 4 s long over a ground that ends a run
+    v2 = Subject("default").spec(TASKS["wall"], True, sensor_set("lab"))
+    assert v2.trials == theirs.trials
+    lab = RecoveryStudy(n=1_000, sensors="indoor", estimator="ekf").sweep_spec()
+    assert v2.base == {**lab.base, "final_time_s": 4.0, "ground": "crash"}
 
 
 def test_the_pillars_edge_is_on_the_poles_axis_and_its_faces_at_45_degrees():
@@ -121,7 +126,7 @@ def test_cell_numbers_of_a_hand_made_table():
         "false_detection": [False] * 5, "t_stage1_s": [0.05, 0.05, np.nan, 0.05, np.nan],
         "cost__kernel_cpu_s": [0.01] * 4 + [np.nan], "cost__total_cpu_s": [0.02] * 4 + [np.nan],
     })  # fmt: skip
-    n = cell_numbers(t)
+    n = cell_numbers(t, "1")
     assert (n["success_k"], n["valid"], n["excluded"], n["failed_runs"]) == (3, 4, 1, 1)
     assert n["success"] == 0.75 and n["success_low"] < 0.75 < n["success_high"]
     assert n["recover_p50_s"] == pytest.approx(0.2)
@@ -129,6 +134,30 @@ def test_cell_numbers_of_a_hand_made_table():
     assert n["height_lost_p50_m"] == pytest.approx(1.25)
     assert n["missed_detections"] == 1 and n["declares_recovery"]
     assert n["cpu_s"] == pytest.approx(0.08) and n["cpu_ms_per_trial"] == pytest.approx(20.0)
+
+
+def test_suite_2_numbers_of_a_hand_made_table():
+    """Suite 2 counts the held hover (``success``), keeps the published criterion beside
+    it, and gives the time and distance to the hover of the successes."""
+    t = pd.DataFrame({
+        "run_id": range(5), "status": ["completed"] * 4 + ["failed"],
+        "success": [True, False, False, True, False], "valid": [True] * 4 + [False],
+        "published_success": [True, True, False, True, False],
+        "held_hover": [True, False, False, True, None],
+        "time_to_held_hover_s": [1.0, np.nan, np.nan, 2.0, np.nan],
+        "held_hover_distance_m": [0.2, np.nan, np.nan, 0.4, np.nan],
+        "height_lost_m": [0.5, -1.0, 3.0, 1.5, np.nan],
+        "not_detected": [False] * 5, "false_detection": [False] * 5,
+        "t_stage1_s": [0.05] * 5,
+        "cost__kernel_cpu_s": [0.01] * 4 + [np.nan], "cost__total_cpu_s": [0.02] * 4 + [np.nan],
+    })  # fmt: skip
+    n = cell_numbers(t, "2")
+    assert (n["success_k"], n["valid"], n["excluded"]) == (2, 4, 1)
+    assert n["success"] == 0.5 and n["published_success"] == 0.75
+    assert n["hover_p50_s"] == pytest.approx(1.5) and n["hover_distance_p50_m"] == pytest.approx(
+        0.3
+    )
+    assert n["height_lost_p50_m"] == pytest.approx(1.0)
 
 
 @pytest.fixture(scope="module")
@@ -152,13 +181,13 @@ def test_a_smoke_run_writes_every_output_with_the_suite_version(smoke):
     assert len(computed) == len(REFERENCES) * 2 * 2
     assert set(computed["row"]) == {r.name for r in REFERENCES}
     published = t[t["source"] == "published"]
-    assert sorted(published["success"]) == sorted(p.share for p in PUBLISHED)
+    assert sorted(published["published_success"]) == sorted(p.share for p in PUBLISHED)
     assert all(isinstance(n, str) and n for n in published["note"])
     report = (out / "report.md").read_text()
     assert f"Suite {SUITE_VERSION}" in report and "A smoke test, not a benchmark" in report
     study = json.loads((out / "study.json").read_text())
     assert study["identity"]["suite_version"] == SUITE_VERSION
-    cell = pd.read_parquet(out / "cells" / "baseline" / "pole-impact.parquet")
+    cell = pd.read_parquet(out / "cells" / "baseline" / "pole-lab.parquet")
     assert len(cell) == 3 and "success" in cell
 
 
@@ -241,7 +270,7 @@ def test_a_plugin_controller_runs_tasks_of_the_quick_suite(tmp_path):
     plugin.write_text(PLUGIN)
     out = tmp_path / "bench"
     result = CliRunner().invoke(cli, [
-        "benchmark", "--quick", "--tasks", "wall,pole", "--plugin", str(plugin),
+        "benchmark", "--suite", "1", "--quick", "--tasks", "wall,pole", "--plugin", str(plugin),
         "--controller", "test-hold-declare", "--no-references", "--no-cache",
         "--workers", "1", "--out", str(out), "--no-progress",
     ])  # fmt: skip

@@ -37,7 +37,7 @@ from typing import Any
 
 from quadimpact.errors import InputError
 from quadimpact.studies.pole import PoleStudy
-from quadimpact.studies.recovery import RecoveryStudy
+from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
 from quadimpact.studies.trial_analysis import SUCCESS_LOSS_M
 
 __all__ = [
