@@ -91,7 +91,7 @@ def _refuse_in_a_starting_worker() -> None:
         print(
             "quadimpact: error: a sweep worker, starting up, ran the script's top level "
             'again: guard the code that runs the sweep with `if __name__ == "__main__":` '
-            "(README, 'Sweeps from Python')",
+            "(docs/SWEEPS.md, 'A sweep run from a script')",
             file=sys.stderr,
             flush=True,
         )
