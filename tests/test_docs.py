@@ -109,3 +109,40 @@ def test_no_tracked_symlink_points_outside_the_repository():
         if not target.exists() or ROOT not in target.parents:
             bad.append(name)
     assert not bad, bad
+
+
+# ------------------------------------------------- issue 60 item 1: a short README
+def test_readme_is_short_and_opens_with_make_run_and_make_test():
+    """The README is at most 150 lines, and its first two commands are the two that do
+    everything on a fresh machine: ``make run``, then ``make test`` (what CI runs)."""
+    lines = (ROOT / "README.md").read_text(encoding="utf-8").splitlines()
+    assert len(lines) <= 150, f"README.md has {len(lines)} lines, more than 150"
+    start = lines.index("```sh")  # the first block of commands
+    commands = []
+    for line in lines[start + 1 :]:
+        if line.startswith("```"):
+            break
+        if line.split("#")[0].strip():
+            commands.append(line.split("#")[0].strip())
+    assert commands[:2] == ["make run", "make test"], commands
+    ci = (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+    assert "make test" in ci, "the README's test command is no longer what CI runs"
+
+
+def test_readme_names_each_first_task_within_its_first_screen():
+    """Issue 60: within its first screen (60 lines) the README says what quadimpact is
+    and gives the command of each first task."""
+    head = "\n".join((ROOT / "README.md").read_text(encoding="utf-8").splitlines()[:60])
+    assert "quadimpact simulates" in head
+    for command in ("quadimpact run ", "quadimpact sweep ", "quadimpact recovery ",
+                    "quadimpact benchmark ", "benchmarks/train_policy.py"):  # fmt: skip
+        assert command in head, command
+
+
+def test_readme_images_exist():
+    """Every picture the README shows is a file of the repository."""
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    images = re.findall(r"!\[[^\]]*\]\(([^)\s]+)\)", text) + re.findall(r'<img src="([^"]+)"', text)
+    assert images, "the README shows no picture"
+    missing = [image for image in images if not (ROOT / image).is_file()]
+    assert not missing, missing
