@@ -41,7 +41,7 @@ from quadimpact.inputs.registry import is_compiled
 from quadimpact.simulation.plugin_kernel import PluginError, PluginStep, step_name, typing_text
 from quadimpact.simulation.setup import prepare
 
-__all__ = ["SIGNATURES", "check_plugins", "check_signature"]
+__all__ = ["SIGNATURES", "check_first_run", "check_plugins", "check_signature"]
 
 #: The step each kind of plug-in registers: its parameters, and what it writes.
 SIGNATURES: dict[str, tuple[tuple[str, ...], str]] = {
@@ -238,3 +238,14 @@ def check_plugins(scenario: Any, where: str = "") -> list[PluginStep]:
     except PluginError as exc:
         raise PluginError(f"{where}{exc}") from None
     return [who for who, _ in steps]
+
+
+def check_first_run(spec: Any, where: str = "") -> list[PluginStep]:
+    """:func:`check_plugins` on a sweep's first run (cheap when it names no plug-in).
+
+    ``spec``: a ``quadimpact.sweep.SweepSpec`` (its ``scenario_dict(0)`` and
+    ``where``), e.g. a study's sweep before it starts.
+    """
+    from quadimpact.inputs.scenarios import scenario_from_dict
+
+    return check_plugins(scenario_from_dict(spec.scenario_dict(0), where=spec.where), where)

@@ -221,6 +221,25 @@ def test_quadimpact_run_refuses_a_bad_plugin_before_it_flies(plugins, capsys, tm
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("recovery", "--n", "3", "--no-example", "--no-animation"),
+        ("pole", "--pitch-step", "15", "--offset-step", "0.35"),
+    ],
+)
+def test_the_studies_refuse_a_bad_estimator_plugin_before_any_trial(
+    plugins, capsys, tmp_path, args
+):
+    out = tmp_path / "study"
+    code, err = _cli(
+        capsys, *args, "--estimator", "t-estimator-raises", "--workers", "1", "--no-progress",
+        "--out", str(out),
+    )  # fmt: skip
+    _one_error_line(code, err, "estimator plug-in 't-estimator-raises' (estimator_raises)")
+    assert not (out / "runs.parquet").exists() and not (out / "trials.parquet").exists()
+
+
 # ------------------------------------------------------------ in the loop (slow)
 def _raising_from(offset_m: float, name: str) -> None:
     """A plug-in that holds its rotors and raises at the first tick of a trial started at

@@ -45,8 +45,7 @@ def check_rows(study: Any) -> int:
     PluginError
         ``benchmark: <row> <task>/<sensors>: <the plug-in's error>``, one line.
     """
-    from quadimpact.inputs.scenarios import scenario_from_dict
-    from quadimpact.simulation.plugin_check import check_plugins
+    from quadimpact.simulation.plugin_check import check_first_run
     from quadimpact.studies.benchmark.suite import SENSOR_SETS, TASKS, sensor_set
 
     checked = 0
@@ -56,8 +55,7 @@ def check_rows(study: Any) -> int:
         for task_name in study.tasks:
             for sensors in SENSOR_SETS:
                 spec = row.spec(TASKS[task_name], study.quick, sensor_set(sensors), 1)
-                scenario = scenario_from_dict(spec.scenario_dict(0), where=spec.where)
-                check_plugins(scenario, where=f"benchmark: {row.name} {task_name}/{sensors}: ")
+                check_first_run(spec, where=f"benchmark: {row.name} {task_name}/{sensors}: ")
                 checked += 1
     return checked
 
