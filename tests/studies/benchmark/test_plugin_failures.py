@@ -324,3 +324,25 @@ def test_run_benchmark_stops_on_a_plugin_raising_in_a_run(tmp_path):
         assert "the 0 cells finished are kept" in text
     finally:
         unregister_controller(name)
+
+
+@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s)
+def test_the_loops_compilation_is_in_its_own_cost_and_in_no_other(caplog, plugins):
+    """The first run of a process compiles the loop: its ``compile_cpu_s`` holds it (seconds),
+    its kernel and total CPU do not (the second run's cost is of the same size as the
+    first's); it is announced once."""
+    from quadimpact.simulation.batch import simulate_batch
+
+    name = "t-hold-costs"
+    register_controller(name, step=hold, replace=True)
+    try:
+        first, second = (
+            s["cost"] for s in simulate_batch([ImpactTrial(controller=name, final_time_s=0.3)] * 2)
+        )
+        assert first["compile_cpu_s"] > 2.0 and second["compile_cpu_s"] == 0.0, (first, second)
+        assert first["total_cpu_s"] < first["compile_cpu_s"] / 2, first
+        assert first["kernel_cpu_s"] < 20 * second["kernel_cpu_s"] + 0.05, (first, second)
+        said = [r.getMessage() for r in caplog.records if "compiling the loop" in r.getMessage()]
+        assert len(said) == 1 and f"for plug-in {name!r}" in said[0], said
+    finally:
+        unregister_controller(name)
