@@ -161,6 +161,9 @@ def pole(
                f"{offset_step_m:g}")  # fmt: skip
     folder = study_folder(study, out)
     folder.check()  # another study, or other options: refused at once
+    from quadimpact.simulation.plugin_check import check_first_run
+
+    check_first_run(study.sweep_spec())  # a plug-in estimator: its signature, one tick
     from quadimpact.sweep.runner import warm_pool
 
     if folder.finished_description() is None:  # a finished study has nothing left to run

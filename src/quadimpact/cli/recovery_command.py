@@ -144,6 +144,10 @@ def recovery(
     from quadimpact.studies.recovery.recovery_study import study_folder
 
     study_folder(study, out).check()  # another study, or other options: refused at once
+    from quadimpact.simulation.plugin_check import check_first_run
+    from quadimpact.sweep import SweepSpec
+
+    check_first_run(study if isinstance(study, SweepSpec) else study.sweep_spec())  # plug-ins
     with stoppable(out):
         result = run_study(
             study, out, workers=workers, scheduler=scheduler, progress=not no_progress,

@@ -255,7 +255,8 @@ def run(
     Exit status:
       0  the run completed or crashed (a simulated crash is a result)
       1  an unexpected error, or the result folder could not be written
-      2  bad input (flag, file, value); nothing was simulated
+      2  bad input (flag, file, value): nothing was simulated; or a plug-in
+         controller or estimator that failed (docs/CONTROLLERS.md)
       3  the run failed numerically (status "failed", e.g. the state became
          NaN); its folder is still written, with the reason in summary.json
     """
@@ -270,7 +271,9 @@ def run(
     click.echo(f"quadimpact: {_describe(built, vehicle.name)} ...", err=True)
 
     from quadimpact.simulation import simulate
+    from quadimpact.simulation.plugin_check import check_plugins
 
+    check_plugins(built)  # a plug-in controller or estimator: its signature, one tick
     result = simulate(built)
     try:
         result.write(out)

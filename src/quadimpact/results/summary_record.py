@@ -215,6 +215,9 @@ class CostTable(Part):
 
     kernel_cpu_s: float = metric("f", "s", "CPU time in the compiled loop (shooting runs included)")
     total_cpu_s: float = metric("f", "s", "CPU time of the whole run, scenario to summary or row")
+    compile_cpu_s: float = metric(
+        "f", "s", "CPU time compiling a plug-in's loop in this run (in neither of the others)"
+    )
 
 
 # ------------------------------------------------------------------ parts

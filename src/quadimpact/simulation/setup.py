@@ -41,6 +41,7 @@ from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_imu, check_prepared, check_scenario_type
+from quadimpact.simulation.plugin_kernel import PluginStep, compile_cpu_total, guarded, step_name
 from quadimpact.simulation.sharing import SharedSetup, kept_shared
 from quadimpact.simulation.trim import trim_rotor_speeds
 
@@ -100,6 +101,9 @@ class RunSetup:
     """CPU time of :func:`prepare` (this thread), s; the summary's ``cost`` adds it in."""
     kernel_cpu_s: float = 0.0
     """Of which in the compiled loop (the approach's shooting runs), s."""
+    compile_cpu_s: float = 0.0
+    """CPU time compiling a plug-in's loop during this run (its first in a process), s: in
+    neither of the others (``simulation.plugin_kernel``)."""
 
     def model(self, **changes: Any) -> Model:
         """The run as the compiled core's :class:`~quadimpact.core.records.Model`.
@@ -172,16 +176,24 @@ def _ground(s: RunSettings) -> list[Plane]:
     return []
 
 
-def _kernel(entry, estimator=None) -> Kernel | None:
+def _kernel(entry, est_entry=None) -> Kernel | None:
     """The compiled loop of a plug-in controller or estimator (once per process and pair).
 
-    None for built-ins.
+    None for built-ins. Guarded (``simulation.plugin_kernel``): its compilation
+    announced and timed apart, an exception in it a one-line ``PluginError``.
     """
+    estimator = getattr(est_entry, "step", None)
     if entry.step is None and estimator is None:
         return None
     key = "kernel" if estimator is None else ("kernel", id(estimator))
     if key not in entry.kernel_cache:
-        entry.kernel_cache[key] = make_kernel(entry.step, estimator=estimator)
+        plugins = []
+        if entry.step is not None:
+            plugins.append(PluginStep("controller", entry.name, step_name(entry.step)))
+        if estimator is not None:
+            plugins.append(PluginStep("estimator", est_entry.name, step_name(estimator)))
+        kernel = make_kernel(entry.step, estimator=estimator)
+        entry.kernel_cache[key] = guarded(kernel, plugins)
     return entry.kernel_cache[key]
 
 
@@ -209,7 +221,7 @@ def _shared(
         estimator=est.name,
         estimator_settings=est.settings,
         controller=s.controller,
-        kernel=_kernel(packing.entry, est.step),
+        kernel=_kernel(packing.entry, est.entry),
         resolved=packing.resolved,
     )
     setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())
@@ -440,6 +452,7 @@ def prepare(
     not in Numba's disk cache says that it compiles (``core.announce_compilation``).
     """
     started = cpu_time()
+    compiled = compile_cpu_total()
     check_scenario_type(scenario)
     announce_compilation()
     if isinstance(scenario, WallApproach):
@@ -451,5 +464,8 @@ def prepare(
     if kernel is not None:
         setup.kernel = kernel
     check_prepared(scenario, setup)
-    setup.prepare_cpu_s = cpu_time() - started
+    # a plug-in's loop compiled here (a wall approach's shooting): its time apart
+    setup.compile_cpu_s = compile_cpu_total() - compiled
+    setup.kernel_cpu_s = max(setup.kernel_cpu_s - setup.compile_cpu_s, 0.0)
+    setup.prepare_cpu_s = cpu_time() - started - setup.compile_cpu_s
     return setup

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING, Any
 from quadimpact import __version__
 from quadimpact.errors import InputError
 from quadimpact.results.files import atomic_write
+from quadimpact.studies.benchmark import plugin_guard as guard
 from quadimpact.studies.benchmark.cells import (
     CellCache,
     cell_key,
@@ -193,13 +194,16 @@ def run_benchmark(
     ------
     InputError
         A folder holding something else (or another benchmark), bad workers
-        or scheduler.
+        or scheduler; a plug-in that fails its pre-flight check, or raised in
+        a run (the cells finished kept: :mod:`~quadimpact.studies.benchmark.plugin_guard`).
     """
     from quadimpact.studies.benchmark import benchmark_report as report
     from quadimpact.sweep import read_runs, run_sweep
 
     start = time.perf_counter()
     folder = study_folder(study, out_dir)
+    if guard.check_rows(study):  # a plug-in checked before any trial (one line, exit 2)
+        _note("the plug-in passed its pre-flight check (signature, one tick)", progress)
     out = folder.claim()
     store = CellCache(cache)
     done: dict[str, tuple[pd.DataFrame, dict[str, Any]]] = {}  # by key: run or read once
@@ -228,12 +232,18 @@ def run_benchmark(
                         spec, where / "sweep", workers=workers, scheduler=scheduler,
                         progress=progress, load=False, allow_large=allow_large,
                     )  # fmt: skip
-                    table = cell_table(read_runs(where / "sweep"), spec, task, version)
+                    runs = read_runs(where / "sweep")
+                    guard.stop_if_plugin_raised(runs, where / "sweep", label, len(cells), out)
+                    table = cell_table(runs, spec, task, version)
                     facts = {
                         "source": "run", "run": describe_run(info), "key": key,
                         "quadimpact_version": __version__, "code": code_digest(),
-                        "suite_version": version,
+                        "suite_version": version, "compile_cpu_s": guard.compile_cpu_s(runs),
                     }  # fmt: skip
+                    if facts["compile_cpu_s"] > 0.0:
+                        _note(f"{label}: {facts['compile_cpu_s']:.1f} s of CPU compiling the "
+                              "plug-in's loop (compile_cpu_s, not in cpu_ms_per_trial)",
+                              progress)  # fmt: skip
                     if row.cacheable:
                         where_from = {"row": row.name, "task": task.name, "sensors": sensors}
                         store.put(key, table, {**facts, **where_from, "quick": study.quick})
@@ -246,6 +256,7 @@ def run_benchmark(
                     **row.describe(), "task": task.name, "sensors": sensors,
                     "estimator": sensor_set(sensors, row.estimator).estimator,
                     "source": source, "sweep_s": facts.get("run", {}).get("sweep_s"),
+                    "compile_cpu_s": facts.get("compile_cpu_s", 0.0) if source == "run" else 0.0,
                     **cell_numbers(table, version),
                 })  # fmt: skip
                 tables[(row.name, task.name, sensors)] = table

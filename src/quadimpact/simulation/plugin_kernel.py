@@ -1,0 +1,185 @@
+"""The run loop compiled around plug-ins, guarded: its compilation said and timed, its errors named.
+
+``core.kernel.make_kernel`` compiles the loop again around a plug-in
+controller or estimator step, on the loop's first call in a process (about
+15 s of CPU). :func:`guarded` wraps that kernel's entry points so that:
+
+* the compilation is **announced** on stderr as it starts (once per process
+  and plug-in: ``quadimpact: compiling the loop for plug-in 'X' ...``), in the
+  command's process and in every sweep worker;
+* its CPU time is **measured apart**: :func:`compile_cpu_total` is the
+  process's total so far, which the run costs subtract
+  (``simulation.setup.prepare``, ``simulation.batch``, ``simulation.simulate``)
+  and report as the summary's ``cost.compile_cpu_s``;
+* an exception raised inside the loop (only a plug-in raises there: the
+  core's loop reports its numerical failures as a status) becomes a
+  :class:`PluginError` naming the plug-in and its step, in one line.
+
+A sweep records such a run as failed with ``reason = "PluginError: ..."``;
+:func:`plugin_failure` finds that reason in a sweep's rows (the benchmark
+stops on it: docs/CONTROLLERS.md).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import Any
+
+from quadimpact.core.kernel import Kernel
+from quadimpact.errors import InputError, one_line
+from quadimpact.results.costs import cpu_time
+
+__all__ = [
+    "PLUGIN_REASON",
+    "PluginError",
+    "PluginStep",
+    "compile_cpu_total",
+    "guarded",
+    "plugin_failure",
+    "typing_text",
+]
+
+PLUGIN_REASON = "PluginError: "
+"""How a sweep row's ``reason`` starts when a plug-in raised (``<type>: <message>``)."""
+
+_log = logging.getLogger("quadimpact")
+_COMPILE_CPU = [0.0]  # CPU time this process spent compiling plug-in loops, s
+
+
+class PluginError(InputError):
+    """A plug-in controller or estimator that cannot run: it raised, or its loop does not
+    compile (one line naming the plug-in, its function and the rule)."""
+
+
+@dataclass(frozen=True)
+class PluginStep:
+    """A plug-in's step as messages name it: its kind, registered name and function."""
+
+    kind: str  # "controller" or "estimator"
+    name: str
+    function: str
+
+    def __str__(self) -> str:
+        return f"{self.kind} plug-in {self.name!r} ({self.function})"
+
+
+def step_name(step: Any) -> str:
+    """The Python name of a compiled step (``level_step``)."""
+    py = getattr(step, "py_func", step)
+    return getattr(py, "__name__", repr(py))
+
+
+def compile_cpu_total() -> float:
+    """CPU time (this process) spent compiling the loops of plug-ins so far, s."""
+    return _COMPILE_CPU[0]
+
+
+def typing_text(exc: BaseException) -> str:
+    """A Numba compile error's message in one line: its first line of substance and where."""
+    lines = [ln.strip() for ln in str(exc).splitlines()]
+    skip = ("Failed in ", "During:", "- Resolution failure", "Resolution failure", "File ")
+    body = [i for i, ln in enumerate(lines) if ln and not ln.startswith(skip)]
+    text = type(exc).__name__
+    if body:
+        i = body[0]
+        text = lines[i].lstrip("> ").replace("Function(<built-in function getitem>)", "getitem")
+        after = [ln for ln in lines[i + 1 :] if ln]
+        if text.endswith(":") and after and after[0].startswith(">>>"):
+            text += " " + after[0].lstrip("> ")
+    where = re.search(r'File "([^"]+)", line (\d+)', str(exc))
+    if where:
+        text += f" ({os.path.basename(where.group(1))}, line {where.group(2)})"
+    return one_line(text)
+
+
+def _is_compile_error(exc: BaseException) -> bool:
+    try:
+        from numba.core.errors import NumbaError
+    except ImportError:  # pragma: no cover (numba is a dependency)
+        return False
+    return isinstance(exc, NumbaError)
+
+
+class _Guard:
+    """What the entry points of one guarded kernel share: its plug-ins, the notice said."""
+
+    def __init__(self, plugins: tuple[PluginStep, ...]) -> None:
+        self.plugins = plugins
+        self.announced = False
+
+    def who(self) -> str:
+        return " and ".join(str(p) for p in self.plugins)
+
+    def announce(self) -> None:
+        if self.announced:
+            return
+        self.announced = True
+        names = " and ".join(repr(p.name) for p in self.plugins)
+        _log.warning(
+            f"quadimpact: compiling the loop for plug-in {names} (process {os.getpid()}, once "
+            "per process: about 15 s of CPU, reported apart from the runs' as compile_cpu_s) ..."
+        )
+
+    def error(self, exc: Exception, entry: str) -> PluginError:
+        if _is_compile_error(exc):
+            return PluginError(
+                f"{self.who()}: the loop does not compile around it ({entry}): {typing_text(exc)}"
+            )
+        raised = one_line(f"{type(exc).__name__}: {exc}".rstrip(": "))
+        verb = "raised" if len(self.plugins) == 1 else "(one of them) raised"
+        return PluginError(f"{self.who()} {verb} {raised}: a plug-in's step must not raise")
+
+    def wrap(self, fn: Callable, entry: str) -> Callable:
+        """``fn`` (a Numba dispatcher) compiled, announced and timed on its first call."""
+
+        def call(*args: Any) -> Any:
+            if not fn.overloads:  # the first call in this process compiles
+                self.announce()
+                started = cpu_time()
+                try:
+                    fn.compile(tuple(fn.typeof_pyval(a) for a in args))
+                except Exception as exc:
+                    raise self.error(exc, entry) from None
+                finally:
+                    _COMPILE_CPU[0] += cpu_time() - started
+            try:
+                return fn(*args)
+            except Exception as exc:
+                raise self.error(exc, entry) from None
+
+        call.__name__ = getattr(fn, "__name__", entry)
+        call.__wrapped__ = fn  # type: ignore[attr-defined]
+        return call
+
+
+def guarded(kernel: Kernel, plugins: Iterable[PluginStep]) -> Kernel:
+    """``kernel`` (from ``make_kernel``) with its entry points guarded (module docstring)."""
+    guard = _Guard(tuple(plugins))
+    return Kernel(
+        run=guard.wrap(kernel.run, "run"),
+        start=guard.wrap(kernel.start, "start"),
+        advance=guard.wrap(kernel.advance, "advance"),
+        approach=guard.wrap(kernel.approach, "approach"),
+        step=kernel.step,
+    )
+
+
+def plugin_failure(runs: Any) -> tuple[int, str] | None:
+    """The first run of a sweep table whose plug-in raised: ``(run_id, the error)``, or None.
+
+    ``runs``: a sweep's rows (``runs.parquet``, with ``status``, ``reason`` and
+    ``run_id``). Ordinary failures (numerical, of any row) are not a plug-in's.
+    """
+    if "reason" not in runs or "status" not in runs:
+        return None
+    failed = runs[(runs["status"] == "failed") & runs["reason"].fillna("").str.startswith(
+        PLUGIN_REASON
+    )]  # fmt: skip
+    if failed.empty:
+        return None
+    first = failed.sort_values("run_id").iloc[0]
+    return int(first["run_id"]), str(first["reason"]).removeprefix(PLUGIN_REASON)
