@@ -556,6 +556,8 @@ def format_summary(summary: Mapping[str, Any], out: Path, scenario: Any = None) 
     str
         Several lines.
     """
+    from quadimpact.simulation.summary import episode_count
+
     status = str(summary.get("status", "n/a"))
     reason = summary.get("reason")
     leading = summary.get("leading_bumpers")
@@ -568,7 +570,7 @@ def format_summary(summary: Mapping[str, Any], out: Path, scenario: Any = None) 
         f"peak force     {_fmt(summary.get('peak_force_n'), unit='N')}",
         f"leading bumper {leading if leading is not None else 'n/a'}",
         f"response type  {_response_type(summary, scenario)}",
-        f"episodes       {_fmt(summary.get('n_episodes'))}",
+        f"episodes       {_fmt(episode_count(summary))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]
     if summary.get("controller") == "recovery":
