@@ -322,8 +322,27 @@ def _parse_options(options: tuple[str, ...], flag: str = "--option") -> dict[str
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             raise InputError(f"{flag}: must be NAME=VALUE (got {item!r})")
+        rule = _non_finite(value.strip())
+        if rule:
+            raise InputError(f"{flag}: {name.strip()}: {rule} (got {value.strip()!r})")
         parsed[name.strip()] = _option_value(value.strip())
     return parsed
+
+
+def _non_finite(text: str) -> str:
+    """The rule a value breaks when it reads as a number that is not finite ('' otherwise):
+    ``nan``, ``inf``, ``1e999`` or a list holding one."""
+    import tomllib
+
+    toml = f"[{text}]" if "," in text and not text.startswith("[") else text
+    try:
+        value = tomllib.loads(f"v = {toml}")["v"]
+    except (tomllib.TOMLDecodeError, KeyError):
+        return ""
+    values = value if isinstance(value, list) else [value]
+    if any(isinstance(v, float) and not math.isfinite(v) for v in values):
+        return "must be finite numbers" if isinstance(value, list) else "must be a finite number"
+    return ""
 
 
 def build_scenario(
