@@ -1,5 +1,7 @@
 # quadimpact: one-command entry points.
-#   make run    set up .venv (once) and reproduce the paper's study (report in results/paper)
+#   make run    set up .venv (once) and reproduce the paper's study (report in results/paper);
+#               make run DATA=DIR reads the flight logs from DIR (quadimpact reproduce --data
+#               DIR), else $QUADIMPACT_DATA or the search of docs/EXPERIMENTS.md
 #   make test   set up .venv (once), install headless Chromium if missing (root only), run the
 #               tests but those marked slow (what CI runs)
 #   make test-avx2 the tests marked pinned again, NumPy's SIMD dispatch limited to AVX2 (CI
@@ -14,6 +16,14 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.quadimpact-installed
 
 OUT := results/paper
+
+# The flight logs' folder for make run, given on make's command line (DATA=DIR): it
+# becomes reproduce's --data. A DATA variable of the environment is not read (too
+# common a name); the environment's route is QUADIMPACT_DATA, which reproduce reads.
+ifeq ($(origin DATA),environment)
+DATA :=
+endif
+DATA_FLAG := $(if $(strip $(DATA)),--data "$(strip $(DATA))")
 
 .PHONY: setup run test test-avx2 test-all lint bench clean browser
 
@@ -32,7 +42,7 @@ $(STAMP): pyproject.toml
 # Table III, the findings with computed verdicts) to $(OUT)/report.md, then a
 # movie and an interactive viewer of the example impact.
 run: $(STAMP)
-	$(BIN)/quadimpact reproduce --out $(OUT)
+	$(BIN)/quadimpact reproduce --out $(OUT) $(DATA_FLAG)
 	$(BIN)/quadimpact animate $(OUT)/example-paper-replica
 	$(BIN)/quadimpact view $(OUT)/example-paper-replica
 

@@ -14,12 +14,15 @@ deliberately plain law, to show the interface, not to win:
   than 0.3 m/s). The grids' criterion (height lost) and the hover columns do
   not read it.
 
-Run it: ``python examples/benchmark_controller.py [--out DIR]`` (about two
-minutes on 2 cores with the reference rows in the cache; the first run of a
-quadimpact version computes them too, and every worker process compiles the
-loop around the plug-in once, about 15 s). The registration is at the top
-level of this file, so the sweeps' worker processes, which import it again,
-register it too.
+Run it: ``python examples/benchmark_controller.py [--out DIR]``. Measured on
+the project's 2-core machine, shared with other jobs (1-minute load average
+3.6 to 7.2), the workers at their default: 260 s (4.3 min) with the
+reference rows in the benchmark cache (its 6 cells of ``level-first`` run);
+1,087 s (18 min) and 993 s (16.5 min) when the code is new to the cache, as
+on a first run, which computes the five reference controllers' 30 cells too.
+Each worker process compiles the loop around the plug-in once; these times
+include it. The registration is at the top level of this file, so the sweeps'
+worker processes, which import it again, register it too.
 """
 
 from __future__ import annotations

@@ -248,7 +248,7 @@ def test_numeric_model_switches_are_parsed_from_the_flag() -> None:
     assert s.model_options.crash_rule == "cm-ground" and s.model_options.bumper1_yaw_twice is True
     from quadimpact.errors import InputError
 
-    with pytest.raises(InputError, match="contact_gate_m: must be a number .got 'nan'"):
+    with pytest.raises(InputError, match="contact_gate_m: must be a finite number .got 'nan'"):
         build_scenario(None, {}, ("contact_gate_m=nan",))
 
 

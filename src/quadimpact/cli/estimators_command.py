@@ -8,9 +8,18 @@ from typing import Any
 import click
 
 from quadimpact.cli.command_output import file_lines
-from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
+from quadimpact.cli.options import (
+    Count,
+    allow_large_option,
+    out_option,
+    parallel_options,
+    stoppable,
+)
 
 __all__ = ["estimators"]
+
+#: The most trials of one study (each runs every estimator: six runs a trial).
+MAX_TRIALS = 100_000
 
 _SWITCHES = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error", "sensors")
 
@@ -29,8 +38,8 @@ _SWITCHES = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error
     "waypoint flight into the wall, recovery, 5 s after stage 4; their sensors; observers).",
 )  # fmt: skip
 @click.option(
-    "--n", "n", type=click.IntRange(1, 100_000), default=250, show_default=True, metavar="N",
-    help="Trials, each run with every estimator.",
+    "--n", "n", type=Count(1, MAX_TRIALS, "trials"), default=250, show_default=True, metavar="N",
+    help=f"Trials (1 to {MAX_TRIALS:,}), each run with every estimator.",
 )  # fmt: skip
 @click.option(
     "--initial-error", type=click.Choice(("none", "authors")), default="none",

@@ -325,8 +325,27 @@ def _parse_options(options: tuple[str, ...], flag: str = "--option") -> dict[str
         name, sep, value = item.partition("=")
         if not sep or not name.strip():
             raise InputError(f"{flag}: must be NAME=VALUE (got {item!r})")
+        rule = _non_finite(value.strip())
+        if rule:
+            raise InputError(f"{flag}: {name.strip()}: {rule} (got {value.strip()!r})")
         parsed[name.strip()] = _option_value(value.strip())
     return parsed
+
+
+def _non_finite(text: str) -> str:
+    """The rule a value breaks when it reads as a number that is not finite ('' otherwise):
+    ``nan``, ``inf``, ``1e999`` or a list holding one."""
+    import tomllib
+
+    toml = f"[{text}]" if "," in text and not text.startswith("[") else text
+    try:
+        value = tomllib.loads(f"v = {toml}")["v"]
+    except (tomllib.TOMLDecodeError, KeyError):
+        return ""
+    values = value if isinstance(value, list) else [value]
+    if any(isinstance(v, float) and not math.isfinite(v) for v in values):
+        return "must be finite numbers" if isinstance(value, list) else "must be a finite number"
+    return ""
 
 
 def build_scenario(
@@ -559,6 +578,8 @@ def format_summary(summary: Mapping[str, Any], out: Path, scenario: Any = None) 
     str
         Several lines.
     """
+    from quadimpact.simulation.summary import episode_count
+
     status = str(summary.get("status", "n/a"))
     reason = summary.get("reason")
     leading = summary.get("leading_bumpers")
@@ -571,7 +592,7 @@ def format_summary(summary: Mapping[str, Any], out: Path, scenario: Any = None) 
         f"peak force     {_fmt(summary.get('peak_force_n'), unit='N')}",
         f"leading bumper {leading if leading is not None else 'n/a'}",
         f"response type  {_response_type(summary, scenario)}",
-        f"episodes       {_fmt(summary.get('n_episodes'))}",
+        f"episodes       {_fmt(episode_count(summary))}",
         f"crash time     {'no crash' if crash is None else _fmt(crash, unit='s')}",
     ]
     if summary.get("controller") == "recovery":

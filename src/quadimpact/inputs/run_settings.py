@@ -243,6 +243,12 @@ class RunSettings(BaseModel):
     output_rate_hz: Real = Field(
         1000.0, gt=0, le=100000, description="Output time-series sampling rate, Hz."
     )
+    control_rate_hz: Real | None = Field(
+        None,
+        ge=10,
+        le=10000,
+        description="Rate of the control ticks (the controller's steps), Hz; None: 200 Hz.",
+    )
     rtol: Real | None = Field(
         None, gt=0, lt=0.1, description="Integrator relative tolerance; None: kernel default."
     )

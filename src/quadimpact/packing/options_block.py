@@ -24,6 +24,7 @@ from quadimpact.packing.constants import (
 
 __all__ = [
     "PAPER_CRASH_ALTITUDE_M",
+    "control_rate_hz",
     "pack_options",
     "pack_run_options",
     "pack_schedule",
@@ -98,6 +99,12 @@ def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -
     return rates
 
 
+def control_rate_hz(s: RunSettings) -> float:
+    """The rate of a run's control ticks, Hz: its ``control_rate_hz``, else
+    :data:`~quadimpact.packing.constants.CONTROL_RATE_HZ` (200 Hz)."""
+    return CONTROL_RATE_HZ if s.control_rate_hz is None else float(s.control_rate_hz)
+
+
 def slew_limit_rad_s2(s: RunSettings, v: Vehicle) -> float | None:
     """The rotor slew limit (rad/s^2) of a run: its own, the vehicle's (``"vehicle"``) or none."""
     if s.rotor_slew_limit_rad_s2 == "vehicle":
@@ -152,6 +159,7 @@ def pack_run_options(
         opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
     if s.end_after_recovery_s is not None:
         opts[L.O_END_AFTER_RECOVERY] = float(s.end_after_recovery_s)
+    opts[L.O_DT_CONTROL] = 1.0 / control_rate_hz(s)
     return opts
 
 

@@ -26,10 +26,14 @@ from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.run_settings import RunSettings
 from quadimpact.inputs.sensors import ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
-from quadimpact.packing.constants import CONTROL_RATE_HZ
 from quadimpact.packing.controller_block import pack_controller, set_references
 from quadimpact.packing.estimator_block import Estimation, draw_estimation, pack_estimation
-from quadimpact.packing.options_block import pack_run_options, pack_schedule, slew_limit_rad_s2
+from quadimpact.packing.options_block import (
+    control_rate_hz,
+    pack_run_options,
+    pack_schedule,
+    slew_limit_rad_s2,
+)
 from quadimpact.packing.sensor_block import draw_imu_noise, pack_sensors
 from quadimpact.packing.vehicle_block import pack_features, pack_vehicle
 from quadimpact.packing.world_block import pack_surfaces
@@ -98,7 +102,7 @@ def pack_shared(
         pre_impact=s.resolved_pre_impact(),
         nominal_controller=s.nominal_controller,
     )
-    imu = s.imu.resolved(v.imu_position_m, CONTROL_RATE_HZ)
+    imu = s.imu.resolved(v.imu_position_m, control_rate_hz(s))
     scfg, n_imu = pack_sensors(imu, s.detection, v, duration_s)
     est = pack_estimation(s, imu, scfg, v)
     params = s.resolved_controller_params()

@@ -10,7 +10,7 @@ the first onset, the approach solution and the metrics of
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -46,7 +46,14 @@ from quadimpact.simulation.recovery_metrics import onset_normal, recovery_metric
 from quadimpact.simulation.response_types import classify_response
 from quadimpact.simulation.setup import RunSetup
 
-__all__ = ["KIND_PARTS", "STATUS_NAMES", "build_summary", "describe_outcome", "summary_record"]
+__all__ = [
+    "KIND_PARTS",
+    "STATUS_NAMES",
+    "build_summary",
+    "describe_outcome",
+    "episode_count",
+    "summary_record",
+]
 
 STATUS_NAMES = {
     L.STATUS_COMPLETED: "completed",
@@ -363,6 +370,16 @@ def _obstacle_names(setup: RunSetup) -> list[str]:
     return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, L.SH_IS_GROUND] < 0.5]
 
 
+def episode_count(s: Mapping[str, Any]) -> int | None:
+    """The run's contact episodes with obstacles, the initial impact's included (None: unknown).
+
+    One definition (the summary's ``n_episodes``), for the run's outcome
+    sentence (the viewer's headline) and ``quadimpact run``'s summary.
+    """
+    n = s.get("n_episodes")
+    return None if n is None else int(n)
+
+
 def describe_outcome(s: dict[str, Any], feature_names: Any = None) -> str:
     """One sentence saying what the run did after the first impact.
 
@@ -380,9 +397,11 @@ def describe_outcome(s: dict[str, Any], feature_names: Any = None) -> str:
             what = "feature(s) " + ", ".join(feature_names[b - 1] for b in s["leading_bumpers"])
         first = (
             f"initial impact on {what} (delta_init {s['delta_init_m'] * 1e3:.2f} mm), "
-            f"then {s['n_subsequent_impacts']} subsequent impact(s) "
-            f"({s['n_subsequent_episodes']} episode(s))"
+            f"then {s['n_subsequent_impacts']} subsequent impact(s)"
         )
+        n = episode_count(s)
+        if n is not None:
+            first += f"; {n} contact episode{'' if n == 1 else 's'} in all"
     if s.get("t_detect_s") is not None:
         first += f"; impact detected at t = {s['t_detect_s']:.3f} s"
     if s.get("recovered"):

@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from quadimpact import __version__
-from quadimpact.errors import InputError, format_value
+from quadimpact.errors import InputError, one_line
 from quadimpact.results.files import (
     STUDY_JSON,
     atomic_write,
@@ -116,17 +116,43 @@ class StudyFolder:
         theirs = held.get("identity")
         if not isinstance(theirs, dict) or theirs == self.identity:
             return
-        differ = [
-            f"{self.flags.get(k, k)} {format_value(theirs.get(k))} there, "
-            f"{format_value(self.identity.get(k))} asked"
-            for k in sorted(set(theirs) | set(self.identity))
-            if theirs.get(k) != self.identity.get(k)
-        ]
         label = f"{self.where} {self.path}" if self.where else str(self.path)
         raise InputError(
-            f"{label}: holds {kind_words(self.kind)} with other options ({'; '.join(differ)}); "
+            f"{label}: holds {kind_words(self.kind)} with other options "
+            f"({'; '.join(self._differences(theirs))}); "
             "use a new folder, or the same options to resume it"
         )
+
+    def _differences(self, theirs: Mapping[str, Any]) -> list[str]:
+        """Each option that differs, by its flag, with both values in full.
+
+        Nested options (a mapping) are compared part by part (``approach.hover_s``);
+        of several that share a flag (a value and what it implies), the one the flag
+        is named after is said.
+        """
+        held, asked = _flat(theirs), _flat(self.identity)
+        said: dict[str, tuple[str, str]] = {}
+        for key in sorted(set(held) | set(asked)):
+            if held.get(key) == asked.get(key):
+                continue
+            flag = self._flag(key)
+            if flag in said and said[flag][0] == _key_of_flag(flag):
+                continue  # the option the flag is named after is said already
+            said[flag] = (
+                key,
+                f"{flag} {_full(held.get(key))} there, {_full(asked.get(key))} asked",
+            )
+        return [text for _, text in said.values()]
+
+    def _flag(self, key: str) -> str:
+        """An identity key's name in messages: its flag, else its parent's flag (and
+        the part), else the key."""
+        if key in self.flags:
+            return self.flags[key]
+        top, _, rest = key.partition(".")
+        if rest and top in self.flags:
+            return f"{self.flags[top]} ({rest})"
+        return key
 
     def claim(self) -> Path:
         """Check the folder, create it and mark it as this study's (``study.json`` first)."""
@@ -194,6 +220,29 @@ class StudyFolder:
     def report_path(self) -> Path:
         """Where ``report.md`` is."""
         return self.path / REPORT_MD
+
+
+def _key_of_flag(flag: str) -> str:
+    """The identity key a flag is named after (``--initial-error``: ``initial_error``)."""
+    return flag.removeprefix("--").replace("-", "_")
+
+
+def _flat(identity: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
+    """``{"a": {"b": 1}}`` as ``{"a.b": 1}`` (an empty mapping stays a value)."""
+    flat: dict[str, Any] = {}
+    for key, value in identity.items():
+        if isinstance(value, Mapping) and value:
+            flat.update(_flat(value, f"{prefix}{key}."))
+        else:
+            flat[f"{prefix}{key}"] = value
+    return flat
+
+
+def _full(value: Any) -> str:
+    """A value for the message, whole (strings quoted, on one line)."""
+    if isinstance(value, tuple):
+        value = list(value)
+    return one_line(repr(value) if isinstance(value, str) else str(value))
 
 
 def describe_run(info: Mapping[str, Any]) -> dict[str, Any]:

@@ -67,3 +67,33 @@ def test_the_command_writes_its_table_and_resumes(tmp_path: Path) -> None:
         run_cli("estimators", "--back", "gain", "--out", str(tmp_path / "x"), cwd=tmp_path),
         "back: only with scenario 'authors-2016'",
     )
+
+
+@pytest.mark.parametrize("initial_error", ["none", "authors"])
+def test_the_report_gives_both_of_the_authors_numbers(initial_error: str) -> None:
+    """Issue 60 item 5: the column "authors: crash / not-crash" showed one number."""
+    from quadimpact.studies.estimators.estimator_report import render_report
+    from quadimpact.studies.estimators.estimator_scenarios import AUTHORS_2016, AUTHORS_ROWS
+
+    study = EstimatorStudy(scenario="authors-2016", n=2, initial_error=initial_error)
+    rows = [
+        {"estimator": label, "crash_rms_mean_deg": 1.0, "crash_rms_mean_ci95_deg": 0.1,
+         "crash_rms_median_deg": 1.0, "crash_rms_p90_deg": 1.5, "crash_rms_sd_deg": 0.2,
+         "not_crash_rms_mean_deg": 0.5, "trials": 2, "trials_counted": 2}
+        for label, _, _ in ESTIMATORS
+    ]  # fmt: skip
+    run = {"n_runs": 12, "n_ran": 12, "sweep_s": 1.0, "backend": "serial"}
+    report = render_report(study, rows, [Path("a.png"), Path("b.png")], run)
+    table = [line for line in report.splitlines() if line.startswith("| ")]
+    assert table[0].endswith("| authors: crash / not-crash (°) |")
+    for line in table[1:]:
+        label = line.split(" | ")[0][2:]
+        theirs = line.rstrip(" |").rsplit("| ", 1)[1]
+        if label not in AUTHORS_ROWS:
+            assert theirs == "–", line
+            continue
+        a = AUTHORS_2016[initial_error][AUTHORS_ROWS[label]]
+        crash, not_crash = theirs.split(" / ")
+        assert float(crash) == a["crash"], line
+        assert not_crash == (f"{a['not_crash']:.2f}" if "not_crash" in a else "–"), line
+    assert ("no not-crash figure" in report) == (initial_error == "none")

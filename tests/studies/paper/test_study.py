@@ -1,6 +1,8 @@
 """The paper's study, end to end (reduced where it costs)."""
 
+import io
 import re
+import sys
 
 import pandas as pd
 import pytest
@@ -141,3 +143,65 @@ def test_a_long_stage_of_pieces_is_never_silent(capsys, monkeypatch) -> None:
     assert err.rstrip().endswith("s") and "piece 1: 1.5 s" in err
     time.sleep(1.2)  # stopped: no more lines
     assert capsys.readouterr().err == ""
+
+
+class _Terminal(io.StringIO):
+    """A stderr that says it is a terminal (what ``make run`` in a shell writes to)."""
+
+    def isatty(self) -> bool:
+        return True
+
+
+def test_a_long_stage_on_a_terminal_is_one_line_redrawn_in_place(monkeypatch) -> None:
+    """Issue 60 item 4: the compile printed eleven 150-character lines, one every 15 s."""
+    import time
+
+    from quadimpact.studies.paper.paper_study import StageClock
+
+    monkeypatch.setattr(StageClock, "TICK_S", 0.05)
+    monkeypatch.setattr(StageClock, "HEARTBEAT_S", 0.05)  # (what a non-terminal would use)
+    monkeypatch.setenv("COLUMNS", "60")
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    clock = StageClock(progress=True)
+    stage = "the paper's runs: 3 pieces on 2 processes (sweeps, crashes and more)"
+    clock.start(stage, n_pieces=3)
+    time.sleep(0.6)
+    clock.piece("piece 1", 0.5)
+    time.sleep(0.3)
+    clock.stop()
+    time.sleep(0.2)  # stopped: nothing more
+    text = terminal.getvalue()
+    lines = text.split("\n")
+    # Three lines said (the stage, its piece, its end), and the status between them drawn
+    # over itself: never a line of its own, never wider than the terminal.
+    assert len(lines) == 4 and lines[-1] == "", lines
+    assert lines[0] == f"reproduce: {stage}"
+    assert lines[1].endswith("\r\x1b[Kreproduce: piece 1: 0.5 s"), lines[1]
+    assert re.search(rf"\r\x1b\[Kreproduce: {re.escape(stage)}: \d+\.\d s$", lines[2]), lines[2]
+    drawn = lines[1].split("\r\x1b[K")[1:-1]  # before the piece
+    assert len(drawn) >= 5, drawn  # redrawn about every TICK_S
+    assert drawn[0] == "reproduce: still running: 0 s so far, 0 of 3 pieces done..."
+    assert drawn[0].endswith("...") and len(drawn[0]) == 59  # cut to the 60 columns
+    redrawn = lines[2].split("\r\x1b[K")[1:-1]  # after the piece, before the stage's end
+    assert redrawn and all(d.endswith(", 1 of 3 pieces done") for d in redrawn), redrawn
+    assert all(len(d) <= 59 for d in drawn + redrawn)
+
+
+def test_a_long_stage_off_a_terminal_prints_a_line_only_every_heartbeat(capsys, monkeypatch):
+    """Issue 60 item 4: off a terminal, a line after each HEARTBEAT_S without one, no '\\r'."""
+    import time
+
+    from quadimpact.studies.paper.paper_study import StageClock
+
+    monkeypatch.setattr(StageClock, "TICK_S", 0.05)
+    monkeypatch.setattr(StageClock, "HEARTBEAT_S", 1.0)
+    clock = StageClock(progress=True)
+    clock.start("the paper's runs: 3 pieces on 2 processes (sweeps)", n_pieces=3)
+    time.sleep(2.6)
+    clock.stop()
+    err = capsys.readouterr().err
+    assert "\r" not in err
+    still = [line for line in err.splitlines() if "still running" in line]
+    assert len(still) == 2, err
+    assert still[0].startswith("reproduce: the paper's runs: 3 pieces on 2 processes: still")

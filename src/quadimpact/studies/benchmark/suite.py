@@ -335,13 +335,19 @@ def parse_tasks(text: str | None) -> tuple[str, ...]:
     Raises
     ------
     InputError
-        An unknown or empty task name.
+        An unknown, empty or repeated task name.
     """
     if text is None:
         return tuple(TASKS)
     names = [part.strip() for part in text.split(",")]
     if not all(names):
         raise InputError(f"--tasks: empty task name (got {text!r})")
+    twice = sorted({name for name in names if names.count(name) > 1})
+    if twice:
+        raise InputError(
+            f"--tasks: each task at most once; {', '.join(map(repr, twice))} named more than "
+            f"once (got {text!r})"
+        )
     for name in names:
         task(name)
     return tuple(t for t in TASKS if t in names)

@@ -103,9 +103,9 @@ def render_report(
             )
         theirs = "–"
         key = AUTHORS_ROWS.get(r["estimator"])
-        if key in authors:
+        if key in authors:  # both numbers, "–" where their results give none
             a = authors[key]
-            theirs = f"{a['crash']}" + (f" / {a['not_crash']}" if "not_crash" in a else "")
+            theirs = f"{_f(a.get('crash'))} / {_f(a.get('not_crash'))}"
         lines.append(
             f"| {r['estimator']} | {_f(r['crash_rms_mean_deg'])} ± "
             f"{_f(r['crash_rms_mean_ci95_deg'])} | {_f(r['crash_rms_median_deg'])} "
@@ -115,6 +115,11 @@ def render_report(
         )
     excluded = [r for r in rows if r["trials_counted"] < r["trials"]]
     lines.append("")
+    if any("not_crash" not in a for a in authors.values()):
+        lines.append(
+            "- The authors' column: their crash / not-crash means; their saved results give "
+            f"no not-crash figure with initial errors `{study.initial_error}` (–)."
+        )
     for r in excluded:
         lines.append(
             f"- `{r['estimator']}`: {r['trials'] - r['trials_counted']} trials not counted "

@@ -261,7 +261,8 @@ class EstimatorResult:
 
 #: The study's options as its command line names them (messages).
 FLAGS = {"scenario": "--scenario", "n": "--n", "initial_error": "--initial-error", "loop": "--loop",
-         "seed": "--seed", "back": "--back"}  # fmt: skip
+         "seed": "--seed", "back": "--back", "in_loop": "--loop", "approach.hover_s": "--hover",
+         "initial_bias": "--initial-bias"}  # fmt: skip
 
 
 def study_folder(study: EstimatorStudy, out_dir: str | os.PathLike[str]) -> StudyFolder:

@@ -137,11 +137,17 @@ class StageClock:
     time given when it ends (``reproduce: <stage>: 3.2 s``); ``times`` holds
     (stage, seconds) in order, for the report, and ``pieces`` the same for the
     pieces of a stage that ran on worker processes (their own wall times,
-    which overlap).
+    which overlap). While a stage of pieces runs, one status line (pieces
+    done, time so far) is redrawn in place every :attr:`TICK_S` on a terminal;
+    when stderr is not a terminal, a line is printed instead after each
+    :attr:`HEARTBEAT_S` without one.
     """
 
-    #: Seconds without a line after which a running stage says it is still running.
+    #: Seconds without a line after which a running stage says it is still running
+    #: (stderr not a terminal).
     HEARTBEAT_S = 15.0
+    #: Seconds between redraws of the status line on a terminal.
+    TICK_S = 1.0
 
     def __init__(self, progress: bool) -> None:
         self.progress = progress
@@ -152,19 +158,48 @@ class StageClock:
         self._done_pieces = 0
         self._last_line = time.perf_counter()
         self._beat: threading.Event | None = None
+        self._lock = threading.Lock()
+        self._status = False  # a status line is drawn (terminal), to be cleared first
+
+    @staticmethod
+    def _tty() -> bool:
+        isatty = getattr(sys.stderr, "isatty", None)
+        try:
+            return bool(isatty and isatty())
+        except (OSError, ValueError):  # a closed or detached stream
+            return False
 
     def _say(self, line: str) -> None:
-        self._last_line = time.perf_counter()
-        if self.progress:
-            print(f"reproduce: {line}", file=sys.stderr, flush=True)
+        with self._lock:
+            self._last_line = time.perf_counter()
+            if self.progress:
+                clear = "\r\x1b[K" if self._status else ""
+                self._status = False
+                print(f"{clear}reproduce: {line}", file=sys.stderr, flush=True)
+
+    def _draw(self, stage: tuple[str, float]) -> None:
+        """Redraw the status line of ``stage`` in place (a terminal), cut to its width."""
+        import shutil
+
+        width = max(shutil.get_terminal_size().columns - 1, 20)
+        line = f"reproduce: {self._still_running(*stage, named=False)}"
+        if len(line) > width:
+            line = line[: width - 3] + "..."
+        with self._lock:
+            if self._current is not stage:  # the stage ended meanwhile: its line is said
+                return
+            self._status = True
+            sys.stderr.write(f"\r\x1b[K{line}")
+            sys.stderr.flush()
 
     def start(self, text: str, n_pieces: int = 0) -> None:
         """End the running stage (if any) and start the one named ``text``.
 
-        ``n_pieces``: the pieces it runs on worker processes; while none has
-        ended for :attr:`HEARTBEAT_S`, a line says the stage is still running
-        (how many pieces are done, the time so far), so that a long stage (a
-        first run also compiles the simulator) is never silent.
+        ``n_pieces``: the pieces it runs on worker processes; while they run,
+        the stage says it is still running (how many pieces are done, the time
+        so far), so that a long stage (a first run also compiles the
+        simulator) is never silent: one line redrawn in place on a terminal,
+        else a line after each :attr:`HEARTBEAT_S` without one.
         """
         self.stop()
         self._current = (text, time.perf_counter())
@@ -174,19 +209,27 @@ class StageClock:
             self._beat = threading.Event()
             threading.Thread(target=self._heartbeat, args=(self._beat,), daemon=True).start()
 
+    def _still_running(self, name: str, t0: float, named: bool = True) -> str:
+        """The status: pieces done and time so far, after the stage's name (without its
+        parenthesis) when ``named`` (a terminal's status line sits under the name)."""
+        done = f"{self._done_pieces} of {self._n_pieces} pieces done" if self._n_pieces else ""
+        so_far = f"{time.perf_counter() - t0:.0f} s so far"
+        compiling = "" if self._done_pieces else "; a first run compiles the simulator first"
+        if not named:
+            return f"still running: {so_far}{', ' + done if done else ''}{compiling}"
+        done = f"{done}, " if done else ""
+        return f"{name.split(' (')[0]}: still running ({done}{so_far}{compiling})"
+
     def _heartbeat(self, stop: threading.Event) -> None:
-        while not stop.wait(1.0):
+        tty = self._tty()
+        while not stop.wait(self.TICK_S if tty else 1.0):
             current = self._current
-            if current is None or time.perf_counter() - self._last_line < self.HEARTBEAT_S:
+            if current is None:
                 continue
-            done = (
-                f"{self._done_pieces} of {self._n_pieces} pieces done, " if self._n_pieces else ""
-            )
-            compiling = "" if self._done_pieces else "; a first run compiles the simulator first"
-            self._say(
-                f"{current[0]}: still running ({done}{time.perf_counter() - current[1]:.0f} s "
-                f"so far{compiling})"
-            )
+            if tty:
+                self._draw(current)
+            elif time.perf_counter() - self._last_line >= self.HEARTBEAT_S:
+                self._say(self._still_running(*current))
 
     def piece(self, text: str, seconds: float) -> None:
         """A piece of the running stage finished (on a worker process) in ``seconds``."""
