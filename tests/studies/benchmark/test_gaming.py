@@ -62,16 +62,15 @@ def test_climbing_away_and_doing_nothing_rank_below_the_default_law(tmp_path):
 
     plugin = str(EXAMPLES / "gaming_controllers.py")
     tables = {}
-    for controller in ("climb-away", "do-nothing"):
+    for controller in ("recovery", "climb-away", "do-nothing"):
         out = tmp_path / controller
         result = CliRunner().invoke(cli, [
             "benchmark", "--quick", "--plugin", plugin, "--controller", controller,
-            "--no-cache", "--out", str(out), "--no-progress",
-            *(["--no-references"] if controller == "do-nothing" else []),
+            "--no-references", "--no-cache", "--out", str(out), "--no-progress",
         ])  # fmt: skip
         assert result.exit_code == 0, result.output
         tables[controller] = pd.read_csv(out / "benchmark.csv")
-    default = tables["climb-away"]
+    default = tables.pop("recovery")
     default = default[default["row"] == "default"].set_index(["task", "sensors"])
     assert len(default) == 6
     for controller, t in tables.items():
