@@ -87,6 +87,10 @@ N_ARCS = 32  # initial arcs of the branch and bound
 MAX_EVALS = 4000  # point depths of the branch and bound at most
 STACK = 512
 TWO_PI = 2.0 * math.pi
+POLISH_ITERS = 8  # secant steps refining the branch and bound's best angle
+POLISH_STEP = 1e-6  # rad: the refinement's first secant step
+POLISH_REACH = 1e-3  # rad: how far the refinement may move the angle
+TWIN_BAND = 1e-6  # m: a second crease this close in depth shares the contact point
 
 Ring = tuple[float, float, float, float, float, float, float, float, float, float]
 """(cx, cy, cz, ax, ay, az, bx, by, bz, R): centre, two orthonormal in-plane axes, radius."""
@@ -431,7 +435,129 @@ def _search(ring: Ring, shapes: np.ndarray, s: int):
             return bx_, gx, kx, ky, kz
         if ok and gx >= best[1] - TOL:
             return best
-    return _branch_and_bound(ring, shapes, s, best)
+    return _polish(ring, shapes, s, _branch_and_bound(ring, shapes, s, best))
+
+
+@compiled
+def _polish(ring: Ring, shapes: np.ndarray, s: int, best: tuple):
+    """The branch and bound's best angle refined to the stationary point of its piece's depth.
+
+    The branch and bound returns the best of the angles it sampled: its depth
+    is within :data:`TOL` of the maximum, but the angle only within about
+    ``sqrt(TOL / R)`` (1e-6 rad), and which sampled angle wins changes from one
+    state to the next. That made the contact point (and so the contact
+    moment) jump by up to a micrometre between evaluations, a discontinuous
+    right-hand side that held the integrator to sub-microsecond steps (a ring
+    around a pole: docs/NUMERICS.md, "Pathological trials"). Secant steps on
+    ``dg/db`` on the same piece of the solid move the angle to the maximum to
+    rounding; kept only if they stay on that piece, near the angle, and no
+    shallower than ``TOL`` below it (else the branch and bound's point).
+    """
+    b0, g0, _, _, _ = best
+    px, py, pz, tx, ty, tz = _point(ring, b0)
+    g, mx, my, mz, k = solid_depth(px, py, pz, shapes, s)
+    fp_prev = -(mx * tx + my * ty + mz * tz)
+    b_prev = b0
+    b = b0 + (POLISH_STEP if fp_prev > 0.0 else -POLISH_STEP)
+    for _ in range(POLISH_ITERS):
+        px, py, pz, tx, ty, tz = _point(ring, b)
+        g, mx, my, mz, kb = solid_depth(px, py, pz, shapes, s)
+        if kb != k:
+            return best
+        fp = -(mx * tx + my * ty + mz * tz)
+        if fp == fp_prev:
+            break
+        step = -fp * (b - b_prev) / (fp - fp_prev)
+        b_prev = b
+        fp_prev = fp
+        b += step
+        if abs(b - b0) > POLISH_REACH:
+            return best
+        if abs(step) <= 4e-16 * (1.0 + abs(b)):
+            break
+    px, py, pz, _, _, _ = _point(ring, b)
+    g, mx, my, mz, kb = solid_depth(px, py, pz, shapes, s)
+    if kb != k or not g >= g0 - TOL:
+        return best
+    return b, g, mx, my, mz
+
+
+@compiled
+def _crease_twin(
+    ring: Ring, b: float, g: float, shapes: np.ndarray, s: int
+) -> tuple[float, float, float, float, float, float, float]:
+    """The other crossing of the circle with the box crease its deepest point ``b`` sits on.
+
+    A ring across an edge of a box crosses the edge's crease twice; when both
+    crossings are local maxima equally deep (a hoop leaning on an edge), the
+    deepest point jumps from one to the other at every evaluation, and so
+    does the contact moment: the integrator then chatters between them. The
+    two crossings within :data:`TWIN_BAND` in depth share the contact: the
+    returned weight ``w`` (0 to 1/2, a C1 ramp of the depth difference; 0
+    beyond the band) goes to the twin. Returns ``(w, point, normal)``, the
+    twin's point (inertial) and its certifying normal (as
+    :func:`_crease_normal`'s); ``w = 0``: no twin.
+    """
+    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    px, py, pz, _, _, _ = _point(ring, b)
+    _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    if k < 0:
+        return none
+    j = -1
+    vj = math.inf
+    for i in range(6):
+        if i != k:
+            v = box_piece(px, py, pz, shapes, s, i)[0]
+            if v < vj:
+                vj = v
+                j = i
+    if j < 0 or vj > g + CREASE_TOL:
+        return none
+    # the faces' depths are affine in the point: their difference on the circle is
+    # c0 + A cos + B sin, zero at b and at the twin
+    cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
+    vk, nkx, nky, nkz = box_piece(cx, cy, cz, shapes, s, k)
+    vj, njx, njy, njz = box_piece(cx, cy, cz, shapes, s, j)
+    c0 = vk - vj
+    dx = njx - nkx
+    dy = njy - nky
+    dz = njz - nkz
+    a_ = r * (dx * ax + dy * ay + dz * az)
+    b_ = r * (dx * bx + dy * by + dz * bz)
+    amp = math.sqrt(a_ * a_ + b_ * b_)
+    if not amp > abs(c0):
+        return none
+    phi = math.atan2(b_, a_)
+    half = math.acos(-c0 / amp)
+    b1 = phi + half
+    b2 = phi - half
+    d1 = abs((b1 - b + math.pi) % TWO_PI - math.pi)
+    d2 = abs((b2 - b + math.pi) % TWO_PI - math.pi)
+    bt = b1 if d1 > d2 else b2
+    qx, qy, qz, tx, ty, tz = _point(ring, bt)
+    gt, _, _, _, _ = solid_depth(qx, qy, qz, shapes, s)
+    if not gt > g - TWIN_BAND or gt <= 0.0:
+        return none
+    vk, nkx, nky, nkz = box_piece(qx, qy, qz, shapes, s, k)
+    vj, njx, njy, njz = box_piece(qx, qy, qz, shapes, s, j)
+    if abs(gt - min(vk, vj)) > CREASE_TOL:
+        return none  # another face is nearer there: not the same crease
+    sk = -(nkx * tx + nky * ty + nkz * tz)
+    sj = -(njx * tx + njy * ty + njz * tz)
+    if sk * sj > 0.0:
+        return none  # not a local maximum of the depth on the circle
+    lam = 0.5 if sk == sj else sj / (sj - sk)
+    u = min(1.0, max(-1.0, (gt - g) / TWIN_BAND))
+    w = 0.5 + 0.75 * u - 0.25 * u * u * u
+    return (
+        w,
+        qx,
+        qy,
+        qz,
+        lam * nkx + (1.0 - lam) * njx,
+        lam * nky + (1.0 - lam) * njy,
+        lam * nkz + (1.0 - lam) * njz,
+    )
 
 
 @njit(cache=True, inline="always")
@@ -485,4 +611,13 @@ def ring_solid(
     ring = ring_frame(x, C, feat, f)
     b, g, mx, my, mz = ring_deepest(ring, shapes, s)
     px, py, pz, _, _, _ = _point(ring, b)
+    if g > 0.0 and int(shapes[s, SH_KIND]) == SHAPE_BOX:
+        w, qx, qy, qz, nx, ny, nz = _crease_twin(ring, b, g, shapes, s)
+        if w > 0.0:
+            px += w * (qx - px)
+            py += w * (qy - py)
+            pz += w * (qz - pz)
+            mx += w * (nx - mx)
+            my += w * (ny - my)
+            mz += w * (nz - mz)
     return material_record(x, C, g, px - x[X_POS], py - x[X_POS + 1], pz - x[X_POS + 2], mx, my, mz)
