@@ -75,6 +75,7 @@ from quadimpact.core.layout import (
     SH_KIND,
     SH_LENGTH,
     SH_NORMAL,
+    SH_POINT,
     SHAPE_BOX,
     SHAPE_CYLINDER,
     X_POS,
@@ -435,7 +436,112 @@ def _search(ring: Ring, shapes: np.ndarray, s: int):
             return bx_, gx, kx, ky, kz
         if ok and gx >= best[1] - TOL:
             return best
+    if int(shapes[s, SH_KIND]) == SHAPE_CYLINDER and not shapes[s, SH_LENGTH] < math.inf:
+        # a ring around a pole: every stationary point of the distance from the axis
+        ok, ba, ga, ax_, ay_, az_ = _ring_around_axis(ring, shapes, s)
+        if ok and ga >= best[1] - TOL:
+            return ba, ga, ax_, ay_, az_
     return _polish(ring, shapes, s, _branch_and_bound(ring, shapes, s, best))
+
+
+@compiled
+def _ring_around_axis(ring: Ring, shapes: np.ndarray, s: int):
+    """The deepest point of a circle in the infinite cylinder ``s``, from all candidates.
+
+    The squared distance of the circle's point ``P(b)`` from the axis is a
+    trigonometric polynomial of degree 2, ``D(b) = D0 + al cos b + be sin b
+    + ga cos 2b + de sin 2b``; its stationary points are the roots on the unit
+    circle of a quartic in ``z = exp(i b)``, all four found by the
+    Durand-Kerner iteration and each polished by Newton steps on ``D'(b)``.
+    The deepest point is the one with the least ``D``: the maximum to
+    rounding, a pure function of the pose (no sampled angle). Returns
+    ``(ok, angle, depth, normal)``; ``ok`` false: a degenerate quartic (the
+    circle's projection across the axis a circle), left to the branch and bound.
+    """
+    cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
+    ex = shapes[s, SH_NORMAL]
+    ey = shapes[s, SH_NORMAL + 1]
+    ez = shapes[s, SH_NORMAL + 2]
+    dx = cx - shapes[s, SH_POINT]
+    dy = cy - shapes[s, SH_POINT + 1]
+    dz = cz - shapes[s, SH_POINT + 2]
+    t = dx * ex + dy * ey + dz * ez
+    dx, dy, dz = dx - t * ex, dy - t * ey, dz - t * ez
+    t = ax * ex + ay * ey + az * ez
+    ux, uy, uz = ax - t * ex, ay - t * ey, az - t * ez
+    t = bx * ex + by * ey + bz * ez
+    vx, vy, vz = bx - t * ex, by - t * ey, bz - t * ez
+    du = dx * ux + dy * uy + dz * uz
+    dv = dx * vx + dy * vy + dz * vz
+    uu = ux * ux + uy * uy + uz * uz
+    vv = vx * vx + vy * vy + vz * vz
+    uv = ux * vx + uy * vy + uz * vz
+    al = 2.0 * r * du
+    be = 2.0 * r * dv
+    ga = 0.5 * r * r * (uu - vv)
+    de = r * r * uv
+    # 2 z^2 D'(b) = c4 z^4 + c3 z^3 + c1 z + c0
+    c4 = complex(2.0 * de, 2.0 * ga)
+    c3 = complex(be, al)
+    c1 = complex(be, -al)
+    c0 = complex(2.0 * de, -2.0 * ga)
+    if not abs(c4) > 1e-9 * (abs(c3) + abs(c0)):
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    p3 = c3 / c4
+    p1 = c1 / c4
+    p0 = c0 / c4
+    seed = complex(0.4, 0.9)
+    z1 = complex(1.0, 0.0)
+    z2 = seed
+    z3 = seed * seed
+    z4 = z3 * seed
+    for _ in range(200):
+        f = (((z1 + p3) * z1) * z1 + p1) * z1 + p0
+        n1 = f / ((z1 - z2) * (z1 - z3) * (z1 - z4))
+        z1 = z1 - n1
+        f = (((z2 + p3) * z2) * z2 + p1) * z2 + p0
+        n2 = f / ((z2 - z1) * (z2 - z3) * (z2 - z4))
+        z2 = z2 - n2
+        f = (((z3 + p3) * z3) * z3 + p1) * z3 + p0
+        n3 = f / ((z3 - z1) * (z3 - z2) * (z3 - z4))
+        z3 = z3 - n3
+        f = (((z4 + p3) * z4) * z4 + p1) * z4 + p0
+        n4 = f / ((z4 - z1) * (z4 - z2) * (z4 - z3))
+        z4 = z4 - n4
+        if max(abs(n1), abs(n2), abs(n3), abs(n4)) <= 1e-15:
+            break
+    d_best = math.inf
+    b_best = 0.0
+    for k in range(4):
+        z = z1 if k == 0 else (z2 if k == 1 else (z3 if k == 2 else z4))
+        if not (abs(z.real) < math.inf and abs(z.imag) < math.inf):
+            return False, 0.0, 0.0, 0.0, 0.0, 0.0
+        b = math.atan2(z.imag, z.real)
+        for _ in range(4):
+            c = math.cos(b)
+            sn = math.sin(b)
+            c2 = c * c - sn * sn
+            s2 = 2.0 * sn * c
+            d1 = -al * sn + be * c - 2.0 * ga * s2 + 2.0 * de * c2
+            d2 = -al * c - be * sn - 4.0 * ga * c2 - 4.0 * de * s2
+            if d2 == 0.0:
+                break
+            step = d1 / d2
+            if abs(step) > 0.1:
+                break
+            b -= step
+        c = math.cos(b)
+        sn = math.sin(b)
+        wx = dx + r * (c * ux + sn * vx)
+        wy = dy + r * (c * uy + sn * vy)
+        wz = dz + r * (c * uz + sn * vz)
+        dd = wx * wx + wy * wy + wz * wz
+        if dd < d_best:
+            d_best = dd
+            b_best = b
+    px, py, pz, _, _, _ = _point(ring, b_best)
+    g, mx, my, mz, _ = solid_depth(px, py, pz, shapes, s)
+    return True, b_best, g, mx, my, mz
 
 
 @compiled
@@ -488,7 +594,7 @@ def _crease_twin(
 ) -> tuple[float, float, float, float, float, float, float]:
     """The other crossing of the circle with the box crease its deepest point ``b`` sits on.
 
-    A ring across an edge of a box crosses the edge's crease twice; when both
+    A ring across an edge of a box (two adjacent faces) crosses the edge's crease twice; when both
     crossings are local maxima equally deep (a hoop leaning on an edge), the
     deepest point jumps from one to the other at every evaluation, and so
     does the contact moment: the integrator then chatters between them. The
@@ -511,8 +617,8 @@ def _crease_twin(
             if v < vj:
                 vj = v
                 j = i
-    if j < 0 or vj > g + CREASE_TOL:
-        return none
+    if j < 0 or vj > g + CREASE_TOL or j // 2 == k // 2:
+        return none  # no crease, or two opposite faces (a ring through a slab): not an edge
     # the faces' depths are affine in the point: their difference on the circle is
     # c0 + A cos + B sin, zero at b and at the twin
     cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
