@@ -11,7 +11,7 @@ side, so the contact moment was discontinuous and the integrator rejected step a
 * the pole trial at pitch -30 deg, offset 0, with the plug-in of
   ``examples/benchmark_controller.py`` and the ``impact`` sensors: two rings around the pole,
   whose deepest points the branch and bound gave only to about 1e-6 rad: 84,866 steps
-  (27,543 rejected), 14 s of CPU; now 14,258.
+  (27,543 rejected), 14 s of CPU; now 14,265.
 
 The bounds count steps (accepted and rejected), not time. The runs' physics is checked
 elsewhere (tests/simulation/test_obstacles.py); here they complete within a few times their
@@ -58,7 +58,7 @@ def test_the_pole_replicas_edge_trial_takes_a_bounded_step_count():
 
 @pytest.mark.slow
 def test_the_example_plug_ins_pole_trial_takes_a_bounded_step_count():
-    """Two rings around the pole: 84,866 steps before the fix, 14,258 after (the plug-in's
+    """Two rings around the pole: 84,866 steps before the fix, 14,265 after (the plug-in's
     loop compiles first: about 30 s)."""
     from quadimpact.inputs.controllers import unregister_controller
 

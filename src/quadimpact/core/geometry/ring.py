@@ -36,13 +36,15 @@ The search (:func:`ring_deepest`):
 2. if that does not certify within :data:`MAX_LOCAL` evaluations: against a
    box (a corner or an edge of the box through the ring's disk), the exact
    solution from the box's pieces (``ring_box.ring_box_exact``: closed-form
-   candidates, evaluated with the box's depth); against a cylinder (a ring
-   around a pole or a bar, a maximum on the far side), a branch and bound
-   over arcs of the circle: every arc's bound is the largest value of the
-   lower of its two end cuts (closed form: the ends, the cuts' peaks and
-   their crossings); arcs whose bound exceeds the best point found by more
-   than :data:`TOL` are halved, until none is left (at most
-   :data:`MAX_EVALS` evaluations).
+   candidates, evaluated with the box's depth); against an infinite cylinder
+   (a ring around a pole), every stationary point of the distance from the
+   axis (:func:`_ring_around_axis`, a quartic); against a finite one (a ring
+   around a bar, a maximum on the far side), a branch and bound over arcs of
+   the circle: every arc's bound is the largest value of the lower of its two
+   end cuts (closed form: the ends, the cuts' peaks and their crossings);
+   arcs whose bound exceeds the best point found by more than :data:`TOL` are
+   halved, until none is left (at most :data:`MAX_EVALS` evaluations); its
+   best angle is then refined (:func:`_polish`).
 
 Each returns a point whose depth is within :data:`TOL` of the maximum over
 the circle (the exact box solution: to rounding), so the depth is continuous
