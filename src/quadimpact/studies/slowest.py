@@ -9,16 +9,19 @@ with the reason "step budget exhausted" (docs/NUMERICS.md, "Step budget").
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
+
+if TYPE_CHECKING:
+    import pandas as pd  # loaded by the functions that take a table: not at import
 
 __all__ = ["SLOWEST_N", "slowest_lines", "slowest_trials"]
 
 #: How many of the slowest trials a report lists.
 SLOWEST_N = 5
-_CPU = ("cost__total_cpu_s", "cost__kernel_cpu_s")  # the first the table has
+# the compiled loop's CPU first (the total adds the scenario's preparation and summary)
+_CPU = ("cost__kernel_cpu_s", "cost__total_cpu_s")  # the first the table has
 _COUNTS = {
     "steps": "integrator__steps",
     "rejected_steps": "integrator__rejected_steps",
@@ -41,8 +44,8 @@ def slowest_trials(
     Parameters
     ----------
     table : DataFrame
-        A sweep's rows: the CPU columns (``cost__total_cpu_s``, else
-        ``cost__kernel_cpu_s``, s), and where present the step counts
+        A sweep's rows: the CPU columns (``cost__kernel_cpu_s``, the
+        compiled loop's, else ``cost__total_cpu_s``, s), and where present the step counts
         (``integrator__steps``, ``integrator__rejected_steps``), the contact
         onsets (``n_episodes``), ``status`` and ``reason``.
     ids : sequence of str
@@ -58,6 +61,8 @@ def slowest_trials(
         ``contact_onsets``, ``status`` and ``reason`` (JSON-able); ``None``
         when the table has no CPU column or no row.
     """
+    import pandas as pd
+
     column = next((c for c in _CPU if c in table.columns), None)
     if column is None or len(table) == 0:
         return None
@@ -100,7 +105,8 @@ def slowest_lines(slowest: dict[str, Any] | None, title: str = "## Slowest trial
         title,
         "",
         f"CPU per trial ({slowest['cpu_column']}): median {slowest['median_cpu_ms']:.1f} ms. "
-        "Steps: accepted and rejected integration steps. Onsets: contact onsets (episodes).",
+        "Steps: accepted and rejected integration steps. Onsets: contact onsets (episodes). "
+        "A worker's first trial also loads the compiled code.",
         "",
         "| " + " | ".join([*ids, "CPU (ms)", "x median", "steps", "rejected", "onsets",
                           "status"]) + " |",

@@ -224,9 +224,10 @@ def _slowest_trials(out: Path, study: Any) -> list[str]:
     lines = [
         "## Slowest trials",
         "",
-        f"The slowest trial of each of {study.subject.name}'s cells: its CPU, against the "
-        "cell's median, and what the integrator did (accepted and rejected steps, contact "
-        "onsets). A trial that would exceed the step budget fails (docs/NUMERICS.md).",
+        f"The slowest trial of each of {study.subject.name}'s cells: its CPU in the "
+        "compiled loop, against the cell's median, and what the integrator did (accepted "
+        "and rejected steps, contact onsets). A worker's first trial also loads the "
+        "compiled code. A trial that would exceed the step budget fails (docs/NUMERICS.md).",
         "",
         "| task | sensors | run | CPU (ms) | x median | steps | rejected | onsets | status |",
         "|---|---|---|---|---|---|---|---|---|",
