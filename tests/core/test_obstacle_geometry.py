@@ -289,6 +289,58 @@ def test_the_corner_depth_is_continuous_along_a_path():
         previous = g
 
 
+def _ring_points_along(feat, row, positions):
+    """The contact point (inertial) of the ring ``feat`` against ``row`` at each CM position."""
+    x = np.zeros(L.NX)
+    x[L.X_QUAT] = 1.0
+    points = []
+    for p in positions:
+        x[L.X_POS : L.X_POS + 3] = p
+        _, _, _, rc, _, _ = _record(x, feat, row)
+        points.append(p + rc)
+    return np.array(points)
+
+
+def test_a_ring_around_a_pole_has_a_smooth_contact_point():
+    """A pole through the ring's hole (the branch and bound): the deepest point is a smooth
+    function of the pose, its second differences along a straight path at rounding level.
+
+    The branch and bound alone returned the best angle it sampled, within about 1e-6 rad of
+    the maximum, which made the contact point (and moment) jump by up to a micrometre from
+    one evaluation to the next (issue 59: the pole trial at pitch -30 deg)."""
+    rng = np.random.default_rng(71)
+    for _ in range(5):
+        row = cylinder_row(rng.uniform(-0.01, 0.01, 3), rng.standard_normal(3), 0.03)
+        feat = _feature("ring", np.zeros(3), 0.1, rng.standard_normal(3))
+        step = rng.standard_normal(3)
+        step *= 1e-7 / np.linalg.norm(step)
+        points = _ring_points_along(feat, row, [k * step for k in range(400)])
+        assert np.abs(np.diff(points, 2, axis=0)).max() < 1e-11
+
+
+def test_a_ring_across_a_box_edge_moves_its_point_continuously():
+    """A hoop across a box's edge, its two crossings of the edge equally deep: the contact
+    point moves from one crossing to the other continuously as the tilt passes through the
+    tie (the crossings within ``TWIN_BAND`` share the point), instead of jumping by the chord.
+
+    The jump made the contact moment discontinuous and the integrator chatter between the two
+    points (issue 59: the pole-replica's edge trial at pitch -42 deg, offset 0.2 m)."""
+    half = 0.5
+    row = box_row(np.array([half, half, 0.0]), np.array([half, half, 1.0]), np.eye(3))
+    u0, radius = 1e-3, 0.125  # the ring's centre 1 mm inside both faces of the edge
+    n0 = np.array([1.0, 1.0, 0.0]) / math.sqrt(2.0)  # the ring's plane: x + y = 2 u0
+    up = np.array([0.0, 0.0, 1.0])
+    points = []
+    for theta in np.linspace(-2e-5, 2e-5, 4001):  # tilt: the top crossing leans out or in
+        feat = _feature(
+            "ring", np.array([u0, u0, 0.0]), radius, math.cos(theta) * n0 + math.sin(theta) * up
+        )
+        points.append(_ring_points_along(feat, row, [np.zeros(3)])[0])
+    points = np.array(points)
+    assert np.linalg.norm(points[-1] - points[0]) > 1.9 * radius  # from one crossing to the other
+    assert np.linalg.norm(np.diff(points, axis=0), axis=1).max() < 2e-3
+
+
 # ------------------------------------------------------------------ python-fcl
 def _fcl():
     return pytest.importorskip(

@@ -18,6 +18,7 @@ from quadimpact.packing.constants import (
     EVENT_TOL_S,
     FRICTION_V_REG_M_S,
     MAX_STEPS_PER_S,
+    MIN_STEP_BUDGET,
     RPM,
     V_MIN_M_S,
 )
@@ -78,7 +79,7 @@ def pack_options(
     opts[L.O_RTOL] = DEFAULT_RTOL if rtol is None else rtol
     opts[L.O_ATOL] = DEFAULT_ATOL if atol is None else atol
     opts[L.O_H_MAX] = 0.0
-    opts[L.O_MAX_STEPS] = max(100_000, MAX_STEPS_PER_S * duration_s)
+    opts[L.O_MAX_STEPS] = max(MIN_STEP_BUDGET, MAX_STEPS_PER_S * duration_s)
     opts[L.O_EVENT_TOL] = EVENT_TOL_S
     opts[L.O_POWER_OFF_T] = np.inf
     opts[L.O_CUT_STEP_MOTORS] = float(sum(1 << (m - 1) for m in set(cut_step_motors)))

@@ -1,9 +1,9 @@
 """How long a sweep waits for a run before it gives up on its worker (``--timeout``).
 
 A run is bounded by the kernel's step budget (``MAX_STEPS_PER_S`` =
-2,000,000 steps per simulated second, then it ends with "step budget
-exhausted"), so the default limit of a run is derived from its final time and
-from what runs cost on this machine::
+20,000 steps per simulated second, at least ``MIN_STEP_BUDGET`` = 20,000,
+then it ends with "step budget exhausted"), so the default limit of a run
+is derived from its final time and from what runs cost on this machine::
 
     limit = max(60 s, 4 x (budget steps x slowest kernel cost per step
                            + slowest cost outside the kernel))
@@ -12,7 +12,7 @@ where the costs are the slowest measured so far in this sweep (before the
 first measurement: 10 us per step, about three times a 2-core AMD EPYC's
 3.5 us). A legitimate run, even one that exhausts its budget on a loaded
 machine, stays below it, so that a timeout never changes the table; a stopped
-or stuck worker is found within minutes (90 s for a 3-s scenario on that
+or stuck worker is found within minutes (60 s for a 3-s scenario on that
 machine). ``--timeout SECONDS`` replaces it with a fixed limit per run.
 
 A local pool applies the limit to each run (its workers report every run);
@@ -95,10 +95,11 @@ class RunLimits:
         self.outside_s = max(self.outside_s, cost.wall_s - cost.kernel_s)
 
     def _estimate(self, item: Item) -> float:
-        from quadimpact.packing.constants import MAX_STEPS_PER_S
+        from quadimpact.packing.constants import MAX_STEPS_PER_S, MIN_STEP_BUDGET
 
         step = PRIOR_STEP_S if self.step_s is None else self.step_s
-        return MARGIN * (MAX_STEPS_PER_S * final_time_s(item[1]) * step + self.outside_s)
+        budget = max(MIN_STEP_BUDGET, MAX_STEPS_PER_S * final_time_s(item[1]))
+        return MARGIN * (budget * step + self.outside_s)
 
     def run_limit(self, item: Item) -> float:
         """How long one run may take on a worker, s."""

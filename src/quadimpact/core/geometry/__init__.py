@@ -25,8 +25,9 @@ ring      plane     ``plane.ring_plane``          closed form, paper eqs. 10-15 
 sphere    plane     ``plane.sphere_plane``        closed form (exact)
 point     plane     ``plane.point_plane``         closed form (exact)
 ring      cylinder  ``ring.ring_solid``           certified search over the circle
-                                                  (within 1e-13 m; 3-6 point depths,
-                                                  rarely a branch and bound)
+                                                  (within 1e-13 m; 3-6 point depths;
+                                                  around a pole, a quartic; rarely a
+                                                  branch and bound)
 sphere    cylinder  ``cylinder.sphere_cylinder``  closed form (exact)
 point     cylinder  ``cylinder.point_cylinder``   closed form (exact)
 ring      box       ``ring.ring_solid``           certified search (as for the cylinder;

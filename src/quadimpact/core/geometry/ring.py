@@ -36,13 +36,15 @@ The search (:func:`ring_deepest`):
 2. if that does not certify within :data:`MAX_LOCAL` evaluations: against a
    box (a corner or an edge of the box through the ring's disk), the exact
    solution from the box's pieces (``ring_box.ring_box_exact``: closed-form
-   candidates, evaluated with the box's depth); against a cylinder (a ring
-   around a pole or a bar, a maximum on the far side), a branch and bound
-   over arcs of the circle: every arc's bound is the largest value of the
-   lower of its two end cuts (closed form: the ends, the cuts' peaks and
-   their crossings); arcs whose bound exceeds the best point found by more
-   than :data:`TOL` are halved, until none is left (at most
-   :data:`MAX_EVALS` evaluations).
+   candidates, evaluated with the box's depth); against an infinite cylinder
+   (a ring around a pole), every stationary point of the distance from the
+   axis (:func:`_ring_around_axis`, a quartic); against a finite one (a ring
+   around a bar, a maximum on the far side), a branch and bound over arcs of
+   the circle: every arc's bound is the largest value of the lower of its two
+   end cuts (closed form: the ends, the cuts' peaks and their crossings);
+   arcs whose bound exceeds the best point found by more than :data:`TOL` are
+   halved, until none is left (at most :data:`MAX_EVALS` evaluations); its
+   best angle is then refined (:func:`_polish`).
 
 Each returns a point whose depth is within :data:`TOL` of the maximum over
 the circle (the exact box solution: to rounding), so the depth is continuous
@@ -75,6 +77,7 @@ from quadimpact.core.layout import (
     SH_KIND,
     SH_LENGTH,
     SH_NORMAL,
+    SH_POINT,
     SHAPE_BOX,
     SHAPE_CYLINDER,
     X_POS,
@@ -87,6 +90,10 @@ N_ARCS = 32  # initial arcs of the branch and bound
 MAX_EVALS = 4000  # point depths of the branch and bound at most
 STACK = 512
 TWO_PI = 2.0 * math.pi
+POLISH_ITERS = 8  # secant steps refining the branch and bound's best angle
+POLISH_STEP = 1e-6  # rad: the refinement's first secant step
+POLISH_REACH = 1e-3  # rad: how far the refinement may move the angle
+TWIN_BAND = 1e-6  # m: a second crease this close in depth shares the contact point
 
 Ring = tuple[float, float, float, float, float, float, float, float, float, float]
 """(cx, cy, cz, ax, ay, az, bx, by, bz, R): centre, two orthonormal in-plane axes, radius."""
@@ -431,7 +438,234 @@ def _search(ring: Ring, shapes: np.ndarray, s: int):
             return bx_, gx, kx, ky, kz
         if ok and gx >= best[1] - TOL:
             return best
-    return _branch_and_bound(ring, shapes, s, best)
+    if int(shapes[s, SH_KIND]) == SHAPE_CYLINDER and not shapes[s, SH_LENGTH] < math.inf:
+        # a ring around a pole: every stationary point of the distance from the axis
+        ok, ba, ga, ax_, ay_, az_ = _ring_around_axis(ring, shapes, s)
+        if ok and ga >= best[1] - TOL:
+            return ba, ga, ax_, ay_, az_
+    return _polish(ring, shapes, s, _branch_and_bound(ring, shapes, s, best))
+
+
+@compiled
+def _ring_around_axis(ring: Ring, shapes: np.ndarray, s: int):
+    """The deepest point of a circle in the infinite cylinder ``s``, from all candidates.
+
+    The squared distance of the circle's point ``P(b)`` from the axis is a
+    trigonometric polynomial of degree 2, ``D(b) = D0 + al cos b + be sin b
+    + ga cos 2b + de sin 2b``; its stationary points are the roots on the unit
+    circle of a quartic in ``z = exp(i b)``, all four found by the
+    Durand-Kerner iteration and each polished by Newton steps on ``D'(b)``.
+    The deepest point is the one with the least ``D``: the maximum to
+    rounding, a pure function of the pose (no sampled angle). Returns
+    ``(ok, angle, depth, normal)``; ``ok`` false: a degenerate quartic (the
+    circle's projection across the axis a circle), left to the branch and bound.
+    """
+    cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
+    ex = shapes[s, SH_NORMAL]
+    ey = shapes[s, SH_NORMAL + 1]
+    ez = shapes[s, SH_NORMAL + 2]
+    dx = cx - shapes[s, SH_POINT]
+    dy = cy - shapes[s, SH_POINT + 1]
+    dz = cz - shapes[s, SH_POINT + 2]
+    t = dx * ex + dy * ey + dz * ez
+    dx, dy, dz = dx - t * ex, dy - t * ey, dz - t * ez
+    t = ax * ex + ay * ey + az * ez
+    ux, uy, uz = ax - t * ex, ay - t * ey, az - t * ez
+    t = bx * ex + by * ey + bz * ez
+    vx, vy, vz = bx - t * ex, by - t * ey, bz - t * ez
+    du = dx * ux + dy * uy + dz * uz
+    dv = dx * vx + dy * vy + dz * vz
+    uu = ux * ux + uy * uy + uz * uz
+    vv = vx * vx + vy * vy + vz * vz
+    uv = ux * vx + uy * vy + uz * vz
+    al = 2.0 * r * du
+    be = 2.0 * r * dv
+    ga = 0.5 * r * r * (uu - vv)
+    de = r * r * uv
+    # 2 z^2 D'(b) = c4 z^4 + c3 z^3 + c1 z + c0
+    c4 = complex(2.0 * de, 2.0 * ga)
+    c3 = complex(be, al)
+    c1 = complex(be, -al)
+    c0 = complex(2.0 * de, -2.0 * ga)
+    if not abs(c4) > 1e-9 * (abs(c3) + abs(c0)):
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    p3 = c3 / c4
+    p1 = c1 / c4
+    p0 = c0 / c4
+    seed = complex(0.4, 0.9)
+    z1 = complex(1.0, 0.0)
+    z2 = seed
+    z3 = seed * seed
+    z4 = z3 * seed
+    for _ in range(200):
+        f = (((z1 + p3) * z1) * z1 + p1) * z1 + p0
+        n1 = f / ((z1 - z2) * (z1 - z3) * (z1 - z4))
+        z1 = z1 - n1
+        f = (((z2 + p3) * z2) * z2 + p1) * z2 + p0
+        n2 = f / ((z2 - z1) * (z2 - z3) * (z2 - z4))
+        z2 = z2 - n2
+        f = (((z3 + p3) * z3) * z3 + p1) * z3 + p0
+        n3 = f / ((z3 - z1) * (z3 - z2) * (z3 - z4))
+        z3 = z3 - n3
+        f = (((z4 + p3) * z4) * z4 + p1) * z4 + p0
+        n4 = f / ((z4 - z1) * (z4 - z2) * (z4 - z3))
+        z4 = z4 - n4
+        if max(abs(n1), abs(n2), abs(n3), abs(n4)) <= 1e-15:
+            break
+    d_best = math.inf
+    b_best = 0.0
+    for k in range(4):
+        z = z1 if k == 0 else (z2 if k == 1 else (z3 if k == 2 else z4))
+        if not (abs(z.real) < math.inf and abs(z.imag) < math.inf):
+            return False, 0.0, 0.0, 0.0, 0.0, 0.0
+        b = math.atan2(z.imag, z.real)
+        for _ in range(4):
+            c = math.cos(b)
+            sn = math.sin(b)
+            c2 = c * c - sn * sn
+            s2 = 2.0 * sn * c
+            d1 = -al * sn + be * c - 2.0 * ga * s2 + 2.0 * de * c2
+            d2 = -al * c - be * sn - 4.0 * ga * c2 - 4.0 * de * s2
+            if d2 == 0.0:
+                break
+            step = d1 / d2
+            if abs(step) > 0.1:
+                break
+            b -= step
+        c = math.cos(b)
+        sn = math.sin(b)
+        wx = dx + r * (c * ux + sn * vx)
+        wy = dy + r * (c * uy + sn * vy)
+        wz = dz + r * (c * uz + sn * vz)
+        dd = wx * wx + wy * wy + wz * wz
+        if dd < d_best:
+            d_best = dd
+            b_best = b
+    px, py, pz, _, _, _ = _point(ring, b_best)
+    g, mx, my, mz, _ = solid_depth(px, py, pz, shapes, s)
+    return True, b_best, g, mx, my, mz
+
+
+@compiled
+def _polish(ring: Ring, shapes: np.ndarray, s: int, best: tuple):
+    """The branch and bound's best angle refined to the stationary point of its piece's depth.
+
+    The branch and bound returns the best of the angles it sampled: its depth
+    is within :data:`TOL` of the maximum, but the angle only within about
+    ``sqrt(TOL / R)`` (1e-6 rad), and which sampled angle wins changes from one
+    state to the next. That made the contact point (and so the contact
+    moment) jump by up to a micrometre between evaluations, a discontinuous
+    right-hand side that held the integrator to sub-microsecond steps (a ring
+    around a pole: docs/NUMERICS.md, "Pathological trials"). Secant steps on
+    ``dg/db`` on the same piece of the solid move the angle to the maximum to
+    rounding; kept only if they stay on that piece, near the angle, and no
+    shallower than ``TOL`` below it (else the branch and bound's point).
+    """
+    b0, g0, _, _, _ = best
+    px, py, pz, tx, ty, tz = _point(ring, b0)
+    g, mx, my, mz, k = solid_depth(px, py, pz, shapes, s)
+    fp_prev = -(mx * tx + my * ty + mz * tz)
+    b_prev = b0
+    b = b0 + (POLISH_STEP if fp_prev > 0.0 else -POLISH_STEP)
+    for _ in range(POLISH_ITERS):
+        px, py, pz, tx, ty, tz = _point(ring, b)
+        g, mx, my, mz, kb = solid_depth(px, py, pz, shapes, s)
+        if kb != k:
+            return best
+        fp = -(mx * tx + my * ty + mz * tz)
+        if fp == fp_prev:
+            break
+        step = -fp * (b - b_prev) / (fp - fp_prev)
+        b_prev = b
+        fp_prev = fp
+        b += step
+        if abs(b - b0) > POLISH_REACH:
+            return best
+        if abs(step) <= 4e-16 * (1.0 + abs(b)):
+            break
+    px, py, pz, _, _, _ = _point(ring, b)
+    g, mx, my, mz, kb = solid_depth(px, py, pz, shapes, s)
+    if kb != k or not g >= g0 - TOL:
+        return best
+    return b, g, mx, my, mz
+
+
+@compiled
+def _crease_twin(
+    ring: Ring, b: float, g: float, shapes: np.ndarray, s: int
+) -> tuple[float, float, float, float, float, float, float]:
+    """The other crossing of the circle with the box crease its deepest point ``b`` sits on.
+
+    A ring across an edge of a box (two adjacent faces) crosses the edge's crease twice; when both
+    crossings are local maxima equally deep (a hoop leaning on an edge), the
+    deepest point jumps from one to the other at every evaluation, and so
+    does the contact moment: the integrator then chatters between them. The
+    two crossings within :data:`TWIN_BAND` in depth share the contact: the
+    returned weight ``w`` (0 to 1/2, a C1 ramp of the depth difference; 0
+    beyond the band) goes to the twin. Returns ``(w, point, normal)``, the
+    twin's point (inertial) and its certifying normal (as
+    :func:`_crease_normal`'s); ``w = 0``: no twin.
+    """
+    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    px, py, pz, _, _, _ = _point(ring, b)
+    _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    if k < 0:
+        return none
+    j = -1
+    vj = math.inf
+    for i in range(6):
+        if i != k:
+            v = box_piece(px, py, pz, shapes, s, i)[0]
+            if v < vj:
+                vj = v
+                j = i
+    if j < 0 or vj > g + CREASE_TOL or j // 2 == k // 2:
+        return none  # no crease, or two opposite faces (a ring through a slab): not an edge
+    # the faces' depths are affine in the point: their difference on the circle is
+    # c0 + A cos + B sin, zero at b and at the twin
+    cx, cy, cz, ax, ay, az, bx, by, bz, r = ring
+    vk, nkx, nky, nkz = box_piece(cx, cy, cz, shapes, s, k)
+    vj, njx, njy, njz = box_piece(cx, cy, cz, shapes, s, j)
+    c0 = vk - vj
+    dx = njx - nkx
+    dy = njy - nky
+    dz = njz - nkz
+    a_ = r * (dx * ax + dy * ay + dz * az)
+    b_ = r * (dx * bx + dy * by + dz * bz)
+    amp = math.sqrt(a_ * a_ + b_ * b_)
+    if not amp > abs(c0):
+        return none
+    phi = math.atan2(b_, a_)
+    half = math.acos(-c0 / amp)
+    b1 = phi + half
+    b2 = phi - half
+    d1 = abs((b1 - b + math.pi) % TWO_PI - math.pi)
+    d2 = abs((b2 - b + math.pi) % TWO_PI - math.pi)
+    bt = b1 if d1 > d2 else b2
+    qx, qy, qz, tx, ty, tz = _point(ring, bt)
+    gt, _, _, _, _ = solid_depth(qx, qy, qz, shapes, s)
+    if not gt > g - TWIN_BAND or gt <= 0.0:
+        return none
+    vk, nkx, nky, nkz = box_piece(qx, qy, qz, shapes, s, k)
+    vj, njx, njy, njz = box_piece(qx, qy, qz, shapes, s, j)
+    if abs(gt - min(vk, vj)) > CREASE_TOL:
+        return none  # another face is nearer there: not the same crease
+    sk = -(nkx * tx + nky * ty + nkz * tz)
+    sj = -(njx * tx + njy * ty + njz * tz)
+    if sk * sj > 0.0:
+        return none  # not a local maximum of the depth on the circle
+    lam = 0.5 if sk == sj else sj / (sj - sk)
+    u = min(1.0, max(-1.0, (gt - g) / TWIN_BAND))
+    w = 0.5 + 0.75 * u - 0.25 * u * u * u
+    return (
+        w,
+        qx,
+        qy,
+        qz,
+        lam * nkx + (1.0 - lam) * njx,
+        lam * nky + (1.0 - lam) * njy,
+        lam * nkz + (1.0 - lam) * njz,
+    )
 
 
 @njit(cache=True, inline="always")
@@ -485,4 +719,13 @@ def ring_solid(
     ring = ring_frame(x, C, feat, f)
     b, g, mx, my, mz = ring_deepest(ring, shapes, s)
     px, py, pz, _, _, _ = _point(ring, b)
+    if g > 0.0 and int(shapes[s, SH_KIND]) == SHAPE_BOX:
+        w, qx, qy, qz, nx, ny, nz = _crease_twin(ring, b, g, shapes, s)
+        if w > 0.0:
+            px += w * (qx - px)
+            py += w * (qy - py)
+            pz += w * (qz - pz)
+            mx += w * (nx - mx)
+            my += w * (ny - my)
+            mz += w * (nz - mz)
     return material_record(x, C, g, px - x[X_POS], py - x[X_POS + 1], pz - x[X_POS + 2], mx, my, mz)

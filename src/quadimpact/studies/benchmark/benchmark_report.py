@@ -322,6 +322,40 @@ def _where_fails(out: Path, study: Any) -> list[str]:
     return lines
 
 
+def _slowest_trials(out: Path, study: Any) -> list[str]:
+    """The subject's slowest trial of each task and sensor set: its CPU and why (issue 59)."""
+    from quadimpact.studies.slowest import slowest_trials
+
+    lines = [
+        "## Slowest trials",
+        "",
+        f"The slowest trial of each of {study.subject.name}'s cells: its CPU in the "
+        "compiled loop, against the cell's median, and what the integrator did (accepted "
+        "and rejected steps, contact onsets). A worker's first trial also loads the "
+        "compiled code. A trial that would exceed the step budget fails (docs/NUMERICS.md).",
+        "",
+        "| task | sensors | run | CPU (ms) | x median | steps | rejected | onsets | status |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for name in study.tasks:
+        for sensors in SENSOR_SETS:
+            t = _cell(out, study.subject.name, name, sensors)
+            found = None if t is None else slowest_trials(t, n=1)
+            if found is None:
+                continue
+            w = found["trials"][0]
+            status = w["status"] + (f" ({w['reason']})" if w["reason"] else "")
+            counts = [("–" if w[k] is None else str(w[k]))
+                      for k in ("steps", "rejected_steps", "contact_onsets")]  # fmt: skip
+            cost = f"{w['cpu_ms']:.1f} | {w['times_median']:.1f}"
+            run = w.get("run_id", "–")
+            lines.append(
+                f"| {name} | {sensors} | {run} | {cost} | {' | '.join(counts)} | {status} |"
+            )
+    lines.append("")
+    return lines
+
+
 def render_report(
     table: pd.DataFrame,
     study: Any,
@@ -397,6 +431,7 @@ def render_report(
             "",
         ]
     lines += [f"## Where {s.name} fails", "", *_where_fails(out, study)]
+    lines += _slowest_trials(out, study)
     lines += ["## What ran", "", "| row | task | sensors | source | sweep (s) | CPU (s) |",
               "|---|---|---|---|---|---|"]  # fmt: skip
     for c in description["cells"]:

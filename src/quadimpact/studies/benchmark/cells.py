@@ -70,7 +70,7 @@ KEPT = (
     "inclination_deg", "time_to_recover_s", "time_to_hover_s", "height_lost_m",
     "min_altitude_m", "horizontal_drift_m", "detected", "not_detected", "false_detection",
     "t_stage1_s", "max_tilt_deg", "impacts_after_detection", "cost__kernel_cpu_s",
-    "cost__total_cpu_s",
+    "cost__total_cpu_s", "integrator__steps", "integrator__rejected_steps", "n_episodes",
 )  # fmt: skip
 #: The per-trial columns a cell of suite 2 keeps: suite 1's, the held hover's and the crash.
 KEPT_HELD = (

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+from quadimpact.studies.slowest import slowest_lines
 from quadimpact.studies.statistics import rate_text
 
 __all__ = ["render_report"]
@@ -97,6 +98,7 @@ def render_report(description: dict[str, Any], numbers: dict[str, Any], figures:
     if "laws" in numbers:
         lines += ["", *_laws_section(numbers, st["model"], examples)]
     lines += _failures_lines(numbers["failures"], arms, st)
+    lines += ["", *slowest_lines(description.get("slowest_trials"))]
     for path in figures:
         if path in examples:
             continue

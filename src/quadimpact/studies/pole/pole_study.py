@@ -42,6 +42,7 @@ from quadimpact.inputs.toml_files import read_toml_file
 from quadimpact.inputs.vehicle import bundled_vehicles, load_vehicle
 from quadimpact.inputs.world import obstacle_from
 from quadimpact.results.files import atomic_write
+from quadimpact.studies.slowest import slowest_trials
 from quadimpact.studies.study_folder import SWEEP_DIR, TRIALS_PARQUET, StudyFolder, describe_run
 from quadimpact.studies.trial_analysis import (  # the analysis the studies share, here too
     SUCCESS_LOSS_M,
@@ -554,6 +555,7 @@ def run_pole_study(
         "elapsed_s": elapsed,
         "numbers": numbers,
         "figures": [str(p.relative_to(out)) for p in paths],
+        "slowest_trials": slowest_trials(table, ("run_id", "arm", "pitch_deg", "lateral_offset_m")),
     }
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
     report_path = folder.finish(description, md)

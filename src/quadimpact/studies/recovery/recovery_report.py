@@ -18,6 +18,7 @@ import pandas as pd
 from quadimpact.results.costs import cost_text
 from quadimpact.studies.recovery.estimation_numbers import estimation_lines
 from quadimpact.studies.recovery.recovery_analysis import FLIP_DEG, OUTCOME_CLASSES
+from quadimpact.studies.slowest import slowest_lines
 from quadimpact.studies.statistics import percent, rate_text
 
 __all__ = [
@@ -368,6 +369,7 @@ def render_report(
         *_failures(numbers),
         *estimation_lines(numbers),
     ]  # fmt: skip
+    lines += slowest_lines(d.get("slowest_trials"))
     ex = d.get("example")
     if ex is not None:
         lines += _example_lines(ex, names)

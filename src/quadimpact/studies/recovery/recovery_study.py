@@ -49,6 +49,7 @@ from quadimpact.studies.recovery.recovery_spec import (  # noqa: F401  (the spec
     RecoveryStudy,
     sample_trials,
 )
+from quadimpact.studies.slowest import slowest_trials
 from quadimpact.studies.study_folder import (
     SWEEP_DIR,
     TRIALS_PARQUET,
@@ -405,6 +406,7 @@ def _finish(
     description["elapsed_s"] = elapsed
     description["figures"] = [str(p.relative_to(out)) for p in paths]
     description["example_dir"] = None if example_dir is None else str(example_dir.relative_to(out))
+    description["slowest_trials"] = slowest_trials(table, ("run_id", "arm", "seed"))
     md = report.render_report(description, numbers, [p.relative_to(out) for p in paths])
     report_path = folder.finish(description, md)
     for w in warnings:

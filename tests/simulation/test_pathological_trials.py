@@ -1,0 +1,77 @@
+"""Trials that cost a thousand times their task's median (issue 59) now take a bounded step count.
+
+Both were ring contacts whose contact point jumped between evaluations of the right-hand
+side, so the contact moment was discontinuous and the integrator rejected step after step
+(docs/NUMERICS.md, "Pathological trials"):
+
+* the ``pole-replica`` row's edge trial (pitch -42 deg, offset 0.2 m, ideal sensors): a
+  bumper ring across the pillar's vertical edge, its two crossings of the edge equally deep;
+  the deepest point jumped from one to the other (18 cm apart) and the run chattered between
+  them: 536,608 steps (377,431 rejected), 9 s of CPU; now 7,031;
+* the pole trial at pitch -30 deg, offset 0, with the plug-in of
+  ``examples/benchmark_controller.py`` and the ``impact`` sensors: two rings around the pole,
+  whose deepest points the branch and bound gave only to about 1e-6 rad: 84,866 steps
+  (27,543 rejected), 14 s of CPU; now 14,265.
+
+The bounds count steps (accepted and rejected), not time. The runs' physics is checked
+elsewhere (tests/simulation/test_obstacles.py); here they complete within a few times their
+present count, far below the step budget.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+from quadimpact import simulate
+from quadimpact.inputs.scenarios import scenario_from_dict
+from quadimpact.studies.benchmark.subject import Subject
+from quadimpact.studies.benchmark.suite import sensor_set, task
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+
+
+def _trial(subject: Subject, task_name: str, sensors: str, pitch_deg: float, offset_m: float):
+    """The quick suite's grid trial at (pitch, offset), as the benchmark builds it."""
+    spec = subject.spec(task(task_name), True, sensor_set(sensors))
+    for i in range(spec.n_runs):
+        v = spec.inputs(i)
+        if v["pitch_deg"] == pitch_deg and abs(v["lateral_offset_m"] - offset_m) < 1e-9:
+            return scenario_from_dict(spec.scenario_dict(i))
+    raise AssertionError(f"no point ({pitch_deg}, {offset_m}) in the {task_name} grid")
+
+
+def _steps(summary) -> int:
+    counters = summary["integrator"]
+    return int(counters["steps"]) + int(counters["rejected_steps"])
+
+
+def test_the_pole_replicas_edge_trial_takes_a_bounded_step_count():
+    """The hoop across the pillar's edge: 536,608 steps before the fix, 7,031 after."""
+    subject = Subject("pole-replica", model="pole-replica")
+    summary = simulate(_trial(subject, "edge", "ideal", -42.0, 0.2)).summary
+    assert summary["status"] == "completed"
+    assert _steps(summary) < 20_000
+
+
+@pytest.mark.slow
+def test_the_example_plug_ins_pole_trial_takes_a_bounded_step_count():
+    """Two rings around the pole: 84,866 steps before the fix, 14,265 after (the plug-in's
+    loop compiles first: about 30 s)."""
+    from quadimpact.inputs.controllers import unregister_controller
+
+    spec = importlib.util.spec_from_file_location(
+        "benchmark_controller", EXAMPLES / "benchmark_controller.py"
+    )
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)  # registers "level-first"
+    try:
+        subject = Subject("level-first", controller="level-first")
+        summary = simulate(_trial(subject, "pole", "impact", -30.0, 0.0)).summary
+    finally:
+        unregister_controller("level-first")
+    assert summary["status"] == "completed"
+    assert _steps(summary) < 30_000
