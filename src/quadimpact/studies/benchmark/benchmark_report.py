@@ -338,7 +338,7 @@ def _slowest_trials(out: Path, study: Any) -> list[str]:
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for name in study.tasks:
-        for sensors in SENSOR_SETS:
+        for sensors in study.sensor_sets():
             t = _cell(out, study.subject.name, name, sensors)
             found = None if t is None else slowest_trials(t, n=1)
             if found is None:

@@ -75,7 +75,7 @@ KEPT = (
 #: The per-trial columns a cell of suite 2 keeps: suite 1's, the held hover's and the crash.
 KEPT_HELD = (
     *KEPT, "published_success", "held_hover", "time_to_held_hover_s", "held_hover_distance_m",
-    "touched_after_hover", "crash_time_s", "first_contact_s", "n_steps", "n_rejected_steps",
+    "touched_after_hover", "crash_time_s", "first_contact_s",
 )  # fmt: skip
 
 
@@ -135,8 +135,6 @@ def cell_table(
         t["valid"] = True
     if not suite(version).held_hover:
         return t[[c for c in KEPT if c in t.columns]].copy()
-    t = t.rename(columns={"integrator__steps": "n_steps",
-                          "integrator__rejected_steps": "n_rejected_steps"})  # fmt: skip
     crashed = pd.to_numeric(t["crash_time_s"], errors="coerce").notna().to_numpy()
     t["published_success"] = t["success"].to_numpy(dtype=bool) & ~crashed  # the ground is there
     t["valid"] = analysis.valid_mask(t) if task.kind == "wall" else analysis.model_valid(t)
