@@ -39,6 +39,25 @@ def test_the_suite_sizes():
         parse_tasks("wall,")
 
 
+def test_the_sensor_sets_of_each_suite():
+    """Suite 2 flies ideal and lab, impact only when named; suite 1 ideal and impact."""
+    from quadimpact.studies.benchmark.suite import parse_sensor_sets, suite
+
+    assert parse_sensor_sets(None) == ("ideal", "lab")
+    assert parse_sensor_sets("impact, ideal") == ("ideal", "impact")
+    assert parse_sensor_sets(None, "1") == ("ideal", "impact")
+    with pytest.raises(InputError, match="--sensors: suite 1 flies ideal, impact"):
+        parse_sensor_sets("lab", "1")
+    with pytest.raises(InputError, match="--sensors: a sensor set named twice"):
+        parse_sensor_sets("lab,lab")
+    with pytest.raises(InputError, match="--sensors: unknown sensor set 'gps'"):
+        parse_sensor_sets("gps")
+    with pytest.raises(InputError, match="--suite: unknown suite version '3'"):
+        suite("3")
+    assert sensor_set("lab").sensors == "indoor" and sensor_set("lab", "ekf-additive").estimator \
+        == "ekf-additive"  # fmt: skip
+
+
 def test_the_wall_task_is_the_recovery_studys_trials():
     from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
 
