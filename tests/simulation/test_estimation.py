@@ -24,7 +24,8 @@ from quadimpact.studies.recovery.recovery_study import sample_trials
 TRIAL = {"roll_deg": 8.0, "pitch_deg": -25.0, "yaw_deg": 10.0, "speed_m_s": 1.6, "seed": 11}
 UP_TO_STAGE4 = [k for k in RECOVERY_KEYS if k not in (
     "t_stage5_s", "time_to_hover_s", "min_altitude_m", "impacts_after_detection",
-    "max_tilt_deg", "max_rate_rad_s", "final_speed_m_s")]  # fmt: skip
+    "max_tilt_deg", "max_rate_rad_s", "final_speed_m_s", "held_hover", "time_to_held_hover_s",
+    "held_hover_distance_m", "touched_after_hover")]  # fmt: skip
 
 
 def test_ideal_is_the_default_and_changes_nothing():

@@ -35,7 +35,7 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 def _trial(subject: Subject, task_name: str, sensors: str, pitch_deg: float, offset_m: float):
     """The quick suite's grid trial at (pitch, offset), as the benchmark builds it."""
-    spec = subject.spec(task(task_name), True, sensor_set(sensors))
+    spec = subject.spec(task(task_name), True, sensor_set(sensors), version="1")
     for i in range(spec.n_runs):
         v = spec.inputs(i)
         if v["pitch_deg"] == pitch_deg and abs(v["lateral_offset_m"] - offset_m) < 1e-9:

@@ -34,12 +34,13 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.scenarios import ImpactTrial
 
 if TYPE_CHECKING:
+    import pandas as pd
+
     from quadimpact.sweep import SweepSpec
 
 __all__ = [
@@ -123,6 +124,8 @@ def _edge(x: float) -> str:
 
 def binned(values: pd.Series, width: float, offset: float = 0.0) -> pd.Series:
     """Each value's bin label (``"[lo, hi)"``, the last ``"[lo, hi]"``), ordered categories."""
+    import pandas as pd
+
     v = values.to_numpy(dtype=float)
     edges = bin_edges(v, width, offset)
     n_bins = len(edges) - 1
@@ -166,6 +169,8 @@ def _flag(table: pd.DataFrame, column: str) -> np.ndarray:
 
 def outcome_class(table: pd.DataFrame) -> pd.Series:
     """Each trial's class (:data:`OUTCOME_CLASSES`, see the module docstring)."""
+    import pandas as pd
+
     from quadimpact.simulation.checks import STARTED_IN_CONTACT
 
     failed = (table["status"] == "failed").to_numpy()
