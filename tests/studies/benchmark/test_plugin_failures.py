@@ -17,14 +17,12 @@ from __future__ import annotations
 
 import functools
 import json
-import warnings
 
 import numpy as np
 import pandas as pd
 import pytest
 from numba import njit
 
-from quadimpact.cli import main
 from quadimpact.core import named
 from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import register_controller, unregister_controller
@@ -35,6 +33,8 @@ from quadimpact.simulation.plugin_kernel import PluginError, plugin_failure, typ
 from quadimpact.studies.benchmark import benchmark_study
 from quadimpact.studies.benchmark.benchmark_study import BenchmarkStudy, run_benchmark
 from quadimpact.studies.benchmark.subject import Subject
+
+from helpers import cli_here
 
 
 # ------------------------------------------------------------------ the steps
@@ -173,18 +173,6 @@ def test_a_plugins_failed_runs_are_found_and_ordinary_failures_are_not():
     assert plugin_failure(runs.iloc[:2]) is None  # a numerical failure stays a failed run
 
 
-def _cli(capsys, *args: str) -> tuple[int, str]:
-    shown = warnings.showwarning
-    try:
-        main(list(args))
-        code = 0
-    except SystemExit as exc:
-        code = int(exc.code or 0)
-    finally:
-        warnings.showwarning = shown
-    return code, capsys.readouterr().err
-
-
 def _one_error_line(code: int, err: str, *fragments: str) -> str:
     assert code == 2, err
     lines = [ln for ln in err.strip().splitlines() if ln.startswith("quadimpact: error: ")]
@@ -202,7 +190,7 @@ def test_the_benchmark_command_refuses_a_bad_plugin_before_any_trial(
     plugins, capsys, tmp_path, name, fragment
 ):
     out = tmp_path / "bench"
-    code, err = _cli(
+    code, err = cli_here(
         capsys, "benchmark", "--quick", "--controller", name, "--no-references", "--no-cache",
         "--workers", "1", "--no-progress", "--out", str(out),
     )  # fmt: skip
@@ -213,7 +201,7 @@ def test_the_benchmark_command_refuses_a_bad_plugin_before_any_trial(
 
 def test_quadimpact_run_refuses_a_bad_plugin_before_it_flies(plugins, capsys, tmp_path):
     out = tmp_path / "run"
-    code, err = _cli(
+    code, err = cli_here(
         capsys, "run", "--controller", "t-reads-past-its-memory", "--final-time", "0.6",
         "--out", str(out),
     )  # fmt: skip
@@ -232,7 +220,7 @@ def test_the_studies_refuse_a_bad_estimator_plugin_before_any_trial(
     plugins, capsys, tmp_path, args
 ):
     out = tmp_path / "study"
-    code, err = _cli(
+    code, err = cli_here(
         capsys, *args, "--estimator", "t-estimator-raises", "--workers", "1", "--no-progress",
         "--out", str(out),
     )  # fmt: skip
@@ -275,7 +263,7 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
             "benchmark", "--tasks", "wall,pole", "--controller", name, "--no-references",
             "--no-cache", "--workers", "1", "--out", str(out),
         )  # fmt: skip
-        code, err = _cli(capsys, *args)
+        code, err = cli_here(capsys, *args)
         _one_error_line(
             code, err, f"benchmark: {name} pole/ideal, run 2: ", "offset_trials_raise",
             "raised ValueError: this trial is too far to the side for me",
@@ -292,7 +280,7 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
 
         # fixed (never raising): the same command resumes, the wall cells not flown again
         _raising_from(1.0, name)
-        code, err = _cli(capsys, *args)
+        code, err = cli_here(capsys, *args)
         assert code == 0, err
         assert wall_sweep.stat().st_mtime_ns == stamp
         t = pd.read_csv(out / "benchmark.csv")
