@@ -213,15 +213,24 @@ def valid_mask(table: pd.DataFrame) -> np.ndarray:
 
 
 def model_valid(table: pd.DataFrame) -> np.ndarray:
-    """The trials whose outcome means something, whatever the task: not of an
-    :data:`EXCLUDED_CLASSES` class (started in contact, failed, bumper model exceeded)."""
-    failed = (table["status"] == "failed").to_numpy()  # a run started in contact fails too
+    """The trials whose outcome means something, whatever the task (the benchmark's
+    suite 2): not started in contact and no bumper beyond its radius. A run that failed
+    numerically stays: it counts as a failure, never as a success."""
+    from quadimpact.simulation.checks import STARTED_IN_CONTACT
+
+    failed = (table["status"] == "failed").to_numpy()
+    reason = table["reason"].fillna("").astype(str) if "reason" in table else None
+    in_contact = (
+        failed & reason.str.contains(STARTED_IN_CONTACT, regex=False).to_numpy()
+        if reason is not None
+        else np.zeros(len(table), dtype=bool)
+    )
     too_deep = (
         (table["bumper_model_valid"] == False).fillna(False).to_numpy(dtype=bool)  # noqa: E712
         if "bumper_model_valid" in table
         else np.zeros(len(table), dtype=bool)
     )
-    return ~(failed | too_deep)
+    return ~(in_contact | too_deep)
 
 
 def success_mask(table: pd.DataFrame) -> np.ndarray:

@@ -137,7 +137,7 @@ def cell_table(
         return t[[c for c in KEPT if c in t.columns]].copy()
     crashed = pd.to_numeric(t["crash_time_s"], errors="coerce").notna().to_numpy()
     t["published_success"] = t["success"].to_numpy(dtype=bool) & ~crashed  # the ground is there
-    t["valid"] = analysis.valid_mask(t) if task.kind == "wall" else analysis.model_valid(t)
+    t["valid"] = analysis.model_valid(t)
     lowest = pd.to_numeric(t["min_altitude_m"], errors="coerce").to_numpy(dtype=float)
     t["height_lost_m"] = altitude - lowest
     t["success"] = held_hover_success(t)
