@@ -6,16 +6,20 @@
 Both are drawn from ``benchmark.csv``'s table and the cells' trials tables
 (``cells/<row>/<task>-<sensors>.parquet``), never from numbers typed in:
 
-* the **leaderboard**, one table per task: every row with each sensor set,
-  ranked by its success with the ``ideal`` sensors, with its 95 % Wilson
-  interval, what the ``impact`` sensors cost it, the times, the height lost,
-  the drift, the missed and false detections, the CPU time and where the line
-  comes from (run now, the cache, or the authors' publication);
+* the **leaderboard**, one table per task: every row with each sensor set of
+  the suite, ranked by its success with the first (``ideal``), with its 95 %
+  Wilson interval; in suite 2 its paired difference to the default row, the
+  published criterion, the time and distance to the hover; in suite 1 what
+  the ``impact`` sensors cost it, the times to recover and to hover, the drift;
+  in both the height lost, the missed and false detections, the CPU time and
+  where the line comes from (run now, the cache, or the authors' publication);
+* in suite 2, **what the suite resolves**: the half-widths of the rows'
+  paired intervals, per task and sensor set;
 * the subject **against each reference**, trial by trial (the same trials):
   the trials only one of the two succeeds on;
 * **where the subject fails**: success by inclination bin (the wall) or pitch
-  band (the grids);
-* **what ran**: each cell's source and time.
+  band (the grids), bins in order;
+* its **slowest trials** and **what ran**: each cell's source and time.
 """
 
 from __future__ import annotations
