@@ -342,6 +342,10 @@ SC_POSE_LAG = _scfg.slot("SC_POSE_LAG")  # latency, IMU samples (< MAX_POSE_LAG)
 SC_IMPACT_REPLACE = _scfg.slot("SC_IMPACT_REPLACE")  # 1: the impact noise replaces the nominal
 #   noise while it is the larger, restarting at each onset (the authors' model); 0: added
 SC_MAG_BIAS = _scfg.slot("SC_MAG_BIAS", 3)  # magnetometer static bias, body (drawn per run)
+# the sensor components' tails (core/sensors/registry.py): their sizes in this run's arrays
+SC_TAIL_ST = _scfg.slot("SC_TAIL_ST")  # numbers after NSST in sst
+SC_TAIL_MEAS = _scfg.slot("SC_TAIL_MEAS")  # numbers after NMEAS in meas
+SC_TAIL_REC = _scfg.slot("SC_TAIL_REC")  # columns after NIMU in each imu row
 NSCFG = _scfg.end("NSCFG")
 MAX_POSE_LAG = 64  # IMU samples
 MAX_AVERAGE_WINDOW = 64  # samples

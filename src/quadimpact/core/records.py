@@ -58,6 +58,9 @@ from quadimpact.core.layout import (
     NSST,
     NSTAT,
     NX,
+    SC_TAIL_MEAS,
+    SC_TAIL_REC,
+    SC_TAIL_ST,
     SPAN_T0,
     SPAN_TF,
     ST_N_EPISODES,
@@ -103,6 +106,7 @@ class Model(NamedTuple):
     t_out: np.ndarray  # (n_out,) output times, s
     ecfg: np.ndarray  # (NECFG,) estimator: kind, initial error, gains, noises
     snoise: np.ndarray  # (n_snoise, NSN) standard normal draws of the added sensors
+    cnoise: np.ndarray  # (n_cnoise, noise tail) the sensor components' draws (sensors/registry.py)
 
 
 class Data(NamedTuple):
@@ -114,15 +118,15 @@ class Data(NamedTuple):
     rin: np.ndarray  # (NRIN,) rotor inputs of the interval
     mem: np.ndarray  # (NMEM,) controller memory
     est: np.ndarray  # (NEST,) estimator state
-    meas: np.ndarray  # (NMEAS,) measurement record
-    sst: np.ndarray  # (NSST,) sensor state
+    meas: np.ndarray  # (NMEAS + measurement tail,) measurement record
+    sst: np.ndarray  # (NSST + state tail,) sensor state
 
 
 class Output(NamedTuple):
     """What a run returns (the caller allocates it; the loop fills it)."""
 
     out: np.ndarray  # (n_out, out_width(n_features)) time series at t_out
-    imu: np.ndarray  # (n_imu, NIMU) IMU samples
+    imu: np.ndarray  # (n_imu, NIMU + record tail) IMU samples
     episodes: np.ndarray  # (max_episodes, NEP) contact episodes
     stats: np.ndarray  # (NSTAT,) status, counters, records
 
@@ -148,6 +152,12 @@ class Work(NamedTuple):
 
 
 # ---------------------------------------------------------------- factories
+@njit(cache=True, inline="always")
+def tail_size(scfg: np.ndarray, slot: int) -> int:
+    """A sensor-component tail's size written in ``scfg`` (0 for a run packed without one)."""
+    return int(scfg[slot]) if scfg.shape[0] > slot else 0
+
+
 @njit(cache=True)
 def new_data(m: Model) -> Data:
     """Zeroed loop state for the run ``m`` (``step.start`` initialises it)."""
@@ -158,8 +168,8 @@ def new_data(m: Model) -> Data:
         np.zeros(NRIN),
         np.zeros(NMEM),
         np.zeros(NEST),
-        np.zeros(NMEAS),
-        np.zeros(NSST),
+        np.zeros(NMEAS + tail_size(m.scfg, SC_TAIL_MEAS)),
+        np.zeros(NSST + tail_size(m.scfg, SC_TAIL_ST)),
     )
 
 
@@ -182,7 +192,7 @@ def new_output(
     width = NOUT + 2 * m.feat.shape[0] if contact_columns else NOUT  # layout.out_width
     return Output(
         np.zeros((m.t_out.shape[0] if rows else 0, width)),
-        np.zeros((max(n_imu, 0), NIMU)),
+        np.zeros((max(n_imu, 0), NIMU + tail_size(m.scfg, SC_TAIL_REC))),
         np.zeros((max_episodes, NEP)),
         np.zeros(NSTAT),
     )
@@ -222,6 +232,7 @@ MODEL_ABSENT: dict[str, tuple[int, ...]] = {
     "t_out": (0,),
     "ecfg": (NECFG,),
     "snoise": (0, NSN),
+    "cnoise": (0, 0),
 }
 
 
@@ -252,6 +263,7 @@ def model(
     sched_stop: np.ndarray | None = None,
     ecfg: np.ndarray | None = None,
     snoise: np.ndarray | None = None,
+    cnoise: np.ndarray | None = None,
 ) -> Model:
     """A :class:`Model` of contiguous arrays (absent sensors, schedule, estimator: none, ideal).
 
@@ -262,7 +274,7 @@ def model(
         "x0": x0, "veh": veh, "feat": feat, "shapes": shapes, "pairs": pairs, "opts": opts,
         "ctrl": ctrl, "scfg": scfg, "noise": noise, "sched_t": sched_t,
         "sched_rate": sched_rate, "sched_stop": sched_stop, "t_out": t_out, "ecfg": ecfg,
-        "snoise": snoise,
+        "snoise": snoise, "cnoise": cnoise,
     }  # fmt: skip
     fields = {name: model_array(name, a) for name, a in arrays.items()}
     return Model(span=model_span(t0, tf), **fields)
@@ -297,6 +309,7 @@ def model_row(M: Model, k: int) -> Model:
         M.t_out[k],
         M.ecfg[k],
         M.snoise[k],
+        M.cnoise[k],
     )
 
 

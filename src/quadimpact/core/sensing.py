@@ -1,7 +1,8 @@
 """The sensor stage of the loop: one IMU sample, the estimator's update there, detection.
 
 At each IMU sample: the IMU (``imu.py``), the magnetometer and the pose
-sensor when the run has them (``magnetometer.py``, ``pose.py``), the
+sensor when the run has them (``magnetometer.py``, ``pose.py``), every
+sensor component (``sensors/registry.py``: the barometer...), the
 estimator's update (``core/estimators``), the detector with the estimated
 attitude (``detection.py``), then a plug-in sensor. The run loop takes the
 samples on the dense output of each step (so a sample at a control tick
@@ -22,6 +23,7 @@ from quadimpact.core.sensors.detection import detect
 from quadimpact.core.sensors.imu import imu_sample
 from quadimpact.core.sensors.magnetometer import magnetometer_sample
 from quadimpact.core.sensors.pose import pose_sample
+from quadimpact.core.sensors.registry import sample_components
 
 
 @njit(cache=True, inline="always")
@@ -48,6 +50,7 @@ def take_sample(
     imu_sample(t, xs, xd, w.C, m, d, o)
     magnetometer_sample(t, w.C, m, d, o)
     pose_sample(t, xs, m, d, o)
+    sample_components(t, xs, xd, w.C, m, d, o)
     estimate_sample(t, xs, w.C, m, d, o, w)
     detect(t, xs, attitude_at_sample(t, xs, w.C, m, d, w), m, d, o)
     plugin_sensor(t, xs, xd, w.C, m, d)

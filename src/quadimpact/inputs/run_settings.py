@@ -32,6 +32,7 @@ from quadimpact.inputs.sensors import (
     SENSOR_PRESETS,
     DetectionSettings,
     ImuSettings,
+    Instruments,
     Magnetometer,
     PoseSensor,
 )
@@ -183,6 +184,10 @@ class RunSettings(BaseModel):
         A magnetometer sampled with the IMU (docs/ESTIMATION.md); ``None``: none.
     pose_sensor : PoseSensor or None
         A pose sensor (motion capture, vision); ``None``: none.
+    instruments : dict
+        Sensor components (``core/sensors/registry.py``: the barometer, and
+        any plug-in registered) by name, each with its validated settings;
+        empty by default.
     sensors : {"ideal", "noisy", "impact", "indoor"} or None
         A preset of sensors (:data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`):
         it sets ``imu``, ``magnetometer`` and ``pose_sensor`` where the scenario
@@ -298,6 +303,11 @@ class RunSettings(BaseModel):
 
     magnetometer: Magnetometer | None = Field(None, description="A magnetometer (None: none).")
     pose_sensor: PoseSensor | None = Field(None, description="A pose sensor (None: none).")
+    instruments: Instruments = Field(
+        default_factory=dict,
+        description="Sensor components by name, each with its settings table "
+        "([instruments.barometer]); none by default.",
+    )
     sensors: Literal["ideal", "noisy", "impact", "indoor", "authors-2016"] | None = Field(
         None, description="A preset of sensors (imu, magnetometer, pose_sensor not set)."
     )

@@ -34,9 +34,17 @@ preset has both (with the ``"noisy"`` preset's noise).
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from collections.abc import Mapping
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, StrictBool, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    BeforeValidator,
+    Field,
+    StrictBool,
+    field_validator,
+    model_validator,
+)
 
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3
 
@@ -46,6 +54,7 @@ __all__ = [
     "DetectionSettings",
     "ImpactDisturbance",
     "ImuSettings",
+    "Instruments",
     "Magnetometer",
     "PoseSensor",
     "ResolvedImu",
@@ -366,3 +375,51 @@ class DetectionSettings(BaseModel):
         if isinstance(value, bool):
             raise ValueError("must be an integer")
         return value
+
+
+def _instruments(value: Any) -> dict[str, Any]:
+    """A scenario's ``instruments``: component name -> its settings, validated by its model.
+
+    Each value is a table of the component's settings (``{}``: its defaults)
+    or ``true`` (the defaults too); ``false`` or an absent name: none.
+    """
+    from pydantic import ValidationError
+
+    from quadimpact.core.sensors.registry import component, components
+    from quadimpact.errors import format_value, input_error_from_validation
+
+    if value is None:
+        return {}
+    if not isinstance(value, Mapping):
+        raise ValueError(
+            "must be a table of sensor name = settings table ([instruments.barometer])"
+        )
+    out: dict[str, Any] = {}
+    for name, table in value.items():
+        try:
+            comp = component(str(name))
+        except KeyError:
+            known = ", ".join(repr(c.name) for c in components())
+            raise ValueError(f"{name}: no such sensor component (registered: {known})") from None
+        if table is False:
+            continue
+        if table is True:
+            table = {}
+        if isinstance(table, comp.settings):
+            out[comp.name] = table
+            continue
+        if hasattr(table, "model_dump"):
+            table = table.model_dump()
+        if not isinstance(table, Mapping):
+            raise ValueError(
+                f"{name}: must be a table of its settings or true (got {format_value(table)})"
+            )
+        try:
+            out[comp.name] = comp.settings.model_validate(dict(table))
+        except ValidationError as exc:
+            raise ValueError(str(input_error_from_validation(exc, str(name)))) from None
+    return out
+
+
+Instruments = Annotated[dict[str, Any], BeforeValidator(_instruments)]
+"""A scenario's sensor components by name (``core/sensors/registry.py``), validated."""

@@ -21,11 +21,13 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import Model, model
+from quadimpact.core.sensors.component import PackContext as ComponentContext
 from quadimpact.inputs.controllers import ControllerEntry, PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.run_settings import RunSettings
 from quadimpact.inputs.sensors import ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.packing.component_block import draw_component_noise, pack_components
 from quadimpact.packing.controller_block import pack_controller, set_references
 from quadimpact.packing.estimator_block import Estimation, draw_estimation, pack_estimation
 from quadimpact.packing.options_block import (
@@ -69,6 +71,8 @@ class SharedPacking:
         The controller's registry entry it was packed with.
     context : PackContext
         What the controller's packer was given (vehicle, options, pre-impact behaviour).
+    instruments : dict
+        The sensor components the run has, name -> settings (what their draws need).
     resolved : dict
         What the settings resolved to, as plain data (``scenario.json``'s ``resolved``).
     """
@@ -80,6 +84,7 @@ class SharedPacking:
     entry: ControllerEntry
     context: PackContext
     resolved: dict[str, Any]
+    instruments: dict[str, Any]
 
 
 def pack_shared(
@@ -104,6 +109,15 @@ def pack_shared(
     )
     imu = s.imu.resolved(v.imu_position_m, control_rate_hz(s))
     scfg, n_imu = pack_sensors(imu, s.detection, v, duration_s)
+    scfg = pack_components(
+        scfg,
+        s.instruments,
+        ComponentContext(
+            gravity_m_s2=float(v.gravity_m_s2),
+            imu_rate_hz=float(imu.rate_hz),
+            duration_s=float(duration_s),
+        ),
+    )
     est = pack_estimation(s, imu, scfg, v)
     params = s.resolved_controller_params()
     feat = pack_features(v, s.friction_coefficient, o.bumper_force_scale)
@@ -136,7 +150,9 @@ def pack_shared(
         "rotor_slew_limit_rad_s2": slew_limit_rad_s2(s, v),
         **(est.resolved or {}),
     }
-    return SharedPacking(packed, n_imu, imu, est, entry, context, resolved)
+    if s.instruments:
+        resolved["instruments"] = {k: v.model_dump(mode="json") for k, v in s.instruments.items()}
+    return SharedPacking(packed, n_imu, imu, est, entry, context, resolved, dict(s.instruments))
 
 
 def pack_own(shared: SharedPacking, seed: int, refs: dict[str, float]) -> dict[str, np.ndarray]:
@@ -144,13 +160,22 @@ def pack_own(shared: SharedPacking, seed: int, refs: dict[str, float]) -> dict[s
 
     ``refs``: ``altitude_m`` (m), ``roll_rad``, ``pitch_rad``, ``yaw_rad``
     (rad). Returns ``ctrl``, ``scfg`` (with the IMU's drawn biases),
-    ``noise``, ``ecfg`` (with the estimator's initial error) and ``snoise``;
+    ``noise``, ``ecfg`` (with the estimator's initial error), ``snoise`` and
+    ``cnoise`` (the sensor components' draws);
     the shared arrays are not changed.
     """
     base = shared.model
     scfg = base.scfg.copy()
     noise = draw_imu_noise(shared.imu, seed, shared.n_imu, scfg)
     ecfg, snoise = draw_estimation(shared.est, seed, shared.n_imu, scfg)
+    cnoise = draw_component_noise(shared.instruments, seed, shared.n_imu)
     ctrl = base.ctrl.copy()
     set_references(ctrl, refs)
-    return {"ctrl": ctrl, "scfg": scfg, "noise": noise, "ecfg": ecfg, "snoise": snoise}
+    return {
+        "ctrl": ctrl,
+        "scfg": scfg,
+        "noise": noise,
+        "ecfg": ecfg,
+        "snoise": snoise,
+        "cnoise": cnoise,
+    }

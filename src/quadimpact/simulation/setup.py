@@ -59,7 +59,7 @@ __all__ = [
 #: may change (``t0`` and ``tf`` are its ``span``).
 MODEL_ARRAYS = (
     "x0", "veh", "feat", "shapes", "pairs", "opts", "ctrl", "scfg", "noise", "sched_t",
-    "sched_rate", "sched_stop", "t_out", "ecfg", "snoise",
+    "sched_rate", "sched_stop", "t_out", "ecfg", "snoise", "cnoise",
 )  # fmt: skip
 
 
@@ -158,6 +158,7 @@ class RunSetup:
     sched_stop = property(lambda self: self.run.sched_stop, doc="Motors stalled at the trigger.")
     ecfg = property(lambda self: self.run.ecfg, doc="Estimator (``EC_*``).")
     snoise = property(lambda self: self.run.snoise, doc="The added sensors' normal draws.")
+    cnoise = property(lambda self: self.run.cnoise, doc="The sensor components' normal draws.")
 
 
 # ---------------------------------------------------------------- settings

@@ -181,10 +181,10 @@ def analyse(
         if name == "episodes_columns":
             return episode_columns(ep, ep.shape[0], names, nf)
         if name == "imu_columns":
-            return imu_columns(imu)
+            return imu_columns(imu, setup.scfg)
         if name == "world":
             return world_record(setup, scenario)
-        return imu_frame(imu)
+        return imu_frame(imu, setup.scfg)
 
     return SimulationResult(
         summary=summary,

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.sensors.registry import record_columns
 from quadimpact.inputs.features import feature_column
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
 from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
@@ -262,9 +263,14 @@ def timeseries_columns(
     return {k: np.array(v, dtype=np.float64) for k, v in data.items()}
 
 
-def imu_columns(raw: np.ndarray) -> dict[str, np.ndarray]:
-    """The columns of :func:`imu_frame` as NumPy arrays (no DataFrame)."""
-    rows = np.asarray(raw, dtype=np.float64).reshape(-1, L.NIMU)
+def imu_columns(raw: np.ndarray, scfg: np.ndarray | None = None) -> dict[str, np.ndarray]:
+    """The columns of :func:`imu_frame` as NumPy arrays (no DataFrame).
+
+    ``scfg``: the run's sensor settings; the sensor components it has add
+    their record columns (``<name>_<slot>``) after the fixed ones.
+    """
+    rows = np.asarray(raw, dtype=np.float64)
+    rows = rows.reshape(-1, rows.shape[-1] if rows.ndim == 2 else L.NIMU)
     sources = (
         L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
         L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
@@ -274,10 +280,14 @@ def imu_columns(raw: np.ndarray) -> dict[str, np.ndarray]:
         *range(L.I_VEL_HAT, L.I_VEL_HAT + 3), *range(L.I_POS_HAT, L.I_POS_HAT + 3),
         *range(L.I_BIAS_TRUE, L.I_BIAS_TRUE + 3), *range(L.I_ERR, L.I_ERR + 4),
     )  # fmt: skip
-    return {name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources, strict=True)}
+    out = {name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources, strict=True)}
+    if scfg is not None:
+        for name, col, _unit in record_columns(scfg):
+            out[name] = rows[:, col].copy() if col < rows.shape[1] else np.full(len(rows), np.nan)
+    return out
 
 
-def imu_frame(raw: np.ndarray) -> pd.DataFrame:
+def imu_frame(raw: np.ndarray, scfg: np.ndarray | None = None) -> pd.DataFrame:
     """IMU table from the kernel's IMU samples (layout ``I_*``).
 
     Returns
@@ -288,8 +298,9 @@ def imu_frame(raw: np.ndarray) -> pd.DataFrame:
         ``p/q/r_rad_s``; the true values (``*_true_*``); the detector's horizontal
         measure ``f_horizontal_m_s2``; the magnetometer and the pose sensor (NaN
         where absent); the estimate after the sample (``*_hat*``), the gyro's true
-        bias and the estimate's errors (docs/RESULTS.md).
+        bias and the estimate's errors (docs/RESULTS.md); then the columns of the
+        run's sensor components (``barometer_altitude_m``...), when ``scfg`` is given.
     """
     import pandas as pd
 
-    return pd.DataFrame(imu_columns(raw))
+    return pd.DataFrame(imu_columns(raw, scfg))

@@ -1,0 +1,148 @@
+"""A sensor component: everything one added sensor is, declared in one module.
+
+A component module (``barometer.py`` is the example) holds, side by side:
+
+* its **slot blocks**, each slot with a name, a width and a unit: ``config``
+  (what the run packs: rates, noises, switches), ``state`` (what it carries
+  between samples), ``measurement`` (what a controller or an estimator reads),
+  ``noise`` (standard normal draws per IMU sample, from the run's seed) and
+  ``record`` (the columns it adds to each row of the IMU table);
+* its **settings model** (pydantic): the table a scenario gives it
+  (``[instruments.<name>]``), with a default for every field;
+* its **pack function**: settings and the run's context to the config block;
+* its **compiled sample function**, called at every IMU sample.
+
+It registers with one line in ``registry.py`` (a built-in) or with
+:func:`~quadimpact.core.sensors.registry.register_sensor` (a plug-in). The
+registry lays the components' blocks one after another (an address from each
+declared size, as MuJoCo MJX computes ``sensor_adr`` from ``sensor_dim``) at
+the end of the run's arrays: config after ``scfg``'s ``SC_*`` slots, state
+after ``sst``'s, measurements after ``meas``'s, records after each IMU row's
+``I_*`` columns; its noise draws get a block of ``cnoise``. A component sees
+only its own blocks, as arrays indexed from 0 with its own slot offsets.
+
+The sample function's arguments, all SI, inertial NED and body FRD::
+
+    sample(t, x, xdot, C, veh, cfg, st, meas, noise, rec) -> None
+
+``t`` the IMU sample's time (s); ``x`` the true state and ``xdot`` its
+derivative (layout ``X_*``); ``C`` the body-to-inertial rotation of ``x``;
+``veh`` the vehicle's slots (``V_*``); ``cfg``, ``st``, ``meas`` its config,
+state and measurement blocks; ``noise`` its draws for this sample (empty
+when the run has none left); ``rec`` its columns of this sample's IMU row
+(empty when the table has no room). It is called at every IMU sample whether
+or not the run has the sensor: a sensor that is off (its config block all
+zeros, as when a scenario does not name it) must return at once. A sensor
+slower than the IMU keeps its own schedule in its state and samples at the
+first IMU sample at or after each of its times.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+__all__ = ["Slot", "SensorComponent", "offsets"]
+
+
+@dataclass(frozen=True)
+class Slot:
+    """One named slot of a component's block: ``width`` numbers in ``unit``."""
+
+    name: str
+    width: int = 1
+    unit: str = ""
+    doc: str = ""
+
+
+def offsets(slots: tuple[Slot, ...]) -> dict[str, int]:
+    """Each slot's offset in its block (slots laid out in declaration order)."""
+    out: dict[str, int] = {}
+    at = 0
+    for s in slots:
+        if s.name in out or s.width < 1:
+            raise ValueError(f"slot {s.name}: declared twice or with width < 1")
+        out[s.name] = at
+        at += s.width
+    return out
+
+
+def size(slots: tuple[Slot, ...]) -> int:
+    """The numbers a block of ``slots`` takes."""
+    return sum(s.width for s in slots)
+
+
+@dataclass(frozen=True)
+class SensorComponent:
+    """An added sensor, as its module declares it.
+
+    Parameters
+    ----------
+    name : str
+        Its name in scenario files (``[instruments.<name>]``) and the prefix
+        of its record columns (``<name>_<slot>``).
+    settings : type
+        Its settings model (a pydantic ``BaseModel``; every field defaulted).
+    pack : callable
+        ``pack(settings, context) -> sequence of floats``: the config block
+        (``context``: :class:`PackContext`). Every slot of a sensor that is
+        on must make the block differ from all zeros (zeros: off).
+    sample : numba function
+        The compiled sample function (module docstring).
+    config, state, measurement, noise, record : tuple of Slot
+        Its blocks.
+    doc : str
+        One line: what it measures.
+    """
+
+    name: str
+    settings: type
+    pack: Callable[..., Any]
+    sample: Callable[..., None]
+    config: tuple[Slot, ...] = ()
+    state: tuple[Slot, ...] = ()
+    measurement: tuple[Slot, ...] = ()
+    noise: tuple[Slot, ...] = ()
+    record: tuple[Slot, ...] = ()
+    doc: str = ""
+    plugin: bool = field(default=False, compare=False)
+
+    def sizes(self) -> tuple[int, int, int, int, int]:
+        """Numbers of its config, state, measurement, noise and record blocks."""
+        return (
+            size(self.config),
+            size(self.state),
+            size(self.measurement),
+            size(self.noise),
+            size(self.record),
+        )
+
+    def record_columns(self) -> list[tuple[str, str]]:
+        """Its record columns in order: ``(column name, unit)``, one per number."""
+        out = []
+        for s in self.record:
+            if s.width == 1:
+                out.append((f"{self.name}_{s.name}", s.unit))
+            else:
+                out += [(f"{self.name}_{s.name}_{k}", s.unit) for k in range(s.width)]
+        return out
+
+
+@dataclass(frozen=True)
+class PackContext:
+    """What a component's pack function may read of the run.
+
+    Attributes
+    ----------
+    gravity_m_s2 : float
+        The vehicle's gravity, m/s^2.
+    imu_rate_hz : float
+        The IMU's sample rate (the rate the sample function is called at), Hz.
+    duration_s : float
+        The run's length, s.
+    """
+
+    gravity_m_s2: float
+    imu_rate_hz: float
+    duration_s: float
