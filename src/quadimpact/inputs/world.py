@@ -23,7 +23,16 @@ from pydantic import (
 from quadimpact.errors import format_value
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3
 
-__all__ = ["GROUND", "OBSTACLE_KINDS", "Box", "Cylinder", "Obstacle", "Plane", "obstacle_from"]
+__all__ = [
+    "GROUND",
+    "OBSTACLE_KINDS",
+    "Box",
+    "Cylinder",
+    "Obstacle",
+    "Plane",
+    "obstacle_from",
+    "obstacle_models",
+]
 
 
 def _unit(value: tuple[float, float, float]) -> tuple[float, float, float]:
@@ -163,10 +172,19 @@ class Box(BaseModel):
 
 
 OBSTACLE_KINDS: dict[str, type[BaseModel]] = {"plane": Plane, "cylinder": Cylinder, "box": Box}
-"""Obstacle classes by their ``kind`` tag."""
+"""The original obstacle classes by their ``kind`` tag (:func:`obstacle_models` adds the
+shape components')."""
 
 
-def obstacle_from(value: Any, where: str = "obstacle") -> Plane | Cylinder | Box:
+def obstacle_models() -> dict[str, type[BaseModel]]:
+    """Every obstacle settings model by its ``kind`` tag: the original three, then the
+    shape components' (``core/geometry/shapes.py``)."""
+    from quadimpact.core.geometry.shapes import BUILTIN
+
+    return {**OBSTACLE_KINDS, **{c.name: c.settings for c in BUILTIN}}
+
+
+def obstacle_from(value: Any, where: str = "obstacle") -> Any:
     """One obstacle from a mapping with a ``kind`` (or an obstacle object, returned as is).
 
     Raises
@@ -174,16 +192,17 @@ def obstacle_from(value: Any, where: str = "obstacle") -> Plane | Cylinder | Box
     ValueError
         One line naming the field and the rule (pydantic adds the list's field).
     """
-    if isinstance(value, (Plane, Cylinder, Box)):
+    models = obstacle_models()
+    if isinstance(value, tuple(models.values())):
         return value
     if not isinstance(value, dict):
         raise ValueError(f"{where}: must be a table with a kind (got {format_value(value)})")
     kind = value.get("kind")
-    if kind not in OBSTACLE_KINDS:
-        known = ", ".join(repr(k) for k in OBSTACLE_KINDS)
+    if kind not in models:
+        known = ", ".join(repr(k) for k in models)
         raise ValueError(f"{where}: kind: must be one of {known} (got {format_value(kind)})")
     try:
-        return OBSTACLE_KINDS[kind].model_validate(value)
+        return models[kind].model_validate(value)
     except ValidationError as exc:
         from quadimpact.errors import input_error_from_validation
 
@@ -204,7 +223,7 @@ def _obstacles(value: Any) -> Any:
 
 
 Obstacle = Plane | Cylinder | Box
-"""Any obstacle shape."""
+"""Any of the original obstacle shapes (a shape component's settings are obstacles too)."""
 
-Obstacles = Annotated[tuple[Obstacle, ...], BeforeValidator(_obstacles)]
+Obstacles = Annotated[tuple[Any, ...], BeforeValidator(_obstacles)]
 """A scenario's obstacle list: tables with a ``kind``, validated one by one."""

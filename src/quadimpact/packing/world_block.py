@@ -9,6 +9,8 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.geometry.shapes import BUILTIN as SHAPE_COMPONENTS
+from quadimpact.core.geometry.shapes import by_kind, by_name, kind_of
 from quadimpact.inputs.world import Box, Cylinder, Plane
 from quadimpact.linalg import norm
 
@@ -19,6 +21,7 @@ SURFACE_KINDS: dict[str, int] = {
     "plane": L.SHAPE_PLANE,
     "cylinder": L.SHAPE_CYLINDER,
     "box": L.SHAPE_BOX,
+    **{c.name: kind_of(c) for c in SHAPE_COMPONENTS},
 }
 
 
@@ -31,6 +34,10 @@ def pack_surfaces(surfaces: Sequence[Plane | Cylinder | Box]) -> np.ndarray:
     """
     surf = np.zeros((len(surfaces), L.NSHAPE))
     for i, s in enumerate(surfaces):
+        comp = by_name(getattr(s, "kind", ""))
+        if comp is not None:  # a shape component: its declared slots
+            surf[i] = comp.pack(s, kind_of(comp))
+            continue
         surf[i, L.SH_IS_GROUND] = 1.0 if getattr(s, "is_ground", False) else 0.0
         if isinstance(s, Cylinder):
             e = np.asarray(s.axis, dtype=float)
@@ -82,6 +89,10 @@ def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, An
     out: list[dict[str, Any]] = []
     for name, row in zip(names, surf, strict=True):
         kind = kinds[int(row[L.SH_KIND])]
+        comp = by_kind(int(row[L.SH_KIND]))
+        if comp is not None:
+            out.append(comp.record(row, name))
+            continue
         if kind == "plane":
             rec: dict[str, Any] = {
                 "name": str(name),
@@ -129,6 +140,10 @@ def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
             known = ", ".join(SURFACE_KINDS)
             name = r.get("name")
             raise ValueError(f"surface {name!r}: kind must be one of {known} (got {kind!r})")
+        comp = by_name(kind)
+        if comp is not None:
+            surf[i] = comp.unpack(r, kind_of(comp))
+            continue
         surf[i, L.SH_IS_GROUND] = 1.0 if r.get("is_ground") else 0.0
         surf[i, L.SH_KIND] = SURFACE_KINDS[kind]
         if kind == "cylinder":

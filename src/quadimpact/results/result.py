@@ -326,6 +326,14 @@ _SHAPE_KEYS = {
 }
 
 
+def _component_keys(kind: str) -> tuple[str, ...] | None:
+    """The record keys of a shape component's surfaces (``core/geometry/shapes.py``)."""
+    from quadimpact.core.geometry.shapes import by_name
+
+    comp = by_name(kind)
+    return comp.record_keys() if comp is not None else None
+
+
 def _check_world(world: dict, path: Path) -> None:
     """Refuse a ``scenario.json`` whose parts are not what quadimpact writes (one line)."""
     for key, kinds in _WORLD_PARTS.items():
@@ -337,7 +345,7 @@ def _check_world(world: dict, path: Path) -> None:
             )
     for i, surface in enumerate(world.get("surfaces") or []):
         kind = surface.get("kind", "plane") if isinstance(surface, dict) else "plane"
-        keys = _SHAPE_KEYS.get(kind, _SURFACE_KEYS)
+        keys = _SHAPE_KEYS.get(kind) or _component_keys(kind) or _SURFACE_KEYS
         missing = [k for k in keys if not isinstance(surface, dict) or k not in surface]
         if missing:
             raise InputError(

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
+from quadimpact.core.geometry.shapes import by_kind, by_name
 from quadimpact.inputs.world import GROUND, Box, Cylinder, Plane, obstacle_from
 
 __all__ = ["plane_axes", "plane_grid", "rim_points", "scene_surfaces", "shape_lines", "world_part"]
@@ -68,6 +69,9 @@ def _surface_of_record(r: Mapping[str, Any]) -> Plane | Cylinder | Box:
     """The shape of a ``scenario.json`` surface record (its drawing; the kernel's numbers are
     packed from the records themselves)."""
     kind = r.get("kind", "plane")
+    comp = by_name(kind)
+    if comp is not None:
+        return obstacle_from({k: r[k] for k in comp.record_keys() if k != "is_ground"})
     if kind == "cylinder":
         return obstacle_from(
             {k: r[k] for k in ("name", "point_m", "axis", "radius_m", "length_m")}
@@ -122,6 +126,9 @@ def shape_lines(row: np.ndarray, centre: np.ndarray, extent: float = 1.5) -> lis
                     base = o + sj * half[j] * axes[j] + sk * half[k] * axes[k]
                     lines.append(np.array([base - half[i] * axes[i], base + half[i] * axes[i]]))
         return lines
+    comp = by_kind(kind)  # a shape component draws itself
+    if comp is not None and comp.lines is not None:
+        return comp.lines(row)
     return []
 
 

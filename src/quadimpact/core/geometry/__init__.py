@@ -39,10 +39,13 @@ point     box       ``box.point_box``             closed form (exact)
 
 docs/OBSTACLES.md (section 2) gives each pair's method, accuracy and cost.
 
-**A new row** (a new feature or shape kind, a new pair): write the function
-in the shape's module; for a built-in, give it a ``GEOM_*`` id, a row in
-:data:`GEOMETRIES` and a branch in :func:`pair_contact` (and, for a new shape
-kind, a branch in :func:`shape_distance`); or register it at run time with
+**A new shape kind** is a shape component: one module declaring its
+settings, slots and compiled functions, and one line in ``shapes.py``
+(``sphere.py`` is the example); its rows join this table with ids from
+``shapes.FIRST_GEOMETRY`` and the dispatch reaches them without an edit
+here. **A new row for a built-in kind** (plane, cylinder, box): write the
+function in the shape's module, give it a ``GEOM_*`` id, a row in
+:data:`GEOMETRIES` and a branch in :func:`pair_contact`; or register it at run time with
 :func:`register_geometry` (and :func:`register_shape_distance`): a run whose
 pairs use a registered row runs in a loop compiled around the registered
 functions (``core.kernel.make_kernel``), as a plug-in controller does.
@@ -55,7 +58,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import literal_unroll, njit
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.geometry.box import box_distance, point_box, sphere_box
@@ -63,6 +66,7 @@ from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
 from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
 from quadimpact.core.geometry.plane import plane_distance, point_plane, ring_plane, sphere_plane
 from quadimpact.core.geometry.ring import ring_solid
+from quadimpact.core.geometry.shapes import CONTACT_ENTRIES, DISTANCE_ENTRIES, geometry_rows
 from quadimpact.core.layout import (
     F_KIND,
     FEAT_POINT,
@@ -135,11 +139,14 @@ GEOMETRIES: dict[tuple[int, int], Geometry] = {
     (FEAT_POINT, SHAPE_BOX): Geometry(FEAT_POINT, SHAPE_BOX, GEOM_POINT_BOX, point_box),
 }
 """The table: (feature kind, shape kind) -> its geometry."""
+for _feature, _shape, _gid, _fn in geometry_rows():  # the shape components' rows (shapes.py)
+    GEOMETRIES[(_feature, _shape)] = Geometry(_feature, _shape, _gid, _fn)
 
 SHAPE_DISTANCES: dict[int, tuple[Callable, bool]] = {
     SHAPE_PLANE: (plane_distance, False),
     SHAPE_CYLINDER: (cylinder_distance, False),
     SHAPE_BOX: (box_distance, False),
+    **{kind: (fn, False) for kind, fn in DISTANCE_ENTRIES},
 }
 """Shape kind -> (its point-distance function, registered at run time)."""
 
@@ -180,7 +187,21 @@ def pair_contact(
         return sphere_box(x, C, feat, f, shapes, s)
     if g == GEOM_POINT_BOX:
         return point_box(x, C, feat, f, shapes, s)
+    if g < GEOM_PLUGIN:
+        return component_contact(g, x, C, feat, f, shapes, s)
     return plugin_contact(g, x, C, feat, f, shapes, s)
+
+
+@compiled
+def component_contact(
+    g: int, x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> ContactRecord:
+    """The rows of the shape components (``shapes.py``), by geometry id."""
+    rec = no_contact()
+    for e in literal_unroll(CONTACT_ENTRIES):
+        if g == e[0]:
+            rec = e[1](x, C, feat, f, shapes, s)
+    return rec
 
 
 @compiled
@@ -208,6 +229,14 @@ def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) 
         return cylinder_distance(px, py, pz, shapes, s)
     if kind == SHAPE_BOX:
         return box_distance(px, py, pz, shapes, s)
+    found = False
+    d = math.inf
+    for e in literal_unroll(DISTANCE_ENTRIES):
+        if kind == e[0]:
+            d = e[1](px, py, pz, shapes, s)
+            found = True
+    if found:
+        return d
     return plugin_distance(px, py, pz, shapes, s)
 
 
@@ -248,7 +277,10 @@ def _kind_name(enum: type, value: int) -> str:
     try:
         return enum(int(value)).name.lower()
     except ValueError:
-        return str(int(value))
+        from quadimpact.core.geometry.shapes import by_kind
+
+        comp = by_kind(int(value)) if enum is ShapeKind else None
+        return comp.name if comp is not None else str(int(value))
 
 
 def pair_table(feat: np.ndarray, shapes: np.ndarray) -> np.ndarray:
