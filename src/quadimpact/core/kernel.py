@@ -36,6 +36,7 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from quadimpact.core import geometry as _geometry
+from quadimpact.core.sensors import registry as _sensor_registry
 from quadimpact.core.approach import solve_approach
 from quadimpact.core.geometry.contact_record import no_contact
 from quadimpact.core.layout import SH_KIND
@@ -197,6 +198,7 @@ def make_kernel(
     geometry: bool = False,
     sensor: Callable | None = None,
     estimator: Callable | None = None,
+    sensors: bool = False,
 ) -> Kernel:
     """Compile the run loop around plug-ins.
 
@@ -219,6 +221,9 @@ def make_kernel(
         An estimator ``estimator(t, dt, meas, ecfg, est)`` updated at every IMU
         sample, bound in place of ``core.estimators.plugin_estimator``; it runs
         when ``ecfg[EC_KIND]`` is ``EST_USER`` (docs/ESTIMATION.md).
+    sensors : bool
+        Compile in the sensor components registered as plug-ins so far
+        (``core.sensors.registry.register_sensor``), after the built-in ones.
 
     Returns
     -------
@@ -243,6 +248,13 @@ def make_kernel(
                 f"estimator: expected estimator(t, dt, meas, ecfg, est); got {n_params} parameters"
             )
         replacements["plugin_estimator"] = _refcounted(estimator)
+    if sensors:
+        comps = _sensor_registry.components()
+        entries = _sensor_registry.entries(comps)
+        replacements["ENTRIES"] = tuple(
+            (_refcounted(e[0]) if c.plugin else e[0], *e[1:])
+            for c, e in zip(comps, entries, strict=True)
+        )
     if geometry:
         contact_fns = {g.id: g.fn for g in _geometry.plugin_geometries()}
         replacements["plugin_contact"] = _contact_dispatch(contact_fns)

@@ -121,6 +121,27 @@ def locate_vehicle(data: Mapping[str, Any], folder: str | Path) -> dict[str, Any
     return out
 
 
+def _set_nested(out: dict[str, Any], path: list[str], value: Any) -> None:
+    """Set ``out[a][b]...[z] = value`` for the dotted path ``a.b...z``, copying each table
+    on the way (a preset name such as ``imu = "noisy"`` becomes ``{preset = "noisy"}``)."""
+    head, rest = path[0], path[1:]
+    if not rest:
+        out[head] = value
+        return
+    table = out.get(head)
+    if isinstance(table, str):
+        table = {"preset": table}
+    elif table is None or table is True:
+        table = {}
+    elif not isinstance(table, Mapping):
+        raise InputError(
+            f"{'.'.join(path)}: {head} is not a table (got {format_value(table)})"
+        )
+    table = dict(table)
+    _set_nested(table, rest, value)
+    out[head] = table
+
+
 def apply_overrides(
     data: Mapping[str, Any], fields: Mapping[str, Any], vehicle_fields: Iterable[str] = ()
 ) -> dict[str, Any]:
@@ -133,6 +154,7 @@ def apply_overrides(
     fields : mapping
         New values, field -> value (``quadimpact run``'s flags, a sweep run's
         swept values). A ``vehicle_overrides`` value replaces the base's table.
+        A dotted name sets a field of a table (``instruments.barometer.noise_m``).
     vehicle_fields : iterable of str
         Fields that are vehicle parameters: they go to ``vehicle_overrides``
         (added to the base's) instead of the scenario.
@@ -159,6 +181,8 @@ def apply_overrides(
             continue
         if name in vehicle_fields:
             overrides[name] = value
+        elif "." in name:  # a field of a table: instruments.barometer.noise_m, imu.rate_hz
+            _set_nested(out, name.split("."), value)
         else:
             out[name] = value
     if overrides:

@@ -27,6 +27,7 @@ from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
 from quadimpact.core.kernel import Kernel, make_kernel
+from quadimpact.core.sensors.registry import plugin_sensors
 from quadimpact.core.records import Model, model_array, model_span
 from quadimpact.errors import InputError
 from quadimpact.inputs.model import ModelOptions
@@ -177,23 +178,32 @@ def _ground(s: RunSettings) -> list[Plane]:
     return []
 
 
-def _kernel(entry, est_entry=None) -> Kernel | None:
-    """The compiled loop of a plug-in controller or estimator (once per process and pair).
+def _kernel(entry, est_entry=None, instruments: tuple[str, ...] = ()) -> Kernel | None:
+    """The compiled loop of a plug-in controller, estimator or sensor (once per process).
 
     None for built-ins. Guarded (``simulation.plugin_kernel``): its compilation
     announced and timed apart, an exception in it a one-line ``PluginError``.
+    ``instruments``: the run's sensor components; a plug-in among them puts
+    every registered plug-in sensor into the loop.
     """
     estimator = getattr(est_entry, "step", None)
-    if entry.step is None and estimator is None:
+    sensors = tuple(c.name for c in plugin_sensors())
+    if not any(name in sensors for name in instruments):
+        sensors = ()
+    if entry.step is None and estimator is None and not sensors:
         return None
     key = "kernel" if estimator is None else ("kernel", id(estimator))
+    if sensors:
+        key = (key, sensors, tuple(id(c.sample) for c in plugin_sensors()))
     if key not in entry.kernel_cache:
         plugins = []
         if entry.step is not None:
             plugins.append(PluginStep("controller", entry.name, step_name(entry.step)))
         if estimator is not None:
             plugins.append(PluginStep("estimator", est_entry.name, step_name(estimator)))
-        kernel = make_kernel(entry.step, estimator=estimator)
+        for c in plugin_sensors() if sensors else ():
+            plugins.append(PluginStep("sensor", c.name, step_name(c.sample)))
+        kernel = make_kernel(entry.step, estimator=estimator, sensors=bool(sensors))
         entry.kernel_cache[key] = guarded(kernel, plugins)
     return entry.kernel_cache[key]
 
@@ -222,7 +232,7 @@ def _shared(
         estimator=est.name,
         estimator_settings=est.settings,
         controller=s.controller,
-        kernel=_kernel(packing.entry, est.entry),
+        kernel=_kernel(packing.entry, est.entry, tuple(s.instruments)),
         resolved=packing.resolved,
     )
     setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())

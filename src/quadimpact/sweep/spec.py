@@ -210,6 +210,8 @@ class SweepSpec:
     def _check_field(self, name: str, section: str) -> None:
         if name in self._scenario_fields or name in self._vehicle_fields:
             return
+        if "." in name and name.split(".")[0] in self._scenario_fields:
+            return  # a field of a table (instruments.barometer.noise_m): checked by validation
         if name == "kind":
             raise InputError(f"{self.where}: {section}: kind: cannot be swept (set it in base)")
         known = self._scenario_fields + self._vehicle_fields
