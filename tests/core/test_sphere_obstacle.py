@@ -132,8 +132,10 @@ def test_point_and_sphere_features_are_exact():
 def test_flown_into_from_a_scenario_file_and_recorded(tmp_path):
     path = tmp_path / "ball.toml"
     path.write_text(
-        'kind = "flight"\nfinal_time_s = 0.4\ncontroller = "paper"\nvelocity_m_s = [1.5, 0.0, 0.0]\n'
-        '[[obstacles]]\nkind = "sphere"\nname = "ball"\ncentre_m = [0.6, 0.0, -2.0]\nradius_m = 0.2\n'
+        'kind = "flight"\nfinal_time_s = 0.4\ncontroller = "paper"\n'
+        "velocity_m_s = [1.5, 0.0, 0.0]\n"
+        '[[obstacles]]\nkind = "sphere"\nname = "ball"\n'
+        "centre_m = [0.6, 0.0, -2.0]\nradius_m = 0.2\n"
     )
     r = simulate(load_scenario_file(path))
     ep = r.episodes

@@ -36,11 +36,11 @@ from numba import njit
 from numba.core.dispatcher import Dispatcher
 
 from quadimpact.core import geometry as _geometry
-from quadimpact.core.sensors import registry as _sensor_registry
 from quadimpact.core.approach import solve_approach
 from quadimpact.core.geometry.contact_record import no_contact
 from quadimpact.core.layout import SH_KIND
 from quadimpact.core.records import Model, Output, RawRecord, new_data, new_output, raw_record
+from quadimpact.core.sensors import registry as _sensor_registry
 from quadimpact.core.step import advance, start
 
 __all__ = ["BUILTIN", "Kernel", "execute", "make_kernel", "run", "specialise"]

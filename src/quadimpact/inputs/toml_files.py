@@ -134,9 +134,7 @@ def _set_nested(out: dict[str, Any], path: list[str], value: Any) -> None:
     elif table is None or table is True:
         table = {}
     elif not isinstance(table, Mapping):
-        raise InputError(
-            f"{'.'.join(path)}: {head} is not a table (got {format_value(table)})"
-        )
+        raise InputError(f"{'.'.join(path)}: {head} is not a table (got {format_value(table)})")
     table = dict(table)
     _set_nested(table, rest, value)
     out[head] = table

@@ -27,8 +27,8 @@ from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
 from quadimpact.core.kernel import Kernel, make_kernel
-from quadimpact.core.sensors.registry import plugin_sensors
 from quadimpact.core.records import Model, model_array, model_span
+from quadimpact.core.sensors.registry import plugin_sensors
 from quadimpact.errors import InputError
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
