@@ -335,3 +335,37 @@ def test_the_index_lists_every_page():
     headings = re.findall(r"^## (\w+)", index, flags=re.M)
     assert headings == ["Tutorial", "How", "Reference", "Explanation"], headings
     assert "docs/README.md" in (ROOT / "README.md").read_text(encoding="utf-8")
+
+
+COMMAND = re.compile(r"quadimpact ([a-z]+)((?:\s+[^`|;&\n]*)?)")
+
+
+def _misplaced_flags(text: str, options: dict[str, set[str]]) -> list[tuple[int, str]]:
+    """(line, "command --flag") of each flag given to a quadimpact command that lacks it."""
+    found = []
+    for n, line in enumerate(text.splitlines(), 1):
+        for match in COMMAND.finditer(line):
+            command = match.group(1)
+            if command in options:
+                found += [(n, f"quadimpact {command} {flag}")
+                          for flag in FLAG.findall(match.group(2))
+                          if flag not in options[command]]  # fmt: skip
+    return found
+
+
+def test_each_command_in_the_docs_has_the_flags_given_to_it():
+    """A command line of the docs gives each quadimpact command only its own options
+    (docs/howto once gave ``quadimpact sweep`` a ``--model`` that only ``run`` has)."""
+    from quadimpact.cli import cli
+
+    options = {
+        name: {"--help", *(o for p in command.params for o in (*p.opts, *p.secondary_opts))}
+        for name, command in cli.commands.items()
+    }
+    sample = "`quadimpact sweep --grid model=paper-replica --model paper-replica --out x`"
+    assert _misplaced_flags(sample, options) == [(1, "quadimpact sweep --model")]
+    bad = []
+    for page in _doc_pages():
+        for n, flag in _misplaced_flags(page.read_text(encoding="utf-8"), options):
+            bad.append(f"{page.relative_to(ROOT)}:{n}: {flag}")
+    assert not bad, "\n".join(bad)
