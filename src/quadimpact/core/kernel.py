@@ -37,6 +37,7 @@ from numba.core.dispatcher import Dispatcher
 
 from quadimpact.core import geometry as _geometry
 from quadimpact.core.approach import solve_approach
+from quadimpact.core.geometry import shapes as _shapes
 from quadimpact.core.geometry.contact_record import no_contact
 from quadimpact.core.layout import SH_KIND
 from quadimpact.core.records import Model, Output, RawRecord, new_data, new_output, raw_record
@@ -199,6 +200,7 @@ def make_kernel(
     sensor: Callable | None = None,
     estimator: Callable | None = None,
     sensors: bool = False,
+    shapes: bool = False,
 ) -> Kernel:
     """Compile the run loop around plug-ins.
 
@@ -224,6 +226,9 @@ def make_kernel(
     sensors : bool
         Compile in the sensor components registered as plug-ins so far
         (``core.sensors.registry.register_sensor``), after the built-in ones.
+    shapes : bool
+        Compile in the shape components registered as plug-ins so far
+        (``core.geometry.shapes.register_shape``).
 
     Returns
     -------
@@ -255,6 +260,14 @@ def make_kernel(
             (_refcounted(e[0]) if c.plugin else e[0], *e[1:])
             for c, e in zip(comps, entries, strict=True)
         )
+    if shapes:
+        user = {id(f) for c in _shapes.plugin_shapes() for f in (c.distance, *c.contacts.values())}
+
+        def own(entries: tuple) -> tuple:
+            return tuple((k, _refcounted(f) if id(f) in user else f) for k, f in entries)
+
+        replacements["CONTACT_ENTRIES"] = own(_shapes.contact_entries())
+        replacements["DISTANCE_ENTRIES"] = own(_shapes.distance_entries())
     if geometry:
         contact_fns = {g.id: g.fn for g in _geometry.plugin_geometries()}
         replacements["plugin_contact"] = _contact_dispatch(contact_fns)

@@ -179,9 +179,9 @@ shape components')."""
 def obstacle_models() -> dict[str, type[BaseModel]]:
     """Every obstacle settings model by its ``kind`` tag: the original three, then the
     shape components' (``core/geometry/shapes.py``)."""
-    from quadimpact.core.geometry.shapes import BUILTIN
+    from quadimpact.core.geometry.shapes import components
 
-    return {**OBSTACLE_KINDS, **{c.name: c.settings for c in BUILTIN}}
+    return {**OBSTACLE_KINDS, **{c.name: c.settings for c in components()}}
 
 
 def obstacle_from(value: Any, where: str = "obstacle") -> Any:

@@ -9,20 +9,24 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.geometry.shapes import BUILTIN as SHAPE_COMPONENTS
-from quadimpact.core.geometry.shapes import by_kind, by_name, kind_of
+from quadimpact.core.geometry.shapes import by_kind, by_name, components, kind_of
 from quadimpact.inputs.world import Box, Cylinder, Plane
 from quadimpact.linalg import norm
 
 __all__ = ["SURFACE_KINDS", "pack_surface_records", "pack_surfaces", "surface_records"]
 
-#: Surface kinds by the names written in ``scenario.json`` (``core.layout.ShapeKind``).
+#: Surface kinds by the names written in ``scenario.json`` (``core.layout.ShapeKind``); the
+#: shape components' are :func:`surface_kinds`'.
 SURFACE_KINDS: dict[str, int] = {
     "plane": L.SHAPE_PLANE,
     "cylinder": L.SHAPE_CYLINDER,
     "box": L.SHAPE_BOX,
-    **{c.name: kind_of(c) for c in SHAPE_COMPONENTS},
 }
+
+
+def surface_kinds() -> dict[str, int]:
+    """Every surface kind by name: :data:`SURFACE_KINDS` and the registered shape components."""
+    return {**SURFACE_KINDS, **{c.name: kind_of(c) for c in components()}}
 
 
 def pack_surfaces(surfaces: Sequence[Plane | Cylinder | Box]) -> np.ndarray:
@@ -85,7 +89,7 @@ def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, An
         ``half_extents_m`` and ``axes`` (its own x, y, z axes, rows).
         :func:`pack_surface_records` gives ``surf`` back bit for bit.
     """
-    kinds = {v: k for k, v in SURFACE_KINDS.items()}
+    kinds = {v: k for k, v in surface_kinds().items()}
     out: list[dict[str, Any]] = []
     for name, row in zip(names, surf, strict=True):
         kind = kinds[int(row[L.SH_KIND])]
@@ -136,8 +140,8 @@ def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
     surf = np.zeros((len(records), L.NSHAPE))
     for i, r in enumerate(records):
         kind = r.get("kind", "plane")
-        if kind not in SURFACE_KINDS:
-            known = ", ".join(SURFACE_KINDS)
+        if kind not in surface_kinds():
+            known = ", ".join(surface_kinds())
             name = r.get("name")
             raise ValueError(f"surface {name!r}: kind must be one of {known} (got {kind!r})")
         comp = by_name(kind)

@@ -26,6 +26,7 @@ import numpy as np
 from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
+from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
 from quadimpact.core.kernel import Kernel, make_kernel
 from quadimpact.core.records import Model, model_array, model_span
 from quadimpact.core.sensors.registry import plugin_sensors
@@ -178,23 +179,31 @@ def _ground(s: RunSettings) -> list[Plane]:
     return []
 
 
-def _kernel(entry, est_entry=None, instruments: tuple[str, ...] = ()) -> Kernel | None:
+def _kernel(
+    entry, est_entry=None, instruments: tuple[str, ...] = (), kinds: tuple[str, ...] = ()
+) -> Kernel | None:
     """The compiled loop of a plug-in controller, estimator or sensor (once per process).
 
     None for built-ins. Guarded (``simulation.plugin_kernel``): its compilation
     announced and timed apart, an exception in it a one-line ``PluginError``.
     ``instruments``: the run's sensor components; a plug-in among them puts
-    every registered plug-in sensor into the loop.
+    every registered plug-in sensor into the loop; ``kinds``: its obstacles'
+    kinds, and a plug-in shape among them every registered plug-in shape.
     """
     estimator = getattr(est_entry, "step", None)
     sensors = tuple(c.name for c in plugin_sensors())
     if not any(name in sensors for name in instruments):
         sensors = ()
-    if entry.step is None and estimator is None and not sensors:
+    shapes = tuple(c.name for c in plugin_shapes())
+    if not any(kind in shapes for kind in kinds):
+        shapes = ()
+    if entry.step is None and estimator is None and not sensors and not shapes:
         return None
     key = "kernel" if estimator is None else ("kernel", id(estimator))
     if sensors:
         key = (key, sensors, tuple(id(c.sample) for c in plugin_sensors()))
+    if shapes:
+        key = (key, shapes, tuple(id(c.distance) for c in plugin_shapes()))
     if key not in entry.kernel_cache:
         plugins = []
         if entry.step is not None:
@@ -203,7 +212,11 @@ def _kernel(entry, est_entry=None, instruments: tuple[str, ...] = ()) -> Kernel 
             plugins.append(PluginStep("estimator", est_entry.name, step_name(estimator)))
         for c in plugin_sensors() if sensors else ():
             plugins.append(PluginStep("sensor", c.name, step_name(c.sample)))
-        kernel = make_kernel(entry.step, estimator=estimator, sensors=bool(sensors))
+        for c in plugin_shapes() if shapes else ():
+            plugins.append(PluginStep("shape", c.name, step_name(c.distance)))
+        kernel = make_kernel(
+            entry.step, estimator=estimator, sensors=bool(sensors), shapes=bool(shapes)
+        )
         entry.kernel_cache[key] = guarded(kernel, plugins)
     return entry.kernel_cache[key]
 
@@ -232,7 +245,12 @@ def _shared(
         estimator=est.name,
         estimator_settings=est.settings,
         controller=s.controller,
-        kernel=_kernel(packing.entry, est.entry, tuple(s.instruments)),
+        kernel=_kernel(
+            packing.entry,
+            est.entry,
+            tuple(s.instruments),
+            tuple(getattr(x, "kind", "") for x in surfaces),
+        ),
         resolved=packing.resolved,
     )
     setup.warnings.extend(f"vehicle {v.name}: {w}" for w in v.plausibility_warnings())
@@ -419,9 +437,10 @@ def _trial_shared(s: ImpactTrial) -> SharedSetup:
 def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
     """Where the line along +X through an obstacle's centre enters it, and that centre (m).
 
-    The centre is a plane's point, a cylinder's axis point or a box's
-    centre; the entry is found by bisection on the shape's signed distance
-    along -X from the centre (exact to rounding; a plane's point is on it).
+    The centre is a plane's point, a cylinder's axis point, a box's or a
+    sphere's centre (a shape component's ``SH_POINT``); the entry is found by
+    bisection on the shape's signed distance along -X from the centre (exact
+    to rounding; a plane's point is on it).
 
     Raises
     ------
@@ -437,15 +456,17 @@ def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
                 "so its plane's normal must point toward -X"
             )
         return float(centre[0]), centre
+    comp = by_kind(int(row[0, L.SH_KIND]))  # a shape component: its own distance
+    distance = comp.distance if comp is not None else shape_distance
     inside = 0.0
     outside = 1.0
-    while shape_distance(centre[0] - outside, centre[1], centre[2], row, 0) <= 0.0:
+    while distance(centre[0] - outside, centre[1], centre[2], row, 0) <= 0.0:
         outside *= 2.0
     for _ in range(200):
         mid = 0.5 * (inside + outside)
         if mid in (inside, outside):
             break
-        if shape_distance(centre[0] - mid, centre[1], centre[2], row, 0) > 0.0:
+        if distance(centre[0] - mid, centre[1], centre[2], row, 0) > 0.0:
             outside = mid
         else:
             inside = mid

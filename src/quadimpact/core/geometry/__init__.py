@@ -66,6 +66,7 @@ from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
 from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
 from quadimpact.core.geometry.plane import plane_distance, point_plane, ring_plane, sphere_plane
 from quadimpact.core.geometry.ring import ring_solid
+from quadimpact.core.geometry.shapes import BUILTIN as BUILTIN_SHAPES
 from quadimpact.core.geometry.shapes import CONTACT_ENTRIES, DISTANCE_ENTRIES, geometry_rows
 from quadimpact.core.layout import (
     F_KIND,
@@ -139,7 +140,7 @@ GEOMETRIES: dict[tuple[int, int], Geometry] = {
     (FEAT_POINT, SHAPE_BOX): Geometry(FEAT_POINT, SHAPE_BOX, GEOM_POINT_BOX, point_box),
 }
 """The table: (feature kind, shape kind) -> its geometry."""
-for _feature, _shape, _gid, _fn in geometry_rows():  # the shape components' rows (shapes.py)
+for _feature, _shape, _gid, _fn in geometry_rows(BUILTIN_SHAPES):  # shape components' rows
     GEOMETRIES[(_feature, _shape)] = Geometry(_feature, _shape, _gid, _fn)
 
 SHAPE_DISTANCES: dict[int, tuple[Callable, bool]] = {

@@ -2,7 +2,8 @@
 
 **Adding a shape** is its module (``shape_component.py`` says what it
 declares; ``sphere.py`` is the example) and one line of :data:`BUILTIN`
-below. The registry numbers the kinds from :data:`FIRST_KIND` in the order
+below; a plug-in is the same module outside the package and one call of
+:func:`register_shape`. The registry numbers the kinds from :data:`FIRST_KIND` in the order
 of the tuple and gives each (feature kind, shape) pair a geometry id from
 :data:`FIRST_GEOMETRY`; ``core/geometry/__init__.py`` adds those rows to the
 contact table and its compiled dispatch reaches their functions through
@@ -29,7 +30,12 @@ __all__ = [
     "by_kind",
     "by_name",
     "geometry_rows",
+    "components",
+    "contact_entries",
+    "distance_entries",
     "kind_of",
+    "plugin_shapes",
+    "register_shape",
 ]
 
 warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
@@ -39,19 +45,31 @@ BUILTIN: tuple[ShapeComponent, ...] = (
 )
 """The shape components, one line each (the plane, cylinder and box predate them)."""
 
+_PLUGINS: list[ShapeComponent] = []
+
 FIRST_KIND = 16  # SH_KIND of the first component (the built-in kinds are 0-2)
 FIRST_GEOMETRY = 100  # geometry id of the first component row (built-in rows 0-8)
 N_FEATURE_KINDS = 8  # geometry ids per shape component: one per feature kind
 
 
+def components() -> tuple[ShapeComponent, ...]:
+    """Every registered shape component: the built-ins, then the plug-ins in order."""
+    return BUILTIN + tuple(_PLUGINS)
+
+
+def plugin_shapes() -> tuple[ShapeComponent, ...]:
+    """The shape components registered as plug-ins so far."""
+    return tuple(_PLUGINS)
+
+
 def kind_of(comp: ShapeComponent) -> int:
     """The ``SH_KIND`` number of a registered shape component."""
-    return FIRST_KIND + BUILTIN.index(comp)
+    return FIRST_KIND + components().index(comp)
 
 
 def by_name(name: str) -> ShapeComponent | None:
     """The shape component whose kind tag is ``name`` (None: none)."""
-    for c in BUILTIN:
+    for c in components():
         if c.name == name:
             return c
     return None
@@ -60,13 +78,57 @@ def by_name(name: str) -> ShapeComponent | None:
 def by_kind(kind: int) -> ShapeComponent | None:
     """The shape component of ``SH_KIND`` number ``kind`` (None: none)."""
     k = int(kind) - FIRST_KIND
-    return BUILTIN[k] if 0 <= k < len(BUILTIN) else None
+    comps = components()
+    return comps[k] if 0 <= k < len(comps) else None
 
 
-def geometry_rows() -> list[tuple[int, int, int, object]]:
-    """Every component row of the contact table: ``(feature kind, shape kind, id, fn)``."""
+def register_shape(comp: ShapeComponent) -> None:
+    """Add a plug-in shape component: named from ``[[obstacles]]`` like a built-in.
+
+    A run with one of its obstacles compiles a loop of its own around the
+    registered shapes (``core.kernel.make_kernel(shapes=True)``), once per process.
+
+    Raises
+    ------
+    TypeError
+        Not a :class:`ShapeComponent`, or a function of it not compiled.
+    ValueError
+        Its name is taken (a built-in kind, or another plug-in).
+    """
+    from quadimpact.core.geometry import GEOMETRIES, SHAPE_DISTANCES, Geometry
+
+    if not isinstance(comp, ShapeComponent):
+        raise TypeError("register_shape: expected a ShapeComponent")
+    for fn in (comp.distance, *comp.contacts.values()):
+        if not hasattr(fn, "py_func"):
+            raise TypeError(f"shape {comp.name}: its functions must be numba.njit functions")
+    if comp.name in ("plane", "cylinder", "box") or by_name(comp.name) is not None:
+        raise ValueError(f"register_shape: {comp.name!r} is registered already")
+    _PLUGINS.append(comp)
+    kind = kind_of(comp)
+    for feature, shape, gid, fn in geometry_rows():
+        if shape == kind:
+            GEOMETRIES[(feature, shape)] = Geometry(feature, shape, gid, fn)
+    SHAPE_DISTANCES[kind] = (comp.distance, False)
+
+
+def contact_entries(comps: tuple[ShapeComponent, ...] | None = None) -> tuple:
+    """The dispatch's pairs ``(geometry id, contact function)`` of ``comps`` (all registered)."""
+    return tuple((gid, fn) for _, _, gid, fn in geometry_rows(comps))
+
+
+def distance_entries(comps: tuple[ShapeComponent, ...] | None = None) -> tuple:
+    """The dispatch's pairs ``(shape kind, distance function)`` of ``comps`` (all registered)."""
+    comps = components() if comps is None else comps
+    return tuple((FIRST_KIND + i, c.distance) for i, c in enumerate(comps))
+
+
+def geometry_rows(
+    comps: tuple[ShapeComponent, ...] | None = None,
+) -> list[tuple[int, int, int, object]]:
+    """The component rows of the contact table: ``(feature kind, shape kind, id, fn)``."""
     rows = []
-    for i, c in enumerate(BUILTIN):
+    for i, c in enumerate(components() if comps is None else comps):
         for feature, fn in sorted(c.contacts.items()):
             rows.append(
                 (
@@ -79,7 +141,7 @@ def geometry_rows() -> list[tuple[int, int, int, object]]:
     return rows
 
 
-CONTACT_ENTRIES = tuple((gid, fn) for _, _, gid, fn in geometry_rows())
-"""The compiled dispatch's pairs: (geometry id, contact function)."""
-DISTANCE_ENTRIES = tuple((FIRST_KIND + i, c.distance) for i, c in enumerate(BUILTIN))
-"""The compiled dispatch's pairs: (shape kind, distance function)."""
+CONTACT_ENTRIES = contact_entries(BUILTIN)
+"""The compiled dispatch's pairs of the built-ins: (geometry id, contact function)."""
+DISTANCE_ENTRIES = distance_entries(BUILTIN)
+"""The compiled dispatch's pairs of the built-ins: (shape kind, distance function)."""
