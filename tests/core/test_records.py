@@ -36,14 +36,14 @@ PACKAGE = Path(quadimpact.__file__).resolve().parent
 EDITS: list[tuple[str, str, str]] = [
     (
         "core/records.py",
-        "    sst: np.ndarray  # (NSST,) sensor state\n",
-        "    sst: np.ndarray  # (NSST,) sensor state\n"
+        "    sst: np.ndarray  # (NSST + state tail,) sensor state\n",
+        "    sst: np.ndarray  # (NSST + state tail,) sensor state\n"
         "    baro: np.ndarray  # (2,) the barometer's last altitude (m) and its time (s)\n",
     ),
     (
         "core/records.py",
-        "        np.zeros(NSST),\n",
-        "        np.zeros(NSST),\n        np.zeros(2),\n",
+        "        np.zeros(NSST + tail_size(m.scfg, SC_TAIL_ST)),\n",
+        "        np.zeros(NSST + tail_size(m.scfg, SC_TAIL_ST)),\n        np.zeros(2),\n",
     ),
     ("core/records.py", "D.meas[k], D.sst[k])", "D.meas[k], D.sst[k], D.baro[k])"),
     (

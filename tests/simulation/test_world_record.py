@@ -103,6 +103,8 @@ def test_the_surfaces_are_the_packed_ones_bit_for_bit(flight_result, tmp_path: P
     assert not {"surfaces", "resolved", "world"} & set(summary)
     assert "scenario" not in {k.name for k in SUMMARY_KEYS}
     with pytest.raises(ValueError, match="kind must be one of"):
+        pack_surface_records([{**records[0], "kind": "torus"}])
+    with pytest.raises(ValueError, match="a sphere record needs centre_m"):
         pack_surface_records([{**records[0], "kind": "sphere"}])
     assert surface_records(surf, ["a", "b", "c"])[1]["name"] == "b"
 

@@ -106,7 +106,7 @@ class Slots:
         self.E = B.Env(
             state=np.zeros((n, B.NB)),
             par=par,
-            tmeas=np.zeros((n, L.NMEAS)),
+            tmeas=np.zeros((n, self.D.meas.shape[1])),  # NMEAS and the components' tail
             reported=np.full(n, -1.0),
             obs=np.zeros((n, n_obs), dtype=obs_dtype),
             reward=np.zeros(n),

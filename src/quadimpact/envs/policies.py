@@ -71,7 +71,7 @@ class RecoveryPolicy:
         self._seen = s.episode_id.copy() - 1
         self._actions = np.zeros((s.n, 4))
         self._stages = np.zeros(s.n)
-        self._meas = np.zeros((s.n, L.NMEAS))
+        self._meas = np.zeros((s.n, s.E.tmeas.shape[1]))
         self.inexact = np.zeros(s.n)
         """Estimate mode: commands the rotor map could not give exactly, per row (this episode)."""
         self.from_observation = bool(s.par[B.EP_OBSERVE] == B.OBS_ESTIMATE)

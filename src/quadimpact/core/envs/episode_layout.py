@@ -21,7 +21,7 @@ class Env(NamedTuple):
 
     state: np.ndarray  # (N, NB) per-run episode state (B_*)
     par: np.ndarray  # (NPAR,) parameters shared by the runs (EP_*)
-    tmeas: np.ndarray  # (N, NMEAS) the measurement record of each run's next tick
+    tmeas: np.ndarray  # (N, NMEAS + tail) the measurement record of each run's next tick
     reported: np.ndarray  # (N,) the stage the policy reports for this tick (< 0: none)
     obs: np.ndarray  # (N, n_obs) float32 observations
     reward: np.ndarray  # (N,)

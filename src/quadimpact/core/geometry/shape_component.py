@@ -93,7 +93,18 @@ class ShapeComponent:
         return out
 
     def unpack(self, record: Mapping[str, Any], kind: int) -> np.ndarray:
-        """The row of a :meth:`record` (as recorded, bit for bit)."""
+        """The row of a :meth:`record` (as recorded, bit for bit).
+
+        Raises
+        ------
+        ValueError
+            A field of its slots missing from ``record`` (one line).
+        """
+        missing = [s.field for s in self.slots if s.field not in record]
+        if missing:
+            raise ValueError(
+                f"surface {record.get('name')!r}: a {self.name} record needs {', '.join(missing)}"
+            )
         row = np.zeros(NSHAPE)
         row[SH_KIND] = kind
         row[SH_IS_GROUND] = 1.0 if record.get("is_ground") else 0.0
