@@ -4,6 +4,7 @@ built-in is: named in a scenario, its noise from the run's seed, its columns rec
 from __future__ import annotations
 
 import importlib.util
+import sys
 import math
 from pathlib import Path
 
@@ -21,6 +22,7 @@ TEMPLATE = Path(__file__).resolve().parents[2] / "examples" / "sensor_template.p
 def _load():
     spec = importlib.util.spec_from_file_location("sensor_template", TEMPLATE)
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # pydantic resolves the annotations there
     spec.loader.exec_module(module)
     return module
 

@@ -4,6 +4,7 @@ like a built-in: a caged vehicle hits a long capsule as it hits a cylinder of it
 from __future__ import annotations
 
 import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,6 +23,7 @@ def _load():
         "shape_template", ROOT / "examples" / "shape_template.py"
     )
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # pydantic resolves the annotations there
     spec.loader.exec_module(module)
 
 
