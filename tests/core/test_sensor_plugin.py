@@ -4,8 +4,8 @@ built-in is: named in a scenario, its noise from the run's seed, its columns rec
 from __future__ import annotations
 
 import importlib.util
-import sys
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
