@@ -95,8 +95,11 @@ class Slots:
         setups = [self._prepare({**fields, "imu": p}) for p in trials.imu_choices()]
         self.n_noise = max(x.noise.shape[0] for x in setups)
         self.n_snoise = max(x.snoise.shape[0] for x in [template, *setups])
+        self.n_cnoise = max(x.cnoise.shape[0] for x in [template, *setups])
         m = template.model(
-            noise=np.zeros((self.n_noise, 6)), snoise=np.zeros((self.n_snoise, L.NSN))
+            noise=np.zeros((self.n_noise, 6)),
+            snoise=np.zeros((self.n_snoise, L.NSN)),
+            cnoise=np.zeros((self.n_cnoise, template.cnoise.shape[1])),
         )
         self.M = stacked(m, n)
         self.D = stacked(new_data(m), n)
@@ -194,7 +197,11 @@ class Slots:
                 f"of the environment's trials ({self.M.shapes.shape[1]} surfaces, "
                 f"{self.trials.final_time_s:g} s)"
             )
-        if s.noise.shape[0] > self.n_noise or s.snoise.shape[0] > self.n_snoise:
+        if (
+            s.noise.shape[0] > self.n_noise
+            or s.snoise.shape[0] > self.n_snoise
+            or s.cnoise.shape[0] > self.n_cnoise
+        ):
             raise ValueError("trial: a noisy sensor in an environment made for ideal ones")
         if s.kernel is not None or s.controller != "recovery":
             raise ValueError("trial: the environment's trials run the 'recovery' controller")
@@ -202,7 +209,9 @@ class Slots:
         noise[: s.noise.shape[0]] = s.noise
         snoise = np.zeros((self.n_snoise, L.NSN))
         snoise[: s.snoise.shape[0]] = s.snoise
-        set_row(self.M, k, m._replace(noise=noise, snoise=snoise))
+        cnoise = np.zeros((self.n_cnoise, m.cnoise.shape[1]))
+        cnoise[: s.cnoise.shape[0]] = s.cnoise
+        set_row(self.M, k, m._replace(noise=noise, snoise=snoise, cnoise=cnoise))
         self.setups[k] = s
         self.scenarios[k] = scenario
         self.trial_fields[k] = fields
