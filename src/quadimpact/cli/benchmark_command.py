@@ -132,13 +132,14 @@ def subject_from_options(
 )  # fmt: skip
 @click.option(
     "--suite", "suite_version", default=None, metavar="VERSION",
-    help="The suite's version: 2 (the default: success is a held hover, sensor sets ideal and "
-    "lab) or 1 (the published criteria, sensor sets ideal and impact; its numbers unchanged).",
+    help="The suite's version: 3 (the default: success is a held hover, sensor sets ideal, "
+    "lab and onboard), 2 (the same without onboard) or 1 (the published criteria, sensor "
+    "sets ideal and impact; its numbers unchanged).",
 )  # fmt: skip
 @click.option(
     "--sensors", metavar="ideal,lab,...",
-    help="The sensor sets to fly, comma-separated: the suite's own by default; suite 2 also "
-    "flies impact (an IMU alone) when named.",
+    help="The sensor sets to fly, comma-separated: the suite's own by default; suites 2 and 3 "
+    "also fly impact (an IMU alone) when named.",
 )  # fmt: skip
 @click.option("--name", metavar="NAME", help="The benchmarked row's name in every output.")
 @click.option(
@@ -180,9 +181,11 @@ def benchmark(
     Flies the suite's seeded tasks (docs/BENCHMARK.md): wall, the authors'
     Monte Carlo of wall impacts (10,000 trials; --quick 1,000); pole, the
     authors' pole grid (3,266 points; --quick 240); edge, the same grid against
-    the vertical edge of a 1 m x 1 m pillar; each with the ideal sensors and
+    the vertical edge of a 1 m x 1 m pillar; each with the ideal sensors,
     with the lab sensors (an IMU, a magnetometer, motion capture) and a state
-    estimator (ekf unless --estimator). Success (suite 2) is a held hover:
+    estimator (ekf unless --estimator), and with the onboard sensors (flow,
+    range, barometer, magnetometer, IMU) and the nav-ekf navigation filter.
+    Success (suites 2 and 3) is a held hover:
     slow, level, not turning and touching nothing for 0.5 s, with less than
     2 m of height lost and the ground untouched.
     The thing benchmarked (by default the default law) flies beside the

@@ -40,10 +40,14 @@ def test_the_suite_sizes():
 
 
 def test_the_sensor_sets_of_each_suite():
-    """Suite 2 flies ideal and lab, impact only when named; suite 1 ideal and impact."""
+    """Suite 3 flies ideal, lab and onboard, suite 2 ideal and lab, both impact only when
+    named; suite 1 ideal and impact."""
     from quadimpact.studies.benchmark.suite import parse_sensor_sets, suite
 
-    assert parse_sensor_sets(None) == ("ideal", "lab")
+    assert parse_sensor_sets(None) == ("ideal", "lab", "onboard")
+    assert parse_sensor_sets(None, "2") == ("ideal", "lab")
+    with pytest.raises(InputError, match="--sensors: suite 2 flies ideal, lab, impact"):
+        parse_sensor_sets("onboard", "2")
     assert parse_sensor_sets("impact, ideal") == ("ideal", "impact")
     assert parse_sensor_sets(None, "1") == ("ideal", "impact")
     with pytest.raises(InputError, match="--sensors: suite 1 flies ideal, impact"):
@@ -52,10 +56,13 @@ def test_the_sensor_sets_of_each_suite():
         parse_sensor_sets("lab,lab")
     with pytest.raises(InputError, match="--sensors: unknown sensor set 'gps'"):
         parse_sensor_sets("gps")
-    with pytest.raises(InputError, match="--suite: unknown suite version '3'"):
-        suite("3")
+    with pytest.raises(InputError, match="--suite: unknown suite version '4'"):
+        suite("4")
     assert sensor_set("lab").sensors == "indoor" and sensor_set("lab", "ekf-additive").estimator \
         == "ekf-additive"  # fmt: skip
+    # the onboard set keeps its navigation filter unless a row names another estimator
+    assert sensor_set("onboard").estimator == "nav-ekf"
+    assert sensor_set("onboard", "complementary").estimator == "complementary"
 
 
 def test_the_wall_task_is_the_recovery_studys_trials():

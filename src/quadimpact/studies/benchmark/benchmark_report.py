@@ -8,12 +8,12 @@ Both are drawn from ``benchmark.csv``'s table and the cells' trials tables
 
 * the **leaderboard**, one table per task: every row with each sensor set of
   the suite, ranked by its success with the first (``ideal``), with its 95 %
-  Wilson interval; in suite 2 its paired difference to the default row, the
+  Wilson interval; in suites 2 and 3 its paired difference to the default row, the
   published criterion, the time and distance to the hover; in suite 1 what
   the ``impact`` sensors cost it, the times to recover and to hover, the drift;
   in both the height lost, the missed and false detections, the CPU time and
   where the line comes from (run now, the cache, or the authors' publication);
-* in suite 2, **what the suite resolves**: the half-widths of the rows'
+* in suites 2 and 3, **what the suite resolves**: the half-widths of the rows'
   paired intervals, per task and sensor set;
 * the subject **against each reference**, trial by trial (the same trials):
   the trials only one of the two succeeds on;

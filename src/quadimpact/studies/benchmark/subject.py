@@ -196,10 +196,9 @@ class Subject:
         return fields
 
     def _sensing(self, sensing: SensorSet) -> SensorSet:
-        """The set as this row flies it: its own estimator for a set of real sensors."""
-        if sensing.sensors is not None:
-            return SensorSet(sensing.name, sensing.sensors, self.estimator, sensing.title)
-        return sensing
+        """The set as this row flies it: its own estimator for a set of real sensors (a set
+        with an estimator of its own keeps it unless the row names another than the default)."""
+        return sensing.flown_with(self.estimator)
 
     def wall_spec(self, task: Task, quick: bool, sensing: SensorSet) -> SweepSpec:
         """The wall task's trials flown by this row (the recovery study's sweep)."""

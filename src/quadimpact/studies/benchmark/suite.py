@@ -15,18 +15,20 @@ Three tasks, each an existing study's trials (reused, not copied):
 
 Each task is flown with the sensor sets of the suite's version
 (:data:`SUITES`), each a preset of sensors and a state estimator declared
-once in :data:`SENSOR_SET_DEFS` (``ideal``, ``impact``, ``lab``): a new
+once in :data:`SENSOR_SET_DEFS` (``ideal``, ``impact``, ``lab``, ``onboard``): a new
 sensor set is one entry there and a new version that names it; the tasks do
 not change. Every trial is seeded: the wall's by the Monte Carlo's seed and
 its index, the grid points' sensors by :data:`GRID_SEED` and the point's
-index (:meth:`PoleStudy.point_seeds`).
+index (:meth:`PoleStudy.point_seeds`). Version 3 adds the ``onboard`` set
+(flow, range, barometer and a navigation filter) to version 2.
 
 A :class:`Suite` is one version of the benchmark: its sensor sets, the
 sets it can fly by name beyond them, the run length of its trials and its
 success criterion. Version 1 counts the authors' published criteria;
-version 2 (:data:`SUITE_VERSION`, the default) counts a held hover
-(docs/BENCHMARK.md 1). Any change to a task, a sensor set, a success
-criterion or a metric gets a new version, and every output says which it is.
+version 2 counts a held hover (docs/BENCHMARK.md 1); version 3
+(:data:`SUITE_VERSION`, the default) is version 2 with the ``onboard`` set.
+Any change to a task, a sensor set, a success criterion or a metric gets a
+new version, and every output says which it is.
 """
 
 from __future__ import annotations
@@ -62,7 +64,7 @@ __all__ = [
 
 #: The suite's latest version (the default): in every output; a new one for any change of
 #: what it measures.
-SUITE_VERSION = "2"
+SUITE_VERSION = "3"
 #: The seed of the wall task's trials (``quadimpact recovery``'s default).
 WALL_SEED = 0
 #: The seed of the grid tasks' points' own seeds (their sensors' noise).
@@ -98,12 +100,23 @@ class SensorSet:
         The state estimator (``"ideal"``: the true state).
     title : str
         What it is, in one line (for reports).
+    own_estimator : bool
+        The set needs its own estimator (``onboard``: a navigation filter that
+        fuses its flow and range): a row keeps it unless the row names another
+        than the default ``ekf``.
     """
 
     name: str
     sensors: str | None
     estimator: str
     title: str = ""
+    own_estimator: bool = False
+
+    def flown_with(self, estimator: str) -> SensorSet:
+        """The set as a row whose estimator is ``estimator`` flies it."""
+        if self.sensors is None or (self.own_estimator and estimator == DEFAULT_ESTIMATOR):
+            return self
+        return SensorSet(self.name, self.sensors, estimator, self.title, self.own_estimator)
 
 
 #: Every sensor set a suite can fly, by name: a new one is an entry here (and a suite
@@ -123,6 +136,15 @@ SENSOR_SET_DEFS: dict[str, SensorSet] = {
         "what the authors flew: the IMU with its impact disturbance, a magnetometer and "
         "motion-capture pose at 100 Hz (the `indoor` preset), and a state estimator",
     ),
+    "onboard": SensorSet(
+        "onboard",
+        "onboard",
+        "nav-ekf",
+        "what a small drone carries to hover without motion capture: the IMU with its "
+        "impact disturbance, a magnetometer, a barometer, a lidar rangefinder and a downward "
+        "optical-flow camera (the `onboard` preset), fused by the `nav-ekf` navigation filter",
+        own_estimator=True,
+    ),
 }
 
 #: The sensor sets of suite 1, in the order of its tables.
@@ -130,14 +152,11 @@ SENSOR_SETS = ("ideal", "impact")
 
 
 def sensor_set(name: str, estimator: str = DEFAULT_ESTIMATOR) -> SensorSet:
-    """The sensor set ``name``; ``estimator``: the estimator of a set that is not ``ideal``."""
+    """The sensor set ``name`` flown with ``estimator`` (:meth:`SensorSet.flown_with`)."""
     if name not in SENSOR_SET_DEFS:
         known = ", ".join(repr(s) for s in SENSOR_SET_DEFS)
         raise InputError(f"--sensors: unknown sensor set {name!r} (one of {known})")
-    base = SENSOR_SET_DEFS[name]
-    if base.sensors is None:
-        return base
-    return SensorSet(base.name, base.sensors, estimator, base.title)
+    return SENSOR_SET_DEFS[name].flown_with(estimator)
 
 
 @dataclass(frozen=True)
@@ -147,7 +166,7 @@ class Suite:
     Attributes
     ----------
     version : str
-        Its name in every output (``"1"``, ``"2"``).
+        Its name in every output (``"1"``, ``"2"``, ``"3"``).
     sensor_sets : tuple of str
         The sensor sets of its leaderboard, in table order.
     extra_sensor_sets : tuple of str
@@ -192,6 +211,16 @@ SUITES: dict[str, Suite] = {
         "the `impact` set (an IMU alone) measures no velocity or position, so no law reaches "
         "a held hover with it (1-2 % of trials in suite 1): it is off the leaderboard, and "
         "flies only when named (`--sensors ideal,lab,impact`)",
+    ),
+    "3": Suite(
+        "3",
+        ("ideal", "lab", "onboard"),
+        ("impact",),
+        RUN_LENGTH_S,
+        "held-hover",
+        "the `impact` set (an IMU alone) measures no velocity or position, so no law reaches "
+        "a held hover with it (1-2 % of trials in suite 1): it is off the leaderboard, and "
+        "flies only when named (`--sensors ideal,lab,onboard,impact`)",
     ),
 }
 """The benchmark's versions by name."""
