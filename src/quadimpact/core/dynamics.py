@@ -11,13 +11,13 @@ from quadimpact.core.actuators import rotor_rates
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_wrench
 from quadimpact.core.layout import (
-    N_ROTORS,
     O_SPINUP_PAPER,
     O_YAW_REACTION_PAPER,
     RIN_FF,
     RIN_FIRST_ORDER,
     V_GRAVITY,
     V_MASS,
+    V_N_ROTORS,
     X_QUAT,
     X_ROTOR,
 )
@@ -43,11 +43,12 @@ def state_derivative(x: np.ndarray, xdot: np.ndarray, m: Model, d: Data, w: Work
     rin = d.rin
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
     rotor_rates(x, veh, rin, omega_dot)
-    for j in range(N_ROTORS):
+    n = int(veh[V_N_ROTORS])
+    for j in range(n):
         xdot[X_ROTOR + j] = omega_dot[j]
     if rin[RIN_FIRST_ORDER] < 0.5:
         # ideal / scheduled rotors: the reaction torque uses the prescribed rate
-        for j in range(N_ROTORS):
+        for j in range(n):
             omega_dot[j] = rin[RIN_FF + j]
     mg = veh[V_MASS] * veh[V_GRAVITY]
     fx = mg * C[2, 0]

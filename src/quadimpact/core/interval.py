@@ -43,7 +43,6 @@ from quadimpact.core.layout import (
     LS_T,
     LS_T_SCHED,
     MS_DETECTED,
-    N_ROTORS,
     NX,
     O_ATOL,
     O_CRASH_ALTITUDE,
@@ -75,6 +74,7 @@ from quadimpact.core.layout import (
     ST_STATUS,
     ST_T_END,
     STATUS_FAILED,
+    V_N_ROTORS,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -113,17 +113,18 @@ def _schedule_boundary(t: float, tiny: float, m: Model, d: Data, o: Output) -> N
     """The rotor inputs change at ``t``: power-off trigger, next segment, a motor stopping."""
     ls = d.ls
     x = d.x
+    n = int(m.veh[V_N_ROTORS])
     if ls[LS_PO_ACTIVE] < 0.5:
         ls[LS_PO_ACTIVE] = 1.0
         ls[LS_PO_T] = t
         o.stats[ST_POWER_OFF_T] = t
-        for j in range(N_ROTORS):
+        for j in range(n):
             if m.sched_stop[j] > 0.5:
                 x[X_ROTOR + j] = 0.0
     seg = segment_at(t + tiny, ls[LS_PO_T], m.sched_t)
     ls[LS_PO_SEG] = seg
-    apply_segment(x, m.sched_rate, seg, d.rin, int(m.opts[O_CUT_STEP_MOTORS]))
-    ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin)
+    apply_segment(x, m.sched_rate, seg, d.rin, int(m.opts[O_CUT_STEP_MOTORS]), n)
+    ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin, n)
 
 
 @compiled

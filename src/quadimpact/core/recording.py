@@ -35,7 +35,7 @@ from quadimpact.core.layout import (
     E_T_START,
     E_V_I,
     LS_STAGE,
-    N_ROTORS,
+    MAX_ROTORS,
     NEX,
     NX,
     O_V_MIN,
@@ -101,7 +101,7 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     out[row, OUT_T] = t
     for i in range(NX):
         out[row, OUT_X + i] = xs[i]
-    for j in range(N_ROTORS):
+    for j in range(MAX_ROTORS):  # a copy: zeros beyond the vehicle's rotors
         out[row, OUT_CMD + j] = d.rin[RIN_CMD + j]
     out[row, OUT_STAGE] = d.ls[LS_STAGE]
     if out.shape[1] <= OUT_DELTA:
