@@ -181,10 +181,11 @@ def apply_command(
         rin[RIN_PREV_CMD + j] = w
 
 
-@compiled
-def rotor_rates(x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray) -> None:
-    """Rotor accelerations (rad/s^2) of the current rotor mode, into ``omega_dot``."""
-    n = int(veh[V_N_ROTORS])
+@compiled(inline="always")
+def rotor_rates(
+    x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray, n: int
+) -> None:
+    """Accelerations (rad/s^2) of the ``n`` rotors in the current rotor mode, into ``omega_dot``."""
     if rin[RIN_FIRST_ORDER] > 0.5:
         for j in range(n):
             omega_dot[j] = (rin[RIN_CMD + j] - x[X_ROTOR + j]) / veh[V_TAU_M]

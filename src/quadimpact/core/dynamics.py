@@ -28,6 +28,21 @@ from quadimpact.core.rotors import rotor_wrench
 
 
 @compiled(inline="always")
+def _rotor_states(
+    x: np.ndarray, xdot: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray, n: int
+) -> None:
+    """The ``n`` rotor speeds' derivatives into ``xdot``; ``omega_dot``: the rates of the
+    reaction torque (the prescribed ones in the ideal and scheduled modes)."""
+    rotor_rates(x, veh, rin, omega_dot, n)
+    for j in range(n):
+        xdot[X_ROTOR + j] = omega_dot[j]
+    if rin[RIN_FIRST_ORDER] < 0.5:
+        # ideal / scheduled rotors: the reaction torque uses the prescribed rate
+        for j in range(n):
+            omega_dot[j] = rin[RIN_FF + j]
+
+
+@compiled(inline="always")
 def state_derivative(x: np.ndarray, xdot: np.ndarray, m: Model, d: Data, w: Work) -> None:
     """Full state derivative ``xdot = f(x)`` (the system is autonomous).
 
@@ -42,14 +57,11 @@ def state_derivative(x: np.ndarray, xdot: np.ndarray, m: Model, d: Data, w: Work
     veh = m.veh
     rin = d.rin
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
-    rotor_rates(x, veh, rin, omega_dot)
     n = int(veh[V_N_ROTORS])
-    for j in range(n):
-        xdot[X_ROTOR + j] = omega_dot[j]
-    if rin[RIN_FIRST_ORDER] < 0.5:
-        # ideal / scheduled rotors: the reaction torque uses the prescribed rate
-        for j in range(n):
-            omega_dot[j] = rin[RIN_FF + j]
+    if n == 4:  # a quadrotor: the loops' count known to the compiler (unrolled, as before)
+        _rotor_states(x, xdot, veh, rin, omega_dot, 4)
+    else:
+        _rotor_states(x, xdot, veh, rin, omega_dot, n)
     mg = veh[V_MASS] * veh[V_GRAVITY]
     fx = mg * C[2, 0]
     fy = mg * C[2, 1]

@@ -65,6 +65,7 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.rotors import active_states
 from quadimpact.core.sensors.disturbance import impact_onset
 
 
@@ -141,7 +142,7 @@ def observe_peak(
     The step starts at ``d.x`` (time ``t``, s) with size ``h`` (s) and
     coefficients ``w.Q``. Returns the penetration rate there (m/s).
     """
-    dense_eval(d.x, w.Q, h, sigma, w.xs)
+    dense_eval(d.x[: active_states(m.veh)], w.Q, h, sigma, w.xs)
     rotation_matrix(w.xs[X_QUAT : X_QUAT + 4], w.C)
     dp, dd = pair_depth(w.xs, w.C, m.feat, m.shapes, m.pairs, c)
     track_peak(o, e, t + sigma * h, dp, pair_normal_force(m, c, dp, dd, d.cs[c, CS_LAMBDA]))

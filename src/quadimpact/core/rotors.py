@@ -21,6 +21,7 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import (
+    N_RIGID,
     V_DT,
     V_JR,
     V_KT,
@@ -30,6 +31,16 @@ from quadimpact.core.layout import (
     X_OMEGA,
     X_ROTOR,
 )
+
+
+@compiled(inline="always")
+def active_states(veh: np.ndarray) -> int:
+    """The state's components in use: the rigid body's and the vehicle's ``n`` rotor speeds.
+
+    The rotor slots beyond ``n`` (up to ``MAX_ROTORS``) stay 0; the integrator
+    runs over the first ``N_RIGID + n`` components only.
+    """
+    return N_RIGID + int(veh[V_N_ROTORS])
 
 
 @compiled
@@ -52,13 +63,29 @@ def rotor_wrench(
     fz : thrust force along z_B (N, negative = up).
     mx, my, mz : moment about the CM (N m).
     """
+    n = int(veh[V_N_ROTORS])
+    if n == 4:  # a quadrotor: the loop's count known to the compiler (unrolled, as before)
+        return _rotor_sums(x, omega_dot, veh, 4, drag_paper, spinup_paper)
+    return _rotor_sums(x, omega_dot, veh, n, drag_paper, spinup_paper)
+
+
+@compiled(inline="always")
+def _rotor_sums(
+    x: np.ndarray,
+    omega_dot: np.ndarray,
+    veh: np.ndarray,
+    n: int,
+    drag_paper: bool,
+    spinup_paper: bool,
+) -> tuple[float, float, float, float]:
+    """:func:`rotor_wrench` over rotors ``0..n-1``, summed in rotor order."""
     jr = veh[V_JR]
     fz = 0.0
     mx = 0.0
     my = 0.0
     mz = 0.0
     spin_sum = 0.0
-    for j in range(int(veh[V_N_ROTORS])):
+    for j in range(n):
         w = x[X_ROTOR + j]
         s = veh[V_SPIN + j]
         dt = veh[V_DT + j]
