@@ -34,6 +34,7 @@ __all__ = [
     "matvec",
     "matvec_t",
     "norm",
+    "pseudo_inverse",
     "solve",
 ]
 
@@ -145,6 +146,18 @@ def inverse(a: ArrayLike) -> np.ndarray:
     """The inverse of a square matrix (:func:`solve` with the identity)."""
     n = np.asarray(a).shape[0]
     return solve(a, np.eye(n))
+
+
+def pseudo_inverse(a: ArrayLike) -> np.ndarray:
+    """The Moore-Penrose pseudo-inverse ``A^T (A A^T)^-1`` of a full-row-rank ``A`` (r x c, r <= c).
+
+    ``A A^T`` and the product are summed in index order (:func:`dot`), the
+    inverse is :func:`inverse`: the same bits on every machine.
+    """
+    a = np.asarray(a, dtype=np.float64)
+    gram = dot(a[:, None, :], a[None, :, :])  # (r, r): sum_j a[i, j] a[k, j]
+    g_inv = inverse(gram)
+    return dot(a.T[:, None, :], g_inv.T[None, :, :])  # (c, r): sum_k a[k, j] g_inv[k, i]
 
 
 def dot(a: ArrayLike, b: ArrayLike) -> np.ndarray | float:

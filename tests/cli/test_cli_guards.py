@@ -155,7 +155,7 @@ def test_run_refuses_a_record_too_large_for_memory_with_its_estimate(
     assert MAX_RECORD_MB == checks.MAX_RECORD_MB
     monkeypatch.chdir(tmp_path)
     args = ("--final-time", "600", "--output-rate", "100000", "--ground", "none", "--out", "o")
-    input_error(cli(capsys, "run", *args), "record would take 13.9 GiB (600 s at output_rate_hz "
+    input_error(cli(capsys, "run", *args), "record would take 17.5 GiB (600 s at output_rate_hz "
                 "= 100000)", "--max-record-mb MB raises the limit")  # fmt: skip
     assert not Path("o").exists()
     # the option raises the limit (checked here without running: the estimate passes)
@@ -164,7 +164,7 @@ def test_run_refuses_a_record_too_large_for_memory_with_its_estimate(
     big = WallApproach(final_time_s=600, output_rate_hz=100000, ground="none")
     checks.check_record_size(big, 20000.0)
     input_error(cli(capsys, "sweep", "--grid", "output_rate_hz=1000,100000", "--grid",
-                    "final_time_s=600", "--out", "s"), "run 1 (", "13.9 GiB")  # fmt: skip
+                    "final_time_s=600", "--out", "s"), "run 1 (", "17.5 GiB")  # fmt: skip
 
 
 def test_snapshots_and_animate_refuse_pictures_beyond_reason(tmp_path, capsys) -> None:

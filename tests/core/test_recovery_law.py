@@ -49,6 +49,7 @@ def _packed(mass=1.0, g=9.81):
     ctrl = np.zeros(L.NCTRL)
     # an identity "allocation" so cmd^2 = (T, tau_x, tau_y, tau_z) can be read back
     ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = np.eye(4).ravel()
+    ctrl[L.C_N_ROTORS] = veh[L.V_N_ROTORS] = 4  # a quadrotor
     ctrl[L.C_OMEGA_MIN] = 0.0
     ctrl[L.C_OMEGA_MAX] = 1e9
     p = L.C_PARAMS

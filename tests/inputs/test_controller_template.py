@@ -118,7 +118,7 @@ def test_each_named_quantity_is_its_slots() -> None:
     assert got[0].tolist() == list(range(x + L.X_POS, x + L.X_POS + 3))
     assert got[1].tolist() == list(range(x + L.X_QUAT, x + L.X_QUAT + 4))
     assert got[2].tolist() == list(range(L.MS_W_HAT, L.MS_W_HAT + 3))
-    assert got[3].tolist() == list(range(x + L.X_ROTOR, x + L.X_ROTOR + 4))
+    assert got[3].tolist() == list(range(x + L.X_ROTOR, x + L.X_ROTOR + L.MAX_ROTORS))
     assert got[4].tolist() == list(range(L.MS_IMU_F, L.MS_IMU_F + 3))
     assert got[5].tolist() == list(range(L.MS_NORMAL, L.MS_NORMAL + 3))
     assert (got[6], got[7]) == (L.MS_T, L.MS_T_DETECT)

@@ -151,7 +151,7 @@ BAD_VEHICLES = [
     (
         "  [ 0.13192, -0.12662, -0.02416],  # rotor 4: port front\n",
         "",
-        ["rotor_positions_m: must have exactly 4 rows", "(got 3)"],
+        ["rotor_positions_m: must have 4 to 8 rows", "(got 3)"],
     ),
     (
         "spin_directions = [-1, 1, -1, 1]",

@@ -45,7 +45,6 @@ from quadimpact.core.layout import (
     LS_PO_T,
     LS_T0,
     MOTOR_OFF,
-    N_ROTORS,
     O_CUT_STEP_MOTORS,
     O_DT_CONTROL,
     O_OMEGA_MAX,
@@ -56,6 +55,7 @@ from quadimpact.core.layout import (
     RIN_FIRST_ORDER,
     RIN_PREV_CMD,
     RIN_RATE,
+    V_N_ROTORS,
     V_TAU_M,
     X_ROTOR,
 )
@@ -66,16 +66,16 @@ ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
 
 @compiled
 def apply_segment(
-    x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray, cut: int
+    x: np.ndarray, sched_rate: np.ndarray, seg: int, rin: np.ndarray, cut: int, n: int
 ) -> None:
-    """Rotor inputs for segment ``seg``: prescribed rates, floored at zero speed.
+    """Rotor inputs of the ``n`` rotors for segment ``seg``: prescribed rates, floored at zero.
 
     A rate of :data:`MOTOR_OFF` stops the motor. The motors of the bit mask
     ``cut`` (``opts[O_CUT_STEP_MOTORS]``) are left alone: :func:`cut_step`
     drives them.
     """
     rin[RIN_FIRST_ORDER] = 0.0
-    for j in range(N_ROTORS):
+    for j in range(n):
         if (cut >> j) & 1:
             continue
         r = sched_rate[seg, j]
@@ -89,11 +89,12 @@ def apply_segment(
 
 @compiled
 def next_boundary(
-    t: float, x: np.ndarray, t_p: float, sched_t: np.ndarray, seg: int, rin: np.ndarray
+    t: float, x: np.ndarray, t_p: float, sched_t: np.ndarray, seg: int, rin: np.ndarray, n: int
 ) -> float:
-    """Next instant (s) where the rotor inputs change: a segment start or a motor stopping."""
+    """Next instant (s) where the rotor inputs change: a segment start or one of the ``n``
+    motors stopping."""
     t_b = t_p + sched_t[seg + 1] if seg + 1 < sched_t.shape[0] else math.inf
-    for j in range(N_ROTORS):
+    for j in range(n):
         r = rin[RIN_RATE + j]
         if r < 0.0 and x[X_ROTOR + j] > 0.0:
             t_b = min(t_b, t + x[X_ROTOR + j] / -r)
@@ -121,7 +122,7 @@ def cut_step(m: Model, d: Data) -> None:
     first = ls[LS_PO_T] >= ls[LS_T0] + (k - 1) * dt  # the trigger fell in the last interval
     x = d.x
     rin = d.rin
-    for j in range(N_ROTORS):
+    for j in range(int(m.veh[V_N_ROTORS])):
         if (cut >> j) & 1:
             rin[RIN_FF + j] = -x[X_ROTOR + j] / dt if first else 0.0
             rin[RIN_RATE + j] = 0.0
@@ -145,8 +146,9 @@ def apply_command(
     opts: np.ndarray,
     dt: float,
     scheduled: bool,
+    n: int,
 ) -> None:
-    """Limit the tick's speed commands (rad/s) and set the interval's rotor inputs.
+    """Limit the tick's speed commands of the ``n`` rotors (rad/s); set the interval's inputs.
 
     ``scheduled``: a power-off schedule is in force, so only the recorded command
     changes (the schedule keeps driving the rotor states).
@@ -155,7 +157,7 @@ def apply_command(
     w_hi = opts[O_OMEGA_MAX]
     slew = opts[O_SLEW_MAX]
     first_order = rin[RIN_FIRST_ORDER] > 0.5
-    for j in range(N_ROTORS):
+    for j in range(n):
         prev = rin[RIN_PREV_CMD + j]
         w = cmd[j]
         if slew > 0.0:
@@ -179,12 +181,14 @@ def apply_command(
         rin[RIN_PREV_CMD + j] = w
 
 
-@compiled
-def rotor_rates(x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray) -> None:
-    """Rotor accelerations (rad/s^2) of the current rotor mode, into ``omega_dot``."""
+@compiled(inline="always")
+def rotor_rates(
+    x: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray, n: int
+) -> None:
+    """Accelerations (rad/s^2) of the ``n`` rotors in the current rotor mode, into ``omega_dot``."""
     if rin[RIN_FIRST_ORDER] > 0.5:
-        for j in range(N_ROTORS):
+        for j in range(n):
             omega_dot[j] = (rin[RIN_CMD + j] - x[X_ROTOR + j]) / veh[V_TAU_M]
     else:
-        for j in range(N_ROTORS):
+        for j in range(n):
             omega_dot[j] = rin[RIN_RATE + j]

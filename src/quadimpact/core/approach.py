@@ -45,7 +45,7 @@ from quadimpact.core.layout import (
     APPROACH_NO_BRACKET,
     APPROACH_RUN_FAILED,
     APPROACH_SOLVED,
-    N_ROTORS,
+    MAX_ROTORS,
     NX,
     OUT_X,
     SPAN_T0,
@@ -95,7 +95,7 @@ def _shoot(t0: float, v0: float, x_start: float, m: Model, o: Output, ap: np.nda
     for j in range(3):
         x0[X_VEL + j] = C[0, j] * v0 + C[1, j] * 0.0 + C[2, j] * 0.0
     x0[X_QUAT : X_QUAT + 4] = ap[AP_Q : AP_Q + 4]
-    x0[X_ROTOR : X_ROTOR + N_ROTORS] = ap[AP_ROTORS : AP_ROTORS + N_ROTORS]
+    x0[X_ROTOR : X_ROTOR + MAX_ROTORS] = ap[AP_ROTORS : AP_ROTORS + MAX_ROTORS]
     ap[AP_X0 : AP_X0 + NX] = x0
     m.span[SPAN_T0] = t0
     m.span[SPAN_TF] = ap[AP_TC]

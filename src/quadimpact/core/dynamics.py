@@ -11,13 +11,13 @@ from quadimpact.core.actuators import rotor_rates
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_wrench
 from quadimpact.core.layout import (
-    N_ROTORS,
     O_SPINUP_PAPER,
     O_YAW_REACTION_PAPER,
     RIN_FF,
     RIN_FIRST_ORDER,
     V_GRAVITY,
     V_MASS,
+    V_N_ROTORS,
     X_QUAT,
     X_ROTOR,
 )
@@ -25,6 +25,21 @@ from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Work
 from quadimpact.core.rigid_body import rigid_body_derivative
 from quadimpact.core.rotors import rotor_wrench
+
+
+@compiled(inline="always")
+def _rotor_states(
+    x: np.ndarray, xdot: np.ndarray, veh: np.ndarray, rin: np.ndarray, omega_dot: np.ndarray, n: int
+) -> None:
+    """The ``n`` rotor speeds' derivatives into ``xdot``; ``omega_dot``: the rates of the
+    reaction torque (the prescribed ones in the ideal and scheduled modes)."""
+    rotor_rates(x, veh, rin, omega_dot, n)
+    for j in range(n):
+        xdot[X_ROTOR + j] = omega_dot[j]
+    if rin[RIN_FIRST_ORDER] < 0.5:
+        # ideal / scheduled rotors: the reaction torque uses the prescribed rate
+        for j in range(n):
+            omega_dot[j] = rin[RIN_FF + j]
 
 
 @compiled(inline="always")
@@ -42,13 +57,11 @@ def state_derivative(x: np.ndarray, xdot: np.ndarray, m: Model, d: Data, w: Work
     veh = m.veh
     rin = d.rin
     rotation_matrix(x[X_QUAT : X_QUAT + 4], C)
-    rotor_rates(x, veh, rin, omega_dot)
-    for j in range(N_ROTORS):
-        xdot[X_ROTOR + j] = omega_dot[j]
-    if rin[RIN_FIRST_ORDER] < 0.5:
-        # ideal / scheduled rotors: the reaction torque uses the prescribed rate
-        for j in range(N_ROTORS):
-            omega_dot[j] = rin[RIN_FF + j]
+    n = int(veh[V_N_ROTORS])
+    if n == 4:  # a quadrotor: the loops' count known to the compiler (unrolled, as before)
+        _rotor_states(x, xdot, veh, rin, omega_dot, 4)
+    else:
+        _rotor_states(x, xdot, veh, rin, omega_dot, n)
     mg = veh[V_MASS] * veh[V_GRAVITY]
     fx = mg * C[2, 0]
     fy = mg * C[2, 1]

@@ -23,6 +23,7 @@ from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import CS_ACTIVE, O_EVENT_TOL, X_POS, X_QUAT
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Work
+from quadimpact.core.rotors import active_states
 
 EV_GAP = 0
 EV_RATE = 1
@@ -79,7 +80,7 @@ def locate(
         s = sb - fb * (sb - sa) / denom if denom != 0.0 else 0.5 * (sa + sb)
         if not (sa < s < sb):
             s = 0.5 * (sa + sb)
-        dense_eval(d.x, w.Q, h, s, w.xs)
+        dense_eval(d.x[: active_states(m.veh)], w.Q, h, s, w.xs)
         fs = event_value(kind, c, level, w.xs, w.C, m)
         if (fs > 0.0) == side_b:
             sb = s
@@ -117,7 +118,7 @@ def contact_event(c: int, m: Model, d: Data, w: Work, h: float) -> float:
         if -ga < band or -gb < band:
             for k in range(1, NEAR_GRAZE_SAMPLES + 1):
                 sm = k / (NEAR_GRAZE_SAMPLES + 1.0)
-                dense_eval(d.x, w.Q, h, sm, w.xs)
+                dense_eval(d.x[: active_states(m.veh)], w.Q, h, sm, w.xs)
                 gm = event_value(EV_GAP, c, 0.0, w.xs, w.C, m)
                 if gm > 0.0:
                     return locate(EV_GAP, c, 0.0, m, d, w, h, ga, gm, sm)

@@ -5,6 +5,12 @@ ode45 (each component against ``atol + rtol max(|y|, |y_new|)``), the
 step-size update, and the 4th-order dense output of Shampine (1986), as also
 used by SciPy's ``RK45``. The problem (the right-hand side) is passed in by
 the run loop; nothing here knows about quadrotors.
+
+The vectors have the length of the arrays passed in: the run loop passes the
+state's first ``N_RIGID + n`` components (``core.rotors.active_states``), the
+rigid body and the vehicle's ``n`` rotors. The rotor slots beyond them are
+constant zeros, so the error norm and the dense output are those of the
+vehicle's own state.
 """
 
 import numpy as np
@@ -124,9 +130,10 @@ def step_factor(err: float, accepted_before: bool) -> float:
 
 
 @compiled
-def dense_coefficients(K: np.ndarray, Q: np.ndarray) -> None:
-    """``Q = K^T P`` (n x 4), the dense-output polynomial coefficients of the last step."""
-    for i in range(K.shape[1]):
+def dense_coefficients(K: np.ndarray, Q: np.ndarray, n: int) -> None:
+    """``Q = K^T P`` (n x 4), the dense-output polynomial coefficients of the last step,
+    for the first ``n`` components."""
+    for i in range(n):
         k0 = K[0, i]
         k2 = K[2, i]
         k3 = K[3, i]

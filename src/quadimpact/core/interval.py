@@ -43,7 +43,6 @@ from quadimpact.core.layout import (
     LS_T,
     LS_T_SCHED,
     MS_DETECTED,
-    N_ROTORS,
     NX,
     O_ATOL,
     O_CRASH_ALTITUDE,
@@ -75,6 +74,7 @@ from quadimpact.core.layout import (
     ST_STATUS,
     ST_T_END,
     STATUS_FAILED,
+    V_N_ROTORS,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -89,6 +89,7 @@ from quadimpact.core.recording import (
     write_sample,
 )
 from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.rotors import active_states
 from quadimpact.core.sensing import sample_at, take_sample
 
 MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
@@ -113,17 +114,18 @@ def _schedule_boundary(t: float, tiny: float, m: Model, d: Data, o: Output) -> N
     """The rotor inputs change at ``t``: power-off trigger, next segment, a motor stopping."""
     ls = d.ls
     x = d.x
+    n = int(m.veh[V_N_ROTORS])
     if ls[LS_PO_ACTIVE] < 0.5:
         ls[LS_PO_ACTIVE] = 1.0
         ls[LS_PO_T] = t
         o.stats[ST_POWER_OFF_T] = t
-        for j in range(N_ROTORS):
+        for j in range(n):
             if m.sched_stop[j] > 0.5:
                 x[X_ROTOR + j] = 0.0
     seg = segment_at(t + tiny, ls[LS_PO_T], m.sched_t)
     ls[LS_PO_SEG] = seg
-    apply_segment(x, m.sched_rate, seg, d.rin, int(m.opts[O_CUT_STEP_MOTORS]))
-    ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin)
+    apply_segment(x, m.sched_rate, seg, d.rin, int(m.opts[O_CUT_STEP_MOTORS]), n)
+    ls[LS_T_SCHED] = next_boundary(t, x, ls[LS_PO_T], m.sched_t, seg, d.rin, n)
 
 
 @compiled
@@ -150,14 +152,15 @@ def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
     """
     x = d.x
     K = w.K
+    na = active_states(m.veh)
     for st in range(1 if fsal else 0, 7):
         # stage 0 at x (unless FSAL), 1-5 at w.xs, the last at the step's end w.x_new;
         # one call site, so the inlined right-hand side is compiled once
         xs = x if st == 0 else (w.x_new if st == 6 else w.xs)
         if st > 0:
-            stage_state(x, K, h, st, xs)
+            stage_state(x[:na], K, h, st, xs)
         state_derivative(xs, K[st], m, d, w)
-    return error_norm(x, w.x_new, K, h, m.opts[O_RTOL], m.opts[O_ATOL])
+    return error_norm(x[:na], w.x_new[:na], K, h, m.opts[O_RTOL], m.opts[O_ATOL])
 
 
 @compiled
@@ -189,7 +192,7 @@ def _dense_samples(
     """Output rows and IMU samples in ``(t, t_b]`` of the step of ``h`` (s); the next row."""
     t_out = m.t_out
     while i_out < t_out.shape[0] and t_out[i_out] <= t_b:
-        dense_eval(d.x, w.Q, h, (t_out[i_out] - t) / h, w.xs)
+        dense_eval(d.x[: active_states(m.veh)], w.Q, h, (t_out[i_out] - t) / h, w.xs)
         write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)
         i_out += 1
     sst = d.sst
@@ -200,7 +203,7 @@ def _dense_samples(
             rotation_matrix(w.x_b[X_QUAT : X_QUAT + 4], w.C)
             take_sample(ts, w.x_b, w.K[6], m, d, o, w)
             continue
-        dense_eval(d.x, w.Q, h, (ts - t) / h, w.xs)
+        dense_eval(d.x[: active_states(m.veh)], w.Q, h, (ts - t) / h, w.xs)
         sample_at(ts, w.xs, m, d, o, w)
     return i_out
 
@@ -320,11 +323,11 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
             n_steps += 1
             tol_sig = m.opts[O_EVENT_TOL] / h_try
             h_new = h_try * step_factor(err, True)
-            dense_coefficients(w.K, w.Q)
+            dense_coefficients(w.K, w.Q, active_states(m.veh))
             sig_min, sig_crash = _step_events(m, d, w, h_try)
             if sig_min <= 1.0:
                 t_b = t + sig_min * h_try
-                dense_eval(d.x, w.Q, h_try, sig_min, w.x_b)
+                dense_eval(d.x[: active_states(m.veh)], w.Q, h_try, sig_min, w.x_b)
                 fsal = False
             else:
                 sig_min = 1.0

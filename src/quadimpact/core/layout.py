@@ -83,7 +83,9 @@ class Block:
 # --------------------------------------------------------------------------
 # Kinds
 # --------------------------------------------------------------------------
-N_ROTORS = 4  # a quadrotor: rotor speeds, commands and rotor inputs have four entries
+MAX_ROTORS = 8  # the most rotors a vehicle may have: per-rotor slots have this many entries;
+#   a run's own count is veh[V_N_ROTORS] (4 to MAX_ROTORS) and every compiled loop over the
+#   rotors runs to it, so the entries beyond it stay 0 (no state, no thrust, no error norm)
 
 
 class FeatureKind(IntEnum):
@@ -202,7 +204,7 @@ X_POS = _x.slot("X_POS", 3)  # p, CM position, inertial (m)
 X_VEL = _x.slot("X_VEL", 3)  # v, CM velocity, body (m/s)
 X_QUAT = _x.slot("X_QUAT", 4)  # q = [q0, q1, q2, q3], scalar first, body -> inertial
 X_OMEGA = _x.slot("X_OMEGA", 3)  # omega = [p, q, r], body angular velocity (rad/s)
-X_ROTOR = _x.slot("X_ROTOR", N_ROTORS)  # Omega_1..4, rotor speeds (rad/s)
+X_ROTOR = _x.slot("X_ROTOR", MAX_ROTORS)  # Omega_1..n, rotor speeds (rad/s); 0 beyond n
 NX = _x.end("NX")
 N_RIGID = X_ROTOR  # the rigid-body states come first
 
@@ -211,10 +213,11 @@ _veh = Block("veh", "V_")
 V_MASS = _veh.slot("V_MASS")  # kg
 V_INERTIA = _veh.slot("V_INERTIA", 9)  # kg m^2, row-major, body
 V_INERTIA_INV = _veh.slot("V_INERTIA_INV", 9)  # row-major
-V_ROTOR_POS = _veh.slot("V_ROTOR_POS", 3 * N_ROTORS)  # rotor j at V_ROTOR_POS + 3 j (body, m)
-V_SPIN = _veh.slot("V_SPIN", N_ROTORS)  # +-1, spin sense about +z_B
-V_KT = _veh.slot("V_KT")  # thrust coefficient, N/(rad/s)^2
-V_DT = _veh.slot("V_DT")  # drag-torque coefficient, N m/(rad/s)^2
+V_N_ROTORS = _veh.slot("V_N_ROTORS")  # n, the vehicle's rotor count (4 to MAX_ROTORS)
+V_ROTOR_POS = _veh.slot("V_ROTOR_POS", 3 * MAX_ROTORS)  # rotor j at V_ROTOR_POS + 3 j (body, m)
+V_SPIN = _veh.slot("V_SPIN", MAX_ROTORS)  # +-1, spin sense about +z_B (0 beyond n)
+V_KT = _veh.slot("V_KT", MAX_ROTORS)  # rotor j's thrust coefficient at V_KT + j, N/(rad/s)^2
+V_DT = _veh.slot("V_DT", MAX_ROTORS)  # rotor j's drag-torque coefficient, N m/(rad/s)^2
 V_JR = _veh.slot("V_JR")  # rotor inertia about its axis, kg m^2
 V_GRAVITY = _veh.slot("V_GRAVITY")  # m/s^2
 V_TAU_M = _veh.slot("V_TAU_M")  # motor time constant, s (first-order rotor mode)
@@ -294,7 +297,10 @@ C_PHI_REF = _ctrl.slot("C_PHI_REF")  # rad
 C_THETA_REF = _ctrl.slot("C_THETA_REF")  # rad
 C_PSI_REF = _ctrl.slot("C_PSI_REF")  # rad
 C_Z_REF = _ctrl.slot("C_Z_REF", 3)  # the reference attitude's body z axis, inertial (unit)
-C_ALLOC_INV = _ctrl.slot("C_ALLOC_INV", 16)  # inverse allocation matrix, row-major
+N_WRENCH = 4  # the allocation's wrench components: thrust, roll, pitch and yaw torques
+C_N_ROTORS = _ctrl.slot("C_N_ROTORS")  # n, the vehicle's rotor count (the allocation's rows)
+C_ALLOC_INV = _ctrl.slot("C_ALLOC_INV", N_WRENCH * MAX_ROTORS)  # (pseudo-)inverse allocation:
+#   rotor j's row (its Omega_j^2 per thrust, tau_x, tau_y, tau_z) at C_ALLOC_INV + N_WRENCH j
 C_OMEGA_MIN = _ctrl.slot("C_OMEGA_MIN")  # rad/s, the vehicle's rotor speed range
 C_OMEGA_MAX = _ctrl.slot("C_OMEGA_MAX")
 C_WAYPOINT_ON = _ctrl.slot("C_WAYPOINT_ON")  # 1: cascade-pid's position loop (a waypoint flight)
@@ -420,7 +426,7 @@ AP_VC = _ap.slot("AP_VC")  # m/s, V_c: the speed toward the wall at T_c (inertia
 AP_LATE_RULE = _ap.slot("AP_LATE_RULE")  # 1: start later at rest whenever v0 < 0 is needed
 AP_START = _ap.slot("AP_START", 3)  # m, the initial CM position before the X shift
 AP_Q = _ap.slot("AP_Q", 4)  # the attitude held (quaternion, body FRD to inertial)
-AP_ROTORS = _ap.slot("AP_ROTORS", N_ROTORS)  # rad/s, initial rotor speeds
+AP_ROTORS = _ap.slot("AP_ROTORS", MAX_ROTORS)  # rad/s, initial rotor speeds
 AP_X0 = _ap.slot("AP_X0", NX)  # found: the initial state (layout X_*)
 AP_T0 = _ap.slot("AP_T0")  # s, found: the start time (0 unless a late start)
 AP_V0 = _ap.slot("AP_V0")  # m/s, found: the start speed (inertial X)
@@ -451,7 +457,7 @@ LS_PO_SEG = _ls.slot("LS_PO_SEG")  # its segment in force
 LS_T_SCHED = _ls.slot("LS_T_SCHED")  # s, next instant the scheduled rotor inputs change
 LS_STAGE = _ls.slot("LS_STAGE")  # the controller's stage in force (MEM_STAGE at the last tick)
 LS_EXT = _ls.slot("LS_EXT")  # 1: the next tick applies LS_EXT_CMD instead of the controller
-LS_EXT_CMD = _ls.slot("LS_EXT_CMD", N_ROTORS)  # external rotor speed command (rad/s)
+LS_EXT_CMD = _ls.slot("LS_EXT_CMD", MAX_ROTORS)  # external rotor speed command (rad/s)
 NLS = _ls.end("NLS")
 
 # ---- contact pairs cs (n_pairs, NCS); changed only at located events
@@ -463,11 +469,11 @@ NCS = _cs.end("NCS")
 
 # ---- rotor inputs over the current sub-interval rin (NRIN)
 _rin = Block("rin", "RIN_")
-RIN_CMD = _rin.slot("RIN_CMD", N_ROTORS)  # speed command in force (rad/s)
-RIN_RATE = _rin.slot("RIN_RATE", N_ROTORS)  # prescribed d(Omega)/dt of the rotor states
-RIN_FF = _rin.slot("RIN_FF", N_ROTORS)  # Omega_dot used in the reaction torque
+RIN_CMD = _rin.slot("RIN_CMD", MAX_ROTORS)  # speed command in force (rad/s)
+RIN_RATE = _rin.slot("RIN_RATE", MAX_ROTORS)  # prescribed d(Omega)/dt of the rotor states
+RIN_FF = _rin.slot("RIN_FF", MAX_ROTORS)  # Omega_dot used in the reaction torque
 RIN_FIRST_ORDER = _rin.slot("RIN_FIRST_ORDER")  # 1: rotor states follow (cmd - Omega) / tau
-RIN_PREV_CMD = _rin.slot("RIN_PREV_CMD", N_ROTORS)  # the previous tick's command, limited
+RIN_PREV_CMD = _rin.slot("RIN_PREV_CMD", MAX_ROTORS)  # the previous tick's command, limited
 NRIN = _rin.end("NRIN")
 
 # ---- controller memory mem (NMEM), zeroed at the start; each controller
@@ -560,7 +566,7 @@ NIMU = _imu.end("NIMU")
 _out = Block("out", "OUT_")
 OUT_T = _out.slot("OUT_T")  # s
 OUT_X = _out.slot("OUT_X", NX)  # state
-OUT_CMD = _out.slot("OUT_CMD", N_ROTORS)  # rotor speed command in force (rad/s)
+OUT_CMD = _out.slot("OUT_CMD", MAX_ROTORS)  # rotor speed command in force (rad/s)
 OUT_STAGE = _out.slot("OUT_STAGE")  # the controller's stage in force (MEM_STAGE)
 NOUT = _out.end("NOUT")
 OUT_DELTA = NOUT  # feature f's deflection at OUT_DELTA + f

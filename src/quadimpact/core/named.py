@@ -17,7 +17,8 @@ indexing)::
         ...
 
 Arrays are returned as views: read them, never write them (the loop owns
-them); ``cmd`` (four rotor speeds, rad/s) is what a step writes, and ``mem``
+them); ``cmd`` (a speed per rotor, rad/s: ``rotor_count(veh)`` of them) is
+what a step writes, and ``mem``
 (its own floats, kept between ticks) what it may write. Its own parameters
 are ``params(ctrl)``, in the order of its parameter model's fields when the
 registry packs them (``param_index`` names them: docs/CONTROLLERS.md).
@@ -43,6 +44,7 @@ from quadimpact.core.layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
+    MAX_ROTORS,
     MS_BIAS_HAT,
     MS_DETECTED,
     MS_IMU_F,
@@ -54,13 +56,14 @@ from quadimpact.core.layout import (
     MS_T_DETECT,
     MS_W_HAT,
     MS_X,
-    N_ROTORS,
+    N_WRENCH,
     NPARAM,
     NX,
     V_GRAVITY,
     V_INERTIA,
     V_KT,
     V_MASS,
+    V_N_ROTORS,
     X_OMEGA,
     X_POS,
     X_QUAT,
@@ -90,9 +93,11 @@ __all__ = [
     "params",
     "position",
     "references",
+    "rotor_count",
     "rotor_speed_range",
     "rotor_speeds",
     "thrust_coefficient",
+    "thrust_coefficients",
     "tick_time",
     "velocity_body",
     "wall_normal",
@@ -126,8 +131,9 @@ def body_rates(meas: np.ndarray) -> np.ndarray:
 
 @allocating(inline="always")
 def rotor_speeds(meas: np.ndarray) -> np.ndarray:
-    """The rotor speeds at the tick, rad/s (4,) (measured: the motor controllers report them)."""
-    return meas[MS_X + X_ROTOR : MS_X + X_ROTOR + N_ROTORS]
+    """The rotor speeds at the tick, rad/s (MAX_ROTORS,) (measured: the motor controllers
+    report them); the entries beyond the vehicle's ``rotor_count(veh)`` are 0."""
+    return meas[MS_X + X_ROTOR : MS_X + X_ROTOR + MAX_ROTORS]
 
 
 @allocating(inline="always")
@@ -199,9 +205,10 @@ def references(ctrl: np.ndarray) -> tuple[float, float, float, float]:
 
 @allocating(inline="always")
 def allocation_inverse(ctrl: np.ndarray) -> np.ndarray:
-    """The inverse allocation (4, 4): squared rotor speeds, (rad/s)^2, of thrust (N) and the
-    body torques (N m): ``Omega^2 = A^-1 [T, tau_x, tau_y, tau_z]``."""
-    return ctrl[C_ALLOC_INV : C_ALLOC_INV + 16].reshape((4, 4))
+    """The (pseudo-)inverse allocation (MAX_ROTORS, 4): squared rotor speeds, (rad/s)^2, of
+    thrust (N) and the body torques (N m): ``Omega^2 = A^+ [T, tau_x, tau_y, tau_z]``; the
+    rows beyond the vehicle's rotor count are 0 (``controllers.common.allocate``)."""
+    return ctrl[C_ALLOC_INV : C_ALLOC_INV + N_WRENCH * MAX_ROTORS].reshape((MAX_ROTORS, N_WRENCH))
 
 
 @allocating(inline="always")
@@ -231,8 +238,20 @@ def inertia(veh: np.ndarray) -> np.ndarray:
 
 @allocating(inline="always")
 def thrust_coefficient(veh: np.ndarray) -> float:
-    """The rotors' thrust coefficient, N/(rad/s)^2."""
+    """Rotor 1's thrust coefficient, N/(rad/s)^2 (every rotor's when they share one)."""
     return veh[V_KT]
+
+
+@allocating(inline="always")
+def thrust_coefficients(veh: np.ndarray) -> np.ndarray:
+    """Each rotor's thrust coefficient, N/(rad/s)^2 (MAX_ROTORS,); 0 beyond the rotor count."""
+    return veh[V_KT : V_KT + MAX_ROTORS]
+
+
+@allocating(inline="always")
+def rotor_count(veh: np.ndarray) -> int:
+    """The vehicle's number of rotors ``n`` (4 to MAX_ROTORS)."""
+    return int(veh[V_N_ROTORS])
 
 
 # ------------------------------------------------------------- from Python
@@ -253,7 +272,7 @@ STATE_FIELDS: tuple[Field, ...] = (
     Field("velocity_body", X_VEL, 3, "m/s", "CM velocity, body FRD"),
     Field("attitude", X_QUAT, 4, "1", "quaternion, scalar first, body -> inertial"),
     Field("body_rates", X_OMEGA, 3, "rad/s", "angular velocity, body FRD"),
-    Field("rotor_speeds", X_ROTOR, N_ROTORS, "rad/s", "rotor speeds"),
+    Field("rotor_speeds", X_ROTOR, MAX_ROTORS, "rad/s", "rotor speeds (0 beyond the rotor count)"),
 )
 assert sum(f.size for f in STATE_FIELDS) == NX
 

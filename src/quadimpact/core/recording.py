@@ -35,7 +35,7 @@ from quadimpact.core.layout import (
     E_T_START,
     E_V_I,
     LS_STAGE,
-    N_ROTORS,
+    MAX_ROTORS,
     NEX,
     NX,
     O_V_MIN,
@@ -65,6 +65,7 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.rotors import active_states
 from quadimpact.core.sensors.disturbance import impact_onset
 
 
@@ -101,7 +102,7 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     out[row, OUT_T] = t
     for i in range(NX):
         out[row, OUT_X + i] = xs[i]
-    for j in range(N_ROTORS):
+    for j in range(MAX_ROTORS):  # a copy: zeros beyond the vehicle's rotors
         out[row, OUT_CMD + j] = d.rin[RIN_CMD + j]
     out[row, OUT_STAGE] = d.ls[LS_STAGE]
     if out.shape[1] <= OUT_DELTA:
@@ -141,7 +142,7 @@ def observe_peak(
     The step starts at ``d.x`` (time ``t``, s) with size ``h`` (s) and
     coefficients ``w.Q``. Returns the penetration rate there (m/s).
     """
-    dense_eval(d.x, w.Q, h, sigma, w.xs)
+    dense_eval(d.x[: active_states(m.veh)], w.Q, h, sigma, w.xs)
     rotation_matrix(w.xs[X_QUAT : X_QUAT + 4], w.C)
     dp, dd = pair_depth(w.xs, w.C, m.feat, m.shapes, m.pairs, c)
     track_peak(o, e, t + sigma * h, dp, pair_normal_force(m, c, dp, dd, d.cs[c, CS_LAMBDA]))

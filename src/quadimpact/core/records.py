@@ -41,7 +41,7 @@ from numba import njit
 
 from quadimpact.core.layout import (
     MAX_AVERAGE_WINDOW,
-    N_ROTORS,
+    MAX_ROTORS,
     NCS,
     NECFG,
     NEP,
@@ -101,8 +101,8 @@ class Model(NamedTuple):
     scfg: np.ndarray  # (NSCFG,) IMU and detector
     noise: np.ndarray  # (n_noise, 6) standard normal draws of the IMU
     sched_t: np.ndarray  # (K,) power-off segment starts after the trigger, s
-    sched_rate: np.ndarray  # (K, N_ROTORS) power-off rates, rad/s^2
-    sched_stop: np.ndarray  # (N_ROTORS,) 1: motor stalls at the trigger
+    sched_rate: np.ndarray  # (K, MAX_ROTORS) power-off rates, rad/s^2 (0 beyond the n rotors)
+    sched_stop: np.ndarray  # (MAX_ROTORS,) 1: motor stalls at the trigger
     t_out: np.ndarray  # (n_out,) output times, s
     ecfg: np.ndarray  # (NECFG,) estimator: kind, initial error, gains, noises
     snoise: np.ndarray  # (n_snoise, NSN) standard normal draws of the added sensors
@@ -141,8 +141,8 @@ class Work(NamedTuple):
     K: np.ndarray  # (7, NX) Runge-Kutta stages
     Q: np.ndarray  # (NX, 4) dense-output coefficients
     C: np.ndarray  # (3, 3) a rotation matrix
-    wdot: np.ndarray  # (N_ROTORS,) rotor accelerations
-    cmd: np.ndarray  # (N_ROTORS,) the tick's rotor command
+    wdot: np.ndarray  # (MAX_ROTORS,) rotor accelerations (the first n used)
+    cmd: np.ndarray  # (MAX_ROTORS,) the tick's rotor command (the first n used)
     g_a: np.ndarray  # (n_pairs,) contact gaps at the step's start
     gd_a: np.ndarray  # (n_pairs,) penetration rates there
     g_b: np.ndarray  # (n_pairs,) gaps at the step's end
@@ -202,15 +202,15 @@ def new_output(
 def new_work(n_pairs: int) -> Work:
     """Scratch space of ``step.tick`` for ``n_pairs`` contact pairs."""
     return Work(
-        np.empty(NX),
-        np.empty(NX),
-        np.empty(NX),
-        np.empty(NX),
+        np.zeros(NX),
+        np.zeros(NX),
+        np.zeros(NX),
+        np.zeros(NX),
         np.zeros((7, NX)),
         np.zeros((NX, 4)),
         np.zeros((3, 3)),
-        np.zeros(N_ROTORS),
-        np.zeros(N_ROTORS),
+        np.zeros(MAX_ROTORS),
+        np.zeros(MAX_ROTORS),
         np.zeros(n_pairs),
         np.zeros(n_pairs),
         np.zeros(n_pairs),
@@ -227,8 +227,8 @@ MODEL_ABSENT: dict[str, tuple[int, ...]] = {
     "scfg": (NSCFG,),
     "noise": (0, 6),
     "sched_t": (0,),
-    "sched_rate": (0, N_ROTORS),
-    "sched_stop": (N_ROTORS,),
+    "sched_rate": (0, MAX_ROTORS),
+    "sched_stop": (MAX_ROTORS,),
     "t_out": (0,),
     "ecfg": (NECFG,),
     "snoise": (0, NSN),

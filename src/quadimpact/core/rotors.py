@@ -2,8 +2,8 @@
 
 Physically consistent form (the default):
 
-* thrust of rotor j: ``F_Tj = -kt Omega_j^2 e_z`` (body);
-* moments ``sum_j r_Tj x F_Tj - s_j (dt Omega_j^2 + Jr Omega_dot_j) e_z``;
+* thrust of rotor j: ``F_Tj = -kt_j Omega_j^2 e_z`` (body);
+* moments ``sum_j r_Tj x F_Tj - s_j (dt_j Omega_j^2 + Jr Omega_dot_j) e_z``;
 * gyroscopic moment ``-Jr (sum_j s_j Omega_j) (omega x e_z)``.
 
 The authors' codes got the yaw reaction wrong in two separable ways, each a
@@ -11,12 +11,36 @@ switch: the drag torque with the rotor's own sense, ``+s_j dt Omega_j^2``
 (``drag_paper``; both the paper's code and the later recovery code), and the
 spin-up term without the spin sign, ``-Jr sum_j Omega_dot_j``
 (``spinup_paper``; the paper's code only).
+
+The sums run over the vehicle's ``n`` rotors in order (``veh[V_N_ROTORS]``).
+``Jr = 0`` (a model without rotor gyroscopics) leaves no gyroscopic or
+spin-up moment.
 """
 
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import N_ROTORS, V_DT, V_JR, V_KT, V_ROTOR_POS, V_SPIN, X_OMEGA, X_ROTOR
+from quadimpact.core.layout import (
+    N_RIGID,
+    V_DT,
+    V_JR,
+    V_KT,
+    V_N_ROTORS,
+    V_ROTOR_POS,
+    V_SPIN,
+    X_OMEGA,
+    X_ROTOR,
+)
+
+
+@compiled(inline="always")
+def active_states(veh: np.ndarray) -> int:
+    """The state's components in use: the rigid body's and the vehicle's ``n`` rotor speeds.
+
+    The rotor slots beyond ``n`` (up to ``MAX_ROTORS``) stay 0; the integrator
+    runs over the first ``N_RIGID + n`` components only.
+    """
+    return N_RIGID + int(veh[V_N_ROTORS])
 
 
 @compiled
@@ -28,8 +52,9 @@ def rotor_wrench(
     Parameters
     ----------
     x : state; rotor speeds ``Omega_j`` (rad/s) at ``X_ROTOR``.
-    omega_dot : rotor accelerations ``Omega_dot_j`` (rad/s^2), shape (4,).
-    veh : packed vehicle.
+    omega_dot : rotor accelerations ``Omega_dot_j`` (rad/s^2), one per rotor.
+    veh : packed vehicle: its rotor count ``n`` (``V_N_ROTORS``) and, per rotor
+        ``j``, its position, spin sense and coefficients ``kt_j``, ``dt_j``.
     drag_paper : drag torque ``+s_j dt Omega_j^2`` (authors' sense) instead of ``-s_j ...``.
     spinup_paper : spin-up reaction ``-Jr Omega_dot_j`` without the spin sign.
 
@@ -38,18 +63,33 @@ def rotor_wrench(
     fz : thrust force along z_B (N, negative = up).
     mx, my, mz : moment about the CM (N m).
     """
-    kt = veh[V_KT]
-    dt = veh[V_DT]
+    n = int(veh[V_N_ROTORS])
+    if n == 4:  # a quadrotor: the loop's count known to the compiler (unrolled, as before)
+        return _rotor_sums(x, omega_dot, veh, 4, drag_paper, spinup_paper)
+    return _rotor_sums(x, omega_dot, veh, n, drag_paper, spinup_paper)
+
+
+@compiled(inline="always")
+def _rotor_sums(
+    x: np.ndarray,
+    omega_dot: np.ndarray,
+    veh: np.ndarray,
+    n: int,
+    drag_paper: bool,
+    spinup_paper: bool,
+) -> tuple[float, float, float, float]:
+    """:func:`rotor_wrench` over rotors ``0..n-1``, summed in rotor order."""
     jr = veh[V_JR]
     fz = 0.0
     mx = 0.0
     my = 0.0
     mz = 0.0
     spin_sum = 0.0
-    for j in range(N_ROTORS):
+    for j in range(n):
         w = x[X_ROTOR + j]
         s = veh[V_SPIN + j]
-        t = kt * w * w
+        dt = veh[V_DT + j]
+        t = veh[V_KT + j] * w * w
         fz -= t
         # r_Tj x (0, 0, -t)
         mx -= veh[V_ROTOR_POS + 3 * j + 1] * t

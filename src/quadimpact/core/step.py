@@ -65,7 +65,6 @@ from quadimpact.core.layout import (
     MS_MAG_T,
     MS_POSE_T,
     MS_T_DETECT,
-    N_ROTORS,
     N_STAGES,
     NEX,
     O_CRASH_ALTITUDE,
@@ -107,6 +106,7 @@ from quadimpact.core.layout import (
     STATUS_COMPLETED,
     STATUS_CRASHED,
     STATUS_FAILED,
+    V_N_ROTORS,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -156,7 +156,7 @@ def start(m: Model, d: Data, o: Output) -> None:
     if m.opts[O_POWER_OFF_T] >= 0.0:
         ls[LS_T_SCHED] = max(m.opts[O_POWER_OFF_T], t0)
     d.rin[:] = 0.0
-    for j in range(N_ROTORS):
+    for j in range(int(m.veh[V_N_ROTORS])):
         d.rin[RIN_CMD + j] = x[X_ROTOR + j]
         d.rin[RIN_PREV_CMD + j] = x[X_ROTOR + j]
     d.rin[RIN_FIRST_ORDER] = 1.0 if int(m.opts[O_ROTOR_MODE]) == ROTOR_FIRST_ORDER else 0.0
@@ -216,7 +216,7 @@ def _command(t: float, m: Model, d: Data, o: Output, w: Work) -> None:
     """
     ls = d.ls
     if ls[LS_EXT] > 0.5:
-        for j in range(N_ROTORS):
+        for j in range(int(m.veh[V_N_ROTORS])):
             w.cmd[j] = ls[LS_EXT_CMD + j]
         ls[LS_EXT] = 0.0
     else:
@@ -256,7 +256,7 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
     track_hover(t_k, d.x, o.stats)
     track_held_hover(t_k, d.x, d.cs, o.stats)
     _command(t_k, m, d, o, w)
-    apply_command(w.cmd, d.x, d.rin, m.opts, dt_c, ls[LS_PO_ACTIVE] > 0.5)
+    apply_command(w.cmd, d.x, d.rin, m.opts, dt_c, ls[LS_PO_ACTIVE] > 0.5, int(m.veh[V_N_ROTORS]))
     cut_step(m, d)
     contact_values(d.x, m, d, w, w.g_a, w.gd_a)
     result = integrate_interval(t_k, t_next, m, d, o, w)

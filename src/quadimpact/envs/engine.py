@@ -19,6 +19,7 @@ import numpy as np
 from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
+from quadimpact.core.envs.episode_layout import ENV_ROTORS
 from quadimpact.core.records import (
     Data,
     Output,
@@ -30,6 +31,7 @@ from quadimpact.core.records import (
 )
 from quadimpact.core.step import finish
 from quadimpact.envs.settings import TrialDistribution
+from quadimpact.errors import InputError
 from quadimpact.inputs.scenarios import ImpactTrial
 from quadimpact.results.result import SimulationResult
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS, recovery_metrics
@@ -51,6 +53,18 @@ OUTCOMES = {
     B.OC_FAILED: "simulation failed",
 }
 """Episode outcomes (``info["outcome"]``)."""
+
+
+def _quadrotor(setup: RunSetup) -> RunSetup:
+    """The prepared run, refused unless its vehicle is a quadrotor (the environments'
+    actions and observations have four rotors: ``core.envs.episode_layout.ENV_ROTORS``)."""
+    n = int(setup.veh[L.V_N_ROTORS])
+    if n != ENV_ROTORS:
+        raise InputError(
+            f"vehicle: the learning environments fly quadrotors ({ENV_ROTORS} rotors); "
+            f"{setup.vehicle.name} has {n}"
+        )
+    return setup
 
 
 class Slots:
@@ -174,7 +188,9 @@ class Slots:
         return first
 
     def _prepare(self, fields: Mapping[str, Any]) -> RunSetup:
-        return prepare(self.trials.trial(fields, ground=self.ground, record=self.record))
+        return _quadrotor(
+            prepare(self.trials.trial(fields, ground=self.ground, record=self.record))
+        )
 
     def load(self, k: int, trial: ImpactTrial | Mapping[str, Any]) -> None:
         """Put a trial's packed arrays into row ``k`` (not started)."""
@@ -187,7 +203,7 @@ class Slots:
         else:
             fields = dict(trial)
             scenario = self.trials.trial(fields, ground=self.ground, record=self.record)
-        s = prepare(scenario)
+        s = _quadrotor(prepare(scenario))
         m = s.model()
         same_grid = m.t_out.shape[0] == self.M.t_out.shape[1]
         if (m.shapes.shape != self.M.shapes.shape[1:] or m.feat.shape != self.M.feat.shape[1:]

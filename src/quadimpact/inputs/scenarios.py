@@ -61,7 +61,7 @@ from pydantic import Field, ValidationError, field_validator, model_validator
 from quadimpact.errors import InputError, format_value, input_error_from_validation
 from quadimpact.inputs.run_settings import PowerOff, RunSettings, check_before_final, check_euler
 from quadimpact.inputs.toml_files import locate_vehicle, read_toml_file
-from quadimpact.inputs.types import Real, Vec3, Vec4
+from quadimpact.inputs.types import Real, RotorReals, Vec3
 from quadimpact.inputs.waypoint import Waypoint
 from quadimpact.inputs.world import Plane
 
@@ -169,8 +169,9 @@ class FlightScenario(RunSettings):
         Initial attitude [roll, pitch, yaw], ZYX Euler angles, deg.
     angular_velocity_rad_s : tuple of 3 floats
         Initial angular velocity [p, q, r], body FRD, rad/s.
-    rotor_speeds_rad_s : tuple of 4 floats or None
-        Initial rotor speeds, rad/s; ``None``: trimmed for the attitude.
+    rotor_speeds_rad_s : tuple of n floats or None
+        Initial rotor speeds, rad/s, one per rotor of the vehicle; ``None``:
+        trimmed for the attitude.
     altitude_ref_m : float or None
         Altitude set-point, m; ``None``: the initial altitude.
     attitude_ref_deg : tuple of 3 floats or None
@@ -200,8 +201,8 @@ class FlightScenario(RunSettings):
     angular_velocity_rad_s: Vec3 = Field(
         (0.0, 0.0, 0.0), description="Initial body angular velocity [p, q, r], FRD, rad/s."
     )
-    rotor_speeds_rad_s: Vec4 | None = Field(
-        None, description="Initial rotor speeds, rad/s; None: trimmed."
+    rotor_speeds_rad_s: RotorReals | None = Field(
+        None, description="Initial rotor speeds, rad/s, one per rotor; None: trimmed."
     )
     altitude_ref_m: Real | None = Field(
         None, gt=0, description="Altitude set-point, m; None: initial altitude."

@@ -13,7 +13,22 @@ from typing import Annotated, Any
 
 from pydantic import BeforeValidator, ConfigDict
 
-__all__ = ["MODEL_CONFIG", "Real", "Sign", "SignVec4", "Vec2", "Vec3", "Vec4", "Mat3", "Mat4x3"]
+from quadimpact.core.layout import MAX_ROTORS
+
+__all__ = [
+    "MODEL_CONFIG",
+    "Real",
+    "Sign",
+    "SignVec4",
+    "Vec2",
+    "Vec3",
+    "Vec4",
+    "Mat3",
+    "Mat4x3",
+    "RotorRows",
+    "RotorSigns",
+    "RotorReals",
+]
 
 MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 """The settings of every input model: unknown keys refused, immutable, finite numbers only."""
@@ -66,6 +81,35 @@ def _matrix(rows: int, cols: int, row_name: str = "rows"):
     return check
 
 
+def _rotor_rows(value: Any) -> Any:
+    if hasattr(value, "tolist"):
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)) or not all(
+        isinstance(row, (list, tuple)) for row in value
+    ):
+        raise ValueError(f"must be a list of {MIN_ROTORS} to {MAX_ROTORS} rows of 3 numbers")
+    if not MIN_ROTORS <= len(value) <= MAX_ROTORS:
+        raise ValueError(
+            f"must have {MIN_ROTORS} to {MAX_ROTORS} rows, one per rotor (got {len(value)})"
+        )
+    for i, row in enumerate(value):
+        if len(row) != 3:
+            raise ValueError(f"row {i + 1} must have exactly 3 numbers (got {len(row)})")
+    return value
+
+
+def _rotor_list(value: Any) -> Any:
+    if hasattr(value, "tolist"):
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)):
+        return value  # a single number: the model's union takes it
+    if not MIN_ROTORS <= len(value) <= MAX_ROTORS:
+        raise ValueError(
+            f"must have {MIN_ROTORS} to {MAX_ROTORS} entries, one per rotor (got {len(value)})"
+        )
+    return value
+
+
 Real = Annotated[float, BeforeValidator(_real)]
 """A finite float (finiteness is enforced by ``allow_inf_nan=False`` on the models)."""
 
@@ -77,6 +121,15 @@ Vec3 = Annotated[tuple[Real, Real, Real], BeforeValidator(_vector(3))]
 Vec4 = Annotated[tuple[Real, Real, Real, Real], BeforeValidator(_vector(4))]
 SignVec4 = Annotated[tuple[Sign, Sign, Sign, Sign], BeforeValidator(_vector(4))]
 """Four integers, meant to be +1 or -1 (checked by the model)."""
+
+#: The fewest and the most rotors a vehicle may have (``core.layout.MAX_ROTORS``).
+MIN_ROTORS = 4
+RotorRows = Annotated[tuple[tuple[Real, Real, Real], ...], BeforeValidator(_rotor_rows)]
+"""One row of 3 numbers per rotor, MIN_ROTORS to MAX_ROTORS rows."""
+RotorSigns = Annotated[tuple[Sign, ...], BeforeValidator(_rotor_list)]
+"""One integer per rotor (+1 or -1, checked by the model), MIN_ROTORS to MAX_ROTORS of them."""
+RotorReals = Annotated[tuple[Real, ...], BeforeValidator(_rotor_list)]
+"""One number per rotor, MIN_ROTORS to MAX_ROTORS of them."""
 
 Mat3 = Annotated[
     tuple[tuple[Real, Real, Real], tuple[Real, Real, Real], tuple[Real, Real, Real]],

@@ -1,4 +1,4 @@
-"""Vehicle parameters: a validated, immutable description of a quadrotor with bumpers.
+"""Vehicle parameters: a validated, immutable description of a multirotor with bumpers.
 
 Vehicles are data: the Spiri of the paper ships as ``inputs/vehicles/spiri.toml``
 and a user can write another file with the same keys (see that file for
@@ -31,7 +31,18 @@ from pydantic import BaseModel, Field, ValidationError, field_validator, model_v
 from quadimpact.errors import InputError, input_error_from_validation, near_miss
 from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.toml_files import read_toml_file
-from quadimpact.inputs.types import MODEL_CONFIG, Mat3, Mat4x3, Real, SignVec4, Vec2, Vec3, Vec4
+from quadimpact.inputs.types import (
+    MODEL_CONFIG,
+    Mat3,
+    Mat4x3,
+    Real,
+    RotorReals,
+    RotorRows,
+    RotorSigns,
+    Vec2,
+    Vec3,
+    Vec4,
+)
 from quadimpact.linalg import norm
 
 __all__ = ["Vehicle", "load_vehicle", "bundled_vehicles"]
@@ -40,13 +51,16 @@ _SYMMETRY_RTOL = 1e-9
 
 
 class Vehicle(BaseModel):
-    """A quadrotor with four bumpers: mass properties, rotors, bumpers and contact law.
+    """A multirotor with bumpers: mass properties, rotors, bumpers and contact law.
 
     All vectors are in the body frame (FRD: x forward, y right, z down, origin
-    at the centre of mass). Rotor ``j`` (1-4) is row ``j-1`` of
-    ``rotor_positions_m``; bumper ``j`` is centred on rotor ``j`` unless
-    ``bumper_centres_m`` says otherwise. The model is frozen; derive variants
-    with :meth:`with_overrides`.
+    at the centre of mass). The vehicle has ``n`` rotors (4 to
+    ``core.layout.MAX_ROTORS`` = 8: the rows of ``rotor_positions_m``); rotor
+    ``j`` (1-n) is row ``j-1``. A quadrotor may describe its four bumper rings
+    with the ``bumper_*`` keys (bumper ``j`` centred on rotor ``j`` unless
+    ``bumper_centres_m`` says otherwise); a vehicle with another rotor count
+    lists its contact ``features``. The model is frozen; derive variants with
+    :meth:`with_overrides`.
 
     Attributes
     ----------
@@ -56,16 +70,19 @@ class Vehicle(BaseModel):
         Total mass m, kg.
     inertia_kg_m2 : tuple of 3 tuples of 3 floats
         Inertia tensor about the CM in body axes, kg m^2; symmetric positive definite.
-    rotor_positions_m : tuple of 4 tuples of 3 floats
-        Rotor hub positions r_Tj from the CM, body FRD, m.
-    spin_directions : tuple of 4 ints
-        Spin sense s_j of each rotor about +z_B (down): +1 or -1, two of each.
-    thrust_coefficient : float
-        kt, thrust per rotor ``kt Omega^2``, N/(rad/s)^2.
-    drag_torque_coefficient : float
-        dt, aerodynamic drag torque per rotor ``dt Omega^2``, N m/(rad/s)^2.
+    rotor_positions_m : tuple of n tuples of 3 floats
+        Rotor hub positions r_Tj from the CM, body FRD, m; 4 to 8 rows.
+    spin_directions : tuple of n ints
+        Spin sense s_j of each rotor about +z_B (down): +1 or -1, as many of each.
+    thrust_coefficient : float or tuple of n floats
+        kt, thrust per rotor ``kt_j Omega_j^2``, N/(rad/s)^2: one value for
+        every rotor, or one per rotor.
+    drag_torque_coefficient : float or tuple of n floats
+        dt, aerodynamic drag torque per rotor ``dt_j Omega_j^2``, N m/(rad/s)^2:
+        one value for every rotor, or one per rotor.
     rotor_inertia_kg_m2 : float
-        Jr, rotor and propeller inertia about the spin axis, kg m^2.
+        Jr, rotor and propeller inertia about the spin axis, kg m^2; 0 for a
+        model without rotor gyroscopics (no gyroscopic, no spin-up moment).
     gravity_m_s2 : float
         Gravitational acceleration g, m/s^2 (along +Z of the NED inertial frame).
     bumper_radius_m : float
@@ -110,18 +127,22 @@ class Vehicle(BaseModel):
     inertia_kg_m2: Mat3 = Field(
         description="Inertia tensor about the CM, body FRD axes, kg m^2 (symmetric, PD)."
     )
-    rotor_positions_m: Mat4x3 = Field(
-        description="Rotor hub positions from the CM, body FRD, m; row j-1 is rotor j."
+    rotor_positions_m: RotorRows = Field(
+        description="Rotor hub positions from the CM, body FRD, m; row j-1 is rotor j (4 to 8)."
     )
-    spin_directions: SignVec4 = Field(
+    spin_directions: RotorSigns = Field(
         description="Spin sense of each rotor about +z_B (down): +1 or -1, summing to 0."
     )
-    thrust_coefficient: Real = Field(gt=0, description="kt: thrust = kt Omega^2, N/(rad/s)^2.")
-    drag_torque_coefficient: Real = Field(
-        gt=0, description="dt: rotor drag torque = dt Omega^2, N m/(rad/s)^2."
+    thrust_coefficient: Real | RotorReals = Field(
+        description="kt: thrust = kt Omega^2, N/(rad/s)^2; one for all rotors or one per rotor."
+    )
+    drag_torque_coefficient: Real | RotorReals = Field(
+        description="dt: rotor drag torque = dt Omega^2, N m/(rad/s)^2; one or one per rotor."
     )
     rotor_inertia_kg_m2: Real = Field(
-        gt=0, description="Jr: rotor + propeller inertia about the spin axis, kg m^2."
+        ge=0,
+        description="Jr: rotor + propeller inertia about the spin axis, kg m^2 (0: no rotor "
+        "gyroscopics).",
     )
     gravity_m_s2: Real = Field(gt=0, description="Gravitational acceleration g, m/s^2.")
     bumper_radius_m: Real | None = Field(
@@ -228,8 +249,33 @@ class Vehicle(BaseModel):
         if any(s not in (1, -1) for s in value):
             raise ValueError("each entry must be +1 or -1")
         if sum(value) != 0:
-            raise ValueError("must sum to 0 (two rotors each way, for balanced yaw)")
+            raise ValueError("must sum to 0 (as many rotors each way, for balanced yaw)")
         return value
+
+    @field_validator("thrust_coefficient", "drag_torque_coefficient")
+    @classmethod
+    def _check_coefficients(cls, value: float | tuple) -> float | tuple:
+        values = value if isinstance(value, tuple) else (value,)
+        if not all(c > 0 for c in values):
+            raise ValueError("must be > 0 (each rotor's)")
+        return value
+
+    @model_validator(mode="after")
+    def _rotor_counts(self) -> Vehicle:
+        n = len(self.rotor_positions_m)
+        for key in ("spin_directions", "thrust_coefficient", "drag_torque_coefficient"):
+            value = getattr(self, key)
+            if isinstance(value, tuple) and len(value) != n:
+                raise ValueError(
+                    f"{key}: {len(value)} entries for the {n} rotors of rotor_positions_m "
+                    "(one per rotor)"
+                )
+        if self.features is None and n != 4:
+            raise ValueError(
+                f"features: required for a vehicle with {n} rotors (the bumper_* keys describe "
+                "the four rings of a quadrotor; list [[features]] instead)"
+            )
+        return self
 
     @field_validator("rotor_speed_range_rpm")
     @classmethod
@@ -286,11 +332,11 @@ class Vehicle(BaseModel):
                 f"rotor_speed_range_rpm: hovering needs {hover_rpm:.4g} rpm per rotor, outside "
                 f"[{lo:g}, {hi:g}] rpm: the rotors cannot hold the vehicle up{hint}"
             )
-        kt = self.thrust_coefficient
+        kt = self.thrust_coefficients
         r = np.asarray(self.rotor_positions_m, dtype=float)
         spins = np.asarray(self.spin_directions, dtype=float)
-        alloc = np.vstack([np.full(4, kt), -kt * r[:, 1], kt * r[:, 0],
-                           -self.drag_torque_coefficient * spins])  # fmt: skip
+        alloc = np.vstack([kt, -kt * r[:, 1], kt * r[:, 0],
+                           -self.drag_torque_coefficients * spins])  # fmt: skip
         if np.linalg.cond(alloc) > 1e12:
             raise ValueError(
                 "rotor_positions_m, spin_directions: the rotors cannot produce thrust and the "
@@ -323,7 +369,8 @@ class Vehicle(BaseModel):
                 f"{arms.mean():.3g} m (a bumper circle around each rotor)"
             )
         r = self.rotor_positions[:, :2]
-        gaps = [float(norm(r[i] - r[j])) for i in range(4) for j in range(i + 1, 4)]
+        n = self.rotor_count
+        gaps = [float(norm(r[i] - r[j])) for i in range(n) for j in range(i + 1, n)]
         if rings and 2.0 * self.bumper_radius_m > min(gaps):
             out.append(
                 f"bumper rings overlap: 2 x bumper_radius_m = {2 * self.bumper_radius_m:.3g} m "
@@ -335,7 +382,7 @@ class Vehicle(BaseModel):
         if not 1.2 <= ratio <= 10.0:
             out.append(
                 f"thrust-to-weight ratio at the top rotor speed is {ratio:.3g} "
-                "(quadrotors fly with about 1.5 to 5)"
+                "(multirotors fly with about 1.5 to 5)"
             )
         for f in self.contact_features():
             if f.restitution < 0.3:
@@ -351,19 +398,40 @@ class Vehicle(BaseModel):
         return np.array(self.inertia_kg_m2, dtype=float)
 
     @property
+    def rotor_count(self) -> int:
+        """The number of rotors ``n`` (4 to 8)."""
+        return len(self.rotor_positions_m)
+
+    @property
     def rotor_positions(self) -> np.ndarray:
-        """Rotor hub positions from the CM, body FRD, m, shape (4, 3); row j-1 is rotor j."""
+        """Rotor hub positions from the CM, body FRD, m, shape (n, 3); row j-1 is rotor j."""
         return np.array(self.rotor_positions_m, dtype=float)
 
     @property
     def spins(self) -> np.ndarray:
-        """Spin senses s_j about +z_B as floats (+1.0 or -1.0), shape (4,)."""
+        """Spin senses s_j about +z_B as floats (+1.0 or -1.0), shape (n,)."""
         return np.array(self.spin_directions, dtype=float)
 
     @property
+    def thrust_coefficients(self) -> np.ndarray:
+        """Each rotor's thrust coefficient kt_j, N/(rad/s)^2, shape (n,)."""
+        return _per_rotor(self.thrust_coefficient, self.rotor_count)
+
+    @property
+    def drag_torque_coefficients(self) -> np.ndarray:
+        """Each rotor's drag-torque coefficient dt_j, N m/(rad/s)^2, shape (n,)."""
+        return _per_rotor(self.drag_torque_coefficient, self.rotor_count)
+
+    @property
     def hover_speed_rad_s(self) -> float:
-        """Level-hover rotor speed ``sqrt(m g / (4 kt))``, rad/s (about 598 for the Spiri)."""
-        return math.sqrt(self.mass_kg * self.gravity_m_s2 / (4.0 * self.thrust_coefficient))
+        """Level-hover rotor speed ``sqrt(m g / (n kt))``, rad/s (about 598 for the Spiri).
+
+        With coefficients that differ between rotors: ``sqrt(m g / sum_j kt_j)``,
+        the speed the rotors would share (the trim gives each its own).
+        """
+        kt = self.thrust_coefficients
+        total = float(self.rotor_count) * float(kt[0]) if np.all(kt == kt[0]) else float(kt.sum())
+        return math.sqrt(self.mass_kg * self.gravity_m_s2 / total)
 
     def bumper_frames(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Geometry of the four bumper circles in the body frame (docs/MODEL.md section 4).
@@ -524,6 +592,13 @@ class Vehicle(BaseModel):
                 _OVERRIDDEN.pop(next(iter(_OVERRIDDEN)))
             _OVERRIDDEN[key] = (self, vehicle)  # holds self, so its id stays its own
         return vehicle
+
+
+def _per_rotor(value: float | tuple, n: int) -> np.ndarray:
+    """A coefficient as one value per rotor: a single value repeated ``n`` times."""
+    if isinstance(value, tuple):
+        return np.array(value, dtype=float)
+    return np.full(n, float(value))
 
 
 # -------------------------------------------------------------------- loading

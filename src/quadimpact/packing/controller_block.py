@@ -23,9 +23,8 @@ from quadimpact.inputs.controllers import (
 )
 from quadimpact.inputs.policy_file import load_policy
 from quadimpact.inputs.vehicle import Vehicle
-from quadimpact.linalg import inverse
 from quadimpact.packing.constants import RPM
-from quadimpact.packing.vehicle_block import allocation_matrix, vehicle_memo
+from quadimpact.packing.vehicle_block import allocation_inverse, vehicle_memo
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
 __all__ = [
@@ -53,8 +52,10 @@ def pack_controller(
     v: Vehicle = context.vehicle
     ctrl = np.zeros(L.NCTRL)
     ctrl[L.C_KIND] = entry.kind
-    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = vehicle_memo(
-        f"alloc-inv-{yaw_paper}", v, lambda: inverse(allocation_matrix(v, yaw_paper)).ravel()
+    n = v.rotor_count
+    ctrl[L.C_N_ROTORS] = n
+    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + L.N_WRENCH * n] = vehicle_memo(
+        f"alloc-inv-{yaw_paper}", v, lambda: allocation_inverse(v, yaw_paper).ravel()
     )
     lo, hi = v.rotor_speed_range_rpm
     ctrl[L.C_OMEGA_MIN] = lo * RPM

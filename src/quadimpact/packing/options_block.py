@@ -94,9 +94,10 @@ def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -
     from the segment's start); with ``"hold"`` it keeps its speed.
     """
     rpm = np.asarray(rates_rpm_per_s, dtype=float).reshape(-1, 4)
-    rates = rpm * RPM
+    rates = np.zeros((rpm.shape[0], L.MAX_ROTORS))  # a quadrotor's motors 1-4; 0 beyond
+    rates[:, :4] = rpm * RPM
     if zero_rate == "off":
-        rates[rpm == 0.0] = L.MOTOR_OFF
+        rates[:, :4][rpm == 0.0] = L.MOTOR_OFF
     return rates
 
 
@@ -168,7 +169,7 @@ def pack_schedule(s: RunSettings) -> dict[str, np.ndarray]:
     """The power-off schedule as the kernel's arrays (s; rad/s^2; stall flags)."""
     if s.power_off is None:
         return {}
-    stop = np.zeros(4)
+    stop = np.zeros(L.MAX_ROTORS)
     for m in s.power_off.stopped_motors:
         stop[m - 1] = 1.0
     return {

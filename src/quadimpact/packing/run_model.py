@@ -22,6 +22,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import Model, model
 from quadimpact.core.sensors.component import PackContext as ComponentContext
+from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import ControllerEntry, PackContext, controller_entry
 from quadimpact.inputs.model import ModelOptions
 from quadimpact.inputs.run_settings import RunSettings
@@ -87,6 +88,22 @@ class SharedPacking:
     instruments: dict[str, Any]
 
 
+def _check_rotor_count(s: RunSettings, o: ModelOptions, v: Vehicle) -> None:
+    """Refuse the settings that name a quadrotor's motors 1-4 for another rotor count."""
+    if v.rotor_count == 4:
+        return
+    if s.power_off is not None:
+        raise InputError(
+            f"power_off: a schedule of motors 1-4 is for a quadrotor (vehicle {v.name} has "
+            f"{v.rotor_count} rotors)"
+        )
+    if o.cut_step_motors:
+        raise InputError(
+            f"model_options.cut_step_motors: motors 1-4 of a quadrotor (vehicle {v.name} has "
+            f"{v.rotor_count} rotors)"
+        )
+
+
 def pack_shared(
     s: RunSettings,
     v: Vehicle,
@@ -100,6 +117,7 @@ def pack_shared(
     integrator's step budget are sized by it). The run starts at ``t0 = 0``
     and ends at ``s.final_time_s`` (a run's own start: :func:`pack_own`).
     """
+    _check_rotor_count(s, o, v)
     entry = controller_entry(s.controller)
     context = PackContext(
         vehicle=v,

@@ -12,10 +12,11 @@ from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.vehicle import Vehicle
-from quadimpact.linalg import inverse
+from quadimpact.linalg import inverse, pseudo_inverse
 
 __all__ = [
     "FEATURE_KINDS",
+    "allocation_inverse",
     "allocation_matrix",
     "feature_records",
     "pack_features",
@@ -57,10 +58,12 @@ def _pack_vehicle(v: Vehicle) -> np.ndarray:
     veh[L.V_MASS] = v.mass_kg
     veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
     veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = inverse(inertia).ravel()
-    veh[L.V_ROTOR_POS : L.V_ROTOR_POS + 12] = v.rotor_positions.ravel()
-    veh[L.V_SPIN : L.V_SPIN + 4] = v.spins
-    veh[L.V_KT] = v.thrust_coefficient
-    veh[L.V_DT] = v.drag_torque_coefficient
+    n = v.rotor_count
+    veh[L.V_N_ROTORS] = n
+    veh[L.V_ROTOR_POS : L.V_ROTOR_POS + 3 * n] = v.rotor_positions.ravel()
+    veh[L.V_SPIN : L.V_SPIN + n] = v.spins
+    veh[L.V_KT : L.V_KT + n] = v.thrust_coefficients
+    veh[L.V_DT : L.V_DT + n] = v.drag_torque_coefficients
     veh[L.V_JR] = v.rotor_inertia_kg_m2
     veh[L.V_GRAVITY] = v.gravity_m_s2
     veh[L.V_TAU_M] = v.motor_time_constant_s
@@ -143,12 +146,26 @@ def feature_records(feat: np.ndarray, names: Sequence[str]) -> list[dict[str, An
 
 
 def allocation_matrix(v: Vehicle, yaw_paper: bool) -> np.ndarray:
-    """``A`` with ``[T, tau_x, tau_y, tau_z] = A [Omega_1^2 .. Omega_4^2]`` (docs/MODEL.md 6.1).
+    """``A`` (4 x n) with ``[T, tau_x, tau_y, tau_z] = A [Omega_1^2 .. Omega_n^2]``
+    (docs/MODEL.md 6.1), the vehicle's effectiveness matrix.
 
-    Rows: ``kt``, ``-kt y_j``, ``kt x_j`` and the yaw row of the rotor-torque
-    model in use: ``-s_j dt`` (physical) or ``+s_j dt`` (paper replica).
+    Column ``j`` is rotor ``j``'s: ``kt_j``, ``-kt_j y_j``, ``kt_j x_j`` and the
+    yaw entry of the rotor-torque model in use: ``-s_j dt_j`` (physical) or
+    ``+s_j dt_j`` (paper replica).
     """
-    kt = v.thrust_coefficient
+    kt = v.thrust_coefficients
     r = v.rotor_positions
-    yaw = v.drag_torque_coefficient * v.spins * (1.0 if yaw_paper else -1.0)
-    return np.vstack([np.full(4, kt), -kt * r[:, 1], kt * r[:, 0], yaw])
+    yaw = v.drag_torque_coefficients * v.spins * (1.0 if yaw_paper else -1.0)
+    return np.vstack([kt, -kt * r[:, 1], kt * r[:, 0], yaw])
+
+
+def allocation_inverse(v: Vehicle, yaw_paper: bool) -> np.ndarray:
+    """The allocation's inverse ``A^+`` (n x 4): ``Omega^2 = A^+ [T, tau_x, tau_y, tau_z]``.
+
+    A quadrotor's square ``A`` has the exact inverse ``A^-1`` (``linalg.inverse``,
+    the same bits as before rotor counts other than 4). Any other count has the
+    Moore-Penrose pseudo-inverse ``A^T (A A^T)^-1`` (``linalg.pseudo_inverse``):
+    of all ``Omega^2`` giving the wrench, the one of the smallest norm.
+    """
+    a = allocation_matrix(v, yaw_paper)
+    return inverse(a) if a.shape[1] == 4 else pseudo_inverse(a)

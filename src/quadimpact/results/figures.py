@@ -66,6 +66,8 @@ def _feature_lines(ts) -> list[tuple[str, str, str]]:
     for k, (name, delta, _) in enumerate(feature_columns(list(ts.keys()))):
         if name.isdigit() and int(name) in BUMPER_COLORS:
             out.append((f"Bumper {name}", delta, BUMPER_COLORS[int(name)]))
+        elif name.isdigit():  # a bumper beyond the fourth (a vehicle with more rotors)
+            out.append((f"Bumper {name}", delta, f"C{(k + 4) % 10}"))
         else:
             out.append((name, delta, f"C{(k + 4) % 10}"))
     return out

@@ -83,13 +83,14 @@ def initial_state(
     omega: np.ndarray,
     rotors: np.ndarray,
 ) -> np.ndarray:
-    """The kernel's state vector (layout ``X_*``) from inertial position and velocity."""
+    """The kernel's state vector (layout ``X_*``) from inertial position and velocity;
+    ``rotors``: the speeds of the vehicle's ``n`` rotors (rad/s), 0 beyond them."""
     x = np.zeros(L.NX)
     x[L.X_POS : L.X_POS + 3] = position
     x[L.X_VEL : L.X_VEL + 3] = matvec_t(quat_to_matrix(q), v_inertial)
     x[L.X_QUAT : L.X_QUAT + 4] = q
     x[L.X_OMEGA : L.X_OMEGA + 3] = omega
-    x[L.X_ROTOR : L.X_ROTOR + 4] = rotors
+    x[L.X_ROTOR : L.X_ROTOR + len(rotors)] = rotors
     return x
 
 
@@ -196,7 +197,7 @@ def _shooting_inputs(
     ap[L.AP_LATE_RULE] = 1.0 if late else 0.0
     ap[L.AP_START : L.AP_START + 3] = start
     ap[L.AP_Q : L.AP_Q + 4] = q
-    ap[L.AP_ROTORS : L.AP_ROTORS + L.N_ROTORS] = rotors
+    ap[L.AP_ROTORS : L.AP_ROTORS + len(rotors)] = rotors
     return ap
 
 

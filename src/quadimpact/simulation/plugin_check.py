@@ -186,11 +186,12 @@ def _first_tick(scenario: Any, plugins: list[tuple[PluginStep, Any]], kind_of: d
     for who, entry in plugins:
         kind = kind_of[who]
         if kind == "controller":
-            cmd = np.array(d.x[L.X_ROTOR : L.X_ROTOR + L.N_ROTORS])  # the rotors' speeds
+            n = int(m.veh[L.V_N_ROTORS])
+            cmd = np.array(d.x[L.X_ROTOR : L.X_ROTOR + L.MAX_ROTORS])  # the rotors' speeds
             dt = float(m.opts[L.O_DT_CONTROL])
             checked = _call(who, entry.step, (t0, d.meas, m.ctrl, d.mem, m.veh, dt, cmd))
             _returns_nothing(who, checked, kind)
-            bad = [j for j in range(L.N_ROTORS) if not math.isfinite(cmd[j])]
+            bad = [j for j in range(n) if not math.isfinite(cmd[j])]
             if bad:
                 raise PluginError(
                     f"{who}: left cmd[{bad[0]}] = {cmd[bad[0]]} at the first tick; "

@@ -169,7 +169,11 @@ def _initial_speeds(
 ) -> np.ndarray:
     weight = v.mass_kg * v.gravity_m_s2
     if rule == "level-hover":
-        return np.full(4, math.sqrt(weight / (4.0 * v.thrust_coefficient)))
+        n = v.rotor_count  # rotors sharing one coefficient: sqrt(m g / (n kt)) each
+        kt = v.thrust_coefficients
+        if np.all(kt == kt[0]):
+            return np.full(n, math.sqrt(weight / (float(n) * float(kt[0]))))
+        return np.full(n, v.hover_speed_rad_s)
     return trim_rotor_speeds(v, weight / (math.cos(roll) * math.cos(pitch)), yaw_paper)
 
 
@@ -297,6 +301,11 @@ def prepare_flight(s: FlightScenario) -> RunSetup:
         if s.rotor_speeds_rad_s is not None
         else _initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper")
     )
+    if len(rotors) != v.rotor_count:
+        raise InputError(
+            f"rotor_speeds_rad_s: {len(rotors)} speeds for the {v.rotor_count} rotors of "
+            f"vehicle {v.name} (one per rotor)"
+        )
     x0 = initial_state(
         np.asarray(s.position_m, float),
         np.asarray(s.velocity_m_s, float),

@@ -169,13 +169,14 @@ def analyse(
     summary["cost"] = run_cost(setup, kernel_cpu_s, since)
     names = setup.shape_names
     features = setup.feature_names
+    rotors = int(setup.veh[L.V_N_ROTORS])
     imu = rec.imu
 
     def tables(name: str) -> Any:
         if name == "timeseries":
-            return timeseries_frame(out, out.shape[0], features)
+            return timeseries_frame(out, out.shape[0], features, rotors)
         if name == "timeseries_columns":
-            return timeseries_columns(out, out.shape[0], features)
+            return timeseries_columns(out, out.shape[0], features, rotors)
         if name == "episodes":
             return episodes_frame(ep, ep.shape[0], names, nf)
         if name == "episodes_columns":

@@ -86,14 +86,15 @@ class Simulation:
         advance = self._kernel.advance
         if command is None:
             return int(advance(int(n_ticks), self._m, self._d, self._o))
-        cmd = np.asarray(command, dtype=np.float64).reshape(4)
-        if not np.all(np.isfinite(cmd)):
-            raise ValueError("command: four finite rotor speeds (rad/s)")
+        n = int(self._m.veh[L.V_N_ROTORS])
+        cmd = np.asarray(command, dtype=np.float64).ravel()
+        if cmd.shape != (n,) or not np.all(np.isfinite(cmd)):
+            raise ValueError(f"command: {n} finite rotor speeds (rad/s), one per rotor")
         ticks = 0
         ls = self._d.ls
         while not self.done and (n_ticks < 0 or ticks < n_ticks):
             ls[L.LS_EXT] = 1.0
-            ls[L.LS_EXT_CMD : L.LS_EXT_CMD + L.N_ROTORS] = cmd
+            ls[L.LS_EXT_CMD : L.LS_EXT_CMD + n] = cmd
             ticks += int(advance(1, self._m, self._d, self._o))
         ls[L.LS_EXT] = 0.0
         return ticks

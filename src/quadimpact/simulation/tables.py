@@ -176,7 +176,7 @@ _RINGS = tuple(str(j) for j in BUMPERS)
 
 
 def timeseries_frame(
-    raw: np.ndarray, n: int, feature_names: Sequence[str] = _RINGS
+    raw: np.ndarray, n: int, feature_names: Sequence[str] = _RINGS, rotors: int = 4
 ) -> pd.DataFrame:
     """Time-series table from the kernel's output samples.
 
@@ -188,6 +188,9 @@ def timeseries_frame(
         Number of valid rows (``stats[ST_N_OUT]``).
     feature_names : sequence of str
         The vehicle's contact features (default: the four bumpers ``"1"``..``"4"``).
+    rotors : int
+        The vehicle's rotor count ``n`` (default a quadrotor's 4): the columns
+        ``omega1..n_rad_s`` and ``omega_cmd1..n_rad_s``.
 
     Returns
     -------
@@ -196,7 +199,7 @@ def timeseries_frame(
         (inertial NED, m); CM velocity in body axes ``u/v/w_m_s`` and in
         inertial axes ``vx/vy/vz_m_s`` (m/s, ``C(q) [u, v, w]``); quaternion
         ``q0..q3`` (scalar first, body -> inertial, as integrated); body rates
-        ``p/q/r_rad_s``; rotor speeds and commands (rad/s); ZYX Euler angles
+        ``p/q/r_rad_s``; rotor speeds and commands of rotors 1 to n (rad/s); ZYX Euler angles
         ``roll/pitch/yaw_deg`` (degrees; roll and yaw wrapped to (-180, 180],
         pitch in [-90, 90]; not unwrapped); ``altitude_m = -z_m``; per contact
         feature its deflection (``delta1..4_m`` for the four bumpers, m, max
@@ -206,11 +209,11 @@ def timeseries_frame(
     """
     import pandas as pd
 
-    return pd.DataFrame(timeseries_columns(raw, n, feature_names))
+    return pd.DataFrame(timeseries_columns(raw, n, feature_names, rotors))
 
 
 def timeseries_columns(
-    raw: np.ndarray, n: int, feature_names: Sequence[str] = _RINGS
+    raw: np.ndarray, n: int, feature_names: Sequence[str] = _RINGS, rotors: int = 4
 ) -> dict[str, np.ndarray]:
     """The columns of :func:`timeseries_frame` as NumPy arrays (no DataFrame)."""
     names = list(feature_names)
@@ -221,7 +224,7 @@ def timeseries_columns(
     vel_b = rows[:, x0 + L.X_VEL : x0 + L.X_VEL + 3]
     quat = rows[:, x0 + L.X_QUAT : x0 + L.X_QUAT + 4]
     omega = rows[:, x0 + L.X_OMEGA : x0 + L.X_OMEGA + 3]
-    rotor = rows[:, x0 + L.X_ROTOR : x0 + L.X_ROTOR + 4]
+    rotor = rows[:, x0 + L.X_ROTOR : x0 + L.X_ROTOR + rotors]
     if rows.shape[0] > 0:
         vel_i = body_to_inertial(quat, vel_b)
         roll, pitch, yaw = quat_to_euler_zyx(quat)
@@ -247,9 +250,9 @@ def timeseries_columns(
         "q_rad_s": omega[:, 1],
         "r_rad_s": omega[:, 2],
     }
-    for j in BUMPERS:
+    for j in range(1, rotors + 1):
         data[f"omega{j}_rad_s"] = rotor[:, j - 1]
-    for j in BUMPERS:
+    for j in range(1, rotors + 1):
         data[f"omega_cmd{j}_rad_s"] = rows[:, L.OUT_CMD + j - 1]
     data["roll_deg"] = np.degrees(roll)
     data["pitch_deg"] = np.degrees(pitch)

@@ -188,7 +188,9 @@ class VehicleDrawing:
         rotors = vehicle.rotor_positions
         arm = float(np.mean(np.linalg.norm(rotors[:, :2], axis=1)))
         e_z = np.array([0.0, 0.0, 1.0])
-        discs = np.stack([rim_points(rotors[j], eye[0], -e_z, 0.5 * arm, beta) for j in range(4)])
+        n = len(rotors)  # every rotor of the vehicle (4 to 8)
+        disc = 0.5 * arm if n == 4 else arm * math.sin(math.pi / n)  # n > 4: discs do not overlap
+        discs = np.stack([rim_points(rotors[j], eye[0], -e_z, disc, beta) for j in range(n)])
         z_hub = float(np.mean(rotors[:, 2]))
         h = HUB_HALF_M
         hub = np.array(
@@ -204,7 +206,7 @@ class VehicleDrawing:
             circles=np.stack(lines),
             discs=discs,
             hub=hub,
-            arms=np.stack([np.stack([np.zeros(3), rotors[j]]) for j in range(4)]),
+            arms=np.stack([np.stack([np.zeros(3), rotors[j]]) for j in range(n)]),
             axes=AXIS_LENGTH_M * np.eye(3),
             label_points=np.array(labels),
             packed=pack_features(vehicle, 0.0),

@@ -14,7 +14,8 @@ Interface of a controller step (built-in or plugged in, all Numba ``njit``)::
 * ``mem``: ``NMEM`` float64 slots the controller owns across ticks (zeroed at
   the start of a run); ``mem[MEM_STAGE]`` is reported as its stage;
 * ``veh``: the packed vehicle; ``dt``: the control period, s;
-* ``cmd``: the four rotor-speed commands it writes, rad/s.
+* ``cmd``: the rotor-speed commands it writes, rad/s, one for each of the
+  vehicle's ``n = int(veh[V_N_ROTORS])`` rotors.
 
 The run loop then applies the generic speed and slew limits
 (``actuators.apply_command``) and holds the command for the period.
@@ -41,7 +42,7 @@ from quadimpact.core.layout import (
     CTRL_PAPER,
     CTRL_RECOVERY,
     MS_X,
-    N_ROTORS,
+    V_N_ROTORS,
     X_ROTOR,
 )
 
@@ -57,7 +58,7 @@ def hold_step(
     cmd: np.ndarray,
 ) -> None:
     """No controller: the rotors keep their current speeds."""
-    for j in range(N_ROTORS):
+    for j in range(int(veh[V_N_ROTORS])):
         cmd[j] = meas[MS_X + X_ROTOR + j]
 
 

@@ -52,10 +52,10 @@ from quadimpact.core.layout import (
     C_THETA_REF,
     C_WAYPOINT_ON,
     MS_X,
-    N_ROTORS,
     NX,
     V_GRAVITY,
     V_MASS,
+    V_N_ROTORS,
     X_OMEGA,
 )
 from quadimpact.core.quaternion import wrap_pi
@@ -120,7 +120,7 @@ def cascade_pid_step(
     dt: float,
     cmd: np.ndarray,
 ) -> None:
-    """One tick of the cascade PID; writes four rotor speeds (rad/s) into ``cmd``."""
+    """One tick of the cascade PID; writes the rotor speeds (rad/s) into ``cmd``."""
     x = meas[MS_X : MS_X + NX]
     g = ctrl[C_PARAMS + P_GAINS : C_PARAMS + P_GAINS + 15]
     floor = ctrl[C_PARAMS + P_THRUST_COS_FLOOR]
@@ -153,7 +153,7 @@ def cascade_pid_step(
     saturated = allocate(ctrl, thrust, tx, ty, tz, cmd)
     lo = ctrl[C_OMEGA_MIN]
     hi = ctrl[C_OMEGA_MAX]
-    for j in range(N_ROTORS):
+    for j in range(int(veh[V_N_ROTORS])):
         if cmd[j] < lo:
             cmd[j] = lo
             saturated = True

@@ -10,7 +10,8 @@ import numpy as np
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.layout import (
     C_ALLOC_INV,
-    N_ROTORS,
+    C_N_ROTORS,
+    N_WRENCH,
     V_INERTIA,
     X_OMEGA,
     X_POS,
@@ -42,15 +43,24 @@ def allocate(
 ) -> bool:
     """Solve ``[T, tx, ty, tz] = A Omega^2`` with the packed inverse; clip negative squares.
 
-    ``thrust`` in N, torques in N m (body FRD); writes rotor speeds (rad/s) into
-    ``cmd``. Returns True if any square was clipped.
+    ``A`` is the vehicle's 4 x n effectiveness matrix (docs/MODEL.md 6.1; ``n``
+    rotors, ``ctrl[C_N_ROTORS]``). The packed inverse ``A^+`` (n x 4, row ``j``
+    at ``C_ALLOC_INV + N_WRENCH j``) is ``A^-1`` for a quadrotor and the
+    Moore-Penrose pseudo-inverse ``A^T (A A^T)^-1`` otherwise: the least-squares
+    ``Omega^2`` of the smallest norm, so ``A Omega^2`` is the commanded wrench
+    exactly while every square is >= 0. A negative square is clipped to 0 (a
+    rotor cannot push): the wrench is then not reproduced, and this returns
+    True. The other squares are not redistributed.
+
+    ``thrust`` in N, torques in N m (body FRD); writes the ``n`` rotor speeds
+    (rad/s) into ``cmd``. Returns True if any square was clipped.
     """
     clipped = False
-    for j in range(N_ROTORS):
-        a = ctrl[C_ALLOC_INV + N_ROTORS * j]
-        b = ctrl[C_ALLOC_INV + N_ROTORS * j + 1]
-        c = ctrl[C_ALLOC_INV + N_ROTORS * j + 2]
-        d = ctrl[C_ALLOC_INV + N_ROTORS * j + 3]
+    for j in range(int(ctrl[C_N_ROTORS])):
+        a = ctrl[C_ALLOC_INV + N_WRENCH * j]
+        b = ctrl[C_ALLOC_INV + N_WRENCH * j + 1]
+        c = ctrl[C_ALLOC_INV + N_WRENCH * j + 2]
+        d = ctrl[C_ALLOC_INV + N_WRENCH * j + 3]
         w2 = a * thrust + b * tx + c * ty + d * tz
         if w2 < 0.0:
             w2 = 0.0

@@ -62,7 +62,7 @@ def paper_step(
     dt: float,
     cmd: np.ndarray,
 ) -> None:
-    """One tick of the authors' controller; writes four rotor speeds (rad/s) into ``cmd``."""
+    """One tick of the authors' controller; writes the rotor speeds (rad/s) into ``cmd``."""
     x = meas[MS_X : MS_X + NX]
     g = ctrl[C_PARAMS + P_GAINS : C_PARAMS + P_GAINS + 15]
     roll, pitch, yaw, h, hdot = attitude_altitude(x)

@@ -126,10 +126,10 @@ from quadimpact.core.layout import (
     MS_NORMAL,
     MS_W_HAT,
     MS_X,
-    N_ROTORS,
     NX,
     V_GRAVITY,
     V_MASS,
+    V_N_ROTORS,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -345,7 +345,7 @@ def rate_loop(
     allocate(ctrl, thrust, tx, ty, tz, cmd)
     lo = ctrl[C_OMEGA_MIN]
     hi = ctrl[C_OMEGA_MAX]
-    for j in range(N_ROTORS):
+    for j in range(int(veh[V_N_ROTORS])):
         if cmd[j] < lo:
             cmd[j] = lo
         elif cmd[j] > hi:
@@ -414,7 +414,7 @@ def recovery_step(
     dt: float,
     cmd: np.ndarray,
 ) -> None:
-    """One tick of the recovery controller; writes four rotor speeds (rad/s) into ``cmd``."""
+    """One tick of the recovery controller; writes the rotor speeds (rad/s) into ``cmd``."""
     p0 = C_PARAMS
     x = meas[MS_X : MS_X + NX]
     stage = int(mem[MEM_STAGE])
@@ -427,10 +427,10 @@ def recovery_step(
                 else:
                     paper_step(t, meas, ctrl, mem, veh, dt, cmd)
             elif pre == PRE_HOLD:
-                for j in range(N_ROTORS):
+                for j in range(int(veh[V_N_ROTORS])):
                     cmd[j] = x[X_ROTOR + j]
             else:
-                for j in range(N_ROTORS):
+                for j in range(int(veh[V_N_ROTORS])):
                     cmd[j] = 0.0
             return
         stage = STAGE_DETECTED
@@ -464,7 +464,7 @@ def recovery_step(
             t, stage, (thrust, p_des, q_des), meas, ctrl, veh
         )
     if stage == STAGE_DETECTED and lean_cut(x, normal, meas, ctrl):
-        for j in range(N_ROTORS):
+        for j in range(int(veh[V_N_ROTORS])):
             cmd[j] = ctrl[C_OMEGA_MIN]
     else:
         rate_loop(thrust, p_des, q_des, r_des, meas[MS_W_HAT : MS_W_HAT + 3], ctrl, veh, cmd)

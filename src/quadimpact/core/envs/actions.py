@@ -16,6 +16,7 @@ from quadimpact.core.controllers.recovery import (
 )
 from quadimpact.core.envs.episode_layout import (
     ACT_CTBR,
+    ENV_ROTORS,
     EP_ACTION,
     EP_RATE_MAX,
     EP_ZERO_LOW,
@@ -24,7 +25,6 @@ from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
     MS_W_HAT,
-    N_ROTORS,
     V_KT,
 )
 
@@ -108,7 +108,7 @@ def action_command(
     ``meas``: the tick's measurement record (the gyro for the ctbr rate loop).
     """
     a = np.empty(4)
-    for j in range(N_ROTORS):
+    for j in range(ENV_ROTORS):
         v = action[j]
         a[j] = -1.0 if not v >= -1.0 else (1.0 if v > 1.0 else v)  # NaN -> -1
     if int(par[EP_ACTION]) == ACT_CTBR:
@@ -119,5 +119,5 @@ def action_command(
         )
     else:
         lo, hi = rotor_range(ctrl, par)
-        for j in range(N_ROTORS):
+        for j in range(ENV_ROTORS):
             cmd[j] = affine_map(a[j], lo, hi)

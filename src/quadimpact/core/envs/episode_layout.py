@@ -14,6 +14,11 @@ import numpy as np
 
 from quadimpact.core.layout import Block
 
+#: The environments fly quadrotors: four rotor commands per action (the ``rotors``
+#: action mode) and four rotor speeds per observation. ``envs/engine.py`` refuses a
+#: vehicle with another rotor count.
+ENV_ROTORS = 4
+
 
 # ---------------------------------------------------------------- records
 class Env(NamedTuple):

@@ -12,6 +12,7 @@ from quadimpact.core.envs.actions import rotor_range
 from quadimpact.core.envs.episode_layout import (
     B_H_REF,
     B_Y_REF,
+    ENV_ROTORS,
     EP_OBS_CLIP,
     EP_OBS_F,
     EP_OBS_POS,
@@ -41,7 +42,6 @@ from quadimpact.core.layout import (
     MS_T_DETECT,
     MS_W_HAT,
     MS_X,
-    N_ROTORS,
     NX,
     O_DT_CONTROL,
     RIN_CMD,
@@ -111,7 +111,7 @@ def observe(
             obs[6 + i] = _clip(sign * x[X_QUAT + i], clip)
         for i in range(3):
             obs[10 + i] = _clip(x[X_OMEGA + i] / par[EP_OBS_W], clip)
-        for j in range(N_ROTORS):
+        for j in range(ENV_ROTORS):
             obs[13 + j] = _clip((x[X_ROTOR + j] - lo) / h - 1.0, clip)
         obs[17] = _clip(since / par[EP_OBS_T], clip)
         obs[18] = 1.0 if detected else 0.0
@@ -127,7 +127,7 @@ def observe(
     obs[17] = 1.0 if detected else 0.0
     obs[18] = _clip(tmeas[MS_NORMAL], clip)
     obs[19] = _clip(tmeas[MS_NORMAL + 1], clip)
-    for j in range(N_ROTORS):
+    for j in range(ENV_ROTORS):
         obs[20 + j] = _clip((rin[RIN_CMD + j] - lo) / h - 1.0, clip)
 
 

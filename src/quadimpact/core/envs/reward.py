@@ -12,6 +12,7 @@ from quadimpact.core.envs.episode_layout import (
     B_H_REF,
     B_X_REF,
     B_Y_REF,
+    ENV_ROTORS,
     EP_MAX_DIST,
     EP_MAX_DROP,
     EP_MAX_RATE,
@@ -33,7 +34,6 @@ from quadimpact.core.envs.episode_layout import (
 from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
-    N_ROTORS,
     RIN_CMD,
     V_GRAVITY,
     V_KT,
@@ -71,7 +71,7 @@ def cost_rate(
     hover = math.sqrt(veh[V_MASS] * veh[V_GRAVITY] / (4.0 * veh[V_KT]))
     span = ctrl[C_OMEGA_MAX] - ctrl[C_OMEGA_MIN]
     effort = 0.0
-    for j in range(N_ROTORS):
+    for j in range(ENV_ROTORS):
         d = (rin[RIN_CMD + j] - hover) / span
         effort += 0.25 * d * d
     effort = min(effort, 1.0)

@@ -91,6 +91,7 @@ from quadimpact.core.envs.episode_layout import (
     B_STEPS,
     B_X_REF,
     B_Y_REF,
+    ENV_ROTORS,
     EP_ACTION,
     EP_END_ON_RECOVERY,
     EP_FAIL_REMAINING,
@@ -164,13 +165,13 @@ from quadimpact.core.layout import (
     LS_EXT_CMD,
     LS_T,
     LS_TF,
+    MAX_ROTORS,
     MEM_STAGE,
     MS_DETECTED,
     MS_NORMAL,
     MS_T,
     MS_W_HAT,
     MS_X,
-    N_ROTORS,
     NX,
     O_DT_CONTROL,
     O_SLEW_MAX,
@@ -469,7 +470,7 @@ def _step_one(k: int, actions: np.ndarray, m: Model, d: Data, o: Output, E: Env,
         env[B_STAGE] = takeover_stage(int(env[B_STAGE]), tmeas)
     d.mem[MEM_STAGE] = env[B_STAGE]
     d.ls[LS_EXT] = 1.0
-    copy_into(d.ls[LS_EXT_CMD : LS_EXT_CMD + N_ROTORS], w.cmd)
+    copy_into(d.ls[LS_EXT_CMD : LS_EXT_CMD + MAX_ROTORS], w.cmd)
     t_before = d.ls[LS_T]
     _tick(m, d, o, w)
     d.ls[LS_EXT] = 0.0
@@ -556,7 +557,7 @@ def staged_actions(
     policy's own configuration); ``inexact`` (N,) counts the commands the
     rotor map cannot give exactly.
     """
-    cmd = np.zeros(N_ROTORS)
+    cmd = np.zeros(MAX_ROTORS)
     for k in range(TMEAS.shape[0]):
         if not active[k]:
             continue
@@ -588,7 +589,7 @@ def staged_actions(
             continue
         lo, hi = rotor_range(ctrl, par)
         slew = opts[O_SLEW_MAX] * opts[O_DT_CONTROL]
-        for j in range(N_ROTORS):
+        for j in range(ENV_ROTORS):
             a, exact = affine_inverse(cmd[j], lo, hi)
             actions[k, j] = a
             prev = tmeas[MS_X + X_ROTOR + j]
