@@ -34,9 +34,9 @@ import numpy as np
 from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
+from quadimpact.core.geometry import register_shape
 from quadimpact.core.geometry.contact_record import feature_offset, material_record
 from quadimpact.core.geometry.shape_component import ShapeComponent, ShapeSlot
-from quadimpact.core.geometry.shapes import register_shape
 from quadimpact.core.layout import (
     F_RADIUS,
     FEAT_POINT,

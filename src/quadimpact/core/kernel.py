@@ -228,7 +228,7 @@ def make_kernel(
         (``core.sensors.registry.register_sensor``), after the built-in ones.
     shapes : bool
         Compile in the shape components registered as plug-ins so far
-        (``core.geometry.shapes.register_shape``).
+        (``core.geometry.register_shape``).
 
     Returns
     -------

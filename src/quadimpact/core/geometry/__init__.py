@@ -66,8 +66,15 @@ from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
 from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
 from quadimpact.core.geometry.plane import plane_distance, point_plane, ring_plane, sphere_plane
 from quadimpact.core.geometry.ring import ring_solid
+from quadimpact.core.geometry.shape_component import ShapeComponent
 from quadimpact.core.geometry.shapes import BUILTIN as BUILTIN_SHAPES
-from quadimpact.core.geometry.shapes import CONTACT_ENTRIES, DISTANCE_ENTRIES, geometry_rows
+from quadimpact.core.geometry.shapes import (
+    CONTACT_ENTRIES,
+    DISTANCE_ENTRIES,
+    add_plugin,
+    by_name,
+    geometry_rows,
+)
 from quadimpact.core.layout import (
     F_KIND,
     FEAT_POINT,
@@ -95,6 +102,7 @@ __all__ = [
     "pair_table",
     "plugin_geometries",
     "register_geometry",
+    "register_shape",
     "register_shape_distance",
     "shape_distance",
 ]
@@ -338,6 +346,34 @@ def register_geometry(feature_kind: int, shape_kind: int, fn: Callable) -> int:
     gid = GEOMETRIES[key].id if key in GEOMETRIES else GEOM_PLUGIN + len(plugin_geometries())
     GEOMETRIES[key] = Geometry(key[0], key[1], gid, fn, plugin=True)
     return gid
+
+
+def register_shape(comp: ShapeComponent) -> None:
+    """Add a plug-in shape component: named from ``[[obstacles]]`` like a built-in.
+
+    Its rows join :data:`GEOMETRIES` and its distance :data:`SHAPE_DISTANCES`;
+    a run with one of its obstacles compiles a loop of its own around the
+    registered shapes (``core.kernel.make_kernel(shapes=True)``), once per process.
+
+    Raises
+    ------
+    TypeError
+        Not a ``ShapeComponent``, or a function of it not compiled.
+    ValueError
+        Its name is taken (a built-in kind, or another plug-in).
+    """
+    if not isinstance(comp, ShapeComponent):
+        raise TypeError("register_shape: expected a ShapeComponent")
+    for fn in (comp.distance, *comp.contacts.values()):
+        if not hasattr(fn, "py_func"):
+            raise TypeError(f"shape {comp.name}: its functions must be numba.njit functions")
+    if comp.name in ("plane", "cylinder", "box") or by_name(comp.name) is not None:
+        raise ValueError(f"register_shape: {comp.name!r} is registered already")
+    kind = add_plugin(comp)
+    for feature, shape, gid, fn in geometry_rows():
+        if shape == kind:
+            GEOMETRIES[(feature, shape)] = Geometry(feature, shape, gid, fn)
+    SHAPE_DISTANCES[kind] = (comp.distance, False)
 
 
 def register_shape_distance(shape_kind: int, fn: Callable) -> None:

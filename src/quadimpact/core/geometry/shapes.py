@@ -3,8 +3,9 @@
 **Adding a shape** is its module (``shape_component.py`` says what it
 declares; ``sphere.py`` is the example) and one line of :data:`BUILTIN`
 below; a plug-in is the same module outside the package and one call of
-:func:`register_shape`. The registry numbers the kinds from :data:`FIRST_KIND` in the order
-of the tuple and gives each (feature kind, shape) pair a geometry id from
+``core.geometry.register_shape``. The registry numbers the kinds from
+:data:`FIRST_KIND` in the order of the tuple and gives each (feature kind,
+shape) pair a geometry id from
 :data:`FIRST_GEOMETRY`; ``core/geometry/__init__.py`` adds those rows to the
 contact table and its compiled dispatch reaches their functions through
 :data:`CONTACT_ENTRIES` and :data:`DISTANCE_ENTRIES` (tuples of functions,
@@ -34,8 +35,8 @@ __all__ = [
     "contact_entries",
     "distance_entries",
     "kind_of",
+    "add_plugin",
     "plugin_shapes",
-    "register_shape",
 ]
 
 warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
@@ -82,34 +83,10 @@ def by_kind(kind: int) -> ShapeComponent | None:
     return comps[k] if 0 <= k < len(comps) else None
 
 
-def register_shape(comp: ShapeComponent) -> None:
-    """Add a plug-in shape component: named from ``[[obstacles]]`` like a built-in.
-
-    A run with one of its obstacles compiles a loop of its own around the
-    registered shapes (``core.kernel.make_kernel(shapes=True)``), once per process.
-
-    Raises
-    ------
-    TypeError
-        Not a :class:`ShapeComponent`, or a function of it not compiled.
-    ValueError
-        Its name is taken (a built-in kind, or another plug-in).
-    """
-    from quadimpact.core.geometry import GEOMETRIES, SHAPE_DISTANCES, Geometry
-
-    if not isinstance(comp, ShapeComponent):
-        raise TypeError("register_shape: expected a ShapeComponent")
-    for fn in (comp.distance, *comp.contacts.values()):
-        if not hasattr(fn, "py_func"):
-            raise TypeError(f"shape {comp.name}: its functions must be numba.njit functions")
-    if comp.name in ("plane", "cylinder", "box") or by_name(comp.name) is not None:
-        raise ValueError(f"register_shape: {comp.name!r} is registered already")
+def add_plugin(comp: ShapeComponent) -> int:
+    """Append a plug-in component (``core.geometry.register_shape`` checks it); its kind."""
     _PLUGINS.append(comp)
-    kind = kind_of(comp)
-    for feature, shape, gid, fn in geometry_rows():
-        if shape == kind:
-            GEOMETRIES[(feature, shape)] = Geometry(feature, shape, gid, fn)
-    SHAPE_DISTANCES[kind] = (comp.distance, False)
+    return kind_of(comp)
 
 
 def contact_entries(comps: tuple[ShapeComponent, ...] | None = None) -> tuple:
