@@ -467,6 +467,83 @@ def _clear(H: np.ndarray) -> None:
             H[a, k] = 0.0
 
 
+@compiled
+def _gravity(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: np.ndarray,
+             PHt: np.ndarray, S: np.ndarray, ecfg: np.ndarray, f: np.ndarray, g: float,
+             C: np.ndarray, impact: float) -> None:  # fmt: skip
+    """The accelerometer as gravity, ``f - b_a = -g C^T e_Z``, behind the ``ekf``'s gate.
+
+    ``H_theta = -g [u x]`` (``u = C^T e_Z``), ``H_ba = I``.
+    """
+    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+    excess = abs(fn - g)
+    gate = ecfg[EC_GATE]
+    rg = ecfg[EC_SIG_GRAV] ** 2
+    if impact > 0.0:
+        sa = ecfg[EC_SIG_ACC]
+        extra = _with_impact(sa, ecfg[EC_IMPACT_F], impact, ecfg[EC_IMPACT_REPLACE] > 0.5)
+        rg += extra * extra - sa * sa
+    use = excess <= gate
+    if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
+        use = True
+        rg *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
+    est[ES_GATED] = 0.0 if excess <= gate else 1.0
+    if not use:
+        return
+    _clear(H)
+    _skew(H, -g, C[2, 0], C[2, 1], C[2, 2])
+    for a in range(3):
+        y[a] = f[a] - est[ES_ACC_BIAS + a] + g * C[2, a]
+        H[a, I_BA + a] = 1.0
+        r[a] = rg
+    nav_update(est, P, H, y, r, 3, 0.0, PHt, S)
+
+
+@compiled
+def _flow(t: float, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray,
+          r: np.ndarray, PHt: np.ndarray, S: np.ndarray, ecfg: np.ndarray, meas: np.ndarray,
+          C: np.ndarray) -> None:  # fmt: skip
+    """The optical flow compensated with the gyro, ``flow + (p, q) = (v_By, -v_Bx) C_22 / h``.
+
+    Fused when the sample is new, of quality > 0, the tilt within
+    ``EC_NAV_MAX_TILT`` and the estimated height above ``EC_NAV_MIN_HEIGHT``.
+    """
+    h = -est[ES_POS + 2]
+    c22 = C[2, 2]
+    if not _new_sample(est, meas, FLOW_N, 2):
+        return
+    if not (meas[FLOW_QUALITY] > 0.0 and c22 >= ecfg[EC_NAV_MAX_TILT]):
+        return
+    if not h > ecfg[EC_NAV_MIN_HEIGHT]:
+        return
+    p_cap, q_cap = _rates_at(est, meas[FLOW_CAPTURE])
+    v0, v1, v2 = est[ES_VEL], est[ES_VEL + 1], est[ES_VEL + 2]
+    bx = C[0, 0] * v0 + C[1, 0] * v1 + C[2, 0] * v2
+    by = C[0, 1] * v0 + C[1, 1] * v1 + C[2, 1] * v2
+    bz = C[0, 2] * v0 + C[1, 2] * v1 + C[2, 2] * v2
+    k = c22 / h
+    u0, u1 = C[2, 0], C[2, 1]
+    _clear(H)
+    # d v_B / d theta = [v_B x]; d C_22 / d theta = (-u_1, u_0, 0); d k / d p_z = C_22 / h^2
+    H[0, 0] = k * bz - by / h * u1
+    H[0, 1] = by / h * u0
+    H[0, 2] = -k * bx
+    H[1, 0] = bx / h * u1
+    H[1, 1] = k * bz - bx / h * u0
+    H[1, 2] = -k * by
+    for a in range(3):
+        H[0, I_V + a] = k * C[a, 1]
+        H[1, I_V + a] = -k * C[a, 0]
+    H[0, I_P + 2] = by * c22 / (h * h)
+    H[1, I_P + 2] = -bx * c22 / (h * h)
+    y[0] = meas[FLOW_X] + p_cap - k * by
+    y[1] = meas[FLOW_Y] + q_cap + k * bx
+    s = max(meas[FLOW_NOISE], ecfg[EC_NAV_FLOW])
+    r[0] = s * s
+    r[1] = s * s
+    _fuse(t, SRC_FLOW, est, P, H, y, r, 2, ecfg, PHt, S, I_V, I_V + 2, h / c22)
+
+
 @allocating
 def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
@@ -502,37 +579,14 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
     q = est[ES_Q : ES_Q + 4]
     dcm(q, C)
     impact = impact_noise_factor(t, f, ecfg, est)
-    fh = y  # f - b_a, in y until the updates
-    for a in range(3):
-        fh[a] = f[a] - est[ES_ACC_BIAS + a]
     if dt > 0.0:
+        for a in range(3):
+            y[a] = f[a] - est[ES_ACC_BIAS + a]  # f - b_a before the prediction
         nav_predict(est, P, A, ecfg, m.scfg, w, f, dt, C, impact)
         dcm(q, C)
-        integrate_navigation(est, C, fh, g, dt)
-    # accelerometer: gravity, f - b_a = -g C^T e_Z (H_theta = -g [u x], u = C^T e_Z; H_ba = I)
-    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
-    excess = abs(fn - g)
-    gate = ecfg[EC_GATE]
-    rg = ecfg[EC_SIG_GRAV] ** 2
-    if impact > 0.0:
-        sa = ecfg[EC_SIG_ACC]
-        extra = _with_impact(sa, ecfg[EC_IMPACT_F], impact, ecfg[EC_IMPACT_REPLACE] > 0.5)
-        rg += extra * extra - sa * sa
-    use = excess <= gate
-    if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
-        use = True
-        rg *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
-    est[ES_GATED] = 0.0 if excess <= gate else 1.0
-    if use:
-        _clear(H)
-        u0, u1, u2 = C[2, 0], C[2, 1], C[2, 2]
-        _skew(H, -g, u0, u1, u2)
-        for a in range(3):
-            y[a] = f[a] - est[ES_ACC_BIAS + a] + g * C[2, a]
-            H[a, I_BA + a] = 1.0
-            r[a] = rg
-        nav_update(est, P, H, y, r, 3, 0.0, PHt, S)
-        dcm(q, C)
+        integrate_navigation(est, C, y, g, dt)
+    _gravity(est, P, H, y, r, PHt, S, ecfg, f, g, C, impact)
+    dcm(q, C)
     # magnetometer: m = C^T m_I (H_theta = [u_m x], u_m = C^T m_I)
     if meas[MS_MAG_T] == t:
         mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
@@ -557,56 +611,20 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
         r[0] = ecfg[EC_NAV_BARO] ** 2
         _fuse(t, SRC_BARO, est, P, H, y, r, 1, ecfg, PHt, S, I_P + 2, I_P + 3, 1.0)
         dcm(q, C)
+    # rangefinder: range = h / C_22, h = -p_z; dC_22/dtheta = (-u_1, u_0, 0), u = C^T e_Z
     c22 = C[2, 2]
-    level = c22 >= ecfg[EC_NAV_MAX_TILT]
-    # rangefinder: range = h / C_22, h = -p_z
-    if _new_sample(est, meas, RNG_N, 1) and meas[RNG_VALID] > 0.5 and level:
+    if _new_sample(est, meas, RNG_N, 1) and meas[RNG_VALID] > 0.5 and c22 >= ecfg[EC_NAV_MAX_TILT]:
         h = -est[ES_POS + 2]
         _clear(H)
-        u0, u1 = C[2, 0], C[2, 1]
-        # dC_22/dtheta = (-u_1, u_0, 0) with u = C^T e_Z
-        H[0, I_TH] = h / (c22 * c22) * u1
-        H[0, I_TH + 1] = -h / (c22 * c22) * u0
+        H[0, I_TH] = h / (c22 * c22) * C[2, 1]
+        H[0, I_TH + 1] = -h / (c22 * c22) * C[2, 0]
         H[0, I_P + 2] = -1.0 / c22
         y[0] = meas[RNG_RANGE] - h / c22
         r[0] = max(meas[RNG_NOISE], ecfg[EC_NAV_RANGE]) ** 2
         _fuse(t, SRC_RANGE, est, P, H, y, r, 1, ecfg, PHt, S, I_P + 2, I_P + 3, c22)
         dcm(q, C)
-        c22 = C[2, 2]
-    # optical flow: flow + (p, q) = (v_By, -v_Bx) C_22 / h
-    h = -est[ES_POS + 2]
-    if (
-        _new_sample(est, meas, FLOW_N, 2)
-        and meas[FLOW_QUALITY] > 0.0
-        and c22 >= ecfg[EC_NAV_MAX_TILT]
-        and h > ecfg[EC_NAV_MIN_HEIGHT]
-    ):
-        p_cap, q_cap = _rates_at(est, meas[FLOW_CAPTURE])
-        v0, v1, v2 = est[ES_VEL], est[ES_VEL + 1], est[ES_VEL + 2]
-        bx = C[0, 0] * v0 + C[1, 0] * v1 + C[2, 0] * v2
-        by = C[0, 1] * v0 + C[1, 1] * v1 + C[2, 1] * v2
-        bz = C[0, 2] * v0 + C[1, 2] * v1 + C[2, 2] * v2
-        k = c22 / h
-        u0, u1 = C[2, 0], C[2, 1]
-        _clear(H)
-        # d v_B / d theta = [v_B x]; d C_22 / d theta = (-u_1, u_0, 0); d k / d p_z = C_22 / h^2
-        H[0, 0] = k * bz - by / h * u1
-        H[0, 1] = by / h * u0
-        H[0, 2] = -k * bx
-        H[1, 0] = bx / h * u1
-        H[1, 1] = k * bz - bx / h * u0
-        H[1, 2] = -k * by
-        for a in range(3):
-            H[0, I_V + a] = k * C[a, 1]
-            H[1, I_V + a] = -k * C[a, 0]
-        H[0, I_P + 2] = by * c22 / (h * h)
-        H[1, I_P + 2] = -bx * c22 / (h * h)
-        y[0] = meas[FLOW_X] + p_cap - k * by
-        y[1] = meas[FLOW_Y] + q_cap + k * bx
-        s = max(meas[FLOW_NOISE], ecfg[EC_NAV_FLOW])
-        r[0] = r[1] = s * s
-        _fuse(t, SRC_FLOW, est, P, H, y, r, 2, ecfg, PHt, S, I_V, I_V + 2, h / c22)
-        dcm(q, C)
+    _flow(t, est, P, H, y, r, PHt, S, ecfg, meas, C)
+    dcm(q, C)
     for i in range(n):
         for j in range(n):
             est[ES_NAV_P + i * n + j] = 0.5 * (P[i, j] + P[j, i])
