@@ -217,7 +217,7 @@ class NavEkfParams(EstimatorParams):
     below. The gates are PX4 EKF2's defaults (``EKF2_MAG_GATE`` 3,
     ``EKF2_BARO_GATE`` 5, ``EKF2_RNG_GATE`` 5, ``EKF2_OF_GATE`` 3), in sigma:
     a sample is refused when its normalised innovation squared exceeds the
-    gate squared times its rows. docs/ESTIMATION.md 9 describes the filter.
+    gate squared times its rows. docs/ESTIMATION.md 2.6 describes the filter.
     """
 
     gyro_noise_rad_s: Real | None = Field(None, ge=0, description="Gyro noise per sample.")
