@@ -243,10 +243,13 @@ def test_velocity_is_observable_from_the_flow_at_constant_height():
         h = _harness(n, fl, flow=flow)
         _perturb(h, fl, rng, sn, 0.0)
         h.est[L.ES_VEL : L.ES_VEL + 2] += (0.3, -0.2)
-        errs = []
-        _fly(h, fl, sn, n, dt, flow=flow,
-             on_sample=lambda i, t, h=h, fl=fl: errs.append(np.linalg.norm(_error(h, fl, t)[3:5])))  # fmt: skip
-        out[flow] = np.array(errs)
+        errs = np.zeros(n)
+
+        def score(i, t, h=h, fl=fl, errs=errs):
+            errs[i] = np.linalg.norm(_error(h, fl, t)[3:5])
+
+        _fly(h, fl, sn, n, dt, flow=flow, on_sample=score)
+        out[flow] = errs
     with_flow, without = out[True], out[False]
     assert with_flow[-1000:].max() < 0.05  # m/s over the last 5 s
     assert np.sqrt(np.mean(with_flow[-1000:] ** 2)) < 0.03
@@ -258,9 +261,9 @@ def _converge(flow, params=None):
     rng = np.random.default_rng(11)
     fl = Flight(expmap(np.radians([3.0, -2.0, 100.0])), (0.0, 0.0, -2.0))
     sn = Sensors(rng, np.array([2e-3, -1e-3, 1e-3]), np.array([0.05, 0.04, -0.05]), 0.1)
-    h = _harness(n, fl, flow=flow, params={"initial_attitude_std_deg": 5.0,
-                                           "initial_velocity_std_m_s": 0.5,
-                                           "initial_position_std_m": 0.5, **(params or {})})  # fmt: skip
+    p0 = {"initial_attitude_std_deg": 5.0, "initial_velocity_std_m_s": 0.5,
+          "initial_position_std_m": 0.5}  # fmt: skip
+    h = _harness(n, fl, flow=flow, params={**p0, **(params or {})})
     _perturb(h, fl, rng, sn, 0.0)
     h.est[L.ES_Q : L.ES_Q + 4] = qmul(fl.q, expmap(np.radians([4.0, -4.0, 6.0])))
     h.est[L.ES_VEL : L.ES_VEL + 3] += (0.4, -0.4, 0.3)
@@ -351,8 +354,9 @@ def test_the_barometer_is_reacquired_after_a_step():
 def test_packer_takes_the_sensors_noise_and_documents_defaults():
     from quadimpact.inputs.estimators import NavEkfParams
 
+    baro = {"noise_m": 0.3, "bias_walk_m_sqrt_s": 0.02}
     h = Harness("nav-ekf", 10, imu="noisy", magnetometer={"noise": 0.02},
-                instruments={"barometer": {"noise_m": 0.3, "bias_walk_m_sqrt_s": 0.02}})  # fmt: skip
+                instruments={"barometer": baro})  # fmt: skip
     e = h.m.ecfg
     assert e[L.EC_KIND] == L.EST_NAV_EKF
     assert e[L.EC_SIG_ACC] == 1.0 and e[L.EC_SIG_GYRO] == pytest.approx(1.8e-3)

@@ -302,16 +302,21 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
 
 
 @compiled
-def nav_update(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: np.ndarray,
-               rows: int, gate: float, PHt: np.ndarray, S: np.ndarray) -> float:  # fmt: skip
+def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: float) -> float:
     """A Kalman update with ``rows`` (1-3) rows of ``H`` (16 columns), innovation ``y`` and
     noise variances ``r``, unless refused by the gate; its correction injected.
 
-    ``gate``: refuse when ``y^T S^-1 y > gate^2 rows`` (``<= 0``: no gate).
-    Returns the normalised innovation squared, negated when refused.
-    ``PHt`` (16 x 6), ``S`` (3 x 6): scratch.
+    ``W`` (14 x 16, as :func:`nav_ekf_sample` makes it) holds ``H`` (rows 0-2), ``y`` and ``r``
+    (row 4) and the scratch. ``gate``: refuse when ``y^T S^-1 y > gate^2 rows``
+    (``<= 0``: no gate). Returns the normalised innovation squared, negated
+    when refused.
     """
     n = N_NAV
+    H = W[0:4]
+    y = W[4, 0:3]
+    r = W[4, 3:6]
+    S = W[5:8, 0:6]
+    Q = W[8:14]  # (P H^T)^T in rows 0-2, K^T in rows 3-5
     for i in range(n):
         for a in range(rows):
             s = 0.0
@@ -319,14 +324,14 @@ def nav_update(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: 
                 h = H[a, k]
                 if h != 0.0:
                     s += P[i, k] * h
-            PHt[i, a] = s
+            Q[a, i] = s
     for a in range(rows):
         for b in range(rows):
             s = 0.0
             for k in range(n):
                 h = H[a, k]
                 if h != 0.0:
-                    s += h * PHt[k, b]
+                    s += h * Q[b, k]
             S[a, b] = s
         S[a, a] += r[a]
     # S^-1 into S[:, 3:6] (Gauss-Jordan, S symmetric positive definite)
@@ -350,27 +355,27 @@ def nav_update(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: 
             nis += y[a] * S[a, 3 + b] * y[b]
     if gate > 0.0 and nis > gate * gate * rows:
         return -nis
-    # K = P H^T S^-1 into PHt[:, 3:6]; the correction dx into H's row 3
+    # K = P H^T S^-1, transposed, into Q's rows 3-5; the correction dx into H's row 3
     dx = H[3]
     for i in range(n):
         for a in range(rows):
             s = 0.0
             for b in range(rows):
-                s += PHt[i, b] * S[b, 3 + a]
-            PHt[i, 3 + a] = s
+                s += Q[b, i] * S[b, 3 + a]
+            Q[3 + a, i] = s
         s = 0.0
         for a in range(rows):
-            s += PHt[i, 3 + a] * y[a]
+            s += Q[3 + a, i] * y[a]
         dx[i] = s
     # P <- P - K (P H^T)^T, then symmetric
     for i in range(n):
         for j in range(i, n):
             s = 0.0
             for a in range(rows):
-                s += PHt[i, 3 + a] * PHt[j, a]
+                s += Q[3 + a, i] * Q[a, j]
             s2 = 0.0
             for a in range(rows):
-                s2 += PHt[j, 3 + a] * PHt[i, a]
+                s2 += Q[3 + a, j] * Q[a, i]
             v = 0.5 * (P[i, j] + P[j, i]) - 0.5 * (s + s2)
             P[i, j] = v
             P[j, i] = v
@@ -399,9 +404,8 @@ def _inflate(P: np.ndarray, lo: int, hi: int, extra: float) -> None:
 
 
 @compiled
-def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray,
-          r: np.ndarray, rows: int, ecfg: np.ndarray, PHt: np.ndarray, S: np.ndarray,
-          lo: int, hi: int, scale: float) -> bool:  # fmt: skip
+def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int,
+          ecfg: np.ndarray, lo: int, hi: int, scale: float) -> bool:  # fmt: skip
     """One aiding source's update through its gate, with the re-acquisition rule.
 
     ``lo..hi-1``: the states inflated on re-acquisition, by the innovation's
@@ -410,9 +414,10 @@ def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: 
     """
     gate = ecfg[EC_NAV_GATES + src]
     c = ES_NAV_COUNT + 3 * src
+    y = W[4, 0:3]
     # a copy of the innovation: the update writes its correction over H's row 3
     y0, y1, y2 = y[0], y[1], y[2]
-    nis = nav_update(est, P, H, y, r, rows, gate, PHt, S)
+    nis = nav_update(est, P, W, rows, gate)
     if nis >= 0.0:
         est[ES_NAV_NIS + src] = nis
         est[c + CNT_FUSED] += 1.0
@@ -427,7 +432,7 @@ def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: 
     for a in range(rows):
         e2 += y[a] * y[a]
     _inflate(P, lo, hi, e2 * scale * scale)
-    nav_update(est, P, H, y, r, rows, 0.0, PHt, S)
+    nav_update(est, P, W, rows, 0.0)
     est[c + CNT_REACQUIRED] += 1.0
     est[ES_NAV_FUSED_T + src] = t
     return True
@@ -468,9 +473,8 @@ def _clear(H: np.ndarray) -> None:
 
 
 @compiled
-def _gravity(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: np.ndarray,
-             PHt: np.ndarray, S: np.ndarray, ecfg: np.ndarray, f: np.ndarray, g: float,
-             C: np.ndarray, impact: float) -> None:  # fmt: skip
+def _gravity(est: np.ndarray, P: np.ndarray, W: np.ndarray, ecfg: np.ndarray, f: np.ndarray,
+             g: float, C: np.ndarray, impact: float) -> None:  # fmt: skip
     """The accelerometer as gravity, ``f - b_a = -g C^T e_Z``, behind the ``ekf``'s gate.
 
     ``H_theta = -g [u x]`` (``u = C^T e_Z``), ``H_ba = I``.
@@ -490,19 +494,19 @@ def _gravity(est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray, r: np
     est[ES_GATED] = 0.0 if excess <= gate else 1.0
     if not use:
         return
+    H, y, r = W[0:4], W[4, 0:3], W[4, 3:6]
     _clear(H)
     _skew(H, -g, C[2, 0], C[2, 1], C[2, 2])
     for a in range(3):
         y[a] = f[a] - est[ES_ACC_BIAS + a] + g * C[2, a]
         H[a, I_BA + a] = 1.0
         r[a] = rg
-    nav_update(est, P, H, y, r, 3, 0.0, PHt, S)
+    nav_update(est, P, W, 3, 0.0)
 
 
 @compiled
-def _flow(t: float, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray,
-          r: np.ndarray, PHt: np.ndarray, S: np.ndarray, ecfg: np.ndarray, meas: np.ndarray,
-          C: np.ndarray) -> None:  # fmt: skip
+def _flow(t: float, est: np.ndarray, P: np.ndarray, W: np.ndarray, ecfg: np.ndarray,
+          meas: np.ndarray, C: np.ndarray) -> None:  # fmt: skip
     """The optical flow compensated with the gyro, ``flow + (p, q) = (v_By, -v_Bx) C_22 / h``.
 
     Fused when the sample is new, of quality > 0, the tilt within
@@ -523,6 +527,7 @@ def _flow(t: float, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray
     bz = C[0, 2] * v0 + C[1, 2] * v1 + C[2, 2] * v2
     k = c22 / h
     u0, u1 = C[2, 0], C[2, 1]
+    H, y, r = W[0:4], W[4, 0:3], W[4, 3:6]
     _clear(H)
     # d v_B / d theta = [v_B x]; d C_22 / d theta = (-u_1, u_0, 0); d k / d p_z = C_22 / h^2
     H[0, 0] = k * bz - by / h * u1
@@ -541,7 +546,7 @@ def _flow(t: float, est: np.ndarray, P: np.ndarray, H: np.ndarray, y: np.ndarray
     s = max(meas[FLOW_NOISE], ecfg[EC_NAV_FLOW])
     r[0] = s * s
     r[1] = s * s
-    _fuse(t, SRC_FLOW, est, P, H, y, r, 2, ecfg, PHt, S, I_V, I_V + 2, h / c22)
+    _fuse(t, SRC_FLOW, est, P, W, 2, ecfg, I_V, I_V + 2, h / c22)
 
 
 @allocating
@@ -557,11 +562,8 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
     n = N_NAV
     W = np.empty((2, n, n))
     P, A = W[0], W[1]
-    H = np.zeros((4, n))
-    PHt = np.empty((n, 6))
-    S = np.empty((3, 6))
-    y = np.zeros(3)
-    r = np.zeros(3)
+    Wu = np.zeros((14, n))  # the updates' work: H, y and r, scratch (nav_update)
+    H, y, r = Wu[0:4], Wu[4, 0:3], Wu[4, 3:6]
     for i in range(n):
         for j in range(n):
             P[i, j] = est[ES_NAV_P + i * n + j]
@@ -585,7 +587,7 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
         nav_predict(est, P, A, ecfg, m.scfg, w, f, dt, C, impact)
         dcm(q, C)
         integrate_navigation(est, C, y, g, dt)
-    _gravity(est, P, H, y, r, PHt, S, ecfg, f, g, C, impact)
+    _gravity(est, P, Wu, ecfg, f, g, C, impact)
     dcm(q, C)
     # magnetometer: m = C^T m_I (H_theta = [u_m x], u_m = C^T m_I)
     if meas[MS_MAG_T] == t:
@@ -600,7 +602,7 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
         y[2] = meas[MS_MAG + 2] - u2
         r[0] = r[1] = r[2] = ecfg[EC_SIG_MAG] ** 2
         norm = math.sqrt(mi[0] * mi[0] + mi[1] * mi[1] + mi[2] * mi[2])
-        _fuse(t, SRC_MAG, est, P, H, y, r, 3, ecfg, PHt, S, I_TH, I_TH + 3, 1.0 / norm)
+        _fuse(t, SRC_MAG, est, P, Wu, 3, ecfg, I_TH, I_TH + 3, 1.0 / norm)
         dcm(q, C)
     # barometer: altitude = -p_z + b_b
     if _new_sample(est, meas, BARO_N, 0):
@@ -609,7 +611,7 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
         H[0, I_BB] = 1.0
         y[0] = meas[BARO_ALT] - (-est[ES_POS + 2] + est[ES_BARO_BIAS])
         r[0] = ecfg[EC_NAV_BARO] ** 2
-        _fuse(t, SRC_BARO, est, P, H, y, r, 1, ecfg, PHt, S, I_P + 2, I_P + 3, 1.0)
+        _fuse(t, SRC_BARO, est, P, Wu, 1, ecfg, I_P + 2, I_P + 3, 1.0)
         dcm(q, C)
     # rangefinder: range = h / C_22, h = -p_z; dC_22/dtheta = (-u_1, u_0, 0), u = C^T e_Z
     c22 = C[2, 2]
@@ -621,9 +623,9 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
         H[0, I_P + 2] = -1.0 / c22
         y[0] = meas[RNG_RANGE] - h / c22
         r[0] = max(meas[RNG_NOISE], ecfg[EC_NAV_RANGE]) ** 2
-        _fuse(t, SRC_RANGE, est, P, H, y, r, 1, ecfg, PHt, S, I_P + 2, I_P + 3, c22)
+        _fuse(t, SRC_RANGE, est, P, Wu, 1, ecfg, I_P + 2, I_P + 3, c22)
         dcm(q, C)
-    _flow(t, est, P, H, y, r, PHt, S, ecfg, meas, C)
+    _flow(t, est, P, Wu, ecfg, meas, C)
     dcm(q, C)
     for i in range(n):
         for j in range(n):
