@@ -176,7 +176,7 @@ class TrialDistribution:
         Its parameters.
     sensors : str or None
         A preset of sensors (``"ideal"``, ``"noisy"``, ``"impact"``, ``"indoor"``,
-        ``"authors-2016"``);
+        ``"onboard"``, ``"authors-2016"``);
         it replaces the IMU preset choice.
     overrides : mapping
         Any other :class:`~quadimpact.inputs.scenarios.ImpactTrial` field

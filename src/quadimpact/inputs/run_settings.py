@@ -113,6 +113,10 @@ class PowerOff(BaseModel):
 
 
 # ---------------------------------------------------------------- settings
+SensorPreset = Literal["ideal", "noisy", "impact", "indoor", "onboard", "authors-2016"]
+"""The names of :data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`."""
+
+
 class RunSettings(BaseModel):
     """Settings common to every scenario: model, controller, vehicle, rotors, integrator.
 
@@ -188,7 +192,7 @@ class RunSettings(BaseModel):
         Sensor components (``core/sensors/registry.py``: the barometer, and
         any plug-in registered) by name, each with its validated settings;
         empty by default.
-    sensors : {"ideal", "noisy", "impact", "indoor"} or None
+    sensors : {"ideal", "noisy", "impact", "indoor", "onboard", "authors-2016"} or None
         A preset of sensors (:data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`):
         it sets ``imu``, ``magnetometer`` and ``pose_sensor`` where the scenario
         does not set them itself.
@@ -308,8 +312,10 @@ class RunSettings(BaseModel):
         description="Sensor components by name, each with its settings table "
         "([instruments.barometer]); none by default.",
     )
-    sensors: Literal["ideal", "noisy", "impact", "indoor", "authors-2016"] | None = Field(
-        None, description="A preset of sensors (imu, magnetometer, pose_sensor not set)."
+    sensors: SensorPreset | None = Field(
+        None,
+        description="A preset of sensors (fills imu, magnetometer, pose_sensor and "
+        "instruments where not set).",
     )
     estimator: str = Field(
         "ideal", description="State estimator: 'ideal', 'complementary', 'ekf' or a registered one."

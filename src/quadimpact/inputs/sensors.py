@@ -172,6 +172,13 @@ SENSOR_PRESETS: dict[str, dict[str, Any]] = {
     "noisy": {"imu": "noisy"},
     "impact": {"imu": "impact"},
     "indoor": {"imu": "impact", "magnetometer": {}, "pose_sensor": {}},
+    # what a small drone carries to hold a hover without motion capture: the impact IMU,
+    # a magnetometer, a barometer, a lidar rangefinder and a downward flow camera
+    "onboard": {
+        "imu": "impact",
+        "magnetometer": {},
+        "instruments": {"barometer": {}, "rangefinder": {"preset": "lidar"}, "optical_flow": {}},
+    },
     # the authors' 2016 estimator study: 100 Hz at the CM, their magnetometer
     "authors-2016": {
         "imu": {"preset": "authors-2016", "rate_hz": 100.0, "position": "cm"},
@@ -179,8 +186,9 @@ SENSOR_PRESETS: dict[str, dict[str, Any]] = {
     },
 }
 """Realistic combinations of sensors (a scenario's ``sensors``): the IMU preset and the
-optional sensors (``{}``: present with their defaults). Fields a scenario sets itself
-(``imu``, ``magnetometer``, ``pose_sensor``) win over its preset's."""
+optional sensors (``{}``: present with their defaults) and the sensor components
+(``instruments``). Fields a scenario sets itself (``imu``, ``magnetometer``,
+``pose_sensor``, ``instruments``) win over its preset's."""
 
 
 class ResolvedImu(BaseModel):

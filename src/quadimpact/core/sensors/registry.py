@@ -29,7 +29,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import NIMU, NMEAS, NSCFG, NSST, SS_N
 from quadimpact.core.records import Data, Model, Output
-from quadimpact.core.sensors import barometer
+from quadimpact.core.sensors import barometer, optical_flow, rangefinder
 from quadimpact.core.sensors.component import SensorComponent, offsets
 
 __all__ = [
@@ -52,6 +52,8 @@ warnings.filterwarnings("ignore", category=NumbaExperimentalFeatureWarning)
 
 BUILTIN: tuple[SensorComponent, ...] = (
     barometer.SENSOR,  # altitude, white noise, bias walk
+    rangefinder.SENSOR,  # slant range to the ground along the body's down axis
+    optical_flow.SENSOR,  # the ground image's angular rate, with quality and delay
 )
 """The built-in sensor components, one line each."""
 
@@ -181,6 +183,47 @@ ENTRIES = entries(BUILTIN)
 
 
 @compiled
+def _sample_one(
+    e: tuple,
+    t: float,
+    xs: np.ndarray,
+    xd: np.ndarray,
+    C: np.ndarray,
+    m: Model,
+    d: Data,
+    o: Output,
+    i: int,
+) -> None:
+    """Component ``e`` (an entry of :data:`ENTRIES`) at the IMU sample ``i``, time ``t`` (s)."""
+    scfg = m.scfg
+    sst = d.sst
+    meas = d.meas
+    if scfg.shape[0] < NSCFG + e[2] or sst.shape[0] < NSST + e[4]:
+        return
+    if meas.shape[0] < NMEAS + e[6]:
+        return
+    empty = m.span[0:0]
+    noise = empty
+    if 0 <= i < m.cnoise.shape[0] and m.cnoise.shape[1] >= e[8]:
+        noise = m.cnoise[i, e[7] : e[8]]
+    rec = empty
+    if 0 <= i < o.imu.shape[0] and o.imu.shape[1] >= NIMU + e[10]:
+        rec = o.imu[i, NIMU + e[9] : NIMU + e[10]]
+    e[0](
+        t,
+        xs,
+        xd,
+        C,
+        m.veh,
+        scfg[NSCFG + e[1] : NSCFG + e[2]],
+        sst[NSST + e[3] : NSST + e[4]],
+        meas[NMEAS + e[5] : NMEAS + e[6]],
+        noise,
+        rec,
+    )
+
+
+@compiled
 def sample_components(
     t: float, xs: np.ndarray, xd: np.ndarray, C: np.ndarray, m: Model, d: Data, o: Output
 ) -> None:
@@ -190,30 +233,5 @@ def sample_components(
     registered) skips it.
     """
     i = int(d.sst[SS_N]) - 1
-    empty = m.span[0:0]
-    scfg = m.scfg
-    sst = d.sst
-    meas = d.meas
     for e in literal_unroll(ENTRIES):
-        if scfg.shape[0] < NSCFG + e[2] or sst.shape[0] < NSST + e[4]:
-            continue
-        if meas.shape[0] < NMEAS + e[6]:
-            continue
-        noise = empty
-        if 0 <= i < m.cnoise.shape[0] and m.cnoise.shape[1] >= e[8]:
-            noise = m.cnoise[i, e[7] : e[8]]
-        rec = empty
-        if 0 <= i < o.imu.shape[0] and o.imu.shape[1] >= NIMU + e[10]:
-            rec = o.imu[i, NIMU + e[9] : NIMU + e[10]]
-        e[0](
-            t,
-            xs,
-            xd,
-            C,
-            m.veh,
-            scfg[NSCFG + e[1] : NSCFG + e[2]],
-            sst[NSST + e[3] : NSST + e[4]],
-            meas[NMEAS + e[5] : NMEAS + e[6]],
-            noise,
-            rec,
-        )
+        _sample_one(e, t, xs, xd, C, m, d, o, i)

@@ -166,7 +166,7 @@ class PoleStudy:
         registered one.
     sensors : str or None
         A preset of sensors (docs/ESTIMATION.md: ``"ideal"``, ``"noisy"``,
-        ``"impact"``, ``"indoor"``, ``"authors-2016"``); ``None``: the ideal IMU.
+        ``"impact"``, ``"indoor"``, ``"onboard"``, ``"authors-2016"``); ``None``: the ideal IMU.
         With a preset, each grid point draws its sensors' noise from a seed of
         its own (:meth:`point_seeds`), the same for every arm of the point.
     seed : int

@@ -30,7 +30,7 @@ MODELS = ("default", "classic", "recovery-replica", "pole-replica")
 #: IMU presets (``quadimpact.inputs.sensors.IMU_PRESETS``).
 IMUS = ("ideal", "noisy", "impact", "authors-2016")
 #: Presets of sensors (``quadimpact.inputs.sensors.SENSOR_PRESETS``).
-SENSORS = ("ideal", "noisy", "impact", "indoor", "authors-2016")
+SENSORS = ("ideal", "noisy", "impact", "indoor", "onboard", "authors-2016")
 #: Built-in state estimators (``quadimpact.inputs.estimators``; a registered one is accepted too).
 ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive")
 #: Pre-impact behaviours of the recovery controller in the study.

@@ -119,7 +119,7 @@ class RecoveryStudy:
         The state estimator the controller and the detector read
         (docs/ESTIMATION.md): ``"ideal"`` (the default), ``"complementary"``,
         ``"ekf"`` or a registered one.
-    sensors : {"ideal", "noisy", "impact", "indoor", "authors-2016"} or None
+    sensors : {"ideal", "noisy", "impact", "indoor", "onboard", "authors-2016"} or None
         A preset of sensors; it replaces ``imu`` (``None``: ``imu`` alone).
         The same seed gives the same trials (conditions and IMU seeds) with
         any estimator and sensors, so studies compare row by row.

@@ -1,0 +1,51 @@
+"""A plug-in sensor component (``examples/sensor_template.py``, a variometer) flown as a
+built-in is: named in a scenario, its noise from the run's seed, its columns recorded."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from quadimpact import simulate
+from quadimpact.inputs.scenarios import scenario_from_dict
+
+pytestmark = pytest.mark.slow  # compiles a loop around the plug-in (about a minute)
+
+TEMPLATE = Path(__file__).resolve().parents[2] / "examples" / "sensor_template.py"
+
+
+def _load():
+    spec = importlib.util.spec_from_file_location("sensor_template", TEMPLATE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_plugin_variometer_measures_the_climb_rate():
+    _load()
+    base = {
+        "kind": "flight",
+        "final_time_s": 1.0,
+        "controller": "cascade-pid",
+        "velocity_m_s": (0.0, 0.0, -0.5),  # climbing at 0.5 m/s at the start
+        "imu": {"preset": "ideal", "rate_hz": 200},
+    }
+    exact = simulate(scenario_from_dict({**base, "instruments": {"variometer": {"noise_m_s": 0}}}))
+    imu = exact.imu
+    assert imu["variometer_climb_m_s"].iloc[0] == pytest.approx(0.5, abs=1e-12)
+    assert np.array_equal(imu["variometer_climb_m_s"], imu["variometer_climb_true_m_s"])
+    sigma = 0.2
+    noisy = simulate(
+        scenario_from_dict({**base, "seed": 5, "instruments": {"variometer": {"noise_m_s": sigma}}})
+    )
+    e = (noisy.imu["variometer_climb_m_s"] - noisy.imu["variometer_climb_true_m_s"]).to_numpy()
+    n = e.size
+    assert abs(e.var(ddof=1) / sigma**2 - 1.0) < 4 * math.sqrt(2.0 / (n - 1))
+    again = simulate(
+        scenario_from_dict({**base, "seed": 5, "instruments": {"variometer": {"noise_m_s": sigma}}})
+    )
+    assert np.array_equal(noisy.imu["variometer_climb_m_s"], again.imu["variometer_climb_m_s"])
