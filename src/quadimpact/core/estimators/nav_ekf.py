@@ -48,11 +48,13 @@ refused when its normalised innovation squared ``y^T S^-1 y`` exceeds
 ``n^2 m`` (``n`` the source's gate in sigma, ``EC_NAV_GATES``; ``m`` its
 rows; ``n <= 0``: no gate). Re-acquisition: a source none of whose samples has
 been fused for ``EC_NAV_REACQUIRE`` seconds (a dropout while the vehicle
-tumbles, or a run of refusals) is re-acquired at its next usable sample: if
-the gate refuses it, the variance of the states it measures is raised by the
-innovation's square in those states' units (their cross-covariances
-cleared), and the sample fused without the gate. So the gate can never lock
-a source out for longer than ``EC_NAV_REACQUIRE``.
+tumbles, or a run of refusals) is re-acquired at its next usable sample: the
+variance of the states it measures is raised by the innovation's square in
+those states' units (their cross-covariances cleared), and the sample fused
+without the gate. So the gate can never lock a source out for longer than
+``EC_NAV_REACQUIRE``, and after a dropout the estimate jumps to the source
+instead of creeping towards it with the gain of a covariance that did not
+see the impact.
 
 The measurements are read from the sensor components' blocks of the
 measurement record (``core.sensors.registry.measurement_address``); a
@@ -408,32 +410,29 @@ def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, W: np.ndarray, row
           ecfg: np.ndarray, lo: int, hi: int, scale: float) -> bool:  # fmt: skip
     """One aiding source's update through its gate, with the re-acquisition rule.
 
-    ``lo..hi-1``: the states inflated on re-acquisition, by the innovation's
-    norm squared times ``scale^2`` (the innovation in those states' units).
-    Returns whether the sample was fused.
+    A source none of whose samples was fused for ``EC_NAV_REACQUIRE`` s is
+    re-acquired: the states ``lo..hi-1`` lose their cross-covariances and
+    their variances grow by the innovation's norm squared times ``scale^2``
+    (the innovation in those states' units); the sample is then fused
+    without the gate. Returns whether the sample was fused.
     """
-    gate = ecfg[EC_NAV_GATES + src]
     c = ES_NAV_COUNT + 3 * src
-    y = W[4, 0:3]
-    # a copy of the innovation: the update writes its correction over H's row 3
-    y0, y1, y2 = y[0], y[1], y[2]
-    nis = nav_update(est, P, W, rows, gate)
-    if nis >= 0.0:
-        est[ES_NAV_NIS + src] = nis
-        est[c + CNT_FUSED] += 1.0
+    if t - est[ES_NAV_FUSED_T + src] > ecfg[EC_NAV_REACQUIRE]:
+        y = W[4, 0:3]
+        e2 = 0.0
+        for a in range(rows):
+            e2 += y[a] * y[a]
+        _inflate(P, lo, hi, e2 * scale * scale)
+        est[ES_NAV_NIS + src] = nav_update(est, P, W, rows, 0.0)
+        est[c + CNT_REACQUIRED] += 1.0
         est[ES_NAV_FUSED_T + src] = t
         return True
-    est[ES_NAV_NIS + src] = -nis
-    if not (t - est[ES_NAV_FUSED_T + src] > ecfg[EC_NAV_REACQUIRE]):
+    nis = nav_update(est, P, W, rows, ecfg[EC_NAV_GATES + src])
+    est[ES_NAV_NIS + src] = abs(nis)
+    if nis < 0.0:
         est[c + CNT_REFUSED] += 1.0
         return False
-    y[0], y[1], y[2] = y0, y1, y2
-    e2 = 0.0
-    for a in range(rows):
-        e2 += y[a] * y[a]
-    _inflate(P, lo, hi, e2 * scale * scale)
-    nav_update(est, P, W, rows, 0.0)
-    est[c + CNT_REACQUIRED] += 1.0
+    est[c + CNT_FUSED] += 1.0
     est[ES_NAV_FUSED_T + src] = t
     return True
 
