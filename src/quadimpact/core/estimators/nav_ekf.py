@@ -22,8 +22,9 @@ covariance with::
 (the ``ekf``'s conventions: ``s_g``, ``s_a`` the noises per sample). The
 IMU's impact disturbance grows ``s_g`` and ``s_a`` after each impact the
 filter sees, as in the ``ekf`` (``ekf.impact_noise_factor``). While an axis
-of the accelerometer (gyro) reads at its range, the reading is clipped: that
-sample's ``s_a`` (``s_g``) gets the range itself added in quadrature.
+of the gyro reads at its range, the reading is clipped: that sample's ``s_g``
+on that axis gets the range added in quadrature; an accelerometer axis at its
+range adds its range to ``s_a`` on every axis (the velocity error is inertial).
 
 Updates (each a Kalman update of 1 to 3 rows, ``P <- P - K S K^T``, then the
 injection of the correction into the nominal state), at each IMU sample:
@@ -285,15 +286,18 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
         sa = _with_impact(sa, ecfg[EC_IMPACT_F], impact, replace)
     range_w = scfg[SC_RANGE_W]
     range_f = scfg[SC_RANGE_F]
+    # a clipped accelerometer axis: its range in quadrature, on every inertial axis (the
+    # velocity error is inertial; a body axis's noise lands on all three)
+    va = sa * sa
+    for k in range(3):
+        if range_f > 0.0 and abs(f[k]) >= range_f:
+            va += range_f * range_f
     sw = ecfg[EC_SIG_WALK]
     swa = ecfg[EC_NAV_ACC_WALK]
     for k in range(3):
         vg = sg * sg
         if range_w > 0.0 and abs(w[k]) >= range_w:
-            vg += range_w * range_w
-        va = sa * sa
-        if range_f > 0.0 and abs(f[k]) >= range_f:
-            va += range_f * range_f
+            vg += range_w * range_w  # the attitude error is in body axes: this axis only
         P[k, k] += vg * dt * dt
         P[3 + k, 3 + k] += va * dt * dt
         P[9 + k, 9 + k] += sw * sw * dt
