@@ -86,11 +86,12 @@ class Harness:
     """A run's records with an estimator, fed sample by sample."""
 
     def __init__(self, estimator: str, n: int, *, params=None, imu="ideal", magnetometer=None,
-                 pose_sensor=None, q0=None, dt=0.005, g=G, pos0=(0.0, 0.0, -5.0)):  # fmt: skip
+                 pose_sensor=None, q0=None, dt=0.005, g=G, pos0=(0.0, 0.0, -5.0),
+                 instruments=None):  # fmt: skip
         scenario = FlightScenario(
             estimator=estimator, estimator_params=params or {}, imu=imu,
             magnetometer=magnetometer, pose_sensor=pose_sensor, final_time_s=max(n * dt, 0.01),
-            position_m=pos0,
+            position_m=pos0, instruments=instruments or {},
         )  # fmt: skip
         setup = prepare(scenario)
         self.setup = setup

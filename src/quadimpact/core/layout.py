@@ -121,6 +121,7 @@ class EstimatorKind(IntEnum):
     COMPLEMENTARY = 1  # Mahony-type nonlinear complementary filter
     EKF = 2  # multiplicative (error-state) extended Kalman filter
     EKF_ADDITIVE = 3  # the authors' 7-state additive-quaternion EKF (ekf_additive.py)
+    NAV_EKF = 4  # the navigation filter: 16 error states, baro, range and flow (nav_ekf.py)
     USER = 99  # a plug-in compiled into its own loop (core/kernel.py, make_kernel)
 
 
@@ -169,6 +170,7 @@ EST_IDEAL = int(EstimatorKind.IDEAL)
 EST_COMPLEMENTARY = int(EstimatorKind.COMPLEMENTARY)
 EST_EKF = int(EstimatorKind.EKF)
 EST_EKF_ADDITIVE = int(EstimatorKind.EKF_ADDITIVE)
+EST_NAV_EKF = int(EstimatorKind.NAV_EKF)
 EST_USER = int(EstimatorKind.USER)
 ROTOR_IDEAL = int(RotorMode.IDEAL)
 ROTOR_FIRST_ORDER = int(RotorMode.FIRST_ORDER)
@@ -408,6 +410,16 @@ EC_IMPACT_REPLACE = _ecfg.slot("EC_IMPACT_REPLACE")  # EKF: 1: it replaces the n
 EC_IMPACT_THRESHOLD = _ecfg.slot("EC_IMPACT_THRESHOLD")  # EKF: |(f_x, f_y)| marking an impact
 N_USER_ECFG = 16
 EC_USER = _ecfg.slot("EC_USER", N_USER_ECFG)  # a plug-in estimator's parameters
+# the navigation filter nav-ekf (core/estimators/nav_ekf.py); it also reads the EKF's slots
+EC_NAV_ACC_WALK = _ecfg.slot("EC_NAV_ACC_WALK")  # accelerometer bias random walk, m/s^2/sqrt(s)
+EC_NAV_BARO = _ecfg.slot("EC_NAV_BARO", 2)  # barometer: noise m, bias walk m/sqrt(s)
+EC_NAV_RANGE = _ecfg.slot("EC_NAV_RANGE")  # rangefinder noise floor, m
+EC_NAV_FLOW = _ecfg.slot("EC_NAV_FLOW")  # optical-flow noise floor, rad/s
+EC_NAV_GATES = _ecfg.slot("EC_NAV_GATES", 4)  # innovation gates (sigma): mag, baro, range, flow
+EC_NAV_REACQUIRE = _ecfg.slot("EC_NAV_REACQUIRE")  # s: a source unfused this long is re-acquired
+EC_NAV_P0 = _ecfg.slot("EC_NAV_P0", 2)  # initial std: accelerometer bias m/s^2, baro bias m
+EC_NAV_MIN_HEIGHT = _ecfg.slot("EC_NAV_MIN_HEIGHT")  # m: flow not fused below this height
+EC_NAV_MAX_TILT = _ecfg.slot("EC_NAV_MAX_TILT")  # cos of the largest tilt for range and flow
 NECFG = _ecfg.end("NECFG")
 GATE_SKIP = 0
 GATE_DEWEIGHT = 1
@@ -536,6 +548,20 @@ ES_SCRATCH = _est.slot("ES_SCRATCH", 4)  # a quaternion's worth of scratch (EKF 
 ES_T_IMPACT = _est.slot("ES_T_IMPACT")  # s, the EKF's latest impact sample (NaN: none)
 N_USER_EST = 32
 ES_USER = _est.slot("ES_USER", N_USER_EST)  # a plug-in estimator's own state
+# the navigation filter nav-ekf (core/estimators/nav_ekf.py)
+N_NAV = 16  # error state: attitude, velocity, position, gyro bias, accel. bias (3 each), baro bias
+ES_NAV_P = _est.slot("ES_NAV_P", N_NAV * N_NAV)  # its error covariance, row-major
+ES_ACC_BIAS = _est.slot("ES_ACC_BIAS", 3)  # accelerometer bias estimate, body, m/s^2
+ES_BARO_BIAS = _est.slot("ES_BARO_BIAS")  # barometer bias estimate, m
+ES_NAV_SEEN = _est.slot("ES_NAV_SEEN", 3)  # samples seen so far: barometer, rangefinder, flow
+ES_NAV_FUSED_T = _est.slot("ES_NAV_FUSED_T", 4)  # s, the latest fused sample of mag, baro,
+#   range, flow (NaN: none yet)
+ES_NAV_COUNT = _est.slot("ES_NAV_COUNT", 12)  # per source (mag, baro, range, flow):
+#   fused, rejected by the gate, re-acquisitions
+ES_NAV_NIS = _est.slot("ES_NAV_NIS", 4)  # the latest normalised innovation squared of each
+N_NAV_RING = 64  # IMU samples of gyro history (the flow's capture time)
+ES_NAV_RING = _est.slot("ES_NAV_RING", 3 * N_NAV_RING)  # (t, p, q) of the latest samples
+ES_NAV_RING_AT = _est.slot("ES_NAV_RING_AT")  # the ring's next row
 NEST = _est.end("NEST")
 
 # ==========================================================================

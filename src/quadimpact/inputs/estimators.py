@@ -13,7 +13,9 @@ and may set its parameters (``[estimator_params]``). Built in:
 * ``ekf``: a multiplicative error-state extended Kalman filter
   (:class:`EkfParams`);
 * ``ekf-additive``: the authors' 7-state EKF on an additive quaternion, with
-  its transition matrix as written or correct (:class:`AdditiveEkfParams`).
+  its transition matrix as written or correct (:class:`AdditiveEkfParams`);
+* ``nav-ekf``: the navigation filter, fusing the magnetometer, barometer,
+  rangefinder and optical flow (:class:`NavEkfParams`).
 
 A user's compiled estimator plugs in like a controller:
 ``register_estimator(name, step=..., params=..., pack=...)`` (the step's
@@ -42,6 +44,7 @@ __all__ = [
     "EstimatorContext",
     "EstimatorEntry",
     "EstimatorParams",
+    "NavEkfParams",
     "estimator_entry",
     "estimator_names",
     "register_estimator",
@@ -205,6 +208,91 @@ class AdditiveEkfParams(EstimatorParams):
     gate_m_s2: Real = Field(0.5, ge=0, description="Skip the accelerometer while ||f|-g| > this.")
 
 
+class NavEkfParams(EstimatorParams):
+    """Noise figures, gates and initial covariance of the navigation filter ``nav-ekf``.
+
+    A noise left ``None`` is the sensor's own setting (with the ``ekf``'s
+    floors). The rangefinder's and the flow's noises are each sample's own
+    (the ``noise_m`` and ``noise_rad_s`` they deliver), at least the floors
+    below. The gates are PX4 EKF2's defaults (``EKF2_MAG_GATE`` 3,
+    ``EKF2_BARO_GATE`` 5, ``EKF2_RNG_GATE`` 5, ``EKF2_OF_GATE`` 3), in sigma:
+    a sample is refused when its normalised innovation squared exceeds the
+    gate squared times its rows. docs/ESTIMATION.md 2.6 describes the filter.
+    """
+
+    gyro_noise_rad_s: Real | None = Field(None, ge=0, description="Gyro noise per sample.")
+    gyro_bias_walk_rad_s_sqrt_s: Real | None = Field(
+        None, ge=0, description="Gyro bias random walk, rad/s/sqrt(s)."
+    )
+    accel_noise_m_s2: Real | None = Field(None, ge=0, description="Accel. noise per sample.")
+    accel_bias_walk_m_s2_sqrt_s: Real = Field(
+        3e-3, gt=0, description="Accel. bias random walk, m/s^2/sqrt(s) (PX4 EKF2_ACC_B_NOISE)."
+    )
+    gravity_noise_m_s2: Real | None = Field(
+        None,
+        gt=0,
+        description="Std of the accelerometer as a gravity measurement, m/s^2; None: "
+        "sqrt(accel_noise^2 + maneuver_accel^2).",
+    )
+    maneuver_accel_m_s2: Real = Field(
+        4.0, ge=0, description="The vehicle's own acceleration the gate lets through, m/s^2."
+    )
+    gate_m_s2: Real = Field(0.5, ge=0, description="Gate on ||f| - g|, m/s^2 (as the ekf).")
+    gate: Literal["skip", "deweight"] = Field(
+        "skip", description="Beyond the gate: skip the gravity update, or de-weight it."
+    )
+    deweight: Real = Field(
+        1.0, gt=0, description="De-weighting: variance times this (||f|-g| / gate)^2."
+    )
+    magnetometer_noise: Real | None = Field(None, gt=0, description="Unit field.")
+    barometer_noise_m: Real | None = Field(None, gt=0, description="m; None: the barometer's.")
+    barometer_bias_walk_m_sqrt_s: Real | None = Field(
+        None, ge=0, description="m/sqrt(s); None: the barometer's, at least 1e-4."
+    )
+    range_noise_floor_m: Real = Field(0.01, gt=0, description="Least rangefinder noise, m.")
+    flow_noise_floor_rad_s: Real = Field(0.05, gt=0, description="Least flow noise, rad/s.")
+    mag_gate_sigma: Real = Field(3.0, ge=0, description="Magnetometer gate (0: none).")
+    baro_gate_sigma: Real = Field(5.0, ge=0, description="Barometer gate (0: none).")
+    range_gate_sigma: Real = Field(5.0, ge=0, description="Rangefinder gate (0: none).")
+    flow_gate_sigma: Real = Field(3.0, ge=0, description="Optical-flow gate (0: none).")
+    reacquire_after_s: Real = Field(
+        0.5,
+        gt=0,
+        description="A source unfused this long is re-acquired at its next sample: the gate "
+        "is lifted once and its states' variance raised by the innovation, s.",
+    )
+    max_tilt_deg: Real = Field(
+        45.0, gt=0, lt=90, description="Range and flow fused only within this tilt, deg."
+    )
+    min_flow_height_m: Real = Field(0.1, ge=0, description="Flow fused only above this, m.")
+    initial_attitude_std_deg: Real | None = Field(
+        None, gt=0, description="Initial std, deg; None: the initial error's std, at least 0.5."
+    )
+    initial_bias_std_rad_s: Real | None = Field(
+        None, gt=0, description="Initial gyro bias std, rad/s; None: the initial error's, >= 1e-3."
+    )
+    initial_velocity_std_m_s: Real | None = Field(
+        None, gt=0, description="m/s; None: the initial error's, >= 0.01."
+    )
+    initial_position_std_m: Real | None = Field(
+        None, gt=0, description="m; None: the initial error's, >= 0.01."
+    )
+    initial_accel_bias_std_m_s2: Real | None = Field(
+        None,
+        gt=0,
+        description="m/s^2; None: 0.01, or the IMU's bias std when the estimate starts at 0.",
+    )
+    initial_baro_bias_std_m: Real = Field(0.1, gt=0, description="Initial baro bias std, m.")
+    impact_noise: Literal["sensor", "none"] = Field(
+        "sensor",
+        description="'sensor': the IMU's impact disturbance in the gyro and accelerometer "
+        "noise after each impact the filter sees (as the ekf); 'none': not modelled.",
+    )
+    impact_threshold_g: Real = Field(
+        0.5, gt=0, description="|(f_x, f_y)| that marks an impact for the noise model, in g."
+    )
+
+
 class _NoParams(BaseModel):
     model_config = MODEL_CONFIG
 
@@ -214,13 +302,15 @@ class EstimatorContext:
     """What a packer may need besides its parameters: the run's sensors.
 
     ``imu``: :class:`~quadimpact.inputs.sensors.ResolvedImu`; ``magnetometer``
-    and ``pose_sensor``: their settings or ``None``; ``vehicle``.
+    and ``pose_sensor``: their settings or ``None``; ``vehicle``;
+    ``instruments``: the sensor components' settings, by name.
     """
 
     imu: Any
     magnetometer: Any = None
     pose_sensor: Any = None
     vehicle: Any = None
+    instruments: Mapping[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -258,7 +348,7 @@ def _empty(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     return np.zeros(L.NECFG)
 
 
-BUILTIN = ("ideal", "complementary", "ekf", "ekf-additive")
+BUILTIN = ("ideal", "complementary", "ekf", "ekf-additive", "nav-ekf")
 _REGISTRY: Registry[EstimatorEntry] = Registry(
     "estimator",
     BUILTIN,
@@ -351,4 +441,10 @@ register_estimator(
     kind=L.EST_EKF_ADDITIVE,
     params=AdditiveEkfParams,
     description="the authors' 7-state EKF on an additive quaternion (their 2016 study)",
+)
+register_estimator(
+    "nav-ekf",
+    kind=L.EST_NAV_EKF,
+    params=NavEkfParams,
+    description="navigation EKF: attitude, velocity, position, IMU biases; baro, range, flow",
 )

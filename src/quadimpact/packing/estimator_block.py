@@ -44,6 +44,7 @@ from quadimpact.inputs.estimators import (
     EkfParams,
     EstimatorContext,
     EstimatorParams,
+    NavEkfParams,
     estimator_entry,
     settings_text,
 )
@@ -167,6 +168,69 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     return e
 
 
+def _pack_impact(p: Any, ctx: EstimatorContext, e: np.ndarray) -> None:
+    """The IMU's impact disturbance as the filter models it (the ``ekf``'s and ``nav-ekf``'s)."""
+    dist = ctx.imu.impact_disturbance
+    if p.impact_noise == "sensor" and dist is not None:
+        e[L.EC_IMPACT_W] = dist.gyro_rad_s
+        e[L.EC_IMPACT_F] = dist.accel_m_s2
+        e[L.EC_IMPACT_TAU] = dist.time_constant_s
+        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
+        g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
+        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
+
+
+BARO_NOISE_FLOOR = 0.01  # m
+BARO_WALK_FLOOR = 1e-4  # m/sqrt(s)
+ACCEL_BIAS_STD_FLOOR = 0.01  # m/s^2
+
+
+def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
+    p: NavEkfParams = params  # type: ignore[assignment]
+    imu = ctx.imu
+    mag = ctx.magnetometer
+    baro = ctx.instruments.get("barometer")
+    e = np.zeros(L.NECFG)
+    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
+    e[L.EC_SIG_WALK] = _or(
+        p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
+    )
+    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
+    e[L.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
+    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
+    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
+    e[L.EC_GATE] = p.gate_m_s2
+    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
+    e[L.EC_DEWEIGHT] = p.deweight
+    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
+    e[L.EC_NAV_BARO] = _or(p.barometer_noise_m, baro.noise_m if baro else 0.0, BARO_NOISE_FLOOR)
+    e[L.EC_NAV_BARO + 1] = _or(
+        p.barometer_bias_walk_m_sqrt_s, baro.bias_walk_m_sqrt_s if baro else 0.0, BARO_WALK_FLOOR
+    )
+    e[L.EC_NAV_RANGE] = p.range_noise_floor_m
+    e[L.EC_NAV_FLOW] = p.flow_noise_floor_rad_s
+    e[L.EC_NAV_GATES : L.EC_NAV_GATES + 4] = (
+        p.mag_gate_sigma,
+        p.baro_gate_sigma,
+        p.range_gate_sigma,
+        p.flow_gate_sigma,
+    )
+    e[L.EC_NAV_REACQUIRE] = p.reacquire_after_s
+    e[L.EC_NAV_MAX_TILT] = math.cos(math.radians(p.max_tilt_deg))
+    e[L.EC_NAV_MIN_HEIGHT] = p.min_flow_height_m
+    e[L.EC_P0] = math.radians(
+        _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
+    )
+    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
+    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
+    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
+    acc0 = imu.accel_bias_m_s2 if p.initial_bias == "zero" else 0.0
+    e[L.EC_NAV_P0] = _or(p.initial_accel_bias_std_m_s2, acc0, ACCEL_BIAS_STD_FLOOR)
+    e[L.EC_NAV_P0 + 1] = p.initial_baro_bias_std_m
+    _pack_impact(p, ctx, e)
+    return e
+
+
 def _zeros(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     return np.zeros(L.NECFG)
 
@@ -176,6 +240,7 @@ BUILTIN_PACKERS = {
     L.EST_COMPLEMENTARY: _pack_complementary,
     L.EST_EKF: _pack_ekf,
     L.EST_EKF_ADDITIVE: _pack_additive,
+    L.EST_NAV_EKF: _pack_nav_ekf,
 }
 
 
@@ -266,7 +331,13 @@ def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) ->
     mag, pose = s.magnetometer, s.pose_sensor
     entry = estimator_entry(s.estimator)
     params = s.resolved_estimator_params()
-    context = EstimatorContext(imu=imu, magnetometer=mag, pose_sensor=pose, vehicle=vehicle)
+    context = EstimatorContext(
+        imu=imu,
+        magnetometer=mag,
+        pose_sensor=pose,
+        vehicle=vehicle,
+        instruments=dict(getattr(s, "instruments", None) or {}),
+    )
     pack = entry.pack if entry.pack is not None else BUILTIN_PACKERS.get(entry.kind, _zeros)
     ecfg = np.array(pack(params, context), dtype=float)
     if ecfg.shape != (L.NECFG,):

@@ -16,6 +16,8 @@ The estimator is chosen by ``ecfg[EC_KIND]`` (``EST_*``):
 * ``ekf`` (``ekf.py``): a multiplicative error-state Kalman filter;
 * ``ekf-additive`` (``ekf_additive.py``): the authors' 7-state EKF on an
   additive quaternion;
+* ``nav-ekf`` (``nav_ekf.py``): the navigation filter, 16 error states,
+  fusing the magnetometer, barometer, rangefinder and optical flow;
 * a plug-in (``EST_USER``): a compiled step bound in place of
   :func:`plugin_estimator` by ``core.kernel.make_kernel(estimator=...)``.
 
@@ -41,6 +43,7 @@ from quadimpact.core.estimators.complementary import complementary_sample
 from quadimpact.core.estimators.ekf import ekf_init, ekf_sample
 from quadimpact.core.estimators.ekf_additive import additive_init, additive_sample
 from quadimpact.core.estimators.estimate_errors import record_estimate
+from quadimpact.core.estimators.nav_ekf import nav_ekf_sample, nav_init
 from quadimpact.core.layout import (
     EC_INIT_ATT,
     EC_INIT_BIAS,
@@ -62,6 +65,7 @@ from quadimpact.core.layout import (
     EST_EKF,
     EST_EKF_ADDITIVE,
     EST_IDEAL,
+    EST_NAV_EKF,
     MS_BIAS_HAT,
     MS_IMU_W,
     MS_W_HAT,
@@ -145,6 +149,8 @@ def init_estimate(m: Model, d: Data) -> None:
         ekf_init(m, d)
     elif int(e[EC_KIND]) == EST_EKF_ADDITIVE:
         additive_init(m, d)
+    elif int(e[EC_KIND]) == EST_NAV_EKF:
+        nav_init(m, d)
 
 
 @compiled
@@ -184,6 +190,8 @@ def estimate_sample(
         ekf_sample(t, dt, m, d, w.C_hat)
     elif kind == EST_EKF_ADDITIVE:
         additive_sample(t, dt, m, d, w.C_hat)
+    elif kind == EST_NAV_EKF:
+        nav_ekf_sample(t, dt, m, d, w.C_hat)
     else:
         plugin_estimator(t, dt, d.meas, m.ecfg, est)
     if kind != EST_IDEAL:

@@ -53,7 +53,7 @@ __all__ = [
 KINDS = ("controller", "estimator", "policy")
 #: The controllers the cached kernel runs (any other is a plug-in, compiled per process).
 BUILTIN_CONTROLLERS = ("paper", "cascade-pid", "recovery")
-BUILTIN_ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive")
+BUILTIN_ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive", "nav-ekf")
 
 _POLICIES: dict[str, Callable[[], dict[str, Any]]] = {}
 

@@ -32,6 +32,6 @@ IMUS = ("ideal", "noisy", "impact", "authors-2016")
 #: Presets of sensors (``quadimpact.inputs.sensors.SENSOR_PRESETS``).
 SENSORS = ("ideal", "noisy", "impact", "indoor", "onboard", "authors-2016")
 #: Built-in state estimators (``quadimpact.inputs.estimators``; a registered one is accepted too).
-ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive")
+ESTIMATORS = ("ideal", "complementary", "ekf", "ekf-additive", "nav-ekf")
 #: Pre-impact behaviours of the recovery controller in the study.
 PRE_IMPACTS = ("spin-down", "hold")
