@@ -204,7 +204,10 @@ def test_a_smoke_run_writes_every_output_with_the_suite_version(smoke):
     assert set(t["suite_version"].astype(str)) == {SUITE_VERSION}
     computed = t[t["source"] != "published"]
     # every row, task and sensor set; the subject is the default law, so no second "default"
-    assert len(computed) == len(REFERENCES) * 2 * 2
+    from quadimpact.studies.benchmark.suite import suite
+
+    assert len(computed) == len(REFERENCES) * 2 * len(suite(SUITE_VERSION).sensor_sets)
+    assert set(computed["sensors"]) == {"ideal", "lab", "onboard"}
     assert set(computed["row"]) == {r.name for r in REFERENCES}
     published = t[t["source"] == "published"]
     assert sorted(published["published_success"]) == sorted(p.share for p in PUBLISHED)
