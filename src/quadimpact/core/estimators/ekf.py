@@ -192,6 +192,34 @@ def _with_impact(sigma: float, amplitude: float, factor: float, replace: bool) -
 
 
 @compiled
+def gravity_variance(
+    f: np.ndarray, g: float, ecfg: np.ndarray, est: np.ndarray, impact: float
+) -> tuple[bool, float]:
+    """Whether to fuse the specific force ``f`` (m/s^2) as gravity, and its noise variance.
+
+    The variance is ``EC_SIG_GRAV^2``, plus the impact disturbance's share at
+    ``impact`` (per unit amplitude). While ``||f| - g| > EC_GATE`` the sample
+    is skipped (``GATE_SKIP``) or its variance multiplied by
+    ``EC_DEWEIGHT (excess / gate)^2`` (``GATE_DEWEIGHT``); ``est[ES_GATED]``
+    records whether the gate was crossed. The ``ekf`` and ``nav-ekf`` share it.
+    """
+    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
+    excess = abs(fn - g)
+    gate = ecfg[EC_GATE]
+    r = ecfg[EC_SIG_GRAV] ** 2
+    if impact > 0.0:
+        sa = ecfg[EC_SIG_ACC]
+        extra = _with_impact(sa, ecfg[EC_IMPACT_F], impact, ecfg[EC_IMPACT_REPLACE] > 0.5)
+        r += extra * extra - sa * sa
+    use = excess <= gate
+    if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
+        use = True
+        r *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
+    est[ES_GATED] = 0.0 if excess <= gate else 1.0
+    return use, r
+
+
+@compiled
 def impact_noise_factor(t: float, f: np.ndarray, ecfg: np.ndarray, est: np.ndarray) -> float:
     """The IMU's impact disturbance at the sample ``t`` (s) per unit amplitude, as the
     filter sees it: 0 unless modelled (``EC_IMPACT_TAU``) and an impact seen, else
@@ -291,19 +319,7 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     H = W[4]
     y = H[3, :3]  # the innovation, in H's fourth row
     # accelerometer: gravity
-    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
-    excess = abs(fn - g)
-    gate = ecfg[EC_GATE]
-    r = ecfg[EC_SIG_GRAV] ** 2
-    if impact > 0.0:
-        sa = ecfg[EC_SIG_ACC]
-        extra = _with_impact(sa, ecfg[EC_IMPACT_F], impact, ecfg[EC_IMPACT_REPLACE] > 0.5)
-        r += extra * extra - sa * sa
-    use = excess <= gate
-    if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
-        use = True
-        r *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
-    est[ES_GATED] = 0.0 if excess <= gate else 1.0
+    use, r = gravity_variance(f, g, ecfg, est, impact)
     if use:
         for k in range(3):
             y[k] = f[k] + g * C[2, k]

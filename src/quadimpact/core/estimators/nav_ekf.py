@@ -67,12 +67,9 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.estimators.ekf import _with_impact, impact_noise_factor
+from quadimpact.core.estimators.ekf import _with_impact, gravity_variance, impact_noise_factor
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.layout import (
-    EC_DEWEIGHT,
-    EC_GATE,
-    EC_GATE_MODE,
     EC_IMPACT_F,
     EC_IMPACT_REPLACE,
     EC_IMPACT_W,
@@ -88,14 +85,12 @@ from quadimpact.core.layout import (
     EC_NAV_REACQUIRE,
     EC_P0,
     EC_SIG_ACC,
-    EC_SIG_GRAV,
     EC_SIG_GYRO,
     EC_SIG_MAG,
     EC_SIG_WALK,
     ES_ACC_BIAS,
     ES_BARO_BIAS,
     ES_BIAS,
-    ES_GATED,
     ES_NAV_COUNT,
     ES_NAV_FUSED_T,
     ES_NAV_NIS,
@@ -108,7 +103,6 @@ from quadimpact.core.layout import (
     ES_SCRATCH,
     ES_VEL,
     ES_W,
-    GATE_DEWEIGHT,
     MS_IMU_F,
     MS_IMU_W,
     MS_MAG,
@@ -482,19 +476,7 @@ def _gravity(est: np.ndarray, P: np.ndarray, W: np.ndarray, ecfg: np.ndarray, f:
 
     ``H_theta = -g [u x]`` (``u = C^T e_Z``), ``H_ba = I``.
     """
-    fn = math.sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2])
-    excess = abs(fn - g)
-    gate = ecfg[EC_GATE]
-    rg = ecfg[EC_SIG_GRAV] ** 2
-    if impact > 0.0:
-        sa = ecfg[EC_SIG_ACC]
-        extra = _with_impact(sa, ecfg[EC_IMPACT_F], impact, ecfg[EC_IMPACT_REPLACE] > 0.5)
-        rg += extra * extra - sa * sa
-    use = excess <= gate
-    if not use and int(ecfg[EC_GATE_MODE]) == GATE_DEWEIGHT and gate > 0.0:
-        use = True
-        rg *= max(1.0, ecfg[EC_DEWEIGHT] * (excess / gate) ** 2)
-    est[ES_GATED] = 0.0 if excess <= gate else 1.0
+    use, rg = gravity_variance(f, g, ecfg, est, impact)
     if not use:
         return
     H, y, r = W[0:4], W[4, 0:3], W[4, 3:6]

@@ -31,7 +31,13 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import X_POS
-from quadimpact.core.sensors.component import PackContext, SensorComponent, Slot, offsets
+from quadimpact.core.sensors.component import (
+    PackContext,
+    SensorComponent,
+    Slot,
+    offsets,
+    sample_due,
+)
 
 __all__ = ["SENSOR", "BarometerSettings"]
 
@@ -116,11 +122,10 @@ def sample(
         return
     rate = cfg[C_RATE]
     n = st[S_N]
-    if n == 0.0:
-        st[S_T0] = t
-        st[S_BIAS] = cfg[C_OFFSET]
-    elif t < st[S_T0] + n / rate - 1e-12:
+    if not sample_due(t, st, S_T0, S_N, rate):
         return
+    if n == 0.0:
+        st[S_BIAS] = cfg[C_OFFSET]
     h = -x[X_POS + 2]
     white = 0.0
     if noise.shape[0] > 0:

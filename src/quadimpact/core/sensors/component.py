@@ -34,7 +34,7 @@ when the run has none left); ``rec`` its columns of this sample's IMU row
 or not the run has the sensor: a sensor that is off (its config block all
 zeros, as when a scenario does not name it) must return at once. A sensor
 slower than the IMU keeps its own schedule in its state and samples at the
-first IMU sample at or after each of its times.
+first IMU sample at or after each of its times (:func:`sample_due`).
 """
 
 from __future__ import annotations
@@ -43,7 +43,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-__all__ = ["Slot", "SensorComponent", "offsets"]
+import numpy as np
+
+from quadimpact.core.compiled import compiled
+
+__all__ = ["PackContext", "SensorComponent", "Slot", "offsets", "sample_due", "size"]
 
 
 @dataclass(frozen=True)
@@ -127,6 +131,21 @@ class SensorComponent:
             else:
                 out += [(f"{self.name}_{s.name}_{k}", s.unit) for k in range(s.width)]
         return out
+
+
+@compiled
+def sample_due(t: float, st: np.ndarray, t0_slot: int, n_slot: int, rate: float) -> bool:
+    """Whether a sensor of ``rate`` (Hz) samples at the IMU sample ``t`` (s).
+
+    It samples at its first call (whose time it records in ``st[t0_slot]``)
+    and then at the first IMU sample at or after each ``t0 + n / rate``, with
+    ``n = st[n_slot]`` its samples so far (the caller counts them).
+    """
+    n = st[n_slot]
+    if n == 0.0:
+        st[t0_slot] = t
+        return True
+    return t >= st[t0_slot] + n / rate - 1e-12
 
 
 @dataclass(frozen=True)

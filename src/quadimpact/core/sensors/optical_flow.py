@@ -38,7 +38,13 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import X_OMEGA, X_POS, X_VEL
-from quadimpact.core.sensors.component import PackContext, SensorComponent, Slot, offsets
+from quadimpact.core.sensors.component import (
+    PackContext,
+    SensorComponent,
+    Slot,
+    offsets,
+    sample_due,
+)
 
 __all__ = ["SENSOR", "OpticalFlowSettings"]
 
@@ -181,9 +187,7 @@ def sample(
     if cfg[C_ON] < 0.5:
         return
     n = st[S_N]
-    if n == 0.0:
-        st[S_T0] = t
-    elif t < st[S_T0] + n / cfg[C_RATE] - 1e-12:
+    if not sample_due(t, st, S_T0, S_N, cfg[C_RATE]):
         return
     fx, fy, q = image(x, xdot, C, cfg)
     k = int(n) % RING

@@ -34,7 +34,13 @@ from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import X_POS
-from quadimpact.core.sensors.component import PackContext, SensorComponent, Slot, offsets
+from quadimpact.core.sensors.component import (
+    PackContext,
+    SensorComponent,
+    Slot,
+    offsets,
+    sample_due,
+)
 
 __all__ = ["PRESETS", "SENSOR", "RangefinderSettings"]
 
@@ -170,9 +176,7 @@ def sample(
     if cfg[C_ON] < 0.5:
         return
     n = st[S_N]
-    if n == 0.0:
-        st[S_T0] = t
-    elif t < st[S_T0] + n / cfg[C_RATE] - 1e-12:
+    if not sample_due(t, st, S_T0, S_N, cfg[C_RATE]):
         return
     st[S_N] = n + 1.0
     meas[M_T] = t
