@@ -157,14 +157,7 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
     e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
     e[L.EC_NAV] = 1.0 if pose is not None else 0.0
-    dist = imu.impact_disturbance
-    if p.impact_noise == "sensor" and dist is not None:
-        e[L.EC_IMPACT_W] = dist.gyro_rad_s
-        e[L.EC_IMPACT_F] = dist.accel_m_s2
-        e[L.EC_IMPACT_TAU] = dist.time_constant_s
-        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
-        g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
-        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
+    _pack_impact(p, ctx, e)
     return e
 
 
