@@ -19,6 +19,12 @@ Fly it::
 
 A run naming a plug-in sensor compiles a loop of its own around it (once per
 process). Its noise is drawn from the run's seed, on a stream of its own.
+
+Studies and the benchmark name presets of sensors: this file registers
+``variometer-impact`` (the impact IMU and the variometer), so that::
+
+    quadimpact recovery --plugin sensor_template.py --sensors variometer-impact ...
+    quadimpact benchmark --quick --plugin sensor_template.py --sensors ideal,variometer-impact
 """
 
 from __future__ import annotations
@@ -29,6 +35,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from quadimpact.core.layout import X_QUAT, X_VEL
 from quadimpact.core.sensors.component import SensorComponent, Slot, offsets
 from quadimpact.core.sensors.registry import register_sensor
+from quadimpact.inputs.sensors import register_sensor_preset
 
 
 class VariometerSettings(BaseModel):
@@ -86,3 +93,5 @@ SENSOR = SensorComponent(
     doc="climb rate with white noise",
 )
 register_sensor(SENSOR)
+# a preset of sensors that holds it, for the studies and the benchmark (after the sensor)
+register_sensor_preset("variometer-impact", {"imu": "impact", "instruments": {"variometer": {}}})

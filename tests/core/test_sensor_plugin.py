@@ -51,3 +51,19 @@ def test_plugin_variometer_measures_the_climb_rate():
         scenario_from_dict({**base, "seed": 5, "instruments": {"variometer": {"noise_m_s": sigma}}})
     )
     assert np.array_equal(noisy.imu["variometer_climb_m_s"], again.imu["variometer_climb_m_s"])
+
+
+def test_plugin_preset_of_the_variometer_flies_in_a_study_and_the_benchmark(tmp_path):
+    """The template's preset (impact IMU + variometer) names the plug-in in a study."""
+    from quadimpact.studies.benchmark.benchmark_study import BenchmarkStudy, run_benchmark
+    from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
+
+    _load()
+    base = RecoveryStudy(n=2, sensors="variometer-impact", estimator="ekf").sweep_spec().base
+    assert "variometer" in base.instruments and base.imu.preset == "impact"
+    study = BenchmarkStudy(
+        tasks=("wall",), sensors=("variometer-impact",), references=False, limit=2
+    )
+    result = run_benchmark(study, tmp_path / "bench", workers=1, cache=tmp_path / "cache")
+    cells = [c for c in result.cells if c["sensors"] == "variometer-impact"]
+    assert len(cells) == 1 and cells[0]["source"] == "run" and cells[0]["trials"] == 2

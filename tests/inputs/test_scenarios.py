@@ -41,7 +41,7 @@ REPLICA_SWITCHES = {
     "detection_tick_reference": "tilt-away",
     "contact_gate_m": 0.0,
     "pre_impact": "scenario",
-    "recovery_law": "default",
+    "recovery_law": "classic",
     "cut_step_motors": (),
     "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
 }
@@ -52,10 +52,10 @@ RECOVERY_REPLICA_SWITCHES = {
     "detection_tick_reference": "level",
     "contact_gate_m": 0.30,
     "pre_impact": "spin-down",
-    "recovery_law": "default",  # the law that was the default's before issue #45, classic
+    "recovery_law": "classic",  # the law that was the default before issue #45
 }
 # the previous default model: the default physics with the law it had before issue #45
-CLASSIC_SWITCHES = {**DEFAULT_SWITCHES, "recovery_law": "default"}
+CLASSIC_SWITCHES = {**DEFAULT_SWITCHES, "recovery_law": "classic"}
 # the pole replica: the default physics, the retuned staged law and held rotors
 # (docs/VARIANTS.md 8)
 POLE_REPLICA_SWITCHES = {
@@ -351,3 +351,15 @@ def test_missing_scenario_file(tmp_path: Path) -> None:
     missing = tmp_path / "missing.toml"
     with pytest.raises(InputError, match="missing.toml: file not found"):
         load_scenario_file(missing)
+
+
+def test_the_classic_law_is_named_classic_and_its_old_name_still_reads():
+    """The law named ``"default"`` before issue #45 is not the default model's: it is
+    ``"classic"`` now, and a file of then that names it ``"default"`` gets the same law."""
+    from quadimpact.inputs.scenarios import scenario_from_dict
+
+    old = scenario_from_dict({"kind": "impact-trial", "model_options": {"recovery_law": "default"}})
+    new = scenario_from_dict({"kind": "impact-trial", "model_options": {"recovery_law": "classic"}})
+    assert old.resolved_model_options().recovery_law == "classic"
+    assert old.resolved_controller_params() == new.resolved_controller_params()
+    assert ModelOptions(recovery_law="default").recovery_law == "classic"

@@ -80,10 +80,12 @@ def test_the_variant_is_the_default_model_with_the_pole_law_and_hold():
     assert differ == {"pre_impact", "recovery_law"}
     assert (pole["pre_impact"], pole["recovery_law"]) == ("hold", "pole-replica")
     # the replicas and the classic variant keep the law that was the default before the
-    # benchmark (issue #45: the switch's value "default" then), the default model the new one
+    # benchmark (issue #45: the switch's value "default" then, "classic" now), the default
+    # model the new one
     laws = {k: v["recovery_law"] for k, v in MODEL_VARIANTS.items() if k != "pole-replica"}
-    assert laws.pop("default") == "lean-cut" and set(laws.values()) == {"default"}
-    assert RECOVERY_LAWS["default"] == CLASSIC_LAW and RECOVERY_LAWS["lean-cut"] == {}
+    assert laws.pop("default") == "lean-cut" and set(laws.values()) == {"classic"}
+    assert RECOVERY_LAWS["classic"] == CLASSIC_LAW and RECOVERY_LAWS["lean-cut"] == {}
+    assert "default" not in RECOVERY_LAWS  # no law is named after a model it is not
     # the pole law is the classic law with the table's values
     assert (
         RECOVERY_LAWS["pole-replica"].items()

@@ -22,7 +22,7 @@ def test_the_replica_is_this_set_of_switches():
     default = MODEL_VARIANTS["default"]
     differ = {k for k in default if default[k] != rep[k]}
     # and the staged law the default had before the benchmark (issue #45), the classic law
-    assert rep["recovery_law"] == MODEL_VARIANTS["classic"]["recovery_law"] == "default"
+    assert rep["recovery_law"] == MODEL_VARIANTS["classic"]["recovery_law"] == "classic"
     differ.discard("recovery_law")
     assert differ == {"yaw_reaction", "detection_tick_reference", "contact_gate_m", "pre_impact"}
     assert rep["spinup_reaction"] == "physical"  # the recovery code had the spin sign

@@ -69,7 +69,7 @@ def test_the_world_holds_the_whole_scenario_resolved(flight_result) -> None:
     assert r["model_options"] == options.model_dump(mode="json")  # tuples as JSON lists
     assert None not in r["model_options"].values() and r["model_options"]["contact_gate_m"] == 0
     assert r["controller"] == "recovery"
-    # the replica flies the classic law (its recovery_law switch, "default")
+    # the replica flies the classic law (its recovery_law switch, "classic")
     law = recovery_law_params(options.recovery_law, {"k_att_1_s": 15.0})
     assert r["controller_params"] == RecoveryParams(**law).model_dump(mode="json")
     assert set(r["controller_params"]) == set(RecoveryParams.model_fields)

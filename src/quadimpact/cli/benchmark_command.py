@@ -7,7 +7,13 @@ from typing import Any
 
 import click
 
-from quadimpact.cli.options import allow_large_option, out_option, parallel_options, stoppable
+from quadimpact.cli.options import (
+    allow_large_option,
+    out_option,
+    parallel_options,
+    plugin_option,
+    stoppable,
+)
 from quadimpact.errors import InputError
 
 __all__ = ["benchmark", "subject_from_options"]
@@ -126,11 +132,6 @@ def subject_from_options(
     "own; or a policy registered with quadimpact.studies.benchmark.subject.register_policy.",
 )  # fmt: skip
 @click.option(
-    "--plugin", "plugins", multiple=True, metavar="FILE.py|MODULE",
-    help="Import this file or module first (repeatable): it registers a controller or an "
-    "estimator, in this process and in the sweeps' worker processes.",
-)  # fmt: skip
-@click.option(
     "--suite", "suite_version", default=None, metavar="VERSION",
     help="The suite's version: 3 (the default: success is a held hover, sensor sets ideal, "
     "lab and onboard), 2 (the same without onboard) or 1 (the published criteria, sensor "
@@ -155,6 +156,7 @@ def subject_from_options(
 @click.option("--no-cache", is_flag=True, help="Neither read nor keep cached cells.")
 @allow_large_option
 @parallel_options
+@plugin_option
 def benchmark(
     out: Path,
     quick: bool,
@@ -164,7 +166,6 @@ def benchmark(
     params: tuple[str, ...],
     estimator: str | None,
     policy: str | None,
-    plugins: tuple[str, ...],
     suite_version: str | None,
     sensors: str | None,
     name: str | None,
@@ -214,11 +215,6 @@ def benchmark(
         raise InputError("--workers and --scheduler: give one or the other")
     if cache is not None and no_cache:
         raise InputError("--cache and --no-cache: give one or the other")
-    from quadimpact.inputs.plugins import add_to_env, load_plugin
-
-    for ref in plugins:  # before anything names what they register
-        load_plugin(ref)
-        add_to_env(ref)
     from quadimpact.cli.run_command import _parse_options
     from quadimpact.studies.benchmark.benchmark_study import (
         BenchmarkStudy,

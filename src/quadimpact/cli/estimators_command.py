@@ -13,6 +13,7 @@ from quadimpact.cli.options import (
     allow_large_option,
     out_option,
     parallel_options,
+    plugin_option,
     stoppable,
 )
 
@@ -72,6 +73,7 @@ _SWITCHES = ("flight", "gain", "rate", "impact_noise", "in_loop", "initial_error
 )  # fmt: skip
 @allow_large_option
 @parallel_options
+@plugin_option
 def estimators(
     out: Path,
     scenario: str,

@@ -27,7 +27,8 @@ def allow_large_option(command: Callable[..., Any]) -> Callable[..., Any]:
 
 SENSORS_HELP = (
     "A preset of sensors: impact = the noisy IMU with the impact disturbance and a gyro bias "
-    "walk; indoor = impact + magnetometer + pose sensor."
+    "walk; indoor = impact + magnetometer + pose sensor; onboard = impact + magnetometer, "
+    "barometer, rangefinder, optical flow; or a preset a plug-in registers (--plugin)."
 )
 
 
@@ -36,13 +37,46 @@ def sensing_options(estimator_help: str, sensors_help: str = SENSORS_HELP) -> De
     (the studies' presets of sensors); both default to None (not given)."""
     from quadimpact.studies.recovery import ESTIMATORS, SENSORS
 
+    # a name, checked by the study once the plug-ins (--plugin) have registered theirs
     def add(command: Callable[..., Any]) -> Callable[..., Any]:
-        command = click.option("--sensors", type=click.Choice(SENSORS), help=sensors_help)(command)
+        command = click.option("--sensors", metavar="|".join(SENSORS), help=sensors_help)(command)
         return click.option("--estimator", metavar="|".join(ESTIMATORS), help=estimator_help)(
             command
         )
 
     return add
+
+
+def plugin_option(command: Callable[..., Any]) -> Callable[..., Any]:
+    """Add ``--plugin FILE.py|MODULE`` (repeatable), imported before the command runs.
+
+    A plug-in registers controllers, estimators, sensor components, presets of
+    sensors or obstacle shapes (docs/howto). Each is imported in this process
+    and named in ``QUADIMPACT_PLUGINS`` so that the worker processes of the
+    command's sweeps import it too. A file that is missing or raises on import
+    is refused in one line (exit status 2).
+    """
+
+    @functools.wraps(command)
+    def loaded(*args: Any, **kwargs: Any) -> Any:
+        refs = kwargs.pop("plugins", ()) or ()
+        if refs:
+            from quadimpact.inputs.plugins import add_to_env, load_plugin
+
+            for ref in refs:  # before anything names what they register
+                load_plugin(ref)
+                add_to_env(ref)
+        return command(*args, **kwargs)
+
+    return click.option(
+        "--plugin",
+        "plugins",
+        multiple=True,
+        metavar="FILE.py|MODULE",
+        help="Import this file or module first (repeatable): what it registers (a controller, "
+        "an estimator, a sensor, a preset of sensors, an obstacle shape) can then be named, "
+        "in this process and in the sweeps' worker processes.",
+    )(loaded)
 
 
 def policy_option(command: Callable[..., Any]) -> Callable[..., Any]:

@@ -13,6 +13,7 @@ from quadimpact.cli.options import (
     allow_large_option,
     out_option,
     parallel_options,
+    plugin_option,
     policy_option,
     sensing_options,
     stoppable,
@@ -84,6 +85,7 @@ __all__ = ["pole"]
 )  # fmt: skip
 @allow_large_option
 @parallel_options
+@plugin_option
 def pole(
     out: Path,
     vehicle: str,

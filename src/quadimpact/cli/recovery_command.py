@@ -16,6 +16,7 @@ from quadimpact.cli.options import (
     allow_large_option,
     out_option,
     parallel_options,
+    plugin_option,
     policy_option,
     sensing_options,
     stoppable,
@@ -81,6 +82,7 @@ _STUDY_OPTIONS = (
 )  # fmt: skip
 @allow_large_option
 @parallel_options
+@plugin_option
 def recovery(
     out: Path,
     vehicle: str | None,

@@ -16,6 +16,7 @@ from quadimpact.cli.options import (
     max_record_option,
     number_option,
     out_option,
+    plugin_option,
 )
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
@@ -220,6 +221,7 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     help="Also write the pictures: snapshots.png/.pdf, animation.mp4 and viewer.html "
     "(as 'quadimpact snapshots', 'animate' and 'view' do).",
 )
+@plugin_option
 def run(
     scenario: Path | None,
     out: Path,

@@ -16,6 +16,7 @@ from quadimpact.cli.options import (
     file_argument,
     max_record_option,
     parallel_options,
+    plugin_option,
     stoppable,
 )
 from quadimpact.errors import InputError
@@ -81,6 +82,7 @@ def _parse_grid(options: tuple[str, ...]) -> dict[str, list]:
     "it is refused before any starts."
 )
 @click.option("--no-plots", is_flag=True, help="Do not write plots/.")
+@plugin_option
 def sweep(
     sweep_file: Path | None,
     grid: tuple[str, ...],

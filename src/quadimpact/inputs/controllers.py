@@ -112,7 +112,7 @@ class RecoveryParams(BaseModel):
     docs/BENCHMARK.md 4): a push of 4.8 m/s^2 away from the contact, stage 1's
     rate test at 1 rad/s, a vertical-velocity gain of 2.5 1/s in stages 1 and 2
     and the lean cut at 40 deg with g/4 of push; the law before it is the
-    ``recovery_law = "default"`` tuning (:data:`quadimpact.inputs.model.CLASSIC_LAW`,
+    ``recovery_law = "classic"`` tuning (:data:`quadimpact.inputs.model.CLASSIC_LAW`,
     model variant ``classic``). The pre-impact behaviour and the nominal
     controller are scenario fields (``pre_impact``, ``nominal_controller``).
     """

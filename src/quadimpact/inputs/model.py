@@ -94,14 +94,15 @@ class ModelOptions(BaseModel):
         replica): always spin-down, as in the authors' Monte Carlo code.
         ``"hold"`` (pole replica): always hold, the rotor speeds at their
         trimmed values until the detection.
-    recovery_law : {"lean-cut", "default", "pole-replica"} or None
+    recovery_law : {"lean-cut", "classic", "pole-replica"} or None
         The tuning of the ``recovery`` controller's staged law: the values its
         parameters take when ``[controller_params]`` does not set them
         (:data:`RECOVERY_LAWS`). ``"lean-cut"`` (the default model, since the
         benchmark, issue #45): the controller's own defaults (docs/RECOVERY.md
-        3.5). ``"default"`` (its name from before: the ``classic`` variant and
-        both replicas): the law that was the default until then
-        (:data:`CLASSIC_LAW`). ``"pole-replica"``: the authors' pole branch
+        3.5). ``"classic"`` (the ``classic`` variant and the replicas): the law
+        that was the default until then (:data:`CLASSIC_LAW`; named
+        ``"default"`` before, a name still read as ``"classic"``).
+        ``"pole-replica"``: the authors' pole branch
         (a_mag 4.8 m/s^2, stage 1 test 0.15 and 2 rad/s, stage 2's Euler-angle
         test at 0.2 rad and 2 rad/s, stage 3 ends at w < 0.2 m/s) on the
         classic law.
@@ -156,10 +157,10 @@ class ModelOptions(BaseModel):
     pre_impact: Literal["scenario", "spin-down", "hold"] | None = Field(
         None, description="Recovery pre-impact behaviour: the scenario's, spin-down or hold."
     )
-    recovery_law: Literal["lean-cut", "default", "pole-replica"] | None = Field(
+    recovery_law: Literal["lean-cut", "classic", "pole-replica"] | None = Field(
         None,
         description="Staged recovery law's parameters not set in [controller_params]: the "
-        "default law's, the classic law's (named 'default' before issue #45), or the "
+        "default law's (lean-cut), the classic law's (named 'default' before), or the "
         "authors' pole branch's.",
     )
     cut_step_motors: tuple[int, ...] | None = Field(
@@ -170,6 +171,13 @@ class ModelOptions(BaseModel):
     bumper_force_scale: Vec4 | None = Field(
         None, description="Factor (> 0) on the contact force of bumpers 1-4."
     )
+
+    @field_validator("recovery_law", mode="before")
+    @classmethod
+    def _classic_law_old_name(cls, value: Any) -> Any:
+        # "default" was the classic law's name while it was the default (before issue #45);
+        # files written then still read, as the law they meant
+        return "classic" if value == "default" else value
 
     @field_validator("cut_step_motors")
     @classmethod
@@ -200,7 +208,7 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "tilt-away",
         "contact_gate_m": 0.0,
         "pre_impact": "scenario",
-        "recovery_law": "default",
+        "recovery_law": "classic",
         "cut_step_motors": (),
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
@@ -215,7 +223,7 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "tilt-away",
         "contact_gate_m": 0.0,
         "pre_impact": "scenario",
-        "recovery_law": "default",
+        "recovery_law": "classic",
         "cut_step_motors": (),
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
@@ -230,7 +238,7 @@ MODEL_VARIANTS: dict[str, dict[str, Any]] = {
         "detection_tick_reference": "level",
         "contact_gate_m": 0.30,
         "pre_impact": "spin-down",
-        "recovery_law": "default",
+        "recovery_law": "classic",
         "cut_step_motors": (),
         "bumper_force_scale": (1.0, 1.0, 1.0, 1.0),
     },
@@ -260,7 +268,7 @@ CLASSIC_LAW: dict[str, Any] = {
 
 RECOVERY_LAWS: dict[str, dict[str, Any]] = {
     "lean-cut": {},
-    "default": CLASSIC_LAW,
+    "classic": CLASSIC_LAW,
     "pole-replica": {
         **CLASSIC_LAW,
         "a_mag_m_s2": 4.8,
@@ -282,7 +290,7 @@ def recovery_law_params(law: str, given: Mapping[str, Any]) -> dict[str, Any]:
 
     Parameters
     ----------
-    law : {"lean-cut", "default", "pole-replica"}
+    law : {"lean-cut", "classic", "pole-replica"}
         The ``recovery_law`` switch.
     given : mapping
         The scenario's ``[controller_params]``; they win over the tuning.

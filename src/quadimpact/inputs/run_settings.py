@@ -113,8 +113,10 @@ class PowerOff(BaseModel):
 
 
 # ---------------------------------------------------------------- settings
-SensorPreset = Literal["ideal", "noisy", "impact", "indoor", "onboard", "authors-2016"]
-"""The names of :data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`."""
+SensorPreset = str
+"""A name of :data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`: a built-in preset
+("ideal", "noisy", "impact", "indoor", "onboard", "authors-2016") or a registered one
+(:func:`~quadimpact.inputs.sensors.register_sensor_preset`)."""
 
 
 class RunSettings(BaseModel):
@@ -192,10 +194,11 @@ class RunSettings(BaseModel):
         Sensor components (``core/sensors/registry.py``: the barometer, and
         any plug-in registered) by name, each with its validated settings;
         empty by default.
-    sensors : {"ideal", "noisy", "impact", "indoor", "onboard", "authors-2016"} or None
-        A preset of sensors (:data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`):
-        it sets ``imu``, ``magnetometer`` and ``pose_sensor`` where the scenario
-        does not set them itself.
+    sensors : str or None
+        A preset of sensors (:data:`~quadimpact.inputs.sensors.SENSOR_PRESETS`:
+        "ideal", "noisy", "impact", "indoor", "onboard", "authors-2016" or a
+        registered one): it sets ``imu``, ``magnetometer``, ``pose_sensor`` and
+        ``instruments`` where the scenario does not set them itself.
     estimator : str
         A registered state estimator (``quadimpact.inputs.estimators``):
         ``"ideal"`` (the true state; the default), ``"complementary"``,
@@ -340,6 +343,14 @@ class RunSettings(BaseModel):
             preset = SENSOR_PRESETS.get(value["sensors"])
             if preset is not None:
                 value = {**{k: v for k, v in preset.items() if k not in value}, **value}
+        return value
+
+    @field_validator("sensors", mode="before")
+    @classmethod
+    def _known_preset(cls, value: Any) -> Any:
+        if value is not None and (not isinstance(value, str) or value not in SENSOR_PRESETS):
+            known = ", ".join(repr(k) for k in SENSOR_PRESETS)
+            raise ValueError(f"unknown preset of sensors {value!r} (one of {known})")
         return value
 
     @field_validator("estimator")

@@ -52,12 +52,15 @@ __all__ = [
     "IMU_PRESETS",
     "SENSOR_PRESETS",
     "DetectionSettings",
+    "BUILTIN_SENSOR_PRESETS",
     "ImpactDisturbance",
     "ImuSettings",
     "Instruments",
     "Magnetometer",
     "PoseSensor",
     "ResolvedImu",
+    "register_sensor_preset",
+    "sensor_preset_names",
 ]
 
 G0 = 9.80665  # standard gravity, m/s^2 (sensor ranges are quoted in g)
@@ -189,6 +192,74 @@ SENSOR_PRESETS: dict[str, dict[str, Any]] = {
 optional sensors (``{}``: present with their defaults) and the sensor components
 (``instruments``). Fields a scenario sets itself (``imu``, ``magnetometer``,
 ``pose_sensor``, ``instruments``) win over its preset's."""
+
+#: The presets that ship with quadimpact (a registered one is a plug-in's).
+BUILTIN_SENSOR_PRESETS: tuple[str, ...] = tuple(SENSOR_PRESETS)
+_PRESET_FIELDS = ("imu", "magnetometer", "pose_sensor", "instruments")
+
+
+def register_sensor_preset(name: str, preset: Mapping[str, Any]) -> None:
+    """Register a preset of sensors of your own, by name (a plug-in's).
+
+    A scenario names it as ``sensors = "<name>"``; ``quadimpact recovery`` and
+    ``quadimpact pole`` take it as ``--sensors <name>`` and the benchmark as a
+    sensor set (``--sensors ideal,<name>``), once the module that registers it
+    is loaded (``--plugin FILE.py``). Registering the same name again replaces
+    it (a sweep's worker processes import the module again).
+
+    Parameters
+    ----------
+    name : str
+        The preset's name; not one of :data:`BUILTIN_SENSOR_PRESETS`.
+    preset : mapping
+        Its sensors, as in a scenario: ``imu`` (an IMU preset's name or a table
+        of settings), ``magnetometer`` and ``pose_sensor`` (tables; ``{}``: the
+        defaults) and ``instruments`` (sensor component name -> its settings
+        table). Components must be registered before the preset names them.
+
+    Raises
+    ------
+    InputError
+        A bad name, a field that is not a sensor, or settings the sensors refuse
+        (one line naming the preset and the field).
+    """
+    from quadimpact.errors import InputError
+
+    where = f"sensor preset {name!r}"
+    if not isinstance(name, str) or not name.strip() or name != name.strip():
+        raise InputError(f"sensor preset: the name must be a non-empty word (got {name!r})")
+    if name in BUILTIN_SENSOR_PRESETS:
+        raise InputError(f"{where}: a built-in preset has that name (choose another)")
+    if not isinstance(preset, Mapping):
+        raise InputError(f"{where}: must be a mapping of sensors (got {type(preset).__name__})")
+    for key in preset:
+        if key not in _PRESET_FIELDS:
+            raise InputError(
+                f"{where}: {key}: not a sensor field (one of {', '.join(_PRESET_FIELDS)})"
+            )
+    from pydantic import ValidationError
+
+    from quadimpact.errors import input_error_from_validation
+
+    checks = {"magnetometer": Magnetometer, "pose_sensor": PoseSensor}
+    for key, value in preset.items():  # each field checked now, so that a bad preset fails here
+        try:
+            if key == "imu":
+                ImuSettings.model_validate({"preset": value} if isinstance(value, str) else value)
+            elif key == "instruments":
+                _instruments(value)
+            elif value is not None:
+                checks[key].model_validate(value)
+        except ValidationError as exc:
+            raise input_error_from_validation(exc, where, prefix=(key,)) from None
+        except ValueError as exc:
+            raise InputError(f"{where}: {key}: {exc}") from None
+    SENSOR_PRESETS[name] = dict(preset)
+
+
+def sensor_preset_names() -> tuple[str, ...]:
+    """Every preset's name: the built-in ones, then the registered ones."""
+    return tuple(SENSOR_PRESETS)
 
 
 class ResolvedImu(BaseModel):

@@ -33,7 +33,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from quadimpact.studies.benchmark.suite import SENSOR_SET_DEFS, TASKS
+from quadimpact.studies.benchmark.suite import TASKS, sensor_set
 from quadimpact.studies.statistics import percent, rate, rate_text
 
 __all__ = ["FIGURES", "leaderboard_figure", "render_report", "write_figures"]
@@ -384,7 +384,7 @@ def render_report(
     )
     suite = study.definition
     sets = study.sensor_sets()
-    set_words = "; ".join(f"`{n}`: {SENSOR_SET_DEFS[n].title}" for n in sets)
+    set_words = "; ".join(f"`{n}`: {sensor_set(n).title}" for n in sets)
     lines = [
         f"# quadimpact benchmark: {s.name}",
         "",

@@ -25,6 +25,7 @@ and writes, in ``DIR``:
 
 from __future__ import annotations
 
+import json
 import os
 import sys
 import time
@@ -138,7 +139,15 @@ class BenchmarkStudy:
             "references": self.references,
             "subject": self.subject.describe(),
             **({"limit": self.limit} if self.limit is not None else {}),
+            **({"plugin_sensor_presets": presets} if (presets := self._plugin_presets()) else {}),
         }
+
+    def _plugin_presets(self) -> dict[str, Any]:
+        """The plug-in presets of sensors flown, with their contents (JSON-ready)."""
+        from quadimpact.inputs.sensors import SENSOR_PRESETS
+
+        names = [n for n in self.sensor_sets() if sensor_set(n).plugin]
+        return {n: json.loads(json.dumps(SENSOR_PRESETS[n], default=str)) for n in names}
 
 
 @dataclass
@@ -217,7 +226,9 @@ def run_benchmark(
                 spec = row.spec(task, study.quick, sensor_set(sensors), study.limit, version)
                 key = cell_key(spec, version)
                 label = f"{row.name} {task.name}/{sensors}"
-                cached = store.get(key) if row.cacheable else None
+                # a plug-in's sensor preset is not cached: its name does not say what it is
+                cacheable = row.cacheable and not sensor_set(sensors).plugin
+                cached = store.get(key) if cacheable else None
                 if key in done:
                     table, facts = done[key]
                     source = facts["source"]
@@ -244,7 +255,7 @@ def run_benchmark(
                         _note(f"{label}: {facts['compile_cpu_s']:.1f} s of CPU compiling the "
                               "plug-in's loop (compile_cpu_s, not in cpu_ms_per_trial)",
                               progress)  # fmt: skip
-                    if row.cacheable:
+                    if cacheable:
                         where_from = {"row": row.name, "task": task.name, "sensors": sensors}
                         store.put(key, table, {**facts, **where_from, "quick": study.quick})
                 source = facts["source"]

@@ -104,6 +104,10 @@ class SensorSet:
         The set needs its own estimator (``onboard``: a navigation filter that
         fuses its flow and range): a row keeps it unless the row names another
         than the default ``ekf``.
+    plugin : bool
+        A plug-in's preset of sensors (registered with
+        :func:`~quadimpact.inputs.sensors.register_sensor_preset`): its cells are
+        never cached, since the name alone does not say what the sensors are.
     """
 
     name: str
@@ -111,12 +115,15 @@ class SensorSet:
     estimator: str
     title: str = ""
     own_estimator: bool = False
+    plugin: bool = False
 
     def flown_with(self, estimator: str) -> SensorSet:
         """The set as a row whose estimator is ``estimator`` flies it."""
         if self.sensors is None or (self.own_estimator and estimator == DEFAULT_ESTIMATOR):
             return self
-        return SensorSet(self.name, self.sensors, estimator, self.title, self.own_estimator)
+        return SensorSet(
+            self.name, self.sensors, estimator, self.title, self.own_estimator, self.plugin
+        )
 
 
 #: Every sensor set a suite can fly, by name: a new one is an entry here (and a suite
@@ -151,12 +158,30 @@ SENSOR_SET_DEFS: dict[str, SensorSet] = {
 SENSOR_SETS = ("ideal", "impact")
 
 
+def plugin_sensor_sets() -> tuple[str, ...]:
+    """The presets of sensors plug-ins registered: each is a sensor set of its own name."""
+    from quadimpact.inputs.sensors import BUILTIN_SENSOR_PRESETS, sensor_preset_names
+
+    return tuple(
+        n
+        for n in sensor_preset_names()
+        if n not in BUILTIN_SENSOR_PRESETS and n not in SENSOR_SET_DEFS
+    )
+
+
 def sensor_set(name: str, estimator: str = DEFAULT_ESTIMATOR) -> SensorSet:
-    """The sensor set ``name`` flown with ``estimator`` (:meth:`SensorSet.flown_with`)."""
-    if name not in SENSOR_SET_DEFS:
-        known = ", ".join(repr(s) for s in SENSOR_SET_DEFS)
-        raise InputError(f"--sensors: unknown sensor set {name!r} (one of {known})")
-    return SENSOR_SET_DEFS[name].flown_with(estimator)
+    """The sensor set ``name`` flown with ``estimator`` (:meth:`SensorSet.flown_with`).
+
+    ``name`` is a built-in set (:data:`SENSOR_SET_DEFS`) or a preset of sensors a
+    plug-in registered (flown with ``estimator``, the row's: ``ekf`` by default).
+    """
+    if name in SENSOR_SET_DEFS:
+        return SENSOR_SET_DEFS[name].flown_with(estimator)
+    if name in plugin_sensor_sets():
+        title = f"the plug-in preset of sensors `{name}`, and a state estimator"
+        return SensorSet(name, name, DEFAULT_ESTIMATOR, title, plugin=True).flown_with(estimator)
+    known = ", ".join(repr(s) for s in (*SENSOR_SET_DEFS, *plugin_sensor_sets()))
+    raise InputError(f"--sensors: unknown sensor set {name!r} (one of {known})")
 
 
 @dataclass(frozen=True)
@@ -248,7 +273,9 @@ def parse_sensor_sets(text: str | None, version: str = SUITE_VERSION) -> tuple[s
     names = [part.strip() for part in text.split(",")]
     if not all(names):
         raise InputError(f"--sensors: empty sensor set name (got {text!r})")
-    allowed = (*s.sensor_sets, *s.extra_sensor_sets)
+    # a plug-in's preset flies in any suite that judges by the held hover (2 and later)
+    plugins = plugin_sensor_sets() if s.held_hover else ()
+    allowed = (*s.sensor_sets, *s.extra_sensor_sets, *plugins)
     for name in names:
         sensor_set(name)
         if name not in allowed:

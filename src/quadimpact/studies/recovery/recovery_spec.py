@@ -16,9 +16,10 @@ from quadimpact.errors import InputError, format_value
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.model import resolve_model_options
 from quadimpact.inputs.policy_file import checked_policy, record_policy
+from quadimpact.inputs.sensors import sensor_preset_names
 from quadimpact.inputs.vehicle import Vehicle, bundled_vehicles, load_vehicle
 from quadimpact.packing.constants import RPM
-from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS, SENSORS
+from quadimpact.studies.recovery import DEFAULT_N, IMUS, MODELS, PRE_IMPACTS
 
 if TYPE_CHECKING:
     from quadimpact.sweep.spec import SweepSpec
@@ -119,8 +120,10 @@ class RecoveryStudy:
         The state estimator the controller and the detector read
         (docs/ESTIMATION.md): ``"ideal"`` (the default), ``"complementary"``,
         ``"ekf"`` or a registered one.
-    sensors : {"ideal", "noisy", "impact", "indoor", "onboard", "authors-2016"} or None
-        A preset of sensors; it replaces ``imu`` (``None``: ``imu`` alone).
+    sensors : str or None
+        A preset of sensors ("ideal", "noisy", "impact", "indoor", "onboard",
+        "authors-2016" or a registered one); it replaces ``imu`` (``None``:
+        ``imu`` alone).
         The same seed gives the same trials (conditions and IMU seeds) with
         any estimator and sensors, so studies compare row by row.
     policy : str or None
@@ -164,8 +167,8 @@ class RecoveryStudy:
                 self, "pre_impact", forced if forced in PRE_IMPACTS else PRE_IMPACTS[0]
             )
         _check_choice("pre_impact", self.pre_impact, PRE_IMPACTS)
-        if self.sensors is not None:
-            _check_choice("sensors", self.sensors, SENSORS)
+        if self.sensors is not None:  # a built-in preset or a plug-in's (registered)
+            _check_choice("sensors", self.sensors, sensor_preset_names())
         estimator_entry(self.estimator)
         if not isinstance(self.vehicle, str) or not self.vehicle:
             raise InputError(f"vehicle: must be a vehicle name or file (got {self.vehicle!r})")
