@@ -80,7 +80,9 @@ from quadimpact.core.layout import (
     SH_POINT,
     SHAPE_BOX,
     SHAPE_CYLINDER,
+    X_OMEGA,
     X_POS,
+    X_VEL,
 )
 
 TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum
@@ -94,6 +96,8 @@ POLISH_ITERS = 8  # secant steps refining the branch and bound's best angle
 POLISH_STEP = 1e-6  # rad: the refinement's first secant step
 POLISH_REACH = 1e-3  # rad: how far the refinement may move the angle
 TWIN_BAND = 1e-6  # m: a second crease this close in depth shares the contact point
+BOUND_MARGIN = 1e-9  # m: added to the broad phase's depth bound (rounding of the point depths)
+RATE_MARGIN = 1e-9  # relative: added to its rate bound
 
 Ring = tuple[float, float, float, float, float, float, float, float, float, float]
 """(cx, cy, cz, ax, ay, az, bx, by, bz, R): centre, two orthonormal in-plane axes, radius."""
@@ -729,3 +733,37 @@ def ring_solid(
             my += w * (ny - my)
             mz += w * (nz - mz)
     return material_record(x, C, g, px - x[X_POS], py - x[X_POS + 1], pz - x[X_POS + 2], mx, my, mz)
+
+
+@compiled
+def ring_solid_bound(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> tuple[float, float]:
+    """Certified bounds on ring ``f``'s record against the cylinder or box ``s``: the broad phase.
+
+    Every point of the circle lies within ``R`` of its centre ``c`` and the
+    solid's point depth is 1-Lipschitz, so the depth :func:`ring_solid`
+    returns (the depth of a point of the circle) is at most ``g(c) + R``;
+    its rate ``-v_P . n`` (``|n| <= 1``) is at most the largest speed of a
+    point of the ring, ``|v| + |omega| (|c_b| + R)``. Returns ``(depth bound
+    (m), rate bound (m/s))``, each with a margin for rounding
+    (:data:`BOUND_MARGIN`, :data:`RATE_MARGIN`): one point depth, against
+    :func:`ring_solid`'s three to six and its contact point's velocity.
+    """
+    cb0 = feat[f, F_CENTRE]
+    cb1 = feat[f, F_CENTRE + 1]
+    cb2 = feat[f, F_CENTRE + 2]
+    cx = x[X_POS] + C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
+    cy = x[X_POS + 1] + C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
+    cz = x[X_POS + 2] + C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    r = feat[f, F_RADIUS]
+    g = solid_depth(cx, cy, cz, shapes, s)[0]
+    u = x[X_VEL]
+    v = x[X_VEL + 1]
+    w = x[X_VEL + 2]
+    p = x[X_OMEGA]
+    q = x[X_OMEGA + 1]
+    rr = x[X_OMEGA + 2]
+    reach = math.sqrt(cb0 * cb0 + cb1 * cb1 + cb2 * cb2) + r
+    speed = math.sqrt(u * u + v * v + w * w) + math.sqrt(p * p + q * q + rr * rr) * reach
+    return g + r + BOUND_MARGIN, speed * (1.0 + RATE_MARGIN)
