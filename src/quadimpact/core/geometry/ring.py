@@ -361,17 +361,47 @@ def _crease_normal(
     or ``m_j`` where the maximum leaves the crease, so the force's direction
     is continuous too. Elsewhere: ``m`` unchanged (unit).
     """
-    if g <= 0.0:
-        return b, g, mx, my, mz
-    kind = int(shapes[s, SH_KIND])
-    if kind == SHAPE_BOX:
-        n_pieces = 6
-    elif kind == SHAPE_CYLINDER and shapes[s, SH_LENGTH] < math.inf:
-        n_pieces = 3
-    else:
+    n_pieces = _crease_pieces(g, shapes, s)
+    if n_pieces == 0:
         return b, g, mx, my, mz
     px, py, pz, tx, ty, tz = _point(ring, b)
     _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    nx, ny, nz = _crease_blend(px, py, pz, tx, ty, tz, k, n_pieces, g, mx, my, mz, shapes, s)
+    return b, g, nx, ny, nz
+
+
+@njit(cache=True, inline="always")
+def _crease_pieces(g: float, shapes: np.ndarray, s: int) -> int:
+    """How many pieces the depth of shape ``s`` has where a ring is ``g`` deep (0: no crease
+    to look for: out of contact, or an infinite cylinder, whose depth is smooth)."""
+    if g <= 0.0:
+        return 0
+    kind = int(shapes[s, SH_KIND])
+    if kind == SHAPE_BOX:
+        return 6
+    if kind == SHAPE_CYLINDER and shapes[s, SH_LENGTH] < math.inf:
+        return 3
+    return 0
+
+
+@compiled
+def _crease_blend(
+    px: float,
+    py: float,
+    pz: float,
+    tx: float,
+    ty: float,
+    tz: float,
+    k: int,
+    n_pieces: int,
+    g: float,
+    mx: float,
+    my: float,
+    mz: float,
+    shapes: np.ndarray,
+    s: int,
+) -> tuple[float, float, float]:
+    """:func:`_crease_normal`'s normal at the deepest point ``p`` (tangent ``t``, piece ``k``)."""
     j = -1
     vj = math.inf
     for i in range(n_pieces):
@@ -382,17 +412,15 @@ def _crease_normal(
             vj = v
             j = i
     if j < 0 or vj > g + CREASE_TOL:
-        return b, g, mx, my, mz
+        return mx, my, mz
     _, nkx, nky, nkz = solid_piece(px, py, pz, shapes, s, k)
     _, njx, njy, njz = solid_piece(px, py, pz, shapes, s, j)
     sk = -(nkx * tx + nky * ty + nkz * tz)
     sj = -(njx * tx + njy * ty + njz * tz)
     if sk * sj > 0.0:
-        return b, g, mx, my, mz
+        return mx, my, mz
     lam = 0.5 if sk == sj else sj / (sj - sk)
     return (
-        b,
-        g,
         lam * nkx + (1.0 - lam) * njx,
         lam * nky + (1.0 - lam) * njy,
         lam * nkz + (1.0 - lam) * njz,
@@ -610,9 +638,25 @@ def _crease_twin(
     twin's point (inertial) and its certifying normal (as
     :func:`_crease_normal`'s); ``w = 0``: no twin.
     """
-    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     px, py, pz, _, _, _ = _point(ring, b)
     _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    return _crease_twin_at(ring, b, g, px, py, pz, k, shapes, s)
+
+
+@compiled
+def _crease_twin_at(
+    ring: Ring,
+    b: float,
+    g: float,
+    px: float,
+    py: float,
+    pz: float,
+    k: int,
+    shapes: np.ndarray,
+    s: int,
+) -> tuple[float, float, float, float, float, float, float]:
+    """:func:`_crease_twin` with the deepest point ``p = P(b)`` and its piece ``k`` given."""
+    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     if k < 0:
         return none
     j = -1
@@ -721,10 +765,15 @@ def ring_solid(
 ) -> ContactRecord:
     """Ring feature ``f`` against the cylinder or box ``s``: the certified deepest point."""
     ring = ring_frame(x, C, feat, f)
-    b, g, mx, my, mz = ring_deepest(ring, shapes, s)
-    px, py, pz, _, _, _ = _point(ring, b)
-    if g > 0.0 and int(shapes[s, SH_KIND]) == SHAPE_BOX:
-        w, qx, qy, qz, nx, ny, nz = _crease_twin(ring, b, g, shapes, s)
+    b, g, mx, my, mz = _search(ring, shapes, s)
+    px, py, pz, tx, ty, tz = _point(ring, b)
+    n_pieces = _crease_pieces(g, shapes, s)
+    k = -1
+    if n_pieces > 0:  # ring_deepest's normal, and the crease's twin, from this one point
+        _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+        mx, my, mz = _crease_blend(px, py, pz, tx, ty, tz, k, n_pieces, g, mx, my, mz, shapes, s)
+    if n_pieces == 6:  # a box
+        w, qx, qy, qz, nx, ny, nz = _crease_twin_at(ring, b, g, px, py, pz, k, shapes, s)
         if w > 0.0:
             px += w * (qx - px)
             py += w * (qy - py)
