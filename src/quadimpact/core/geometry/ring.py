@@ -366,7 +366,7 @@ def _crease_normal(
         return b, g, mx, my, mz
     px, py, pz, tx, ty, tz = _point(ring, b)
     _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
-    nx, ny, nz = _crease_blend(px, py, pz, tx, ty, tz, k, n_pieces, g, mx, my, mz, shapes, s)
+    nx, ny, nz = _crease_blend((px, py, pz, tx, ty, tz), k, n_pieces, g, (mx, my, mz), shapes, s)
     return b, g, nx, ny, nz
 
 
@@ -386,22 +386,18 @@ def _crease_pieces(g: float, shapes: np.ndarray, s: int) -> int:
 
 @compiled
 def _crease_blend(
-    px: float,
-    py: float,
-    pz: float,
-    tx: float,
-    ty: float,
-    tz: float,
+    pt: tuple[float, float, float, float, float, float],
     k: int,
     n_pieces: int,
     g: float,
-    mx: float,
-    my: float,
-    mz: float,
+    m: tuple[float, float, float],
     shapes: np.ndarray,
     s: int,
 ) -> tuple[float, float, float]:
-    """:func:`_crease_normal`'s normal at the deepest point ``p`` (tangent ``t``, piece ``k``)."""
+    """:func:`_crease_normal`'s normal at the deepest point ``pt = (p, t)`` (its tangent
+    ``t``, its piece ``k``), the solid's normal there ``m``."""
+    px, py, pz, tx, ty, tz = pt
+    mx, my, mz = m
     j = -1
     vj = math.inf
     for i in range(n_pieces):
@@ -771,7 +767,8 @@ def ring_solid(
     k = -1
     if n_pieces > 0:  # ring_deepest's normal, and the crease's twin, from this one point
         _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
-        mx, my, mz = _crease_blend(px, py, pz, tx, ty, tz, k, n_pieces, g, mx, my, mz, shapes, s)
+        pt = (px, py, pz, tx, ty, tz)
+        mx, my, mz = _crease_blend(pt, k, n_pieces, g, (mx, my, mz), shapes, s)
     if n_pieces == 6:  # a box
         w, qx, qy, qz, nx, ny, nz = _crease_twin_at(ring, b, g, px, py, pz, k, shapes, s)
         if w > 0.0:
