@@ -419,3 +419,41 @@ def test_box_axes_are_rows_and_depths_are_those_of_the_rotated_box():
     x[L.X_QUAT] = 1.0
     _, delta, *_ = _record(x, feat, row)
     assert delta == pytest.approx(0.1, abs=1e-15)
+
+
+@pytest.mark.parametrize("shape", ("box", "cylinder", "infinite cylinder"))
+def test_the_broad_phase_bounds_a_rings_depth_and_rate(shape):
+    """The broad phase never claims a ring apart that touches: its depth bound is above the
+    ring's depth and its rate bound above the size of the depth's rate, near and far."""
+    rng = np.random.default_rng({"box": 51, "cylinder": 52, "infinite cylinder": 53}[shape])
+    proved_apart = 0
+    for _ in range(300):
+        row = random_shape(rng, shape)
+        x = _state(rng)
+        x[L.X_POS : L.X_POS + 3] = rng.uniform(-0.4, 0.4, 3)  # from inside to well apart
+        feat = _feature(
+            "ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), rng.standard_normal(3)
+        )
+        C, delta, delta_dot, *_ = _record(x, feat, row)
+        kind = (int(feat[0, L.F_KIND]), int(row[L.SH_KIND]))
+        pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
+        assert geometry.has_bound(pairs, 0)
+        bound, rate = geometry.pair_bound(x, C, feat, row[None, :], pairs, 0)
+        assert delta <= bound
+        assert abs(delta_dot) <= rate
+        proved_apart += bound < 0.0
+    assert 30 < proved_apart < 270  # both cases were met (apart and not proved apart)
+
+
+def test_closed_form_pairs_have_no_broad_phase():
+    """A sphere, a point, or a ring against a plane: the record is as cheap as a bound."""
+    rng = np.random.default_rng(54)
+    x = _state(rng)
+    C = _rotation(x)
+    for feature, shape in (("sphere", "box"), ("point", "cylinder"), ("ring", "plane")):
+        feat = _feature(feature, (0.1, 0.0, 0.0), 0.1)
+        row = _shape(rng, shape)
+        kind = (int(feat[0, L.F_KIND]), int(row[L.SH_KIND]))
+        pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
+        assert not geometry.has_bound(pairs, 0)
+        assert geometry.pair_bound(x, C, feat, row[None, :], pairs, 0) == (math.inf, math.inf)

@@ -48,6 +48,23 @@ def event_value(kind: int, c: int, level: float, xs: np.ndarray, C: np.ndarray, 
 
 
 @compiled
+def pair_values(
+    x: np.ndarray, m: Model, w: Work, g: np.ndarray, gd: np.ndarray, bnd: np.ndarray, c: int
+) -> float:
+    """Pair ``c``'s gap and penetration rate at ``x`` into ``g[c]``, ``gd[c]`` (``bnd[c] = 0``).
+
+    What ``interval.contact_values`` computes for a pair without its broad
+    phase, bit for bit (``w.C`` receives the rotation of ``x``). Returns the gap.
+    """
+    rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
+    d, dd = pair_depth(x, w.C, m.feat, m.shapes, m.pairs, c)
+    g[c] = contact_gap(x, d, m, c)
+    gd[c] = dd
+    bnd[c] = 0.0
+    return g[c]
+
+
+@compiled
 def locate(
     kind: int,
     c: int,
@@ -108,14 +125,32 @@ def contact_event(c: int, m: Model, d: Data, w: Work, h: float) -> float:
     output is also sampled inside the step so that a graze is not stepped over.
     An active contact ends where the gap falls through 0 (at once if it never
     penetrated after its onset).
+
+    A gap and rate held as the broad phase's bounds (``w.bnd_a[c]``,
+    ``w.bnd_b[c]``: an upper bound on the gap, below 0, and one on the rate's
+    size) decide only what they prove: no onset, and no graze within reach.
+    Otherwise the values are computed (:func:`pair_values`), so every event
+    is located from the same numbers as without a broad phase.
     """
     ga = w.g_a[c]
     gb = w.g_b[c]
     if d.cs[c, CS_ACTIVE] < 0.5:
         if gb > 0.0:
+            if w.bnd_a[c] > 0.5:  # apart at the start by its bound: the gap itself
+                ga = pair_values(d.x, m, w, w.g_a, w.gd_a, w.bnd_a, c)
             return locate(EV_GAP, c, 0.0, m, d, w, h, ga, gb, 1.0)
         band = h * (abs(w.gd_a[c]) + abs(w.gd_b[c]))
         if -ga < band or -gb < band:
+            if w.bnd_a[c] > 0.5 or w.bnd_b[c] > 0.5:
+                # the broad phase's bounds (gaps above, rates above in size) do not settle
+                # it: the values, and the test again on them
+                if w.bnd_a[c] > 0.5:
+                    ga = pair_values(d.x, m, w, w.g_a, w.gd_a, w.bnd_a, c)
+                if w.bnd_b[c] > 0.5:
+                    gb = pair_values(w.x_new, m, w, w.g_b, w.gd_b, w.bnd_b, c)
+                band = h * (abs(w.gd_a[c]) + abs(w.gd_b[c]))
+                if not (-ga < band or -gb < band):
+                    return NO_EVENT
             for k in range(1, NEAR_GRAZE_SAMPLES + 1):
                 sm = k / (NEAR_GRAZE_SAMPLES + 1.0)
                 dense_eval(d.x[: active_states(m.veh)], w.Q, h, sm, w.xs)

@@ -22,7 +22,7 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_gap
 from quadimpact.core.dynamics import state_derivative
 from quadimpact.core.events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
-from quadimpact.core.geometry import pair_depth
+from quadimpact.core.geometry import has_bound, pair_bound, pair_depth
 from quadimpact.core.integrator import (
     all_finite,
     copy_into,
@@ -100,13 +100,32 @@ FAILED = 2  # or failed (status and reason in stats)
 
 
 @compiled
-def contact_values(x: np.ndarray, m: Model, d: Data, w: Work, g: np.ndarray, gd: np.ndarray):
-    """Gap ``g`` and penetration rate ``gd`` of every pair at ``x`` (``w.C``: its rotation)."""
+def contact_values(
+    x: np.ndarray, m: Model, d: Data, w: Work, g: np.ndarray, gd: np.ndarray, bnd: np.ndarray
+):
+    """Gap ``g`` and penetration rate ``gd`` of every pair at ``x`` (``w.C``: its rotation).
+
+    The broad phase: a pair out of contact whose record is a search (a ring
+    against a cylinder or a box, ``geometry.has_bound``) is first bounded
+    (``geometry.pair_bound``, one point depth); when the bound proves it
+    apart, ``g[c]`` and ``gd[c]`` hold the bounds (its gap is at most
+    ``g[c] < 0``, its rate at most ``gd[c]`` in size) and ``bnd[c] = 1``.
+    ``events.contact_event`` decides from them only what they prove and
+    computes the values otherwise, so no result changes (bit for bit).
+    """
     rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
     for c in range(g.shape[0]):
+        if d.cs[c, CS_ACTIVE] < 0.5 and has_bound(m.pairs, c):
+            gu, vu = pair_bound(x, w.C, m.feat, m.shapes, m.pairs, c)
+            if gu < 0.0:
+                g[c] = gu
+                gd[c] = vu
+                bnd[c] = 1.0
+                continue
         dp, dd = pair_depth(x, w.C, m.feat, m.shapes, m.pairs, c)
         g[c] = contact_gap(x, dp, m, c)
         gd[c] = dd
+        bnd[c] = 0.0
 
 
 @compiled
@@ -166,7 +185,7 @@ def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
 @compiled
 def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     """Earliest event of the accepted step of ``h`` (s), and the crash's (fractions; NO_EVENT)."""
-    contact_values(w.x_new, m, d, w, w.g_b, w.gd_b)
+    contact_values(w.x_new, m, d, w, w.g_b, w.gd_b, w.bnd_b)
     sig_min = NO_EVENT
     for c in range(d.cs.shape[0]):
         sig = contact_event(c, m, d, w, h)
@@ -256,6 +275,27 @@ def _process_events(
             if m.sched_t.shape[0] > 0 and first_contact:
                 d.ls[LS_T_SCHED] = t  # power-off triggered by the first contact
     return any_event, ended
+
+
+@compiled
+def _arrive(
+    uncut: bool, t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
+) -> tuple[bool, bool]:
+    """At the new state ``d.x`` (time ``t``): extremes, the pairs' gaps, the events there.
+
+    ``uncut``: ``d.x`` is the end of the step just accepted, bit for bit, and
+    no contact changed state since the step's events computed its gaps
+    (``w.g_b``): they are the gaps at ``d.x`` and are taken, not computed again.
+    Returns :func:`_process_events`'s (any event, the run ends).
+    """
+    track_extremes(d.x, d.meas[MS_DETECTED] > 0.5, o.stats)
+    if uncut:
+        copy_into(w.g_a, w.g_b)
+        copy_into(w.gd_a, w.gd_b)
+        copy_into(w.bnd_a, w.bnd_b)
+    else:
+        contact_values(d.x, m, d, w, w.g_a, w.gd_a, w.bnd_a)
+    return _process_events(t, sig, tol_sig, m, d, o, w)
 
 
 @compiled
@@ -349,10 +389,9 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
         if not all_finite(d.x):
             result = _fail(stats, REASON_NOT_FINITE)
             break
-        track_extremes(d.x, d.meas[MS_DETECTED] > 0.5, stats)
         h = h_new
-        contact_values(d.x, m, d, w, w.g_a, w.gd_a)
-        any_event, ended = _process_events(t, sig_min, tol_sig, m, d, o, w)
+        # fsal after a trial step: it ended uncut, at d.x
+        any_event, ended = _arrive(fsal and not pending, t, sig_min, tol_sig, m, d, o, w)
         if any_event:
             fsal = False
         if ended:

@@ -14,7 +14,7 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
 from quadimpact.core.excursion import excursion_add
-from quadimpact.core.geometry import pair_depth
+from quadimpact.core.geometry import has_bound, pair_bound, pair_depth
 from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import (
     C_PHI_REF,
@@ -112,6 +112,10 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
         out[row, OUT_DELTA + nf + f] = 0.0
     for c in range(d.cs.shape[0]):
         f = m.pairs[c, PR_FEATURE]
+        active = d.cs[c, CS_ACTIVE] > 0.5
+        if not active and has_bound(m.pairs, c):
+            if pair_bound(xs, w.C, m.feat, m.shapes, m.pairs, c)[0] < 0.0:
+                continue  # apart (the broad phase): no deflection, no force
         dp, dd = pair_depth(xs, w.C, m.feat, m.shapes, m.pairs, c)
         if dp > out[row, OUT_DELTA + f]:
             out[row, OUT_DELTA + f] = dp

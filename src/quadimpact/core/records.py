@@ -149,6 +149,8 @@ class Work(NamedTuple):
     gd_b: np.ndarray  # (n_pairs,) rates there
     ev_sig: np.ndarray  # (n_pairs,) located event of each pair, fraction of the step
     C_hat: np.ndarray  # (3, 3) the estimated rotation at an IMU sample
+    bnd_a: np.ndarray  # (n_pairs,) 1: g_a, gd_a hold the broad phase's bounds, not values
+    bnd_b: np.ndarray  # (n_pairs,) the same for g_b, gd_b
 
 
 # ---------------------------------------------------------------- factories
@@ -217,6 +219,8 @@ def new_work(n_pairs: int) -> Work:
         np.zeros(n_pairs),
         np.zeros(n_pairs),
         np.zeros((3, 3)),
+        np.zeros(n_pairs),
+        np.zeros(n_pairs),
     )
 
 

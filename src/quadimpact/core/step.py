@@ -258,7 +258,7 @@ def tick(m: Model, d: Data, o: Output, w: Work) -> None:
     _command(t_k, m, d, o, w)
     apply_command(w.cmd, d.x, d.rin, m.opts, dt_c, ls[LS_PO_ACTIVE] > 0.5, int(m.veh[V_N_ROTORS]))
     cut_step(m, d)
-    contact_values(d.x, m, d, w, w.g_a, w.gd_a)
+    contact_values(d.x, m, d, w, w.g_a, w.gd_a, w.bnd_a)
     result = integrate_interval(t_k, t_next, m, d, o, w)
     if result == FAILED:
         ls[LS_DONE] = 1.0

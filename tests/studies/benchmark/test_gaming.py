@@ -52,6 +52,17 @@ def test_each_condition_of_the_held_hover_criterion_is_needed():
     assert held_hover_success(t).tolist() == [True, False, False, False, False, False]
 
 
+def test_a_run_that_ran_out_of_steps_is_no_success_even_after_a_held_hover():
+    """The step budget exhausted after the hover was held: the run failed (it did not fly
+    its length), so it counts as a failure, not a success and not excluded."""
+    t = _rows(
+        held_hover=[True, True],
+        status=["failed", "completed"],
+        reason=["step budget exhausted", ""],
+    )
+    assert held_hover_success(t).tolist() == [False, True]
+
+
 @pytest.mark.slow  # two plug-in loops compiled, ~9,000 trials: a few minutes on 2 cores
 def test_climbing_away_and_doing_nothing_rank_below_the_default_law(tmp_path):
     """On every task and sensor set of suite 2's quick suite, both gaming plug-ins score

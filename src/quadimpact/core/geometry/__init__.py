@@ -39,6 +39,13 @@ point     box       ``box.point_box``             closed form (exact)
 
 docs/OBSTACLES.md (section 2) gives each pair's method, accuracy and cost.
 
+**Broad phase.** A pair whose record is a search (a ring against a cylinder
+or a box: :func:`has_bound`) also has certified bounds on its depth and on
+its rate's size (:func:`pair_bound`, one point depth): the event checks
+skip the search of a pair out of contact that the bound proves apart
+(``interval.contact_values``) and compute it wherever the bound decides
+nothing (``events.contact_event``), so no result changes.
+
 **A new shape kind** is a shape component: one module declaring its
 settings, slots and compiled functions, and one line in ``shapes.py``
 (``sphere.py`` is the example); its rows join this table with ids from
@@ -65,7 +72,7 @@ from quadimpact.core.geometry.box import box_distance, point_box, sphere_box
 from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
 from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
 from quadimpact.core.geometry.plane import plane_distance, point_plane, ring_plane, sphere_plane
-from quadimpact.core.geometry.ring import ring_solid
+from quadimpact.core.geometry.ring import ring_solid, ring_solid_bound
 from quadimpact.core.geometry.shape_component import ShapeComponent
 from quadimpact.core.geometry.shapes import BUILTIN as BUILTIN_SHAPES
 from quadimpact.core.geometry.shapes import (
@@ -97,6 +104,8 @@ __all__ = [
     "SHAPE_DISTANCES",
     "contact_record",
     "geometry_id",
+    "has_bound",
+    "pair_bound",
     "pair_contact",
     "pair_depths",
     "pair_table",
@@ -247,6 +256,30 @@ def shape_distance(px: float, py: float, pz: float, shapes: np.ndarray, s: int) 
     if found:
         return d
     return plugin_distance(px, py, pz, shapes, s)
+
+
+@njit(cache=True, inline="always")
+def has_bound(pairs: np.ndarray, c: int) -> bool:
+    """Whether pair ``c`` has a broad phase (:func:`pair_bound`): a ring against a cylinder or
+    a box, whose record is a search; the closed forms cost what a bound would."""
+    g = pairs[c, PR_GEOMETRY]
+    return g == GEOM_RING_CYLINDER or g == GEOM_RING_BOX
+
+
+@compiled
+def pair_bound(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray, c: int
+) -> tuple[float, float]:
+    """The broad phase of pair ``c`` (:func:`has_bound`): certified upper bounds on its
+    penetration ``delta`` (m) and on ``|delta_dot|`` (m/s) at the state ``x``.
+
+    A bound below zero proves the pair apart without its record
+    (``ring.ring_solid_bound``: one point depth). Pairs without a broad phase:
+    ``(inf, inf)``.
+    """
+    if has_bound(pairs, c):
+        return ring_solid_bound(x, C, feat, pairs[c, PR_FEATURE], shapes, pairs[c, PR_SHAPE])
+    return math.inf, math.inf
 
 
 @compiled

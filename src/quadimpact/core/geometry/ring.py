@@ -80,7 +80,9 @@ from quadimpact.core.layout import (
     SH_POINT,
     SHAPE_BOX,
     SHAPE_CYLINDER,
+    X_OMEGA,
     X_POS,
+    X_VEL,
 )
 
 TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum
@@ -94,6 +96,8 @@ POLISH_ITERS = 8  # secant steps refining the branch and bound's best angle
 POLISH_STEP = 1e-6  # rad: the refinement's first secant step
 POLISH_REACH = 1e-3  # rad: how far the refinement may move the angle
 TWIN_BAND = 1e-6  # m: a second crease this close in depth shares the contact point
+BOUND_MARGIN = 1e-9  # m: added to the broad phase's depth bound (rounding of the point depths)
+RATE_MARGIN = 1e-9  # relative: added to its rate bound
 
 Ring = tuple[float, float, float, float, float, float, float, float, float, float]
 """(cx, cy, cz, ax, ay, az, bx, by, bz, R): centre, two orthonormal in-plane axes, radius."""
@@ -357,17 +361,43 @@ def _crease_normal(
     or ``m_j`` where the maximum leaves the crease, so the force's direction
     is continuous too. Elsewhere: ``m`` unchanged (unit).
     """
-    if g <= 0.0:
-        return b, g, mx, my, mz
-    kind = int(shapes[s, SH_KIND])
-    if kind == SHAPE_BOX:
-        n_pieces = 6
-    elif kind == SHAPE_CYLINDER and shapes[s, SH_LENGTH] < math.inf:
-        n_pieces = 3
-    else:
+    n_pieces = _crease_pieces(g, shapes, s)
+    if n_pieces == 0:
         return b, g, mx, my, mz
     px, py, pz, tx, ty, tz = _point(ring, b)
     _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    nx, ny, nz = _crease_blend((px, py, pz, tx, ty, tz), k, n_pieces, g, (mx, my, mz), shapes, s)
+    return b, g, nx, ny, nz
+
+
+@njit(cache=True, inline="always")
+def _crease_pieces(g: float, shapes: np.ndarray, s: int) -> int:
+    """How many pieces the depth of shape ``s`` has where a ring is ``g`` deep (0: no crease
+    to look for: out of contact, or an infinite cylinder, whose depth is smooth)."""
+    if g <= 0.0:
+        return 0
+    kind = int(shapes[s, SH_KIND])
+    if kind == SHAPE_BOX:
+        return 6
+    if kind == SHAPE_CYLINDER and shapes[s, SH_LENGTH] < math.inf:
+        return 3
+    return 0
+
+
+@compiled
+def _crease_blend(
+    pt: tuple[float, float, float, float, float, float],
+    k: int,
+    n_pieces: int,
+    g: float,
+    m: tuple[float, float, float],
+    shapes: np.ndarray,
+    s: int,
+) -> tuple[float, float, float]:
+    """:func:`_crease_normal`'s normal at the deepest point ``pt = (p, t)`` (its tangent
+    ``t``, its piece ``k``), the solid's normal there ``m``."""
+    px, py, pz, tx, ty, tz = pt
+    mx, my, mz = m
     j = -1
     vj = math.inf
     for i in range(n_pieces):
@@ -378,17 +408,15 @@ def _crease_normal(
             vj = v
             j = i
     if j < 0 or vj > g + CREASE_TOL:
-        return b, g, mx, my, mz
+        return mx, my, mz
     _, nkx, nky, nkz = solid_piece(px, py, pz, shapes, s, k)
     _, njx, njy, njz = solid_piece(px, py, pz, shapes, s, j)
     sk = -(nkx * tx + nky * ty + nkz * tz)
     sj = -(njx * tx + njy * ty + njz * tz)
     if sk * sj > 0.0:
-        return b, g, mx, my, mz
+        return mx, my, mz
     lam = 0.5 if sk == sj else sj / (sj - sk)
     return (
-        b,
-        g,
         lam * nkx + (1.0 - lam) * njx,
         lam * nky + (1.0 - lam) * njy,
         lam * nkz + (1.0 - lam) * njz,
@@ -606,9 +634,25 @@ def _crease_twin(
     twin's point (inertial) and its certifying normal (as
     :func:`_crease_normal`'s); ``w = 0``: no twin.
     """
-    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     px, py, pz, _, _, _ = _point(ring, b)
     _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+    return _crease_twin_at(ring, b, g, px, py, pz, k, shapes, s)
+
+
+@compiled
+def _crease_twin_at(
+    ring: Ring,
+    b: float,
+    g: float,
+    px: float,
+    py: float,
+    pz: float,
+    k: int,
+    shapes: np.ndarray,
+    s: int,
+) -> tuple[float, float, float, float, float, float, float]:
+    """:func:`_crease_twin` with the deepest point ``p = P(b)`` and its piece ``k`` given."""
+    none = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     if k < 0:
         return none
     j = -1
@@ -717,10 +761,16 @@ def ring_solid(
 ) -> ContactRecord:
     """Ring feature ``f`` against the cylinder or box ``s``: the certified deepest point."""
     ring = ring_frame(x, C, feat, f)
-    b, g, mx, my, mz = ring_deepest(ring, shapes, s)
-    px, py, pz, _, _, _ = _point(ring, b)
-    if g > 0.0 and int(shapes[s, SH_KIND]) == SHAPE_BOX:
-        w, qx, qy, qz, nx, ny, nz = _crease_twin(ring, b, g, shapes, s)
+    b, g, mx, my, mz = _search(ring, shapes, s)
+    px, py, pz, tx, ty, tz = _point(ring, b)
+    n_pieces = _crease_pieces(g, shapes, s)
+    k = -1
+    if n_pieces > 0:  # ring_deepest's normal, and the crease's twin, from this one point
+        _, _, _, _, k = solid_depth(px, py, pz, shapes, s)
+        pt = (px, py, pz, tx, ty, tz)
+        mx, my, mz = _crease_blend(pt, k, n_pieces, g, (mx, my, mz), shapes, s)
+    if n_pieces == 6:  # a box
+        w, qx, qy, qz, nx, ny, nz = _crease_twin_at(ring, b, g, px, py, pz, k, shapes, s)
         if w > 0.0:
             px += w * (qx - px)
             py += w * (qy - py)
@@ -729,3 +779,37 @@ def ring_solid(
             my += w * (ny - my)
             mz += w * (nz - mz)
     return material_record(x, C, g, px - x[X_POS], py - x[X_POS + 1], pz - x[X_POS + 2], mx, my, mz)
+
+
+@compiled
+def ring_solid_bound(
+    x: np.ndarray, C: np.ndarray, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
+) -> tuple[float, float]:
+    """Certified bounds on ring ``f``'s record against the cylinder or box ``s``: the broad phase.
+
+    Every point of the circle lies within ``R`` of its centre ``c`` and the
+    solid's point depth is 1-Lipschitz, so the depth :func:`ring_solid`
+    returns (the depth of a point of the circle) is at most ``g(c) + R``;
+    its rate ``-v_P . n`` (``|n| <= 1``) is at most the largest speed of a
+    point of the ring, ``|v| + |omega| (|c_b| + R)``. Returns ``(depth bound
+    (m), rate bound (m/s))``, each with a margin for rounding
+    (:data:`BOUND_MARGIN`, :data:`RATE_MARGIN`): one point depth, against
+    :func:`ring_solid`'s three to six and its contact point's velocity.
+    """
+    cb0 = feat[f, F_CENTRE]
+    cb1 = feat[f, F_CENTRE + 1]
+    cb2 = feat[f, F_CENTRE + 2]
+    cx = x[X_POS] + C[0, 0] * cb0 + C[0, 1] * cb1 + C[0, 2] * cb2
+    cy = x[X_POS + 1] + C[1, 0] * cb0 + C[1, 1] * cb1 + C[1, 2] * cb2
+    cz = x[X_POS + 2] + C[2, 0] * cb0 + C[2, 1] * cb1 + C[2, 2] * cb2
+    r = feat[f, F_RADIUS]
+    g = solid_depth(cx, cy, cz, shapes, s)[0]
+    u = x[X_VEL]
+    v = x[X_VEL + 1]
+    w = x[X_VEL + 2]
+    p = x[X_OMEGA]
+    q = x[X_OMEGA + 1]
+    rr = x[X_OMEGA + 2]
+    reach = math.sqrt(cb0 * cb0 + cb1 * cb1 + cb2 * cb2) + r
+    speed = math.sqrt(u * u + v * v + w * w) + math.sqrt(p * p + q * q + rr * rr) * reach
+    return g + r + BOUND_MARGIN, speed * (1.0 + RATE_MARGIN)

@@ -148,19 +148,23 @@ def held_hover_success(t: pd.DataFrame) -> np.ndarray:
     """Suite 2's success of each trial (docs/BENCHMARK.md 1.2): valid, a held hover, less
     than 2 m of height lost, the ground never touched (no crash) and no contact once the
     hover began. ``t`` has ``valid``, ``held_hover``, ``touched_after_hover``,
-    ``height_lost_m`` (m: the start altitude minus the lowest) and ``crash_time_s``."""
+    ``height_lost_m`` (m: the start altitude minus the lowest) and ``crash_time_s``.
+    A run that failed (``status``: the step budget exhausted, a non-finite state) is
+    never a success, even after a held hover: it did not fly its whole length."""
     import pandas as pd
 
     from quadimpact.studies.trial_analysis import SUCCESS_LOSS_M
 
     lost = pd.to_numeric(t["height_lost_m"], errors="coerce").to_numpy(dtype=float)
     crashed = pd.to_numeric(t["crash_time_s"], errors="coerce").notna().to_numpy()
+    failed = (t["status"] == "failed").to_numpy(dtype=bool) if "status" in t else False
     return (
         _flag(t, "valid")
         & _flag(t, "held_hover")
         & ~_flag(t, "touched_after_hover")
         & (lost < SUCCESS_LOSS_M)
         & ~crashed
+        & ~failed
     )
 
 
