@@ -218,8 +218,8 @@ def _plugin_file(folder: Path, i: int) -> Path:
 def _first_run(src: Path, folder: Path, i: int) -> dict:
     """One fresh command with the plug-in and one with the built-in law."""
     row = {}
+    _child(src, FIRST_RUN, "-", *EXAMPLE)  # warm: this checkout's cache, the disk
     for label, plugin in (("builtin", "-"), ("plugin", str(_plugin_file(folder, i)))):
-        _child(src, FIRST_RUN, plugin, *EXAMPLE)  # warm: this checkout's cache, the disk
         got, wall, cpu = _child(src, FIRST_RUN, plugin, *EXAMPLE)
         row[label] = {"wall_s": wall, "cpu_s": cpu, "compile_cpu_s": got["compile_cpu_s"]}
     return row
@@ -295,10 +295,14 @@ def _med(rows: list, *keys: str) -> float:
     return statistics.median(values) if values else float("nan")
 
 
+def _adds(rows: list, key: str) -> float:
+    """Median plug-in value minus median built-in value of ``key``."""
+    return _med(rows, "plugin", key) - _med(rows, "builtin", key)
+
+
 def _report(results: dict) -> None:
-    print(
-        f"machine: {os.cpu_count()} CPUs, load {os.getloadavg()[0]:.1f}; Python {sys.version.split()[0]}"
-    )
+    load = os.getloadavg()[0]
+    print(f"machine: {os.cpu_count()} CPUs, load {load:.1f}; Python {sys.version.split()[0]}")
     for name, res in results.items():
         print(f"\n== {name}")
         if res["first"]:
@@ -311,8 +315,7 @@ def _report(results: dict) -> None:
                     f"{_med(f, label, 'compile_cpu_s'):5.2f} s)"
                 )
             print(
-                f"  plug-in adds: wall {_med(f, 'plugin', 'wall_s') - _med(f, 'builtin', 'wall_s'):+.2f} s, "
-                f"CPU {_med(f, 'plugin', 'cpu_s') - _med(f, 'builtin', 'cpu_s'):+.2f} s"
+                f"  plug-in adds: wall {_adds(f, 'wall_s'):+.2f} s, CPU {_adds(f, 'cpu_s'):+.2f} s"
             )
         if res["process"]:
             p = res["process"]
@@ -325,16 +328,16 @@ def _report(results: dict) -> None:
                 )
             same = all(row["builtin"]["outcomes"] == row["plugin"]["outcomes"] for row in p)
             print(
-                f"  plug-in adds: CPU {_med(p, 'plugin', 'cpu_s') - _med(p, 'builtin', 'cpu_s'):+.2f} s"
-                f" per process; same outcomes: {same}"
+                f"  plug-in adds: CPU {_adds(p, 'cpu_s'):+.2f} s per process; same outcomes: {same}"
             )
         if res["loop"]:
             lp = res["loop"]
             b, q = _med(lp, "builtin_ms"), _med(lp, "plugin_ms")
             bm, qm = min(r["builtin_min_ms"] for r in lp), min(r["plugin_min_ms"] for r in lp)
+            same = all(r["bit_identical"] for r in lp)
             print(
-                f"loop alone (execute, median): built-in {b:.3f} ms, plug-in {q:.3f} ms, "
-                f"ratio {q / b:.3f} (best: {bm:.3f} / {qm:.3f} ms, ratio {qm / bm:.3f}); bit-identical: {all(r['bit_identical'] for r in lp)}"
+                f"loop alone (median): built-in {b:.3f} ms, plug-in {q:.3f} ms, ratio {q / b:.3f}; "
+                f"best {bm:.3f} / {qm:.3f} ms, ratio {qm / bm:.3f}; bit-identical: {same}"
             )
         if "cold" in res:
             c = res["cold"]
@@ -344,8 +347,8 @@ def _report(results: dict) -> None:
             )
             if "own" in c:
                 print(
-                    f"  {c['functions']} functions, {c['specialisations']} specialisations compiled;"
-                    " the most compile CPU of their own:"
+                    f"  {c['functions']} functions, {c['specialisations']} specialisations "
+                    "compiled; the most compile CPU of their own:"
                 )
                 for fn, s in c["own"]:
                     print(f"  {s:7.2f} s  x{c['count'][fn]:<3d} {fn}")

@@ -20,8 +20,11 @@ from quadimpact import ImpactTrial, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.kernel import BUILTIN, execute
-from quadimpact.inputs.controllers import controller_entry, register_controller
-from quadimpact.inputs.controllers import unregister_controller
+from quadimpact.inputs.controllers import (
+    controller_entry,
+    register_controller,
+    unregister_controller,
+)
 from quadimpact.packing.controller_block import BUILTIN_PACKERS
 from quadimpact.simulation.plugin_kernel import PluginError
 from quadimpact.simulation.setup import prepare
@@ -107,7 +110,11 @@ def test_a_step_that_returns_a_value_is_refused_in_one_line(plugins):
     with pytest.raises(PluginError) as info:
         prepare(ImpactTrial(controller=name, final_time_s=0.05))
     text = str(info.value)
-    assert "\n" not in text and "t-returns" in text and "must return nothing" in text, text
+    assert (
+        "\n" not in text
+        and "t-returns" in text
+        and "returns float64; a controller step returns nothing" in text
+    ), text
 
 
 def test_an_exception_in_a_step_reaches_the_caller_as_a_plugin_error(plugins):

@@ -42,12 +42,19 @@ __all__ = [
     "PLUGIN_REASON",
     "PluginError",
     "PluginStep",
+    "WRITES",
     "compile_cpu_total",
     "guarded",
     "plugin_address",
     "plugin_failure",
     "typing_text",
 ]
+
+WRITES = {
+    "controller": "it writes the four rotor speeds (rad/s) into cmd",
+    "estimator": "it writes the estimate into est",
+}
+"""What each kind of plug-in step gives the loop, instead of returning it."""
 
 PLUGIN_REASON = "PluginError: "
 """How a sweep row's ``reason`` starts when a plug-in raised (``<type>: <message>``)."""
@@ -106,6 +113,10 @@ def plugin_address(who: PluginStep, step: Any, signature: Any) -> int:
     started = cpu_time()
     try:
         address = entry_address(step, signature)
+    except TypeError as exc:  # compiled, but returns a value
+        rule = f"a {who.kind} step returns nothing: {WRITES.get(who.kind, '')}"
+        returned = one_line(str(exc)).split(";")[0]  # "returns <type>"
+        raise PluginError(f"{who}: {returned}; {rule}") from None
     except Exception as exc:
         text = typing_text(exc) if _is_compile_error(exc) else one_line(str(exc))
         raise PluginError(f"{who}: does not compile for the loop's records: {text}") from None

@@ -269,7 +269,7 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
             "raised ValueError: this trial is too far to the side for me",
             "the 2 cells finished are kept", "the same command resumes",
         )  # fmt: skip
-        assert f"quadimpact: compiling the loop for plug-in {name!r}" in err
+        assert f"quadimpact: compiling plug-in {name!r}" in err
         kept = out / "cells" / name
         assert (kept / "wall-ideal.parquet").is_file() and (kept / "wall-impact.parquet").is_file()
         assert not (kept / "pole-ideal.parquet").exists()
@@ -286,9 +286,9 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
         t = pd.read_csv(out / "benchmark.csv")
         mine = t[t["row"] == name]
         assert len(mine) == 4 and (mine["failed_runs"] == 0).all() and (mine["trials"] == 3).all()
-        # the compilation apart: seconds in compile_cpu_s, a trial's CPU in milliseconds
+        # the compilation apart: the step's compile in compile_cpu_s, a trial's CPU in ms
         first = mine[(mine["task"] == "wall") & (mine["sensors"] == "ideal")]
-        assert float(first["compile_cpu_s"].iloc[0]) > 1.0, mine["compile_cpu_s"]
+        assert float(first["compile_cpu_s"].iloc[0]) > 0.0, mine["compile_cpu_s"]
         assert (mine["cpu_ms_per_trial"] < 500.0).all(), mine["cpu_ms_per_trial"]
         study = json.loads((out / "study.json").read_text())
         assert study["identity"]["limit"] == 3
@@ -314,23 +314,22 @@ def test_run_benchmark_stops_on_a_plugin_raising_in_a_run(tmp_path):
         unregister_controller(name)
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s)
-def test_the_loops_compilation_is_in_its_own_cost_and_in_no_other(caplog, plugins):
-    """The first run of a process compiles the loop: its ``compile_cpu_s`` holds it (seconds),
-    its kernel and total CPU do not (the second run's cost is of the same size as the
-    first's); it is announced once."""
+def test_a_plugins_compilation_is_in_its_own_cost_and_in_no_other(caplog, plugins):
+    """The first run of a process compiles the plug-in's step (alone: the loop is the cached
+    one): its ``compile_cpu_s`` holds it, its kernel and total CPU do not (the second run's
+    cost is of the same size as the first's); it is announced once."""
     from quadimpact.simulation.batch import simulate_batch
 
     name = "t-hold-costs"
-    register_controller(name, step=hold, replace=True)
+    register_controller(name, step=njit(hold.py_func), replace=True)  # new to this process
     try:
         first, second = (
             s["cost"] for s in simulate_batch([ImpactTrial(controller=name, final_time_s=0.3)] * 2)
         )
-        assert first["compile_cpu_s"] > 2.0 and second["compile_cpu_s"] == 0.0, (first, second)
-        assert first["total_cpu_s"] < first["compile_cpu_s"] / 2, first
+        assert first["compile_cpu_s"] > 0.0 and second["compile_cpu_s"] == 0.0, (first, second)
+        assert first["total_cpu_s"] < 20 * second["total_cpu_s"] + 0.05, (first, second)
         assert first["kernel_cpu_s"] < 20 * second["kernel_cpu_s"] + 0.05, (first, second)
-        said = [r.getMessage() for r in caplog.records if "compiling the loop" in r.getMessage()]
-        assert len(said) == 1 and f"for plug-in {name!r}" in said[0], said
+        said = [r.getMessage() for r in caplog.records if "compiling plug-in" in r.getMessage()]
+        assert len(said) == 1 and f"plug-in {name!r}" in said[0], said
     finally:
         unregister_controller(name)
