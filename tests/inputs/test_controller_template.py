@@ -149,7 +149,6 @@ def test_a_simulation_hands_out_its_records_by_name_read_only() -> None:
     assert type(x[0:3]).__name__ == "NamedVector" and not hasattr(x[0:3], "position")
 
 
-@pytest.mark.slow  # the loop compiled around the template's step: about a minute
 def test_the_template_flies_a_vehicle_back_to_its_references(template) -> None:
     from quadimpact import simulate
 

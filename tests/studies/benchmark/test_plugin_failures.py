@@ -245,7 +245,7 @@ def _raising_from(offset_m: float, name: str) -> None:
     register_controller(name, step=offset_trials_raise, replace=True)
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s, twice)
+@pytest.mark.slow  # three benchmark cells, twice
 def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
     capsys, tmp_path, monkeypatch
 ):
@@ -296,7 +296,6 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
         unregister_controller(name)
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s)
 def test_run_benchmark_stops_on_a_plugin_raising_in_a_run(tmp_path):
     """The study's own entry: an ``InputError`` of one line, the same as the command's."""
     name = "t-raises-later-2"
