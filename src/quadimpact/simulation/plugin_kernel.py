@@ -44,6 +44,7 @@ __all__ = [
     "PluginStep",
     "WRITES",
     "compile_cpu_total",
+    "compile_registered_plugins",
     "guarded",
     "plugin_address",
     "plugin_failure",
@@ -90,6 +91,33 @@ def step_name(step: Any) -> str:
 def compile_cpu_total() -> float:
     """CPU time (this process) spent compiling plug-ins and their loops so far, s."""
     return _COMPILE_CPU[0]
+
+
+def compile_registered_plugins() -> list[PluginStep]:
+    """Compile the step of every plug-in controller and estimator registered so far.
+
+    For a process that forks workers (the local pool's fork server): each
+    worker inherits the compiled steps, and their addresses, instead of
+    compiling them again. A step that does not compile is left out: the run
+    that needs it says why. Returns the plug-ins compiled.
+    """
+    from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
+    from quadimpact.inputs.controllers import controller_entry, controller_names
+    from quadimpact.inputs.estimators import estimator_entry, estimator_names
+
+    found = [("controller", controller_entry(n), CONTROLLER_SIGNATURE) for n in controller_names()]
+    found += [("estimator", estimator_entry(n), ESTIMATOR_SIGNATURE) for n in estimator_names()]
+    done = []
+    for kind, entry, signature in found:
+        if entry.step is None:
+            continue
+        who = PluginStep(kind, entry.name, step_name(entry.step))
+        try:
+            plugin_address(who, entry.step, signature)
+        except PluginError:
+            continue
+        done.append(who)
+    return done
 
 
 def plugin_address(who: PluginStep, step: Any, signature: Any) -> int:
