@@ -3,9 +3,9 @@ and a Simulation have to the loop's records (quadimpact.core.named).
 
 The template's step, compiled alone, is checked on constructed measurements: at
 its references it asks for the weight and no torque, and an attitude error
-gives the torque that removes it; flown in the loop (slow: the loop is compiled
-around the step) it brings a vehicle started low and rolled back to its
-references.
+gives the torque that removes it; flown in the loop (the cached one, which
+calls the step by its address) it brings a vehicle started low and rolled back
+to its references.
 """
 
 from __future__ import annotations

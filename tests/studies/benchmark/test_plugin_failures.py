@@ -5,12 +5,12 @@ returns a value, reads past an array or leaves a command not finite: each is
 one line naming the plug-in, its function and the rule, before any trial
 (``simulation.plugin_check``). One that raises only at a later trial stops
 the benchmark with one line after its cell's sweep, the cells finished kept,
-and the same command resumes (``studies.benchmark.plugin_guard``). The loop's
+and the same command resumes (``studies.benchmark.plugin_guard``). The step's
 compilation is timed apart from the trials' CPU (``compile_cpu_s``).
 
-The pre-flight compiles a step alone (well under a second): those tests are
-fast. Flying a plug-in in the loop compiles the loop around it (~15 s): those
-are marked slow.
+The pre-flight compiles a step alone (well under a second), and so does a run
+(the cached loop calls the step by its address): these tests are fast but
+those that fly whole benchmark cells.
 """
 
 from __future__ import annotations
