@@ -43,7 +43,6 @@ from quadimpact.simulation.setup import prepare
 from quadimpact.simulation.trim import trim_rotor_speeds
 from quadimpact.sweep import run_sweep
 
-
 NAME = "test-constant-thrust"
 THRUST = 10.5  # N, from [controller_params] (the Spiri weighs 9.15 N)
 DEFAULT_THRUST = 8.0  # N, the parameter's default
