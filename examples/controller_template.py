@@ -16,8 +16,9 @@ angles, torques scaled by the inertia, then the vehicle's allocation. It reads
 the estimate of the state (the true state with the ``ideal`` estimator), as an
 on-board controller would.
 
-Run it: ``python examples/controller_template.py`` (the first run compiles the
-loop around the step: about a minute).
+Run it: ``python examples/controller_template.py`` (the first run of a process
+compiles the step alone, a second or two; the loop is the cached one, which
+calls the step by its address).
 """
 
 from __future__ import annotations

@@ -43,8 +43,6 @@ from quadimpact.simulation.setup import prepare
 from quadimpact.simulation.trim import trim_rotor_speeds
 from quadimpact.sweep import run_sweep
 
-pytestmark = pytest.mark.slow  # one plug-in kernel compiled for the module (~15 s)
-
 NAME = "test-constant-thrust"
 THRUST = 10.5  # N, from [controller_params] (the Spiri weighs 9.15 N)
 DEFAULT_THRUST = 8.0  # N, the parameter's default
@@ -161,6 +159,7 @@ def test_a_sweep_runs_the_plugin_in_process(plugin, tmp_path: Path) -> None:
     np.testing.assert_allclose(table["min_altitude_m"], [5.0, 5.0, 5.0 + sink], rtol=1e-9)
 
 
+@pytest.mark.slow  # a whole command with its figures (~10 s)
 def test_the_command_line_selects_the_plugin(plugin, tmp_path: Path) -> None:
     runner = CliRunner()
     help_text = runner.invoke(cli, ["run", "--help"]).output

@@ -3,9 +3,9 @@ and a Simulation have to the loop's records (quadimpact.core.named).
 
 The template's step, compiled alone, is checked on constructed measurements: at
 its references it asks for the weight and no torque, and an attitude error
-gives the torque that removes it; flown in the loop (slow: the loop is compiled
-around the step) it brings a vehicle started low and rolled back to its
-references.
+gives the torque that removes it; flown in the loop (the cached one, which
+calls the step by its address) it brings a vehicle started low and rolled back
+to its references.
 """
 
 from __future__ import annotations
@@ -149,7 +149,6 @@ def test_a_simulation_hands_out_its_records_by_name_read_only() -> None:
     assert type(x[0:3]).__name__ == "NamedVector" and not hasattr(x[0:3], "position")
 
 
-@pytest.mark.slow  # the loop compiled around the template's step: about a minute
 def test_the_template_flies_a_vehicle_back_to_its_references(template) -> None:
     from quadimpact import simulate
 

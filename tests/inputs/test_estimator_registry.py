@@ -2,8 +2,8 @@
 
 A test estimator registered here through ``register_estimator(name, step=...,
 params=..., pack=...)`` alone is selected by name in a scenario; the run loop
-is compiled around its step (``core.kernel.make_kernel(estimator=...)``, once per
-process), and the controller and the detector read its estimate. The
+calls its step by address (compiled alone, once per process: ``core/plugin_call.py``),
+and the controller and the detector read its estimate. The
 plug-in integrates the gyro (minus a constant bias given as a parameter) and
 never corrects: on an impact trial with an ideal IMU it tracks the truth to
 integration accuracy, and with a wrong bias it drifts at that rate.
@@ -75,7 +75,6 @@ def registered():
 TRIAL = {"roll_deg": 5.0, "pitch_deg": -20.0, "yaw_deg": 10.0, "speed_m_s": 1.2}
 
 
-@pytest.mark.slow  # the loop compiled around the plug-in (1-3 min)
 def test_a_registered_estimator_runs_by_name_and_is_read(registered):
     assert registered in estimator_names()
     truth = simulate(ImpactTrial(**TRIAL, imu={"position": "cm"})).summary

@@ -23,8 +23,9 @@ first compiled from, which would make its behaviour depend on the order of
 compilation; so every other compiled function of ``quadimpact.core`` uses one
 of the two (helpers inlined into their callers excepted), and none marked
 ``compiled`` returns an array (``tests/core/test_core_shape.py``). A user's
-plug-in (controller, sensor, estimator, geometry) is compiled with reference
-counting of its own by ``core.kernel.make_kernel``, so it may allocate.
+plug-in is compiled with reference counting of its own (a controller or
+estimator step alone, called by address: ``core/plugin_call.py``; a sensor or
+a geometry by ``core.kernel.make_kernel``), so it may allocate.
 """
 
 from __future__ import annotations

@@ -8,13 +8,17 @@ compiled entry points of one loop (``run``, ``start``, ``advance`` and the
 wall approach's shooting, ``approach``);
 :data:`BUILTIN` is the cached one.
 
-:func:`make_kernel` compiles the loop again around plug-ins: a user's
-controller step (in place of the built-in dispatch), a sensor sampled with
-the IMU, an estimator updated at every IMU sample, and the rows of the
-contact-geometry table registered at run time (``core.geometry``). It uses
-:func:`specialise`, which rebuilds every compiled core function that reaches
-a replaced global (Numba resolves globals at compile time); such a kernel is
-compiled once per process and not cached on disk.
+A plug-in controller or estimator needs no kernel of its own: its step is
+compiled alone and the cached loop calls it by address (``ctrl[C_STEP]``,
+``ecfg[EC_STEP]``; ``core/plugin_call.py``). :func:`make_kernel` compiles
+the loop again around the plug-ins that do need it: a sensor sampled with
+the IMU, the sensor and shape components registered as plug-ins, the rows of
+the contact-geometry table registered at run time (``core.geometry``), and,
+for code written against it, a controller step or an estimator bound in
+place of the built-in dispatch. It uses :func:`specialise`, which rebuilds
+every compiled core function that reaches a replaced global (Numba resolves
+globals at compile time); such a kernel is compiled once per process and not
+cached on disk.
 
 :func:`execute` allocates the outputs, runs a kernel and returns the filled
 parts as a :class:`~quadimpact.core.records.RawRecord`; ``quadimpact.simulation``

@@ -111,7 +111,7 @@ class ControllerKind(IntEnum):
     PAPER = 1
     CASCADE_PID = 2
     RECOVERY = 3
-    USER = 99  # a plug-in compiled into its own loop (core/kernel.py, make_kernel)
+    USER = 99  # a plug-in, called by address from the one loop (core/plugin_call.py)
 
 
 class EstimatorKind(IntEnum):
@@ -122,7 +122,7 @@ class EstimatorKind(IntEnum):
     EKF = 2  # multiplicative (error-state) extended Kalman filter
     EKF_ADDITIVE = 3  # the authors' 7-state additive-quaternion EKF (ekf_additive.py)
     NAV_EKF = 4  # the navigation filter: 16 error states, baro, range and flow (nav_ekf.py)
-    USER = 99  # a plug-in compiled into its own loop (core/kernel.py, make_kernel)
+    USER = 99  # a plug-in, called by address from the one loop (core/plugin_call.py)
 
 
 class RotorMode(IntEnum):
@@ -315,6 +315,8 @@ C_PARAMS = _ctrl.slot("C_PARAMS", NPARAM)  # the controller's own parameters
 NPOLICY = 1024
 C_POLICY = _ctrl.slot("C_POLICY", NPOLICY)  # a learned residual on the recovery law (first
 #   slot: its hidden width, 0 = none; core/controllers/residual.py lays out the rest)
+C_STEP = _ctrl.slot("C_STEP")  # a plug-in's step: its entry address in this process (0: none;
+#   core/plugin_call.py), set when a run is prepared, never packed from a scenario
 NCTRL = _ctrl.end("NCTRL")
 
 # ---- sensors scfg (NSCFG): the IMU and the impact detector; noise, bias,
@@ -420,6 +422,7 @@ EC_NAV_REACQUIRE = _ecfg.slot("EC_NAV_REACQUIRE")  # s: a source unfused this lo
 EC_NAV_P0 = _ecfg.slot("EC_NAV_P0", 2)  # initial std: accelerometer bias m/s^2, baro bias m
 EC_NAV_MIN_HEIGHT = _ecfg.slot("EC_NAV_MIN_HEIGHT")  # m: flow not fused below this height
 EC_NAV_MAX_TILT = _ecfg.slot("EC_NAV_MAX_TILT")  # cos of the largest tilt for range and flow
+EC_STEP = _ecfg.slot("EC_STEP")  # a plug-in estimator's step: its entry address (as C_STEP)
 NECFG = _ecfg.end("NECFG")
 GATE_SKIP = 0
 GATE_DEWEIGHT = 1

@@ -38,13 +38,16 @@ from quadimpact.core.excursion import excursion_start
 from quadimpact.core.hover_tracking import track_held_hover, track_hover
 from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
 from quadimpact.core.layout import (
+    C_KIND,
     C_PHI_REF,
     C_PSI_REF,
+    C_STEP,
     C_THETA_REF,
     CRASH_PAPER_TICKS,
     CS_ACTIVE,
     CS_EPISODE,
     CS_LAMBDA,
+    CTRL_USER,
     E_OPEN,
     E_PEAK_DELTA,
     E_T_END,
@@ -111,13 +114,14 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_ROTOR,
 )
+from quadimpact.core.plugin_call import call_controller
 from quadimpact.core.quaternion import normalise_quaternion
 from quadimpact.core.recording import record_crash, write_sample
 from quadimpact.core.records import Data, Model, Output, Work, new_work
 from quadimpact.core.sensing import sample_at
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
-controller_step = builtin_step  # rebound by run.make_kernel for plug-in controllers
+controller_step = builtin_step  # rebound by kernel.make_kernel(step=...) (a loop of its own)
 
 
 @allocating
@@ -219,6 +223,10 @@ def _command(t: float, m: Model, d: Data, o: Output, w: Work) -> None:
         for j in range(int(m.veh[V_N_ROTORS])):
             w.cmd[j] = ls[LS_EXT_CMD + j]
         ls[LS_EXT] = 0.0
+    elif int(m.ctrl[C_KIND]) == CTRL_USER and m.ctrl[C_STEP] != 0.0:  # a plug-in, by address
+        call_controller(
+            np.int64(m.ctrl[C_STEP]), t, d.meas, m.ctrl, d.mem, m.veh, m.opts[O_DT_CONTROL], w.cmd
+        )
     else:
         controller_step(t, d.meas, m.ctrl, d.mem, m.veh, m.opts[O_DT_CONTROL], w.cmd)
     stats = o.stats

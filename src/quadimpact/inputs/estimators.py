@@ -19,9 +19,9 @@ and may set its parameters (``[estimator_params]``). Built in:
 
 A user's compiled estimator plugs in like a controller:
 ``register_estimator(name, step=..., params=..., pack=...)`` (the step's
-interface in ``quadimpact.core.estimators.plugin_estimator``); the run loop is
-then compiled around it (``core.kernel.make_kernel(estimator=...)``) once per
-process.
+interface in ``quadimpact.core.estimators.plugin_estimator``); the step is
+then compiled alone once per process and the cached loop calls it by its
+address (``core/plugin_call.py``).
 """
 
 from __future__ import annotations

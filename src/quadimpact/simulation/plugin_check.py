@@ -38,21 +38,21 @@ from quadimpact.errors import InputError, one_line
 from quadimpact.inputs.controllers import controller_entry
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.registry import is_compiled
-from quadimpact.simulation.plugin_kernel import PluginError, PluginStep, step_name, typing_text
+from quadimpact.simulation.plugin_kernel import (
+    WRITES,
+    PluginError,
+    PluginStep,
+    step_name,
+    typing_text,
+)
 from quadimpact.simulation.setup import prepare
 
 __all__ = ["SIGNATURES", "check_first_run", "check_plugins", "check_signature"]
 
 #: The step each kind of plug-in registers: its parameters, and what it writes.
 SIGNATURES: dict[str, tuple[tuple[str, ...], str]] = {
-    "controller": (
-        ("t", "meas", "ctrl", "mem", "veh", "dt", "cmd"),
-        "it writes the four rotor speeds (rad/s) into cmd",
-    ),
-    "estimator": (
-        ("t", "dt", "meas", "ecfg", "est"),
-        "it writes the estimate into est",
-    ),
+    "controller": (("t", "meas", "ctrl", "mem", "veh", "dt", "cmd"), WRITES["controller"]),
+    "estimator": (("t", "dt", "meas", "ecfg", "est"), WRITES["estimator"]),
 }
 #: The estimate's slots an estimator's step must leave finite.
 _ESTIMATE = (
@@ -179,6 +179,8 @@ def _first_tick(scenario: Any, plugins: list[tuple[PluginStep, Any]], kind_of: d
             f"{who}: a run with it cannot be prepared: {type(exc).__name__}: {one_line(str(exc))}"
         ) from None
     m = setup.model()
+    m = m._replace(ctrl=m.ctrl.copy(), ecfg=m.ecfg.copy())
+    m.ctrl[L.C_STEP] = m.ecfg[L.EC_STEP] = 0.0  # the loop's start calls no plug-in here
     d = new_data(m)
     o = new_output(m, 0, 16, contact_columns=False, rows=False)
     BUILTIN.start(m, d, o)  # the records at t0: the measurement, the initial estimate

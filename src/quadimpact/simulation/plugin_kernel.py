@@ -1,19 +1,23 @@
-"""The run loop compiled around plug-ins, guarded: its compilation said and timed, its errors named.
+"""Plug-ins compiled and guarded: their compilation said and timed, their errors named.
 
-``core.kernel.make_kernel`` compiles the loop again around a plug-in
-controller or estimator step, on the loop's first call in a process (about
-15 s of CPU). :func:`guarded` wraps that kernel's entry points so that:
+A plug-in controller or estimator step is compiled alone, once per process,
+for the one signature the loop calls (:func:`plugin_address`: a few seconds
+of CPU, ``core/plugin_call.py``); the cached loop calls it by address. A
+plug-in sensor or shape still has the loop compiled around it
+(``core.kernel.make_kernel``, on the loop's first call in a process: about
+15 s of CPU or more). Either way:
 
 * the compilation is **announced** on stderr as it starts (once per process
-  and plug-in: ``quadimpact: compiling the loop for plug-in 'X' ...``), in the
-  command's process and in every sweep worker;
+  and plug-in: ``quadimpact: compiling plug-in 'X' ...``), in the command's
+  process and in every sweep worker;
 * its CPU time is **measured apart**: :func:`compile_cpu_total` is the
   process's total so far, which the run costs subtract
   (``simulation.setup.prepare``, ``simulation.batch``, ``simulation.simulate``)
   and report as the summary's ``cost.compile_cpu_s``;
 * an exception raised inside the loop (only a plug-in raises there: the
   core's loop reports its numerical failures as a status) becomes a
-  :class:`PluginError` naming the plug-in and its step, in one line.
+  :class:`PluginError` naming the plug-in and its step, in one line
+  (:func:`guarded`).
 
 A sweep records such a run as failed with ``reason = "PluginError: ..."``;
 :func:`plugin_failure` finds that reason in a sweep's rows (the benchmark
@@ -30,6 +34,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from quadimpact.core.kernel import Kernel
+from quadimpact.core.plugin_call import entry_address
 from quadimpact.errors import InputError, one_line
 from quadimpact.results.costs import cpu_time
 
@@ -37,17 +42,27 @@ __all__ = [
     "PLUGIN_REASON",
     "PluginError",
     "PluginStep",
+    "WRITES",
     "compile_cpu_total",
+    "compile_registered_plugins",
     "guarded",
+    "plugin_address",
     "plugin_failure",
     "typing_text",
 ]
+
+WRITES = {
+    "controller": "it writes the four rotor speeds (rad/s) into cmd",
+    "estimator": "it writes the estimate into est",
+}
+"""What each kind of plug-in step gives the loop, instead of returning it."""
 
 PLUGIN_REASON = "PluginError: "
 """How a sweep row's ``reason`` starts when a plug-in raised (``<type>: <message>``)."""
 
 _log = logging.getLogger("quadimpact")
-_COMPILE_CPU = [0.0]  # CPU time this process spent compiling plug-in loops, s
+_COMPILE_CPU = [0.0]  # CPU time this process spent compiling plug-ins and their loops, s
+_ADDRESSES: dict[int, tuple[Any, Any, int]] = {}  # id(step) -> (step, signature, address)
 
 
 class PluginError(InputError):
@@ -74,8 +89,69 @@ def step_name(step: Any) -> str:
 
 
 def compile_cpu_total() -> float:
-    """CPU time (this process) spent compiling the loops of plug-ins so far, s."""
+    """CPU time (this process) spent compiling plug-ins and their loops so far, s."""
     return _COMPILE_CPU[0]
+
+
+def compile_registered_plugins() -> list[PluginStep]:
+    """Compile the step of every plug-in controller and estimator registered so far.
+
+    For a process that forks workers (the local pool's fork server): each
+    worker inherits the compiled steps, and their addresses, instead of
+    compiling them again. A step that does not compile is left out: the run
+    that needs it says why. Returns the plug-ins compiled.
+    """
+    from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
+    from quadimpact.inputs.controllers import controller_entry, controller_names
+    from quadimpact.inputs.estimators import estimator_entry, estimator_names
+
+    found = [("controller", controller_entry(n), CONTROLLER_SIGNATURE) for n in controller_names()]
+    found += [("estimator", estimator_entry(n), ESTIMATOR_SIGNATURE) for n in estimator_names()]
+    done = []
+    for kind, entry, signature in found:
+        if entry.step is None:
+            continue
+        who = PluginStep(kind, entry.name, step_name(entry.step))
+        try:
+            plugin_address(who, entry.step, signature)
+        except PluginError:
+            continue
+        done.append(who)
+    return done
+
+
+def plugin_address(who: PluginStep, step: Any, signature: Any) -> int:
+    """The entry address of a plug-in's step compiled alone for ``signature`` (once per process).
+
+    The first call for a step announces its compilation on stderr and adds
+    its CPU time to :func:`compile_cpu_total`; the step (a ``numba.njit``
+    dispatcher, which owns the compiled code) is kept, so the address stays
+    valid for the life of the process. A step that does not compile for the
+    loop's records, or returns a value, is a :class:`PluginError`.
+    """
+    hit = _ADDRESSES.get(id(step))
+    if hit is not None and hit[0] is step and hit[1] == signature:
+        return hit[2]
+    if tuple(signature.args) not in step.overloads:
+        _log.warning(
+            f"quadimpact: compiling plug-in {who.name!r} ({who.kind} step {who.function}) alone "
+            f"(process {os.getpid()}, once per process: a few s of CPU, reported apart from the "
+            "runs' as compile_cpu_s; the loop is the cached one) ..."
+        )
+    started = cpu_time()
+    try:
+        address = entry_address(step, signature)
+    except TypeError as exc:  # compiled, but returns a value
+        rule = f"a {who.kind} step returns nothing: {WRITES.get(who.kind, '')}"
+        returned = one_line(str(exc)).split(";")[0]  # "returns <type>"
+        raise PluginError(f"{who}: {returned}; {rule}") from None
+    except Exception as exc:
+        text = typing_text(exc) if _is_compile_error(exc) else one_line(str(exc))
+        raise PluginError(f"{who}: does not compile for the loop's records: {text}") from None
+    finally:
+        _COMPILE_CPU[0] += cpu_time() - started
+    _ADDRESSES[id(step)] = (step, signature, address)
+    return address
 
 
 def typing_text(exc: BaseException) -> str:
@@ -107,9 +183,10 @@ def _is_compile_error(exc: BaseException) -> bool:
 class _Guard:
     """What the entry points of one guarded kernel share: its plug-ins, the notice said."""
 
-    def __init__(self, plugins: tuple[PluginStep, ...]) -> None:
+    def __init__(self, plugins: tuple[PluginStep, ...], compiles: bool) -> None:
         self.plugins = plugins
-        self.announced = False
+        self.announced = not compiles  # a loop that compiles nothing says nothing
+        self.compiles = compiles
 
     def who(self) -> str:
         return " and ".join(str(p) for p in self.plugins)
@@ -137,7 +214,7 @@ class _Guard:
         """``fn`` (a Numba dispatcher) compiled, announced and timed on its first call."""
 
         def call(*args: Any) -> Any:
-            if not fn.overloads:  # the first call in this process compiles
+            if self.compiles and not fn.overloads:  # the first call in this process compiles
                 self.announce()
                 started = cpu_time()
                 try:
@@ -156,9 +233,14 @@ class _Guard:
         return call
 
 
-def guarded(kernel: Kernel, plugins: Iterable[PluginStep]) -> Kernel:
-    """``kernel`` (from ``make_kernel``) with its entry points guarded (module docstring)."""
-    guard = _Guard(tuple(plugins))
+def guarded(kernel: Kernel, plugins: Iterable[PluginStep], *, compiles: bool = True) -> Kernel:
+    """``kernel`` with its entry points guarded (module docstring).
+
+    ``compiles``: the kernel is compiled around the plug-ins (``make_kernel``),
+    its compilation announced and timed on its first call; False for the
+    cached loop, which calls plug-in steps by address (only their errors named).
+    """
+    guard = _Guard(tuple(plugins), compiles)
     return Kernel(
         run=guard.wrap(kernel.run, "run"),
         start=guard.wrap(kernel.start, "start"),

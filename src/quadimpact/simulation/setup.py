@@ -27,7 +27,8 @@ from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table, shape_distance
 from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
-from quadimpact.core.kernel import Kernel, make_kernel
+from quadimpact.core.kernel import BUILTIN, Kernel, make_kernel
+from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
 from quadimpact.core.records import Model, model_array, model_span
 from quadimpact.core.sensors.registry import plugin_sensors
 from quadimpact.errors import InputError
@@ -43,7 +44,13 @@ from quadimpact.results.costs import CpuClock, cpu_time
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, solve_approach, wall_attitude
 from quadimpact.simulation.checks import check_imu, check_prepared, check_scenario_type
-from quadimpact.simulation.plugin_kernel import PluginStep, compile_cpu_total, guarded, step_name
+from quadimpact.simulation.plugin_kernel import (
+    PluginStep,
+    compile_cpu_total,
+    guarded,
+    plugin_address,
+    step_name,
+)
 from quadimpact.simulation.sharing import SharedSetup, kept_shared
 from quadimpact.simulation.trim import trim_rotor_speeds
 
@@ -186,13 +193,17 @@ def _ground(s: RunSettings) -> list[Plane]:
 def _kernel(
     entry, est_entry=None, instruments: tuple[str, ...] = (), kinds: tuple[str, ...] = ()
 ) -> Kernel | None:
-    """The compiled loop of a plug-in controller, estimator or sensor (once per process).
+    """The loop of a run with plug-ins, guarded (once per process); None for built-ins only.
 
-    None for built-ins. Guarded (``simulation.plugin_kernel``): its compilation
-    announced and timed apart, an exception in it a one-line ``PluginError``.
-    ``instruments``: the run's sensor components; a plug-in among them puts
-    every registered plug-in sensor into the loop; ``kinds``: its obstacles'
-    kinds, and a plug-in shape among them every registered plug-in shape.
+    A plug-in controller or estimator runs in the cached loop, which calls its
+    step by address (:func:`_plugin_addresses`): the kernel is the built-in
+    one, guarded (``simulation.plugin_kernel``: an exception in a plug-in a
+    one-line ``PluginError``). A plug-in sensor or shape is compiled into a
+    loop of its own (``core.kernel.make_kernel``), its compilation announced
+    and timed apart. ``instruments``: the run's sensor components; a plug-in
+    among them puts every registered plug-in sensor into the loop; ``kinds``:
+    its obstacles' kinds, and a plug-in shape among them every registered
+    plug-in shape.
     """
     estimator = getattr(est_entry, "step", None)
     sensors = tuple(c.name for c in plugin_sensors())
@@ -214,15 +225,30 @@ def _kernel(
             plugins.append(PluginStep("controller", entry.name, step_name(entry.step)))
         if estimator is not None:
             plugins.append(PluginStep("estimator", est_entry.name, step_name(estimator)))
+        components = []
         for c in plugin_sensors() if sensors else ():
-            plugins.append(PluginStep("sensor", c.name, step_name(c.sample)))
+            components.append(PluginStep("sensor", c.name, step_name(c.sample)))
         for c in plugin_shapes() if shapes else ():
-            plugins.append(PluginStep("shape", c.name, step_name(c.distance)))
-        kernel = make_kernel(
-            entry.step, estimator=estimator, sensors=bool(sensors), shapes=bool(shapes)
-        )
-        entry.kernel_cache[key] = guarded(kernel, plugins)
+            components.append(PluginStep("shape", c.name, step_name(c.distance)))
+        if components:  # compiled around the components; the steps still called by address
+            kernel = make_kernel(sensors=bool(sensors), shapes=bool(shapes))
+            entry.kernel_cache[key] = guarded(kernel, [*plugins, *components])
+        else:
+            entry.kernel_cache[key] = guarded(BUILTIN, plugins, compiles=False)
     return entry.kernel_cache[key]
+
+
+def _plugin_addresses(entry, est_entry, ctrl: np.ndarray, ecfg: np.ndarray) -> None:
+    """Write the entry addresses of a plug-in controller's and estimator's steps into the
+    run's ``ctrl[C_STEP]`` and ``ecfg[EC_STEP]``, each step compiled alone (once per
+    process: ``simulation.plugin_kernel.plugin_address``)."""
+    if entry.step is not None:
+        who = PluginStep("controller", entry.name, step_name(entry.step))
+        ctrl[L.C_STEP] = float(plugin_address(who, entry.step, CONTROLLER_SIGNATURE))
+    estimator = getattr(est_entry, "step", None)
+    if estimator is not None:
+        who = PluginStep("estimator", est_entry.name, step_name(estimator))
+        ecfg[L.EC_STEP] = float(plugin_address(who, estimator, ESTIMATOR_SIGNATURE))
 
 
 def _shared(
@@ -236,6 +262,7 @@ def _shared(
     """The packing common to every scenario kind, without the run's state, references and draws."""
     packing = pack_shared(s, v, o, surfaces, duration_s)
     est = packing.est
+    _plugin_addresses(packing.entry, est.entry, packing.model.ctrl, packing.model.ecfg)
     setup = RunSetup(
         run=packing.model,
         feature_names=v.feature_names(),

@@ -256,8 +256,9 @@ def preload() -> None:
     first (see ``pool.start_server``): it ignores Ctrl-C (as will the workers
     it forks), follows the sweep process (below), sets one thread per
     numerical library (before NumPy loads; nothing this package imports
-    before it loads NumPy), then :func:`warm_up` and imports the plug-ins named in
-    ``QUADIMPACT_PLUGINS`` (:mod:`quadimpact.inputs.plugins`). Never
+    before it loads NumPy), then :func:`warm_up`, imports the plug-ins named in
+    ``QUADIMPACT_PLUGINS`` (:mod:`quadimpact.inputs.plugins`) and compiles their
+    steps (``simulation.plugin_kernel.compile_registered_plugins``). Never
     raises: a worker that finds the kernel not loaded loads it itself, and a
     failing preload must not break the fork server (Ctrl-C during start-up
     included).
@@ -279,6 +280,10 @@ def preload() -> None:
             from quadimpact.inputs.plugins import load_env_plugins
 
             load_env_plugins()
+            # their steps compiled here, once: every worker forked from here inherits them
+            from quadimpact.simulation.plugin_kernel import compile_registered_plugins
+
+            compile_registered_plugins()
         if tempdir:  # tell the sweep that workers now start ready
             open(os.path.join(tempdir, SERVER_READY), "w").close()
 

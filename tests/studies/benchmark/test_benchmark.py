@@ -290,7 +290,7 @@ register_controller("test-hold-declare", step=step, params=Params, replace=True)
 """
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s)
+@pytest.mark.slow  # benchmark cells of the quick suite
 def test_a_plugin_controller_runs_tasks_of_the_quick_suite(tmp_path):
     """A plug-in that only holds its rotors and declares recovery at the detection: the
     wall's success is the share it detects without going below ground, and the grids'

@@ -5,12 +5,12 @@ returns a value, reads past an array or leaves a command not finite: each is
 one line naming the plug-in, its function and the rule, before any trial
 (``simulation.plugin_check``). One that raises only at a later trial stops
 the benchmark with one line after its cell's sweep, the cells finished kept,
-and the same command resumes (``studies.benchmark.plugin_guard``). The loop's
+and the same command resumes (``studies.benchmark.plugin_guard``). The step's
 compilation is timed apart from the trials' CPU (``compile_cpu_s``).
 
-The pre-flight compiles a step alone (well under a second): those tests are
-fast. Flying a plug-in in the loop compiles the loop around it (~15 s): those
-are marked slow.
+The pre-flight compiles a step alone (well under a second), and so does a run
+(the cached loop calls the step by its address): these tests are fast but
+those that fly whole benchmark cells.
 """
 
 from __future__ import annotations
@@ -245,7 +245,7 @@ def _raising_from(offset_m: float, name: str) -> None:
     register_controller(name, step=offset_trials_raise, replace=True)
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s, twice)
+@pytest.mark.slow  # three benchmark cells, twice
 def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
     capsys, tmp_path, monkeypatch
 ):
@@ -269,7 +269,7 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
             "raised ValueError: this trial is too far to the side for me",
             "the 2 cells finished are kept", "the same command resumes",
         )  # fmt: skip
-        assert f"quadimpact: compiling the loop for plug-in {name!r}" in err
+        assert f"quadimpact: compiling plug-in {name!r}" in err
         kept = out / "cells" / name
         assert (kept / "wall-ideal.parquet").is_file() and (kept / "wall-impact.parquet").is_file()
         assert not (kept / "pole-ideal.parquet").exists()
@@ -286,9 +286,9 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
         t = pd.read_csv(out / "benchmark.csv")
         mine = t[t["row"] == name]
         assert len(mine) == 4 and (mine["failed_runs"] == 0).all() and (mine["trials"] == 3).all()
-        # the compilation apart: seconds in compile_cpu_s, a trial's CPU in milliseconds
+        # the compilation apart: the step's compile in compile_cpu_s, a trial's CPU in ms
         first = mine[(mine["task"] == "wall") & (mine["sensors"] == "ideal")]
-        assert float(first["compile_cpu_s"].iloc[0]) > 1.0, mine["compile_cpu_s"]
+        assert float(first["compile_cpu_s"].iloc[0]) > 0.0, mine["compile_cpu_s"]
         assert (mine["cpu_ms_per_trial"] < 500.0).all(), mine["cpu_ms_per_trial"]
         study = json.loads((out / "study.json").read_text())
         assert study["identity"]["limit"] == 3
@@ -296,7 +296,6 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
         unregister_controller(name)
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s)
 def test_run_benchmark_stops_on_a_plugin_raising_in_a_run(tmp_path):
     """The study's own entry: an ``InputError`` of one line, the same as the command's."""
     name = "t-raises-later-2"
@@ -314,23 +313,22 @@ def test_run_benchmark_stops_on_a_plugin_raising_in_a_run(tmp_path):
         unregister_controller(name)
 
 
-@pytest.mark.slow  # the loop is compiled around the plug-in (~15 s)
-def test_the_loops_compilation_is_in_its_own_cost_and_in_no_other(caplog, plugins):
-    """The first run of a process compiles the loop: its ``compile_cpu_s`` holds it (seconds),
-    its kernel and total CPU do not (the second run's cost is of the same size as the
-    first's); it is announced once."""
+def test_a_plugins_compilation_is_in_its_own_cost_and_in_no_other(caplog, plugins):
+    """The first run of a process compiles the plug-in's step (alone: the loop is the cached
+    one): its ``compile_cpu_s`` holds it, its kernel and total CPU do not (the second run's
+    cost is of the same size as the first's); it is announced once."""
     from quadimpact.simulation.batch import simulate_batch
 
     name = "t-hold-costs"
-    register_controller(name, step=hold, replace=True)
+    register_controller(name, step=njit(hold.py_func), replace=True)  # new to this process
     try:
         first, second = (
             s["cost"] for s in simulate_batch([ImpactTrial(controller=name, final_time_s=0.3)] * 2)
         )
-        assert first["compile_cpu_s"] > 2.0 and second["compile_cpu_s"] == 0.0, (first, second)
-        assert first["total_cpu_s"] < first["compile_cpu_s"] / 2, first
+        assert first["compile_cpu_s"] > 0.0 and second["compile_cpu_s"] == 0.0, (first, second)
+        assert first["total_cpu_s"] < 20 * second["total_cpu_s"] + 0.05, (first, second)
         assert first["kernel_cpu_s"] < 20 * second["kernel_cpu_s"] + 0.05, (first, second)
-        said = [r.getMessage() for r in caplog.records if "compiling the loop" in r.getMessage()]
-        assert len(said) == 1 and f"for plug-in {name!r}" in said[0], said
+        said = [r.getMessage() for r in caplog.records if "compiling plug-in" in r.getMessage()]
+        assert len(said) == 1 and f"plug-in {name!r}" in said[0], said
     finally:
         unregister_controller(name)

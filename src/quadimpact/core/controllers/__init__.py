@@ -26,8 +26,9 @@ are declared in ``core/controller_layout.py``, which the Python side packs
 without loading this compiled code. A new built-in is its module, its blocks
 there, a branch below, and an entry in the Python-side registry
 (``quadimpact.inputs.controllers``); a controller that is not built in is
-registered there with its step (``register_controller(name, step=...)``),
-and runs in a loop compiled around it (``core.kernel.make_kernel``).
+registered there with its step (``register_controller(name, step=...)``):
+the step is compiled alone and the cached loop calls it by its address
+(``ctrl[C_STEP]``, ``core/plugin_call.py``).
 """
 
 import numpy as np

@@ -18,8 +18,10 @@ The estimator is chosen by ``ecfg[EC_KIND]`` (``EST_*``):
   additive quaternion;
 * ``nav-ekf`` (``nav_ekf.py``): the navigation filter, 16 error states,
   fusing the magnetometer, barometer, rangefinder and optical flow;
-* a plug-in (``EST_USER``): a compiled step bound in place of
-  :func:`plugin_estimator` by ``core.kernel.make_kernel(estimator=...)``.
+* a plug-in (``EST_USER``): a compiled step called by its address
+  (``ecfg[EC_STEP]``, ``core/plugin_call.py``), compiled alone; or, in a loop
+  compiled around it (``core.kernel.make_kernel(estimator=...)``), bound in
+  place of :func:`plugin_estimator`.
 
 The stage runs at each IMU sample, after the IMU, the magnetometer and the
 pose sensor have written their readings into the measurement record and
@@ -53,6 +55,7 @@ from quadimpact.core.layout import (
     EC_INIT_VEL,
     EC_KIND,
     EC_OBSERVER,
+    EC_STEP,
     ES_BIAS,
     ES_N,
     ES_POS,
@@ -77,6 +80,7 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_VEL,
 )
+from quadimpact.core.plugin_call import call_estimator
 from quadimpact.core.quaternion import euler_zyx
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.sensors.measurement import measure
@@ -86,6 +90,8 @@ from quadimpact.core.sensors.rotvec import dcm, rotate_by
 @njit(cache=True, inline="always")
 def plugin_estimator(t: float, dt: float, meas: np.ndarray, ecfg: np.ndarray, est: np.ndarray):
     """A plug-in estimator's step (rebound by ``core.kernel.make_kernel``); none here.
+
+    A plug-in registered for a run is called by address instead (``ecfg[EC_STEP]``).
 
     At each IMU sample ``t`` (s), ``dt`` (s) after the previous one (0 at the
     first), it reads the measurement record ``meas`` (``MS_IMU_F``,
@@ -192,6 +198,8 @@ def estimate_sample(
         additive_sample(t, dt, m, d, w.C_hat)
     elif kind == EST_NAV_EKF:
         nav_ekf_sample(t, dt, m, d, w.C_hat)
+    elif m.ecfg[EC_STEP] != 0.0:  # a plug-in, by address (core/plugin_call.py)
+        call_estimator(np.int64(m.ecfg[EC_STEP]), t, dt, d.meas, m.ecfg, est)
     else:
         plugin_estimator(t, dt, d.meas, m.ecfg, est)
     if kind != EST_IDEAL:
