@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, StrictBool, field_validator
 
 from quadimpact.core import layout as L
 from quadimpact.inputs.registry import Registry
@@ -265,6 +265,22 @@ class NavEkfParams(EstimatorParams):
         45.0, gt=0, lt=90, description="Range and flow fused only within this tilt, deg."
     )
     min_flow_height_m: Real = Field(0.1, ge=0, description="Flow fused only above this, m.")
+    imu_lever_arm: Literal["sensor", "none"] = Field(
+        "sensor",
+        description="'sensor': the IMU's offset from the CM removed from its specific force "
+        "(the rotation's centripetal and tangential parts); 'none': the IMU taken at the CM.",
+    )
+    reacquire_inflation: Literal["excess", "innovation"] = Field(
+        "excess",
+        description="At a re-acquisition, raise the states' variance by the innovation's "
+        "excess over its predicted spread ('excess': nothing when the estimate is still "
+        "consistent) or by the whole innovation squared ('innovation').",
+    )
+    flow_delay_compensation: StrictBool = Field(
+        True,
+        description="Predict each flow sample from the estimate at its image's capture time "
+        "(the correction applied now); false: from the current estimate.",
+    )
     initial_attitude_std_deg: Real | None = Field(
         None, gt=0, description="Initial std, deg; None: the initial error's std, at least 0.5."
     )
