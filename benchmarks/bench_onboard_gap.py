@@ -97,10 +97,11 @@ def main() -> None:
     if args.params:
         for item in args.params.split(","):
             k, _, v = item.partition("=")
+            v = v.strip()
             try:
                 params[k.strip()] = float(v)
             except ValueError:
-                params[k.strip()] = v.strip()
+                params[k.strip()] = {"true": True, "false": False}.get(v, v)
     rows = {}
     for name, (set_name, changes) in chosen.items():
         if params and set_name == "onboard":

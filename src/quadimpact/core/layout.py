@@ -567,6 +567,7 @@ N_NAV_RING_W = 11  # numbers per ring row: t, p, q (gyro minus bias), v (3), q_h
 ES_NAV_RING = _est.slot("ES_NAV_RING", N_NAV_RING_W * N_NAV_RING)  # the latest samples' rows
 ES_NAV_RING_AT = _est.slot("ES_NAV_RING_AT")  # the ring's next row
 ES_NAV_W_PREV = _est.slot("ES_NAV_W_PREV", 3)  # the previous sample's gyro minus bias (NaN: none)
+ES_NAV_ARM_PREV = _est.slot("ES_NAV_ARM_PREV", 6)  # C (w x r), C r at the previous sample (NaN)
 N_NAV_WORK = 2 * N_NAV * N_NAV + 14 * N_NAV + 6  # P, its scratch, the updates' work, f (CM, sensor)
 ES_NAV_WORK = _est.slot("ES_NAV_WORK", N_NAV_WORK)  # nav-ekf's work space (no allocation)
 NEST = _est.end("NEST")

@@ -23,18 +23,18 @@ covariance with::
 
 **The IMU's lever arm.** The accelerometer sits at ``r`` from the CM (body
 axes, ``EC_NAV_LEVER``: the IMU's position, or 0 with ``imu_lever_arm =
-"none"``) and reads the specific force of that point. The filter's velocity
-is the CM's, so the rotation's part is removed first::
-
-    f_cm = f - w_dot x r - w x (w x r)
-
-with ``w = w_gyro - b_g`` and ``w_dot`` the difference of two consecutive
-gyro samples over ``dt``. Summed over samples, the tangential term
-telescopes to ``(w_k - w_0) x r``, so its velocity is exact whatever the
-gyro's noise; the centripetal term needs only the rate. In a tumble at 15
-rad/s with the Navi's 5-cm offset the centripetal part alone is 11 m/s^2. The
-gravity update reads ``f_cm`` too; the impact test and the clipping test
-read the sensor's own ``f``. The
+"none"``) and reads the specific force of that point, ``f = f_cm + w_dot x r
++ w x (w x r)``. In a tumble at 15 rad/s with the Navi's 5-cm offset the
+centripetal part alone is 11 m/s^2. The filter's velocity and position are
+the CM's. Integrating ``f`` gives the IMU point's, ``v_s = v + C (w x r)``
+and ``p_s = p + C r`` (since ``d/dt C (w x r) = C (w_dot x r + w x (w x
+r))``, exactly), so each sample integrates ``f`` and then moves ``v`` by
+``-(C (w x r))`` and ``p`` by ``-(C r)``, each less its value at the previous
+sample (``w = w_gyro - b_g``). The sum telescopes: no angular acceleration is
+needed and no discretisation error is added, however fast the tumble. The
+covariance's Jacobian and the gravity update read ``f_cm = f - w_dot x r -
+w x (w x r)`` (``w_dot`` from two consecutive samples); the impact and
+clipping tests the sensor's own ``f``. The
 IMU's impact disturbance grows ``s_g`` and ``s_a`` after each impact the
 filter sees, as in the ``ekf`` (``ekf.impact_noise_factor``). While an axis
 of the gyro reads at its range, the reading is clipped: that sample's ``s_g``
@@ -120,6 +120,7 @@ from quadimpact.core.layout import (
     ES_ACC_BIAS,
     ES_BARO_BIAS,
     ES_BIAS,
+    ES_NAV_ARM_PREV,
     ES_NAV_COUNT,
     ES_NAV_FUSED_T,
     ES_NAV_NIS,
@@ -220,6 +221,8 @@ def nav_init(m: Model, d: Data) -> None:
     est[ES_NAV_RING_AT] = 0.0
     for k in range(3):
         est[ES_NAV_W_PREV + k] = np.nan
+    for k in range(6):
+        est[ES_NAV_ARM_PREV + k] = np.nan
 
 
 @allocating
@@ -637,6 +640,31 @@ def _at_cm(est: np.ndarray, ecfg: np.ndarray, w: np.ndarray, f: np.ndarray, dt: 
 
 
 @compiled
+def _lever_offset(est: np.ndarray, ecfg: np.ndarray, C: np.ndarray) -> None:
+    """The IMU point's velocity and position made the CM's (module docstring).
+
+    ``v -= C (w x r) - (its previous value)``, ``p -= C r - (its previous
+    value)``, with ``w`` this sample's bias-corrected rate (``ES_NAV_W_PREV``,
+    written by :func:`_at_cm`) and ``C`` the attitude estimate's rotation
+    the integration used. Nothing moves at the first sample.
+    """
+    r0, r1, r2 = ecfg[EC_NAV_LEVER], ecfg[EC_NAV_LEVER + 1], ecfg[EC_NAV_LEVER + 2]
+    w0, w1, w2 = est[ES_NAV_W_PREV], est[ES_NAV_W_PREV + 1], est[ES_NAV_W_PREV + 2]
+    c0 = w1 * r2 - w2 * r1  # w x r
+    c1 = w2 * r0 - w0 * r2
+    c2 = w0 * r1 - w1 * r0
+    first = np.isnan(est[ES_NAV_ARM_PREV])
+    for a in range(3):
+        u = C[a, 0] * c0 + C[a, 1] * c1 + C[a, 2] * c2
+        s = C[a, 0] * r0 + C[a, 1] * r1 + C[a, 2] * r2
+        if not first:
+            est[ES_VEL + a] -= u - est[ES_NAV_ARM_PREV + a]
+            est[ES_POS + a] -= s - est[ES_NAV_ARM_PREV + 3 + a]
+        est[ES_NAV_ARM_PREV + a] = u
+        est[ES_NAV_ARM_PREV + 3 + a] = s
+
+
+@compiled
 def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
 
@@ -680,10 +708,12 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
     impact = impact_noise_factor(t, f, ecfg, est)
     if dt > 0.0:
         for a in range(3):
-            y[a] = fc[a] - est[ES_ACC_BIAS + a]  # f - b_a before the prediction
+            y[a] = f[a] - est[ES_ACC_BIAS + a]  # f - b_a before the prediction (IMU point)
         nav_predict(est, P, A, ecfg, m.scfg, w, fc, dt, C, impact)
         dcm(q, C)
         integrate_navigation(est, C, y, g, dt)
+    dcm(q, C)
+    _lever_offset(est, ecfg, C)
     _gravity(est, P, Wu, ecfg, fc, g, C, impact)
     dcm(q, C)
     # magnetometer: m = C^T m_I (H_theta = [u_m x], u_m = C^T m_I)
