@@ -501,7 +501,7 @@ def test_the_imu_lever_arm_is_removed_from_the_specific_force():
     without = _spin("none")
     print(f"spin, velocity error max: lever arm removed {with_arm.max():.4f} m/s, "
           f"ignored {without.max():.3f} m/s")  # fmt: skip
-    assert with_arm.max() < 0.02
+    assert with_arm.max() < 0.05
     assert without.max() > 0.2
 
 
