@@ -563,7 +563,7 @@ ES_NAV_COUNT = _est.slot("ES_NAV_COUNT", 12)  # per source (mag, baro, range, fl
 #   fused, rejected by the gate, re-acquisitions
 ES_NAV_NIS = _est.slot("ES_NAV_NIS", 4)  # the latest normalised innovation squared of each
 N_NAV_RING = 64  # IMU samples of history (the flow's capture time)
-N_NAV_RING_W = 11  # numbers per ring row: t, p, q (gyro minus bias), v (3), q_hat (4), p_z
+N_NAV_RING_W = 11  # a ring row: t, p, q (gyro minus bias), the prediction's dv, dtheta, dp_z
 ES_NAV_RING = _est.slot("ES_NAV_RING", N_NAV_RING_W * N_NAV_RING)  # the latest samples' rows
 ES_NAV_RING_AT = _est.slot("ES_NAV_RING_AT")  # the ring's next row
 ES_NAV_W_PREV = _est.slot("ES_NAV_W_PREV", 3)  # the previous sample's gyro minus bias (NaN: none)

@@ -250,7 +250,12 @@ class NavEkfParams(EstimatorParams):
         None, ge=0, description="m/sqrt(s); None: the barometer's, at least 1e-4."
     )
     range_noise_floor_m: Real = Field(0.01, gt=0, description="Least rangefinder noise, m.")
-    flow_noise_floor_rad_s: Real = Field(0.05, gt=0, description="Least flow noise, rad/s.")
+    flow_noise_floor_rad_s: Real = Field(
+        2.0,
+        gt=0,
+        description="Least flow noise the filter fuses with, rad/s: above the sensor's "
+        "(0.15-0.5), a smoother velocity for the law to hold (docs/ESTIMATION.md 2.6).",
+    )
     mag_gate_sigma: Real = Field(3.0, ge=0, description="Magnetometer gate (0: none).")
     baro_gate_sigma: Real = Field(5.0, ge=0, description="Barometer gate (0: none).")
     range_gate_sigma: Real = Field(5.0, ge=0, description="Rangefinder gate (0: none).")

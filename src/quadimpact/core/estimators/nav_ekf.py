@@ -60,12 +60,15 @@ injection of the correction into the nominal state), at each IMU sample:
   noise (``noise_rad_s``), at least ``EC_NAV_FLOW``. **Delay**: the image
   was taken ``delay`` before it arrives (20 ms by default). With
   ``EC_NAV_DELAYED`` the predicted flow, its Jacobian and the tilt test use
-  the estimate the filter had at the capture time (the history keeps each
-  sample's velocity, attitude and height), and the correction is applied to
-  the current estimate: the innovation compares like with like, as PX4
-  EKF2's fusion on its delayed horizon does, without re-running the
-  prediction (over 20 ms the error state hardly moves, so the current
-  covariance stands for the delayed one).
+  the current estimate carried back to the capture time by the prediction
+  alone: the history keeps each sample's prediction increments (velocity,
+  attitude, height), and the increments since the capture are undone. So
+  the innovation compares like with like (the vehicle's own motion over the
+  delay is removed), and every correction made since the capture is kept
+  (an estimate stored at the capture time would miss them and count the
+  later samples twice). The correction goes to the current estimate; over
+  20 ms the error state hardly moves, so the current covariance stands for
+  the delayed one.
 
 Gates: each aiding update (magnetometer, barometer, rangefinder, flow) is
 refused when its normalised innovation squared ``y^T S^-1 y`` exceeds
@@ -510,9 +513,9 @@ def _new_sample(est: np.ndarray, meas: np.ndarray, at: int, k: int) -> bool:
 def _ring_row(est: np.ndarray, t: float) -> int:
     """The offset in ``est`` of the history's row nearest ``t`` (s), or -1 when it is empty.
 
-    A row: ``t``, the bias-corrected rates ``(p, q)`` (rad/s), then, once the
-    sample's updates are done, the estimate's velocity (3), attitude (4) and
-    ``p_z`` (NaN while its sample is the current one).
+    A row: ``t``, the bias-corrected rates ``(p, q)`` (rad/s), then the
+    increments the sample's prediction made: velocity (3, m/s), the attitude's
+    rotation vector ``w_hat dt`` (3, rad, body) and ``p_z`` (m).
     """
     best = -1
     gap = math.inf
@@ -573,10 +576,23 @@ def _flow(t: float, est: np.ndarray, P: np.ndarray, W: np.ndarray, ecfg: np.ndar
     v0, v1, v2 = est[ES_VEL], est[ES_VEL + 1], est[ES_VEL + 2]
     if row >= 0:
         p_cap, q_cap = est[row + 1], est[row + 2]
-        if ecfg[EC_NAV_DELAYED] > 0.5 and not np.isnan(est[row + 10]):
-            v0, v1, v2 = est[row + 3], est[row + 4], est[row + 5]
-            dcm(est[row + 6 : row + 10], C)
-            h = -est[row + 10]
+        if ecfg[EC_NAV_DELAYED] > 0.5:
+            # undo the prediction's increments of the samples after the capture
+            qc = est[ES_SCRATCH : ES_SCRATCH + 4]
+            for a in range(4):
+                qc[a] = est[ES_Q + a]
+            k = (int(est[ES_NAV_RING_AT]) - 1) % N_NAV_RING
+            for _ in range(N_NAV_RING):
+                at = ES_NAV_RING + N_NAV_RING_W * k
+                if at == row:
+                    break
+                v0 -= est[at + 3]
+                v1 -= est[at + 4]
+                v2 -= est[at + 5]
+                h += est[at + 10]
+                rotate_by(qc, -est[at + 6], -est[at + 7], -est[at + 8])
+                k = (k - 1) % N_NAV_RING
+            dcm(qc, C)
     c22 = C[2, 2]
     if not (c22 >= ecfg[EC_NAV_MAX_TILT] and h > ecfg[EC_NAV_MIN_HEIGHT]):
         return
@@ -693,14 +709,15 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
             est[ES_NAV_FUSED_T + k] = t  # the initial estimate counts as fused
     f = meas[MS_IMU_F : MS_IMU_F + 3]
     w = meas[MS_IMU_W : MS_IMU_W + 3]
-    # the history (the flow's capture time): this sample's rates now, its estimate at the end
+    # the history (the flow's capture time): this sample's rates, its prediction's increments
     at = int(est[ES_NAV_RING_AT])
     row = ES_NAV_RING + N_NAV_RING_W * at
     est[row] = t
     est[row + 1] = w[0] - est[ES_BIAS]
     est[row + 2] = w[1] - est[ES_BIAS + 1]
-    for k in range(3, N_NAV_RING_W):
-        est[row + k] = np.nan
+    for k in range(3, 6):
+        est[row + k] = est[ES_VEL + k - 3]  # the velocity before (made an increment below)
+    est[row + 10] = est[ES_POS + 2]
     est[ES_NAV_RING_AT] = (at + 1) % N_NAV_RING
     _at_cm(est, ecfg, w, f, dt, fc)
     q = est[ES_Q : ES_Q + 4]
@@ -714,6 +731,10 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
         integrate_navigation(est, C, y, g, dt)
     dcm(q, C)
     _lever_offset(est, ecfg, C)
+    for a in range(3):
+        est[row + 3 + a] = est[ES_VEL + a] - est[row + 3 + a]
+        est[row + 6 + a] = est[ES_NAV_W_PREV + a] * dt
+    est[row + 10] = est[ES_POS + 2] - est[row + 10]
     _gravity(est, P, Wu, ecfg, fc, g, C, impact)
     dcm(q, C)
     # magnetometer: m = C^T m_I (H_theta = [u_m x], u_m = C^T m_I)
@@ -759,10 +780,6 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
             est[ES_NAV_P + i * n + j] = 0.5 * (P[i, j] + P[j, i])
     for a in range(3):
         est[ES_W + a] = w[a] - est[ES_BIAS + a]
-        est[row + 3 + a] = est[ES_VEL + a]
-    for a in range(4):
-        est[row + 6 + a] = q[a]
-    est[row + 10] = est[ES_POS + 2]
 
 
 @compiled
