@@ -282,9 +282,10 @@ class NavEkfParams(EstimatorParams):
         "consistent) or by the whole innovation squared ('innovation').",
     )
     flow_delay_compensation: StrictBool = Field(
-        True,
-        description="Predict each flow sample from the estimate at its image's capture time "
-        "(the correction applied now); false: from the current estimate.",
+        False,
+        description="Predict each flow sample from the current estimate carried back to its "
+        "image's capture time (the correction applied now); false: from the current estimate "
+        "(the default: no measured gain, docs/ESTIMATION.md 2.6).",
     )
     initial_attitude_std_deg: Real | None = Field(
         None, gt=0, description="Initial std, deg; None: the initial error's std, at least 0.5."
