@@ -251,10 +251,10 @@ class NavEkfParams(EstimatorParams):
     )
     range_noise_floor_m: Real = Field(0.01, gt=0, description="Least rangefinder noise, m.")
     flow_noise_floor_rad_s: Real = Field(
-        2.0,
+        0.8,
         gt=0,
         description="Least flow noise the filter fuses with, rad/s: above the sensor's "
-        "(0.15-0.5), a smoother velocity for the law to hold (docs/ESTIMATION.md 2.6).",
+        "(0.15-0.5), a smoother velocity for the law to hold (docs/ESTIMATION.md 9).",
     )
     mag_gate_sigma: Real = Field(3.0, ge=0, description="Magnetometer gate (0: none).")
     baro_gate_sigma: Real = Field(5.0, ge=0, description="Barometer gate (0: none).")
