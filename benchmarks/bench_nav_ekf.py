@@ -13,7 +13,7 @@ Prints:
 * 12 random wall trials: how many reach a hover, the velocity error from 2.5 s on;
 * 60-s hovers after a wall impact (the hover at about 4.9 m), per seed.
 
-Run: ``.venv/bin/python benchmarks/bench_nav_ekf.py [--seeds 5]``.
+Run: ``.venv/bin/python benchmarks/bench_nav_ekf.py [--seeds 5] [--only cost|hover]``.
 """
 
 from __future__ import annotations
@@ -83,13 +83,21 @@ def trial_cost() -> None:
          "yaw_deg": rng.uniform(-30, 30), "speed_m_s": rng.uniform(1.0, 2.5), "seed": 100 + k}
         for k in range(40)
     ]  # fmt: skip
-    for sensors, est in (("impact", "ekf"), ("onboard", "ekf"), ("onboard", "nav-ekf")):
+    pairs = (("impact", "ekf"), ("onboard", "ekf"), ("onboard", "nav-ekf"))
+    best = {k: np.inf for k in pairs}
+    for sensors, est in pairs:
         simulate(ImpactTrial(**trials[0], sensors=sensors, estimator=est, final_time_s=4.0))
-        t0 = time.perf_counter()
-        for tr in trials:
-            simulate(ImpactTrial(**tr, sensors=sensors, estimator=est, final_time_s=4.0))
-        ms = (time.perf_counter() - t0) / len(trials) * 1e3
-        print(f"40 wall trials, {sensors} + {est}: {ms:.1f} ms per trial")
+    for _ in range(3):  # rounds, the three in turn: the best of each (load moves between them)
+        for sensors, est in pairs:
+            t0 = time.process_time()
+            for tr in trials:
+                simulate(ImpactTrial(**tr, sensors=sensors, estimator=est, final_time_s=4.0))
+            ms = (time.process_time() - t0) / len(trials) * 1e3
+            best[(sensors, est)] = min(best[(sensors, est)], ms)
+    for (sensors, est), ms in best.items():
+        print(f"40 wall trials, {sensors} + {est}: {ms:.1f} ms of CPU per trial (best of 3)")
+    ratio = best[("onboard", "nav-ekf")] / best[("impact", "ekf")]
+    print(f"onboard + nav-ekf against impact + ekf: {ratio:.2f} times (the issue allows 2)")
 
 
 def random_trials() -> None:
@@ -139,11 +147,19 @@ def hovers(seeds: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--seeds", type=int, default=5)
+    ap.add_argument(
+        "--only",
+        choices=("cost", "hover"),
+        default=None,
+        help="only the costs (stage and trial), or only the trials and hovers",
+    )
     args = ap.parse_args()
-    stage_cost()
-    trial_cost()
-    random_trials()
-    hovers(args.seeds)
+    if args.only != "hover":
+        stage_cost()
+        trial_cost()
+    if args.only != "cost":
+        random_trials()
+        hovers(args.seeds)
 
 
 if __name__ == "__main__":

@@ -51,6 +51,7 @@ VARIANTS = {
         },
     ),  # fmt: skip
     "IMU without its impact disturbance": ("onboard", {"imu": "noisy"}),
+    "IMU at the CM": ("onboard", {"imu": {"preset": "impact", "position": "cm"}}),
     **{
         f"flow noise / {k}": (
             "onboard",
@@ -72,10 +73,39 @@ def main() -> None:
     ap.add_argument("--task", default="wall", choices=("wall", "pole", "edge"))
     ap.add_argument("--out", type=Path, required=True, help="folder for the sweeps")
     ap.add_argument("--workers", type=int, default=None)
+    ap.add_argument(
+        "--variants",
+        default=None,
+        help="comma-separated variant names to fly (default: all); 'onboard' is always flown",
+    )
+    ap.add_argument(
+        "--params",
+        default=None,
+        help="nav-ekf parameters for every onboard variant, as k=v,k=v (a filter setting "
+        "measured against the same sensors)",
+    )
     args = ap.parse_args()
     task = TASKS[args.task]
+    chosen = VARIANTS
+    if args.variants:
+        names = ["onboard"] + [v.strip() for v in args.variants.split(",") if v.strip()]
+        unknown = [v for v in names if v not in VARIANTS]
+        if unknown:
+            ap.error(f"--variants: unknown {unknown}; known: {list(VARIANTS)}")
+        chosen = {v: VARIANTS[v] for v in dict.fromkeys(names)}
+    params = {}
+    if args.params:
+        for item in args.params.split(","):
+            k, _, v = item.partition("=")
+            v = v.strip()
+            try:
+                params[k.strip()] = float(v)
+            except ValueError:
+                params[k.strip()] = {"true": True, "false": False}.get(v, v)
     rows = {}
-    for name, (set_name, changes) in VARIANTS.items():
+    for name, (set_name, changes) in chosen.items():
+        if params and set_name == "onboard":
+            changes = {**changes, "estimator_params": params}
         spec = Subject("default").spec(task, True, sensor_set(set_name), limit=args.n)
         spec = SweepSpec(
             base={**spec.base, **changes}, grid=spec.grid or None, runs=spec.runs,

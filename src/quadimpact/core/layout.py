@@ -422,6 +422,9 @@ EC_NAV_REACQUIRE = _ecfg.slot("EC_NAV_REACQUIRE")  # s: a source unfused this lo
 EC_NAV_P0 = _ecfg.slot("EC_NAV_P0", 2)  # initial std: accelerometer bias m/s^2, baro bias m
 EC_NAV_MIN_HEIGHT = _ecfg.slot("EC_NAV_MIN_HEIGHT")  # m: flow not fused below this height
 EC_NAV_MAX_TILT = _ecfg.slot("EC_NAV_MAX_TILT")  # cos of the largest tilt for range and flow
+EC_NAV_LEVER = _ecfg.slot("EC_NAV_LEVER", 3)  # IMU position from the CM the filter removes, m
+EC_NAV_DELAYED = _ecfg.slot("EC_NAV_DELAYED")  # 1: flow predicted from the state at its capture
+EC_NAV_REACQ_EXCESS = _ecfg.slot("EC_NAV_REACQ_EXCESS")  # 1: re-acquisition inflates by the excess
 EC_STEP = _ecfg.slot("EC_STEP")  # a plug-in estimator's step: its entry address (as C_STEP)
 NECFG = _ecfg.end("NECFG")
 GATE_SKIP = 0
@@ -562,9 +565,14 @@ ES_NAV_FUSED_T = _est.slot("ES_NAV_FUSED_T", 4)  # s, the latest fused sample of
 ES_NAV_COUNT = _est.slot("ES_NAV_COUNT", 12)  # per source (mag, baro, range, flow):
 #   fused, rejected by the gate, re-acquisitions
 ES_NAV_NIS = _est.slot("ES_NAV_NIS", 4)  # the latest normalised innovation squared of each
-N_NAV_RING = 64  # IMU samples of gyro history (the flow's capture time)
-ES_NAV_RING = _est.slot("ES_NAV_RING", 3 * N_NAV_RING)  # (t, p, q) of the latest samples
+N_NAV_RING = 64  # IMU samples of history (the flow's capture time)
+N_NAV_RING_W = 11  # a ring row: t, p, q (gyro minus bias), the prediction's dv, dtheta, dp_z
+ES_NAV_RING = _est.slot("ES_NAV_RING", N_NAV_RING_W * N_NAV_RING)  # the latest samples' rows
 ES_NAV_RING_AT = _est.slot("ES_NAV_RING_AT")  # the ring's next row
+ES_NAV_W_PREV = _est.slot("ES_NAV_W_PREV", 3)  # the previous sample's gyro minus bias (NaN: none)
+ES_NAV_ARM_PREV = _est.slot("ES_NAV_ARM_PREV", 6)  # C (w x r), C r at the previous sample (NaN)
+N_NAV_WORK = 2 * N_NAV * N_NAV + 14 * N_NAV + 6  # P, its scratch, the updates' work, f (CM, sensor)
+ES_NAV_WORK = _est.slot("ES_NAV_WORK", N_NAV_WORK)  # nav-ekf's work space (no allocation)
 NEST = _est.end("NEST")
 
 # ==========================================================================

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, StrictBool, field_validator
 
 from quadimpact.core import layout as L
 from quadimpact.inputs.registry import Registry
@@ -250,7 +250,12 @@ class NavEkfParams(EstimatorParams):
         None, ge=0, description="m/sqrt(s); None: the barometer's, at least 1e-4."
     )
     range_noise_floor_m: Real = Field(0.01, gt=0, description="Least rangefinder noise, m.")
-    flow_noise_floor_rad_s: Real = Field(0.05, gt=0, description="Least flow noise, rad/s.")
+    flow_noise_floor_rad_s: Real = Field(
+        0.8,
+        gt=0,
+        description="Least flow noise the filter fuses with, rad/s: above the sensor's "
+        "(0.15-0.5), a smoother velocity for the law to hold (docs/ESTIMATION.md 9).",
+    )
     mag_gate_sigma: Real = Field(3.0, ge=0, description="Magnetometer gate (0: none).")
     baro_gate_sigma: Real = Field(5.0, ge=0, description="Barometer gate (0: none).")
     range_gate_sigma: Real = Field(5.0, ge=0, description="Rangefinder gate (0: none).")
@@ -265,6 +270,23 @@ class NavEkfParams(EstimatorParams):
         45.0, gt=0, lt=90, description="Range and flow fused only within this tilt, deg."
     )
     min_flow_height_m: Real = Field(0.1, ge=0, description="Flow fused only above this, m.")
+    imu_lever_arm: Literal["sensor", "none"] = Field(
+        "sensor",
+        description="'sensor': the IMU's offset from the CM removed from its specific force "
+        "(the rotation's centripetal and tangential parts); 'none': the IMU taken at the CM.",
+    )
+    reacquire_inflation: Literal["excess", "innovation"] = Field(
+        "excess",
+        description="At a re-acquisition, raise the states' variance by the innovation's "
+        "excess over its predicted spread ('excess': nothing when the estimate is still "
+        "consistent) or by the whole innovation squared ('innovation').",
+    )
+    flow_delay_compensation: StrictBool = Field(
+        False,
+        description="Predict each flow sample from the current estimate carried back to its "
+        "image's capture time (the correction applied now); false: from the current estimate "
+        "(the default: no measured gain, docs/ESTIMATION.md 2.6).",
+    )
     initial_attitude_std_deg: Real | None = Field(
         None, gt=0, description="Initial std, deg; None: the initial error's std, at least 0.5."
     )

@@ -211,6 +211,10 @@ def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     e[L.EC_NAV_REACQUIRE] = p.reacquire_after_s
     e[L.EC_NAV_MAX_TILT] = math.cos(math.radians(p.max_tilt_deg))
     e[L.EC_NAV_MIN_HEIGHT] = p.min_flow_height_m
+    if p.imu_lever_arm == "sensor":
+        e[L.EC_NAV_LEVER : L.EC_NAV_LEVER + 3] = imu.position_m
+    e[L.EC_NAV_DELAYED] = 1.0 if p.flow_delay_compensation else 0.0
+    e[L.EC_NAV_REACQ_EXCESS] = 1.0 if p.reacquire_inflation == "excess" else 0.0
     e[L.EC_P0] = math.radians(
         _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
     )

@@ -9,7 +9,7 @@ state, 16 numbers (``N_NAV``; covariance ``est[ES_NAV_P]``, row-major)::
 
 with ``q = q_hat (x) exp(dtheta)`` (``dtheta`` in body axes).
 
-Prediction at each IMU sample (``w_hat = w - b_g``, ``f_hat = f - b_a``,
+Prediction at each IMU sample (``w_hat = w - b_g``, ``f_hat = f_cm - b_a``,
 ``dt`` since the last sample): strapdown, ``q_hat <- q_hat (x) exp(w_hat dt)``
 and ``navigation.py``'s integration of ``C_hat f_hat + g e_Z``; the
 covariance with::
@@ -19,7 +19,22 @@ covariance with::
                [0,                 I dt, 0, 0,  0,        0], 0 ...]
     Q   = diag(s_g^2 dt^2 I, s_a^2 dt^2 I, 0, s_wg^2 dt I, s_wa^2 dt I, s_wb^2 dt)
 
-(the ``ekf``'s conventions: ``s_g``, ``s_a`` the noises per sample). The
+(the ``ekf``'s conventions: ``s_g``, ``s_a`` the noises per sample).
+
+**The IMU's lever arm.** The accelerometer sits at ``r`` from the CM (body
+axes, ``EC_NAV_LEVER``: the IMU's position, or 0 with ``imu_lever_arm =
+"none"``) and reads the specific force of that point, ``f = f_cm + w_dot x r
++ w x (w x r)``. In a tumble at 15 rad/s with the Navi's 5-cm offset the
+centripetal part alone is 11 m/s^2. The filter's velocity and position are
+the CM's. Integrating ``f`` gives the IMU point's, ``v_s = v + C (w x r)``
+and ``p_s = p + C r`` (since ``d/dt C (w x r) = C (w_dot x r + w x (w x
+r))``, exactly), so each sample integrates ``f`` and then moves ``v`` by
+``-(C (w x r))`` and ``p`` by ``-(C r)``, each less its value at the previous
+sample (``w = w_gyro - b_g``). The sum telescopes: no angular acceleration is
+needed and no discretisation error is added, however fast the tumble. The
+covariance's Jacobian and the gravity update read ``f_cm = f - w_dot x r -
+w x (w x r)`` (``w_dot`` from two consecutive samples); the impact and
+clipping tests the sensor's own ``f``. The
 IMU's impact disturbance grows ``s_g`` and ``s_a`` after each impact the
 filter sees, as in the ``ekf`` (``ekf.impact_noise_factor``). While an axis
 of the gyro reads at its range, the reading is clipped: that sample's ``s_g``
@@ -38,11 +53,22 @@ injection of the correction into the nominal state), at each IMU sample:
   estimated tilt is within ``EC_NAV_MAX_TILT``; the sample's own noise
   (``noise_m``), at least ``EC_NAV_RANGE``;
 * optical flow: the raw flow compensated with the gyro at the image's
-  capture time (the gyro history ``ES_NAV_RING``), ``c = flow + (p, q) =
+  capture time (the history ``ES_NAV_RING``), ``c = flow + (p, q) =
   (v_By, -v_Bx) C_22 / h`` with ``v_B = C^T v`` and ``h = -p_z`` the
   estimated height, at each new sample of quality > 0 while the tilt is
   within ``EC_NAV_MAX_TILT`` and ``h > EC_NAV_MIN_HEIGHT``; the sample's own
-  noise (``noise_rad_s``), at least ``EC_NAV_FLOW``.
+  noise (``noise_rad_s``), at least ``EC_NAV_FLOW``. **Delay**: the image
+  was taken ``delay`` before it arrives (20 ms by default). With
+  ``EC_NAV_DELAYED`` the predicted flow, its Jacobian and the tilt test use
+  the current estimate carried back to the capture time by the prediction
+  alone: the history keeps each sample's prediction increments (velocity,
+  attitude, height), and the increments since the capture are undone. So
+  the innovation compares like with like (the vehicle's own motion over the
+  delay is removed), and every correction made since the capture is kept
+  (an estimate stored at the capture time would miss them and count the
+  later samples twice). The correction goes to the current estimate; over
+  20 ms the error state hardly moves, so the current covariance stands for
+  the delayed one.
 
 Gates: each aiding update (magnetometer, barometer, rangefinder, flow) is
 refused when its normalised innovation squared ``y^T S^-1 y`` exceeds
@@ -56,6 +82,9 @@ without the gate. So the gate can never lock a source out for longer than
 ``EC_NAV_REACQUIRE``, and after a dropout the estimate jumps to the source
 instead of creeping towards it with the gain of a covariance that did not
 see the impact.
+
+Work space: the covariance's and the updates' scratch live in the state
+(``ES_NAV_WORK``), so a sample allocates nothing.
 
 The measurements are read from the sensor components' blocks of the
 measurement record (``core.sensors.registry.measurement_address``); a
@@ -76,12 +105,15 @@ from quadimpact.core.layout import (
     EC_INIT_BIAS_ZERO,
     EC_NAV_ACC_WALK,
     EC_NAV_BARO,
+    EC_NAV_DELAYED,
     EC_NAV_FLOW,
     EC_NAV_GATES,
+    EC_NAV_LEVER,
     EC_NAV_MAX_TILT,
     EC_NAV_MIN_HEIGHT,
     EC_NAV_P0,
     EC_NAV_RANGE,
+    EC_NAV_REACQ_EXCESS,
     EC_NAV_REACQUIRE,
     EC_P0,
     EC_SIG_ACC,
@@ -91,6 +123,7 @@ from quadimpact.core.layout import (
     ES_ACC_BIAS,
     ES_BARO_BIAS,
     ES_BIAS,
+    ES_NAV_ARM_PREV,
     ES_NAV_COUNT,
     ES_NAV_FUSED_T,
     ES_NAV_NIS,
@@ -98,6 +131,8 @@ from quadimpact.core.layout import (
     ES_NAV_RING,
     ES_NAV_RING_AT,
     ES_NAV_SEEN,
+    ES_NAV_W_PREV,
+    ES_NAV_WORK,
     ES_POS,
     ES_Q,
     ES_SCRATCH,
@@ -109,6 +144,7 @@ from quadimpact.core.layout import (
     MS_MAG_T,
     N_NAV,
     N_NAV_RING,
+    N_NAV_RING_W,
     SC_BIAS,
     SC_MAG_FIELD,
     SC_RANGE_F,
@@ -183,9 +219,13 @@ def nav_init(m: Model, d: Data) -> None:
         est[ES_NAV_COUNT + k] = 0.0
     for k in range(4):
         est[ES_NAV_NIS + k] = np.nan
-    for k in range(3 * N_NAV_RING):
+    for k in range(N_NAV_RING_W * N_NAV_RING):
         est[ES_NAV_RING + k] = np.nan
     est[ES_NAV_RING_AT] = 0.0
+    for k in range(3):
+        est[ES_NAV_W_PREV + k] = np.nan
+    for k in range(6):
+        est[ES_NAV_ARM_PREV + k] = np.nan
 
 
 @allocating
@@ -204,9 +244,11 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
                 impact: float) -> None:  # fmt: skip
     """The covariance's prediction over ``dt`` (s) and the attitude's; ``A``: scratch 16 x 16.
 
-    ``C``: the attitude estimate's rotation before; ``impact``: the impact
-    disturbance's factor (``ekf.impact_noise_factor``). Velocity and position
-    are advanced by the caller.
+    ``f``: the specific force at the CM (0:3, m/s^2) and as the sensor read it
+    (3:6, for its range test); ``C``: the attitude estimate's rotation
+    before; ``impact``: the impact disturbance's factor
+    (``ekf.impact_noise_factor``). Velocity and position are advanced by the
+    caller.
     """
     n = N_NAV
     wx = w[0] - est[ES_BIAS]
@@ -284,7 +326,7 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
     # velocity error is inertial; a body axis's noise lands on all three)
     va = sa * sa
     for k in range(3):
-        if range_f > 0.0 and abs(f[k]) >= range_f:
+        if range_f > 0.0 and abs(f[3 + k]) >= range_f:
             va += range_f * range_f
     sw = ecfg[EC_SIG_WALK]
     swa = ecfg[EC_NAV_ACC_WALK]
@@ -404,6 +446,20 @@ def _inflate(P: np.ndarray, lo: int, hi: int, extra: float) -> None:
 
 
 @compiled
+def _spread(P: np.ndarray, W: np.ndarray, rows: int) -> float:
+    """The innovation's predicted spread, ``trace(H P H^T + R)`` (``W`` as :func:`nav_update`)."""
+    s = 0.0
+    for a in range(rows):
+        s += W[4, 3 + a]
+        for i in range(N_NAV):
+            hi = W[a, i]
+            if hi != 0.0:
+                for j in range(N_NAV):
+                    s += hi * P[i, j] * W[a, j]
+    return s
+
+
+@compiled
 def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int,
           ecfg: np.ndarray, lo: int, hi: int, scale: float) -> bool:  # fmt: skip
     """One aiding source's update through its gate, with the re-acquisition rule.
@@ -411,8 +467,11 @@ def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, W: np.ndarray, row
     A source none of whose samples was fused for ``EC_NAV_REACQUIRE`` s is
     re-acquired: the states ``lo..hi-1`` lose their cross-covariances and
     their variances grow by the innovation's norm squared times ``scale^2``
-    (the innovation in those states' units); the sample is then fused
-    without the gate. Returns whether the sample was fused.
+    (the innovation in those states' units); with ``EC_NAV_REACQ_EXCESS``
+    only by its excess over the predicted spread ``trace(H P H^T + R)``
+    (nothing, and the covariance kept, when the innovation is within it);
+    the sample is then fused without the gate. Returns whether the sample
+    was fused.
     """
     c = ES_NAV_COUNT + 3 * src
     if t - est[ES_NAV_FUSED_T + src] > ecfg[EC_NAV_REACQUIRE]:
@@ -420,7 +479,10 @@ def _fuse(t: float, src: int, est: np.ndarray, P: np.ndarray, W: np.ndarray, row
         e2 = 0.0
         for a in range(rows):
             e2 += y[a] * y[a]
-        _inflate(P, lo, hi, e2 * scale * scale)
+        if ecfg[EC_NAV_REACQ_EXCESS] > 0.5:
+            e2 -= _spread(P, W, rows)
+        if e2 > 0.0:
+            _inflate(P, lo, hi, e2 * scale * scale)
         est[ES_NAV_NIS + src] = nav_update(est, P, W, rows, 0.0)
         est[c + CNT_REACQUIRED] += 1.0
         est[ES_NAV_FUSED_T + src] = t
@@ -448,18 +510,22 @@ def _new_sample(est: np.ndarray, meas: np.ndarray, at: int, k: int) -> bool:
 
 
 @compiled
-def _rates_at(est: np.ndarray, t: float) -> tuple[float, float]:
-    """The bias-corrected body rates ``(p, q)`` (rad/s) of the gyro sample nearest ``t`` (s)."""
+def _ring_row(est: np.ndarray, t: float) -> int:
+    """The offset in ``est`` of the history's row nearest ``t`` (s), or -1 when it is empty.
+
+    A row: ``t``, the bias-corrected rates ``(p, q)`` (rad/s), then the
+    increments the sample's prediction made: velocity (3, m/s), the attitude's
+    rotation vector ``w_hat dt`` (3, rad, body) and ``p_z`` (m).
+    """
     best = -1
     gap = math.inf
     for k in range(N_NAV_RING):
-        tk = est[ES_NAV_RING + 3 * k]
+        at = ES_NAV_RING + N_NAV_RING_W * k
+        tk = est[at]
         if not np.isnan(tk) and abs(tk - t) < gap:
             gap = abs(tk - t)
-            best = k
-    if best < 0:
-        return 0.0, 0.0
-    return est[ES_NAV_RING + 3 * best + 1], est[ES_NAV_RING + 3 * best + 2]
+            best = at
+    return best
 
 
 @compiled
@@ -496,17 +562,40 @@ def _flow(t: float, est: np.ndarray, P: np.ndarray, W: np.ndarray, ecfg: np.ndar
 
     Fused when the sample is new, of quality > 0, the tilt within
     ``EC_NAV_MAX_TILT`` and the estimated height above ``EC_NAV_MIN_HEIGHT``.
+    With ``EC_NAV_DELAYED`` the prediction uses the estimate at the capture
+    time (the history's row; ``C`` is then overwritten with its rotation);
+    the correction goes to the current estimate.
     """
-    h = -est[ES_POS + 2]
-    c22 = C[2, 2]
     if not _new_sample(est, meas, FLOW_N, 2):
         return
-    if not (meas[FLOW_QUALITY] > 0.0 and c22 >= ecfg[EC_NAV_MAX_TILT]):
+    if not meas[FLOW_QUALITY] > 0.0:
         return
-    if not h > ecfg[EC_NAV_MIN_HEIGHT]:
-        return
-    p_cap, q_cap = _rates_at(est, meas[FLOW_CAPTURE])
+    row = _ring_row(est, meas[FLOW_CAPTURE])
+    p_cap, q_cap = 0.0, 0.0
+    h = -est[ES_POS + 2]
     v0, v1, v2 = est[ES_VEL], est[ES_VEL + 1], est[ES_VEL + 2]
+    if row >= 0:
+        p_cap, q_cap = est[row + 1], est[row + 2]
+        if ecfg[EC_NAV_DELAYED] > 0.5:
+            # undo the prediction's increments of the samples after the capture
+            qc = est[ES_SCRATCH : ES_SCRATCH + 4]
+            for a in range(4):
+                qc[a] = est[ES_Q + a]
+            k = (int(est[ES_NAV_RING_AT]) - 1) % N_NAV_RING
+            for _ in range(N_NAV_RING):
+                at = ES_NAV_RING + N_NAV_RING_W * k
+                if at == row:
+                    break
+                v0 -= est[at + 3]
+                v1 -= est[at + 4]
+                v2 -= est[at + 5]
+                h += est[at + 10]
+                rotate_by(qc, -est[at + 6], -est[at + 7], -est[at + 8])
+                k = (k - 1) % N_NAV_RING
+            dcm(qc, C)
+    c22 = C[2, 2]
+    if not (c22 >= ecfg[EC_NAV_MAX_TILT] and h > ecfg[EC_NAV_MIN_HEIGHT]):
+        return
     bx = C[0, 0] * v0 + C[1, 0] * v1 + C[2, 0] * v2
     by = C[0, 1] * v0 + C[1, 1] * v1 + C[2, 1] * v2
     bz = C[0, 2] * v0 + C[1, 2] * v1 + C[2, 2] * v2
@@ -534,20 +623,83 @@ def _flow(t: float, est: np.ndarray, P: np.ndarray, W: np.ndarray, ecfg: np.ndar
     _fuse(t, SRC_FLOW, est, P, W, 2, ecfg, I_V, I_V + 2, h / c22)
 
 
-@allocating
+@compiled
+def _at_cm(est: np.ndarray, ecfg: np.ndarray, w: np.ndarray, f: np.ndarray, dt: float,
+           out: np.ndarray) -> None:  # fmt: skip
+    """The specific force at the CM, ``f - w_dot x r - w x (w x r)``, into ``out[0:3]``.
+
+    ``w``, ``f``: the gyro (rad/s) and accelerometer (m/s^2) samples, body;
+    ``r = EC_NAV_LEVER`` (m, body); ``w_dot`` (rad/s^2) from the previous
+    sample's bias-corrected rate (0 at the first sample or ``dt = 0``). The
+    sensor's own ``f`` into ``out[3:6]``. Notes this sample's rate for the next.
+    """
+    r0, r1, r2 = ecfg[EC_NAV_LEVER], ecfg[EC_NAV_LEVER + 1], ecfg[EC_NAV_LEVER + 2]
+    w0 = w[0] - est[ES_BIAS]
+    w1 = w[1] - est[ES_BIAS + 1]
+    w2 = w[2] - est[ES_BIAS + 2]
+    a0 = a1 = a2 = 0.0
+    if dt > 0.0 and not np.isnan(est[ES_NAV_W_PREV]):
+        a0 = (w0 - est[ES_NAV_W_PREV]) / dt
+        a1 = (w1 - est[ES_NAV_W_PREV + 1]) / dt
+        a2 = (w2 - est[ES_NAV_W_PREV + 2]) / dt
+    est[ES_NAV_W_PREV] = w0
+    est[ES_NAV_W_PREV + 1] = w1
+    est[ES_NAV_W_PREV + 2] = w2
+    c0 = w1 * r2 - w2 * r1  # w x r
+    c1 = w2 * r0 - w0 * r2
+    c2 = w0 * r1 - w1 * r0
+    out[0] = f[0] - (a1 * r2 - a2 * r1) - (w1 * c2 - w2 * c1)
+    out[1] = f[1] - (a2 * r0 - a0 * r2) - (w2 * c0 - w0 * c2)
+    out[2] = f[2] - (a0 * r1 - a1 * r0) - (w0 * c1 - w1 * c0)
+    for k in range(3):
+        out[3 + k] = f[k]
+
+
+@compiled
+def _lever_offset(est: np.ndarray, ecfg: np.ndarray, C: np.ndarray) -> None:
+    """The IMU point's velocity and position made the CM's (module docstring).
+
+    ``v -= C (w x r) - (its previous value)``, ``p -= C r - (its previous
+    value)``, with ``w`` this sample's bias-corrected rate (``ES_NAV_W_PREV``,
+    written by :func:`_at_cm`) and ``C`` the attitude estimate's rotation
+    the integration used. Nothing moves at the first sample.
+    """
+    r0, r1, r2 = ecfg[EC_NAV_LEVER], ecfg[EC_NAV_LEVER + 1], ecfg[EC_NAV_LEVER + 2]
+    w0, w1, w2 = est[ES_NAV_W_PREV], est[ES_NAV_W_PREV + 1], est[ES_NAV_W_PREV + 2]
+    c0 = w1 * r2 - w2 * r1  # w x r
+    c1 = w2 * r0 - w0 * r2
+    c2 = w0 * r1 - w1 * r0
+    first = np.isnan(est[ES_NAV_ARM_PREV])
+    for a in range(3):
+        u = C[a, 0] * c0 + C[a, 1] * c1 + C[a, 2] * c2
+        s = C[a, 0] * r0 + C[a, 1] * r1 + C[a, 2] * r2
+        if not first:
+            est[ES_VEL + a] -= u - est[ES_NAV_ARM_PREV + a]
+            est[ES_POS + a] -= s - est[ES_NAV_ARM_PREV + 3 + a]
+        est[ES_NAV_ARM_PREV + a] = u
+        est[ES_NAV_ARM_PREV + 3 + a] = s
+
+
+@compiled
 def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
     """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
 
-    ``C``: scratch 3x3 (the estimate's rotation on return).
+    ``C``: scratch 3x3 (the estimate's rotation on return). Allocates nothing:
+    its work space is ``est[ES_NAV_WORK]``.
     """
     ecfg = m.ecfg
     est = d.est
     meas = d.meas
     g = m.veh[V_GRAVITY]
     n = N_NAV
-    W = np.empty((2, n, n))
+    nn = 2 * n * n
+    W = est[ES_NAV_WORK : ES_NAV_WORK + nn].reshape((2, n, n))
     P, A = W[0], W[1]
-    Wu = np.zeros((14, n))  # the updates' work: H, y and r, scratch (nav_update)
+    Wu = est[ES_NAV_WORK + nn : ES_NAV_WORK + nn + 14 * n].reshape((14, n))
+    for i in range(14):  # the updates' work: H, y and r, scratch (nav_update)
+        for j in range(n):
+            Wu[i, j] = 0.0
+    fc = est[ES_NAV_WORK + nn + 14 * n : ES_NAV_WORK + nn + 14 * n + 6]
     H, y, r = Wu[0:4], Wu[4, 0:3], Wu[4, 3:6]
     for i in range(n):
         for j in range(n):
@@ -557,22 +709,33 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
             est[ES_NAV_FUSED_T + k] = t  # the initial estimate counts as fused
     f = meas[MS_IMU_F : MS_IMU_F + 3]
     w = meas[MS_IMU_W : MS_IMU_W + 3]
-    # the gyro's history (for the flow's capture time)
+    # the history (the flow's capture time): this sample's rates, its prediction's increments
     at = int(est[ES_NAV_RING_AT])
-    est[ES_NAV_RING + 3 * at] = t
-    est[ES_NAV_RING + 3 * at + 1] = w[0] - est[ES_BIAS]
-    est[ES_NAV_RING + 3 * at + 2] = w[1] - est[ES_BIAS + 1]
+    row = ES_NAV_RING + N_NAV_RING_W * at
+    est[row] = t
+    est[row + 1] = w[0] - est[ES_BIAS]
+    est[row + 2] = w[1] - est[ES_BIAS + 1]
+    for k in range(3, 6):
+        est[row + k] = est[ES_VEL + k - 3]  # the velocity before (made an increment below)
+    est[row + 10] = est[ES_POS + 2]
     est[ES_NAV_RING_AT] = (at + 1) % N_NAV_RING
+    _at_cm(est, ecfg, w, f, dt, fc)
     q = est[ES_Q : ES_Q + 4]
     dcm(q, C)
     impact = impact_noise_factor(t, f, ecfg, est)
     if dt > 0.0:
         for a in range(3):
-            y[a] = f[a] - est[ES_ACC_BIAS + a]  # f - b_a before the prediction
-        nav_predict(est, P, A, ecfg, m.scfg, w, f, dt, C, impact)
+            y[a] = f[a] - est[ES_ACC_BIAS + a]  # f - b_a before the prediction (IMU point)
+        nav_predict(est, P, A, ecfg, m.scfg, w, fc, dt, C, impact)
         dcm(q, C)
         integrate_navigation(est, C, y, g, dt)
-    _gravity(est, P, Wu, ecfg, f, g, C, impact)
+    dcm(q, C)
+    _lever_offset(est, ecfg, C)
+    for a in range(3):
+        est[row + 3 + a] = est[ES_VEL + a] - est[row + 3 + a]
+        est[row + 6 + a] = est[ES_NAV_W_PREV + a] * dt
+    est[row + 10] = est[ES_POS + 2] - est[row + 10]
+    _gravity(est, P, Wu, ecfg, fc, g, C, impact)
     dcm(q, C)
     # magnetometer: m = C^T m_I (H_theta = [u_m x], u_m = C^T m_I)
     if meas[MS_MAG_T] == t:
