@@ -115,7 +115,7 @@ def test_the_reward_is_the_benchmarks_held_hover_success_plus_height_kept():
         (_summary(crash_time_s=1.2), False),  # the ground touched
         (_summary(touched_after_hover=True), False),
         (_summary(bumper_model_valid=False), False),  # invalid: scores 0
-        (_summary(status="failed", reason="x"), False),  # a numerical failure: no hover
+        (_summary(status="failed", reason="x", held_hover=None), False),  # a numerical failure
         (None, False),  # a trial that could not be prepared
     ]
     r, s = rewards([c[0] for c in cases], [5.0] * len(cases), 0.1)
