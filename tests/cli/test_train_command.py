@@ -83,3 +83,28 @@ def test_train_refuses_bad_options_in_one_line(tmp_path):
                          env=_env(), capture_output=True, text=True, timeout=300)  # fmt: skip
     assert res.returncode == 2 and "--tasks: unknown task 'roof'" in res.stderr
     assert not (tmp_path / "x").exists()
+
+
+def test_run_flies_a_policy_file_given_by_its_flag(tmp_path):
+    """``quadimpact run --policy FILE`` is ``--param policy=FILE``: the run records the file,
+    and a strong policy of every stage flies another trajectory than the law."""
+    import numpy as np
+
+    from quadimpact.inputs.policy_file import initial_policy, save_policy
+
+    p = initial_policy(8, 0.3, 4.0, seed=3, last_stage=5)
+    p = p.with_vector(np.random.default_rng(3).normal(0, 1.0, p.vector().size))
+    path = save_policy(p, tmp_path / "my policy.npz")
+    trial = tmp_path / "trial.toml"
+    trial.write_text('kind = "impact-trial"\nvehicle = "navi"\ncontroller = "recovery"\n'
+                     'pitch_deg = -20.0\nspeed_m_s = 1.5\nfinal_time_s = 1.0\n')  # fmt: skip
+    heights = []
+    for extra, name in (([], "law"), (["--policy", str(path)], "policy")):
+        res = subprocess.run(_cli("run", str(trial), *extra, "--out", str(tmp_path / name)),
+                             env=_env(), capture_output=True, text=True, timeout=600)  # fmt: skip
+        assert res.returncode == 0, res.stderr
+        summary = json.loads((tmp_path / name / "summary.json").read_text())
+        heights.append(summary["final_altitude_m"])
+    scenario = json.loads((tmp_path / "policy" / "scenario.json").read_text())
+    assert scenario["scenario"]["controller_params"]["policy"] == str(path)
+    assert heights[0] != heights[1]

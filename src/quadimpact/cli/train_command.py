@@ -155,6 +155,7 @@ def train(
     click.echo(
         f"wrote {out / 'policy.npz'}: check-set success {100 * res.best_check:.1f} % "
         f"(generation {res.best_generation}; the law {100 * res.law_check:.1f} %), "
-        f"{res.generations} generations{again}, {res.runs} runs, {res.minutes:.1f} min"
+        f"{res.generations} generation{'s' if res.generations != 1 else ''}{again}, "
+        f"{res.runs} runs, {res.minutes:.1f} min"
     )
     click.echo(f"fly it: quadimpact benchmark --quick --policy {out / 'policy.npz'}")
