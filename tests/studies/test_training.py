@@ -236,3 +236,16 @@ print(json.dumps({{"status": r["status"], "detected": r["detected"],
     got = json.loads(res.stdout.strip().splitlines()[-1])
     assert got["status"] != "failed" and got["detected"]
     assert not got["cma"] and not got["torch"]
+
+
+def test_one_training_run_at_a_time_in_a_folder(tmp_path):
+    """A second trainer in a folder another one holds is refused (the lock is released
+    when the first ends)."""
+    from quadimpact.studies.training import trainer
+
+    with trainer._folder_lock(tmp_path):
+        with pytest.raises(InputError, match="another quadimpact train is running in it"):
+            trainer.train(_problem(), trainer.Settings(**_SMALL), tmp_path, None, 1,
+                          progress=False)  # fmt: skip
+    with trainer._folder_lock(tmp_path):
+        pass

@@ -14,9 +14,10 @@ numbers, are the optimiser's parameters. They are trained by CMA-ES (the
 
 Each generation CMA-ES proposes ``popsize`` candidate weight vectors; each
 flies the same ``batch`` fresh training trials (the problem's tasks in turn,
-:mod:`quadimpact.studies.training.trials`: never the benchmark's) and scores
-the mean reward (:func:`quadimpact.studies.training.flying.rewards`: the
-benchmark's success plus a little height kept). Every ``check_every``
+:mod:`quadimpact.studies.training.trials`: never the benchmark's; the law
+flies them too, the curve's yardstick) and scores the mean reward
+(:func:`quadimpact.studies.training.flying.rewards`: the benchmark's success
+plus a little height kept). Every ``check_every``
 generations the distribution's mean flies a fixed check set (other trials of
 the same problem), and the best on it is the policy written.
 
@@ -38,6 +39,7 @@ on its saved state, so a resumed run continues the same sequence.
 
 from __future__ import annotations
 
+import contextlib
 import csv
 import io
 import json
@@ -47,6 +49,7 @@ import pickle
 import signal
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -63,9 +66,9 @@ __all__ = ["STATE_FILE", "Settings", "TrainingResult", "load_state", "train"]
 STATE_FILE = "state.pkl"
 STATE_VERSION = 1
 #: The files a training folder holds (a folder with others is refused for a new run).
-OWN_FILES = ("state.pkl", "policy.npz", "curve.csv", "curve.png", "train.json")
-CURVE_COLUMNS = ("generation", "runs", "minutes", "batch_mean", "batch_best", "sigma",
-                 "check_success", "check_score")  # fmt: skip
+OWN_FILES = ("state.pkl", "policy.npz", "curve.csv", "curve.png", "train.json", "train.lock")
+CURVE_COLUMNS = ("generation", "runs", "minutes", "batch_mean", "batch_best", "batch_law",
+                 "sigma", "check_success", "check_score")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -287,8 +290,9 @@ def _fmt(v: Any) -> str:
 
 
 def plot_curve(curve_csv: Path, png: Path) -> Path:
-    """The learning curve as a figure: each generation's mean and best batch score, and the
-    check set's success of the distribution's mean (the law's at generation 0)."""
+    """The learning curve as a figure: above, the check set's success of the distribution's
+    mean against the law's (generation 0); below, each generation's mean candidate reward
+    minus the law's on the same training trials, and its 5-generation mean."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -296,22 +300,28 @@ def plot_curve(curve_csv: Path, png: Path) -> Path:
     import pandas as pd
 
     c = pd.read_csv(curve_csv)
-    fig, ax = plt.subplots(figsize=(7.0, 3.6), constrained_layout=True)
-    batch = c.dropna(subset=["batch_mean"])
-    ax.plot(batch["generation"], batch["batch_mean"], color="0.6", lw=1,
-            label="training batch: mean reward of the candidates")  # fmt: skip
-    ax.plot(batch["generation"], batch["batch_best"], color="0.3", lw=1, ls=":",
-            label="training batch: best candidate")  # fmt: skip
+    fig, (top, low) = plt.subplots(2, 1, figsize=(7.0, 5.2), sharex=True,
+                                   constrained_layout=True)  # fmt: skip
     check = c.dropna(subset=["check_success"])
     if len(check):
-        ax.plot(check["generation"], check["check_success"], "o-", color="C0", ms=3,
-                label="check set: success (the benchmark's)")  # fmt: skip
-        ax.axhline(check["check_success"].iloc[0], color="C3", ls="--", lw=1,
-                   label="the staged law on the check set")  # fmt: skip
-    ax.set_xlabel("generation")
-    ax.set_ylabel("share / reward")
-    ax.legend(fontsize=8, loc="lower right")
-    ax.grid(alpha=0.3)
+        top.plot(check["generation"], check["check_success"], "o-", color="C0", ms=3,
+                 label="the policy (CMA-ES's mean): success on the check set")  # fmt: skip
+        top.axhline(check["check_success"].iloc[0], color="C3", ls="--", lw=1,
+                    label="the staged law on the check set")  # fmt: skip
+    top.set_ylabel("benchmark success")
+    top.legend(fontsize=8, loc="lower right")
+    top.grid(alpha=0.3)
+    batch = c.dropna(subset=["batch_mean"])
+    gain = batch["batch_mean"] - batch["batch_law"]
+    low.plot(batch["generation"], gain, ".-", color="0.7", lw=0.8, ms=3,
+             label="mean candidate minus the law, same trials")  # fmt: skip
+    low.plot(batch["generation"], gain.rolling(5, min_periods=1).mean(), color="0.2", lw=1.5,
+             label="the same, 5-generation mean")  # fmt: skip
+    low.axhline(0.0, color="C3", ls="--", lw=1)
+    low.set_xlabel("generation")
+    low.set_ylabel("training reward\nminus the law's")
+    low.legend(fontsize=8, loc="lower right")
+    low.grid(alpha=0.3)
     fig.savefig(png, dpi=110)
     plt.close(fig)
     return png
@@ -366,9 +376,6 @@ def train(
     the last whole generation reached (``policy.npz`` included) and raises
     :class:`quadimpact.sweep.SweepInterrupted` with how to resume.
     """
-    from quadimpact.sweep import SweepInterrupted
-    from quadimpact.sweep.interrupt import stop_signals
-
     if minutes is None and generations is None:
         raise InputError("--minutes or --generations: give a budget")
     if minutes is not None and not (math.isfinite(minutes) and minutes > 0):
@@ -377,6 +384,35 @@ def train(
         raise InputError(f"--generations: must be >= 1 (got {generations})")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    with _folder_lock(out):
+        return _train(problem, settings, out, minutes, generations, workers, progress, stream)
+
+
+@contextlib.contextmanager
+def _folder_lock(out: Path) -> Iterator[None]:
+    """One training run at a time in a folder (``train.lock``, an advisory lock; none where
+    the system has no ``fcntl``)."""
+    try:
+        import fcntl
+    except ImportError:  # not on this system: no lock
+        yield
+        return
+    with open(out / "train.lock", "a") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise InputError(f"--out {out}: another quadimpact train is running in it") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _train(problem, settings, out, minutes, generations, workers, progress, stream):
+    """:func:`train` in its folder, locked."""
+    from quadimpact.sweep import SweepInterrupted
+    from quadimpact.sweep.interrupt import stop_signals
+
     state = load_state(out)
     if state is None:
         others = sorted(p.name for p in out.iterdir() if p.name not in OWN_FILES)
@@ -457,15 +493,15 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     gen = state["generation"] + 1
     xs = es.ask()
     trials = problem.batch(PURPOSE_TRAIN, (gen - 1) * settings.batch, settings.batch)
-    blocks = [pol.with_vector(x).block() for x in xs]
+    blocks = [None] + [pol.with_vector(x).block() for x in xs]  # the law first: a yardstick
     r, _ = evaluate(trials, blocks, settings.shaping)
-    scores = r.mean(axis=1)
+    law, scores = float(r[0].mean()), r[1:].mean(axis=1)
     es.tell(xs, [-float(v) for v in scores])
     state["generation"] = gen
     state["runs"] += len(blocks) * len(trials)
     row = {"generation": gen, "runs": state["runs"], "minutes": elapsed(),
            "batch_mean": float(scores.mean()), "batch_best": float(scores.max()),
-           "sigma": float(es.sigma)}  # fmt: skip
+           "batch_law": law, "sigma": float(es.sigma)}  # fmt: skip
     state["curve"].append(row)
     if gen % settings.check_every == 0:
         _check(state, problem, settings, evaluate, check_trials)
