@@ -249,3 +249,25 @@ def test_one_training_run_at_a_time_in_a_folder(tmp_path):
                           progress=False)  # fmt: skip
     with trainer._folder_lock(tmp_path):
         pass
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("task_name", ["wall", "pole"])
+def test_the_trainers_success_is_the_benchmarks_on_the_same_trials(tmp_path, task_name):
+    """The benchmark's first trials of a task, flown by the benchmark's sweep and table
+    (cell_table) and by the trainer (fly_job): the same success, trial by trial."""
+    from quadimpact.studies.benchmark.cells import cell_table
+    from quadimpact.studies.benchmark.subject import Subject
+    from quadimpact.studies.benchmark.suite import TASKS, sensor_set
+    from quadimpact.studies.training.trainer import fly_job
+    from quadimpact.sweep import read_runs, run_sweep
+
+    task = TASKS[task_name]
+    spec = Subject("default").spec(task, True, sensor_set("lab"), limit=12)
+    run_sweep(spec, tmp_path / "sweep", workers=1)
+    table = cell_table(read_runs(tmp_path / "sweep"), spec, task)
+    trials = [(task_name, spec.scenario_dict(i)) for i in range(spec.n_runs)]
+    _, success = fly_job((trials, [None], 0.1))
+    want = table.sort_values("run_id")["success"].to_numpy(dtype=bool)
+    assert list(success[0]) == list(want)
+    assert 0 < want.sum() < len(want)  # successes and failures both compared
