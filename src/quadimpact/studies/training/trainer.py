@@ -309,7 +309,7 @@ def plot_curve(curve_csv: Path, png: Path) -> Path:
         top.axhline(check["check_success"].iloc[0], color="C3", ls="--", lw=1,
                     label="the staged law on the check set")  # fmt: skip
     top.set_ylabel("benchmark success")
-    top.legend(fontsize=8, loc="lower right")
+    top.legend(fontsize=8, loc="best", framealpha=0.8)
     top.grid(alpha=0.3)
     batch = c.dropna(subset=["batch_mean"])
     gain = batch["batch_mean"] - batch["batch_law"]
@@ -320,7 +320,7 @@ def plot_curve(curve_csv: Path, png: Path) -> Path:
     low.axhline(0.0, color="C3", ls="--", lw=1)
     low.set_xlabel("generation")
     low.set_ylabel("training reward\nminus the law's")
-    low.legend(fontsize=8, loc="lower right")
+    low.legend(fontsize=8, loc="best", framealpha=0.8)
     low.grid(alpha=0.3)
     fig.savefig(png, dpi=110)
     plt.close(fig)
