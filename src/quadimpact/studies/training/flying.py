@@ -98,6 +98,7 @@ def rewards(
     """
     import pandas as pd
 
+    from quadimpact import libm
     from quadimpact.studies.benchmark.cells import held_hover_success
     from quadimpact.studies.trial_analysis import model_valid
 
@@ -113,7 +114,7 @@ def rewards(
     t["valid"] = model_valid(t) & prepared
     success = held_hover_success(t) if n else np.zeros(0, dtype=bool)
     lost = t["height_lost_m"].to_numpy(dtype=float)
-    kept = np.where(np.isfinite(lost), np.exp(-np.maximum(lost, 0.0)), 0.0)
+    kept = np.where(np.isfinite(lost), libm.exp(-np.maximum(lost, 0.0)), 0.0)  # same on any CPU
     reward = np.where(t["valid"].to_numpy(dtype=bool), success + shaping * kept, 0.0)
     return reward.astype(float), success.astype(bool)
 
