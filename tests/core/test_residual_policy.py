@@ -48,8 +48,10 @@ def _meas(q: np.ndarray, normal=(-1.0, 0.0, 0.0), t_detect: float = 0.1) -> np.n
     return meas
 
 
-def _random_policy(seed: int, hidden: int = 8, scale: float = 1.0) -> PolicyWeights:
-    p = initial_policy(hidden, 0.3, 4.0, seed)
+def _random_policy(
+    seed: int, hidden: int = 8, scale: float = 1.0, last_stage: int = 4
+) -> PolicyWeights:
+    p = initial_policy(hidden, 0.3, 4.0, seed, last_stage)
     rng = np.random.default_rng(seed + 1)
     return p.with_vector(rng.normal(0.0, scale, p.vector().size))
 
@@ -146,17 +148,21 @@ def test_a_policy_changes_the_flight_only_after_the_detection(tmp_path):
     assert not law[cols].equals(res[cols])
 
 
-@pytest.mark.parametrize(("stage", "acts"), [(1, True), (3, True), (5, False)])
-def test_the_residual_acts_until_the_recovery_and_leaves_the_hover_to_the_law(stage, acts):
+@pytest.mark.parametrize(
+    ("stage", "last_stage", "acts"),
+    [(1, 4, True), (3, 4, True), (5, 4, False), (1, 5, True), (4, 5, True), (5, 5, True)],
+)
+def test_the_residual_acts_in_its_stages_and_leaves_the_others_to_the_law(stage, last_stage, acts):
     """One tick of recovery_step in a stage, with and without a strong policy: the commands
-    differ in stages 1-4 and are the same in stage 5 (the law's return to hover)."""
+    differ in stages 1-4, and in stage 5 (the law's return to hover) only for a policy whose
+    last stage is 5."""
     from quadimpact.core import controller_layout as CL
     from quadimpact.core.controllers.recovery import recovery_step
     from quadimpact.simulation.setup import prepare
 
     setup = prepare(_trial())
     cmds = []
-    for policy in (None, _random_policy(7, hidden=16, scale=3.0)):
+    for policy in (None, _random_policy(7, hidden=16, scale=3.0, last_stage=last_stage)):
         ctrl = setup.ctrl.copy()
         if policy is not None:
             block = policy.block()
@@ -197,9 +203,28 @@ def test_a_policy_file_round_trips_with_its_digest(tmp_path):
     assert _random_policy(5).sha256 != p.sha256
 
 
+def test_the_last_stage_round_trips_and_is_part_of_the_identity(tmp_path):
+    """A file without ``last_stage`` (every file before it existed) reads as 4, with the
+    digest it always had; 5 is saved, read back, and makes another policy."""
+    p4 = _random_policy(6)
+    p5 = _random_policy(6, last_stage=5)
+    np.testing.assert_array_equal(p4.vector(), p5.vector())
+    assert p4.sha256 != p5.sha256
+    q5 = load_policy(save_policy(p5, tmp_path / "p5.npz"))
+    assert q5.last_stage == 5 and q5.sha256 == p5.sha256
+    assert q5.block()[CL.PB_LAST_STAGE] == 5.0 and p4.block()[CL.PB_LAST_STAGE] == 4.0
+    old = {"w1": p4.w1, "b1": p4.b1, "w2": p4.w2, "b2": p4.b2,
+           "thrust_scale": np.float64(0.3), "rate_scale_rad_s": np.float64(4.0)}  # fmt: skip
+    np.savez(tmp_path / "old.npz", **old)
+    q4 = load_policy(tmp_path / "old.npz")
+    assert q4.last_stage == 4 and q4.sha256 == p4.sha256
+
+
 @pytest.mark.parametrize(
     ("arrays", "rule"),
     [
+        ({"last_stage": np.int64(3)}, "last_stage: must be one number, 4 or 5 (got 3)"),
+        ({"last_stage": np.array([5, 5])}, "last_stage: must be one number, 4 or 5"),
         ({"w1": np.zeros((4, 23))}, "w1: must be (4, 24)"),
         ({"b2": np.zeros(2)}, "b2: must be (3,)"),
         ({"w1": np.zeros((40, 24)), "b1": np.zeros(40), "w2": np.zeros((3, 40))}, "<= 32"),

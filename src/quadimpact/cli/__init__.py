@@ -8,6 +8,7 @@
 * :mod:`~quadimpact.cli.pole_command`: ``quadimpact pole``;
 * :mod:`~quadimpact.cli.estimators_command`: ``quadimpact estimators``;
 * :mod:`~quadimpact.cli.benchmark_command`: ``quadimpact benchmark``;
+* :mod:`~quadimpact.cli.train_command`: ``quadimpact train``;
 * :mod:`~quadimpact.cli.viz_commands`: ``quadimpact animate``, ``snapshots``, ``view``;
 * :mod:`~quadimpact.cli.compile_command`: ``quadimpact compile``;
 * :mod:`~quadimpact.cli.options`: options shared by several commands.
@@ -40,6 +41,7 @@ from quadimpact.cli.recovery_command import recovery
 from quadimpact.cli.reproduce_command import reproduce
 from quadimpact.cli.run_command import build_scenario, format_summary, run
 from quadimpact.cli.sweep_command import sweep
+from quadimpact.cli.train_command import train
 from quadimpact.cli.viz_commands import animate, snapshots, view
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
@@ -106,6 +108,7 @@ _COMMANDS = (
     pole,
     estimators,
     benchmark,
+    train,
 )
 for _command in (*_COMMANDS, compile_command):
     cli.add_command(_command)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -17,6 +18,7 @@ from quadimpact.cli.options import (
     number_option,
     out_option,
     plugin_option,
+    policy_option,
 )
 from quadimpact.errors import InputError, input_error_from_validation, one_line
 
@@ -172,6 +174,7 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "scenario file does, e.g. --controller recovery --param k_att_1_s=25 "
     "(docs/RECOVERY.md 3.5, docs/CONTROLLERS.md).",
 )
+@policy_option
 @click.option(
     "--controller",
     type=CONTROLLER,
@@ -230,6 +233,7 @@ def run(
     kind: str | None,
     viz: bool,
     max_record_mb: float,
+    policy: str | None,
     **flags: Any,
 ) -> None:
     """Simulate one scenario and write its results to --out.
@@ -264,6 +268,8 @@ def run(
     """
     from quadimpact.results.files import check_out_dir
 
+    if policy is not None:  # the same as --param policy=FILE (the recovery controller's)
+        params = (*params, f"policy={json.dumps(policy)}")
     built = build_scenario(scenario, flags, options, params=params, kind=kind)
     from quadimpact.simulation.checks import check_record_size  # the compiled geometry
 

@@ -173,7 +173,8 @@ class RecoveryParams(BaseModel):
     )
     policy: str | None = Field(
         None,
-        description="A learned residual on the law from the detection to the recovery: "
+        description="A learned residual on the law from the detection on (to the recovery, or "
+        "the hover too, as its file says): "
         "'learned' (the policy shipped with quadimpact) or a .npz policy file; None: the law "
         "alone.",
     )

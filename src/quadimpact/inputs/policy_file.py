@@ -1,12 +1,14 @@
 """Learned recovery policies: the residual network's weights in a ``.npz`` file.
 
 A policy file holds the arrays of the residual network that corrects the
-recovery law from the detection to the recovery (``core/controllers/residual.py``,
-docs/LEARNING.md section 12)::
+recovery law from the detection on (``core/controllers/residual.py``,
+docs/LEARNING.md sections 12 and 14)::
 
     w1 (nh, 24)   b1 (nh,)   w2 (3, nh)   b2 (3,)
     thrust_scale ()    the largest thrust correction, a fraction of m g
     rate_scale_rad_s () the largest roll and pitch rate-reference correction, rad/s
+    last_stage ()      optional: the last stage it acts in, 4 (the default: from the
+                       detection to the recovery) or 5 (the hover too)
     meta ()            optional: a JSON text of how it was trained
 
 ``--policy learned`` names the policy shipped with quadimpact
@@ -42,6 +44,10 @@ __all__ = [
     "save_policy",
 ]
 
+#: The stages a policy may act up to: 4 (from the detection to the recovery) or 5 (the
+#: hover too).
+LAST_STAGES = (4, 5)
+
 #: Policies shipped with quadimpact, by name: their files in ``inputs/policies/``.
 SHIPPED_POLICIES = {"learned": "learned.npz"}
 
@@ -60,6 +66,9 @@ class PolicyWeights:
         The largest thrust correction as a fraction of the hover thrust ``m g``.
     rate_scale_rad_s : float
         The largest roll and pitch rate-reference correction, rad/s.
+    last_stage : int
+        The last stage of the law it corrects: 4 (stages 1-4, the law alone
+        in the hover) or 5 (every stage from the detection on).
     meta : dict
         How the weights were made (training script, seeds, ...), as saved.
     sha256 : str
@@ -74,6 +83,7 @@ class PolicyWeights:
     b2: np.ndarray
     thrust_scale: float
     rate_scale_rad_s: float
+    last_stage: int = 4
     meta: dict = field(default_factory=dict)
     sha256: str = ""
     path: str = ""
@@ -110,8 +120,11 @@ class PolicyWeights:
         return _tanh(matvec(self.w2, h) + self.b2)
 
     def block(self) -> np.ndarray:
-        """The compiled loop's block ``[nh, s_T, s_w, W1, b1, W2, b2]`` (residual.py)."""
-        head = np.array([self.hidden, self.thrust_scale, self.rate_scale_rad_s], dtype=float)
+        """The compiled loop's block ``[nh, s_T, s_w, last stage, W1, b1, W2, b2]``
+        (residual.py)."""
+        head = np.array(
+            [self.hidden, self.thrust_scale, self.rate_scale_rad_s, self.last_stage], dtype=float
+        )
         return np.concatenate([head, self.vector()])
 
 
@@ -126,6 +139,8 @@ def _tanh(x: np.ndarray) -> np.ndarray:
 def _digest(p: PolicyWeights) -> str:
     h = hashlib.sha256(np.ascontiguousarray(p.vector(), dtype="<f8").tobytes())
     h.update(np.array([p.thrust_scale, p.rate_scale_rad_s], dtype="<f8").tobytes())
+    if p.last_stage != 4:  # a policy of stages 1-4 keeps the digest it had before last_stage
+        h.update(np.array([p.last_stage], dtype="<f8").tobytes())
     return h.hexdigest()
 
 
@@ -212,6 +227,13 @@ def load_policy(name: str | Path) -> PolicyWeights:
     for k in ("thrust_scale", "rate_scale_rad_s"):
         if float(w[k]) < 0:
             raise InputError(f"{where}: {k}: must be >= 0 (got {float(w[k])})")
+    last_stage = 4
+    if "last_stage" in arrays:
+        raw = np.asarray(arrays["last_stage"])
+        if raw.shape != () or raw.dtype.kind not in "iuf" or float(raw) not in LAST_STAGES:
+            got = raw.tolist()
+            raise InputError(f"{where}: last_stage: must be one number, 4 or 5 (got {got!r})")
+        last_stage = int(raw)
     meta: dict = {}
     if "meta" in arrays:
         try:
@@ -225,6 +247,7 @@ def load_policy(name: str | Path) -> PolicyWeights:
         w["b2"],
         float(w["thrust_scale"]),
         float(w["rate_scale_rad_s"]),
+        last_stage=last_stage,
         meta=meta,
         path=str(path),
     )
@@ -244,6 +267,7 @@ def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
         b2=policy.b2,
         thrust_scale=np.float64(policy.thrust_scale),
         rate_scale_rad_s=np.float64(policy.rate_scale_rad_s),
+        last_stage=np.int64(policy.last_stage),
         meta=np.array(json.dumps(policy.meta, sort_keys=True)),
     )
     tmp.replace(path)
@@ -251,10 +275,13 @@ def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
 
 
 def initial_policy(
-    hidden: int, thrust_scale: float, rate_scale_rad_s: float, seed: int
+    hidden: int, thrust_scale: float, rate_scale_rad_s: float, seed: int, last_stage: int = 4
 ) -> PolicyWeights:
     """A new policy that flies the law exactly: random ``w1`` (scale 1/sqrt(24)), a zero
-    output layer (``seed``: of ``w1``'s draw; the scales as :class:`PolicyWeights`')."""
+    output layer (``seed``: of ``w1``'s draw; the scales and ``last_stage`` as
+    :class:`PolicyWeights`')."""
+    if last_stage not in LAST_STAGES:
+        raise InputError(f"policy: last_stage: must be 4 or 5 (got {last_stage})")
     if not 1 <= hidden <= MAX_HIDDEN:
         raise InputError(f"policy: hidden: must be in 1..{MAX_HIDDEN} (got {hidden})")
     for name, value in (("thrust_scale", thrust_scale), ("rate_scale_rad_s", rate_scale_rad_s)):
@@ -268,5 +295,6 @@ def initial_policy(
         np.zeros(N_OUTPUTS),
         float(thrust_scale),
         float(rate_scale_rad_s),
+        last_stage=int(last_stage),
     )
     return replace(p, sha256=_digest(p))

@@ -61,8 +61,9 @@ Euler-angle test of stage 2 the switch ``R_LEVEL_TEST`` (:func:`stage_tilt`).
 
 A learned residual (``ctrl[C_POLICY:]``, ``residual.py``) may correct the
 outer loop's thrust and roll and pitch rate references from the detection to
-the recovery (stages 1-4; stage 5's hover is the law's); with none (the
-default) the law is as above.
+the recovery (stages 1-4; stage 5's hover is the law's), or in every stage from
+the detection on, the hover included (its block's ``PB_LAST_STAGE`` 5); with
+none (the default) the law is as above.
 """
 
 import math
@@ -113,7 +114,7 @@ from quadimpact.core.controllers.cascade_pid import cascade_pid_step
 from quadimpact.core.controllers.common import allocate, linearised_torques
 from quadimpact.core.controllers.hover import hover_acceleration, yaw_of
 from quadimpact.core.controllers.paper import paper_step
-from quadimpact.core.controllers.residual import residual_references
+from quadimpact.core.controllers.residual import residual_last_stage, residual_references
 from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -459,7 +460,7 @@ def recovery_step(
     thrust, p_des, q_des, r_des, qex, qey = law_references(
         stage, a_ref_on, x, normal, ctrl, veh, mem
     )
-    if stage <= STAGE_RECOVERED and ctrl[C_POLICY + PB_HIDDEN] > 0.5:
+    if ctrl[C_POLICY + PB_HIDDEN] > 0.5 and stage <= residual_last_stage(ctrl):
         thrust, p_des, q_des = residual_references(
             t, stage, (thrust, p_des, q_des), meas, ctrl, veh
         )

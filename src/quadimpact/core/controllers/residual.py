@@ -1,7 +1,8 @@
 """A learned residual on the recovery law: a small network that corrects the staged law.
 
 From the detection to the recovery (stages 1-4; stage 5, the return to hover,
-is the law's alone) the ``recovery`` controller's outer loop gives a collective
+is then the law's alone), or in every stage from the detection on (the hover
+too: the block's last stage 5), the ``recovery`` controller's outer loop gives a collective
 thrust ``T`` (N) and roll and pitch rate references ``p_des``, ``q_des``
 (rad/s). When ``ctrl[C_POLICY]`` holds a network (its first slot, the hidden
 width, > 0), :func:`residual_references` corrects them from on-board
@@ -33,8 +34,9 @@ Features (body FRD axes; non-finite inputs read as 0):
 22-23   the law's p_des, q_des / 8 rad/s
 ======  ==================================================================
 
-The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, W1 (nh x 24,
-row-major), b1 (nh), W2 (3 x nh, row-major), b2 (3)]``. The weights come from
+The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, last stage, W1
+(nh x 24, row-major), b1 (nh), W2 (3 x nh, row-major), b2 (3)]``; the last
+stage is 4 (stages 1-4; a 0 reads as 4) or 5 (stages 1-5). The weights come from
 a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy forward pass of
 the same network is ``PolicyWeights.outputs``. The block's layout (``PB_*``,
 ``N_FEATURES``, ``MAX_HIDDEN``) is declared in ``core/controller_layout.py``.
@@ -44,14 +46,17 @@ import math
 
 import numpy as np
 
-from quadimpact.core.compiled import allocating
+from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.controller_layout import (
     N_FEATURES,
     N_OUTPUTS,
     PB_HIDDEN,
+    PB_LAST_STAGE,
     PB_RATE_SCALE,
     PB_THRUST_SCALE,
     PB_WEIGHTS,
+    STAGE_HOVER,
+    STAGE_RECOVERED,
 )
 from quadimpact.core.layout import (
     C_POLICY,
@@ -129,6 +134,14 @@ def features(
         if not math.isfinite(f[k]):
             f[k] = 0.0
     return f
+
+
+@compiled
+def residual_last_stage(ctrl: np.ndarray) -> int:
+    """The last stage the network at ``ctrl[C_POLICY:]`` acts in: 5 (the hover too) or 4."""
+    if ctrl[C_POLICY + PB_LAST_STAGE] > STAGE_RECOVERED + 0.5:
+        return STAGE_HOVER
+    return STAGE_RECOVERED
 
 
 @allocating

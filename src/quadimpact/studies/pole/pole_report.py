@@ -80,7 +80,8 @@ def _policy_text(st: dict[str, Any]) -> str:
     return (
         f" The recovery arm's law flies with the learned policy `{st['policy']}` (weights' "
         f"SHA-256 `{st.get('policy_sha256', '')[:16]}`...): a residual on its thrust and roll "
-        "and pitch rate references from the detection to the recovery, from on-board "
+        "and pitch rate references from the detection on (to the recovery, or the hover too: "
+        "its file's `last_stage`), from on-board "
         "quantities only."
     )
 

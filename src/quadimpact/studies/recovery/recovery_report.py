@@ -99,7 +99,8 @@ def _policy_lines(study: dict[str, Any] | None) -> list[str]:
     return [
         f"- **Learned policy**: `{study['policy']}` (weights' SHA-256 "
         f"`{study.get('policy_sha256', '')[:16]}`...): a residual on the staged law's thrust and "
-        "roll and pitch rate references from the detection to the recovery, from on-board "
+        "roll and pitch rate references from the detection on (to the recovery, or the hover "
+        "too: its file's `last_stage`), from on-board "
         "quantities only."
     ]
 

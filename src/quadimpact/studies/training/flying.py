@@ -1,0 +1,128 @@
+"""Flying training trials with candidate policies, and the reward: the benchmark's success.
+
+A trial is prepared once (:func:`prepare_trial`: validated and packed as any
+run is) and then flown with each candidate by writing the candidate's block
+into a copy of the run's controller vector (``ctrl[C_POLICY:]``: exactly what
+``--policy FILE`` packs) and running the compiled loop (:class:`Flyer`). That
+is the computation of ``quadimpact benchmark --policy FILE`` on that trial.
+
+The reward of a trial (:func:`rewards`) is the benchmark's success in its
+latest suite (``held_hover_success`` of ``studies/benchmark/cells.py``, the
+same function on the same columns): a held hover reached (true speed below
+0.2 m/s, tilt below 5 deg, rates below 20 deg/s, no contact, for 0.5 s), less
+than 2 m of height lost (the start altitude minus the lowest), the ground
+never touched and no contact once the hover began. To it is added a small
+term of height kept, ``shaping * exp(-lost / 1 m)`` (lost >= 0), which ranks
+the failures. A trial that is not valid for the benchmark (started in
+contact, a bumper beyond its model) or cannot be prepared scores 0.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+__all__ = ["Flyer", "PreparedTrial", "prepare_trial", "rewards"]
+
+
+@dataclass
+class PreparedTrial:
+    """One prepared trial: its task, the validated scenario and the packed run."""
+
+    task: str
+    scenario: Any
+    setup: Any
+    altitude_m: float
+
+
+def prepare_trial(task: str, data: dict[str, Any]) -> PreparedTrial | None:
+    """Validate and prepare one scenario mapping (None: it cannot run, e.g. in contact)."""
+    from quadimpact.errors import InputError
+    from quadimpact.inputs.scenarios import scenario_from_dict
+    from quadimpact.simulation.setup import prepare
+
+    scenario = scenario_from_dict(data, where=f"train: {task}")  # a bad problem: an error
+    try:
+        setup = prepare(scenario)
+    except (InputError, ValueError):
+        return None  # a trial the benchmark counts invalid (started in contact)
+    return PreparedTrial(task, scenario, setup, float(scenario.altitude_m))
+
+
+class Flyer:
+    """Flies prepared trials with a policy block (or none), keeping the output buffers."""
+
+    def __init__(self) -> None:
+        from quadimpact.simulation.batch import _Buffers
+
+        self.buffers = _Buffers(1024)
+
+    def fly(self, trial: PreparedTrial, block: np.ndarray | None) -> dict[str, Any]:
+        """The trial's summary flown with ``block`` at ``ctrl[C_POLICY:]`` (None: the law)."""
+        import time
+
+        from quadimpact.core import layout as L
+        from quadimpact.core.kernel import BUILTIN
+        from quadimpact.core.records import raw_record
+        from quadimpact.simulation.simulate import analyse
+
+        setup = trial.setup
+        ctrl = setup.ctrl.copy()
+        ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY] = 0.0
+        if block is not None:
+            ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+        m = setup.model(ctrl=ctrl)
+        o = self.buffers.output(m, int(setup.n_imu))
+        start = time.perf_counter()
+        (setup.kernel or BUILTIN).run(m, o)
+        wall = time.perf_counter() - start
+        return analyse(setup, trial.scenario, raw_record(o), wall).summary
+
+
+_COLUMNS = ("status", "reason", "bumper_model_valid", "held_hover", "touched_after_hover",
+            "min_altitude_m", "crash_time_s")  # fmt: skip
+
+
+def rewards(
+    summaries: list[dict[str, Any] | None], altitudes_m: list[float], shaping: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each trial's reward and success (module docstring); ``None``: a trial not prepared.
+
+    Returns
+    -------
+    reward, success : numpy.ndarray
+        Floats in [0, 1 + shaping] and booleans, one per trial.
+    """
+    import pandas as pd
+
+    from quadimpact import libm
+    from quadimpact.studies.benchmark.cells import held_hover_success
+    from quadimpact.studies.trial_analysis import model_valid
+
+    n = len(summaries)
+    rows = [{c: (s or {}).get(c) for c in _COLUMNS} for s in summaries]
+    t = pd.DataFrame(rows, columns=list(_COLUMNS))
+    t["status"] = [
+        "failed" if s is None else r["status"] for s, r in zip(summaries, rows, strict=True)
+    ]
+    lowest = pd.to_numeric(t["min_altitude_m"], errors="coerce").to_numpy(dtype=float)
+    t["height_lost_m"] = np.asarray(altitudes_m, dtype=float) - lowest
+    prepared = np.array([s is not None for s in summaries], dtype=bool)
+    t["valid"] = model_valid(t) & prepared
+    success = held_hover_success(t) if n else np.zeros(0, dtype=bool)
+    lost = t["height_lost_m"].to_numpy(dtype=float)
+    kept = np.where(np.isfinite(lost), libm.exp(-np.maximum(lost, 0.0)), 0.0)  # same on any CPU
+    reward = np.where(t["valid"].to_numpy(dtype=bool), success + shaping * kept, 0.0)
+    return reward.astype(float), success.astype(bool)
+
+
+def finite(value: Any) -> float:
+    """``value`` as a finite float, else NaN."""
+    try:
+        out = float(value)
+    except (TypeError, ValueError):
+        return math.nan
+    return out if math.isfinite(out) else math.nan

@@ -1,0 +1,584 @@
+"""``quadimpact train``: a residual recovery policy trained by CMA-ES, resumable, to a folder.
+
+The policy is the residual network of ``core/controllers/residual.py`` on the
+default staged law (docs/LEARNING.md 12 and 14): its weights, a few hundred
+numbers, are the optimiser's parameters. They are trained by CMA-ES (the
+``cma`` package, Hansen's reference implementation), because
+
+* the reward is episodic and black-box: the benchmark's success of whole
+  trials flown in the compiled loop, with no gradient through contacts,
+  estimators and stage switches;
+* a few hundred parameters are where CMA-ES works well (its covariance is
+  a few hundred squared numbers), on a CPU, in minutes;
+* its whole state pickles, so an interrupted run resumes where it stopped.
+
+Each generation CMA-ES proposes ``popsize`` candidate weight vectors; each
+flies the same ``batch`` fresh training trials (the problem's tasks in turn,
+:mod:`quadimpact.studies.training.trials`: never the benchmark's; the law
+flies them too, the curve's yardstick) and scores the mean reward
+(:func:`quadimpact.studies.training.flying.rewards`: the benchmark's success
+plus a little height kept). Every ``check_every``
+generations the distribution's mean flies a fixed check set (other trials of
+the same problem), and the best on it is the policy written.
+
+The folder ``DIR``:
+
+* ``state.pkl``: the optimiser's state after the last whole generation (the
+  CMA-ES object, NumPy's global generator, which ``cma`` draws from, the
+  curve, the best weights); written atomically after every generation;
+* ``curve.csv`` and ``curve.png``: the learning curve;
+* ``policy.npz``: the best policy (docs/LEARNING.md 12's file, with
+  ``last_stage`` and how it was trained in its ``meta``);
+* ``train.json``: the problem, the settings, the times, the result.
+
+Run the same command with the same ``DIR`` to resume after an interrupt: the
+problem and the settings must be the same (the budget may change). The
+trials of a generation depend on its number alone, and the optimiser's draws
+on its saved state, so a resumed run continues the same sequence.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import csv
+import io
+import json
+import math
+import multiprocessing as mp
+import pickle
+import signal
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from quadimpact.errors import InputError
+from quadimpact.results.files import atomic_write
+from quadimpact.studies.training.flying import Flyer, prepare_trial, rewards
+from quadimpact.studies.training.trials import PURPOSE_CHECK, PURPOSE_TRAIN, Problem
+
+__all__ = ["STATE_FILE", "Settings", "TrainingResult", "load_state", "train"]
+
+STATE_FILE = "state.pkl"
+STATE_VERSION = 1
+#: The files a training folder holds (a folder with others is refused for a new run).
+OWN_FILES = ("state.pkl", "policy.npz", "curve.csv", "curve.png", "train.json", "train.lock")
+CURVE_COLUMNS = ("generation", "runs", "minutes", "batch_mean", "batch_best", "batch_law",
+                 "sigma", "check_success", "check_score")  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Settings:
+    """How a policy is trained (module docstring; ``quadimpact train --help``).
+
+    Attributes
+    ----------
+    hidden : int
+        Hidden units of the network (1-32); ``hidden * 28 + 3`` parameters.
+    popsize : int
+        Candidates per generation (>= 2).
+    batch : int
+        Training trials per generation, each flown by every candidate (>= 1).
+    sigma : float
+        CMA-ES's initial step size, in weight units (> 0).
+    thrust_scale : float
+        The largest thrust correction, a fraction of ``m g`` (>= 0).
+    rate_scale_rad_s : float
+        The largest roll and pitch rate-reference correction, rad/s (>= 0).
+    last_stage : int
+        The last stage the policy acts in: 5 (every stage, the hover too) or 4.
+    shaping : float
+        The weight of the height-kept term in the reward (>= 0).
+    check : int
+        Trials of the check set (>= 1).
+    check_every : int
+        Generations between two checks (>= 1).
+    """
+
+    hidden: int = 8
+    popsize: int = 12
+    batch: int = 24
+    sigma: float = 0.05
+    thrust_scale: float = 0.3
+    rate_scale_rad_s: float = 4.0
+    last_stage: int = 5
+    shaping: float = 0.1
+    check: int = 60
+    check_every: int = 5
+
+    def __post_init__(self) -> None:
+        from quadimpact.core.controller_layout import MAX_HIDDEN
+
+        rules = {
+            "hidden": (self.hidden, 1 <= self.hidden <= MAX_HIDDEN, f"in 1..{MAX_HIDDEN}"),
+            "popsize": (self.popsize, self.popsize >= 2, ">= 2"),
+            "batch": (self.batch, self.batch >= 1, ">= 1"),
+            "sigma": (self.sigma, math.isfinite(self.sigma) and self.sigma > 0, "finite, > 0"),
+            "thrust-scale": (self.thrust_scale, _nonneg(self.thrust_scale), "finite, >= 0"),
+            "rate-scale": (self.rate_scale_rad_s, _nonneg(self.rate_scale_rad_s), "finite, >= 0"),
+            "stages": (self.last_stage, self.last_stage in (4, 5), "4 or 5"),
+            "shaping": (self.shaping, _nonneg(self.shaping), "finite, >= 0"),
+            "check": (self.check, self.check >= 1, ">= 1"),
+            "check-every": (self.check_every, self.check_every >= 1, ">= 1"),
+        }
+        for name, (value, ok, rule) in rules.items():
+            if not ok:
+                raise InputError(f"--{name}: must be {rule} (got {value})")
+
+
+def _nonneg(x: float) -> bool:
+    return math.isfinite(x) and x >= 0.0
+
+
+@dataclass
+class TrainingResult:
+    """What a training run (or its part up to an interrupt) made."""
+
+    out: Path
+    generations: int
+    runs: int
+    minutes: float
+    law_check: float
+    best_check: float
+    best_generation: int
+    finished: bool
+    resumed_from: int
+
+
+# ------------------------------------------------------------------ flying in workers
+_WORKER: dict[str, Any] = {}
+
+
+def _worker_init() -> None:
+    """A pool worker: Ctrl-C is the parent's to handle (it stops the pool)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def fly_job(job: tuple[list[tuple[str, dict[str, Any]]], list[np.ndarray | None], float]) -> tuple:
+    """Fly every block on every trial of ``job``: (rewards, successes), each (blocks, trials)."""
+    trials_data, blocks, shaping = job
+    flyer = _WORKER.get("flyer")
+    if flyer is None:
+        flyer = _WORKER["flyer"] = Flyer()
+    prepared = [prepare_trial(task, data) for task, data in trials_data]
+    altitudes = [float(d.get("altitude_m", 5.0)) if p is None else p.altitude_m
+                 for p, (_, d) in zip(prepared, trials_data, strict=True)]  # fmt: skip
+    r = np.zeros((len(blocks), len(prepared)))
+    s = np.zeros((len(blocks), len(prepared)), dtype=bool)
+    for b, block in enumerate(blocks):
+        summaries = [None if p is None else flyer.fly(p, block) for p in prepared]
+        r[b], s[b] = rewards(summaries, altitudes, shaping)
+    return r, s
+
+
+class _Evaluator:
+    """Flies blocks on trials in this process (1 worker) or in a pool of spawned workers."""
+
+    def __init__(self, workers: int, stop: Any) -> None:
+        self.workers = max(1, int(workers))
+        self.stop = stop
+        self.pool = None
+        if self.workers > 1:
+            self.pool = mp.get_context("spawn").Pool(self.workers, initializer=_worker_init)
+
+    def __call__(self, trials: list, blocks: list, shaping: float) -> tuple:
+        if self.pool is None:
+            return fly_job((trials, blocks, shaping))
+        parts = [trials[w :: self.workers] for w in range(self.workers)]
+        jobs = [(p, blocks, shaping) for p in parts if p]
+        with self.stop.polled():
+            pending = self.pool.map_async(fly_job, jobs)
+            while not pending.ready():
+                pending.wait(0.2)
+                self.stop.check()
+        res = pending.get()
+        r = np.zeros((len(blocks), len(trials)))
+        s = np.zeros((len(blocks), len(trials)), dtype=bool)
+        for w, (rw, sw) in enumerate(res):
+            r[:, w :: self.workers], s[:, w :: self.workers] = rw, sw
+        return r, s
+
+    def close(self, terminate: bool = False) -> None:
+        if self.pool is not None:
+            (self.pool.terminate if terminate else self.pool.close)()
+            self.pool.join()
+            self.pool = None
+
+
+# ------------------------------------------------------------------ state
+def load_state(out: Path) -> dict[str, Any] | None:
+    """The saved state of the training run in ``out`` (None: none there).
+
+    Raises InputError for a file that is not a training state of this version.
+    """
+    path = Path(out) / STATE_FILE
+    if not path.is_file():
+        return None
+    try:
+        state = pickle.loads(path.read_bytes())
+    except Exception as exc:  # noqa: BLE001 - any unreadable state is the same user error
+        raise InputError(f"--out {out}: {STATE_FILE} is not readable ({type(exc).__name__}); "
+                         "remove it to start again") from None  # fmt: skip
+    if not isinstance(state, dict) or state.get("version") != STATE_VERSION:
+        raise InputError(f"--out {out}: {STATE_FILE} is not a training state of this version; "
+                         "remove it to start again")  # fmt: skip
+    return state
+
+
+def _save_state(out: Path, state: dict[str, Any]) -> None:
+    data = pickle.dumps(state, protocol=pickle.HIGHEST_PROTOCOL)
+    atomic_write(out / STATE_FILE, lambda tmp: tmp.write_bytes(data))
+
+
+def _new_state(problem: Problem, settings: Settings) -> dict[str, Any]:
+    import cma
+
+    from quadimpact.inputs.policy_file import initial_policy
+
+    pol = initial_policy(settings.hidden, settings.thrust_scale, settings.rate_scale_rad_s,
+                         problem.seed, settings.last_stage)  # fmt: skip
+    opts = {"seed": problem.seed, "popsize": settings.popsize, "verbose": -9}
+    es = cma.CMAEvolutionStrategy(pol.vector(), settings.sigma, opts)
+    return {
+        "version": STATE_VERSION,
+        "problem": problem.describe(),
+        "settings": asdict(settings),
+        "cma_version": cma.__version__,
+        "es": es,
+        "np_random": np.random.get_state(),  # noqa: NPY002 - cma draws from the legacy global
+        "policy": pol,
+        "generation": 0,
+        "runs": 0,
+        "minutes": 0.0,
+        "curve": [],
+        "law_check": None,
+        "best": None,  # (success, score, generation, theta)
+        "sessions": [],
+    }
+
+
+def _same_run(state: dict[str, Any], problem: Problem, settings: Settings, out: Path) -> None:
+    """Refuse to resume a run of another problem or other settings (one line naming them)."""
+    want = {**problem.describe(), **asdict(settings)}
+    have = {**state["problem"], **state["settings"]}
+    diff = [k for k in want if want[k] != have.get(k)]
+    if diff:
+        what = ", ".join(f"{k} {have.get(k)!r} (now {want[k]!r})" for k in diff)
+        raise InputError(f"--out {out}: holds a training run with other settings: {what}; "
+                         "give the same settings to resume it, or another --out")  # fmt: skip
+
+
+# ------------------------------------------------------------------ the curve
+def _write_curve(out: Path, curve: list[dict[str, Any]]) -> None:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(CURVE_COLUMNS)
+    for row in curve:
+        w.writerow(["" if row.get(c) is None else _fmt(row[c]) for c in CURVE_COLUMNS])
+    text = buf.getvalue()
+    atomic_write(out / "curve.csv", lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def plot_curve(curve_csv: Path, png: Path) -> Path:
+    """The learning curve as a figure: above, the check set's success of the distribution's
+    mean against the law's (generation 0); below, each generation's mean candidate reward
+    minus the law's on the same training trials, and its 5-generation mean."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pandas as pd
+
+    c = pd.read_csv(curve_csv)
+    fig, (top, low) = plt.subplots(2, 1, figsize=(7.0, 5.2), sharex=True,
+                                   constrained_layout=True)  # fmt: skip
+    check = c.dropna(subset=["check_success"])
+    if len(check):
+        top.plot(check["generation"], check["check_success"], "o-", color="C0", ms=3,
+                 label="the policy (CMA-ES's mean): success on the check set")  # fmt: skip
+        top.axhline(check["check_success"].iloc[0], color="C3", ls="--", lw=1,
+                    label="the staged law on the check set")  # fmt: skip
+    top.set_ylabel("benchmark success")
+    top.legend(fontsize=8, loc="best", framealpha=0.8)
+    top.grid(alpha=0.3)
+    batch = c.dropna(subset=["batch_mean"])
+    gain = batch["batch_mean"] - batch["batch_law"]
+    low.plot(batch["generation"], gain, ".-", color="0.7", lw=0.8, ms=3,
+             label="mean candidate minus the law, same trials")  # fmt: skip
+    low.plot(batch["generation"], gain.rolling(5, min_periods=1).mean(), color="0.2", lw=1.5,
+             label="the same, 5-generation mean")  # fmt: skip
+    low.axhline(0.0, color="C3", ls="--", lw=1)
+    low.set_xlabel("generation")
+    low.set_ylabel("training reward\nminus the law's")
+    low.legend(fontsize=8, loc="best", framealpha=0.8)
+    low.grid(alpha=0.3)
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return png
+
+
+# ------------------------------------------------------------------ progress
+class _Progress:
+    """One line on stderr: redrawn in place on a terminal, printed at each check otherwise."""
+
+    def __init__(self, enabled: bool, stream: Any = None) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.enabled = enabled
+        isatty = getattr(self.stream, "isatty", None)
+        self.tty = bool(isatty and isatty())
+
+    def show(self, text: str, checked: bool) -> None:
+        if not self.enabled:
+            return
+        if self.tty:
+            self.stream.write("\r" + text.ljust(110)[:110])
+        elif checked:
+            self.stream.write(text + "\n")
+        self.stream.flush()
+
+    def end(self) -> None:
+        if self.enabled and self.tty:
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _bar(done: float, total: float, width: int = 20) -> str:
+    k = int(width * min(max(done / total, 0.0), 1.0)) if total > 0 else width
+    return "[" + "#" * k + "." * (width - k) + "]"
+
+
+# ------------------------------------------------------------------ training
+def train(
+    problem: Problem,
+    settings: Settings,
+    out: Path,
+    minutes: float | None = 10.0,
+    generations: int | None = None,
+    workers: int = 1,
+    progress: bool = True,
+    stream: Any = None,
+) -> TrainingResult:
+    """Train (or resume training) a policy into ``out`` (module docstring).
+
+    ``minutes``: the run's training time in all, resumes included (None: no
+    limit); ``generations``: stop after this many in all (None: no limit).
+    At least one must be given. Ctrl-C or SIGTERM stops it after saving what
+    the last whole generation reached (``policy.npz`` included) and raises
+    :class:`quadimpact.sweep.SweepInterrupted` with how to resume.
+    """
+    if minutes is None and generations is None:
+        raise InputError("--minutes or --generations: give a budget")
+    if minutes is not None and not (math.isfinite(minutes) and minutes > 0):
+        raise InputError(f"--minutes: must be > 0 (got {minutes})")
+    if generations is not None and generations < 1:
+        raise InputError(f"--generations: must be >= 1 (got {generations})")
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    with _folder_lock(out):
+        return _train(problem, settings, out, minutes, generations, workers, progress, stream)
+
+
+@contextlib.contextmanager
+def _folder_lock(out: Path) -> Iterator[None]:
+    """One training run at a time in a folder (``train.lock``, an advisory lock; none where
+    the system has no ``fcntl``)."""
+    try:
+        import fcntl
+    except ImportError:  # not on this system: no lock
+        yield
+        return
+    with open(out / "train.lock", "a") as fh:
+        try:
+            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            raise InputError(f"--out {out}: another quadimpact train is running in it") from None
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _train(problem, settings, out, minutes, generations, workers, progress, stream):
+    """:func:`train` in its folder, locked."""
+    from quadimpact.sweep import SweepInterrupted
+    from quadimpact.sweep.interrupt import stop_signals
+
+    state = load_state(out)
+    if state is None:
+        others = sorted(p.name for p in out.iterdir() if p.name not in OWN_FILES)
+        if others:
+            raise InputError(f"--out {out}: holds files that are not a training run's "
+                             f"({', '.join(others[:3])}); give an empty or new folder")  # fmt: skip
+        state = _new_state(problem, settings)
+    else:
+        _same_run(state, problem, settings, out)
+    resumed_from = int(state["generation"])
+    np.random.set_state(state["np_random"])  # noqa: NPY002 - cma draws from it
+    bar = _Progress(progress, stream)
+    session_start = time.perf_counter()
+    spent_before = float(state["minutes"])
+    state["sessions"].append({"from_generation": resumed_from, "workers": int(workers)})
+
+    def elapsed() -> float:
+        return spent_before + (time.perf_counter() - session_start) / 60.0
+
+    def budget_left() -> bool:
+        if generations is not None and state["generation"] >= generations:
+            return False
+        return not (minutes is not None and elapsed() >= minutes)
+
+    check_trials = problem.batch(PURPOSE_CHECK, 0, settings.check)
+    finished = False
+    with stop_signals(restore_after_stop=False) as stop:
+        evaluate = _Evaluator(workers, stop)
+        try:
+            if state["law_check"] is None:
+                r, s = evaluate(check_trials, [None], settings.shaping)
+                state["runs"] += len(check_trials)
+                state["law_check"] = (float(s.mean()), float(r.mean()))
+                state["best"] = (float(s.mean()), float(r.mean()), 0, state["es"].mean.copy())
+                state["curve"].append({"generation": 0, "runs": state["runs"],
+                                       "minutes": elapsed(), "check_success": float(s.mean()),
+                                       "check_score": float(r.mean())})  # fmt: skip
+                state["minutes"] = elapsed()
+                state["np_random"] = np.random.get_state()  # noqa: NPY002
+                _save_state(out, state)
+            while budget_left():
+                _generation(state, problem, settings, evaluate, check_trials, elapsed)
+                state["minutes"] = elapsed()
+                state["np_random"] = np.random.get_state()  # noqa: NPY002
+                _save_state(out, state)
+                _write_curve(out, state["curve"])
+                _show(bar, state, minutes, generations)
+            if state["curve"] and state["curve"][-1].get("check_success") is None:
+                _check(state, problem, settings, evaluate, check_trials)
+                state["minutes"] = elapsed()
+                _save_state(out, state)
+            finished = True
+        except SweepInterrupted as exc:
+            evaluate.close(terminate=True)
+            bar.end()
+            saved = load_state(out)  # the last whole generation, not the one cut short
+            if saved is None:
+                exc.args = ("training interrupted before its first generation; nothing saved",)
+                raise
+            result = _finish(out, saved, problem, settings, False, resumed_from)
+            exc.args = (
+                f"training interrupted at generation {result.generations} ({result.runs} runs, "
+                f"{result.minutes:.1f} min): the state of the last whole generation is in "
+                f"{out / STATE_FILE} and the best policy so far in {out / 'policy.npz'}; run "
+                "the same command again to resume",
+            )
+            raise
+        finally:
+            evaluate.close(terminate=not finished)
+    bar.end()
+    return _finish(out, state, problem, settings, True, resumed_from)
+
+
+def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> None:
+    """One CMA-ES generation: ask, fly the batch, tell; a check every ``check_every``."""
+    es = state["es"]
+    pol = state["policy"]
+    gen = state["generation"] + 1
+    xs = es.ask()
+    trials = problem.batch(PURPOSE_TRAIN, (gen - 1) * settings.batch, settings.batch)
+    blocks = [None] + [pol.with_vector(x).block() for x in xs]  # the law first: a yardstick
+    r, _ = evaluate(trials, blocks, settings.shaping)
+    law, scores = float(r[0].mean()), r[1:].mean(axis=1)
+    es.tell(xs, [-float(v) for v in scores])
+    state["generation"] = gen
+    state["runs"] += len(blocks) * len(trials)
+    row = {"generation": gen, "runs": state["runs"], "minutes": elapsed(),
+           "batch_mean": float(scores.mean()), "batch_best": float(scores.max()),
+           "batch_law": law, "sigma": float(es.sigma)}  # fmt: skip
+    state["curve"].append(row)
+    if gen % settings.check_every == 0:
+        _check(state, problem, settings, evaluate, check_trials)
+        row["runs"] = state["runs"]
+
+
+def _check(state, problem, settings, evaluate, check_trials) -> None:
+    """The distribution's mean on the check set; kept as the best if better (success, then
+    reward)."""
+    theta = np.array(state["es"].mean, dtype=float)
+    block = state["policy"].with_vector(theta).block()
+    r, s = evaluate(check_trials, [block], settings.shaping)
+    state["runs"] += len(check_trials)
+    got = (float(s.mean()), float(r.mean()))
+    row = state["curve"][-1]
+    row["check_success"], row["check_score"] = got
+    if got > state["best"][:2]:
+        state["best"] = (*got, state["generation"], theta.copy())
+
+
+def _show(bar: _Progress, state: dict[str, Any], minutes: float | None,
+          generations: int | None) -> None:  # fmt: skip
+    row = state["curve"][-1]
+    if generations is not None:
+        done, total, unit = state["generation"], generations, f"/{generations} gen."
+    else:
+        done, total, unit = state["minutes"], float(minutes), f"/{minutes:g} min"
+    law = state["law_check"][0]
+    best = state["best"]
+    checked = row.get("check_success") is not None
+    text = (f"train {_bar(done, total)} gen {state['generation']} ({state['minutes']:.1f}"
+            f"{unit if generations is None else ' min, ' + str(done) + unit}), "
+            f"{state['runs']} runs, batch {row['batch_mean']:.3f}, check best {best[0]:.3f} "
+            f"(law {law:.3f})")  # fmt: skip
+    bar.show(text, checked)
+
+
+def _finish(out: Path, state: dict[str, Any], problem: Problem, settings: Settings,
+            finished: bool, resumed_from: int) -> TrainingResult:  # fmt: skip
+    """Write policy.npz (the best so far), curve.csv and .png and train.json."""
+    import cma
+
+    from quadimpact.inputs.policy_file import save_policy
+
+    _write_curve(out, state["curve"])
+    if state["best"] is None:
+        return TrainingResult(out, 0, state["runs"], state["minutes"], math.nan, math.nan, 0,
+                              finished, resumed_from)  # fmt: skip
+    plot_curve(out / "curve.csv", out / "curve.png")
+    best_success, best_score, best_gen, theta = state["best"]
+    law_success, law_score = state["law_check"]
+    meta = {
+        "method": f"CMA-ES (cma {cma.__version__}), residual on the default staged law",
+        "command": "quadimpact train",
+        "problem": problem.describe(),
+        "settings": asdict(settings),
+        "trials": "held-out: streams SeedSequence(seed, spawn_key=(task, purpose, index)), "
+        "grid points off the benchmark's lattice (docs/LEARNING.md 14)",
+        "generations": state["generation"],
+        "best_generation": best_gen,
+        "runs": state["runs"],
+        "minutes": round(state["minutes"], 2),
+        "check_success_law": law_success,
+        "check_success_policy": best_success,
+        "check_score_law": law_score,
+        "check_score_policy": best_score,
+        "finished": finished,
+    }
+    save_policy(state["policy"].with_vector(theta, **meta), out / "policy.npz")
+    text = json.dumps({**meta, "sessions": state["sessions"],
+                       "files": list(OWN_FILES)},
+                      indent=1) + "\n"  # fmt: skip
+    atomic_write(out / "train.json", lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    return TrainingResult(out, state["generation"], state["runs"], state["minutes"],
+                          law_success, best_success, best_gen, finished, resumed_from)  # fmt: skip
+
+
+def settings_fields() -> tuple[str, ...]:
+    """The names of :class:`Settings`' fields."""
+    return tuple(f.name for f in fields(Settings))

@@ -1,0 +1,273 @@
+"""``quadimpact train``'s pieces: trials never the benchmark's, the reward the benchmark's
+success, a state that resumes to the same optimiser, and flying its policy without any
+training library."""
+
+from __future__ import annotations
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from quadimpact.errors import InputError
+from quadimpact.studies.training.flying import rewards
+from quadimpact.studies.training.trials import (
+    PURPOSE_CHECK,
+    PURPOSE_TRAIN,
+    Problem,
+    check_seed,
+    held_out_point,
+)
+
+cma = pytest.importorskip("cma")
+
+
+# ------------------------------------------------------------------ the trials
+def _benchmark_wall_draws() -> tuple[set, set]:
+    """The benchmark's 10,000 wall trials: their (roll, pitch, yaw, speed) and their seeds."""
+    from quadimpact.studies.benchmark.subject import Subject
+    from quadimpact.studies.benchmark.suite import TASKS, sensor_set
+    from quadimpact.sweep.trials import trial_draws
+
+    spec = Subject("x").spec(TASKS["wall"], False, sensor_set("onboard"))
+    t = spec.trials
+    draws = [trial_draws(t["seed"], i, t["ranges"], "seed") for i in range(t["n"])]
+    keys = {tuple(d[k] for k in t["ranges"]) for d in draws}
+    return keys, {int(d["seed"]) for d in draws}
+
+
+def test_training_and_check_wall_trials_are_none_of_the_benchmarks():
+    problem = Problem(tasks=("wall",), seed=61)
+    keys, seeds = _benchmark_wall_draws()
+    ranges = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s")
+    train = [d for _, d in problem.batch(PURPOSE_TRAIN, 0, 2000)]
+    check = [d for _, d in problem.batch(PURPOSE_CHECK, 0, 300)]
+    mine = {tuple(d[k] for k in ranges) for d in train + check}
+    assert len(mine) == 2300  # training and check trials differ among themselves too
+    assert not mine & keys
+    assert not {int(d["seed"]) for d in train + check} & seeds
+    # the same distribution as the benchmark's: every draw inside its ranges
+    for d in train:
+        assert -15 <= d["roll_deg"] <= 15 and -45 <= d["pitch_deg"] <= 45
+        assert 0.5 <= d["speed_m_s"] <= 2.5
+        assert d["sensors"] == "onboard" and d["estimator"] == "nav-ekf"
+        assert d["final_time_s"] == 4.0 and d["ground"] == "crash"
+
+
+def test_grid_trials_lie_off_the_benchmark_grid_with_other_sensor_seeds():
+    from quadimpact.studies.benchmark.suite import TASKS, sensor_set
+
+    problem = Problem(tasks=("pole", "edge"), seed=61)
+    study = TASKS["pole"].grid_study(False, sensor_set("onboard"))
+    bench_seeds = set(study.point_seeds())
+    lattice = {(round(p, 6), round(o, 6)) for p in study.pitches() for o in study.offsets()}
+    trials = problem.batch(PURPOSE_TRAIN, 0, 600) + problem.batch(PURPOSE_CHECK, 0, 100)
+    assert {task for task, _ in trials} == {"pole", "edge"}
+    for task, d in trials:
+        assert (round(d["pitch_deg"], 6), round(d["lateral_offset_m"], 6)) not in lattice
+        assert -45 <= d["pitch_deg"] <= 0 and -0.35 <= d["lateral_offset_m"] <= 0.35
+        assert int(d["seed"]) not in bench_seeds
+        assert d["obstacles"][0]["kind"] == ("cylinder" if task == "pole" else "box")
+
+
+def test_a_draw_on_the_benchmark_lattice_is_moved_off_it():
+    assert held_out_point(-12.0, 0.07) == (-11.5, 0.07)
+    assert held_out_point(0.0, -0.35) == (-0.5, -0.35)
+    assert held_out_point(-12.25, 0.07) == (-12.25, 0.07)  # off the lattice: unchanged
+    assert held_out_point(-12.0, 0.075) == (-12.0, 0.075)
+
+
+def test_the_benchmarks_seed_and_bad_problems_are_refused():
+    with pytest.raises(InputError, match="--seed: 0 is the benchmark's own seed"):
+        check_seed(0)
+    with pytest.raises(InputError, match="--seed: 0 is the benchmark's own seed"):
+        Problem(seed=0)
+    with pytest.raises(InputError, match="--tasks: unknown task 'ceiling'"):
+        Problem(tasks=("ceiling",))
+    with pytest.raises(InputError, match="--sensors: unknown sensor set"):
+        Problem(sensors="sonar")
+
+
+def test_trials_depend_on_the_seed_and_their_index_alone():
+    a = Problem(tasks=("wall", "pole"), seed=5)
+    b = Problem(tasks=("wall", "pole"), seed=5)
+    assert a.batch(PURPOSE_TRAIN, 10, 4) == b.batch(PURPOSE_TRAIN, 0, 14)[10:]
+    assert a.batch(PURPOSE_TRAIN, 0, 4) != Problem(tasks=("wall", "pole"), seed=6).batch(
+        PURPOSE_TRAIN, 0, 4
+    )
+
+
+# ------------------------------------------------------------------ the reward
+def _summary(**kw):
+    base = {"status": "ok", "reason": "", "bumper_model_valid": True, "held_hover": True,
+            "touched_after_hover": False, "min_altitude_m": 4.5, "crash_time_s": None}  # fmt: skip
+    return {**base, **kw}
+
+
+def test_the_reward_is_the_benchmarks_held_hover_success_plus_height_kept():
+    cases = [
+        (_summary(), True),  # held hover, 0.5 m lost
+        (_summary(held_hover=False), False),
+        (_summary(min_altitude_m=2.9), False),  # 2.1 m lost
+        (_summary(crash_time_s=1.2), False),  # the ground touched
+        (_summary(touched_after_hover=True), False),
+        (_summary(bumper_model_valid=False), False),  # invalid: scores 0
+        (_summary(status="failed", reason="x", held_hover=None), False),  # a numerical failure
+        (None, False),  # a trial that could not be prepared
+    ]
+    r, s = rewards([c[0] for c in cases], [5.0] * len(cases), 0.1)
+    assert list(s) == [c[1] for c in cases]
+    assert math.isclose(r[0], 1.0 + 0.1 * math.exp(-0.5))
+    assert math.isclose(r[1], 0.1 * math.exp(-0.5))
+    assert math.isclose(r[2], 0.1 * math.exp(-2.1))
+    assert r[5] == 0.0 and r[7] == 0.0
+    climb = rewards([_summary(min_altitude_m=5.0)], [5.0], 0.1)[0][0]  # nothing lost
+    assert math.isclose(climb, 1.1)  # a climb above the start earns nothing more
+
+
+# ------------------------------------------------------------------ state and resume
+_SMALL = dict(hidden=2, popsize=3, batch=2, check=2, check_every=1, sigma=0.5)
+
+
+def _problem():
+    return Problem(tasks=("wall",), sensors="ideal", seed=7)
+
+
+def test_settings_are_checked_with_one_line():
+    from quadimpact.studies.training.trainer import Settings
+
+    with pytest.raises(InputError, match=r"--popsize: must be >= 2 \(got 1\)"):
+        Settings(popsize=1)
+    with pytest.raises(InputError, match="--stages: must be 4 or 5"):
+        Settings(last_stage=3)
+
+
+@pytest.mark.slow
+def test_a_resumed_run_continues_the_same_optimiser(tmp_path):
+    """Two generations straight, or one and then a resume to two: the same CMA-ES state,
+    the same curve, the same policy; another setting is refused."""
+    from quadimpact.inputs.policy_file import load_policy
+    from quadimpact.studies.training.trainer import Settings, load_state, train
+
+    settings = Settings(**_SMALL)
+    a, b = tmp_path / "a", tmp_path / "b"
+    train(_problem(), settings, a, None, 2, progress=False)
+    res1 = train(_problem(), settings, b, None, 1, progress=False)
+    assert res1.generations == 1 and (b / "policy.npz").is_file()
+    res2 = train(_problem(), settings, b, None, 2, progress=False)
+    assert res2.resumed_from == 1 and res2.generations == 2
+    sa, sb = load_state(a), load_state(b)
+    np.testing.assert_array_equal(sa["es"].mean, sb["es"].mean)
+    assert sa["es"].sigma == sb["es"].sigma
+    strip = [{k: v for k, v in row.items() if k != "minutes"} for row in sa["curve"]]
+    assert strip == [{k: v for k, v in row.items() if k != "minutes"} for row in sb["curve"]]
+    pa, pb = load_policy(a / "policy.npz"), load_policy(b / "policy.npz")
+    assert pa.sha256 == pb.sha256 and pa.last_stage == 5
+    assert pa.meta["problem"]["seed"] == 7 and pa.meta["generations"] == 2
+    lines = (a / "curve.csv").read_text().splitlines()
+    assert lines[0].startswith("generation,runs,minutes") and len(lines) == 4
+    assert (a / "curve.png").stat().st_size > 0
+    with pytest.raises(InputError, match="holds a training run with other settings: popsize"):
+        train(_problem(), Settings(**{**_SMALL, "popsize": 4}), b, None, 3, progress=False)
+
+
+@pytest.mark.slow
+def test_an_interrupt_keeps_the_last_whole_generation_and_resumes(tmp_path, monkeypatch):
+    """A stop signal during generation 2 (raised by the evaluator, as the signal handler
+    does): generation 1's state, curve and policy are saved; the rerun goes on from 1."""
+    from quadimpact.studies.training import trainer
+    from quadimpact.sweep import SweepInterrupted
+
+    settings = trainer.Settings(**_SMALL)
+    real = trainer._Evaluator.__call__
+    calls = {"n": 0}
+
+    def flaky(self, trials, blocks, shaping):
+        calls["n"] += 1
+        if calls["n"] == 5:  # law check, gen 1 + its check, then gen 2
+            raise SweepInterrupted(2)
+        return real(self, trials, blocks, shaping)
+
+    monkeypatch.setattr(trainer._Evaluator, "__call__", flaky)
+    with pytest.raises(SweepInterrupted, match="interrupted at generation 1"):
+        trainer.train(_problem(), settings, tmp_path, None, 3, progress=False)
+    assert trainer.load_state(tmp_path)["generation"] == 1
+    assert (tmp_path / "policy.npz").is_file()
+    assert json.loads((tmp_path / "train.json").read_text())["finished"] is False
+    monkeypatch.setattr(trainer._Evaluator, "__call__", real)
+    res = trainer.train(_problem(), settings, tmp_path, None, 3, progress=False)
+    assert res.resumed_from == 1 and res.generations == 3 and res.finished
+
+
+def test_a_folder_of_something_else_is_refused(tmp_path):
+    from quadimpact.studies.training.trainer import Settings, train
+
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(InputError, match="holds files that are not a training run's"):
+        train(_problem(), Settings(**_SMALL), tmp_path, None, 1, progress=False)
+
+
+# ------------------------------------------------------------------ flying a trained file
+def test_a_trained_policy_flies_without_any_training_library(tmp_path):
+    """In a fresh interpreter: a policy file of every stage (last_stage 5) flies a trial with
+    NumPy and the compiled loop, and neither cma nor torch is imported; importing the
+    trainer's module does not import cma either (it is imported when training starts)."""
+    from quadimpact.inputs.policy_file import initial_policy, save_policy
+
+    p = initial_policy(8, 0.3, 4.0, seed=3, last_stage=5)
+    p = p.with_vector(np.random.default_rng(3).normal(0, 0.3, p.vector().size))
+    path = save_policy(p, tmp_path / "policy.npz")
+    code = f"""
+import json, sys
+from quadimpact import ImpactTrial, simulate
+import quadimpact.studies.training.trainer
+s = ImpactTrial(vehicle="navi", speed_m_s=2.0, pitch_deg=-20.0, pre_impact="spin-down",
+                controller_params={{"policy": {str(path)!r}}})
+r = simulate(s).summary
+print(json.dumps({{"status": r["status"], "detected": r["detected"],
+                  "cma": "cma" in sys.modules, "torch": "torch" in sys.modules}}))
+"""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=900)  # fmt: skip
+    assert res.returncode == 0, res.stderr
+    got = json.loads(res.stdout.strip().splitlines()[-1])
+    assert got["status"] != "failed" and got["detected"]
+    assert not got["cma"] and not got["torch"]
+
+
+def test_one_training_run_at_a_time_in_a_folder(tmp_path):
+    """A second trainer in a folder another one holds is refused (the lock is released
+    when the first ends)."""
+    from quadimpact.studies.training import trainer
+
+    with trainer._folder_lock(tmp_path):
+        with pytest.raises(InputError, match="another quadimpact train is running in it"):
+            trainer.train(_problem(), trainer.Settings(**_SMALL), tmp_path, None, 1,
+                          progress=False)  # fmt: skip
+    with trainer._folder_lock(tmp_path):
+        pass
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("task_name", ["wall", "pole"])
+def test_the_trainers_success_is_the_benchmarks_on_the_same_trials(tmp_path, task_name):
+    """The benchmark's first trials of a task, flown by the benchmark's sweep and table
+    (cell_table) and by the trainer (fly_job): the same success, trial by trial."""
+    from quadimpact.studies.benchmark.cells import cell_table
+    from quadimpact.studies.benchmark.subject import Subject
+    from quadimpact.studies.benchmark.suite import TASKS, sensor_set
+    from quadimpact.studies.training.trainer import fly_job
+    from quadimpact.sweep import read_runs, run_sweep
+
+    task = TASKS[task_name]
+    spec = Subject("default").spec(task, True, sensor_set("lab"), limit=12)
+    run_sweep(spec, tmp_path / "sweep", workers=1)
+    table = cell_table(read_runs(tmp_path / "sweep"), spec, task)
+    trials = [(task_name, spec.scenario_dict(i)) for i in range(spec.n_runs)]
+    _, success = fly_job((trials, [None], 0.1))
+    want = table.sort_values("run_id")["success"].to_numpy(dtype=bool)
+    assert list(success[0]) == list(want)
+    assert 0 < want.sum() < len(want)  # successes and failures both compared
