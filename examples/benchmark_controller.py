@@ -21,7 +21,7 @@ reference rows in the benchmark cache (its 6 cells of ``level-first`` run);
 1,087 s (18 min) and 993 s (16.5 min) when the code is new to the cache, as
 on a first run, which computes the five reference controllers' 30 cells too.
 These times were measured when each worker process compiled the loop around
-the plug-in (about 30 s of CPU each); a worker now compiles the step alone, a
+the plug-in (30 s of CPU each, as measured then); a worker now compiles the step alone, a
 second or two. The registration is at the top level of this file, so the sweeps'
 worker processes, which import it again, register it too.
 """

@@ -45,7 +45,7 @@ seed = 2
         ),
         (["--sweep", "approach.toml"], ["approach.toml: base: kind: must be 'impact-trial'"]),
         (["--estimator", "kalman"], ["--estimator: must be one of 'ideal', 'complementary'"]),
-        (["--sensors", "all"], ["'--sensors'", "'all' is not one of 'ideal', 'noisy'"]),
+        (["--sensors", "all"], ["--sensors: must be one of 'ideal', 'noisy'", "(got 'all')"]),
         (["--imu", "noisy", "--sensors", "impact"], ["--imu and --sensors: give one"]),
         (["--policy", "none.npz"], ["--policy: none.npz: no such file"]),
         (["--policy", "trials.toml"], ["--policy: trials.toml: not a .npz policy file"]),
