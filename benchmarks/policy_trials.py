@@ -23,7 +23,9 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
+# the trainer's own flyer (same trial, policy block and summary as quadimpact train),
+# re-exported for train_policy.py and eval_policy.py (PT.Flyer)
+from quadimpact.studies.training.flying import Flyer as Flyer
 
 TRAIN_WALL_SEED = 4747
 TRAIN_POLE_SEED = 4748
@@ -105,36 +107,6 @@ def prepare_trial(task: str, index: int, data: dict[str, Any]) -> Trial | None:
     except Exception:  # noqa: BLE001 - such a trial is counted invalid by the caller
         return None
     return Trial(task, index, scenario, setup, float(data.get("altitude_m", 2.0)))
-
-
-class Flyer:
-    """Flies prepared trials with a policy block (or none), keeping the output buffers."""
-
-    def __init__(self) -> None:
-        from quadimpact.simulation.batch import _Buffers
-
-        self.buffers = _Buffers(1024)
-
-    def fly(self, trial: Trial, block: np.ndarray | None) -> dict[str, Any]:
-        """The trial's summary flown with ``block`` at ``ctrl[C_POLICY:]`` (None: the law)."""
-        import time
-
-        from quadimpact.core import layout as L
-        from quadimpact.core.kernel import BUILTIN
-        from quadimpact.core.records import raw_record
-        from quadimpact.simulation.simulate import analyse
-
-        setup = trial.setup
-        ctrl = setup.ctrl.copy()
-        ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY] = 0.0
-        if block is not None:
-            ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
-        m = setup.model(ctrl=ctrl)
-        o = self.buffers.output(m, int(setup.n_imu))
-        start = time.perf_counter()
-        (setup.kernel or BUILTIN).run(m, o)
-        wall = time.perf_counter() - start
-        return analyse(setup, trial.scenario, raw_record(o), wall).summary
 
 
 def outcome(trial: Trial, s: dict[str, Any]) -> tuple[bool, bool, float]:
