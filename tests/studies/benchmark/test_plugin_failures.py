@@ -250,8 +250,12 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
     capsys, tmp_path, monkeypatch
 ):
     """Three trials per cell: the plug-in passes its pre-flight (the first trial of each
-    cell) and both wall cells, then raises at the pole grid's third point. One line, exit
-    2; the wall cells kept; fixed, the same command resumes without flying them again."""
+    cell) and every wall cell (one per sensor set of the default suite), then raises at the
+    pole grid's third point. One line, exit 2; the wall cells kept; fixed, the same command
+    resumes without flying them again."""
+    from quadimpact.studies.benchmark.suite import SUITE_VERSION, SUITES
+
+    sets = SUITES[SUITE_VERSION].sensor_sets
     name = "t-raises-later"
     _raising_from(-0.335, name)
     try:
@@ -267,11 +271,11 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
         _one_error_line(
             code, err, f"benchmark: {name} pole/ideal, run 2: ", "offset_trials_raise",
             "raised ValueError: this trial is too far to the side for me",
-            "the 2 cells finished are kept", "the same command resumes",
+            f"the {len(sets)} cells finished are kept", "the same command resumes",
         )  # fmt: skip
         assert f"quadimpact: compiling plug-in {name!r}" in err
         kept = out / "cells" / name
-        assert (kept / "wall-ideal.parquet").is_file() and (kept / "wall-impact.parquet").is_file()
+        assert all((kept / f"wall-{s}.parquet").is_file() for s in sets), sorted(kept.iterdir())
         assert not (kept / "pole-ideal.parquet").exists()
         assert (kept / "pole-ideal" / "sweep-failed" / "runs.parquet").is_file()
         assert not (out / "benchmark.csv").exists()
@@ -285,7 +289,8 @@ def test_a_plugin_raising_at_a_later_trial_stops_the_command_and_it_resumes(
         assert wall_sweep.stat().st_mtime_ns == stamp
         t = pd.read_csv(out / "benchmark.csv")
         mine = t[t["row"] == name]
-        assert len(mine) == 4 and (mine["failed_runs"] == 0).all() and (mine["trials"] == 3).all()
+        assert len(mine) == 2 * len(sets), mine
+        assert (mine["failed_runs"] == 0).all() and (mine["trials"] == 3).all()
         # the compilation apart: the step's compile in compile_cpu_s, a trial's CPU in ms
         first = mine[(mine["task"] == "wall") & (mine["sensors"] == "ideal")]
         assert float(first["compile_cpu_s"].iloc[0]) > 0.0, mine["compile_cpu_s"]
