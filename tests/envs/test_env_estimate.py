@@ -41,9 +41,13 @@ def test_the_observation_gives_the_measurement_back_exactly():
     assert not np.array_equal(meas[L.MS_X : L.MS_X + L.NX], env.unwrapped._slots.D.x[0])
 
 
-@pytest.mark.parametrize("estimator", ["complementary", "ekf"])
-def test_the_baseline_on_its_observation_recovers_as_the_built_in(estimator):
-    trials = E.TrialDistribution(estimator=estimator, sensors="impact")
+@pytest.mark.parametrize(
+    ("estimator", "sensors"),
+    [("complementary", "impact"), ("ekf", "impact"), ("nav-ekf", "onboard")],
+)
+def test_the_baseline_on_its_observation_recovers_as_the_built_in(estimator, sensors):
+    """The ``onboard`` set too: its observation is the navigation filter's estimate."""
+    trials = E.TrialDistribution(estimator=estimator, sensors=sensors)
     env = E.ImpactRecoveryEnv(observe="estimate", trials=trials)
     policy = E.RecoveryPolicy(env)
     assert policy.from_observation
@@ -57,7 +61,7 @@ def test_the_baseline_on_its_observation_recovers_as_the_built_in(estimator):
             done = term or trunc
         got.append(info["metrics"])
     want = simulate_batch(scenarios)
-    assert all(s["estimator"] == estimator for s in want)
+    assert all(s["estimator"] == estimator and s["sensors"] == sensors for s in want)
     for m, s in zip(got, want, strict=True):
         assert m["stage_source"] == "policy"
         for key in ("recovered", "t_detect_s", "t_stage2_s", "t_stage3_s", "t_stage4_s"):
