@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import importlib.util
 import shutil
 import signal
+import sys
 import tempfile
 import time
 from collections.abc import Iterator
@@ -17,6 +19,9 @@ import quadimpact
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
 from quadimpact.simulation.setup import RunSetup
+
+#: The repository's examples folder.
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 #: The bundled Spiri's parameter file.
 SPIRI_TOML = Path(quadimpact.__file__).resolve().parent / "inputs" / "vehicles" / "spiri.toml"
@@ -151,3 +156,17 @@ def sigint_as_on_a_terminal() -> None:
     disposition of a terminal's foreground job, wherever the tests run.
     """
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def load_example(filename: str):
+    """Import ``examples/<filename>`` as a module (what it registers is then registered).
+
+    The module is put in ``sys.modules`` under its stem first: pydantic resolves the
+    annotations of the models it defines there.
+    """
+    spec = importlib.util.spec_from_file_location(Path(filename).stem, EXAMPLES / filename)
+    assert spec is not None and spec.loader is not None, filename
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    return module

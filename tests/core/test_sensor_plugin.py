@@ -3,10 +3,7 @@ built-in is: named in a scenario, its noise from the run's seed, its columns rec
 
 from __future__ import annotations
 
-import importlib.util
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,17 +11,13 @@ import pytest
 from quadimpact import simulate
 from quadimpact.inputs.scenarios import scenario_from_dict
 
-pytestmark = pytest.mark.slow  # compiles a loop around the plug-in (about a minute)
+from helpers import load_example
 
-TEMPLATE = Path(__file__).resolve().parents[2] / "examples" / "sensor_template.py"
+pytestmark = pytest.mark.slow  # compiles a loop around the plug-in (about a minute)
 
 
 def _load():
-    spec = importlib.util.spec_from_file_location("sensor_template", TEMPLATE)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # pydantic resolves the annotations there
-    spec.loader.exec_module(module)
-    return module
+    return load_example("sensor_template.py")
 
 
 def test_plugin_variometer_measures_the_climb_rate():

@@ -10,9 +10,6 @@ to its references.
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 from numba import njit
@@ -24,17 +21,12 @@ from quadimpact.core import named
 from quadimpact.inputs.controllers import param_index, param_slots, register_controller
 from quadimpact.simulation.setup import prepare
 
-ROOT = Path(__file__).resolve().parents[2]
+from helpers import load_example
 
 
 @pytest.fixture(scope="module")
 def template():
-    spec = importlib.util.spec_from_file_location(
-        "controller_template", ROOT / "examples" / "controller_template.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_example("controller_template.py")
 
 
 def _records(scenario: FlightScenario):

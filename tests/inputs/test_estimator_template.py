@@ -11,9 +11,7 @@ error law.
 
 from __future__ import annotations
 
-import importlib.util
 import math
-from pathlib import Path
 
 import pytest
 
@@ -22,18 +20,14 @@ from quadimpact.errors import InputError
 from quadimpact.inputs.estimators import estimator_names
 from quadimpact.inputs.scenarios import scenario_from_dict
 
-ROOT = Path(__file__).resolve().parents[2]
+from helpers import load_example
+
 NAME = "template-strapdown"
 
 
 @pytest.fixture(scope="module")
 def template():
-    spec = importlib.util.spec_from_file_location(
-        "estimator_template", ROOT / "examples" / "estimator_template.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_example("estimator_template.py")
 
 
 def test_the_template_registers_by_name_and_validates_its_parameters(template):

@@ -20,9 +20,6 @@ present count, far below the step budget.
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import pytest
 
 from quadimpact import simulate
@@ -30,7 +27,7 @@ from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.studies.benchmark.subject import Subject
 from quadimpact.studies.benchmark.suite import sensor_set, task
 
-EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+from helpers import load_example
 
 
 def _trial(subject: Subject, task_name: str, sensors: str, pitch_deg: float, offset_m: float):
@@ -62,12 +59,7 @@ def test_the_example_plug_ins_pole_trial_takes_a_bounded_step_count():
     loop compiles first: about 30 s)."""
     from quadimpact.inputs.controllers import unregister_controller
 
-    spec = importlib.util.spec_from_file_location(
-        "benchmark_controller", EXAMPLES / "benchmark_controller.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)  # registers "level-first"
+    load_example("benchmark_controller.py")  # registers "level-first"
     try:
         subject = Subject("level-first", controller="level-first")
         summary = simulate(_trial(subject, "pole", "impact", -30.0, 0.0)).summary
