@@ -9,7 +9,11 @@ paired difference to ``onboard``::
 
     python benchmarks/bench_onboard_gap.py --n 300 --out /tmp/gap
 
-Trials run in this process (``--workers 1``) or in a pool.
+Trials run in this process (``--workers 1``) or in a pool. ``--final-time S``
+flies every variant for ``S`` seconds instead of the suite's 4 (the same
+criterion: how much of a gap is time, a hover that begins late)::
+
+    python benchmarks/bench_onboard_gap.py --n 1000 --variants lab --final-time 6 --out /tmp/gap6
 """
 
 from __future__ import annotations
@@ -84,6 +88,12 @@ def main() -> None:
         help="nav-ekf parameters for every onboard variant, as k=v,k=v (a filter setting "
         "measured against the same sensors)",
     )
+    ap.add_argument(
+        "--final-time",
+        type=float,
+        default=None,
+        help="run length of every trial, s (default: the suite's)",
+    )
     args = ap.parse_args()
     task = TASKS[args.task]
     chosen = VARIANTS
@@ -106,6 +116,8 @@ def main() -> None:
     for name, (set_name, changes) in chosen.items():
         if params and set_name == "onboard":
             changes = {**changes, "estimator_params": params}
+        if args.final_time is not None:
+            changes = {**changes, "final_time_s": args.final_time}
         spec = Subject("default").spec(task, True, sensor_set(set_name), limit=args.n)
         spec = SweepSpec(
             base={**spec.base, **changes}, grid=spec.grid or None, runs=spec.runs,
@@ -113,6 +125,8 @@ def main() -> None:
         )  # fmt: skip
         t0 = time.perf_counter()
         folder = args.out / f"{args.task}-{name.replace(' ', '-').replace('/', 'over')}"
+        if args.final_time is not None:
+            folder = folder.with_name(f"{folder.name}-{args.final_time:g}s")
         runs = run_sweep(spec, folder, workers=args.workers)
         table = cell_table(runs, spec, task)
         rows[name] = (table, cell_numbers(table), time.perf_counter() - t0)
