@@ -89,6 +89,10 @@ def test_the_benchmarks_seed_and_bad_problems_are_refused():
         Problem(tasks=("ceiling",))
     with pytest.raises(InputError, match="--sensors: unknown sensor set"):
         Problem(sensors="sonar")
+    with pytest.raises(InputError, match="--sensors: unknown sensor set 'sonar'"):
+        Problem(sensors="onboard,sonar")
+    with pytest.raises(InputError, match="--sensors: name each sensor set once"):
+        Problem(sensors="onboard,onboard")
 
 
 def test_trials_depend_on_the_seed_and_their_index_alone():
@@ -98,6 +102,25 @@ def test_trials_depend_on_the_seed_and_their_index_alone():
     assert a.batch(PURPOSE_TRAIN, 0, 4) != Problem(tasks=("wall", "pole"), seed=6).batch(
         PURPOSE_TRAIN, 0, 4
     )
+
+
+def test_several_sensor_sets_fly_the_same_draws_each():
+    """``onboard,ideal``: each draw of each task is flown once with each set, paired; the
+    first set's trials are the single-set problem's, in a different order."""
+    one = Problem(tasks=("wall", "pole"), sensors="onboard", seed=5)
+    two = Problem(tasks=("wall", "pole"), sensors=" onboard, ideal", seed=5)
+    assert two.sensors == "onboard,ideal" and two.sensor_sets == ("onboard", "ideal")
+    assert two.describe()["sensors"] == "onboard,ideal"
+    batch = two.batch(PURPOSE_TRAIN, 0, 8)
+    assert [t for t, _ in batch] == ["wall", "wall", "pole", "pole"] * 2
+    for (ta, a), (tb, b) in zip(batch[0::2], batch[1::2], strict=True):
+        assert ta == tb
+        assert (a.get("sensors"), a.get("estimator")) == ("onboard", "nav-ekf")
+        assert b.get("sensors") is None and b.get("estimator") in (None, "ideal")
+        drawn = [k for k in ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s", "seed",
+                             "lateral_offset_m") if k in a]  # fmt: skip
+        assert len(drawn) >= 3 and all(a[k] == b[k] for k in drawn), drawn
+    assert batch[0::2] == one.batch(PURPOSE_TRAIN, 0, 4)
 
 
 # ------------------------------------------------------------------ the reward
@@ -136,6 +159,17 @@ def _problem():
     return Problem(tasks=("wall",), sensors="ideal", seed=7)
 
 
+def test_a_trial_lost_to_the_law_costs_the_loss_weight():
+    from quadimpact.studies.training.trainer import candidate_scores
+
+    s = np.array([[1, 1, 0, 0], [1, 0, 1, 0], [1, 1, 1, 0]], dtype=bool)  # law, a, b
+    r = s + 0.1
+    assert np.allclose(candidate_scores(r, s, 0.0), [0.6, 0.85])
+    # a wins trial 2 and loses trial 1 to the law; b loses none
+    assert np.allclose(candidate_scores(r, s, 1.0), [0.6 - 0.25, 0.85])
+    assert np.allclose(candidate_scores(r, s, 2.0), [0.6 - 0.5, 0.85])
+
+
 def test_settings_are_checked_with_one_line():
     from quadimpact.studies.training.trainer import Settings
 
@@ -143,6 +177,8 @@ def test_settings_are_checked_with_one_line():
         Settings(popsize=1)
     with pytest.raises(InputError, match="--stages: must be 4 or 5"):
         Settings(last_stage=3)
+    with pytest.raises(InputError, match=r"--loss-weight: must be finite, >= 0 \(got -1.0\)"):
+        Settings(loss_weight=-1.0)
 
 
 @pytest.mark.slow

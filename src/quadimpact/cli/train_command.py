@@ -11,8 +11,6 @@ from quadimpact.errors import InputError
 
 __all__ = ["train"]
 
-_SENSOR_SETS = ("onboard", "lab", "impact", "ideal")
-
 
 @click.command("train")
 @out_option(
@@ -29,8 +27,10 @@ _SENSOR_SETS = ("onboard", "lab", "impact", "ideal")
     help="The benchmark's tasks to train on (docs/BENCHMARK.md 1), taken in turn.",
 )  # fmt: skip
 @click.option(
-    "--sensors", type=click.Choice(_SENSOR_SETS), default="onboard", show_default=True,
-    help="The benchmark's sensor set the policy flies with (its sensors and estimator).",
+    "--sensors", default="onboard", show_default=True, metavar="onboard|lab|impact|ideal[,...]",
+    help="The benchmark's sensor set the policy flies with (its sensors and estimator); "
+    "several, comma-separated, fly every trial with each (onboard,ideal: learn from the "
+    "onboard set without losing with ideal sensing).",
 )  # fmt: skip
 @click.option(
     "--seed", type=int, default=61, show_default=True,
@@ -73,6 +73,11 @@ _SENSOR_SETS = ("onboard", "lab", "impact", "ideal")
     "--shaping", type=float, default=0.1, show_default=True,
     help="Weight of the height-kept term added to the benchmark's success in the reward.",
 )  # fmt: skip
+@click.option(
+    "--loss-weight", type=float, default=0.0, show_default=True,
+    help="Penalty in the reward for each trial the law succeeds in and the candidate fails "
+    "(0: none).",
+)  # fmt: skip
 @click.option("--check", type=int, default=60, show_default=True, help="Trials of the check set.")
 @click.option(
     "--check-every", type=int, default=5, show_default=True,
@@ -99,6 +104,7 @@ def train(
     rate_scale_rad_s: float,
     stages: str,
     shaping: float,
+    loss_weight: float,
     check: int,
     check_every: int,
     workers: int,
@@ -121,6 +127,7 @@ def train(
     Examples:
       quadimpact train --minutes 20 --out results/train
       quadimpact train --tasks wall --sensors lab --minutes 5 --out results/train-wall
+      quadimpact train --sensors onboard,ideal --loss-weight 1 --out results/train-both
       quadimpact benchmark --quick --policy results/train/policy.npz --out results/bench
     """
     from quadimpact.studies.benchmark.suite import parse_tasks
@@ -140,7 +147,7 @@ def train(
     settings = Settings(
         hidden=hidden, popsize=popsize, batch=batch, sigma=sigma, thrust_scale=thrust_scale,
         rate_scale_rad_s=rate_scale_rad_s, last_stage=5 if stages == "1-5" else 4,
-        shaping=shaping, check=check, check_every=check_every,
+        shaping=shaping, loss_weight=loss_weight, check=check, check_every=check_every,
     )  # fmt: skip
     if workers < 1:
         raise InputError(f"--workers: must be >= 1 (got {workers})")

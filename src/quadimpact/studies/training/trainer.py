@@ -61,7 +61,7 @@ from quadimpact.results.files import atomic_write
 from quadimpact.studies.training.flying import Flyer, prepare_trial, rewards
 from quadimpact.studies.training.trials import PURPOSE_CHECK, PURPOSE_TRAIN, Problem
 
-__all__ = ["STATE_FILE", "Settings", "TrainingResult", "load_state", "train"]
+__all__ = ["STATE_FILE", "Settings", "TrainingResult", "candidate_scores", "load_state", "train"]
 
 STATE_FILE = "state.pkl"
 STATE_VERSION = 1
@@ -93,6 +93,11 @@ class Settings:
         The last stage the policy acts in: 5 (every stage, the hover too) or 4.
     shaping : float
         The weight of the height-kept term in the reward (>= 0).
+    loss_weight : float
+        A candidate's penalty for each training trial the law succeeds in and it
+        fails (>= 0; 0: none). The law flies every batch beside the candidates, so
+        this is free; it pushes the search toward policies that win trials without
+        losing others.
     check : int
         Trials of the check set (>= 1).
     check_every : int
@@ -107,6 +112,7 @@ class Settings:
     rate_scale_rad_s: float = 4.0
     last_stage: int = 5
     shaping: float = 0.1
+    loss_weight: float = 0.0
     check: int = 60
     check_every: int = 5
 
@@ -122,6 +128,7 @@ class Settings:
             "rate-scale": (self.rate_scale_rad_s, _nonneg(self.rate_scale_rad_s), "finite, >= 0"),
             "stages": (self.last_stage, self.last_stage in (4, 5), "4 or 5"),
             "shaping": (self.shaping, _nonneg(self.shaping), "finite, >= 0"),
+            "loss-weight": (self.loss_weight, _nonneg(self.loss_weight), "finite, >= 0"),
             "check": (self.check, self.check >= 1, ">= 1"),
             "check-every": (self.check_every, self.check_every >= 1, ">= 1"),
         }
@@ -264,7 +271,8 @@ def _new_state(problem: Problem, settings: Settings) -> dict[str, Any]:
 def _same_run(state: dict[str, Any], problem: Problem, settings: Settings, out: Path) -> None:
     """Refuse to resume a run of another problem or other settings (one line naming them)."""
     want = {**problem.describe(), **asdict(settings)}
-    have = {**state["problem"], **state["settings"]}
+    # a setting added since the state was written reads as its default
+    have = {**asdict(Settings()), **state["problem"], **state["settings"]}
     diff = [k for k in want if want[k] != have.get(k)]
     if diff:
         what = ", ".join(f"{k} {have.get(k)!r} (now {want[k]!r})" for k in diff)
@@ -494,8 +502,9 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     xs = es.ask()
     trials = problem.batch(PURPOSE_TRAIN, (gen - 1) * settings.batch, settings.batch)
     blocks = [None] + [pol.with_vector(x).block() for x in xs]  # the law first: a yardstick
-    r, _ = evaluate(trials, blocks, settings.shaping)
-    law, scores = float(r[0].mean()), r[1:].mean(axis=1)
+    r, s = evaluate(trials, blocks, settings.shaping)
+    law = float(r[0].mean())
+    scores = candidate_scores(r, s, settings.loss_weight)
     es.tell(xs, [-float(v) for v in scores])
     state["generation"] = gen
     state["runs"] += len(blocks) * len(trials)
@@ -506,6 +515,25 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     if gen % settings.check_every == 0:
         _check(state, problem, settings, evaluate, check_trials)
         row["runs"] = state["runs"]
+
+
+def candidate_scores(rewards: np.ndarray, successes: np.ndarray, loss_weight: float) -> np.ndarray:
+    """Each candidate's score on a batch: its mean reward, less ``loss_weight`` for each
+    trial the law (row 0) succeeds in and the candidate fails.
+
+    Parameters
+    ----------
+    rewards, successes : ndarray, shape (1 + candidates, trials)
+        The law's row first, then the candidates'.
+    loss_weight : float
+        The penalty per trial lost to the law (>= 0).
+
+    Returns
+    -------
+    ndarray, shape (candidates,)
+    """
+    lost = successes[0][np.newaxis, :] & ~successes[1:]
+    return (rewards[1:] - loss_weight * lost).mean(axis=1)
 
 
 def _check(state, problem, settings, evaluate, check_trials) -> None:

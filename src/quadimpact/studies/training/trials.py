@@ -1,8 +1,9 @@
 """The trials a policy is trained on: the benchmark's tasks, drawn from streams of their own.
 
 A :class:`Problem` names what is trained for: a vehicle, the tasks (``wall``,
-``pole``, ``edge``: the benchmark's, docs/BENCHMARK.md 1), a sensor set
-(``onboard`` by default) and a seed. Its trials are the benchmark's trials in
+``pole``, ``edge``: the benchmark's, docs/BENCHMARK.md 1), one or more sensor
+sets (``onboard`` by default; ``"onboard,ideal"`` flies every trial with each)
+and a seed. Its trials are the benchmark's trials in
 every setting (the scenario of the task and sensor set in the benchmark's
 latest suite: 4-s runs, the ground a contact surface that ends the run, the
 sensor set's sensors and estimator), flown by the recovery law, with other
@@ -105,7 +106,10 @@ class Problem:
     tasks : tuple of str
         The benchmark's tasks trained on, in the suite's order.
     sensors : str
-        The benchmark's sensor set (``onboard``, ``lab``, ``impact``, ``ideal``).
+        The benchmark's sensor set (``onboard``, ``lab``, ``impact``, ``ideal``), or
+        several, comma-separated (``"onboard,ideal"``): each trial is then flown with
+        each set, the same draw (a policy that must not lose with one set while it
+        learns from another).
     seed : int
         The trials' seed (>= 1; :func:`check_seed`).
     """
@@ -123,8 +127,18 @@ class Problem:
         for name in self.tasks:
             task(name)
         object.__setattr__(self, "tasks", tuple(t for t in TASKS if t in self.tasks))
-        sensor_set(self.sensors)
+        names = [n.strip() for n in str(self.sensors).split(",")]
+        if not all(names) or len(set(names)) != len(names):
+            raise InputError(f"--sensors: name each sensor set once (got {self.sensors!r})")
+        for name in names:
+            sensor_set(name)
+        object.__setattr__(self, "sensors", ",".join(names))
         check_seed(self.seed)
+
+    @property
+    def sensor_sets(self) -> tuple[str, ...]:
+        """The sensor sets each trial is flown with, in the order given."""
+        return tuple(self.sensors.split(","))
 
     def describe(self) -> dict[str, Any]:
         """The problem as plain data (train.json, the policy's meta)."""
@@ -136,31 +150,36 @@ class Problem:
         }
 
     @cached_property
-    def _bases(self) -> dict[str, tuple[dict[str, Any], dict[str, Any]]]:
-        """Each task's scenario base and ranges: the benchmark's sweep of the default law."""
+    def _bases(self) -> dict[tuple[str, str], tuple[dict[str, Any], dict[str, Any]]]:
+        """Each task's scenario base and ranges with each sensor set: the benchmark's sweep
+        of the default law."""
         from quadimpact.studies.benchmark.subject import Subject
         from quadimpact.studies.benchmark.suite import SUITE_VERSION, TASKS, sensor_set
 
         out = {}
         for name in self.tasks:
             t = TASKS[name]
-            spec = Subject("train").spec(t, False, sensor_set(self.sensors), version=SUITE_VERSION)
-            base = {**spec.base, "vehicle": self.vehicle}
-            if t.kind == "wall":
-                ranges = {k: tuple(v) for k, v in spec.trials["ranges"].items()}
-            else:
-                arm = {k: v for k, v in spec.runs[0].items()
-                       if k not in ("pitch_deg", "lateral_offset_m", "seed")}  # fmt: skip
-                base.update(arm)
-                ranges = {"pitch_deg": _PITCH_RANGE_DEG, "lateral_offset_m": _OFFSET_RANGE_M}
-            out[name] = (base, ranges)
+            for sensors in self.sensor_sets:
+                spec = Subject("train").spec(t, False, sensor_set(sensors), version=SUITE_VERSION)
+                base = {**spec.base, "vehicle": self.vehicle}
+                if t.kind == "wall":
+                    ranges = {k: tuple(v) for k, v in spec.trials["ranges"].items()}
+                else:
+                    arm = {k: v for k, v in spec.runs[0].items()
+                           if k not in ("pitch_deg", "lateral_offset_m", "seed")}  # fmt: skip
+                    base.update(arm)
+                    ranges = {"pitch_deg": _PITCH_RANGE_DEG, "lateral_offset_m": _OFFSET_RANGE_M}
+                out[(name, sensors)] = (base, ranges)
         return out
 
-    def trial(self, task: str, purpose: int, index: int) -> dict[str, Any]:
-        """Trial ``index`` of ``task`` for ``purpose`` as a scenario mapping."""
+    def trial(
+        self, task: str, purpose: int, index: int, sensors: str | None = None
+    ) -> dict[str, Any]:
+        """Trial ``index`` of ``task`` for ``purpose`` as a scenario mapping, flown with
+        ``sensors`` (default: the first sensor set). The draw does not depend on the set."""
         from quadimpact.sweep.trials import SEED_LIMIT
 
-        base, ranges = self._bases[task]
+        base, ranges = self._bases[(task, sensors or self.sensor_sets[0])]
         rng = trial_stream(self.seed, self.tasks.index(task), purpose, index)
         u = rng.random(len(ranges))
         values = {k: float(lo + (hi - lo) * x)
@@ -173,11 +192,14 @@ class Problem:
         return {**base, **values}
 
     def batch(self, purpose: int, start: int, n: int) -> list[tuple[str, dict[str, Any]]]:
-        """``n`` trials, the tasks in turn: trial ``start + k`` goes to task ``k mod tasks``
-        with that task's index ``(start + k) // tasks``."""
-        m = len(self.tasks)
+        """``n`` trials, the tasks in turn and, within a task, the sensor sets in turn:
+        trial ``j = start + k`` is draw ``j // (tasks x sets)`` of task
+        ``(j // sets) mod tasks``, flown with set ``j mod sets``. With one set, trial
+        ``j`` goes to task ``j mod tasks`` with that task's index ``j // tasks``."""
+        m, n_sets = len(self.tasks), len(self.sensor_sets)
         out = []
         for j in range(start, start + n):
-            name = self.tasks[j % m]
-            out.append((name, self.trial(name, purpose, j // m)))
+            name = self.tasks[(j // n_sets) % m]
+            sensors = self.sensor_sets[j % n_sets]
+            out.append((name, self.trial(name, purpose, j // (m * n_sets), sensors)))
         return out
