@@ -28,6 +28,7 @@ from quadimpact.core.geometry import shape_distance
 from quadimpact.core.geometry.shapes import by_kind
 from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
 from quadimpact.errors import InputError
+from quadimpact.inputs.allocation import trim_rotor_speeds
 from quadimpact.inputs.controllers import RecoveryParams, controller_entry
 from quadimpact.inputs.estimators import (
     EstimatorContext,
@@ -51,7 +52,6 @@ from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, wall_attitude
 from quadimpact.simulation.plugin_kernel import PluginStep, plugin_address, step_name
 from quadimpact.simulation.sharing import kept_shared
-from quadimpact.simulation.trim import trim_rotor_speeds
 
 __all__ = [
     "control_rate_hz",

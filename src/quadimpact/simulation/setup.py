@@ -331,7 +331,8 @@ def prepare(
     compiled = compile_cpu_total()
     check_scenario_type(scenario)
     announce_compilation()
-    setup = _prepared(resolve(scenario), kernel)  # resolve -> pack -> (the cached loop)
+    resolved = resolve(scenario)  # every default applied, once
+    setup = _prepared(resolved, kernel)  # pack (one call), then the run's loop
     check_prepared(scenario, setup)
     # a plug-in's loop compiled here (a wall approach's shooting): its time apart
     setup.compile_cpu_s = compile_cpu_total() - compiled
