@@ -1,5 +1,10 @@
 """Validated scenario -> resolved run: every default of a run decided, in one place each.
 
+The settings' defaults are decided in ``inputs/resolve.py`` (one call per
+shared part); this module adds what each scenario kind implies and what
+needs the compiler (a plug-in step's address) or the packed shapes (an
+obstacle's front).
+
 :func:`resolve` turns a validated :class:`~quadimpact.inputs.scenarios.WallApproach`,
 :class:`~quadimpact.inputs.scenarios.FlightScenario` or
 :class:`~quadimpact.inputs.scenarios.ImpactTrial` into one frozen
@@ -29,24 +34,12 @@ from quadimpact.core.geometry.shapes import by_kind
 from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
 from quadimpact.errors import InputError
 from quadimpact.inputs.allocation import trim_rotor_speeds
-from quadimpact.inputs.controllers import RecoveryParams, controller_entry
-from quadimpact.inputs.estimators import (
-    EstimatorContext,
-    estimator_entry,
-    resolve_estimator_params,
-)
-from quadimpact.inputs.model import ModelOptions
-from quadimpact.inputs.resolved import (
-    ResolvedController,
-    ResolvedEstimator,
-    ResolvedRun,
-    ResolvedShared,
-    ResolvedShot,
-)
+from quadimpact.inputs.resolve import control_rate_hz, initial_speeds, resolve_controller
+from quadimpact.inputs.resolve import resolve_shared as settings_resolved
+from quadimpact.inputs.resolved import ResolvedRun, ResolvedShared, ResolvedShot
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
-from quadimpact.packing.constants import CONTROL_RATE_HZ, DEFAULT_ATOL, DEFAULT_RTOL, RPM
 from quadimpact.packing.world_block import pack_surfaces
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.approach import initial_state, wall_attitude
@@ -63,95 +56,13 @@ __all__ = [
 ]
 
 
-# ---------------------------------------------------------------- run settings
-def control_rate_hz(s: Any) -> float:
-    """The rate of a run's control ticks, Hz: its ``control_rate_hz``, else
-    :data:`~quadimpact.packing.constants.CONTROL_RATE_HZ` (200 Hz)."""
-    rate = getattr(s, "control_rate_hz", None)
-    return CONTROL_RATE_HZ if rate is None else float(rate)
-
-
-def slew_limit_rad_s2(s: RunSettings, v: Vehicle) -> float | None:
-    """The rotor slew limit (rad/s^2) of a run: its own, the vehicle's (``"vehicle"``) or
-    none (``None``)."""
-    if s.rotor_slew_limit_rad_s2 == "vehicle":
-        if v.rotor_slew_limit_rpm_per_s is None:
-            return None
-        return v.rotor_slew_limit_rpm_per_s * RPM
-    return s.rotor_slew_limit_rad_s2
-
-
-def resolve_controller(s: RunSettings, v: Vehicle) -> ResolvedController:
-    """The run's controller: its entry, its parameters with every default applied.
-
-    The recovery law's parameters: ``[controller_params]`` over the model's
-    ``recovery_law`` tuning over ``RecoveryParams``' defaults
-    (``RunSettings.resolved_controller_params``); then ``a_mag_m_s2 = None``
-    is the vehicle's g and ``hover_a_max_m_s2 = None`` half of it (m/s^2).
-    A plug-in's step is compiled alone here (once per process) for its address.
-    """
-    entry = controller_entry(s.controller)
-    given = s.resolved_controller_params()
-    params = given
-    if isinstance(given, RecoveryParams):
-        g = float(v.gravity_m_s2)
-        update = {}
-        if given.a_mag_m_s2 is None:
-            update["a_mag_m_s2"] = g
-        if given.hover_a_max_m_s2 is None:
-            update["hover_a_max_m_s2"] = 0.5 * g
-        params = given.model_copy(update=update) if update else given
-    address = 0.0
-    if entry.step is not None:
-        who = PluginStep("controller", entry.name, step_name(entry.step))
-        address = float(plugin_address(who, entry.step, CONTROLLER_SIGNATURE))
-    return ResolvedController(
-        entry=entry,
-        given=given,
-        params=params,
-        pre_impact=s.resolved_pre_impact(),
-        nominal_controller=s.nominal_controller,
-        step_address=address,
-    )
-
-
-def _resolve_estimator(s: RunSettings, v: Vehicle, imu: Any) -> ResolvedEstimator:
-    entry = estimator_entry(s.estimator)
-    given = s.resolved_estimator_params()
-    context = EstimatorContext(
-        imu=imu,
-        magnetometer=s.magnetometer,
-        pose_sensor=s.pose_sensor,
-        vehicle=v,
-        instruments=dict(s.instruments),
-    )
-    address = 0.0
-    if entry.step is not None:
-        who = PluginStep("estimator", entry.name, step_name(entry.step))
-        address = float(plugin_address(who, entry.step, ESTIMATOR_SIGNATURE))
-    return ResolvedEstimator(
-        entry=entry,
-        given=given,
-        params=resolve_estimator_params(entry.kind, given, context),
-        context=context,
-        step_address=address,
-    )
-
-
-def _check_rotor_count(s: RunSettings, o: ModelOptions, v: Vehicle) -> None:
-    """Refuse the settings that name a quadrotor's motors 1-4 for another rotor count."""
-    if v.rotor_count == 4:
-        return
-    if s.power_off is not None:
-        raise InputError(
-            f"power_off: a schedule of motors 1-4 is for a quadrotor (vehicle {v.name} has "
-            f"{v.rotor_count} rotors)"
-        )
-    if o.cut_step_motors:
-        raise InputError(
-            f"model_options.cut_step_motors: motors 1-4 of a quadrotor (vehicle {v.name} has "
-            f"{v.rotor_count} rotors)"
-        )
+def _address_of(role: str, entry: Any) -> float:
+    """A plug-in step's entry address, compiled alone (once per process); 0 for a built-in."""
+    if entry.step is None:
+        return 0.0
+    who = PluginStep(role, entry.name, step_name(entry.step))
+    signature = CONTROLLER_SIGNATURE if role == "controller" else ESTIMATOR_SIGNATURE
+    return float(plugin_address(who, entry.step, signature))
 
 
 def resolve_shared(
@@ -162,61 +73,10 @@ def resolve_shared(
     wall: Plane | None = None,
     front: tuple[float, np.ndarray] | None = None,
 ) -> ResolvedShared:
-    """The part of a run that its state, references and seed do not change, resolved.
-
-    ``v``: the scenario's vehicle (``s.build_vehicle()``); ``surfaces``: the
-    contact surfaces in packing order; ``duration_s``: how long the run
-    lasts (s); ``wall``: its wall plane; ``front``: an impact trial's
-    obstacle front (:func:`obstacle_front`).
-    """
-    o = s.resolved_model_options()
-    _check_rotor_count(s, o, v)
-    rate = control_rate_hz(s)
-    imu = s.imu.resolved(v.imu_position_m, rate)
-    controller = resolve_controller(s, v)
-    slew = slew_limit_rad_s2(s, v)
-    warnings = [f"vehicle {v.name}: {w}" for w in v.plausibility_warnings()]
-    if s.controller == "recovery" and controller.pre_impact == "spin-down" and not slew:
-        warnings.append(
-            f"no rotor slew limit (vehicle {v.name} has none): the pre-impact spin-down "
-            "stops the rotors at the first tick"
-        )
-    return ResolvedShared(
-        settings=s,
-        vehicle=v,
-        options=o,
-        surfaces=tuple(surfaces),
-        wall=wall,
-        duration_s=float(duration_s),
-        final_time_s=float(s.final_time_s),
-        output_rate_hz=float(s.output_rate_hz),
-        control_rate_hz=rate,
-        rtol=DEFAULT_RTOL if s.rtol is None else float(s.rtol),
-        atol=DEFAULT_ATOL if s.atol is None else float(s.atol),
-        slew_limit_rad_s2=slew,
-        imu=imu,
-        controller=controller,
-        estimator=_resolve_estimator(s, v, imu),
-        instruments=dict(s.instruments),
-        front=front,
-        warnings=tuple(warnings),
+    """``inputs.resolve.resolve_shared`` with the plug-in steps' addresses (compiled alone)."""
+    return settings_resolved(
+        s, v, surfaces, duration_s, wall=wall, front=front, address_of=_address_of
     )
-
-
-def initial_speeds(v: Vehicle, roll: float, pitch: float, rule: str, yaw_paper: bool) -> np.ndarray:
-    """The rotor speeds a run starts with (rad/s), by the model's ``initial_rotor_speeds``.
-
-    ``"level-hover"``: every rotor at the level hover speed; ``"trimmed"``:
-    the speeds of the thrust ``m g / (cos(roll) cos(pitch))`` and no torque.
-    """
-    weight = v.mass_kg * v.gravity_m_s2
-    if rule == "level-hover":
-        n = v.rotor_count  # rotors sharing one coefficient: sqrt(m g / (n kt)) each
-        kt = v.thrust_coefficients
-        if np.all(kt == kt[0]):
-            return np.full(n, math.sqrt(weight / (float(n) * float(kt[0]))))
-        return np.full(n, v.hover_speed_rad_s)
-    return trim_rotor_speeds(v, weight / (math.cos(roll) * math.cos(pitch)), yaw_paper)
 
 
 def _ground(s: RunSettings) -> list[Plane]:
