@@ -186,7 +186,7 @@ def record_size_bytes(scenario: Any, n_features: int | None = None) -> int:
     ``n_features``: :func:`vehicle_feature_count` of the scenario, when the
     caller knows it (a sweep, once per vehicle).
     """
-    from quadimpact.simulation.resolve import control_rate_hz
+    from quadimpact.inputs.resolve import control_rate_hz
 
     duration = float(scenario.final_time_s) - float(getattr(scenario, "start_time_s", 0.0) or 0.0)
     rows = math.ceil(max(duration, 0.0) * float(scenario.output_rate_hz)) + 2

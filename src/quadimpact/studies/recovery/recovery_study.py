@@ -110,7 +110,7 @@ def describe(spec: SweepSpec, study: RecoveryStudy | None, table: pd.DataFrame) 
     """
     import pandas as pd
 
-    from quadimpact.simulation.resolve import control_rate_hz
+    from quadimpact.inputs.resolve import control_rate_hz
 
     first = scenario_from_dict(spec.scenario_dict(0), where="recovery: run 0")
     vehicle = first.build_vehicle()
