@@ -8,7 +8,8 @@ writes one (``tests/test_defaults.py`` checks it for every built-in component).
 A ``None`` left here means "none" (no magnetometer, no slew limit, no lean cut),
 never "the default".
 
-The records are frozen: what a run is does not change once resolved. Units
+The records are frozen (their mappings read-only): what a run is does not
+change once resolved. Units
 and frames as in docs/MODEL.md section 1 (SI; inertial NED, body FRD).
 """
 
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -150,6 +152,9 @@ class ResolvedShared:
     warnings: tuple[str, ...] = ()
     memo: dict[str, Any] = field(default_factory=dict, init=False, compare=False, repr=False)
 
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "instruments", MappingProxyType(dict(self.instruments)))
+
 
 @dataclass(frozen=True)
 class ResolvedShot:
@@ -198,3 +203,6 @@ class ResolvedRun:
     waypoint: Any = None
     hold_m: tuple[float, float, float] | None = None
     shot: ResolvedShot | None = None
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "references", MappingProxyType(dict(self.references)))
