@@ -4,9 +4,10 @@
 with every default applied; ``packing/run_model.py``'s ``pack`` writes it. These
 tests resolve runs of every built-in component (both bundled vehicles, the
 three controllers under every recovery-law tuning, every estimator, every
-sensor preset, every obstacle kind) and check two things. The resolved
-description holds a number wherever a packer writes one: a ``None`` left in
-it means "none" and is declared below. And no packer substitutes a default
+sensor preset and sensor component, every obstacle kind) and check two
+things. The resolved description holds a number wherever a packer writes one:
+a ``None`` left in it means "none" and is declared below (a new optional
+parameter fails here until it is resolved or declared). And no packer substitutes a default
 for a missing value: every number a packer reads, made ``None``, is refused
 (a ``None -> g`` fallback in a packer would pack it instead).
 """
@@ -42,6 +43,19 @@ NONE_IS_A_VALUE = {
         "hover_set_point_m",  # hold where hover_hold says
         "policy",  # no learned residual
     },
+    "ResolvedImu": {
+        "accel_range_m_s2",  # no saturation
+        "gyro_range_rad_s",  # no saturation
+        "impact_disturbance",  # none
+        "filter_time_constant_s",  # only with filter = "first-order"
+        "filter_window",  # only with filter = "moving-average"
+    },
+    "Vehicle": {
+        "bumper_centres_m",  # on the rotor hubs: the vehicle's geometry (contact_features)
+        "features",  # the four bumper rings (contact_features)
+        "rotor_slew_limit_rpm_per_s",  # not known
+    },
+    "Cylinder": {"length_m"},  # infinite
 }
 #: Fields of the resolved shared part that may be ``None``: what is absent.
 SHARED_NONE = {"wall", "front", "slew_limit_rad_s2"}
@@ -96,9 +110,13 @@ def test_every_recovery_law_tuning_is_flown_by_a_model_variant() -> None:
 def test_the_resolved_run_holds_a_number_wherever_a_packer_writes_one(name: str) -> None:
     r = resolve(SCENARIOS[name])
     shared = r.shared
-    for part in (shared.controller, shared.estimator):
-        allowed = NONE_IS_A_VALUE.get(type(part.params).__name__, set())
-        assert _none_fields(part.params) <= allowed, type(part.params).__name__
+    components = [shared.controller.params, shared.estimator.params, shared.imu, shared.vehicle]
+    components += [*shared.instruments.values(), *shared.surfaces, shared.options]
+    context = shared.estimator.context
+    components += [c for c in (context.magnetometer, context.pose_sensor) if c is not None]
+    for component in components:
+        allowed = NONE_IS_A_VALUE.get(type(component).__name__, set())
+        assert _none_fields(component) <= allowed, type(component).__name__
     for f in dataclasses.fields(ResolvedShared):
         if f.name not in SHARED_NONE:
             assert getattr(shared, f.name) is not None, f.name
