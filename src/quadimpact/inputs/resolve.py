@@ -8,7 +8,10 @@ the control rate, the integrator's tolerances and the slew limit. The
 defaults of these are decided here and nowhere else (the packers write
 numbers; ``tests/simulation/test_resolve.py``). The rest of a run's
 resolution (the attitude, the start, the references, a plug-in step's
-address, the kept shared parts) is ``simulation/resolve.py``'s.
+address, the kept shared parts, an obstacle's front) is
+``simulation/resolve.py``'s; each kind's own part (:func:`flight_start`,
+:func:`wall_start`, :func:`trial_start`: attitude, trim, start state,
+references) is here.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.allocation import trim_rotor_speeds
 from quadimpact.inputs.controllers import RecoveryParams, controller_entry
@@ -28,22 +32,37 @@ from quadimpact.inputs.estimators import (
     resolve_estimator_params,
 )
 from quadimpact.inputs.model import ModelOptions
-from quadimpact.inputs.resolved import ResolvedController, ResolvedEstimator, ResolvedShared
+from quadimpact.inputs.resolved import (
+    ResolvedController,
+    ResolvedEstimator,
+    ResolvedRun,
+    ResolvedShared,
+    ResolvedShot,
+)
 from quadimpact.inputs.run_settings import RunSettings
 from quadimpact.inputs.vehicle import Vehicle
+from quadimpact.linalg import matvec_t
+from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
 __all__ = [
     "CONTROL_RATE_HZ",
     "DEFAULT_ATOL",
     "DEFAULT_RTOL",
+    "PAPER_FIT_OFFSET_RAD",
+    "PAPER_FIT_SCALE",
     "RPM",
     "check_rotor_count",
     "control_rate_hz",
+    "flight_start",
     "initial_speeds",
+    "initial_state",
     "resolve_controller",
     "resolve_estimator",
     "resolve_shared",
     "slew_limit_rad_s2",
+    "trial_start",
+    "wall_attitude",
+    "wall_start",
 ]
 
 CONTROL_RATE_HZ = 200.0
@@ -224,3 +243,151 @@ def initial_speeds(v: Vehicle, roll: float, pitch: float, rule: str, yaw_paper: 
             return np.full(n, math.sqrt(weight / (float(n) * float(kt[0]))))
         return np.full(n, v.hover_speed_rad_s)
     return trim_rotor_speeds(v, weight / (math.cos(roll) * math.cos(pitch)), yaw_paper)
+
+
+PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (docs/VARIANTS.md 4.4)
+PAPER_FIT_SCALE = 1.3836686
+
+
+# ------------------------------------------------------------------ attitude
+def wall_attitude(
+    heading_deg: float, inclination_deg: float, mapping: str = "exact"
+) -> tuple[float, float, float]:
+    """Roll, pitch, yaw (rad, ZYX) for a heading and an inclination toward the wall.
+
+    ``exact``: yaw = psi and the body z axis in the inertial X-Z plane at
+    angle iota from Z, tilted so the thrust points toward +X (docs/STUDIES.md 1):
+    ``phi = -asin(sin psi sin iota)``, ``theta = asin(-cos psi sin iota / cos phi)``.
+    ``paper-fit``: the authors' mapping (docs/VARIANTS.md 4.4) at psi = 0 and +-45 deg,
+    ``exact`` elsewhere.
+    """
+    psi = math.radians(heading_deg)
+    iota = math.radians(inclination_deg)
+    if mapping == "paper-fit":
+        if heading_deg == 0.0:
+            return 0.0, -iota, psi
+        if abs(heading_deg) == 45.0:
+            a = -(iota - PAPER_FIT_OFFSET_RAD) / PAPER_FIT_SCALE
+            return a, a, psi
+    phi = -math.asin(math.sin(psi) * math.sin(iota))
+    theta = math.asin(-math.cos(psi) * math.sin(iota) / math.cos(phi))
+    return phi, theta, psi
+
+
+def initial_state(
+    position: np.ndarray,
+    v_inertial: np.ndarray,
+    q: np.ndarray,
+    omega: np.ndarray,
+    rotors: np.ndarray,
+) -> np.ndarray:
+    """The kernel's state vector (layout ``X_*``) from inertial position and velocity;
+    ``rotors``: the speeds of the vehicle's ``n`` rotors (rad/s), 0 beyond them."""
+    x = np.zeros(L.NX)
+    x[L.X_POS : L.X_POS + 3] = position
+    x[L.X_VEL : L.X_VEL + 3] = matvec_t(quat_to_matrix(q), v_inertial)
+    x[L.X_QUAT : L.X_QUAT + 4] = q
+    x[L.X_OMEGA : L.X_OMEGA + 3] = omega
+    x[L.X_ROTOR : L.X_ROTOR + len(rotors)] = rotors
+    return x
+
+
+def flight_start(s: Any, shared: ResolvedShared) -> ResolvedRun:
+    """A flight's own part: its start state as given (rotor speeds by the model's
+    ``initial_rotor_speeds`` unless given), its references, its waypoint."""
+    v = shared.vehicle
+    o = shared.options
+    roll, pitch, yaw = (math.radians(a) for a in s.euler_deg)
+    rotors = (
+        np.asarray(s.rotor_speeds_rad_s, dtype=float)
+        if s.rotor_speeds_rad_s is not None
+        else initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper")
+    )
+    if len(rotors) != v.rotor_count:
+        raise InputError(
+            f"rotor_speeds_rad_s: {len(rotors)} speeds for the {v.rotor_count} rotors of "
+            f"vehicle {v.name} (one per rotor)"
+        )
+    x0 = initial_state(
+        np.asarray(s.position_m, float),
+        np.asarray(s.velocity_m_s, float),
+        euler_zyx_to_quat(roll, pitch, yaw),
+        np.asarray(s.angular_velocity_rad_s, float),
+        rotors,
+    )
+    ref_att = s.attitude_ref_deg if s.attitude_ref_deg is not None else s.euler_deg
+    refs = {
+        "altitude_m": float(s.altitude_ref_m if s.altitude_ref_m is not None else -s.position_m[2]),
+        "roll_rad": math.radians(ref_att[0]),
+        "pitch_rad": math.radians(ref_att[1]),
+        "yaw_rad": math.radians(ref_att[2]),
+    }
+    return ResolvedRun(
+        shared=shared,
+        seed=s.seed,
+        references=refs,
+        x0=x0,
+        t0=float(s.start_time_s),
+        waypoint=s.waypoint,
+        hold_m=tuple(float(c) for c in s.position_m),
+    )
+
+
+def wall_start(s: Any, shared: ResolvedShared) -> ResolvedRun:
+    """A wall approach's own part: its attitude (``wall_attitude``, or the roll and pitch
+    given), references and shooting (its start is solved after packing)."""
+    v = shared.vehicle
+    o = shared.options
+    if s.roll_deg is not None and s.pitch_deg is not None:
+        roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.heading_deg))
+    else:
+        roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
+    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
+    h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
+    shot = ResolvedShot(
+        q=euler_zyx_to_quat(roll, pitch, yaw),
+        rotors=initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper"),
+        start=np.array([0.0, 0.0, -float(h0)]),
+        impact_time_s=float(s.impact_time_s),
+        speed_m_s=float(s.speed_m_s),
+        late_start=o.approach_start == "late-start",
+    )
+    return ResolvedRun(shared=shared, seed=s.seed, references=refs, x0=None, shot=shot)
+
+
+def trial_start(s: Any, shared: ResolvedShared) -> ResolvedRun:
+    """An impact trial's own part (docs/RECOVERY.md 5): its start state and references.
+
+    The CM starts at ``X = -start_distance_m``, altitude ``altitude_m``, the
+    attitude and the inertial velocity ``(speed_m_s, 0, 0)`` given, at rest in
+    rotation, with the rotor speeds of the collective thrust
+    ``m g cos(roll) cos(pitch)`` and zero torques. With obstacles, it starts
+    ``start_distance_m`` before the first one's front (``shared.front``),
+    beside its centre by ``lateral_offset_m``.
+    """
+    v = shared.vehicle
+    roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.yaw_deg))
+    weight = v.mass_kg * v.gravity_m_s2
+    rotors = trim_rotor_speeds(
+        v, weight * math.cos(roll) * math.cos(pitch), shared.options.yaw_reaction == "paper"
+    )
+    if shared.front is None:
+        start = np.array([-float(s.start_distance_m), 0.0, -float(s.altitude_m)])
+    else:
+        x_face, centre = shared.front
+        start = np.array(
+            [
+                x_face - float(s.start_distance_m),
+                centre[1] + float(s.lateral_offset_m),
+                -float(s.altitude_m),
+            ]
+        )
+    x0 = initial_state(
+        start,
+        np.array([float(s.speed_m_s), 0.0, 0.0]),
+        euler_zyx_to_quat(roll, pitch, yaw),
+        np.zeros(3),
+        rotors,
+    )
+    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
+    return ResolvedRun(shared=shared, seed=s.seed, references=refs, x0=x0, t0=0.0)

@@ -23,7 +23,6 @@ packing is packed once.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -33,16 +32,20 @@ from quadimpact.core.geometry import shape_distance
 from quadimpact.core.geometry.shapes import by_kind
 from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
 from quadimpact.errors import InputError
-from quadimpact.inputs.allocation import trim_rotor_speeds
-from quadimpact.inputs.resolve import control_rate_hz, initial_speeds, resolve_controller
+from quadimpact.inputs.resolve import (
+    control_rate_hz,
+    flight_start,
+    initial_speeds,
+    resolve_controller,
+    trial_start,
+    wall_start,
+)
 from quadimpact.inputs.resolve import resolve_shared as settings_resolved
-from quadimpact.inputs.resolved import ResolvedRun, ResolvedShared, ResolvedShot
+from quadimpact.inputs.resolved import ResolvedRun, ResolvedShared
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, RunSettings, WallApproach
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.packing.world_block import pack_surfaces
-from quadimpact.rotations import euler_zyx_to_quat
-from quadimpact.simulation.approach import initial_state, wall_attitude
 from quadimpact.simulation.plugin_kernel import PluginStep, plugin_address, step_name
 from quadimpact.simulation.sharing import kept_shared
 
@@ -89,42 +92,7 @@ def _ground(s: RunSettings) -> list[Plane]:
 def _resolve_flight(s: FlightScenario) -> ResolvedRun:
     v = s.build_vehicle()
     surfaces = [*s.surfaces, *s.obstacles, *_ground(s)]
-    shared = resolve_shared(s, v, surfaces, s.final_time_s - s.start_time_s)
-    o = shared.options
-    roll, pitch, yaw = (math.radians(a) for a in s.euler_deg)
-    rotors = (
-        np.asarray(s.rotor_speeds_rad_s, dtype=float)
-        if s.rotor_speeds_rad_s is not None
-        else initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper")
-    )
-    if len(rotors) != v.rotor_count:
-        raise InputError(
-            f"rotor_speeds_rad_s: {len(rotors)} speeds for the {v.rotor_count} rotors of "
-            f"vehicle {v.name} (one per rotor)"
-        )
-    x0 = initial_state(
-        np.asarray(s.position_m, float),
-        np.asarray(s.velocity_m_s, float),
-        euler_zyx_to_quat(roll, pitch, yaw),
-        np.asarray(s.angular_velocity_rad_s, float),
-        rotors,
-    )
-    ref_att = s.attitude_ref_deg if s.attitude_ref_deg is not None else s.euler_deg
-    refs = {
-        "altitude_m": float(s.altitude_ref_m if s.altitude_ref_m is not None else -s.position_m[2]),
-        "roll_rad": math.radians(ref_att[0]),
-        "pitch_rad": math.radians(ref_att[1]),
-        "yaw_rad": math.radians(ref_att[2]),
-    }
-    return ResolvedRun(
-        shared=shared,
-        seed=s.seed,
-        references=refs,
-        x0=x0,
-        t0=float(s.start_time_s),
-        waypoint=s.waypoint,
-        hold_m=tuple(float(c) for c in s.position_m),
-    )
+    return flight_start(s, resolve_shared(s, v, surfaces, s.final_time_s - s.start_time_s))
 
 
 # --------------------------------------------------------------- wall approach
@@ -145,24 +113,7 @@ def wall_shared(s: WallApproach, v: Vehicle | None = None) -> ResolvedShared:
 
 
 def _resolve_wall_approach(s: WallApproach) -> ResolvedRun:
-    v = s.build_vehicle()
-    shared = wall_shared(s, v)
-    o = shared.options
-    if s.roll_deg is not None and s.pitch_deg is not None:
-        roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.heading_deg))
-    else:
-        roll, pitch, yaw = wall_attitude(s.heading_deg, s.inclination_deg, o.attitude_mapping)
-    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    h0 = s.start_altitude_m if s.start_altitude_m is not None else s.altitude_m
-    shot = ResolvedShot(
-        q=euler_zyx_to_quat(roll, pitch, yaw),
-        rotors=initial_speeds(v, roll, pitch, o.initial_rotor_speeds, o.yaw_reaction == "paper"),
-        start=np.array([0.0, 0.0, -float(h0)]),
-        impact_time_s=float(s.impact_time_s),
-        speed_m_s=float(s.speed_m_s),
-        late_start=o.approach_start == "late-start",
-    )
-    return ResolvedRun(shared=shared, seed=s.seed, references=refs, x0=None, shot=shot)
+    return wall_start(s, wall_shared(s, s.build_vehicle()))
 
 
 # ---------------------------------------------------------------- impact trial
@@ -222,33 +173,7 @@ def trial_shared(s: ImpactTrial) -> ResolvedShared:
 
 
 def _resolve_impact_trial(s: ImpactTrial) -> ResolvedRun:
-    shared = trial_shared(s)
-    v = shared.vehicle
-    roll, pitch, yaw = (math.radians(a) for a in (s.roll_deg, s.pitch_deg, s.yaw_deg))
-    weight = v.mass_kg * v.gravity_m_s2
-    rotors = trim_rotor_speeds(
-        v, weight * math.cos(roll) * math.cos(pitch), shared.options.yaw_reaction == "paper"
-    )
-    if shared.front is None:
-        start = np.array([-float(s.start_distance_m), 0.0, -float(s.altitude_m)])
-    else:
-        x_face, centre = shared.front
-        start = np.array(
-            [
-                x_face - float(s.start_distance_m),
-                centre[1] + float(s.lateral_offset_m),
-                -float(s.altitude_m),
-            ]
-        )
-    x0 = initial_state(
-        start,
-        np.array([float(s.speed_m_s), 0.0, 0.0]),
-        euler_zyx_to_quat(roll, pitch, yaw),
-        np.zeros(3),
-        rotors,
-    )
-    refs = {"altitude_m": float(s.altitude_m), "roll_rad": roll, "pitch_rad": pitch, "yaw_rad": yaw}
-    return ResolvedRun(shared=shared, seed=s.seed, references=refs, x0=x0, t0=0.0)
+    return trial_start(s, trial_shared(s))
 
 
 def resolve(scenario: WallApproach | FlightScenario | ImpactTrial) -> ResolvedRun:
