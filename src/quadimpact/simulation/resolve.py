@@ -1,9 +1,10 @@
 """Validated scenario -> resolved run: every default of a run decided, in one place each.
 
-The settings' defaults are decided in ``inputs/resolve.py`` (one call per
-shared part); this module adds what each scenario kind implies and what
-needs the compiler (a plug-in step's address) or the packed shapes (an
-obstacle's front).
+Every default is decided in ``inputs/resolve.py``: one call for the shared
+part (``resolve_shared``), one for the run's own (``flight_start``,
+``wall_start``, ``trial_start``). This module adds what needs the layers
+above the inputs: the kept shared parts, a plug-in step's address (compiled
+alone) and an obstacle's front (from its packed shape).
 
 :func:`resolve` turns a validated :class:`~quadimpact.inputs.scenarios.WallApproach`,
 :class:`~quadimpact.inputs.scenarios.FlightScenario` or
