@@ -212,23 +212,29 @@ def _kernel(
 def _run_setup(r: ResolvedRun, packed: PackedRun) -> RunSetup:
     """A packed run with what the Python side reads (names, references, warnings, the loop).
 
-    The loop of the run's plug-ins (:func:`_kernel`) and the IMU's check are
-    once per resolved shared part (kept in its memo).
+    The loop of the run's plug-ins (:func:`_kernel`), the names and the IMU's
+    check are once per resolved shared part (kept in its memo).
     """
     shared = r.shared
     packing = packed.shared
     est = packing.est
-    if "kernel" not in shared.memo:
-        shared.memo["kernel"] = _kernel(
+    memo = shared.memo
+    if "kernel" not in memo:
+        memo["kernel"] = _kernel(
             shared.controller.entry,
             shared.estimator.entry,
             tuple(shared.instruments),
             tuple(getattr(x, "kind", "") for x in shared.surfaces),
         )
+        memo["names"] = (
+            shared.vehicle.feature_names(),
+            tuple(x.name for x in shared.surfaces),
+        )
+    feature_names, shape_names = memo["names"]
     setup = RunSetup(
         run=packed.model,
-        feature_names=shared.vehicle.feature_names(),
-        shape_names=tuple(x.name for x in shared.surfaces),
+        feature_names=feature_names,
+        shape_names=shape_names,
         references=dict(r.references),
         vehicle=shared.vehicle,
         options=shared.options,
@@ -239,12 +245,12 @@ def _run_setup(r: ResolvedRun, packed: PackedRun) -> RunSetup:
         estimator=est.name,
         estimator_settings=est.settings,
         controller=shared.settings.controller,
-        kernel=shared.memo["kernel"],
+        kernel=memo["kernel"],
         resolved=dict(packing.resolved),
     )
-    if "imu-checked" not in shared.memo:
+    if "imu-checked" not in memo:
         check_imu(setup)  # of the shared packing: no draw changes what it checks
-        shared.memo["imu-checked"] = True
+        memo["imu-checked"] = True
     return setup
 
 
