@@ -1,10 +1,10 @@
 """Impact trials and wall approaches share their packing: kept or not, a packed run is the
 same, bit for bit.
 
-``simulation.setup`` packs the part of an impact trial or a wall approach
+``simulation.resolve`` resolves the part of an impact trial or a wall approach
 that its initial state, attitude and seed do not change once per process
-(``SharedSetup``, kept by ``simulation/sharing.py``) and completes a copy
-per run. These tests pack runs with the kept packing and alone (the cache
+(a ``ResolvedShared``, kept by ``simulation/sharing.py``), which is packed
+once, and completes a copy per run. These tests pack runs with the kept packing and alone (the cache
 emptied) and compare every array byte for byte (a wall approach's solved
 start included); check that no state field reaches the shared part; and
 that a changed field or vehicle file packs again.
@@ -18,9 +18,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from quadimpact.inputs.resolved import ResolvedShared
 from quadimpact.inputs.scenarios import ImpactTrial, WallApproach
 from quadimpact.inputs.world import Cylinder
-from quadimpact.packing.run_model import output_grid
+from quadimpact.packing.run_model import output_grid, pack_shared
+from quadimpact.simulation import resolve as R
 from quadimpact.simulation import setup as S
 from quadimpact.simulation.sharing import TRIAL_STATE_FIELDS, WALL_STATE_FIELDS, clear_kept
 
@@ -65,6 +67,17 @@ def _same(a: S.RunSetup, b: S.RunSetup) -> None:
     assert a.resolved == b.resolved and a.shape_names == b.shape_names
 
 
+def _same_shared(a: ResolvedShared, b: ResolvedShared) -> None:
+    """Two resolved shared parts pack the same arrays, bit for bit."""
+    pa, pb = pack_shared(a), pack_shared(b)
+    for name, x, y in zip(pa.model._fields, pa.model, pb.model, strict=True):
+        x, y = np.asarray(x), np.asarray(y)
+        assert x.shape == y.shape and x.tobytes() == y.tobytes(), name
+    assert pa.n_imu == pb.n_imu and pa.resolved == pb.resolved
+    assert a.warnings == b.warnings
+    assert [x.name for x in a.surfaces] == [x.name for x in b.surfaces]
+
+
 @pytest.mark.parametrize("extra", [{}, NOISY, POLE], ids=["ideal-imu", "noisy-sensors", "pole"])
 def test_a_trial_packed_with_the_kept_packing_is_the_trial_packed_alone(extra: dict) -> None:
     trials = _trials(extra)
@@ -91,10 +104,10 @@ def test_no_state_field_reaches_the_shared_packing(field: str) -> None:
         "altitude_m": 1.3,
     }.get(field, 0.37 if field == "speed_m_s" else 12.5)
     clear_kept()
-    one = S._trial_shared(ImpactTrial(**base))
+    one = R.trial_shared(ImpactTrial(**base))
     clear_kept()
-    two = S._trial_shared(ImpactTrial(**base, **{field: changed}))
-    _same(one.setup, two.setup)
+    two = R.trial_shared(ImpactTrial(**base, **{field: changed}))
+    _same_shared(one, two)
     assert one.front is not None and one.front[0] == two.front[0]
 
 
@@ -179,7 +192,7 @@ def test_no_wall_approach_state_field_reaches_the_shared_packing(field: str) -> 
         "pitch_deg": attitude,
     }.get(field, {field: 12.5})
     clear_kept()
-    one = S._wall_shared(WallApproach(**base))
+    one = R.wall_shared(WallApproach(**base))
     clear_kept()
-    two = S._wall_shared(WallApproach(**base, **changed))
-    _same(one.setup, two.setup)
+    two = R.wall_shared(WallApproach(**base, **changed))
+    _same_shared(one, two)

@@ -197,7 +197,7 @@ class RecoveryParams(BaseModel):
 # ------------------------------------------------------------------ registry
 @dataclass(frozen=True)
 class PackContext:
-    """What a packer may need besides its parameters.
+    """What a packer may need besides its parameters (as resolved: ``simulation/resolve.py``).
 
     Attributes
     ----------
@@ -212,8 +212,8 @@ class PackContext:
 
     vehicle: Any
     options: Any
-    pre_impact: str = "nominal"
-    nominal_controller: str = "paper"
+    pre_impact: str
+    nominal_controller: str
 
 
 @dataclass(frozen=True)

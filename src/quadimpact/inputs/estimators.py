@@ -26,6 +26,7 @@ address (``core/plugin_call.py``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -48,6 +49,7 @@ __all__ = [
     "estimator_entry",
     "estimator_names",
     "register_estimator",
+    "resolve_estimator_params",
     "settings_text",
     "unregister_estimator",
     "validate_estimator_params",
@@ -64,6 +66,11 @@ POSITION_NOISE_FLOOR = 1e-4  # m
 ATTITUDE_NOISE_FLOOR_DEG = 0.01
 BIAS_STD_FLOOR = 1e-3  # rad/s
 INITIAL_ATTITUDE_STD_DEG = 0.5
+VELOCITY_STD_FLOOR = 0.01  # m/s
+POSITION_STD_FLOOR = 0.01  # m
+BARO_NOISE_FLOOR = 0.01  # m
+BARO_WALK_FLOOR = 1e-4  # m/sqrt(s)
+ACCEL_BIAS_STD_FLOOR = 0.01  # m/s^2
 
 
 class EstimatorParams(BaseModel):
@@ -436,6 +443,105 @@ def estimator_entry(name: str) -> EstimatorEntry:
 def validate_estimator_params(name: str, values: Mapping[str, Any] | BaseModel | None):
     """The validated parameters of estimator ``name`` (defaults for what is not given)."""
     return _REGISTRY.params(name, values)
+
+
+def _given_or(value: float | None, sensor: float, floor: float) -> float:
+    """A noise or spread the user gave, else the sensor's own, at least ``floor``."""
+    return float(value) if value is not None else max(float(sensor), floor)
+
+
+def _filter_noises(p: Any, ctx: EstimatorContext) -> dict[str, float]:
+    """The noises and initial spreads the ``ekf`` and the ``nav-ekf`` share, resolved."""
+    imu, mag = ctx.imu, ctx.magnetometer
+    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
+    return {
+        "gyro_noise_rad_s": _given_or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR),
+        "gyro_bias_walk_rad_s_sqrt_s": _given_or(
+            p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
+        ),
+        "accel_noise_m_s2": _given_or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR),
+        "gravity_noise_m_s2": _given_or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR),
+        "magnetometer_noise": _given_or(
+            p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR
+        ),
+        "initial_attitude_std_deg": _given_or(
+            p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG
+        ),
+        "initial_bias_std_rad_s": _given_or(
+            p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR
+        ),
+        "initial_velocity_std_m_s": _given_or(
+            p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, VELOCITY_STD_FLOOR
+        ),
+        "initial_position_std_m": _given_or(
+            p.initial_position_std_m, p.initial_position_error_m, POSITION_STD_FLOOR
+        ),
+    }
+
+
+def _resolve_ekf(p: Any, ctx: EstimatorContext) -> dict[str, float]:
+    pose = ctx.pose_sensor
+    return {
+        **_filter_noises(p, ctx),
+        "pose_position_noise_m": _given_or(
+            p.pose_position_noise_m, pose.position_noise_m if pose else 0.0, POSITION_NOISE_FLOOR
+        ),
+        "pose_attitude_noise_deg": _given_or(
+            p.pose_attitude_noise_deg,
+            pose.attitude_noise_deg if pose else 0.0,
+            ATTITUDE_NOISE_FLOOR_DEG,
+        ),
+    }
+
+
+def _resolve_nav_ekf(p: Any, ctx: EstimatorContext) -> dict[str, float]:
+    baro = ctx.instruments.get("barometer")
+    acc0 = ctx.imu.accel_bias_m_s2 if p.initial_bias == "zero" else 0.0
+    return {
+        **_filter_noises(p, ctx),
+        "barometer_noise_m": _given_or(
+            p.barometer_noise_m, baro.noise_m if baro else 0.0, BARO_NOISE_FLOOR
+        ),
+        "barometer_bias_walk_m_sqrt_s": _given_or(
+            p.barometer_bias_walk_m_sqrt_s,
+            baro.bias_walk_m_sqrt_s if baro else 0.0,
+            BARO_WALK_FLOOR,
+        ),
+        "initial_accel_bias_std_m_s2": _given_or(
+            p.initial_accel_bias_std_m_s2, acc0, ACCEL_BIAS_STD_FLOOR
+        ),
+    }
+
+
+_RESOLVERS: dict[int, Callable[[Any, EstimatorContext], dict[str, float]]] = {
+    L.EST_EKF: _resolve_ekf,
+    L.EST_NAV_EKF: _resolve_nav_ekf,
+}
+
+
+def resolve_estimator_params(kind: int, params: BaseModel, ctx: EstimatorContext) -> BaseModel:
+    """An estimator's parameters with every ``None`` noise and spread a number.
+
+    The ``ekf``'s and the ``nav-ekf``'s noises left ``None`` take the run's
+    sensor's own setting, their initial spreads the initial error's, each at
+    least its floor (so that an ideal sensor does not make the covariance
+    singular). The only place these defaults are decided; the packers
+    (``packing/estimator_block.py``) write the numbers. Other kinds' and
+    plug-ins' parameters are returned as they are.
+
+    Parameters
+    ----------
+    kind : int
+        The estimator's ``EST_*`` kind.
+    params : pydantic.BaseModel
+        Its validated parameters.
+    ctx : EstimatorContext
+        The run's sensors.
+    """
+    resolver = _RESOLVERS.get(kind)
+    if resolver is None or not isinstance(params, (EkfParams, NavEkfParams)):
+        return params
+    return params.model_copy(update=resolver(params, ctx))
 
 
 def settings_text(params: BaseModel) -> str:

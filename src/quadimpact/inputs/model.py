@@ -276,7 +276,6 @@ RECOVERY_LAWS: dict[str, dict[str, Any]] = {
         "rate_tol_rad_s": 2.0,
         "level_test": "euler",
         "euler_tol_rad": 0.2,
-        "k_z_1_s": (0.0, 0.0, 10.0, 10.0),
         "w_tol_m_s": 0.2,
     },
 }

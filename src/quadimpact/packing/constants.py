@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-import numpy as np
+# The defaults of the control rate and of the integrator's tolerances are the resolve
+# step's (inputs/resolve.py), and so is the unit; their names stay here for the code
+# that reads them from here.
+from quadimpact.inputs.resolve import CONTROL_RATE_HZ, DEFAULT_ATOL, DEFAULT_RTOL, RPM
 
 __all__ = [
     "CONTROL_RATE_HZ",
@@ -16,16 +19,6 @@ __all__ = [
     "V_MIN_M_S",
 ]
 
-CONTROL_RATE_HZ = 200.0
-
-RPM = 2.0 * np.pi / 60.0  # rad/s per rpm
-
-# Integrator defaults, chosen by measurement (docs/NUMERICS.md,
-# benchmarks/bench_tolerance.py): tightening both tenfold changes delta_init
-# of the paper example by far less than 1e-4 relative.
-DEFAULT_RTOL = 1e-8
-
-DEFAULT_ATOL = 1e-10
 
 EVENT_TOL_S = 1e-12
 

@@ -15,6 +15,7 @@ from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.inputs.controllers import (
     PRE_IMPACT_KINDS,
+    CascadePidParams,
     ControllerEntry,
     PackContext,
     RecoveryParams,
@@ -34,6 +35,7 @@ __all__ = [
     "pack_waypoint",
     "policy_block",
     "reference_z_axis",
+    "refuse_nan",
     "set_references",
 ]
 
@@ -64,11 +66,30 @@ def pack_controller(
     block = np.asarray(pack(params, context), dtype=float)
     if block.shape != (L.NPARAM,):
         raise ValueError(f"controller {entry.name!r}: its packer must return {L.NPARAM} numbers")
+    refuse_nan(block, f"controller {entry.name!r}: its parameter block")
     ctrl[L.C_PARAMS : L.C_PARAMS + L.NPARAM] = block
     policy = getattr(params, "policy", None) if entry.kind == L.CTRL_RECOVERY else None
     if policy is not None:
         ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY] = policy_block(policy)
     return ctrl
+
+
+def refuse_nan(block: np.ndarray, what: str) -> None:
+    """Refuse a packed block with a NaN: a parameter left ``None`` (NumPy writes ``None``
+    as NaN). Defaults are decided when a run is resolved (``simulation/resolve.py``),
+    never here.
+
+    Raises
+    ------
+    ValueError
+        Naming the block and the first slot.
+    """
+    bad = np.flatnonzero(np.isnan(block))
+    if bad.size:
+        raise ValueError(
+            f"{what}: slot {int(bad[0])} is not a number (a parameter left None? "
+            "defaults are applied when a run is resolved)"
+        )
 
 
 def policy_block(policy: str) -> np.ndarray:
@@ -129,7 +150,8 @@ def pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
 def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block = np.zeros(L.NPARAM)
     block[CL.P_GAINS : CL.P_GAINS + 15] = params.gains()
-    block[CL.P_THRUST_COS_FLOOR] = getattr(params, "thrust_cos_floor", 0.5)
+    if isinstance(params, CascadePidParams):  # the paper's law has no floor (slot unread)
+        block[CL.P_THRUST_COS_FLOOR] = params.thrust_cos_floor
     return block
 
 
@@ -141,7 +163,7 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block[CL.R_PRE_IMPACT] = PRE_IMPACT_KINDS[ctx.pre_impact]
     block[CL.R_K_ATT] = p.k_att_1_s
     block[CL.R_K_RATE : CL.R_K_RATE + 3] = p.k_rate_1_s
-    block[CL.R_A_MAG] = ctx.vehicle.gravity_m_s2 if p.a_mag_m_s2 is None else p.a_mag_m_s2
+    block[CL.R_A_MAG] = p.a_mag_m_s2  # resolved: a number (None, the vehicle's g: resolve)
     block[CL.R_K_Z : CL.R_K_Z + 4] = p.k_z_1_s
     block[CL.R_Q_TOL] = p.tilt_error_tol
     block[CL.R_RATE_TOL] = p.rate_tol_rad_s
@@ -153,12 +175,11 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     level = ctx.options.detection_tick_reference == "level"
     block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
     block[CL.R_HOVER] = 1.0 if p.hover else 0.0
-    a_max = 0.5 * ctx.vehicle.gravity_m_s2 if p.hover_a_max_m_s2 is None else p.hover_a_max_m_s2
     block[CL.R_HOVER_GAINS : CL.R_HOVER_GAINS + 5] = (
         p.hover_kp_1_s,
         p.hover_kv_1_s,
         p.hover_v_max_m_s,
-        a_max,
+        p.hover_a_max_m_s2,  # resolved: a number (None, g/2: resolve)
         p.hover_k_yaw_1_s,
     )
     block[CL.R_HOVER_MODE] = CL.HOLD_STOP if p.hover_hold == "stop" else CL.HOLD_ENTRY

@@ -30,25 +30,17 @@ from pydantic import BaseModel
 
 from quadimpact.core import layout as L
 from quadimpact.inputs.estimators import (
-    ACCEL_NOISE_FLOOR,
-    ATTITUDE_NOISE_FLOOR_DEG,
-    BIAS_STD_FLOOR,
-    GRAVITY_NOISE_FLOOR,
-    GYRO_NOISE_FLOOR,
-    INITIAL_ATTITUDE_STD_DEG,
-    MAG_NOISE_FLOOR,
-    POSITION_NOISE_FLOOR,
-    WALK_FLOOR,
     AdditiveEkfParams,
     ComplementaryParams,
     EkfParams,
     EstimatorContext,
     EstimatorParams,
     NavEkfParams,
-    estimator_entry,
     settings_text,
 )
+from quadimpact.inputs.resolved import ResolvedShared
 from quadimpact.inputs.sensors import ResolvedImu
+from quadimpact.packing.controller_block import refuse_nan
 
 __all__ = [
     "BUILTIN_PACKERS",
@@ -122,43 +114,37 @@ def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     return e
 
 
-def _or(value: float | None, default: float, floor: float) -> float:
-    return float(value) if value is not None else max(float(default), floor)
-
-
 def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    p: EkfParams = params  # type: ignore[assignment]
-    imu = ctx.imu
-    mag = ctx.magnetometer
-    pose = ctx.pose_sensor
+    p: EkfParams = params  # type: ignore[assignment]  # resolved: every noise a number
     e = np.zeros(L.NECFG)
-    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
-    e[L.EC_SIG_WALK] = _or(
-        p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
-    )
-    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
-    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
-    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
-    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
-    e[L.EC_SIG_POS] = _or(
-        p.pose_position_noise_m, pose.position_noise_m if pose else 0.0, POSITION_NOISE_FLOOR
-    )
-    att = p.pose_attitude_noise_deg
-    e[L.EC_SIG_ATT] = math.radians(
-        _or(att, pose.attitude_noise_deg if pose else 0.0, ATTITUDE_NOISE_FLOOR_DEG)
-    )
+    _pack_filter_noises(p, e)
+    e[L.EC_SIG_POS] = p.pose_position_noise_m
+    e[L.EC_SIG_ATT] = math.radians(p.pose_attitude_noise_deg)
     e[L.EC_GATE] = p.gate_m_s2
     e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
     e[L.EC_DEWEIGHT] = p.deweight
-    e[L.EC_P0] = math.radians(
-        _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
-    )
-    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
-    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
-    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
-    e[L.EC_NAV] = 1.0 if pose is not None else 0.0
+    _pack_initial_spreads(p, e)
+    e[L.EC_NAV] = 1.0 if ctx.pose_sensor is not None else 0.0
     _pack_impact(p, ctx, e)
     return e
+
+
+def _pack_filter_noises(p: Any, e: np.ndarray) -> None:
+    """The noises the ``ekf`` and the ``nav-ekf`` share (resolved by
+    ``inputs.estimators.resolve_estimator_params``)."""
+    e[L.EC_SIG_GYRO] = p.gyro_noise_rad_s
+    e[L.EC_SIG_WALK] = p.gyro_bias_walk_rad_s_sqrt_s
+    e[L.EC_SIG_ACC] = p.accel_noise_m_s2
+    e[L.EC_SIG_GRAV] = p.gravity_noise_m_s2
+    e[L.EC_SIG_MAG] = p.magnetometer_noise
+
+
+def _pack_initial_spreads(p: Any, e: np.ndarray) -> None:
+    """The initial covariance's spreads (attitude in rad, gyro bias, velocity, position)."""
+    e[L.EC_P0] = math.radians(p.initial_attitude_std_deg)
+    e[L.EC_P0 + 1] = p.initial_bias_std_rad_s
+    e[L.EC_P0 + 2] = p.initial_velocity_std_m_s
+    e[L.EC_P0 + 3] = p.initial_position_std_m
 
 
 def _pack_impact(p: Any, ctx: EstimatorContext, e: np.ndarray) -> None:
@@ -169,37 +155,20 @@ def _pack_impact(p: Any, ctx: EstimatorContext, e: np.ndarray) -> None:
         e[L.EC_IMPACT_F] = dist.accel_m_s2
         e[L.EC_IMPACT_TAU] = dist.time_constant_s
         e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
-        g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
-        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
-
-
-BARO_NOISE_FLOOR = 0.01  # m
-BARO_WALK_FLOOR = 1e-4  # m/sqrt(s)
-ACCEL_BIAS_STD_FLOOR = 0.01  # m/s^2
+        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * ctx.vehicle.gravity_m_s2
 
 
 def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    p: NavEkfParams = params  # type: ignore[assignment]
+    p: NavEkfParams = params  # type: ignore[assignment]  # resolved: every noise a number
     imu = ctx.imu
-    mag = ctx.magnetometer
-    baro = ctx.instruments.get("barometer")
     e = np.zeros(L.NECFG)
-    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
-    e[L.EC_SIG_WALK] = _or(
-        p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
-    )
-    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
+    _pack_filter_noises(p, e)
     e[L.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
-    grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
-    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
     e[L.EC_GATE] = p.gate_m_s2
     e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
     e[L.EC_DEWEIGHT] = p.deweight
-    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
-    e[L.EC_NAV_BARO] = _or(p.barometer_noise_m, baro.noise_m if baro else 0.0, BARO_NOISE_FLOOR)
-    e[L.EC_NAV_BARO + 1] = _or(
-        p.barometer_bias_walk_m_sqrt_s, baro.bias_walk_m_sqrt_s if baro else 0.0, BARO_WALK_FLOOR
-    )
+    e[L.EC_NAV_BARO] = p.barometer_noise_m
+    e[L.EC_NAV_BARO + 1] = p.barometer_bias_walk_m_sqrt_s
     e[L.EC_NAV_RANGE] = p.range_noise_floor_m
     e[L.EC_NAV_FLOW] = p.flow_noise_floor_rad_s
     e[L.EC_NAV_GATES : L.EC_NAV_GATES + 4] = (
@@ -215,14 +184,8 @@ def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
         e[L.EC_NAV_LEVER : L.EC_NAV_LEVER + 3] = imu.position_m
     e[L.EC_NAV_DELAYED] = 1.0 if p.flow_delay_compensation else 0.0
     e[L.EC_NAV_REACQ_EXCESS] = 1.0 if p.reacquire_inflation == "excess" else 0.0
-    e[L.EC_P0] = math.radians(
-        _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
-    )
-    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
-    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
-    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
-    acc0 = imu.accel_bias_m_s2 if p.initial_bias == "zero" else 0.0
-    e[L.EC_NAV_P0] = _or(p.initial_accel_bias_std_m_s2, acc0, ACCEL_BIAS_STD_FLOOR)
+    _pack_initial_spreads(p, e)
+    e[L.EC_NAV_P0] = p.initial_accel_bias_std_m_s2
     e[L.EC_NAV_P0 + 1] = p.initial_baro_bias_std_m
     _pack_impact(p, ctx, e)
     return e
@@ -319,38 +282,37 @@ def _initial_errors(
     return initial_std, extra if np.any(extra > 0.0) else None
 
 
-def pack_estimation(s: Any, imu: ResolvedImu, scfg: np.ndarray, vehicle: Any) -> Estimation:
+def pack_estimation(r: ResolvedShared, scfg: np.ndarray) -> Estimation:
     """Fill ``scfg``'s added-sensor slots (in place) and pack the estimator (no random draw).
 
-    ``s``: the scenario (``RunSettings``); ``imu``: its resolved IMU.
+    ``r``: the run's resolved description (its estimator's parameters with
+    every default applied, its IMU, magnetometer and pose sensor).
     """
+    s = r.settings
+    est = r.estimator
+    imu = r.imu
     noisy = pack_added_sensors(s, imu, scfg)
-    mag, pose = s.magnetometer, s.pose_sensor
-    entry = estimator_entry(s.estimator)
-    params = s.resolved_estimator_params()
-    context = EstimatorContext(
-        imu=imu,
-        magnetometer=mag,
-        pose_sensor=pose,
-        vehicle=vehicle,
-        instruments=dict(getattr(s, "instruments", None) or {}),
-    )
+    mag, pose = est.context.magnetometer, est.context.pose_sensor
+    entry = est.entry
     pack = entry.pack if entry.pack is not None else BUILTIN_PACKERS.get(entry.kind, _zeros)
-    ecfg = np.array(pack(params, context), dtype=float)
+    ecfg = np.array(pack(est.params, est.context), dtype=float)
     if ecfg.shape != (L.NECFG,):
         raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
+    refuse_nan(ecfg, f"estimator {entry.name!r}: its settings")
     ecfg[L.EC_KIND] = entry.kind
     ecfg[L.EC_OBSERVER] = 0.0 if s.estimate_in_loop else 1.0
-    initial_std, extra_std = _initial_errors(params, entry.kind, mag, ecfg)
+    if est.step_address:
+        ecfg[L.EC_STEP] = est.step_address
+    initial_std, extra_std = _initial_errors(est.params, entry.kind, mag, ecfg)
     return Estimation(
         ecfg=ecfg,
         snoise=np.zeros((0, L.NSN)),
         name=entry.name,
-        settings=settings_text(params),
+        settings=settings_text(est.given),
         step=entry.step,
         resolved={
             "estimator": entry.name,
-            "estimator_params": params.model_dump(mode="json"),
+            "estimator_params": est.given.model_dump(mode="json"),
             "magnetometer": mag.model_dump(mode="json") if mag is not None else None,
             "pose_sensor": pose.model_dump(mode="json") if pose is not None else None,
             "sensors": s.sensors,

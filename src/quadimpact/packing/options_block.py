@@ -8,13 +8,9 @@ from collections.abc import Sequence
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.inputs.model import ModelOptions
+from quadimpact.inputs.resolved import ResolvedShared
 from quadimpact.inputs.run_settings import RunSettings
-from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.packing.constants import (
-    CONTROL_RATE_HZ,
-    DEFAULT_ATOL,
-    DEFAULT_RTOL,
     EVENT_TOL_S,
     FRICTION_V_REG_M_S,
     MAX_STEPS_PER_S,
@@ -22,15 +18,14 @@ from quadimpact.packing.constants import (
     RPM,
     V_MIN_M_S,
 )
+from quadimpact.packing.controller_block import refuse_nan
 
 __all__ = [
     "PAPER_CRASH_ALTITUDE_M",
-    "control_rate_hz",
     "pack_options",
     "pack_run_options",
     "pack_schedule",
     "schedule_rates",
-    "slew_limit_rad_s2",
 ]
 
 #: The crash altitude of the paper's crash rule (m): the centre of mass 0.3 m below
@@ -50,13 +45,17 @@ def pack_options(
     first_order_rotors: bool,
     omega_limits_rad_s: tuple[float, float] | None,
     slew_limit_rad_s2: float | None,
-    rtol: float | None,
-    atol: float | None,
+    rtol: float,
+    atol: float,
+    control_rate_hz: float,
     duration_s: float,
     cut_step_motors: Sequence[int] = (),
 ) -> np.ndarray:
     """Model switches and integrator settings as the ``O_*`` vector.
 
+    ``slew_limit_rad_s2``: ``None`` is no limit (0 in ``O_SLEW_MAX``).
+    ``rtol``, ``atol``, ``control_rate_hz`` (Hz): as resolved
+    (``simulation/resolve.py`` decides their defaults).
     ``cut_step_motors``: the motors (1-4) a power-off schedule cuts at the
     first control tick after its trigger (``O_CUT_STEP_MOTORS``, motor ``j``
     as bit ``j - 1``; docs/VARIANTS.md).
@@ -72,17 +71,18 @@ def pack_options(
     opts[L.O_ROTOR_MODE] = L.ROTOR_FIRST_ORDER if first_order_rotors else L.ROTOR_IDEAL
     if omega_limits_rad_s is not None:
         opts[L.O_OMEGA_MIN], opts[L.O_OMEGA_MAX] = omega_limits_rad_s
-    opts[L.O_SLEW_MAX] = slew_limit_rad_s2 or 0.0
+    opts[L.O_SLEW_MAX] = 0.0 if slew_limit_rad_s2 is None else slew_limit_rad_s2  # 0: none
     opts[L.O_V_REG] = FRICTION_V_REG_M_S
     opts[L.O_V_MIN] = V_MIN_M_S
-    opts[L.O_DT_CONTROL] = 1.0 / CONTROL_RATE_HZ
-    opts[L.O_RTOL] = DEFAULT_RTOL if rtol is None else rtol
-    opts[L.O_ATOL] = DEFAULT_ATOL if atol is None else atol
+    opts[L.O_DT_CONTROL] = 1.0 / control_rate_hz
+    opts[L.O_RTOL] = rtol
+    opts[L.O_ATOL] = atol
     opts[L.O_H_MAX] = 0.0
     opts[L.O_MAX_STEPS] = max(MIN_STEP_BUDGET, MAX_STEPS_PER_S * duration_s)
     opts[L.O_EVENT_TOL] = EVENT_TOL_S
     opts[L.O_POWER_OFF_T] = np.inf
     opts[L.O_CUT_STEP_MOTORS] = float(sum(1 << (m - 1) for m in set(cut_step_motors)))
+    refuse_nan(opts, "the options")
     return opts
 
 
@@ -101,31 +101,16 @@ def schedule_rates(rates_rpm_per_s: Sequence[Sequence[float]], zero_rate: str) -
     return rates
 
 
-def control_rate_hz(s: RunSettings) -> float:
-    """The rate of a run's control ticks, Hz: its ``control_rate_hz``, else
-    :data:`~quadimpact.packing.constants.CONTROL_RATE_HZ` (200 Hz)."""
-    return CONTROL_RATE_HZ if s.control_rate_hz is None else float(s.control_rate_hz)
-
-
-def slew_limit_rad_s2(s: RunSettings, v: Vehicle) -> float | None:
-    """The rotor slew limit (rad/s^2) of a run: its own, the vehicle's (``"vehicle"``) or none."""
-    if s.rotor_slew_limit_rad_s2 == "vehicle":
-        if v.rotor_slew_limit_rpm_per_s is None:
-            return None
-        return v.rotor_slew_limit_rpm_per_s * RPM
-    return s.rotor_slew_limit_rad_s2
-
-
-def pack_run_options(
-    s: RunSettings, o: ModelOptions, v: Vehicle, duration_s: float, *, free: bool = False
-) -> np.ndarray:
-    """A run's ``opts`` vector from its settings, model options and vehicle.
+def pack_run_options(r: ResolvedShared, duration_s: float, *, free: bool = False) -> np.ndarray:
+    """A run's ``opts`` vector from its resolved description (settings, options, rates).
 
     The crash rule from the ground setting and the model's ``crash_rule``
     (``free``: none, for the free flight before an impact trial's impact),
     rotor limits in rad/s, the power-off trigger (s, or -1: first contact),
-    the recovery end time (s after the recovery's end).
+    the recovery end time (s after the recovery's end). ``duration_s``: what
+    the step budget is sized for, s.
     """
+    s, o = r.settings, r.options
     if free:
         crash_rule, level, stop = L.CRASH_NONE, 0.0, False
     elif s.ground in ("contact", "none"):
@@ -150,9 +135,10 @@ def pack_run_options(
         stop_on_crash=stop,
         first_order_rotors=s.rotor_mode == "first-order",
         omega_limits_rad_s=limits,
-        slew_limit_rad_s2=slew_limit_rad_s2(s, v),
-        rtol=s.rtol,
-        atol=s.atol,
+        slew_limit_rad_s2=r.slew_limit_rad_s2,
+        rtol=r.rtol,
+        atol=r.atol,
+        control_rate_hz=r.control_rate_hz,
         duration_s=duration_s,
         cut_step_motors=o.cut_step_motors,
     )
@@ -161,7 +147,6 @@ def pack_run_options(
         opts[L.O_POWER_OFF_T] = -1.0 if trigger == "first-contact" else float(trigger)
     if s.end_after_recovery_s is not None:
         opts[L.O_END_AFTER_RECOVERY] = float(s.end_after_recovery_s)
-    opts[L.O_DT_CONTROL] = 1.0 / control_rate_hz(s)
     return opts
 
 

@@ -1,13 +1,16 @@
-"""A run's whole :class:`~quadimpact.core.records.Model`, block by block, in two parts.
+"""A resolved run as the compiled core's :class:`~quadimpact.core.records.Model`, in one call.
 
-:func:`pack_shared` packs what a run's initial state, references and seed do
-not change (every block of ``core/layout.py``: vehicle, features, shapes and
-their pair table, options, controller without references, sensors and
-estimator without their random draws, the output times); :func:`pack_own`
-packs a run's own part from it (its references and the seeded draws of the
-IMU, the added sensors and the estimator's initial error). Runs that share
-the first part (the trials of a study) pack only the second
-(``simulation/sharing.py``).
+:func:`pack` writes a :class:`~quadimpact.inputs.resolved.ResolvedRun`
+(``simulation/resolve.py``: every default already applied) into every block
+of ``core/layout.py``. It decides nothing: a value the resolved description
+does not hold as a number is an error here, not a default. It packs in two
+parts: :func:`pack_shared`, what a run's initial state, references and seed
+do not change (vehicle, features, shapes and their pair table, options,
+controller without references, sensors and estimator without their random
+draws, the output times), once per resolved shared part (the trials of a
+study share one); and :func:`pack_own`, a run's own part (its references and
+the seeded draws of the IMU, the added sensors and the estimator's initial
+error).
 """
 
 from __future__ import annotations
@@ -20,28 +23,20 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
-from quadimpact.core.records import Model, model
+from quadimpact.core.records import Model, model, model_array, model_span
 from quadimpact.core.sensors.component import PackContext as ComponentContext
-from quadimpact.errors import InputError
-from quadimpact.inputs.controllers import ControllerEntry, PackContext, controller_entry
-from quadimpact.inputs.model import ModelOptions
-from quadimpact.inputs.run_settings import RunSettings
+from quadimpact.inputs.controllers import ControllerEntry, PackContext
+from quadimpact.inputs.resolved import ResolvedRun, ResolvedShared
 from quadimpact.inputs.sensors import ResolvedImu
-from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.packing.component_block import draw_component_noise, pack_components
-from quadimpact.packing.controller_block import pack_controller, set_references
+from quadimpact.packing.controller_block import pack_controller, pack_waypoint, set_references
 from quadimpact.packing.estimator_block import Estimation, draw_estimation, pack_estimation
-from quadimpact.packing.options_block import (
-    control_rate_hz,
-    pack_run_options,
-    pack_schedule,
-    slew_limit_rad_s2,
-)
+from quadimpact.packing.options_block import pack_run_options, pack_schedule
 from quadimpact.packing.sensor_block import draw_imu_noise, pack_sensors
 from quadimpact.packing.vehicle_block import pack_features, pack_vehicle
 from quadimpact.packing.world_block import pack_surfaces
 
-__all__ = ["SharedPacking", "output_grid", "pack_own", "pack_shared"]
+__all__ = ["PackedRun", "SharedPacking", "output_grid", "pack", "pack_own", "pack_shared"]
 
 
 def output_grid(t0: float, tf: float, rate_hz: float) -> np.ndarray:
@@ -88,59 +83,42 @@ class SharedPacking:
     instruments: dict[str, Any]
 
 
-def _check_rotor_count(s: RunSettings, o: ModelOptions, v: Vehicle) -> None:
-    """Refuse the settings that name a quadrotor's motors 1-4 for another rotor count."""
-    if v.rotor_count == 4:
-        return
-    if s.power_off is not None:
-        raise InputError(
-            f"power_off: a schedule of motors 1-4 is for a quadrotor (vehicle {v.name} has "
-            f"{v.rotor_count} rotors)"
-        )
-    if o.cut_step_motors:
-        raise InputError(
-            f"model_options.cut_step_motors: motors 1-4 of a quadrotor (vehicle {v.name} has "
-            f"{v.rotor_count} rotors)"
-        )
+def pack_shared(r: ResolvedShared) -> SharedPacking:
+    """Every block of a run from its resolved shared part, once per object (kept in its memo).
 
-
-def pack_shared(
-    s: RunSettings,
-    v: Vehicle,
-    o: ModelOptions,
-    surfaces: list[Any],
-    duration_s: float,
-) -> SharedPacking:
-    """Every block of a run from its validated settings, vehicle, options and surfaces.
-
-    ``duration_s``: how long the run lasts (s; the IMU's draws and the
-    integrator's step budget are sized by it). The run starts at ``t0 = 0``
-    and ends at ``s.final_time_s`` (a run's own start: :func:`pack_own`).
+    The run starts at ``t0 = 0`` and ends at ``r.final_time_s`` (a run's own
+    start: :func:`pack`); the IMU's draws and the integrator's step budget are
+    sized by ``r.duration_s``.
     """
-    _check_rotor_count(s, o, v)
-    entry = controller_entry(s.controller)
+    hit = r.memo.get("packing")
+    if hit is not None:
+        return hit
+    s, v, o = r.settings, r.vehicle, r.options
+    c = r.controller
     context = PackContext(
         vehicle=v,
         options=o,
-        pre_impact=s.resolved_pre_impact(),
-        nominal_controller=s.nominal_controller,
+        pre_impact=c.pre_impact,
+        nominal_controller=c.nominal_controller,
     )
-    imu = s.imu.resolved(v.imu_position_m, control_rate_hz(s))
-    scfg, n_imu = pack_sensors(imu, s.detection, v, duration_s)
+    imu = r.imu
+    scfg, n_imu = pack_sensors(imu, s.detection, v, r.duration_s)
     scfg = pack_components(
         scfg,
-        s.instruments,
+        r.instruments,
         ComponentContext(
             gravity_m_s2=float(v.gravity_m_s2),
             imu_rate_hz=float(imu.rate_hz),
-            duration_s=float(duration_s),
+            duration_s=float(r.duration_s),
         ),
     )
-    est = pack_estimation(s, imu, scfg, v)
-    params = s.resolved_controller_params()
+    est = pack_estimation(r, scfg)
+    ctrl = pack_controller(c.entry, c.params, context, o.yaw_reaction == "paper")
+    if c.step_address:
+        ctrl[L.C_STEP] = c.step_address
     feat = pack_features(v, s.friction_coefficient, o.bumper_force_scale)
-    shapes = pack_surfaces(surfaces)
-    tf = float(s.final_time_s)
+    shapes = pack_surfaces(list(r.surfaces))
+    tf = r.final_time_s
     packed = model(
         x0=np.zeros(L.NX),
         t0=0.0,
@@ -149,9 +127,9 @@ def pack_shared(
         feat=feat,
         shapes=shapes,
         pairs=pair_table(feat, shapes),
-        opts=pack_run_options(s, o, v, duration_s),
-        ctrl=pack_controller(entry, params, context, o.yaw_reaction == "paper"),
-        t_out=output_grid(0.0, tf, float(s.output_rate_hz)),
+        opts=pack_run_options(r, r.duration_s),
+        ctrl=ctrl,
+        t_out=output_grid(0.0, tf, r.output_rate_hz),
         scfg=scfg,
         ecfg=est.ecfg,
         snoise=est.snoise,
@@ -161,16 +139,18 @@ def pack_shared(
         "model": s.model,
         "model_options": o.model_dump(mode="json"),
         "controller": s.controller,
-        "controller_params": params.model_dump(mode="json"),
-        "pre_impact": context.pre_impact,
-        "nominal_controller": s.nominal_controller,
+        "controller_params": c.given.model_dump(mode="json"),
+        "pre_impact": c.pre_impact,
+        "nominal_controller": c.nominal_controller,
         "imu": imu.model_dump(mode="json"),
-        "rotor_slew_limit_rad_s2": slew_limit_rad_s2(s, v),
+        "rotor_slew_limit_rad_s2": r.slew_limit_rad_s2,
         **(est.resolved or {}),
     }
-    if s.instruments:
-        resolved["instruments"] = {k: v.model_dump(mode="json") for k, v in s.instruments.items()}
-    return SharedPacking(packed, n_imu, imu, est, entry, context, resolved, dict(s.instruments))
+    if r.instruments:
+        resolved["instruments"] = {k: x.model_dump(mode="json") for k, x in r.instruments.items()}
+    shared = SharedPacking(packed, n_imu, imu, est, c.entry, context, resolved, dict(r.instruments))
+    r.memo["packing"] = shared
+    return shared
 
 
 def pack_own(shared: SharedPacking, seed: int, refs: dict[str, float]) -> dict[str, np.ndarray]:
@@ -197,3 +177,45 @@ def pack_own(shared: SharedPacking, seed: int, refs: dict[str, float]) -> dict[s
         "snoise": snoise,
         "cnoise": cnoise,
     }
+
+
+@dataclass(frozen=True)
+class PackedRun:
+    """A packed run: the compiled core's arrays and what they were packed from.
+
+    Attributes
+    ----------
+    model : Model
+        Every array of the run (a wall approach's start still the shared zero
+        state: its shooting solves it).
+    shared : SharedPacking
+        The shared part it was completed from.
+    free_opts : ndarray or None
+        A wall approach's options for the free flight of its shooting (no
+        crash rule, sized for the impact time); ``None`` otherwise.
+    """
+
+    model: Model
+    shared: SharedPacking
+    free_opts: np.ndarray | None = None
+
+
+def pack(r: ResolvedRun) -> PackedRun:
+    """A resolved run's arrays, in one call: the shared part (packed once per resolved
+    shared part), then the run's own (references, seeded draws, start, waypoint)."""
+    shared = pack_shared(r.shared)
+    fields = {
+        name: model_array(name, a) for name, a in pack_own(shared, r.seed, r.references).items()
+    }
+    if r.x0 is not None:
+        fields["x0"] = model_array("x0", r.x0)
+    if r.t0 != 0.0:
+        tf = r.shared.final_time_s
+        fields["span"] = model_span(r.t0, tf)
+        fields["t_out"] = output_grid(r.t0, tf, r.shared.output_rate_hz)
+    if r.waypoint is not None:
+        pack_waypoint(fields["ctrl"], r.waypoint, r.hold_m)
+    free_opts = None
+    if r.shot is not None:
+        free_opts = pack_run_options(r.shared, r.shot.impact_time_s, free=True)
+    return PackedRun(shared.model._replace(**fields), shared, free_opts)

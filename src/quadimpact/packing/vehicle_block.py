@@ -1,5 +1,6 @@
 """The vehicle's blocks: ``veh`` (``V_*``: mass, inertia, rotors) and ``feat`` (``F_*``: its
-contact features, body frame), packed once per vehicle object; the allocation matrix."""
+contact features, body frame), packed once per vehicle object (the allocation matrix:
+``inputs/allocation.py``)."""
 
 from __future__ import annotations
 
@@ -10,9 +11,15 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
+from quadimpact.inputs.allocation import (  # here too: the packing's names of them
+    allocation_inverse,
+    allocation_matrix,
+    vehicle_memo,
+    vehicle_memo_value,
+)
 from quadimpact.inputs.features import ContactFeature
 from quadimpact.inputs.vehicle import Vehicle
-from quadimpact.linalg import inverse, pseudo_inverse
+from quadimpact.linalg import inverse
 
 __all__ = [
     "FEATURE_KINDS",
@@ -24,27 +31,6 @@ __all__ = [
     "vehicle_memo",
     "vehicle_memo_value",
 ]
-
-_PACKED: dict[tuple[int, str], tuple[Vehicle, Any]] = {}
-
-_PACKED_LIMIT = 128
-
-
-def vehicle_memo(kind: str, v: Vehicle, make: Any) -> np.ndarray:
-    """A copy of ``make()`` computed once per (frozen) vehicle object and kind."""
-    return vehicle_memo_value(kind, v, make).copy()
-
-
-def vehicle_memo_value(kind: str, v: Vehicle, make: Any) -> Any:
-    """``make()`` computed once per (frozen) vehicle object and kind (not copied: immutable)."""
-    key = (id(v), kind)
-    hit = _PACKED.get(key)
-    if hit is None or hit[0] is not v:
-        if len(_PACKED) >= _PACKED_LIMIT:
-            _PACKED.pop(next(iter(_PACKED)))
-        hit = (v, make())  # holds v, so its id stays its own
-        _PACKED[key] = hit
-    return hit[1]
 
 
 def pack_vehicle(v: Vehicle) -> np.ndarray:
@@ -143,29 +129,3 @@ def feature_records(feat: np.ndarray, names: Sequence[str]) -> list[dict[str, An
         )
         out.append(rec)
     return out
-
-
-def allocation_matrix(v: Vehicle, yaw_paper: bool) -> np.ndarray:
-    """``A`` (4 x n) with ``[T, tau_x, tau_y, tau_z] = A [Omega_1^2 .. Omega_n^2]``
-    (docs/MODEL.md 6.1), the vehicle's effectiveness matrix.
-
-    Column ``j`` is rotor ``j``'s: ``kt_j``, ``-kt_j y_j``, ``kt_j x_j`` and the
-    yaw entry of the rotor-torque model in use: ``-s_j dt_j`` (physical) or
-    ``+s_j dt_j`` (paper replica).
-    """
-    kt = v.thrust_coefficients
-    r = v.rotor_positions
-    yaw = v.drag_torque_coefficients * v.spins * (1.0 if yaw_paper else -1.0)
-    return np.vstack([kt, -kt * r[:, 1], kt * r[:, 0], yaw])
-
-
-def allocation_inverse(v: Vehicle, yaw_paper: bool) -> np.ndarray:
-    """The allocation's inverse ``A^+`` (n x 4): ``Omega^2 = A^+ [T, tau_x, tau_y, tau_z]``.
-
-    A quadrotor's square ``A`` has the exact inverse ``A^-1`` (``linalg.inverse``,
-    the same bits as before rotor counts other than 4). Any other count has the
-    Moore-Penrose pseudo-inverse ``A^T (A A^T)^-1`` (``linalg.pseudo_inverse``):
-    of all ``Omega^2`` giving the wrench, the one of the smallest norm.
-    """
-    a = allocation_matrix(v, yaw_paper)
-    return inverse(a) if a.shape[1] == 4 else pseudo_inverse(a)

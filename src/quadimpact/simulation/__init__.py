@@ -1,9 +1,12 @@
 """One run, Python side: inputs to packed arrays, the compiled loop, tables and summary.
 
 * (the blocks themselves are packed by :mod:`quadimpact.packing`, one module each);
+* :mod:`~quadimpact.simulation.resolve`: ``resolve(scenario)``, the run's frozen
+  resolved description (every default applied, once);
 * :mod:`~quadimpact.simulation.trim`: the rotor speeds of a thrust without torque;
 * :mod:`~quadimpact.simulation.approach`: the wall approach's attitude and shooting;
-* :mod:`~quadimpact.simulation.setup`: :class:`RunSetup`, ``prepare(scenario)``;
+* :mod:`~quadimpact.simulation.setup`: :class:`RunSetup`, ``prepare(scenario)``
+  (resolve, pack, the run's loop);
 * :mod:`~quadimpact.simulation.tables`: raw kernel arrays -> episodes and time series;
 * :mod:`~quadimpact.simulation.metrics`: impacts, metrics, response types;
 * :mod:`~quadimpact.simulation.summary`: the summary of a run;

@@ -15,7 +15,6 @@ The shooting runs in one compiled call (``core/approach.py``, the kernel's
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
@@ -25,7 +24,12 @@ from quadimpact.core.approach import APPROACH_MAX_ITER, APPROACH_TOL_M_S
 from quadimpact.core.geometry import pair_depths, pair_table
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
-from quadimpact.linalg import matvec_t
+from quadimpact.inputs.resolve import (  # defined with the rest of a run's start; names kept
+    PAPER_FIT_OFFSET_RAD,
+    PAPER_FIT_SCALE,
+    initial_state,
+    wall_attitude,
+)
 from quadimpact.results.costs import CpuClock
 from quadimpact.rotations import inclination_deg, quat_to_matrix
 
@@ -42,56 +46,10 @@ __all__ = [
     "wall_attitude",
 ]
 
-PAPER_FIT_OFFSET_RAD = 0.0042477  # the authors' fitted inclination mapping (docs/VARIANTS.md 4.4)
-PAPER_FIT_SCALE = 1.3836686
-
-
-# ------------------------------------------------------------------ attitude
-def wall_attitude(
-    heading_deg: float, inclination_deg: float, mapping: str = "exact"
-) -> tuple[float, float, float]:
-    """Roll, pitch, yaw (rad, ZYX) for a heading and an inclination toward the wall.
-
-    ``exact``: yaw = psi and the body z axis in the inertial X-Z plane at
-    angle iota from Z, tilted so the thrust points toward +X (docs/STUDIES.md 1):
-    ``phi = -asin(sin psi sin iota)``, ``theta = asin(-cos psi sin iota / cos phi)``.
-    ``paper-fit``: the authors' mapping (docs/VARIANTS.md 4.4) at psi = 0 and +-45 deg,
-    ``exact`` elsewhere.
-    """
-    psi = math.radians(heading_deg)
-    iota = math.radians(inclination_deg)
-    if mapping == "paper-fit":
-        if heading_deg == 0.0:
-            return 0.0, -iota, psi
-        if abs(heading_deg) == 45.0:
-            a = -(iota - PAPER_FIT_OFFSET_RAD) / PAPER_FIT_SCALE
-            return a, a, psi
-    phi = -math.asin(math.sin(psi) * math.sin(iota))
-    theta = math.asin(-math.cos(psi) * math.sin(iota) / math.cos(phi))
-    return phi, theta, psi
-
 
 def inclination_deg_of(q: np.ndarray) -> float:
     """Inclination (deg) of attitude ``q``: angle of body z projected on X-Z from Z, + toward +X."""
     return float(inclination_deg(quat_to_matrix(np.asarray(q, dtype=float))))
-
-
-def initial_state(
-    position: np.ndarray,
-    v_inertial: np.ndarray,
-    q: np.ndarray,
-    omega: np.ndarray,
-    rotors: np.ndarray,
-) -> np.ndarray:
-    """The kernel's state vector (layout ``X_*``) from inertial position and velocity;
-    ``rotors``: the speeds of the vehicle's ``n`` rotors (rad/s), 0 beyond them."""
-    x = np.zeros(L.NX)
-    x[L.X_POS : L.X_POS + 3] = position
-    x[L.X_VEL : L.X_VEL + 3] = matvec_t(quat_to_matrix(q), v_inertial)
-    x[L.X_QUAT : L.X_QUAT + 4] = q
-    x[L.X_OMEGA : L.X_OMEGA + 3] = omega
-    x[L.X_ROTOR : L.X_ROTOR + len(rotors)] = rotors
-    return x
 
 
 # ------------------------------------------------------------------ shooting

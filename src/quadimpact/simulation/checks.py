@@ -186,13 +186,11 @@ def record_size_bytes(scenario: Any, n_features: int | None = None) -> int:
     ``n_features``: :func:`vehicle_feature_count` of the scenario, when the
     caller knows it (a sweep, once per vehicle).
     """
-    from quadimpact.packing.constants import CONTROL_RATE_HZ
+    from quadimpact.inputs.resolve import control_rate_hz
 
     duration = float(scenario.final_time_s) - float(getattr(scenario, "start_time_s", 0.0) or 0.0)
     rows = math.ceil(max(duration, 0.0) * float(scenario.output_rate_hz)) + 2
-    imu_rate = getattr(getattr(scenario, "imu", None), "rate_hz", None) or float(
-        getattr(scenario, "control_rate_hz", None) or CONTROL_RATE_HZ
-    )
+    imu_rate = getattr(getattr(scenario, "imu", None), "rate_hz", None) or control_rate_hz(scenario)
     samples = math.ceil(max(duration, 0.0) * float(imu_rate)) + 1
     if n_features is None:
         n_features = vehicle_feature_count(scenario)

@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 from quadimpact import __version__
 from quadimpact.errors import InputError
 from quadimpact.inputs.scenarios import scenario_from_dict
-from quadimpact.packing.constants import CONTROL_RATE_HZ, RPM
+from quadimpact.packing.constants import RPM
 from quadimpact.results.costs import cost_ratio
 from quadimpact.results.files import atomic_write
 from quadimpact.studies.recovery.recovery_spec import (  # noqa: F401  (the spec, here too)
@@ -110,9 +110,11 @@ def describe(spec: SweepSpec, study: RecoveryStudy | None, table: pd.DataFrame) 
     """
     import pandas as pd
 
+    from quadimpact.inputs.resolve import control_rate_hz
+
     first = scenario_from_dict(spec.scenario_dict(0), where="recovery: run 0")
     vehicle = first.build_vehicle()
-    imu = first.imu.resolved(vehicle.imu_position_m, CONTROL_RATE_HZ)
+    imu = first.imu.resolved(vehicle.imu_position_m, control_rate_hz(first))
 
     def values(column: str) -> list[Any]:
         if column not in table:
