@@ -27,6 +27,7 @@ import json
 import os
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -65,7 +66,12 @@ def quadimpact_times(repeat: int) -> dict:
     }
 
 
-def rotorpy_time(repeat: int) -> dict | None:
+def rotorpy_flight() -> tuple[Callable[[], None], dict] | None:
+    """RotorPy's 3-s flight as a callable, or ``None`` if RotorPy is not installed.
+
+    Returns ``(fly, final)``: each ``fly()`` builds the environment and runs
+    it; ``final["roll"]`` is then the last roll angle (deg).
+    """
     try:
         from rotorpy.controllers.quadrotor_control import SE3Control
         from rotorpy.environments import Environment
@@ -75,7 +81,7 @@ def rotorpy_time(repeat: int) -> dict | None:
     except ImportError:
         return None
     hover = np.sqrt(quad_params["mass"] * 9.81 / (4 * quad_params["k_eta"]))
-    final = {}
+    final: dict = {}
 
     def fly() -> None:
         half = np.radians(ROLL_DEG) / 2  # scalar-last quaternion of the roll
@@ -88,6 +94,14 @@ def rotorpy_time(repeat: int) -> dict | None:
         qx, qw = out["state"]["q"][-1][0], out["state"]["q"][-1][3]
         final["roll"] = float(np.degrees(2 * np.arctan2(qx, qw)))
 
+    return fly, final
+
+
+def rotorpy_time(repeat: int) -> dict | None:
+    flight = rotorpy_flight()
+    if flight is None:
+        return None
+    fly, final = flight
     wall = best(fly, repeat)
     return {"run_s": wall, "final_roll_deg": final["roll"]}
 
