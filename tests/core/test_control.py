@@ -70,6 +70,7 @@ def held_kernel():
     return make_kernel(_hold_initial_speeds)
 
 
+@pytest.mark.slow  # the fixture compiles a whole loop around the plug-in (~20 s)
 def test_plugin_controller_runs_in_the_compiled_loop(held_kernel):
     """A user's njit controller plugs into the same loop (here: open-loop hover speeds)."""
     r = simulate(FlightScenario(final_time_s=1.0), kernel=held_kernel)
@@ -80,6 +81,7 @@ def test_plugin_controller_runs_in_the_compiled_loop(held_kernel):
     assert np.max(np.abs(ts["altitude_m"] - 2.0)) < 1e-9
 
 
+@pytest.mark.slow  # the fixture compiles a whole loop around the plug-in (~20 s)
 def test_a_plugin_loop_flies_the_wall_approach_with_its_own_controller(held_kernel):
     """The approach's shooting runs are the plug-in loop's (``core/approach.py``, compiled
     into the kernel): with the rotors held instead of the paper controller the run still
