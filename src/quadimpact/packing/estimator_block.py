@@ -29,6 +29,10 @@ import numpy as np
 from pydantic import BaseModel
 
 from quadimpact.core import layout as L
+from quadimpact.core.estimators import complementary as CF
+from quadimpact.core.estimators import ekf as EKF
+from quadimpact.core.estimators import ekf_additive as ADD
+from quadimpact.core.estimators import nav_ekf as NAV
 from quadimpact.inputs.estimators import (
     ACCEL_NOISE_FLOOR,
     ATTITUDE_NOISE_FLOOR_DEG,
@@ -92,33 +96,33 @@ class Estimation:
 def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: ComplementaryParams = params  # type: ignore[assignment]
     e = np.zeros(L.NECFG)
-    e[L.EC_K_ACC] = p.k_acc_1_s
-    e[L.EC_K_MAG] = p.k_mag_1_s
-    e[L.EC_K_BIAS] = p.k_bias_1_s2
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_K_POS] = p.k_pose_position
-    e[L.EC_K_VEL] = p.k_pose_velocity_1_s
+    e[CF.EC_K_ACC] = p.k_acc_1_s
+    e[CF.EC_K_MAG] = p.k_mag_1_s
+    e[CF.EC_K_BIAS] = p.k_bias_1_s2
+    e[CF.EC_GATE] = p.gate_m_s2
+    e[CF.EC_K_POS] = p.k_pose_position
+    e[CF.EC_K_VEL] = p.k_pose_velocity_1_s
     if p.form == "raw":
         k_p, w_a, w_m, k_i = p.raw_gains
-        e[L.EC_CF_RAW] = 1.0
-        e[L.EC_K_ACC] = 0.5 * k_p * w_a
-        e[L.EC_K_MAG] = 0.5 * k_p * w_m
-        e[L.EC_K_BIAS] = 0.5 * k_i * w_a
-        e[L.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
+        e[CF.EC_CF_RAW] = 1.0
+        e[CF.EC_K_ACC] = 0.5 * k_p * w_a
+        e[CF.EC_K_MAG] = 0.5 * k_p * w_m
+        e[CF.EC_K_BIAS] = 0.5 * k_i * w_a
+        e[CF.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
     return e
 
 
 def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: AdditiveEkfParams = params  # type: ignore[assignment]
     e = np.zeros(L.NECFG)
-    e[L.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
-    e[L.EC_R_ACC] = p.accel_variance
-    e[L.EC_R_MAG] = p.magnetometer_variance
-    e[L.EC_Q_QUAT] = p.quaternion_process
-    e[L.EC_Q_BIAS] = p.bias_process
-    e[L.EC_P0_QUAT] = p.initial_quaternion_variance
-    e[L.EC_P0_BIAS] = p.initial_bias_variance
-    e[L.EC_GATE] = p.gate_m_s2
+    e[ADD.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
+    e[ADD.EC_R_ACC] = p.accel_variance
+    e[ADD.EC_R_MAG] = p.magnetometer_variance
+    e[ADD.EC_Q_QUAT] = p.quaternion_process
+    e[ADD.EC_Q_BIAS] = p.bias_process
+    e[ADD.EC_P0_QUAT] = p.initial_quaternion_variance
+    e[ADD.EC_P0_BIAS] = p.initial_bias_variance
+    e[ADD.EC_GATE] = p.gate_m_s2
     return e
 
 
@@ -132,31 +136,31 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     mag = ctx.magnetometer
     pose = ctx.pose_sensor
     e = np.zeros(L.NECFG)
-    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
-    e[L.EC_SIG_WALK] = _or(
+    e[EKF.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
+    e[EKF.EC_SIG_WALK] = _or(
         p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
     )
-    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
+    e[EKF.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
     grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
-    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
-    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
-    e[L.EC_SIG_POS] = _or(
+    e[EKF.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
+    e[EKF.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
+    e[EKF.EC_SIG_POS] = _or(
         p.pose_position_noise_m, pose.position_noise_m if pose else 0.0, POSITION_NOISE_FLOOR
     )
     att = p.pose_attitude_noise_deg
-    e[L.EC_SIG_ATT] = math.radians(
+    e[EKF.EC_SIG_ATT] = math.radians(
         _or(att, pose.attitude_noise_deg if pose else 0.0, ATTITUDE_NOISE_FLOOR_DEG)
     )
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
-    e[L.EC_DEWEIGHT] = p.deweight
-    e[L.EC_P0] = math.radians(
+    e[EKF.EC_GATE] = p.gate_m_s2
+    e[EKF.EC_GATE_MODE] = EKF.GATE_DEWEIGHT if p.gate == "deweight" else EKF.GATE_SKIP
+    e[EKF.EC_DEWEIGHT] = p.deweight
+    e[EKF.EC_P0] = math.radians(
         _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
     )
-    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
-    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
-    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
-    e[L.EC_NAV] = 1.0 if pose is not None else 0.0
+    e[EKF.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
+    e[EKF.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
+    e[EKF.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
+    e[EKF.EC_NAV] = 1.0 if pose is not None else 0.0
     _pack_impact(p, ctx, e)
     return e
 
@@ -165,12 +169,12 @@ def _pack_impact(p: Any, ctx: EstimatorContext, e: np.ndarray) -> None:
     """The IMU's impact disturbance as the filter models it (the ``ekf``'s and ``nav-ekf``'s)."""
     dist = ctx.imu.impact_disturbance
     if p.impact_noise == "sensor" and dist is not None:
-        e[L.EC_IMPACT_W] = dist.gyro_rad_s
-        e[L.EC_IMPACT_F] = dist.accel_m_s2
-        e[L.EC_IMPACT_TAU] = dist.time_constant_s
-        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
+        e[EKF.EC_IMPACT_W] = dist.gyro_rad_s
+        e[EKF.EC_IMPACT_F] = dist.accel_m_s2
+        e[EKF.EC_IMPACT_TAU] = dist.time_constant_s
+        e[EKF.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
         g = ctx.vehicle.gravity_m_s2 if ctx.vehicle is not None else 9.81
-        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
+        e[EKF.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * g
 
 
 BARO_NOISE_FLOOR = 0.01  # m
@@ -184,46 +188,46 @@ def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     mag = ctx.magnetometer
     baro = ctx.instruments.get("barometer")
     e = np.zeros(L.NECFG)
-    e[L.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
-    e[L.EC_SIG_WALK] = _or(
+    e[EKF.EC_SIG_GYRO] = _or(p.gyro_noise_rad_s, imu.gyro_noise_rad_s, GYRO_NOISE_FLOOR)
+    e[EKF.EC_SIG_WALK] = _or(
         p.gyro_bias_walk_rad_s_sqrt_s, imu.gyro_bias_walk_rad_s_sqrt_s, WALK_FLOOR
     )
-    e[L.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
-    e[L.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
+    e[EKF.EC_SIG_ACC] = _or(p.accel_noise_m_s2, imu.accel_noise_m_s2, ACCEL_NOISE_FLOOR)
+    e[NAV.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
     grav = math.hypot(imu.accel_noise_m_s2, p.maneuver_accel_m_s2)
-    e[L.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
-    e[L.EC_DEWEIGHT] = p.deweight
-    e[L.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
-    e[L.EC_NAV_BARO] = _or(p.barometer_noise_m, baro.noise_m if baro else 0.0, BARO_NOISE_FLOOR)
-    e[L.EC_NAV_BARO + 1] = _or(
+    e[EKF.EC_SIG_GRAV] = _or(p.gravity_noise_m_s2, grav, GRAVITY_NOISE_FLOOR)
+    e[EKF.EC_GATE] = p.gate_m_s2
+    e[EKF.EC_GATE_MODE] = EKF.GATE_DEWEIGHT if p.gate == "deweight" else EKF.GATE_SKIP
+    e[EKF.EC_DEWEIGHT] = p.deweight
+    e[EKF.EC_SIG_MAG] = _or(p.magnetometer_noise, mag.noise if mag else 0.0, MAG_NOISE_FLOOR)
+    e[NAV.EC_NAV_BARO] = _or(p.barometer_noise_m, baro.noise_m if baro else 0.0, BARO_NOISE_FLOOR)
+    e[NAV.EC_NAV_BARO + 1] = _or(
         p.barometer_bias_walk_m_sqrt_s, baro.bias_walk_m_sqrt_s if baro else 0.0, BARO_WALK_FLOOR
     )
-    e[L.EC_NAV_RANGE] = p.range_noise_floor_m
-    e[L.EC_NAV_FLOW] = p.flow_noise_floor_rad_s
-    e[L.EC_NAV_GATES : L.EC_NAV_GATES + 4] = (
+    e[NAV.EC_NAV_RANGE] = p.range_noise_floor_m
+    e[NAV.EC_NAV_FLOW] = p.flow_noise_floor_rad_s
+    e[NAV.EC_NAV_GATES : NAV.EC_NAV_GATES + 4] = (
         p.mag_gate_sigma,
         p.baro_gate_sigma,
         p.range_gate_sigma,
         p.flow_gate_sigma,
     )
-    e[L.EC_NAV_REACQUIRE] = p.reacquire_after_s
-    e[L.EC_NAV_MAX_TILT] = math.cos(math.radians(p.max_tilt_deg))
-    e[L.EC_NAV_MIN_HEIGHT] = p.min_flow_height_m
+    e[NAV.EC_NAV_REACQUIRE] = p.reacquire_after_s
+    e[NAV.EC_NAV_MAX_TILT] = math.cos(math.radians(p.max_tilt_deg))
+    e[NAV.EC_NAV_MIN_HEIGHT] = p.min_flow_height_m
     if p.imu_lever_arm == "sensor":
-        e[L.EC_NAV_LEVER : L.EC_NAV_LEVER + 3] = imu.position_m
-    e[L.EC_NAV_DELAYED] = 1.0 if p.flow_delay_compensation else 0.0
-    e[L.EC_NAV_REACQ_EXCESS] = 1.0 if p.reacquire_inflation == "excess" else 0.0
-    e[L.EC_P0] = math.radians(
+        e[NAV.EC_NAV_LEVER : NAV.EC_NAV_LEVER + 3] = imu.position_m
+    e[NAV.EC_NAV_DELAYED] = 1.0 if p.flow_delay_compensation else 0.0
+    e[NAV.EC_NAV_REACQ_EXCESS] = 1.0 if p.reacquire_inflation == "excess" else 0.0
+    e[EKF.EC_P0] = math.radians(
         _or(p.initial_attitude_std_deg, p.initial_attitude_error_deg, INITIAL_ATTITUDE_STD_DEG)
     )
-    e[L.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
-    e[L.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
-    e[L.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
+    e[EKF.EC_P0 + 1] = _or(p.initial_bias_std_rad_s, p.initial_bias_error_rad_s, BIAS_STD_FLOOR)
+    e[EKF.EC_P0 + 2] = _or(p.initial_velocity_std_m_s, p.initial_velocity_error_m_s, 0.01)
+    e[EKF.EC_P0 + 3] = _or(p.initial_position_std_m, p.initial_position_error_m, 0.01)
     acc0 = imu.accel_bias_m_s2 if p.initial_bias == "zero" else 0.0
-    e[L.EC_NAV_P0] = _or(p.initial_accel_bias_std_m_s2, acc0, ACCEL_BIAS_STD_FLOOR)
-    e[L.EC_NAV_P0 + 1] = p.initial_baro_bias_std_m
+    e[NAV.EC_NAV_P0] = _or(p.initial_accel_bias_std_m_s2, acc0, ACCEL_BIAS_STD_FLOOR)
+    e[NAV.EC_NAV_P0 + 1] = p.initial_baro_bias_std_m
     _pack_impact(p, ctx, e)
     return e
 
