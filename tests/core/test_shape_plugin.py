@@ -3,14 +3,13 @@ like a built-in: a caged vehicle hits a long capsule as it hits a cylinder of it
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from quadimpact import simulate
+from quadimpact.inputs import plugins
 from quadimpact.inputs.scenarios import scenario_from_dict
 
 pytestmark = pytest.mark.slow  # compiles a loop around the plug-in (about a minute)
@@ -19,12 +18,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _load():
-    spec = importlib.util.spec_from_file_location(
-        "shape_template", ROOT / "examples" / "shape_template.py"
-    )
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # pydantic resolves the annotations there
-    spec.loader.exec_module(module)
+    """Import the template once per process, as ``--plugin`` does (other tests load it so)."""
+    plugins.load_plugin(str(ROOT / "examples" / "shape_template.py"))
 
 
 def test_a_long_capsule_is_a_cylinder_to_a_cage():
