@@ -28,6 +28,7 @@ DECLARING = (
     "quadimpact.core.estimators.ekf",
     "quadimpact.core.estimators.ekf_additive",
     "quadimpact.core.estimators.nav_ekf",
+    "quadimpact.core.sensors.detection",
     "quadimpact.core.envs.episode_layout",
 )
 # constants that carry a block's prefix without being one of its slots
@@ -93,11 +94,15 @@ def test_declared_offsets_are_the_module_constants_and_nothing_escapes_a_block()
 
 
 def test_a_component_block_stays_inside_the_region_it_extends():
-    """A controller's or estimator's block lies inside the central region it extends
-    (``ctrl`` parameters, ``ecfg[EC_OWN:]``, ``est[ES_OWN:]``): its capacity says so."""
+    """An estimator's or the detector's block lies inside the central region it extends
+    (``ecfg[EC_OWN:]``, ``est[ES_OWN:]``, the detector's ``scfg``, ``sst`` and ``imu``
+    regions): its capacity says so."""
     regions = {
         "ecfg.": (L.EC_OWN, L.EC_OWN + L.N_OWN_ECFG),
         "est.": (L.ES_OWN, L.ES_OWN + L.N_OWN_EST),
+        "scfg.detector": (L.SC_DETECTOR, L.SC_DETECTOR + L.N_DETECTOR_CFG),
+        "sst.detector": (L.SS_DETECTOR, L.SS_DETECTOR + 1),
+        "imu.detector": (L.I_DETECTOR, L.I_DETECTOR + 1),
     }
     seen = set()
     for b in _blocks():

@@ -12,8 +12,8 @@ declaration. Only what belongs to no component is declared here (the
 state, time, the run's options, the records' common heads); a component
 declares its own blocks in its own module, after the head it extends (the
 controllers' parameter and memory blocks in ``core/controllers/``, the
-estimators' configuration and state in ``core/estimators/``, the sensor
-components' in ``core/sensors/``). Numba reads these module-level integers
+estimators' configuration and state in ``core/estimators/``, the detector's
+and the sensor components' in ``core/sensors/``). Numba reads these module-level integers
 as compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
@@ -343,9 +343,8 @@ SC_RANGE_F = _scfg.slot("SC_RANGE_F")  # m/s^2, accelerometer range (<= 0: none)
 SC_RANGE_W = _scfg.slot("SC_RANGE_W")  # rad/s, gyro range (<= 0: none)
 SC_FILTER = _scfg.slot("SC_FILTER")  # FILTER_*
 SC_FILTER_PARAM = _scfg.slot("SC_FILTER_PARAM")  # first-order: tau, s; moving average: window
-SC_DET_THRESHOLD = _scfg.slot("SC_DET_THRESHOLD")  # m/s^2, detecting specific force (<= 0: off)
-SC_DET_WORLD = _scfg.slot("SC_DET_WORLD")  # 1: world-horizontal |(C f)_XY|, else body |(f_x, f_y)|
-SC_DET_PERSIST = _scfg.slot("SC_DET_PERSIST")  # consecutive samples at or above the threshold
+N_DETECTOR_CFG = 3
+SC_DETECTOR = _scfg.slot("SC_DETECTOR", N_DETECTOR_CFG)  # the detector's (sensors/detection.py)
 # the IMU's impact disturbance: from each contact onset t_c, extra white noise of std
 # a0 exp(-(t - t_c)/tau) (accelerometer) and g0 exp(-(t - t_c)/tau) (gyro); off when tau <= 0
 SC_IMPACT_F = _scfg.slot("SC_IMPACT_F")  # a0, m/s^2
@@ -507,7 +506,7 @@ NMEAS = _ms.end("NMEAS")
 _sst = Block("sst", "SS_")
 SS_N = _sst.slot("SS_N")  # samples taken
 SS_NEXT_T = _sst.slot("SS_NEXT_T")  # s, time of the next sample
-SS_COUNT = _sst.slot("SS_COUNT")  # consecutive samples at or above the detection threshold
+SS_DETECTOR = _sst.slot("SS_DETECTOR")  # the detector's state (core/sensors/detection.py)
 SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
 SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
 SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
@@ -545,7 +544,7 @@ I_F = _imu.slot("I_F", 3)  # measured specific force, body FRD, m/s^2
 I_W = _imu.slot("I_W", 3)  # measured angular velocity, body FRD, rad/s
 I_F_TRUE = _imu.slot("I_F_TRUE", 3)  # true specific force at the IMU position, m/s^2
 I_W_TRUE = _imu.slot("I_W_TRUE", 3)  # true angular velocity, rad/s
-I_HORIZONTAL = _imu.slot("I_HORIZONTAL")  # the detector's horizontal measure, m/s^2
+I_DETECTOR = _imu.slot("I_DETECTOR")  # the detector's column (core/sensors/detection.py)
 I_MAG = _imu.slot("I_MAG", 3)  # magnetometer sample, body FRD, unit field (NaN: none)
 I_POSE = _imu.slot("I_POSE", 7)  # pose measurement arrived here: position, quaternion (NaN: none)
 I_Q_HAT = _imu.slot("I_Q_HAT", 4)  # attitude estimate after this sample
