@@ -13,6 +13,7 @@ import pytest
 from estimator_streams import Harness, constant_rotation, expmap, qmul
 
 from quadimpact.core import layout as L
+from quadimpact.core.estimators import ekf as EKF
 from quadimpact.core.estimators.ekf_additive import _rotate_t, _transition
 from quadimpact.rotations import quat_to_matrix
 
@@ -133,7 +134,8 @@ def test_the_transition_as_written_resets_the_quaternion_covariance_to_q():
     for transition in ("as-written", "correct"):
         h = Harness("ekf-additive", n, params={"transition": transition}, dt=DT)
         h.run(s)
-        out[transition] = np.diag(h.d.est[L.ES_P : L.ES_P + 7 * L.N_EKF].reshape(7, L.N_EKF))
+        p = h.d.est[EKF.ES_P : EKF.ES_P + 7 * EKF.N_EKF]
+        out[transition] = np.diag(p.reshape(7, EKF.N_EKF))
     q_step = 1.8e-3 * DT
     np.testing.assert_allclose(out["as-written"][:4], q_step, rtol=1e-3)
     np.testing.assert_allclose(out["correct"][:4], 0.1 + (n - 1) * q_step, rtol=1e-3)

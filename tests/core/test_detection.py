@@ -7,6 +7,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
+from quadimpact.core.sensors import detection as DET
 from quadimpact.core.sensors.detection import detect
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
@@ -17,9 +18,9 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     """Run the detector over specific-force samples (body, m/s^2) at 200 Hz."""
     scfg = np.zeros(L.NSCFG)
     scfg[L.SC_RATE] = 200.0
-    scfg[L.SC_DET_THRESHOLD] = threshold
-    scfg[L.SC_DET_PERSIST] = persist
-    scfg[L.SC_DET_WORLD] = 1.0 if world else 0.0
+    scfg[DET.SC_DET_THRESHOLD] = threshold
+    scfg[DET.SC_DET_PERSIST] = persist
+    scfg[DET.SC_DET_WORLD] = 1.0 if world else 0.0
     x = np.zeros(L.NX)
     x[L.X_QUAT : L.X_QUAT + 4] = euler_zyx_to_quat(0.0, pitch, yaw)
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
@@ -48,7 +49,7 @@ def test_quiet_samples_never_detect():
     assert meas[L.MS_DETECTED] == 0.0
     assert np.isnan(stats[L.ST_T_DETECT])
     assert stats[L.ST_N_DETECTIONS] == 0
-    np.testing.assert_allclose(imu[-1, L.I_HORIZONTAL], np.hypot(3.0, 3.0))
+    np.testing.assert_allclose(imu[-1, DET.I_HORIZONTAL], np.hypot(3.0, 3.0))
 
 
 def test_first_sample_at_threshold_detects_and_estimates_the_normal():

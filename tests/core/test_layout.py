@@ -21,11 +21,15 @@ from quadimpact.core.records import new_data, new_output, new_work
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
     "quadimpact.core.layout",
-    "quadimpact.core.controller_layout",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
+    "quadimpact.core.controllers.residual",
+    "quadimpact.core.estimators.complementary",
+    "quadimpact.core.estimators.ekf",
+    "quadimpact.core.estimators.ekf_additive",
+    "quadimpact.core.estimators.nav_ekf",
+    "quadimpact.core.sensors.detection",
     "quadimpact.core.envs.episode_layout",
-    "quadimpact.core.envs.stacked",
 )
 # constants that carry a block's prefix without being one of its slots
 NOT_SLOTS = {"OUT_DELTA"}  # the first per-feature column: the end of the fixed columns
@@ -65,23 +69,50 @@ def test_no_two_slots_overlap_and_every_size_covers_its_slots():
 
 
 def test_declared_offsets_are_the_module_constants_and_nothing_escapes_a_block():
+    blocks = _blocks()
+    declared_anywhere = defaultdict(set)  # a name two alternatives declare has two offsets
+    for b in blocks:
+        for n, (o, _) in b.slots.items():
+            declared_anywhere[n].add(o)
     for modname in DECLARING:
         module = importlib.import_module(modname)
-        declared = [b for b in L.Block.registry.values() if b.slots]
-        mine = [b for b in declared if any(hasattr(module, n) for n in b.slots)]
+        mine = [b for b in blocks if b.module == modname and b.slots]
         for b in mine:
             for name, (offset, _) in b.slots.items():
-                if hasattr(module, name):
-                    assert getattr(module, name) == offset, f"{modname}.{name}"
+                assert getattr(module, name) == offset, f"{modname}.{name}"
             if b.size_name and hasattr(module, b.size_name):
                 assert getattr(module, b.size_name) == b.next, f"{modname}.{b.size_name}"
-        prefixes = {b.prefix: b for b in mine}
+        prefixes = {b.prefix for b in mine}
         for name, value in vars(module).items():
             if not isinstance(value, int) or isinstance(value, bool) or name in NOT_SLOTS:
                 continue
-            for prefix, b in prefixes.items():
-                if name.startswith(prefix):
-                    assert name in b.slots, f"{modname}.{name} = {value} is not a slot of its block"
+            if any(name.startswith(p) for p in prefixes):
+                # a slot of a block declared here, or imported from the module declaring it
+                assert value in declared_anywhere.get(name, ()), (
+                    f"{modname}.{name} = {value} is not a slot of a declared block"
+                )
+
+
+def test_a_component_block_stays_inside_the_region_it_extends():
+    """An estimator's or the detector's block lies inside the central region it extends
+    (``ecfg[EC_OWN:]``, ``est[ES_OWN:]``, the detector's ``scfg``, ``sst`` and ``imu``
+    regions): its capacity says so."""
+    regions = {
+        "ecfg.": (L.EC_OWN, L.EC_OWN + L.N_OWN_ECFG),
+        "est.": (L.ES_OWN, L.ES_OWN + L.N_OWN_EST),
+        "scfg.detector": (L.SC_DETECTOR, L.SC_DETECTOR + L.N_DETECTOR_CFG),
+        "sst.detector": (L.SS_DETECTOR, L.SS_DETECTOR + 1),
+        "imu.detector": (L.I_DETECTOR, L.I_DETECTOR + 1),
+    }
+    seen = set()
+    for b in _blocks():
+        for head, (lo, hi) in regions.items():
+            if b.array.startswith(head) and b.slots:
+                seen.add(head)
+                assert b.capacity == hi, b.array
+                for name, (offset, width) in b.slots.items():
+                    assert lo <= offset and offset + width <= hi, name
+    assert seen == set(regions)
 
 
 def test_the_factories_allocate_the_declared_sizes():

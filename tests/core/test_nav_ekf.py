@@ -123,8 +123,8 @@ def _perturb(h, fl, rng, sn, scale=1.0):
     est[L.ES_VEL : L.ES_VEL + 3] = fl.vel(0.0) - e[3:6]
     est[L.ES_POS : L.ES_POS + 3] = fl.pos(0.0) - e[6:9]
     est[L.ES_BIAS : L.ES_BIAS + 3] = sn.bg - e[9:12]
-    est[L.ES_ACC_BIAS : L.ES_ACC_BIAS + 3] = sn.ba - e[12:15]
-    est[L.ES_BARO_BIAS] = sn.bb - e[15]
+    est[N.ES_ACC_BIAS : N.ES_ACC_BIAS + 3] = sn.ba - e[12:15]
+    est[N.ES_BARO_BIAS] = sn.bb - e[15]
 
 
 def _error(h, fl, t):
@@ -332,7 +332,7 @@ def test_flow_is_reacquired_after_a_dropout():
     t = np.arange(len(errs)) * 0.005
     assert errs[(t > 2.6) & (t < 3.0)].min() > 0.6  # knocked off, nothing to correct it
     assert errs[t > 3.5].max() < 0.1  # back within 0.5 s of the flow's return
-    c = L.ES_NAV_COUNT + 3 * N.SRC_FLOW
+    c = N.ES_NAV_COUNT + 3 * N.SRC_FLOW
     assert h.est[c + N.CNT_REACQUIRED] >= 1
     # without the rule (re-acquisition after 100 s) the gate refuses the first samples,
     # then the estimate creeps back with the gain of a covariance that never saw the knock
@@ -359,7 +359,7 @@ def test_the_barometer_is_reacquired_after_a_step():
 
     _fly(h, fl, sn, n, dt, on_sample=step, flow=False)
     t = np.arange(n) * dt
-    c = L.ES_NAV_COUNT + 3 * N.SRC_BARO
+    c = N.ES_NAV_COUNT + 3 * N.SRC_BARO
     assert np.abs(heights[(t > 1.0) & (t < 1.45)] - 1.5).max() < 0.1  # refused
     assert h.est[c + N.CNT_REFUSED] >= 20
     assert h.est[c + N.CNT_REACQUIRED] >= 1
@@ -374,11 +374,11 @@ def test_packer_takes_the_sensors_noise_and_documents_defaults():
                 instruments={"barometer": baro})  # fmt: skip
     e = h.m.ecfg
     assert e[L.EC_KIND] == L.EST_NAV_EKF
-    assert e[L.EC_SIG_ACC] == 1.0 and e[L.EC_SIG_GYRO] == pytest.approx(1.8e-3)
-    assert e[L.EC_SIG_MAG] == 0.02
-    assert tuple(e[L.EC_NAV_BARO : L.EC_NAV_BARO + 2]) == (0.3, 0.02)
+    assert e[N.EC_SIG_ACC] == 1.0 and e[N.EC_SIG_GYRO] == pytest.approx(1.8e-3)
+    assert e[N.EC_SIG_MAG] == 0.02
+    assert tuple(e[N.EC_NAV_BARO : N.EC_NAV_BARO + 2]) == (0.3, 0.02)
     p = NavEkfParams()
-    assert tuple(e[L.EC_NAV_GATES : L.EC_NAV_GATES + 4]) == (
+    assert tuple(e[N.EC_NAV_GATES : N.EC_NAV_GATES + 4]) == (
         p.mag_gate_sigma, p.baro_gate_sigma, p.range_gate_sigma, p.flow_gate_sigma)  # fmt: skip
     assert (p.mag_gate_sigma, p.baro_gate_sigma, p.range_gate_sigma, p.flow_gate_sigma) == (
         3.0, 5.0, 5.0, 3.0)  # fmt: skip
@@ -428,7 +428,7 @@ def test_a_clipped_accelerometer_sample_inflates_the_velocity_covariance():
                 params={"gate_m_s2": 0.0})  # fmt: skip
     dt = 0.002
     rng_f = h.m.scfg[L.SC_RANGE_F]
-    sa = h.m.ecfg[L.EC_SIG_ACC]
+    sa = h.m.ecfg[N.EC_SIG_ACC]
     g = np.array([0.0, 0.0, -G])
     h.sample(0.0, g, np.zeros(3), fl.q)
     growth = []

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.core.controllers import recovery as CL
 from quadimpact.core.controllers import recovery as R
 
 TOL = dict(q_tol=0.3, rate_tol=0.5, w_tol=0.3)

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, simulate
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.core.controllers import residual as RES
 from quadimpact.core.controllers.residual import features, residual_references
 from quadimpact.errors import InputError
 from quadimpact.inputs.policy_file import (
@@ -156,7 +156,7 @@ def test_the_residual_acts_in_its_stages_and_leaves_the_others_to_the_law(stage,
     """One tick of recovery_step in a stage, with and without a strong policy: the commands
     differ in stages 1-4, and in stage 5 (the law's return to hover) only for a policy whose
     last stage is 5."""
-    from quadimpact.core import controller_layout as CL
+    from quadimpact.core.controllers import recovery as CL
     from quadimpact.core.controllers.recovery import recovery_step
     from quadimpact.simulation.setup import prepare
 
@@ -192,7 +192,7 @@ def test_packing_writes_the_files_block(tmp_path):
     np.testing.assert_array_equal(ctrl[L.C_POLICY : L.C_POLICY + block.size], block)
     assert not ctrl[L.C_POLICY + block.size : L.C_POLICY + L.NPOLICY].any()
     assert not prepare(_trial()).ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY].any()
-    assert int(ctrl[L.C_POLICY + CL.PB_HIDDEN]) == p.hidden
+    assert int(ctrl[L.C_POLICY + RES.PB_HIDDEN]) == p.hidden
 
 
 def test_a_policy_file_round_trips_with_its_digest(tmp_path):
@@ -212,7 +212,7 @@ def test_the_last_stage_round_trips_and_is_part_of_the_identity(tmp_path):
     assert p4.sha256 != p5.sha256
     q5 = load_policy(save_policy(p5, tmp_path / "p5.npz"))
     assert q5.last_stage == 5 and q5.sha256 == p5.sha256
-    assert q5.block()[CL.PB_LAST_STAGE] == 5.0 and p4.block()[CL.PB_LAST_STAGE] == 4.0
+    assert q5.block()[RES.PB_LAST_STAGE] == 5.0 and p4.block()[RES.PB_LAST_STAGE] == 4.0
     old = {"w1": p4.w1, "b1": p4.b1, "w2": p4.w2, "b2": p4.b2,
            "thrust_scale": np.float64(0.3), "rate_scale_rad_s": np.float64(4.0)}  # fmt: skip
     np.savez(tmp_path / "old.npz", **old)

@@ -9,9 +9,8 @@ import numpy as np
 import pytest
 
 from quadimpact import simulate
+from quadimpact.inputs import plugins
 from quadimpact.inputs.scenarios import scenario_from_dict
-
-from helpers import load_example
 
 pytestmark = pytest.mark.slow  # compiles a loop around the plug-in (about a minute)
 
@@ -19,7 +18,8 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def _load():
-    load_example("shape_template.py")
+    """Import the template once per process, as ``--plugin`` does (other tests load it so)."""
+    plugins.load_plugin(str(ROOT / "examples" / "shape_template.py"))
 
 
 def test_a_long_capsule_is_a_cylinder_to_a_cage():

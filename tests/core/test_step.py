@@ -9,6 +9,7 @@ from quadimpact import WallApproach
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
 from quadimpact.core.records import new_data, new_output
+from quadimpact.core.sensors import detection as DET
 from quadimpact.core.step import advance, start
 from quadimpact.simulation.setup import prepare
 
@@ -21,7 +22,7 @@ def test_tick_by_tick_equals_the_whole_run(model, controller):
     setup = prepare(s)
     scfg = np.zeros(L.NSCFG)
     scfg[L.SC_RATE] = 200.0
-    scfg[L.SC_DET_THRESHOLD] = 0.5 * 9.81
+    scfg[DET.SC_DET_THRESHOLD] = 0.5 * 9.81
     m = setup.model(scfg=scfg, noise=np.zeros((0, 6)))
     whole = execute(m, n_imu=1000, max_episodes=64)
     d = new_data(m)

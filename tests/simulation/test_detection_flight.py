@@ -11,6 +11,7 @@ import pytest
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
+from quadimpact.core.sensors import detection as DET
 from quadimpact.simulation.setup import prepare
 
 G = 9.81
@@ -34,7 +35,7 @@ def test_wall_approaches_without_the_wall_never_detect():
         no_wall = np.zeros((0, L.NSHAPE))
         rec = execute(setup.model(shapes=no_wall), n_imu=setup.n_imu)
         assert rec.stats[L.ST_N_DETECTIONS] == 0 and math.isnan(rec.stats[L.ST_T_DETECT])
-        assert rec.imu[:, L.I_HORIZONTAL].max() < 0.1 * 0.5 * G
+        assert rec.imu[:, DET.I_HORIZONTAL].max() < 0.1 * 0.5 * G
         count += 1
     assert count == 40
 

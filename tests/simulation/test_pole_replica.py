@@ -18,8 +18,8 @@ from click.testing import CliRunner
 
 from quadimpact import ImpactTrial, simulate
 from quadimpact.cli import cli
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.core.controllers import recovery as CL
 from quadimpact.inputs.model import CLASSIC_LAW, MODEL_VARIANTS, RECOVERY_LAWS
 from quadimpact.inputs.scenarios import load_scenario_file, scenario_from_dict
 from quadimpact.simulation.setup import prepare

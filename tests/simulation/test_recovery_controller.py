@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, Simulation, simulate
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.core.controllers import recovery as CL
 from quadimpact.inputs.controllers import RecoveryParams
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, simulate
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.core.controllers import recovery as CL
 from quadimpact.core.rotors import rotor_wrench
 from quadimpact.inputs.model import MODEL_VARIANTS, resolve_model_options
 from quadimpact.simulation.setup import prepare

@@ -8,10 +8,13 @@ block cannot overlap and its size always covers them;
 ``tests/core/test_layout.py`` checks every registered block (the
 learning environment's blocks, which are declared with their code,
 included) and that no constant of a block's prefix escapes its
-declaration. The built-in controllers' parameter blocks and memory slots
-are in ``core/controller_layout.py`` (not in ``core/controllers/``), so that
-the Python side packs them without loading any compiled code. Numba reads
-these module-level integers as compile-time constants.
+declaration. Only what belongs to no component is declared here (the
+state, time, the run's options, the records' common heads); a component
+declares its own blocks in its own module, after the head it extends (the
+controllers' parameter and memory blocks in ``core/controllers/``, the
+estimators' configuration and state in ``core/estimators/``, the detector's
+and the sensor components' in ``core/sensors/``). Numba reads these module-level integers
+as compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
 reason) are plain integer constants for the compiled code (Numba cannot
@@ -24,6 +27,7 @@ Everything is SI; frames as in docs/MODEL.md section 1 (inertial NED, body FRD).
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass, field
 from enum import IntEnum
 from typing import ClassVar
@@ -55,10 +59,13 @@ class Block:
     capacity: int | None = None
     slots: dict[str, tuple[int, int]] = field(default_factory=dict)
     size_name: str | None = None
+    module: str = ""
     registry: ClassVar[dict[str, Block]] = {}
 
     def __post_init__(self) -> None:
         self.next = self.start
+        if not self.module:  # the declaring module: the caller of the generated __init__
+            self.module = sys._getframe(2).f_globals.get("__name__", "")
         Block.registry[f"{self.array}:{self.prefix}"] = self  # a module reloaded: the new one
 
     def slot(self, name: str, width: int = 1) -> int:
@@ -313,6 +320,11 @@ C_POS_GAINS = _ctrl.slot("C_POS_GAINS", 4)  # K_p 1/s, K_v 1/s, v_max m/s, tilt_
 NPARAM = 64
 C_PARAMS = _ctrl.slot("C_PARAMS", NPARAM)  # the controller's own parameters
 NPOLICY = 1024
+# the learned residual's network (its block at C_POLICY: core/controllers/residual.py; its
+# file: inputs/policy_file.py): what it reads, what it corrects, its widest hidden layer
+N_FEATURES = 24  # what the network reads (residual.features)
+N_OUTPUTS = 3  # thrust, p_des, q_des corrections
+MAX_HIDDEN = 32  # the widest hidden layer a policy may have (fits in NPOLICY)
 C_POLICY = _ctrl.slot("C_POLICY", NPOLICY)  # a learned residual on the recovery law (first
 #   slot: its hidden width, 0 = none; core/controllers/residual.py lays out the rest)
 C_STEP = _ctrl.slot("C_STEP")  # a plug-in's step: its entry address in this process (0: none;
@@ -331,9 +343,8 @@ SC_RANGE_F = _scfg.slot("SC_RANGE_F")  # m/s^2, accelerometer range (<= 0: none)
 SC_RANGE_W = _scfg.slot("SC_RANGE_W")  # rad/s, gyro range (<= 0: none)
 SC_FILTER = _scfg.slot("SC_FILTER")  # FILTER_*
 SC_FILTER_PARAM = _scfg.slot("SC_FILTER_PARAM")  # first-order: tau, s; moving average: window
-SC_DET_THRESHOLD = _scfg.slot("SC_DET_THRESHOLD")  # m/s^2, detecting specific force (<= 0: off)
-SC_DET_WORLD = _scfg.slot("SC_DET_WORLD")  # 1: world-horizontal |(C f)_XY|, else body |(f_x, f_y)|
-SC_DET_PERSIST = _scfg.slot("SC_DET_PERSIST")  # consecutive samples at or above the threshold
+N_DETECTOR_CFG = 3
+SC_DETECTOR = _scfg.slot("SC_DETECTOR", N_DETECTOR_CFG)  # the detector's (sensors/detection.py)
 # the IMU's impact disturbance: from each contact onset t_c, extra white noise of std
 # a0 exp(-(t - t_c)/tau) (accelerometer) and g0 exp(-(t - t_c)/tau) (gyro); off when tau <= 0
 SC_IMPACT_F = _scfg.slot("SC_IMPACT_F")  # a0, m/s^2
@@ -368,67 +379,25 @@ SN_MAG = _sn.slot("SN_MAG", 3)  # magnetometer noise
 SN_POSE = _sn.slot("SN_POSE", 6)  # pose sensor: position (3), attitude rotation vector (3)
 NSN = _sn.end("NSN")
 
-# ---- estimator ecfg (NECFG): kind, the initial estimate's error, gains and noises
-# (core/estimators/); EC_USER is a plug-in estimator's own parameter block
+# ---- estimator ecfg (NECFG): what every estimator has (its kind, the initial estimate's
+# error), a plug-in's block, then EC_OWN: the built-in estimator's own block, which it
+# declares in its module (core/estimators/*.py; one estimator per run: the built-ins'
+# blocks are alternatives over the same numbers)
 _ecfg = Block("ecfg", "EC_")
 EC_KIND = _ecfg.slot("EC_KIND")  # EST_*
 EC_INIT_ATT = _ecfg.slot("EC_INIT_ATT", 3)  # initial attitude error, rotation vector (body), rad
 EC_INIT_VEL = _ecfg.slot("EC_INIT_VEL", 3)  # initial velocity error, inertial, m/s
 EC_INIT_POS = _ecfg.slot("EC_INIT_POS", 3)  # initial position error, inertial, m
 EC_INIT_BIAS = _ecfg.slot("EC_INIT_BIAS", 3)  # initial gyro bias error, rad/s
-EC_K_ACC = _ecfg.slot("EC_K_ACC")  # complementary: accelerometer gain k_P, 1/s
-EC_K_MAG = _ecfg.slot("EC_K_MAG")  # complementary: magnetometer gain, 1/s
-EC_K_BIAS = _ecfg.slot("EC_K_BIAS")  # complementary: bias (integral) gain k_I, 1/s^2
-EC_K_POS = _ecfg.slot("EC_K_POS")  # complementary: pose position gain, per sample (0-1)
-EC_K_VEL = _ecfg.slot("EC_K_VEL")  # complementary: pose velocity gain, 1/s per sample
-EC_GATE = _ecfg.slot("EC_GATE")  # m/s^2: accelerometer correction gated while ||f| - g| > this
-EC_GATE_MODE = _ecfg.slot("EC_GATE_MODE")  # GATE_SKIP or GATE_DEWEIGHT (EKF)
-EC_DEWEIGHT = _ecfg.slot("EC_DEWEIGHT")  # EKF de-weighting: R times this (excess / gate)^2
-EC_SIG_GYRO = _ecfg.slot("EC_SIG_GYRO")  # EKF: gyro white noise per sample, rad/s
-EC_SIG_WALK = _ecfg.slot("EC_SIG_WALK")  # EKF: gyro bias random walk, rad/s/sqrt(s)
-EC_SIG_ACC = _ecfg.slot("EC_SIG_ACC")  # EKF: accelerometer white noise per sample, m/s^2
-EC_SIG_GRAV = _ecfg.slot("EC_SIG_GRAV")  # EKF: std of the gravity measurement, m/s^2
-EC_SIG_MAG = _ecfg.slot("EC_SIG_MAG")  # EKF: magnetometer noise (unit field)
-EC_SIG_POS = _ecfg.slot("EC_SIG_POS")  # EKF: pose position noise, m
-EC_SIG_ATT = _ecfg.slot("EC_SIG_ATT")  # EKF: pose attitude noise, rad
-EC_P0 = _ecfg.slot("EC_P0", 4)  # EKF initial std: attitude rad, bias rad/s, velocity m/s, pos m
-EC_NAV = _ecfg.slot("EC_NAV")  # EKF: 1: velocity and position are filter states (pose sensor)
 EC_OBSERVER = _ecfg.slot("EC_OBSERVER")  # 1: out of the loop (controller, detector read the truth)
 EC_INIT_EULER = _ecfg.slot("EC_INIT_EULER", 3)  # initial ZYX Euler errors (roll, pitch, yaw), rad
 EC_INIT_BIAS_ZERO = _ecfg.slot("EC_INIT_BIAS_ZERO")  # 1: the gyro bias estimate starts at 0
-EC_CF_RAW = _ecfg.slot("EC_CF_RAW")  # complementary: 1: the authors' form on raw vectors
-EC_K_BIAS_MAG = _ecfg.slot("EC_K_BIAS_MAG")  # complementary, raw form: bias gain of the mag. term
-EC_AS_WRITTEN = _ecfg.slot("EC_AS_WRITTEN")  # additive EKF: 1: the transition -dt/2 (I + Omega)
-EC_R_ACC = _ecfg.slot("EC_R_ACC")  # additive EKF: accelerometer noise variance, (m/s^2)^2
-EC_R_MAG = _ecfg.slot("EC_R_MAG")  # additive EKF: magnetometer noise variance (field units^2)
-EC_Q_QUAT = _ecfg.slot("EC_Q_QUAT")  # additive EKF: quaternion process noise per second
-EC_Q_BIAS = _ecfg.slot("EC_Q_BIAS")  # additive EKF: bias process noise per second, (rad/s)^2
-EC_P0_QUAT = _ecfg.slot("EC_P0_QUAT")  # additive EKF: initial quaternion variance
-EC_P0_BIAS = _ecfg.slot("EC_P0_BIAS")  # additive EKF: initial bias variance, (rad/s)^2
-EC_IMPACT_W = _ecfg.slot("EC_IMPACT_W")  # EKF: the IMU's impact disturbance, gyro g0, rad/s
-EC_IMPACT_F = _ecfg.slot("EC_IMPACT_F")  # EKF: ... accelerometer a0, m/s^2
-EC_IMPACT_TAU = _ecfg.slot("EC_IMPACT_TAU")  # EKF: ... time constant, s (<= 0: not modelled)
-EC_IMPACT_REPLACE = _ecfg.slot("EC_IMPACT_REPLACE")  # EKF: 1: it replaces the nominal noise
-EC_IMPACT_THRESHOLD = _ecfg.slot("EC_IMPACT_THRESHOLD")  # EKF: |(f_x, f_y)| marking an impact
 N_USER_ECFG = 16
 EC_USER = _ecfg.slot("EC_USER", N_USER_ECFG)  # a plug-in estimator's parameters
-# the navigation filter nav-ekf (core/estimators/nav_ekf.py); it also reads the EKF's slots
-EC_NAV_ACC_WALK = _ecfg.slot("EC_NAV_ACC_WALK")  # accelerometer bias random walk, m/s^2/sqrt(s)
-EC_NAV_BARO = _ecfg.slot("EC_NAV_BARO", 2)  # barometer: noise m, bias walk m/sqrt(s)
-EC_NAV_RANGE = _ecfg.slot("EC_NAV_RANGE")  # rangefinder noise floor, m
-EC_NAV_FLOW = _ecfg.slot("EC_NAV_FLOW")  # optical-flow noise floor, rad/s
-EC_NAV_GATES = _ecfg.slot("EC_NAV_GATES", 4)  # innovation gates (sigma): mag, baro, range, flow
-EC_NAV_REACQUIRE = _ecfg.slot("EC_NAV_REACQUIRE")  # s: a source unfused this long is re-acquired
-EC_NAV_P0 = _ecfg.slot("EC_NAV_P0", 2)  # initial std: accelerometer bias m/s^2, baro bias m
-EC_NAV_MIN_HEIGHT = _ecfg.slot("EC_NAV_MIN_HEIGHT")  # m: flow not fused below this height
-EC_NAV_MAX_TILT = _ecfg.slot("EC_NAV_MAX_TILT")  # cos of the largest tilt for range and flow
-EC_NAV_LEVER = _ecfg.slot("EC_NAV_LEVER", 3)  # IMU position from the CM the filter removes, m
-EC_NAV_DELAYED = _ecfg.slot("EC_NAV_DELAYED")  # 1: flow predicted from the state at its capture
-EC_NAV_REACQ_EXCESS = _ecfg.slot("EC_NAV_REACQ_EXCESS")  # 1: re-acquisition inflates by the excess
 EC_STEP = _ecfg.slot("EC_STEP")  # a plug-in estimator's step: its entry address (as C_STEP)
+N_OWN_ECFG = 48
+EC_OWN = _ecfg.slot("EC_OWN", N_OWN_ECFG)  # a built-in's own block (core/estimators/*.py)
 NECFG = _ecfg.end("NECFG")
-GATE_SKIP = 0
-GATE_DEWEIGHT = 1
 
 # ---- the span of the run: span (NSPAN)
 _span = Block("span", "SPAN_")
@@ -500,6 +469,14 @@ NRIN = _rin.end("NRIN")
 NMEM = 64
 MEM_STAGE = NMEM - 1
 N_STAGES = 8  # stages 0..7 have recorded entry ticks
+# the staged recovery law's stages (core/controllers/recovery.py), as the stats and the
+# learning environment read them
+STAGE_PRE_IMPACT = 0
+STAGE_DETECTED = 1
+STAGE_TILTED = 2
+STAGE_LEVEL = 3
+STAGE_RECOVERED = 4
+STAGE_HOVER = 5
 
 # ---- measurement record meas (NMEAS): what a controller sees at a tick
 # (core/sensors/measurement.py writes the estimate; the IMU and the detector
@@ -529,7 +506,7 @@ NMEAS = _ms.end("NMEAS")
 _sst = Block("sst", "SS_")
 SS_N = _sst.slot("SS_N")  # samples taken
 SS_NEXT_T = _sst.slot("SS_NEXT_T")  # s, time of the next sample
-SS_COUNT = _sst.slot("SS_COUNT")  # consecutive samples at or above the detection threshold
+SS_DETECTOR = _sst.slot("SS_DETECTOR")  # the detector's state (core/sensors/detection.py)
 SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
 SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
 SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
@@ -538,7 +515,9 @@ SS_POSE_N = _sst.slot("SS_POSE_N")  # pose measurements taken
 SS_POSE_RING = _sst.slot("SS_POSE_RING", 7 * MAX_POSE_LAG)  # true poses of the last samples
 NSST = _sst.end("NSST")
 
-# ---- estimator state est (NEST): the estimate after the latest IMU sample
+# ---- estimator state est (NEST): the estimate after the latest IMU sample (what every
+# estimator writes), a plug-in's state, then ES_OWN: a built-in's own state, declared in
+# its module (core/estimators/*.py; alternatives over the same numbers, as EC_OWN)
 _est = Block("est", "ES_")
 ES_Q = _est.slot("ES_Q", 4)  # attitude estimate, body -> inertial, scalar first
 ES_BIAS = _est.slot("ES_BIAS", 3)  # gyro bias estimate, rad/s
@@ -548,31 +527,10 @@ ES_W = _est.slot("ES_W", 3)  # estimated body rates (gyro minus bias) at the lat
 ES_T = _est.slot("ES_T")  # s, time of the latest sample processed (NaN: none)
 ES_N = _est.slot("ES_N")  # samples processed
 ES_GATED = _est.slot("ES_GATED")  # 1: the accelerometer correction was gated at the latest sample
-N_EKF = 12  # error state: attitude (3), gyro bias (3), velocity (3), position (3)
-ES_P = _est.slot("ES_P", N_EKF * N_EKF)  # EKF error covariance, row-major
-ES_SCRATCH = _est.slot("ES_SCRATCH", 4)  # a quaternion's worth of scratch (EKF prediction)
-ES_T_IMPACT = _est.slot("ES_T_IMPACT")  # s, the EKF's latest impact sample (NaN: none)
 N_USER_EST = 32
 ES_USER = _est.slot("ES_USER", N_USER_EST)  # a plug-in estimator's own state
-# the navigation filter nav-ekf (core/estimators/nav_ekf.py)
-N_NAV = 16  # error state: attitude, velocity, position, gyro bias, accel. bias (3 each), baro bias
-ES_NAV_P = _est.slot("ES_NAV_P", N_NAV * N_NAV)  # its error covariance, row-major
-ES_ACC_BIAS = _est.slot("ES_ACC_BIAS", 3)  # accelerometer bias estimate, body, m/s^2
-ES_BARO_BIAS = _est.slot("ES_BARO_BIAS")  # barometer bias estimate, m
-ES_NAV_SEEN = _est.slot("ES_NAV_SEEN", 3)  # samples seen so far: barometer, rangefinder, flow
-ES_NAV_FUSED_T = _est.slot("ES_NAV_FUSED_T", 4)  # s, the latest fused sample of mag, baro,
-#   range, flow (NaN: none yet)
-ES_NAV_COUNT = _est.slot("ES_NAV_COUNT", 12)  # per source (mag, baro, range, flow):
-#   fused, rejected by the gate, re-acquisitions
-ES_NAV_NIS = _est.slot("ES_NAV_NIS", 4)  # the latest normalised innovation squared of each
-N_NAV_RING = 64  # IMU samples of history (the flow's capture time)
-N_NAV_RING_W = 11  # a ring row: t, p, q (gyro minus bias), the prediction's dv, dtheta, dp_z
-ES_NAV_RING = _est.slot("ES_NAV_RING", N_NAV_RING_W * N_NAV_RING)  # the latest samples' rows
-ES_NAV_RING_AT = _est.slot("ES_NAV_RING_AT")  # the ring's next row
-ES_NAV_W_PREV = _est.slot("ES_NAV_W_PREV", 3)  # the previous sample's gyro minus bias (NaN: none)
-ES_NAV_ARM_PREV = _est.slot("ES_NAV_ARM_PREV", 6)  # C (w x r), C r at the previous sample (NaN)
-N_NAV_WORK = 2 * N_NAV * N_NAV + 14 * N_NAV + 6  # P, its scratch, the updates' work, f (CM, sensor)
-ES_NAV_WORK = _est.slot("ES_NAV_WORK", N_NAV_WORK)  # nav-ekf's work space (no allocation)
+N_OWN_EST = 1920
+ES_OWN = _est.slot("ES_OWN", N_OWN_EST)  # a built-in's own state (core/estimators/*.py)
 NEST = _est.end("NEST")
 
 # ==========================================================================
@@ -586,7 +544,7 @@ I_F = _imu.slot("I_F", 3)  # measured specific force, body FRD, m/s^2
 I_W = _imu.slot("I_W", 3)  # measured angular velocity, body FRD, rad/s
 I_F_TRUE = _imu.slot("I_F_TRUE", 3)  # true specific force at the IMU position, m/s^2
 I_W_TRUE = _imu.slot("I_W_TRUE", 3)  # true angular velocity, rad/s
-I_HORIZONTAL = _imu.slot("I_HORIZONTAL")  # the detector's horizontal measure, m/s^2
+I_DETECTOR = _imu.slot("I_DETECTOR")  # the detector's column (core/sensors/detection.py)
 I_MAG = _imu.slot("I_MAG", 3)  # magnetometer sample, body FRD, unit field (NaN: none)
 I_POSE = _imu.slot("I_POSE", 7)  # pose measurement arrived here: position, quaternion (NaN: none)
 I_Q_HAT = _imu.slot("I_Q_HAT", 4)  # attitude estimate after this sample

@@ -28,7 +28,6 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, StrictBool, field_validator
 
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.registry import Registry
@@ -291,14 +290,9 @@ def param_index(params: type[BaseModel], name: str) -> int:
     return param_slots(params)[name][0]
 
 
-PRE_IMPACT_KINDS = {
-    "nominal": CL.PRE_NOMINAL,
-    "hold": CL.PRE_HOLD,
-    "spin-down": CL.PRE_SPIN_DOWN,
-    "immediate": CL.PRE_IMMEDIATE,
-}
-PRE_IMPACT_CHOICES: tuple[str, ...] = tuple(PRE_IMPACT_KINDS)
-"""The recovery controller's pre-impact behaviours."""
+PRE_IMPACT_CHOICES: tuple[str, ...] = ("nominal", "hold", "spin-down", "immediate")
+"""The recovery controller's pre-impact behaviours (their ids: ``PRE_IMPACT_KINDS`` of
+``core/controllers/recovery.py``)."""
 
 
 _REGISTRY: Registry[ControllerEntry] = Registry(

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core.controller_layout import MAX_HIDDEN, N_FEATURES, N_OUTPUTS
+from quadimpact.core.layout import MAX_HIDDEN, N_FEATURES, N_OUTPUTS
 from quadimpact.errors import InputError, short_path
 from quadimpact.linalg import matvec
 

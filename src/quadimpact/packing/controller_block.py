@@ -11,10 +11,10 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
-from quadimpact.core import controller_layout as CL
 from quadimpact.core import layout as L
+from quadimpact.core.controllers import common as PID
+from quadimpact.core.controllers import recovery as REC
 from quadimpact.inputs.controllers import (
-    PRE_IMPACT_KINDS,
     CascadePidParams,
     ControllerEntry,
     PackContext,
@@ -149,9 +149,9 @@ def pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
 
 def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
     block = np.zeros(L.NPARAM)
-    block[CL.P_GAINS : CL.P_GAINS + 15] = params.gains()
+    block[PID.P_GAINS : PID.P_GAINS + 15] = params.gains()
     if isinstance(params, CascadePidParams):  # the paper's law has no floor (slot unread)
-        block[CL.P_THRUST_COS_FLOOR] = params.thrust_cos_floor
+        block[PID.P_THRUST_COS_FLOOR] = params.thrust_cos_floor
     return block
 
 
@@ -159,33 +159,35 @@ def _pack_recovery(params: BaseModel, ctx: PackContext) -> np.ndarray:
     nominal = controller_entry(ctx.nominal_controller)
     block = _pack_pid(nominal.params(), ctx)
     p: RecoveryParams = params  # type: ignore[assignment]
-    block[CL.R_NOMINAL_KIND] = nominal.kind
-    block[CL.R_PRE_IMPACT] = PRE_IMPACT_KINDS[ctx.pre_impact]
-    block[CL.R_K_ATT] = p.k_att_1_s
-    block[CL.R_K_RATE : CL.R_K_RATE + 3] = p.k_rate_1_s
-    block[CL.R_A_MAG] = p.a_mag_m_s2  # resolved: a number (None, the vehicle's g: resolve)
-    block[CL.R_K_Z : CL.R_K_Z + 4] = p.k_z_1_s
-    block[CL.R_Q_TOL] = p.tilt_error_tol
-    block[CL.R_RATE_TOL] = p.rate_tol_rad_s
-    block[CL.R_W_TOL] = p.w_tol_m_s
-    block[CL.R_LEVEL_TEST] = CL.LEVEL_EULER if p.level_test == "euler" else CL.LEVEL_TILT_ERROR
-    block[CL.R_EULER_TOL] = p.euler_tol_rad
-    block[CL.R_LEAN_CUT] = 2.0 if p.lean_cut_deg is None else math.sin(math.radians(p.lean_cut_deg))
-    block[CL.R_LEAN_FORCE] = p.lean_cut_force_m_s2
+    block[REC.R_NOMINAL_KIND] = nominal.kind
+    block[REC.R_PRE_IMPACT] = REC.PRE_IMPACT_KINDS[ctx.pre_impact]
+    block[REC.R_K_ATT] = p.k_att_1_s
+    block[REC.R_K_RATE : REC.R_K_RATE + 3] = p.k_rate_1_s
+    block[REC.R_A_MAG] = p.a_mag_m_s2  # resolved: a number (None, the vehicle's g: resolve)
+    block[REC.R_K_Z : REC.R_K_Z + 4] = p.k_z_1_s
+    block[REC.R_Q_TOL] = p.tilt_error_tol
+    block[REC.R_RATE_TOL] = p.rate_tol_rad_s
+    block[REC.R_W_TOL] = p.w_tol_m_s
+    euler = p.level_test == "euler"
+    block[REC.R_LEVEL_TEST] = REC.LEVEL_EULER if euler else REC.LEVEL_TILT_ERROR
+    block[REC.R_EULER_TOL] = p.euler_tol_rad
+    lean = p.lean_cut_deg
+    block[REC.R_LEAN_CUT] = 2.0 if lean is None else math.sin(math.radians(lean))
+    block[REC.R_LEAN_FORCE] = p.lean_cut_force_m_s2
     level = ctx.options.detection_tick_reference == "level"
-    block[CL.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
-    block[CL.R_HOVER] = 1.0 if p.hover else 0.0
-    block[CL.R_HOVER_GAINS : CL.R_HOVER_GAINS + 5] = (
+    block[REC.R_FIRST_TICK_LEVEL] = 1.0 if level else 0.0
+    block[REC.R_HOVER] = 1.0 if p.hover else 0.0
+    block[REC.R_HOVER_GAINS : REC.R_HOVER_GAINS + 5] = (
         p.hover_kp_1_s,
         p.hover_kv_1_s,
         p.hover_v_max_m_s,
         p.hover_a_max_m_s2,  # resolved: a number (None, g/2: resolve)
         p.hover_k_yaw_1_s,
     )
-    block[CL.R_HOVER_MODE] = CL.HOLD_STOP if p.hover_hold == "stop" else CL.HOLD_ENTRY
+    block[REC.R_HOVER_MODE] = REC.HOLD_STOP if p.hover_hold == "stop" else REC.HOLD_ENTRY
     if p.hover_set_point_m is not None:
-        block[CL.R_HOVER_MODE] = CL.HOLD_GIVEN
-        block[CL.R_HOVER_SET : CL.R_HOVER_SET + 3] = p.hover_set_point_m
+        block[REC.R_HOVER_MODE] = REC.HOLD_GIVEN
+        block[REC.R_HOVER_SET : REC.R_HOVER_SET + 3] = p.hover_set_point_m
     return block
 
 

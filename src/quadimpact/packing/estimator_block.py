@@ -29,6 +29,10 @@ import numpy as np
 from pydantic import BaseModel
 
 from quadimpact.core import layout as L
+from quadimpact.core.estimators import complementary as CF
+from quadimpact.core.estimators import ekf as EKF
+from quadimpact.core.estimators import ekf_additive as ADD
+from quadimpact.core.estimators import nav_ekf as NAV
 from quadimpact.inputs.estimators import (
     AdditiveEkfParams,
     ComplementaryParams,
@@ -84,33 +88,33 @@ class Estimation:
 def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: ComplementaryParams = params  # type: ignore[assignment]
     e = np.zeros(L.NECFG)
-    e[L.EC_K_ACC] = p.k_acc_1_s
-    e[L.EC_K_MAG] = p.k_mag_1_s
-    e[L.EC_K_BIAS] = p.k_bias_1_s2
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_K_POS] = p.k_pose_position
-    e[L.EC_K_VEL] = p.k_pose_velocity_1_s
+    e[CF.EC_K_ACC] = p.k_acc_1_s
+    e[CF.EC_K_MAG] = p.k_mag_1_s
+    e[CF.EC_K_BIAS] = p.k_bias_1_s2
+    e[CF.EC_GATE] = p.gate_m_s2
+    e[CF.EC_K_POS] = p.k_pose_position
+    e[CF.EC_K_VEL] = p.k_pose_velocity_1_s
     if p.form == "raw":
         k_p, w_a, w_m, k_i = p.raw_gains
-        e[L.EC_CF_RAW] = 1.0
-        e[L.EC_K_ACC] = 0.5 * k_p * w_a
-        e[L.EC_K_MAG] = 0.5 * k_p * w_m
-        e[L.EC_K_BIAS] = 0.5 * k_i * w_a
-        e[L.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
+        e[CF.EC_CF_RAW] = 1.0
+        e[CF.EC_K_ACC] = 0.5 * k_p * w_a
+        e[CF.EC_K_MAG] = 0.5 * k_p * w_m
+        e[CF.EC_K_BIAS] = 0.5 * k_i * w_a
+        e[CF.EC_K_BIAS_MAG] = 0.5 * k_i * w_m
     return e
 
 
 def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: AdditiveEkfParams = params  # type: ignore[assignment]
     e = np.zeros(L.NECFG)
-    e[L.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
-    e[L.EC_R_ACC] = p.accel_variance
-    e[L.EC_R_MAG] = p.magnetometer_variance
-    e[L.EC_Q_QUAT] = p.quaternion_process
-    e[L.EC_Q_BIAS] = p.bias_process
-    e[L.EC_P0_QUAT] = p.initial_quaternion_variance
-    e[L.EC_P0_BIAS] = p.initial_bias_variance
-    e[L.EC_GATE] = p.gate_m_s2
+    e[ADD.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
+    e[ADD.EC_R_ACC] = p.accel_variance
+    e[ADD.EC_R_MAG] = p.magnetometer_variance
+    e[ADD.EC_Q_QUAT] = p.quaternion_process
+    e[ADD.EC_Q_BIAS] = p.bias_process
+    e[ADD.EC_P0_QUAT] = p.initial_quaternion_variance
+    e[ADD.EC_P0_BIAS] = p.initial_bias_variance
+    e[ADD.EC_GATE] = p.gate_m_s2
     return e
 
 
@@ -118,13 +122,13 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: EkfParams = params  # type: ignore[assignment]  # resolved: every noise a number
     e = np.zeros(L.NECFG)
     _pack_filter_noises(p, e)
-    e[L.EC_SIG_POS] = p.pose_position_noise_m
-    e[L.EC_SIG_ATT] = math.radians(p.pose_attitude_noise_deg)
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
-    e[L.EC_DEWEIGHT] = p.deweight
+    e[EKF.EC_SIG_POS] = p.pose_position_noise_m
+    e[EKF.EC_SIG_ATT] = math.radians(p.pose_attitude_noise_deg)
+    e[EKF.EC_GATE] = p.gate_m_s2
+    e[EKF.EC_GATE_MODE] = EKF.GATE_DEWEIGHT if p.gate == "deweight" else EKF.GATE_SKIP
+    e[EKF.EC_DEWEIGHT] = p.deweight
     _pack_initial_spreads(p, e)
-    e[L.EC_NAV] = 1.0 if ctx.pose_sensor is not None else 0.0
+    e[EKF.EC_NAV] = 1.0 if ctx.pose_sensor is not None else 0.0
     _pack_impact(p, ctx, e)
     return e
 
@@ -132,30 +136,30 @@ def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
 def _pack_filter_noises(p: Any, e: np.ndarray) -> None:
     """The noises the ``ekf`` and the ``nav-ekf`` share (resolved by
     ``inputs.estimators.resolve_estimator_params``)."""
-    e[L.EC_SIG_GYRO] = p.gyro_noise_rad_s
-    e[L.EC_SIG_WALK] = p.gyro_bias_walk_rad_s_sqrt_s
-    e[L.EC_SIG_ACC] = p.accel_noise_m_s2
-    e[L.EC_SIG_GRAV] = p.gravity_noise_m_s2
-    e[L.EC_SIG_MAG] = p.magnetometer_noise
+    e[EKF.EC_SIG_GYRO] = p.gyro_noise_rad_s
+    e[EKF.EC_SIG_WALK] = p.gyro_bias_walk_rad_s_sqrt_s
+    e[EKF.EC_SIG_ACC] = p.accel_noise_m_s2
+    e[EKF.EC_SIG_GRAV] = p.gravity_noise_m_s2
+    e[EKF.EC_SIG_MAG] = p.magnetometer_noise
 
 
 def _pack_initial_spreads(p: Any, e: np.ndarray) -> None:
     """The initial covariance's spreads (attitude in rad, gyro bias, velocity, position)."""
-    e[L.EC_P0] = math.radians(p.initial_attitude_std_deg)
-    e[L.EC_P0 + 1] = p.initial_bias_std_rad_s
-    e[L.EC_P0 + 2] = p.initial_velocity_std_m_s
-    e[L.EC_P0 + 3] = p.initial_position_std_m
+    e[EKF.EC_P0] = math.radians(p.initial_attitude_std_deg)
+    e[EKF.EC_P0 + 1] = p.initial_bias_std_rad_s
+    e[EKF.EC_P0 + 2] = p.initial_velocity_std_m_s
+    e[EKF.EC_P0 + 3] = p.initial_position_std_m
 
 
 def _pack_impact(p: Any, ctx: EstimatorContext, e: np.ndarray) -> None:
     """The IMU's impact disturbance as the filter models it (the ``ekf``'s and ``nav-ekf``'s)."""
     dist = ctx.imu.impact_disturbance
     if p.impact_noise == "sensor" and dist is not None:
-        e[L.EC_IMPACT_W] = dist.gyro_rad_s
-        e[L.EC_IMPACT_F] = dist.accel_m_s2
-        e[L.EC_IMPACT_TAU] = dist.time_constant_s
-        e[L.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
-        e[L.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * ctx.vehicle.gravity_m_s2
+        e[EKF.EC_IMPACT_W] = dist.gyro_rad_s
+        e[EKF.EC_IMPACT_F] = dist.accel_m_s2
+        e[EKF.EC_IMPACT_TAU] = dist.time_constant_s
+        e[EKF.EC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
+        e[EKF.EC_IMPACT_THRESHOLD] = p.impact_threshold_g * ctx.vehicle.gravity_m_s2
 
 
 def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
@@ -163,30 +167,30 @@ def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     imu = ctx.imu
     e = np.zeros(L.NECFG)
     _pack_filter_noises(p, e)
-    e[L.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
-    e[L.EC_GATE] = p.gate_m_s2
-    e[L.EC_GATE_MODE] = L.GATE_DEWEIGHT if p.gate == "deweight" else L.GATE_SKIP
-    e[L.EC_DEWEIGHT] = p.deweight
-    e[L.EC_NAV_BARO] = p.barometer_noise_m
-    e[L.EC_NAV_BARO + 1] = p.barometer_bias_walk_m_sqrt_s
-    e[L.EC_NAV_RANGE] = p.range_noise_floor_m
-    e[L.EC_NAV_FLOW] = p.flow_noise_floor_rad_s
-    e[L.EC_NAV_GATES : L.EC_NAV_GATES + 4] = (
+    e[NAV.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
+    e[EKF.EC_GATE] = p.gate_m_s2
+    e[EKF.EC_GATE_MODE] = EKF.GATE_DEWEIGHT if p.gate == "deweight" else EKF.GATE_SKIP
+    e[EKF.EC_DEWEIGHT] = p.deweight
+    e[NAV.EC_NAV_BARO] = p.barometer_noise_m
+    e[NAV.EC_NAV_BARO + 1] = p.barometer_bias_walk_m_sqrt_s
+    e[NAV.EC_NAV_RANGE] = p.range_noise_floor_m
+    e[NAV.EC_NAV_FLOW] = p.flow_noise_floor_rad_s
+    e[NAV.EC_NAV_GATES : NAV.EC_NAV_GATES + 4] = (
         p.mag_gate_sigma,
         p.baro_gate_sigma,
         p.range_gate_sigma,
         p.flow_gate_sigma,
     )
-    e[L.EC_NAV_REACQUIRE] = p.reacquire_after_s
-    e[L.EC_NAV_MAX_TILT] = math.cos(math.radians(p.max_tilt_deg))
-    e[L.EC_NAV_MIN_HEIGHT] = p.min_flow_height_m
+    e[NAV.EC_NAV_REACQUIRE] = p.reacquire_after_s
+    e[NAV.EC_NAV_MAX_TILT] = math.cos(math.radians(p.max_tilt_deg))
+    e[NAV.EC_NAV_MIN_HEIGHT] = p.min_flow_height_m
     if p.imu_lever_arm == "sensor":
-        e[L.EC_NAV_LEVER : L.EC_NAV_LEVER + 3] = imu.position_m
-    e[L.EC_NAV_DELAYED] = 1.0 if p.flow_delay_compensation else 0.0
-    e[L.EC_NAV_REACQ_EXCESS] = 1.0 if p.reacquire_inflation == "excess" else 0.0
+        e[NAV.EC_NAV_LEVER : NAV.EC_NAV_LEVER + 3] = imu.position_m
+    e[NAV.EC_NAV_DELAYED] = 1.0 if p.flow_delay_compensation else 0.0
+    e[NAV.EC_NAV_REACQ_EXCESS] = 1.0 if p.reacquire_inflation == "excess" else 0.0
     _pack_initial_spreads(p, e)
-    e[L.EC_NAV_P0] = p.initial_accel_bias_std_m_s2
-    e[L.EC_NAV_P0 + 1] = p.initial_baro_bias_std_m
+    e[NAV.EC_NAV_P0] = p.initial_accel_bias_std_m_s2
+    e[NAV.EC_NAV_P0 + 1] = p.initial_baro_bias_std_m
     _pack_impact(p, ctx, e)
     return e
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.sensors import detection as DET
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 
@@ -47,9 +48,9 @@ def pack_sensors(
     elif imu.filter == "moving-average":
         scfg[L.SC_FILTER_PARAM] = float(imu.filter_window)
     if detection.enabled:
-        scfg[L.SC_DET_THRESHOLD] = detection.threshold_g * v.gravity_m_s2
-    scfg[L.SC_DET_WORLD] = 1.0 if detection.frame == "world" else 0.0
-    scfg[L.SC_DET_PERSIST] = float(detection.persistence)
+        scfg[DET.SC_DET_THRESHOLD] = detection.threshold_g * v.gravity_m_s2
+    scfg[DET.SC_DET_WORLD] = 1.0 if detection.frame == "world" else 0.0
+    scfg[DET.SC_DET_PERSIST] = float(detection.persistence)
     return scfg, n_imu
 
 

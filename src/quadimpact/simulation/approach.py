@@ -22,6 +22,7 @@ import numpy as np
 from quadimpact.core import layout as L
 from quadimpact.core.approach import APPROACH_MAX_ITER, APPROACH_TOL_M_S
 from quadimpact.core.geometry import pair_depths, pair_table
+from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
 from quadimpact.inputs.resolve import (  # defined with the rest of a run's start; names kept
@@ -65,11 +66,27 @@ def pair_depths_at(
     x: np.ndarray, feat: np.ndarray, shapes: np.ndarray, pairs: np.ndarray
 ) -> np.ndarray:
     """Penetration (m) of every pair of the table ``pairs`` (``c = shape * n_features +
-    feature``, ``core.geometry.pair_table``) at the state ``x``, in one compiled call."""
+    feature``, ``core.geometry.pair_table``) at the state ``x``, in one compiled call.
+
+    The cached loop's geometry knows the built-in shapes only: a pair with a
+    plug-in shape (``core.geometry.register_shape``) is measured by that
+    shape's own contact function for the feature's kind (compiled alone).
+    """
     xq = np.ascontiguousarray(x, dtype=float)
     C = np.ascontiguousarray(quat_to_matrix(xq[L.X_QUAT : L.X_QUAT + 4]))
     depths = np.empty(pairs.shape[0])
     pair_depths(xq, C, feat, shapes, pairs, depths)
+    plugins = plugin_shapes()
+    if plugins:
+        for c in range(pairs.shape[0]):
+            s = int(pairs[c, L.PR_SHAPE])
+            comp = by_kind(int(shapes[s, L.SH_KIND]))
+            if comp is None or comp not in plugins:
+                continue
+            f = int(pairs[c, L.PR_FEATURE])
+            contact = comp.contacts.get(int(feat[f, L.F_KIND]))
+            if contact is not None:
+                depths[c] = float(contact(xq, C, feat, f, shapes, s)[0])
     return depths
 
 

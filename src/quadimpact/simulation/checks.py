@@ -80,6 +80,9 @@ def check_imu(setup: Any) -> None:
     InputError
         The rule, the value and the limit, naming the ``[imu]`` field.
     """
+    # the detector's slots, loaded where runs are prepared (not by a sweep's checks)
+    from quadimpact.core.sensors import detection as DET
+
     scfg = setup.scfg
     if scfg is None or not scfg[L.SC_RATE] > 0.0:
         return
@@ -102,8 +105,8 @@ def check_imu(setup: Any) -> None:
             f"imu: accel_range_m_s2: must be at least g = {g:g} m/s^2, what the accelerometer "
             f"reads in hover (got {accel_range:g}): it would saturate in level flight"
         )
-    threshold = float(scfg[L.SC_DET_THRESHOLD])
-    reachable = accel_range * (math.sqrt(3.0) if scfg[L.SC_DET_WORLD] > 0.5 else math.sqrt(2.0))
+    threshold = float(scfg[DET.SC_DET_THRESHOLD])
+    reachable = accel_range * (math.sqrt(3.0) if scfg[DET.SC_DET_WORLD] > 0.5 else math.sqrt(2.0))
     if threshold > reachable:
         raise InputError(
             f"detection: threshold_g: {threshold / g:g} g = {threshold:.4g} m/s^2 can never be "

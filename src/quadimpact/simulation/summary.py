@@ -19,6 +19,7 @@ import numpy as np
 from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.excursion import DEG
+from quadimpact.core.sensors import detection as DET
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
 from quadimpact.results.summary_record import (
@@ -293,7 +294,7 @@ def _recovery_part(
     first = onset.first_normal
     return RecoveryPart(
         pre_impact=scenario.resolved_pre_impact() if scenario.controller == "recovery" else None,
-        detection_threshold_m_s2=float(setup.scfg[L.SC_DET_THRESHOLD]) or None,
+        detection_threshold_m_s2=float(setup.scfg[DET.SC_DET_THRESHOLD]) or None,
         final_altitude_m=_nan_to_none(-float(final_state[L.X_POS + 2])),
         first_contact_bumper=None if first is None else int(first[0]),
         first_contact_normal=None if first is None else [float(c) for c in first[1]],

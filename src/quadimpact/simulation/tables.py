@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.sensors import detection as DET
 from quadimpact.core.sensors.registry import record_columns
 from quadimpact.inputs.features import feature_column
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
@@ -277,7 +278,7 @@ def imu_columns(raw: np.ndarray, scfg: np.ndarray | None = None) -> dict[str, np
     sources = (
         L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
         L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
-        L.I_HORIZONTAL,
+        DET.I_HORIZONTAL,
         *range(L.I_MAG, L.I_MAG + 3), *range(L.I_POSE, L.I_POSE + 7),
         *range(L.I_Q_HAT, L.I_Q_HAT + 4), *range(L.I_BIAS_HAT, L.I_BIAS_HAT + 3),
         *range(L.I_VEL_HAT, L.I_VEL_HAT + 3), *range(L.I_POS_HAT, L.I_POS_HAT + 3),

@@ -21,14 +21,15 @@ The run loop then applies the generic speed and slew limits
 (``actuators.apply_command``) and holds the command for the period.
 
 One module per controller: ``paper.py``, ``cascade_pid.py``, ``recovery.py``;
-their parameter blocks and memory slots (``P_*``, ``M_*``, ``R_*``, ``RM_*``)
-are declared in ``core/controller_layout.py``, which the Python side packs
-without loading this compiled code. A new built-in is its module, its blocks
-there, a branch below, and an entry in the Python-side registry
-(``quadimpact.inputs.controllers``); a controller that is not built in is
-registered there with its step (``register_controller(name, step=...)``):
-the step is compiled alone and the cached loop calls it by its address
-(``ctrl[C_STEP]``, ``core/plugin_call.py``).
+each declares its parameter blocks and memory slots (``P_*`` and ``M_*`` in
+``common.py``, shared by the PID laws; ``R_*``, ``RM_*`` in ``recovery.py``;
+``PB_*`` in ``residual.py``), each a ``Block`` placed after the head it
+extends. A new built-in is its module with its blocks, a branch below, and an
+entry in the Python-side registry (``quadimpact.inputs.controllers``); a
+controller that is not built in is registered there with its step
+(``register_controller(name, step=...)``): the step is compiled alone and
+the cached loop calls it by its address (``ctrl[C_STEP]``,
+``core/plugin_call.py``).
 """
 
 import numpy as np

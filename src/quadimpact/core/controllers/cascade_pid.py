@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.controller_layout import (
+from quadimpact.core.controllers.common import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -35,8 +35,6 @@ from quadimpact.core.controller_layout import (
     M_STARTED,
     P_GAINS,
     P_THRUST_COS_FLOOR,
-)
-from quadimpact.core.controllers.common import (
     allocate,
     attitude_altitude,
     linearised_torques,

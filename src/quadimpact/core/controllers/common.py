@@ -1,5 +1,9 @@
 """What every built-in controller shares: the measured attitude, torques, allocation.
 
+It also declares the PID laws' blocks (the paper's and cascade-pid's, and the
+recovery law's nominal pre-impact flight): their parameters at
+``ctrl[C_PARAMS + P_*]`` and their memory ``mem[M_*]``.
+
 Frames: inertial NED, body FRD; angles in rad; rotor speeds in rad/s.
 """
 
@@ -11,14 +15,52 @@ from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.layout import (
     C_ALLOC_INV,
     C_N_ROTORS,
+    MEM_STAGE,
     N_WRENCH,
+    NPARAM,
     V_INERTIA,
     X_OMEGA,
     X_POS,
     X_QUAT,
     X_VEL,
+    Block,
 )
 from quadimpact.core.quaternion import euler_zyx
+
+# ---- the PID laws' blocks
+# The two PID controllers (paper, cascade-pid) and the recovery controller's
+# nominal pre-impact behaviour share this parameter and memory layout.
+# Parameters, at ctrl[C_PARAMS + ...]:
+_params = Block("ctrl.params", "P_", capacity=NPARAM)
+P_GAINS = _params.slot(
+    "P_GAINS", 15
+)  # (P, I, D) for altitude, climb, heading, roll/pitch, yaw rate
+P_THRUST_COS_FLOOR = _params.slot("P_THRUST_COS_FLOOR")  # cascade-pid: floor of cos(phi) cos(theta)
+N_PID_PARAMS = _params.end("N_PID_PARAMS")
+
+G_ALT = 0  # gain block offsets inside P_GAINS: P, I, D at +0, +1, +2
+G_CLIMB = 3
+G_HEADING = 6
+G_ATT = 9
+G_YAWRATE = 12
+
+# Memory slots (slot 0 unused; the last, layout.MEM_STAGE, is reserved):
+_mem = Block("mem", "M_", start=1, capacity=MEM_STAGE)
+M_STARTED = _mem.slot("M_STARTED")  # 1 after the first tick
+M_E_H = _mem.slot("M_E_H")  # previous errors
+M_E_V = _mem.slot("M_E_V")
+M_E_PSI = _mem.slot("M_E_PSI")
+M_E_PHI = _mem.slot("M_E_PHI")
+M_E_THETA = _mem.slot("M_E_THETA")
+M_E_R = _mem.slot("M_E_R")
+M_I_H = _mem.slot("M_I_H")  # running integrals (cascade-pid)
+M_I_V = _mem.slot("M_I_V")
+M_I_PSI = _mem.slot("M_I_PSI")
+M_I_PHI = _mem.slot("M_I_PHI")
+M_I_THETA = _mem.slot("M_I_THETA")
+M_I_R = _mem.slot("M_I_R")
+M_SATURATED = _mem.slot("M_SATURATED")  # 1 if the last command saturated (cascade-pid)
+N_PID_MEM = _mem.end("N_PID_MEM")
 
 
 @compiled

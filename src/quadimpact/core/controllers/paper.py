@@ -17,7 +17,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.controller_layout import (
+from quadimpact.core.controllers.common import (
     G_ALT,
     G_ATT,
     G_CLIMB,
@@ -31,8 +31,6 @@ from quadimpact.core.controller_layout import (
     M_E_V,
     M_STARTED,
     P_GAINS,
-)
-from quadimpact.core.controllers.common import (
     allocate,
     attitude_altitude,
     linearised_torques,

@@ -71,50 +71,20 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.controller_layout import (
-    HOLD_CAPTURE_M_S,
-    HOLD_GIVEN,
-    HOLD_STOP,
-    LEVEL_EULER,
-    PB_HIDDEN,
-    PRE_HOLD,
-    PRE_IMMEDIATE,
-    PRE_NOMINAL,
-    R_A_MAG,
-    R_EULER_TOL,
-    R_FIRST_TICK_LEVEL,
-    R_HOVER,
-    R_HOVER_GAINS,
-    R_HOVER_MODE,
-    R_HOVER_SET,
-    R_K_ATT,
-    R_K_RATE,
-    R_K_Z,
-    R_LEAN_CUT,
-    R_LEAN_FORCE,
-    R_LEVEL_TEST,
-    R_NOMINAL_KIND,
-    R_PRE_IMPACT,
-    R_Q_TOL,
-    R_RATE_TOL,
-    R_W_TOL,
-    RM_HOLD,
-    RM_HOLD_PSI,
-    RM_HOLD_SET,
-    RM_QE_X,
-    RM_QE_Y,
-    STAGE_DETECTED,
-    STAGE_HOVER,
-    STAGE_LEVEL,
-    STAGE_PRE_IMPACT,
-    STAGE_RECOVERED,
-    STAGE_TILTED,
-)
 from quadimpact.core.controllers.cascade_pid import cascade_pid_step
-from quadimpact.core.controllers.common import allocate, linearised_torques
+from quadimpact.core.controllers.common import (
+    N_PID_MEM,
+    N_PID_PARAMS,
+    allocate,
+    linearised_torques,
+)
 from quadimpact.core.controllers.hover import hover_acceleration, yaw_of
 from quadimpact.core.controllers.paper import paper_step
-from quadimpact.core.controllers.residual import residual_last_stage, residual_references
+from quadimpact.core.controllers.residual import (
+    PB_HIDDEN,
+    residual_last_stage,
+    residual_references,
+)
 from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
@@ -127,7 +97,14 @@ from quadimpact.core.layout import (
     MS_NORMAL,
     MS_W_HAT,
     MS_X,
+    NPARAM,
     NX,
+    STAGE_DETECTED,
+    STAGE_HOVER,
+    STAGE_LEVEL,
+    STAGE_PRE_IMPACT,
+    STAGE_RECOVERED,
+    STAGE_TILTED,
     V_GRAVITY,
     V_MASS,
     V_N_ROTORS,
@@ -135,8 +112,65 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_ROTOR,
     X_VEL,
+    Block,
 )
 from quadimpact.core.quaternion import euler_zyx, rotation_matrix
+
+# ---- the recovery law's blocks
+# ---- parameters, at ctrl[C_PARAMS + ...] (after the PID block above)
+_params = Block("ctrl.params", "R_", start=N_PID_PARAMS, capacity=NPARAM)
+R_NOMINAL_KIND = _params.slot("R_NOMINAL_KIND")  # CTRL_PAPER or CTRL_CASCADE_PID (pre-impact)
+R_PRE_IMPACT = _params.slot("R_PRE_IMPACT")  # PRE_* below
+R_K_ATT = _params.slot("R_K_ATT")  # 1/s, tilt error -> rate reference
+R_K_RATE = _params.slot("R_K_RATE", 3)  # 1/s, rate error -> angular acceleration (p, q, r)
+R_A_MAG = _params.slot("R_A_MAG")  # m/s^2, stage 1 push away from the wall
+R_K_Z = _params.slot("R_K_Z", 4)  # 1/s, vertical-velocity gain of stages 1-4
+R_Q_TOL = _params.slot("R_Q_TOL")  # tilt-error tolerance of the stage 1 and 2 tests
+R_RATE_TOL = _params.slot("R_RATE_TOL")  # rad/s, |p|, |q| tolerance of the stage 1 and 2 tests
+R_W_TOL = _params.slot("R_W_TOL")  # m/s, body z velocity below which stage 3 ends
+R_FIRST_TICK_LEVEL = _params.slot("R_FIRST_TICK_LEVEL")  # 1: a_ref = 0 at detection (replica)
+R_HOVER = _params.slot("R_HOVER")  # 1: stage 5 (hold position and yaw) after stage 4
+R_HOVER_GAINS = _params.slot("R_HOVER_GAINS", 5)  # K_p 1/s, K_v 1/s, v_max m/s, a_max m/s^2,
+# K_psi 1/s (controllers/hover.py)
+R_HOVER_MODE = _params.slot("R_HOVER_MODE")  # HOLD_* below: which position stage 5 holds
+R_HOVER_SET = _params.slot("R_HOVER_SET", 3)  # m, the given set-point, inertial NED
+R_LEVEL_TEST = _params.slot("R_LEVEL_TEST")  # LEVEL_* below: the stage 2 -> 3 tilt test
+R_EULER_TOL = _params.slot("R_EULER_TOL")  # rad, |roll|, |pitch| tolerance of LEVEL_EULER
+R_LEAN_CUT = _params.slot("R_LEAN_CUT")  # sine of the lean into the obstacle beyond which
+# stage 1 idles its rotors (> 1: never; controllers/recovery.py's lean_cut)
+R_LEAN_FORCE = _params.slot("R_LEAN_FORCE")  # m/s^2, the cut also needs a body-horizontal
+# specific force at least this (the contact still pushing); 0: whatever it is
+N_RECOVERY_PARAMS = _params.end("N_RECOVERY_PARAMS")
+
+HOLD_ENTRY = 0  # the position estimate at stage 4's entry
+HOLD_STOP = 1  # brake first; hold the position estimate where the speed fell below 0.2 m/s
+HOLD_GIVEN = 2  # R_HOVER_SET
+HOLD_CAPTURE_M_S = 0.2
+
+LEVEL_TILT_ERROR = 0  # stage 2 -> 3 tests |q_e,x|, |q_e,y| < R_Q_TOL, as stage 1 -> 2
+LEVEL_EULER = 1  # stage 2 -> 3 tests the ZYX Euler |roll|, |pitch| < R_EULER_TOL
+
+PRE_NOMINAL = 0
+PRE_HOLD = 1
+PRE_SPIN_DOWN = 2
+PRE_IMMEDIATE = 3
+
+# ---- memory (after the PID slots of the nominal controller)
+_mem = Block("mem", "RM_", start=N_PID_MEM, capacity=MEM_STAGE)
+RM_QE_X = _mem.slot("RM_QE_X")  # previous tick's tilt error quaternion, x and y
+RM_QE_Y = _mem.slot("RM_QE_Y")
+RM_HOLD = _mem.slot("RM_HOLD", 3)  # m, stage 5's position set-point, inertial NED
+RM_HOLD_PSI = _mem.slot("RM_HOLD_PSI")  # rad, stage 5's yaw set-point
+RM_HOLD_SET = _mem.slot("RM_HOLD_SET")  # 1 once the position set-point is set (HOLD_STOP)
+N_RECOVERY_MEM = _mem.end("N_RECOVERY_MEM")
+
+#: the pre-impact behaviours by their names in scenario files (inputs/controllers.py)
+PRE_IMPACT_KINDS = {
+    "nominal": PRE_NOMINAL,
+    "hold": PRE_HOLD,
+    "spin-down": PRE_SPIN_DOWN,
+    "immediate": PRE_IMMEDIATE,
+}
 
 
 @compiled

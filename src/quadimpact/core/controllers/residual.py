@@ -38,8 +38,9 @@ The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, last stage, W1
 (nh x 24, row-major), b1 (nh), W2 (3 x nh, row-major), b2 (3)]``; the last
 stage is 4 (stages 1-4; a 0 reads as 4) or 5 (stages 1-5). The weights come from
 a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy forward pass of
-the same network is ``PolicyWeights.outputs``. The block's layout (``PB_*``,
-``N_FEATURES``, ``MAX_HIDDEN``) is declared in ``core/controller_layout.py``.
+the same network is ``PolicyWeights.outputs``. The block's slots (``PB_*``) are
+declared below; the network's shape (``N_FEATURES``, ``N_OUTPUTS``,
+``MAX_HIDDEN``) in ``core/layout.py``, which the policy file reads too.
 """
 
 import math
@@ -47,29 +48,36 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.controller_layout import (
-    N_FEATURES,
-    N_OUTPUTS,
-    PB_HIDDEN,
-    PB_LAST_STAGE,
-    PB_RATE_SCALE,
-    PB_THRUST_SCALE,
-    PB_WEIGHTS,
-    STAGE_HOVER,
-    STAGE_RECOVERED,
-)
 from quadimpact.core.layout import (
     C_POLICY,
+    MAX_HIDDEN,
     MS_IMU_F,
     MS_NORMAL,
     MS_T_DETECT,
     MS_W_HAT,
     MS_X,
+    N_FEATURES,
+    N_OUTPUTS,
+    NPOLICY,
+    STAGE_HOVER,
+    STAGE_RECOVERED,
     V_GRAVITY,
     V_MASS,
     X_QUAT,
     X_VEL,
+    Block,
 )
+
+# ---- the residual's block, at ctrl[C_POLICY + PB_*]
+_policy = Block("ctrl.policy", "PB_", capacity=NPOLICY)
+PB_HIDDEN = _policy.slot("PB_HIDDEN")  # hidden width (0: no policy)
+PB_THRUST_SCALE = _policy.slot("PB_THRUST_SCALE")  # s_T: the largest thrust correction / (m g)
+PB_RATE_SCALE = _policy.slot("PB_RATE_SCALE")  # s_w, rad/s: the largest p, q reference correction
+PB_LAST_STAGE = _policy.slot("PB_LAST_STAGE")  # the last stage it acts in: 4 (0 reads as 4) or 5
+PB_WEIGHTS = _policy.slot(  # W1 (nh x N_FEATURES, row-major), b1 (nh), W2 (N_OUTPUTS x nh), b2
+    "PB_WEIGHTS", MAX_HIDDEN * (N_FEATURES + 1 + N_OUTPUTS) + N_OUTPUTS
+)
+N_POLICY_BLOCK = _policy.end("N_POLICY_BLOCK")
 
 _V_SCALE_M_S = 2.0
 _W_SCALE_RAD_S = 8.0

@@ -50,17 +50,11 @@ is reached and the recovered condition has held for the window.
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.controller_layout import (
+from quadimpact.core.controllers.recovery import (
     R_FIRST_TICK_LEVEL,
     R_Q_TOL,
     R_RATE_TOL,
     R_W_TOL,
-    STAGE_DETECTED,
-    STAGE_PRE_IMPACT,
-    STAGE_RECOVERED,
-    STAGE_TILTED,
-)
-from quadimpact.core.controllers.recovery import (
     law_references,
     recovery_step,
     staged_references,
@@ -179,6 +173,10 @@ from quadimpact.core.layout import (
     ST_STAGE_T,
     ST_STAGE_X,
     ST_STATUS,
+    STAGE_DETECTED,
+    STAGE_PRE_IMPACT,
+    STAGE_RECOVERED,
+    STAGE_TILTED,
     STATUS_FAILED,
     X_POS,
     X_ROTOR,

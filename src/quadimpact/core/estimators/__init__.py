@@ -42,7 +42,7 @@ from numba import njit
 
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.estimators.complementary import complementary_sample
-from quadimpact.core.estimators.ekf import ekf_init, ekf_sample
+from quadimpact.core.estimators.ekf import ES_T_IMPACT, ekf_init, ekf_sample
 from quadimpact.core.estimators.ekf_additive import additive_init, additive_sample
 from quadimpact.core.estimators.estimate_errors import record_estimate
 from quadimpact.core.estimators.nav_ekf import nav_ekf_sample, nav_init
@@ -61,7 +61,6 @@ from quadimpact.core.layout import (
     ES_POS,
     ES_Q,
     ES_T,
-    ES_T_IMPACT,
     ES_VEL,
     ES_W,
     EST_COMPLEMENTARY,

@@ -49,14 +49,7 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.layout import (
-    EC_CF_RAW,
-    EC_GATE,
-    EC_K_ACC,
-    EC_K_BIAS,
-    EC_K_BIAS_MAG,
-    EC_K_MAG,
-    EC_K_POS,
-    EC_K_VEL,
+    EC_OWN,
     ES_BIAS,
     ES_GATED,
     ES_POS,
@@ -69,12 +62,26 @@ from quadimpact.core.layout import (
     MS_MAG_T,
     MS_POSE,
     MS_POSE_T,
+    N_OWN_ECFG,
     SC_MAG_FIELD,
     SC_POSE_ATT,
     V_GRAVITY,
+    Block,
 )
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
+
+# ---- its block at ecfg[EC_OWN:] (core/layout.py; packed by packing/estimator_block.py)
+_cfg = Block("ecfg.complementary", "EC_", start=EC_OWN, capacity=EC_OWN + N_OWN_ECFG)
+EC_K_ACC = _cfg.slot("EC_K_ACC")  # accelerometer gain k_P, 1/s
+EC_K_MAG = _cfg.slot("EC_K_MAG")  # magnetometer gain, 1/s
+EC_K_BIAS = _cfg.slot("EC_K_BIAS")  # bias (integral) gain k_I, 1/s^2
+EC_K_POS = _cfg.slot("EC_K_POS")  # pose position gain, per sample (0-1)
+EC_K_VEL = _cfg.slot("EC_K_VEL")  # pose velocity gain, 1/s per sample
+EC_GATE = _cfg.slot("EC_GATE")  # m/s^2: accelerometer correction gated while ||f| - g| > this
+EC_CF_RAW = _cfg.slot("EC_CF_RAW")  # 1: the authors' form on raw vectors
+EC_K_BIAS_MAG = _cfg.slot("EC_K_BIAS_MAG")  # raw form: bias gain of the magnetometer term
+N_CF_CFG = _cfg.end("N_CF_CFG")
 
 
 @compiled

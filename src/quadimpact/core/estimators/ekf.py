@@ -57,46 +57,60 @@ import numpy as np
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.layout import (
-    EC_DEWEIGHT,
-    EC_GATE,
-    EC_GATE_MODE,
-    EC_IMPACT_F,
-    EC_IMPACT_REPLACE,
-    EC_IMPACT_TAU,
-    EC_IMPACT_THRESHOLD,
-    EC_IMPACT_W,
-    EC_NAV,
-    EC_P0,
-    EC_SIG_ACC,
-    EC_SIG_ATT,
-    EC_SIG_GRAV,
-    EC_SIG_GYRO,
-    EC_SIG_MAG,
-    EC_SIG_POS,
-    EC_SIG_WALK,
+    EC_OWN,
     ES_BIAS,
     ES_GATED,
-    ES_P,
+    ES_OWN,
     ES_POS,
     ES_Q,
-    ES_SCRATCH,
-    ES_T_IMPACT,
     ES_VEL,
     ES_W,
-    GATE_DEWEIGHT,
     MS_IMU_F,
     MS_IMU_W,
     MS_MAG,
     MS_MAG_T,
     MS_POSE,
     MS_POSE_T,
-    N_EKF,
+    N_OWN_ECFG,
+    N_OWN_EST,
     SC_MAG_FIELD,
     SC_POSE_ATT,
     V_GRAVITY,
+    Block,
 )
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
+
+# ---- its blocks at ecfg[EC_OWN:] and est[ES_OWN:] (core/layout.py); the additive EKF
+# and nav-ekf continue them (they share the gate, the noises and the covariance slots)
+_cfg = Block("ecfg.ekf", "EC_", start=EC_OWN, capacity=EC_OWN + N_OWN_ECFG)
+EC_GATE = _cfg.slot("EC_GATE")  # m/s^2: accelerometer correction gated while ||f| - g| > this
+EC_GATE_MODE = _cfg.slot("EC_GATE_MODE")  # GATE_SKIP or GATE_DEWEIGHT
+EC_DEWEIGHT = _cfg.slot("EC_DEWEIGHT")  # de-weighting: R times this (excess / gate)^2
+EC_SIG_GYRO = _cfg.slot("EC_SIG_GYRO")  # gyro white noise per sample, rad/s
+EC_SIG_WALK = _cfg.slot("EC_SIG_WALK")  # gyro bias random walk, rad/s/sqrt(s)
+EC_SIG_ACC = _cfg.slot("EC_SIG_ACC")  # accelerometer white noise per sample, m/s^2
+EC_SIG_GRAV = _cfg.slot("EC_SIG_GRAV")  # std of the gravity measurement, m/s^2
+EC_SIG_MAG = _cfg.slot("EC_SIG_MAG")  # magnetometer noise (unit field)
+EC_SIG_POS = _cfg.slot("EC_SIG_POS")  # pose position noise, m
+EC_SIG_ATT = _cfg.slot("EC_SIG_ATT")  # pose attitude noise, rad
+EC_P0 = _cfg.slot("EC_P0", 4)  # initial std: attitude rad, bias rad/s, velocity m/s, position m
+EC_NAV = _cfg.slot("EC_NAV")  # 1: velocity and position are filter states (pose sensor)
+EC_IMPACT_W = _cfg.slot("EC_IMPACT_W")  # the IMU's impact disturbance: gyro g0, rad/s
+EC_IMPACT_F = _cfg.slot("EC_IMPACT_F")  # ... accelerometer a0, m/s^2
+EC_IMPACT_TAU = _cfg.slot("EC_IMPACT_TAU")  # ... time constant, s (<= 0: not modelled)
+EC_IMPACT_REPLACE = _cfg.slot("EC_IMPACT_REPLACE")  # 1: it replaces the nominal noise
+EC_IMPACT_THRESHOLD = _cfg.slot("EC_IMPACT_THRESHOLD")  # |(f_x, f_y)| marking an impact, m/s^2
+N_EKF_CFG = _cfg.end("N_EKF_CFG")
+GATE_SKIP = 0
+GATE_DEWEIGHT = 1
+
+N_EKF = 12  # error state: attitude (3), gyro bias (3), velocity (3), position (3)
+_st = Block("est.ekf", "ES_", start=ES_OWN, capacity=ES_OWN + N_OWN_EST)
+ES_P = _st.slot("ES_P", N_EKF * N_EKF)  # error covariance, row-major
+ES_SCRATCH = _st.slot("ES_SCRATCH", 4)  # a quaternion's worth of scratch (the prediction)
+ES_T_IMPACT = _st.slot("ES_T_IMPACT")  # s, the latest impact sample (NaN: none)
+N_EKF_EST = _st.end("N_EKF_EST")
 
 
 @compiled

@@ -33,31 +33,37 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.estimators.ekf import EC_GATE, ES_P, N_EKF, N_EKF_CFG
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.layout import (
-    EC_AS_WRITTEN,
-    EC_GATE,
-    EC_P0_BIAS,
-    EC_P0_QUAT,
-    EC_Q_BIAS,
-    EC_Q_QUAT,
-    EC_R_ACC,
-    EC_R_MAG,
+    EC_OWN,
     ES_BIAS,
     ES_GATED,
-    ES_P,
     ES_Q,
     ES_W,
     MS_IMU_F,
     MS_IMU_W,
     MS_MAG,
     MS_MAG_T,
-    N_EKF,
+    N_OWN_ECFG,
     SC_MAG_FIELD,
     V_GRAVITY,
+    Block,
 )
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.rotvec import dcm
+
+# ---- its block: after the EKF's (core/estimators/ekf.py), whose gate (EC_GATE) and
+# covariance slots (ES_P, 7 x 7 with the row stride N_EKF) it uses
+_cfg = Block("ecfg.ekf-additive", "EC_", start=N_EKF_CFG, capacity=EC_OWN + N_OWN_ECFG)
+EC_AS_WRITTEN = _cfg.slot("EC_AS_WRITTEN")  # 1: the transition -dt/2 (I + Omega)
+EC_R_ACC = _cfg.slot("EC_R_ACC")  # accelerometer noise variance, (m/s^2)^2
+EC_R_MAG = _cfg.slot("EC_R_MAG")  # magnetometer noise variance (field units^2)
+EC_Q_QUAT = _cfg.slot("EC_Q_QUAT")  # quaternion process noise per second
+EC_Q_BIAS = _cfg.slot("EC_Q_BIAS")  # bias process noise per second, (rad/s)^2
+EC_P0_QUAT = _cfg.slot("EC_P0_QUAT")  # initial quaternion variance
+EC_P0_BIAS = _cfg.slot("EC_P0_BIAS")  # initial bias variance, (rad/s)^2
+N_ADDITIVE_CFG = _cfg.end("N_ADDITIVE_CFG")
 
 N_ADDITIVE = 7  # quaternion (4), gyro bias (3)
 

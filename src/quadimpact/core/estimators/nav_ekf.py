@@ -96,64 +96,86 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.estimators.ekf import _with_impact, gravity_variance, impact_noise_factor
-from quadimpact.core.estimators.navigation import integrate_navigation
-from quadimpact.core.layout import (
+from quadimpact.core.estimators.ekf import (
     EC_IMPACT_F,
     EC_IMPACT_REPLACE,
     EC_IMPACT_W,
-    EC_INIT_BIAS_ZERO,
-    EC_NAV_ACC_WALK,
-    EC_NAV_BARO,
-    EC_NAV_DELAYED,
-    EC_NAV_FLOW,
-    EC_NAV_GATES,
-    EC_NAV_LEVER,
-    EC_NAV_MAX_TILT,
-    EC_NAV_MIN_HEIGHT,
-    EC_NAV_P0,
-    EC_NAV_RANGE,
-    EC_NAV_REACQ_EXCESS,
-    EC_NAV_REACQUIRE,
     EC_P0,
     EC_SIG_ACC,
     EC_SIG_GYRO,
     EC_SIG_MAG,
     EC_SIG_WALK,
-    ES_ACC_BIAS,
-    ES_BARO_BIAS,
+    ES_SCRATCH,
+    N_EKF_CFG,
+    N_EKF_EST,
+    _with_impact,
+    gravity_variance,
+    impact_noise_factor,
+)
+from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.layout import (
+    EC_INIT_BIAS_ZERO,
+    EC_OWN,
     ES_BIAS,
-    ES_NAV_ARM_PREV,
-    ES_NAV_COUNT,
-    ES_NAV_FUSED_T,
-    ES_NAV_NIS,
-    ES_NAV_P,
-    ES_NAV_RING,
-    ES_NAV_RING_AT,
-    ES_NAV_SEEN,
-    ES_NAV_W_PREV,
-    ES_NAV_WORK,
+    ES_OWN,
     ES_POS,
     ES_Q,
-    ES_SCRATCH,
     ES_VEL,
     ES_W,
     MS_IMU_F,
     MS_IMU_W,
     MS_MAG,
     MS_MAG_T,
-    N_NAV,
-    N_NAV_RING,
-    N_NAV_RING_W,
+    N_OWN_ECFG,
+    N_OWN_EST,
     SC_BIAS,
     SC_MAG_FIELD,
     SC_RANGE_F,
     SC_RANGE_W,
     V_GRAVITY,
+    Block,
 )
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.registry import measurement_address
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
+
+# ---- its blocks: after the EKF's (core/estimators/ekf.py), whose noises, gate, initial
+# stds (EC_SIG_*, EC_P0), impact model (EC_IMPACT_*) and scratch state it uses
+_cfg = Block("ecfg.nav-ekf", "EC_NAV_", start=N_EKF_CFG, capacity=EC_OWN + N_OWN_ECFG)
+EC_NAV_ACC_WALK = _cfg.slot("EC_NAV_ACC_WALK")  # accelerometer bias random walk, m/s^2/sqrt(s)
+EC_NAV_BARO = _cfg.slot("EC_NAV_BARO", 2)  # barometer: noise m, bias walk m/sqrt(s)
+EC_NAV_RANGE = _cfg.slot("EC_NAV_RANGE")  # rangefinder noise floor, m
+EC_NAV_FLOW = _cfg.slot("EC_NAV_FLOW")  # optical-flow noise floor, rad/s
+EC_NAV_GATES = _cfg.slot("EC_NAV_GATES", 4)  # innovation gates (sigma): mag, baro, range, flow
+EC_NAV_REACQUIRE = _cfg.slot("EC_NAV_REACQUIRE")  # s: a source unfused this long is re-acquired
+EC_NAV_P0 = _cfg.slot("EC_NAV_P0", 2)  # initial std: accelerometer bias m/s^2, baro bias m
+EC_NAV_MIN_HEIGHT = _cfg.slot("EC_NAV_MIN_HEIGHT")  # m: flow not fused below this height
+EC_NAV_MAX_TILT = _cfg.slot("EC_NAV_MAX_TILT")  # cos of the largest tilt for range and flow
+EC_NAV_LEVER = _cfg.slot("EC_NAV_LEVER", 3)  # IMU position from the CM the filter removes, m
+EC_NAV_DELAYED = _cfg.slot("EC_NAV_DELAYED")  # 1: flow predicted from the state at its capture
+EC_NAV_REACQ_EXCESS = _cfg.slot("EC_NAV_REACQ_EXCESS")  # 1: re-acquisition inflates by the excess
+N_NAV_CFG = _cfg.end("N_NAV_CFG")
+
+N_NAV = 16  # error state: attitude, velocity, position, gyro bias, accel. bias (3 each), baro bias
+N_NAV_RING = 64  # IMU samples of history (the flow's capture time)
+N_NAV_RING_W = 11  # a ring row: t, p, q (gyro minus bias), the prediction's dv, dtheta, dp_z
+N_NAV_WORK = 2 * N_NAV * N_NAV + 14 * N_NAV + 6  # P, its scratch, the updates' work, f (CM, sensor)
+_st = Block("est.nav-ekf", "ES_", start=N_EKF_EST, capacity=ES_OWN + N_OWN_EST)
+ES_NAV_P = _st.slot("ES_NAV_P", N_NAV * N_NAV)  # its error covariance, row-major
+ES_ACC_BIAS = _st.slot("ES_ACC_BIAS", 3)  # accelerometer bias estimate, body, m/s^2
+ES_BARO_BIAS = _st.slot("ES_BARO_BIAS")  # barometer bias estimate, m
+ES_NAV_SEEN = _st.slot("ES_NAV_SEEN", 3)  # samples seen so far: barometer, rangefinder, flow
+ES_NAV_FUSED_T = _st.slot("ES_NAV_FUSED_T", 4)  # s, the latest fused sample of mag, baro,
+#   range, flow (NaN: none yet)
+ES_NAV_COUNT = _st.slot("ES_NAV_COUNT", 12)  # per source (mag, baro, range, flow):
+#   fused, rejected by the gate, re-acquisitions
+ES_NAV_NIS = _st.slot("ES_NAV_NIS", 4)  # the latest normalised innovation squared of each
+ES_NAV_RING = _st.slot("ES_NAV_RING", N_NAV_RING_W * N_NAV_RING)  # the latest samples' rows
+ES_NAV_RING_AT = _st.slot("ES_NAV_RING_AT")  # the ring's next row
+ES_NAV_W_PREV = _st.slot("ES_NAV_W_PREV", 3)  # the previous sample's gyro minus bias (NaN: none)
+ES_NAV_ARM_PREV = _st.slot("ES_NAV_ARM_PREV", 6)  # C (w x r), C r at the previous sample (NaN)
+ES_NAV_WORK = _st.slot("ES_NAV_WORK", N_NAV_WORK)  # nav-ekf's work space (no allocation)
+N_NAV_EST = _st.end("N_NAV_EST")
 
 # the error state's parts
 I_TH, I_V, I_P, I_BG, I_BA, I_BB = 0, 3, 6, 9, 12, 15

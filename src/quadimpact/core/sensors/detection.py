@@ -29,23 +29,33 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import (
-    I_HORIZONTAL,
+    I_DETECTOR,
     MS_DETECTED,
     MS_IMU_F,
     MS_NORMAL,
     MS_T_DETECT,
+    N_DETECTOR_CFG,
     NX,
-    SC_DET_PERSIST,
-    SC_DET_THRESHOLD,
-    SC_DET_WORLD,
-    SS_COUNT,
+    SC_DETECTOR,
+    SS_DETECTOR,
     SS_N,
     ST_DETECT_NORMAL,
     ST_DETECT_X,
     ST_N_DETECTIONS,
     ST_T_DETECT,
+    Block,
 )
 from quadimpact.core.records import Data, Model, Output
+
+# ---- its blocks, in the regions core/layout.py keeps for it in scfg, sst and imu
+_cfg = Block("scfg.detector", "SC_DET_", start=SC_DETECTOR, capacity=SC_DETECTOR + N_DETECTOR_CFG)
+SC_DET_THRESHOLD = _cfg.slot("SC_DET_THRESHOLD")  # m/s^2, detecting specific force (<= 0: off)
+SC_DET_WORLD = _cfg.slot("SC_DET_WORLD")  # 1: world-horizontal |(C f)_XY|, else body |(f_x, f_y)|
+SC_DET_PERSIST = _cfg.slot("SC_DET_PERSIST")  # consecutive samples at or above the threshold
+_st = Block("sst.detector", "SS_", start=SS_DETECTOR, capacity=SS_DETECTOR + 1)
+SS_COUNT = _st.slot("SS_COUNT")  # consecutive samples at or above the detection threshold
+_rec = Block("imu.detector", "I_", start=I_DETECTOR, capacity=I_DETECTOR + 1)
+I_HORIZONTAL = _rec.slot("I_HORIZONTAL")  # the detector's horizontal measure, m/s^2
 
 
 @compiled

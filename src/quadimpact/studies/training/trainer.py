@@ -117,7 +117,7 @@ class Settings:
     check_every: int = 5
 
     def __post_init__(self) -> None:
-        from quadimpact.core.controller_layout import MAX_HIDDEN
+        from quadimpact.core.layout import MAX_HIDDEN
 
         rules = {
             "hidden": (self.hidden, 1 <= self.hidden <= MAX_HIDDEN, f"in 1..{MAX_HIDDEN}"),
