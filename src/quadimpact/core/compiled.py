@@ -30,111 +30,14 @@ a geometry by ``core.kernel.make_kernel``), so it may allocate.
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Callable
 from typing import Any
 
 from numba import njit, types
-from numba.core import codegen, errors, event
-from numba.core.caching import FunctionCache
+from numba.core import errors
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["allocating", "compiled", "link_once_installed"]
-
-
-# ---------------------------------------------------------------- linked once
-# Numba finalises each compiled function as a library of its own: it links in the
-# code of every function it calls (their libraries, each holding its own callees),
-# optimises the whole with LLVM and generates its machine code. Along the loop's
-# call chain (run, advance, tick, integrate_interval, ...) each function so paid
-# again for everything below it. Here a core function compiled from inside another
-# compilation is finalised alone: its own code optimised and generated, its callees
-# left to the process's JIT linker (they are compiled, in this process, before it).
-# The function compiled from Python (an entry point: run, start, advance, the
-# approach's solve...) links in the code of all the functions below it once, which
-# LLVM optimises as a whole, as before; that library alone goes to the disk cache.
-
-_COMPILING: list[object] = []  # the dispatchers being compiled, outermost first
-
-
-class _CompileStack(event.Listener):
-    def on_start(self, ev: event.Event) -> None:
-        _COMPILING.append(ev.data["dispatcher"])
-
-    def on_end(self, ev: event.Event) -> None:
-        _COMPILING.pop()
-
-
-def _closure(libraries: list) -> list:
-    """``libraries`` and, through each one finalised alone, the libraries it calls."""
-    seen: list = []
-    todo = list(libraries)
-    while todo:
-        library = todo.pop(0)
-        if library in seen:
-            continue
-        seen.append(library)
-        if getattr(library, "_alone", False):
-            todo.extend(library._linking_libraries)
-    return seen
-
-
-class _LinkOnceLibrary(codegen.JITCodeLibrary):
-    """Numba's JIT library, finalised alone when it is a core function compiled from a caller."""
-
-    def finalize(self) -> None:
-        if len(_COMPILING) > 1 and isinstance(_COMPILING[-1], TypedDispatcher):
-            self._finalize_alone()
-            return
-        self._linking_libraries = _closure(self._linking_libraries)
-        super().finalize()
-
-    def _finalize_alone(self) -> None:
-        """``CPUCodeLibrary.finalize`` without linking in the callees' code."""
-        self._codegen._check_llvm_bugs()
-        self._raise_if_finalized()
-        self._alone = True
-        for library in self._linking_libraries:
-            self._reload_init.update(library._reload_init)
-        self._optimize_final_module()
-        self._final_module.verify()
-        self._finalize_dynamic_globals()
-        self._final_module._CPUCodeLibrary__library = weakref.proxy(self)  # object-cache hooks
-        cleanup = self._codegen._add_module(self._final_module)
-        if cleanup:
-            weakref.finalize(self, cleanup)
-        self._finalize_specific()
-        self._finalized = True
-
-
-class _EntryCache(FunctionCache):
-    """Numba's disk cache of a function, for its compilations that link in their callees."""
-
-    def save_overload(self, sig: Any, data: Any) -> None:
-        if not getattr(getattr(data, "library", None), "_alone", False):
-            super().save_overload(sig, data)
-
-
-_NUMBA_PARTS = (
-    "_optimize_final_module",
-    "_finalize_dynamic_globals",
-    "_finalize_specific",
-    "_reload_init",
-    "_linking_libraries",
-)
-
-
-def _install_link_once() -> bool:
-    """Make Numba's CPU JIT finalise libraries as above; False where its internals differ."""
-    probe = codegen.JITCodeLibrary
-    if not all(hasattr(probe, n) for n in _NUMBA_PARTS[:3]) or not hasattr(
-        codegen.JITCPUCodegen, "_library_class"
-    ):
-        return False
-    if codegen.JITCPUCodegen._library_class is not _LinkOnceLibrary:
-        codegen.JITCPUCodegen._library_class = _LinkOnceLibrary
-        event.register("numba:compile", _CompileStack())
-    return True
+__all__ = ["allocating", "compiled"]
 
 
 class TypedDispatcher(CPUDispatcher):
@@ -160,16 +63,6 @@ class TypedDispatcher(CPUDispatcher):
             except errors.TypingError:
                 pass
         return super().get_call_template(args, kws)
-
-    def enable_caching(self) -> None:
-        """Numba's disk cache, without the compilations finalised alone (never called from
-        Python: a caller that is has their code)."""
-        self._cache = _EntryCache(self.py_func)
-
-
-link_once_installed: bool = _install_link_once()
-"""Whether core functions compiled from a caller are finalised alone (Numba's internals
-as expected); if not, Numba's own finalisation is used, slower to compile, same results."""
 
 
 def _decorator(nrt: bool, options: dict[str, Any]) -> Callable[[Callable], CPUDispatcher]:
