@@ -75,7 +75,13 @@ def _decorator(nrt: bool, options: dict[str, Any]) -> Callable[[Callable], CPUDi
         return njit(cache=True, _nrt=nrt, **options)
 
     def decorate(fn: Callable) -> CPUDispatcher:
-        target = {"nopython": True, "boundscheck": None, "_nrt": nrt, **options}
+        target = {
+            "nopython": True,
+            "boundscheck": None,
+            "_nrt": nrt,
+            "no_cfunc_wrapper": True,  # never called through a C pointer: no wrapper to compile
+            **options,
+        }
         dispatcher = TypedDispatcher(py_func=fn, locals={}, targetoptions=target)
         dispatcher.enable_caching()
         return dispatcher
