@@ -34,7 +34,7 @@ from collections.abc import Callable
 from typing import Any
 
 from numba import njit, types
-from numba.core import errors
+from numba.core import config, errors
 from numba.core.registry import CPUDispatcher
 
 __all__ = ["allocating", "compiled"]
@@ -69,9 +69,10 @@ def _decorator(nrt: bool, options: dict[str, Any]) -> Callable[[Callable], CPUDi
     """``njit(cache=True, _nrt=nrt, **options)`` making a :class:`TypedDispatcher`.
 
     An inlined function (``inline="always"``) is typed inside each caller and
-    keeps Numba's own dispatcher.
+    keeps Numba's own dispatcher; with ``NUMBA_DISABLE_JIT`` every function
+    stays Python (``njit`` returns it unchanged).
     """
-    if options.get("inline", "never") != "never":
+    if options.get("inline", "never") != "never" or config.DISABLE_JIT:
         return njit(cache=True, _nrt=nrt, **options)
 
     def decorate(fn: Callable) -> CPUDispatcher:
