@@ -520,7 +520,7 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch) -> None:
     assert not core.cache_is_warm()
     assert core.announce_compilation(say=said.append)
     assert said == [
-        "quadimpact: compiling the simulator (first use only: about 120 s of CPU on a 2-core "
+        "quadimpact: compiling the simulator (first use only: about 110 s of CPU on a 2-core "
         "machine, more on a slower one; Numba keeps it in its disk cache for every later "
         "process, and `quadimpact compile` does it ahead of time) ..."
     ]

@@ -33,22 +33,75 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from numba import njit
+from numba import njit, types
+from numba.core import config, errors
+from numba.core.registry import CPUDispatcher
 
 __all__ = ["allocating", "compiled"]
+
+
+class TypedDispatcher(CPUDispatcher):
+    """A core function compiled once per argument types, not per literal value.
+
+    Numba types a call from compiled code with its constant arguments as
+    literals (``locate(EV_GAP, ...)``: ``Literal[int](3)``) and compiles the
+    callee again for each value, with everything it calls linked in and
+    optimised again. This dispatcher compiles such a call for the plain types
+    of its arguments (``int64``), so one specialisation serves every caller;
+    where a function needs a literal to type (a constant index into a
+    heterogeneous tuple), it falls back to Numba's literal typing. LLVM still
+    propagates the constants where it inlines the call.
+    """
+
+    def get_call_template(self, args: tuple, kws: dict) -> tuple:
+        """Numba's call template for the arguments' plain types, else their literal types."""
+        plain = tuple(types.unliteral(a) for a in args)
+        plain_kws = {k: types.unliteral(v) for k, v in kws.items()}
+        if plain != tuple(args) or plain_kws != kws:
+            try:
+                return super().get_call_template(plain, plain_kws)
+            except errors.TypingError:
+                pass
+        return super().get_call_template(args, kws)
+
+
+def _decorator(nrt: bool, options: dict[str, Any]) -> Callable[[Callable], CPUDispatcher]:
+    """``njit(cache=True, _nrt=nrt, **options)`` making a :class:`TypedDispatcher`.
+
+    An inlined function (``inline="always"``) is typed inside each caller and
+    keeps Numba's own dispatcher; with ``NUMBA_DISABLE_JIT`` every function
+    stays Python (``njit`` returns it unchanged).
+    """
+    if options.get("inline", "never") != "never" or config.DISABLE_JIT:
+        return njit(cache=True, _nrt=nrt, **options)
+
+    def decorate(fn: Callable) -> CPUDispatcher:
+        target = {
+            "nopython": True,
+            "boundscheck": None,
+            "_nrt": nrt,
+            "no_cfunc_wrapper": True,  # never called through a C pointer: no wrapper to compile
+            **options,
+        }
+        dispatcher = TypedDispatcher(py_func=fn, locals={}, targetoptions=target)
+        dispatcher.enable_caching()
+        return dispatcher
+
+    return decorate
 
 
 def compiled(fn: Callable | None = None, **options: Any) -> Any:
     """``numba.njit`` for a function of the loop: cached, no reference counting.
 
     ``options`` go to ``njit`` (for example ``inline="always"``). Use as
-    ``@compiled`` or ``@compiled(inline="always")``.
+    ``@compiled`` or ``@compiled(inline="always")``. Compiled once per
+    argument types (:class:`TypedDispatcher`).
     """
-    decorate = njit(cache=True, _nrt=False, **options)
+    decorate = _decorator(False, options)
     return decorate if fn is None else decorate(fn)
 
 
 def allocating(fn: Callable | None = None, **options: Any) -> Any:
     """``numba.njit`` for a function that allocates or returns arrays: cached, reference counted."""
-    decorate = njit(cache=True, _nrt=True, **options)
+    decorate = _decorator(True, options)
     return decorate if fn is None else decorate(fn)
