@@ -11,7 +11,9 @@ prints, against the issue's targets (docs/ESTIMATION.md 9):
 * the velocity error of the estimate (``|v_hat - v|``, m/s) over the same
   2 s, all samples of all those trials pooled, median and 90th percentile.
 
-``--params k=v,...`` sets ``nav-ekf`` parameters (as ``bench_onboard_gap.py``)::
+``--params k=v,...`` sets ``nav-ekf`` parameters (as ``bench_onboard_gap.py``);
+``--policy learned|FILE`` flies the law with a learned policy, ``--sensors ideal``
+the ideal sensors instead::
 
     python benchmarks/bench_onboard_hover.py --n 200
 """
@@ -49,8 +51,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=200, help="quick wall trials (the task's first)")
     ap.add_argument("--params", default=None, help="nav-ekf parameters, k=v,k=v")
+    ap.add_argument("--policy", default=None, help="a learned policy: learned or a file")
+    ap.add_argument("--sensors", default="onboard", help="the benchmark's sensor set")
     args = ap.parse_args()
-    spec = Subject("default").spec(TASKS["wall"], True, sensor_set("onboard"), limit=args.n)
+    spec = Subject("default").spec(TASKS["wall"], True, sensor_set(args.sensors), limit=args.n)
     params = _params(args.params)
     drifts, verrs = [], []
     held = 0
@@ -61,6 +65,8 @@ def main() -> None:
         d["final_time_s"] = suite_end + WATCH_S
         if params:
             d["estimator_params"] = {**d.get("estimator_params", {}), **params}
+        if args.policy:
+            d["controller_params"] = {**d.get("controller_params", {}), "policy": args.policy}
         r = simulate(scenario_from_dict(d))
         s = r.summary
         start = s.get("time_to_held_hover_s")
@@ -83,7 +89,8 @@ def main() -> None:
         return
     dr = np.array(drifts)
     ve = np.concatenate(verrs) if verrs else np.array([np.nan])
-    print(f"{args.n} quick wall trials, onboard + nav-ekf {params or ''}: {held} held hovers "
+    what = f"{args.sensors} {params or ''} {'policy ' + args.policy if args.policy else 'the law'}"
+    print(f"{args.n} quick wall trials, {what}: {held} held hovers "
           f"begun by {suite_end - 0.5:.1f} s ({seconds:.0f} s)")  # fmt: skip
     print(f"drift over the {WATCH_S:.0f} s after the hover begins: median {np.median(dr):.3f} m, "
           f"p90 {np.quantile(dr, 0.9):.3f} m (target p90 < 0.3 m)")  # fmt: skip

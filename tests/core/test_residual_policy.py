@@ -265,7 +265,8 @@ SHIPPED = policy_path("learned")
 @pytest.mark.skipif(not SHIPPED.is_file(), reason="no shipped policy (inputs/policies/learned.npz)")
 def test_the_shipped_policy_flies_seeded_trials_with_numpy_and_the_loop_only():
     """In a fresh interpreter: the shipped weights load, fly five seeded wall trials, and
-    no deep-learning framework is imported; the NumPy network gives bounded outputs."""
+    no training library (cma, a deep-learning framework) is imported; the NumPy network
+    gives bounded outputs. The policy shipped before it, ``learned-imu``, loads too."""
     code = """
 import json, sys
 import numpy as np
@@ -276,17 +277,21 @@ out = p.outputs(np.zeros((2, 24)))
 rows = []
 for seed in range(5):
     s = ImpactTrial(vehicle="navi", speed_m_s=2.0, pitch_deg=-30.0 + 10 * seed,
-                    pre_impact="spin-down", sensors="impact",
-                    estimator="ekf", seed=seed, controller_params={"policy": "learned"})
+                    pre_impact="spin-down", sensors="onboard",
+                    estimator="nav-ekf", seed=seed, controller_params={"policy": "learned"})
     r = simulate(s).summary
     rows.append([r["status"], r["detected"], r["recovered"], r["height_loss_m"]])
+old = load_policy("learned-imu")
 print(json.dumps({"rows": rows, "hidden": p.hidden, "out": out.tolist(), "sha": p.sha256,
-                  "torch": "torch" in sys.modules, "jax": "jax" in sys.modules}))
+                  "old": [old.sha256, old.last_stage], "last_stage": p.last_stage,
+                  "libraries": [m for m in ("cma", "torch", "jax", "stable_baselines3")
+                                if m in sys.modules]}))
 """
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=600)
     assert res.returncode == 0, res.stderr
     got = json.loads(res.stdout.strip().splitlines()[-1])
-    assert not got["torch"] and not got["jax"]
+    assert got["libraries"] == []
+    assert got["last_stage"] == 5 and got["old"][1] == 4 and got["old"][0] != got["sha"]
     assert len(got["rows"]) == 5 and all(r[0] != "failed" and r[1] for r in got["rows"])
     assert sum(bool(r[2]) for r in got["rows"]) >= 3
     assert np.all(np.abs(got["out"]) < 1.0) and len(got["sha"]) == 64

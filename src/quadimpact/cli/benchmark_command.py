@@ -126,9 +126,10 @@ def subject_from_options(
     "default law. [default: ekf]",
 )  # fmt: skip
 @click.option(
-    "--policy", metavar="learned|FILE",
+    "--policy", metavar="learned|learned-imu|FILE",
     help="A learned policy flown by the recovery controller: learned = the residual on the "
-    "staged law shipped with quadimpact (docs/LEARNING.md 12), or a .npz policy file of your "
+    "staged law shipped with quadimpact (docs/LEARNING.md 15; learned-imu: the one before "
+    "it), or a .npz policy file of your "
     "own; or a policy registered with quadimpact.studies.benchmark.subject.register_policy.",
 )  # fmt: skip
 @click.option(

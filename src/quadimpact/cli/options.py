@@ -83,9 +83,10 @@ def policy_option(command: Callable[..., Any]) -> Callable[..., Any]:
     """Add ``--policy learned|FILE``: a learned residual on the recovery law (None: not given)."""
     return click.option(
         "--policy",
-        metavar="learned|FILE",
-        help="Fly the recovery law with a learned residual (docs/LEARNING.md 12): learned = "
-        "the policy shipped with quadimpact, or a .npz policy file of your own. The study "
+        metavar="learned|learned-imu|FILE",
+        help="Fly the recovery law with a learned residual (docs/LEARNING.md 15): learned = "
+        "the policy shipped with quadimpact (learned-imu: the one before it, docs/LEARNING.md "
+        "12), or a .npz policy file of your own. The study "
         "records the policy and its weights' SHA-256. [default: the law alone]",
     )(command)
 

@@ -12,7 +12,10 @@ docs/LEARNING.md sections 12 and 14)::
     meta ()            optional: a JSON text of how it was trained
 
 ``--policy learned`` names the policy shipped with quadimpact
-(``inputs/policies/learned.npz``); any other value is a file path. Flying a
+(``inputs/policies/learned.npz``: a residual in every stage, trained for the
+``onboard`` and ``ideal`` sensors, docs/LEARNING.md 15); ``learned-imu`` the one
+shipped before it (``learned-imu.npz``: stages 1-4, trained for the ``impact``
+sensors, docs/LEARNING.md 12); any other value is a file path. Flying a
 policy needs NumPy only: the compiled loop evaluates the network itself, and
 :meth:`PolicyWeights.outputs` is the same network in NumPy.
 """
@@ -49,7 +52,7 @@ __all__ = [
 LAST_STAGES = (4, 5)
 
 #: Policies shipped with quadimpact, by name: their files in ``inputs/policies/``.
-SHIPPED_POLICIES = {"learned": "learned.npz"}
+SHIPPED_POLICIES = {"learned": "learned.npz", "learned-imu": "learned-imu.npz"}
 
 _POLICY_DIR = Path(__file__).parent / "policies"
 
