@@ -170,7 +170,9 @@ def _returns_nothing(who: PluginStep, checked: Any, kind: str) -> None:
 def _first_tick(scenario: Any, plugins: list[tuple[PluginStep, Any]], kind_of: dict) -> None:
     """Prepare the scenario and call each step once on the records of its first tick."""
     try:
-        setup = prepare(scenario, BUILTIN)  # the built-in loop's start only: nothing compiles
+        # the built-in loop's start only: nothing compiles, and no run calls the plug-in
+        # before its first tick is checked here (a wall approach's shooting would)
+        setup = prepare(scenario, BUILTIN, plugins=False)
     except InputError:
         raise
     except Exception as exc:

@@ -281,12 +281,18 @@ def _shoot(setup: RunSetup, shot: ResolvedShot, free_opts: np.ndarray) -> None:
         )
 
 
-def _prepared(r: ResolvedRun, kernel: Kernel | None = None) -> RunSetup:
-    """Resolved run -> packed run (one ``pack`` call), its start solved when it is shot."""
+def _prepared(r: ResolvedRun, kernel: Kernel | None = None, plugins: bool = True) -> RunSetup:
+    """Resolved run -> packed run (one ``pack`` call), its start solved when it is shot
+    (``plugins=False``: with its own copies of ``ctrl`` and ``ecfg`` whose plug-in
+    addresses are 0, so that no run calls a plug-in step)."""
     packed = pack(r)
     setup = _run_setup(r, packed)
     if kernel is not None:
         setup.kernel = kernel
+    if not plugins:  # copies: the packed arrays may be shared with other runs
+        m = setup.run
+        setup.run = m._replace(ctrl=m.ctrl.copy(), ecfg=m.ecfg.copy())
+        setup.run.ctrl[L.C_STEP] = setup.run.ecfg[L.EC_STEP] = 0.0
     if r.shot is not None:
         _shoot(setup, r.shot, packed.free_opts)
     return setup
@@ -321,7 +327,10 @@ def prepare_impact_trial(s: ImpactTrial) -> RunSetup:
 
 
 def prepare(
-    scenario: WallApproach | FlightScenario | ImpactTrial, kernel: Kernel | None = None
+    scenario: WallApproach | FlightScenario | ImpactTrial,
+    kernel: Kernel | None = None,
+    *,
+    plugins: bool = True,
 ) -> RunSetup:
     """Validated scenario -> packed run (refused if it starts in contact...: ``checks.py``).
 
@@ -332,13 +341,17 @@ def prepare(
     scenario's controller and estimator select; a wall approach's shooting
     runs fly with it too. The first call in a process whose compiled loop is
     not in Numba's disk cache says that it compiles (``core.announce_compilation``).
+    ``plugins=False``: no plug-in step is called, a wall approach's shooting runs
+    holding the rotors where a plug-in controller would command them (what a
+    plug-in's pre-flight needs: ``simulation.plugin_check`` calls the step itself
+    before any run does).
     """
     started = cpu_time()
     compiled = compile_cpu_total()
     check_scenario_type(scenario)
     announce_compilation()
     resolved = resolve(scenario)  # every default applied, once
-    setup = _prepared(resolved, kernel)  # pack (one call), then the run's loop
+    setup = _prepared(resolved, kernel, plugins)  # pack (one call), then the run's loop
     check_prepared(scenario, setup)
     # a plug-in's loop compiled here (a wall approach's shooting): its time apart
     setup.compile_cpu_s = compile_cpu_total() - compiled
