@@ -52,8 +52,10 @@ def test_plugin_preset_of_the_variometer_flies_in_a_study_and_the_benchmark(tmp_
     from quadimpact.studies.recovery.recovery_spec import RecoveryStudy
 
     _load()
-    base = RecoveryStudy(n=2, sensors="variometer-impact", estimator="ekf").sweep_spec().base
-    assert "variometer" in base.instruments and base.imu.preset == "impact"
+    spec = RecoveryStudy(n=2, sensors="variometer-impact", estimator="ekf").sweep_spec()
+    assert spec.base["sensors"] == "variometer-impact"  # the preset by name, filled when read
+    trial = scenario_from_dict(spec.scenario_dict(0))
+    assert "variometer" in trial.instruments and trial.imu.preset == "impact"
     study = BenchmarkStudy(
         tasks=("wall",), sensors=("variometer-impact",), references=False, limit=2
     )
