@@ -43,6 +43,7 @@ __all__ = [
     "pair_depths_at",
     "inclination_deg_of",
     "initial_state",
+    "shooting_record",
     "solve_approach",
     "wall_attitude",
 ]
@@ -139,6 +140,41 @@ def solve_approach(
         ``start_time_s``, ``start_x_m``, ``start_speed_m_s``, ``late_start``,
         ``speed_residual_m_s`` (the summary's ``approach``).
     """
+    ap = shooting_record(
+        run=run,
+        free_opts=free_opts,
+        wall=wall,
+        q=q,
+        rotors=rotors,
+        start=start,
+        impact_time_s=impact_time_s,
+        speed_m_s=speed_m_s,
+        late_start=late_start,
+        kernel=kernel,
+        clock=clock,
+    )
+    return _shooting_result(ap)
+
+
+def shooting_record(
+    *,
+    run: Model,
+    free_opts: np.ndarray,
+    wall: np.ndarray,
+    q: np.ndarray,
+    rotors: np.ndarray,
+    start: np.ndarray,
+    impact_time_s: float,
+    speed_m_s: float,
+    late_start: bool,
+    kernel: Kernel | None = None,
+    clock: CpuClock | None = None,
+) -> np.ndarray:
+    """The compiled shooting's record (layout ``AP_*``) after its call, unchecked.
+
+    The arguments are :func:`solve_approach`'s. Besides what that function
+    reads back, the record counts the free-flight runs flown (``AP_RUNS``).
+    """
     free = run._replace(
         x0=np.zeros(L.NX),
         span=np.zeros(L.NSPAN),
@@ -157,7 +193,7 @@ def solve_approach(
     else:
         with clock:
             solve(*args)
-    return _shooting_result(ap)
+    return ap
 
 
 def _shooting_inputs(
