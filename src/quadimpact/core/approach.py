@@ -9,8 +9,12 @@ no crash) gives A and the depth, a correction of v0 and a shift of X0 make
 the first contact happen at ``T_c`` with ``V_X = V_c`` (repeated until both
 residuals are below ``APPROACH_TOL_M_S``, at most ``APPROACH_MAX_ITER``
 runs). If that needs ``v0 < 0``, the vehicle starts later, at rest, at the
-``t0`` found by Brent's method (``core/roots.py``) on ``V_X(T_c; t0) = V_c``,
-one free-flight run per evaluation.
+``t0`` found by the secant method on ``V_X(T_c; t0) = V_c``, one free-flight
+run per evaluation, from the guess of a constant acceleration (Brent's method,
+``core/roots.py``, if the secant leaves ``[0, T_c)``). No run is flown twice:
+the first solve stops at a correction that leaves v0 far below 0 (the late
+start replaces it), and the search's last run, at the root, is the late
+solve's first (``AP_RUNS`` counts the runs).
 
 :func:`solve_approach` does all of it in one compiled call: the free-flight
 runs are the loop's own ``start`` and ``advance`` (so a plug-in kernel's
@@ -69,10 +73,11 @@ __all__ = ["APPROACH_MAX_ITER", "APPROACH_TOL_M_S", "solve_approach"]
 
 APPROACH_TOL_M_S = 1e-12  # shooting residuals (speed m/s, depth m)
 APPROACH_MAX_ITER = 4
-LATE_START_XTOL_S = 1e-14  # Brent's tolerances on the late start time
+LATE_START_XTOL_S = 1e-14  # the search's tolerances on the late start time (s, relative)
 LATE_START_RTOL = 4.0 * 2.220446049250313e-16
 LATE_START_MAXITER = 100
 LATE_START_END_GAP_S = 1e-9  # the bracket ends this far before T_c
+LATE_START_SECANT_MAXITER = 12  # secant runs before the search falls back to Brent's method
 # A first solve whose corrected v0 is below this (m/s) under the late-start rule
 # stops there: a further run would only remove rounding from a v0 < 0 that the
 # late start replaces (the run's corrections are of order 1e-15 m/s).
@@ -184,6 +189,46 @@ def _solve_from(
     return True
 
 
+@allocating(inline="always")
+def _late_start_secant(m: Model, o: Output, ap: np.ndarray) -> float:
+    """The late start ``t0`` (s) by the secant method on ``V_X(T_c; t0) = V_c``; NaN if
+    it leaves ``[0, T_c)`` or does not converge (``AP_STATUS`` tells a failed run).
+
+    The first guess is a constant acceleration: a flight of ``T_c`` gains ``A =
+    V_c - v0`` (the first solve's v0), so ``t0 = T_c (1 - V_c / A)``; the second
+    point is the flight of zero length (``V_X = 0`` at ``t0 = T_c``). The search
+    stops as Brent's did, when the step is below ``xtol + rtol |t0|``, at a time
+    it flew: its last run is the late start's run from rest at the root.
+    """
+    tc = ap[AP_TC]
+    vc = ap[AP_VC]
+    end = tc - LATE_START_END_GAP_S
+    gain = vc - ap[AP_V0]
+    a = tc
+    fa = -vc
+    b = tc * (1.0 - vc / gain)
+    xe = np.empty(NX)
+    C = np.empty((3, 3))
+    for _ in range(LATE_START_SECANT_MAXITER):
+        if not (0.0 <= b <= end):
+            return math.nan
+        if not _shoot(b, 0.0, 0.0, m, o, ap):
+            return math.nan
+        xe[:] = o.out[0, OUT_X : OUT_X + NX]
+        fb = _inertial_vx(xe, C) - vc
+        if fb == 0.0:
+            return b
+        if fb == fa or fb != fb:
+            return math.nan
+        c = b - fb * (b - a) / (fb - fa)
+        if abs(c - b) <= LATE_START_XTOL_S + LATE_START_RTOL * abs(b):
+            return b
+        a = b
+        fa = fb
+        b = c
+    return math.nan
+
+
 @allocating
 def solve_approach(
     m: Model, o: Output, wall: np.ndarray, pairs: np.ndarray, ap: np.ndarray
@@ -224,6 +269,14 @@ def solve_approach(
             x0 = ap[AP_X0 : AP_X0 + NX].copy()
             late = _deepest(x0, np.empty((3, 3)), m.feat, wall, pairs) > 0.0
     if not late:
+        return
+    t0 = _late_start_secant(m, o, ap)
+    if ap[AP_STATUS] == APPROACH_RUN_FAILED:
+        return
+    if t0 == t0:
+        ap[AP_T0] = t0
+        ap[AP_LATE] = 1.0
+        _solve_from(t0, 0.0, m, o, wall, pairs, ap, True, -math.inf)
         return
     br = np.empty(NBR)
     xe = np.empty(NX)

@@ -7,7 +7,8 @@ depends on X or V_X, so ``V_X(T_c) = v0 + A`` and the leading bumper's depth at
 a correction of v0 and a shift of X0 make the first contact happen at ``T_c``
 with ``V_X = V_c`` (repeated until the residuals are below 1e-12). If that
 needs ``v0 < 0``, the vehicle starts later, at rest, at the ``t0`` found by
-Brent's method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial).
+the secant method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial;
+Brent's method if the secant leaves ``[0, T_c)``).
 
 The shooting runs in one compiled call (``core/approach.py``, the kernel's
 ``approach``); :func:`solve_approach` packs its inputs and reads what it found.
