@@ -10,6 +10,10 @@ V_c = 0.75 m/s, 3-s scenario) in both model variants it reports
   the pandas tables and the summary);
 * accepted / rejected steps, right-hand-side evaluations, control ticks and
   ns per RHS evaluation (kernel median / RHS evaluations);
+* in CPU time (``time.thread_time``, which a loaded machine disturbs less),
+  calls alternated: the kernel with its IMU record, ``simulate()``, and the
+  ratio of the two (best and median: issue 59's target is 1.2); ``prepare``
+  and its approach shooting, and how many free-flight runs the shooting flew;
 * cold start in fresh subprocesses: ``import quadimpact`` + the first
   ``simulate()``, (i) with Numba's on-disk cache warm (run twice, the second
   is reported) and (ii) with ``NUMBA_CACHE_DIR`` pointing to a fresh empty
@@ -36,6 +40,8 @@ import numpy as np
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
+from quadimpact.simulation import approach as approach_py
+from quadimpact.simulation import setup as setup_py
 from quadimpact.simulation.setup import prepare
 
 EXAMPLE = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
@@ -137,6 +143,55 @@ def bench_simulate(model: str, repeat: int) -> dict:
     }
 
 
+def shooting_runs(case: str) -> int:
+    """Free-flight runs the approach's shooting flies for ``case`` (``AP_RUNS``)."""
+    seen: dict = {}
+    real = setup_py.solve_approach
+
+    def spy(**kw):
+        seen.update(kw)
+        return real(**kw)
+
+    setup_py.solve_approach = spy
+    try:
+        prepare(scenario(case))
+    finally:
+        setup_py.solve_approach = real
+    return int(approach_py.shooting_record(**seen)[L.AP_RUNS])
+
+
+def bench_cpu(case: str, repeat: int) -> dict:
+    """CPU time of the kernel (with its IMU record, as ``simulate()`` runs it), of
+    ``simulate()`` and of ``prepare`` (its shooting apart), calls alternated."""
+    sc = scenario(case)
+    setup = prepare(sc)
+    m = setup.model()
+    simulate(sc)
+    kernel, whole, prep, shoot = [], [], [], []
+    for _ in range(repeat):
+        t = time.thread_time()
+        execute(m, n_imu=setup.n_imu, kernel=setup.kernel)
+        kernel.append(time.thread_time() - t)
+        t = time.thread_time()
+        simulate(sc)
+        whole.append(time.thread_time() - t)
+        t = time.thread_time()
+        s = prepare(sc)
+        prep.append(time.thread_time() - t)
+        shoot.append(s.kernel_cpu_s)
+    return {
+        "cpu_kernel_best_s": min(kernel),
+        "cpu_kernel_median_s": statistics.median(kernel),
+        "cpu_simulate_best_s": min(whole),
+        "cpu_simulate_median_s": statistics.median(whole),
+        "cpu_ratio_best": min(whole) / min(kernel),
+        "cpu_ratio_median": statistics.median(whole) / statistics.median(kernel),
+        "cpu_prepare_best_s": min(prep),
+        "cpu_shooting_best_s": min(shoot),
+        "shooting_runs": shooting_runs(case),
+    }
+
+
 def cold_start(model: str, cache_dir: str | None) -> dict:
     code = COLD_SNIPPET.format(
         h=EXAMPLE["heading_deg"], i=EXAMPLE["inclination_deg"], v=EXAMPLE["speed_m_s"], m=model
@@ -166,6 +221,10 @@ def bench_cold(model: str) -> dict:
 
 def fmt_ms(s: float) -> str:
     return f"{s * 1e3:.2f} ms"
+
+
+def ms_pair(a: float, b: float) -> str:
+    return f"{a * 1e3:.2f} / {b * 1e3:.2f} ms"
 
 
 def report(info: dict, results: dict, repeat: int, cold: bool) -> str:
@@ -199,6 +258,22 @@ def report(info: dict, results: dict, repeat: int, cold: bool) -> str:
     row("RHS evaluations", lambda r: str(r["rhs_evaluations"]))
     row("control ticks", lambda r: str(r["control_ticks"]))
     row("ns per RHS evaluation", lambda r: f"{r['ns_per_rhs']:.0f}")
+    lines.append("CPU time (thread_time), calls alternated:")
+    row(
+        "  kernel best / median",
+        lambda r: ms_pair(r["cpu_kernel_best_s"], r["cpu_kernel_median_s"]),
+    )
+    row(
+        "  simulate() best / median",
+        lambda r: ms_pair(r["cpu_simulate_best_s"], r["cpu_simulate_median_s"]),
+    )
+    row(
+        "  simulate()/kernel (target 1.2)",
+        lambda r: f"{r['cpu_ratio_best']:.2f} / {r['cpu_ratio_median']:.2f}",
+    )
+    row("  prepare best", lambda r: fmt_ms(r["cpu_prepare_best_s"]))
+    row("  of which shooting", lambda r: fmt_ms(r["cpu_shooting_best_s"]))
+    row("  shooting runs", lambda r: str(r["shooting_runs"]))
     if cold:
         results = {k: v for k, v in results.items() if "cold" in v}
         row(
@@ -238,6 +313,7 @@ def main(argv: list[str] | None = None) -> int:
     for case in CASES:
         r = bench_kernel(case, a.repeat)
         r.update(bench_simulate(case, a.repeat))
+        r.update(bench_cpu(case, a.repeat))
         if not a.no_cold and case in MODELS:
             r["cold"] = bench_cold(case)
         results[case] = r

@@ -9,10 +9,21 @@ compiled status.
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
+from quadimpact.core.approach import (
+    APPROACH_TOL_M_S,
+    LATE_START_END_GAP_S,
+    LATE_START_MAXITER,
+    LATE_START_RTOL,
+    LATE_START_XTOL_S,
+    _inertial_vx,
+)
+from quadimpact.core.kernel import execute
+from quadimpact.core.roots import brentq
 from quadimpact.simulation import approach as approach_py
 from quadimpact.simulation import setup as setup_py
 from quadimpact.simulation.setup import prepare
@@ -51,3 +62,69 @@ def test_a_late_start_without_a_bracket_is_an_error(monkeypatch):
     assert found["late_start"] and 0.0 < t0 < T_C  # the scenario as it is: a late start
     with pytest.raises(ValueError, match="no late start reaches the wall"):
         approach_py.solve_approach(**{**kw, "speed_m_s": 0.0})
+
+
+def _runs(monkeypatch: pytest.MonkeyPatch, scenario: WallApproach) -> tuple[int, float]:
+    """Free-flight runs the shooting flew for ``scenario``, and the start time it found."""
+    ap = approach_py.shooting_record(**_solve_inputs(monkeypatch, scenario))
+    assert ap[L.AP_STATUS] == L.APPROACH_SOLVED
+    return int(ap[L.AP_RUNS]), float(ap[L.AP_T0])
+
+
+def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
+    """Inertial X speed (m/s) at ``T_c`` of a free flight (no wall) from rest at ``t`` (s),
+    from the start before any X shift: one run of the late start's search."""
+    x0 = np.zeros(L.NX)
+    x0[L.X_POS : L.X_POS + 3] = kw["start"] + 0.0
+    x0[L.X_QUAT : L.X_QUAT + 4] = kw["q"]
+    x0[L.X_ROTOR : L.X_ROTOR + len(kw["rotors"])] = kw["rotors"]
+    span = np.zeros(L.NSPAN)
+    span[L.SPAN_T0], span[L.SPAN_TF] = t, kw["impact_time_s"]
+    free = kw["run"]._replace(
+        x0=x0,
+        span=span,
+        shapes=np.zeros((0, L.NSHAPE)),
+        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        opts=kw["free_opts"],
+        scfg=np.zeros(L.NSCFG),
+        noise=np.zeros((0, 6)),
+        t_out=np.array([float(kw["impact_time_s"])]),
+    )
+    out = execute(free, kernel=kw["kernel"]).out
+    return _inertial_vx(np.ascontiguousarray(out[0, L.OUT_X : L.OUT_X + L.NX]), np.empty((3, 3)))
+
+
+def test_an_approach_without_late_start_flies_a_run_and_its_check(monkeypatch):
+    """The replica's rule keeps t = 0 here: one run gives the corrections (the
+    velocity gained and the depth are exact shifts), a second checks them."""
+    scenario = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75,
+                            model="paper-replica")  # fmt: skip
+    runs, t0 = _runs(monkeypatch, scenario)
+    assert t0 == 0.0
+    assert runs == 2
+
+
+def test_a_late_start_finds_brents_root_in_a_few_runs(monkeypatch):
+    """The default's rule starts the paper's example late, at rest. The first
+    solve stops at its first correction (v0 far below 0: the late start
+    replaces it). The secant search from the constant-acceleration guess finds
+    the start time that Brent's method finds on the same runs, to Brent's
+    tolerance, in at most four runs; its last run, at the root, is the late
+    solve's first, which adds one run (the check of the X shift)."""
+    scenario = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75)
+    runs, t0 = _runs(monkeypatch, scenario)
+    assert 0.0 < t0 < T_C
+    kw = _solve_inputs(monkeypatch, scenario)
+    searched: list[float] = []
+
+    def speed_gap(t: float) -> float:  # one run of Brent's search, from rest at t
+        searched.append(t)
+        return _speed_at_impact_from_rest(kw, t) - kw["speed_m_s"]
+
+    root = brentq(speed_gap, 0.0, T_C - LATE_START_END_GAP_S, LATE_START_XTOL_S, LATE_START_RTOL,
+                  LATE_START_MAXITER)  # fmt: skip
+    brent_runs = len(searched)
+    assert abs(t0 - root) <= LATE_START_XTOL_S + LATE_START_RTOL * root
+    assert abs(speed_gap(t0)) <= APPROACH_TOL_M_S
+    assert runs <= 1 + 4 + 1
+    assert runs < brent_runs  # the whole shooting, against Brent's search alone

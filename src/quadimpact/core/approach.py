@@ -9,8 +9,12 @@ no crash) gives A and the depth, a correction of v0 and a shift of X0 make
 the first contact happen at ``T_c`` with ``V_X = V_c`` (repeated until both
 residuals are below ``APPROACH_TOL_M_S``, at most ``APPROACH_MAX_ITER``
 runs). If that needs ``v0 < 0``, the vehicle starts later, at rest, at the
-``t0`` found by Brent's method (``core/roots.py``) on ``V_X(T_c; t0) = V_c``,
-one free-flight run per evaluation.
+``t0`` found by the secant method on ``V_X(T_c; t0) = V_c``, one free-flight
+run per evaluation, from the guess of a constant acceleration (Brent's method,
+``core/roots.py``, if the secant leaves ``[0, T_c)``). No run is flown twice:
+the first solve stops at a correction that leaves v0 far below 0 (the late
+start replaces it), and the search's last run, at the root, is the late
+solve's first (``AP_RUNS`` counts the runs).
 
 :func:`solve_approach` does all of it in one compiled call: the free-flight
 runs are the loop's own ``start`` and ``advance`` (so a plug-in kernel's
@@ -35,6 +39,7 @@ from quadimpact.core.layout import (
     AP_Q,
     AP_REASON,
     AP_ROTORS,
+    AP_RUNS,
     AP_START,
     AP_STATUS,
     AP_T0,
@@ -68,10 +73,15 @@ __all__ = ["APPROACH_MAX_ITER", "APPROACH_TOL_M_S", "solve_approach"]
 
 APPROACH_TOL_M_S = 1e-12  # shooting residuals (speed m/s, depth m)
 APPROACH_MAX_ITER = 4
-LATE_START_XTOL_S = 1e-14  # Brent's tolerances on the late start time
+LATE_START_XTOL_S = 1e-14  # the search's tolerances on the late start time (s, relative)
 LATE_START_RTOL = 4.0 * 2.220446049250313e-16
 LATE_START_MAXITER = 100
 LATE_START_END_GAP_S = 1e-9  # the bracket ends this far before T_c
+LATE_START_SECANT_MAXITER = 12  # secant runs before the search falls back to Brent's method
+# A first solve whose corrected v0 is below this (m/s) under the late-start rule
+# stops there: a further run would only remove rounding from a v0 < 0 that the
+# late start replaces (the run's corrections are of order 1e-15 m/s).
+LATE_START_DECIDED_M_S = -1e-6
 
 
 @allocating(inline="always")
@@ -100,6 +110,7 @@ def _shoot(t0: float, v0: float, x_start: float, m: Model, o: Output, ap: np.nda
     m.span[SPAN_T0] = t0
     m.span[SPAN_TF] = ap[AP_TC]
     d = new_data(m)
+    ap[AP_RUNS] += 1.0
     start(m, d, o)
     advance(-1, m, d, o)
     if o.stats[ST_STATUS] == STATUS_FAILED or o.stats[ST_N_OUT] != 1:
@@ -134,11 +145,23 @@ def _deepest(
 
 @allocating(inline="always")
 def _solve_from(
-    t0: float, v0: float, m: Model, o: Output, wall: np.ndarray, pairs: np.ndarray, ap: np.ndarray
+    t0: float,
+    v0: float,
+    m: Model,
+    o: Output,
+    wall: np.ndarray,
+    pairs: np.ndarray,
+    ap: np.ndarray,
+    flown: bool,
+    v0_below: float,
 ) -> bool:
     """Correct v0 (unless at rest after ``t0 > 0``) and X0 until the residuals vanish.
 
-    Writes ``AP_X0``, ``AP_V0``, ``AP_DV``; False if a run failed.
+    ``flown``: the first run (``t0``, ``v0``, no X shift) has flown already,
+    its state at ``T_c`` is in ``o.out[0]`` and its start in ``AP_X0`` (the late
+    start search's last run, when the root is the last time it asked). A
+    correction that leaves v0 below ``v0_below`` (m/s) ends the solve (a late
+    start follows). Writes ``AP_X0``, ``AP_V0``, ``AP_DV``; False if a run failed.
     """
     tc = ap[AP_TC]
     vc = ap[AP_VC]
@@ -146,8 +169,8 @@ def _solve_from(
     C = np.empty((3, 3))
     x_start = 0.0
     dv = 0.0
-    for _ in range(APPROACH_MAX_ITER):
-        if not _shoot(t0, v0, x_start, m, o, ap):
+    for k in range(APPROACH_MAX_ITER):
+        if not (flown and k == 0) and not _shoot(t0, v0, x_start, m, o, ap):
             return False
         xe[:] = o.out[0, OUT_X : OUT_X + NX]
         dv = vc - _inertial_vx(xe, C)
@@ -157,11 +180,53 @@ def _solve_from(
         if t0 == 0.0 or v0 != 0.0:
             v0 += dv
             x_start -= depth + dv * (tc - t0)
+            if v0 < v0_below:
+                break
         else:
             x_start -= depth
     ap[AP_V0] = v0
     ap[AP_DV] = dv
     return True
+
+
+@allocating(inline="always")
+def _late_start_secant(m: Model, o: Output, ap: np.ndarray) -> float:
+    """The late start ``t0`` (s) by the secant method on ``V_X(T_c; t0) = V_c``; NaN if
+    it leaves ``[0, T_c)`` or does not converge (``AP_STATUS`` tells a failed run).
+
+    The first guess is a constant acceleration: a flight of ``T_c`` gains ``A =
+    V_c - v0`` (the first solve's v0), so ``t0 = T_c (1 - V_c / A)``; the second
+    point is the flight of zero length (``V_X = 0`` at ``t0 = T_c``). The search
+    stops as Brent's did, when the step is below ``xtol + rtol |t0|``, at a time
+    it flew: its last run is the late start's run from rest at the root.
+    """
+    tc = ap[AP_TC]
+    vc = ap[AP_VC]
+    end = tc - LATE_START_END_GAP_S
+    gain = vc - ap[AP_V0]
+    a = tc
+    fa = -vc
+    b = tc * (1.0 - vc / gain)
+    xe = np.empty(NX)
+    C = np.empty((3, 3))
+    for _ in range(LATE_START_SECANT_MAXITER):
+        if not (0.0 <= b <= end):
+            return math.nan
+        if not _shoot(b, 0.0, 0.0, m, o, ap):
+            return math.nan
+        xe[:] = o.out[0, OUT_X : OUT_X + NX]
+        fb = _inertial_vx(xe, C) - vc
+        if fb == 0.0:
+            return b
+        if fb == fa or fb != fb:
+            return math.nan
+        c = b - fb * (b - a) / (fb - fa)
+        if abs(c - b) <= LATE_START_XTOL_S + LATE_START_RTOL * abs(b):
+            return b
+        a = b
+        fa = fb
+        b = c
+    return math.nan
 
 
 @allocating
@@ -185,15 +250,17 @@ def solve_approach(
     ap : numpy.ndarray, shape (NAP,)
         In: ``AP_TC``, ``AP_VC``, ``AP_LATE_RULE``, ``AP_START``, ``AP_Q``,
         ``AP_ROTORS``. Out: ``AP_X0``, ``AP_T0``, ``AP_V0``, ``AP_DV``,
-        ``AP_LATE`` and ``AP_STATUS`` (``APPROACH_*``; ``AP_REASON`` for a
-        failed run).
+        ``AP_LATE``, ``AP_STATUS`` (``APPROACH_*``; ``AP_REASON`` for a
+        failed run) and ``AP_RUNS`` (the free-flight runs flown).
     """
     ap[AP_STATUS] = APPROACH_SOLVED
     ap[AP_REASON] = 0.0
     ap[AP_T0] = 0.0
     ap[AP_LATE] = 0.0
+    ap[AP_RUNS] = 0.0
     vc = ap[AP_VC]
-    if not _solve_from(0.0, vc, m, o, wall, pairs, ap):
+    decided = LATE_START_DECIDED_M_S if ap[AP_LATE_RULE] != 0.0 else -math.inf
+    if not _solve_from(0.0, vc, m, o, wall, pairs, ap, False, decided):
         return
     late = False
     if ap[AP_V0] < 0.0:
@@ -202,6 +269,14 @@ def solve_approach(
             x0 = ap[AP_X0 : AP_X0 + NX].copy()
             late = _deepest(x0, np.empty((3, 3)), m.feat, wall, pairs) > 0.0
     if not late:
+        return
+    t0 = _late_start_secant(m, o, ap)
+    if ap[AP_STATUS] == APPROACH_RUN_FAILED:
+        return
+    if t0 == t0:
+        ap[AP_T0] = t0
+        ap[AP_LATE] = 1.0
+        _solve_from(t0, 0.0, m, o, wall, pairs, ap, True, -math.inf)
         return
     br = np.empty(NBR)
     xe = np.empty(NX)
@@ -215,8 +290,10 @@ def solve_approach(
         LATE_START_MAXITER,
     )
     code = BRENT_ASK
+    last = math.nan  # the start time of the search's last run
     while code == BRENT_ASK:
-        if not _shoot(br[BR_X], 0.0, 0.0, m, o, ap):
+        last = br[BR_X]
+        if not _shoot(last, 0.0, 0.0, m, o, ap):
             return
         xe[:] = o.out[0, OUT_X : OUT_X + NX]
         code = brent_next(br, _inertial_vx(xe, C) - vc)
@@ -226,4 +303,4 @@ def solve_approach(
     t0 = br[BR_X]
     ap[AP_T0] = t0
     ap[AP_LATE] = 1.0
-    _solve_from(t0, 0.0, m, o, wall, pairs, ap)
+    _solve_from(t0, 0.0, m, o, wall, pairs, ap, t0 == last, -math.inf)

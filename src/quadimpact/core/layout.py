@@ -421,6 +421,7 @@ AP_DV = _ap.slot("AP_DV")  # m/s, found: the speed residual at T_c
 AP_LATE = _ap.slot("AP_LATE")  # found: 1 if the vehicle starts later, at rest
 AP_STATUS = _ap.slot("AP_STATUS")  # APPROACH_*
 AP_REASON = _ap.slot("AP_REASON")  # REASON_* of a failed shooting run
+AP_RUNS = _ap.slot("AP_RUNS")  # found: the free-flight runs the shooting flew
 NAP = _ap.end("NAP")
 APPROACH_SOLVED = 0
 APPROACH_RUN_FAILED = 1  # a shooting run failed (AP_REASON) or sampled no state at T_c

@@ -7,7 +7,8 @@ depends on X or V_X, so ``V_X(T_c) = v0 + A`` and the leading bumper's depth at
 a correction of v0 and a shift of X0 make the first contact happen at ``T_c``
 with ``V_X = V_c`` (repeated until the residuals are below 1e-12). If that
 needs ``v0 < 0``, the vehicle starts later, at rest, at the ``t0`` found by
-Brent's method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial).
+the secant method on ``V_X(T_c; t0) = V_c`` (one free-flight run per trial;
+Brent's method if the secant leaves ``[0, T_c)``).
 
 The shooting runs in one compiled call (``core/approach.py``, the kernel's
 ``approach``); :func:`solve_approach` packs its inputs and reads what it found.
@@ -43,6 +44,7 @@ __all__ = [
     "pair_depths_at",
     "inclination_deg_of",
     "initial_state",
+    "shooting_record",
     "solve_approach",
     "wall_attitude",
 ]
@@ -139,6 +141,41 @@ def solve_approach(
         ``start_time_s``, ``start_x_m``, ``start_speed_m_s``, ``late_start``,
         ``speed_residual_m_s`` (the summary's ``approach``).
     """
+    ap = shooting_record(
+        run=run,
+        free_opts=free_opts,
+        wall=wall,
+        q=q,
+        rotors=rotors,
+        start=start,
+        impact_time_s=impact_time_s,
+        speed_m_s=speed_m_s,
+        late_start=late_start,
+        kernel=kernel,
+        clock=clock,
+    )
+    return _shooting_result(ap)
+
+
+def shooting_record(
+    *,
+    run: Model,
+    free_opts: np.ndarray,
+    wall: np.ndarray,
+    q: np.ndarray,
+    rotors: np.ndarray,
+    start: np.ndarray,
+    impact_time_s: float,
+    speed_m_s: float,
+    late_start: bool,
+    kernel: Kernel | None = None,
+    clock: CpuClock | None = None,
+) -> np.ndarray:
+    """The compiled shooting's record (layout ``AP_*``) after its call, unchecked.
+
+    The arguments are :func:`solve_approach`'s. Besides what that function
+    reads back, the record counts the free-flight runs flown (``AP_RUNS``).
+    """
     free = run._replace(
         x0=np.zeros(L.NX),
         span=np.zeros(L.NSPAN),
@@ -157,7 +194,7 @@ def solve_approach(
     else:
         with clock:
             solve(*args)
-    return _shooting_result(ap)
+    return ap
 
 
 def _shooting_inputs(
