@@ -49,9 +49,9 @@ def _meas(q: np.ndarray, normal=(-1.0, 0.0, 0.0), t_detect: float = 0.1) -> np.n
 
 
 def _random_policy(
-    seed: int, hidden: int = 8, scale: float = 1.0, last_stage: int = 4
+    seed: int, hidden: int = 8, scale: float = 1.0, last_stage: int = 4, centred: bool = False
 ) -> PolicyWeights:
-    p = initial_policy(hidden, 0.3, 4.0, seed, last_stage)
+    p = initial_policy(hidden, 0.3, 4.0, seed, last_stage, centred)
     rng = np.random.default_rng(seed + 1)
     return p.with_vector(rng.normal(0.0, scale, p.vector().size))
 
@@ -106,6 +106,85 @@ def test_the_compiled_network_is_the_numpy_network():
             refs[2] + p.rate_scale_rad_s * o[2],
         )
         np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+def _hover_meas(yaw_rad: float, normal=(-1.0, 0.0, 0.0)) -> np.ndarray:
+    """The measurement of a vehicle level and at rest, heading ``yaw_rad``: the
+    accelerometer reads -g along body z (FRD), the rates are zero."""
+    meas = _meas(euler_zyx_to_quat(0.0, 0.0, yaw_rad), normal)
+    meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = 0.0
+    meas[L.MS_W_HAT : L.MS_W_HAT + 3] = 0.0
+    meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (0.0, 0.0, -G)
+    return meas
+
+
+def test_a_hover_centred_policy_does_not_move_the_hover():
+    """At the hover itself (level, at rest, the law at m g and zero rate references) a
+    hover-centred policy corrects nothing in stage 5, whatever its weights, the heading,
+    the wall normal and the time; one that is not centred does (a bias the law's hover
+    must then fight), and off the hover both correct."""
+    hover = (NAVI_MASS_KG * G, 0.0, 0.0)
+    for k in range(20):
+        centred = _random_policy(k, scale=2.0, last_stage=5, centred=True)
+        plain = _random_policy(k, scale=2.0, last_stage=5)
+        yaw = 0.3 * k - 3.0
+        normal = (math.cos(yaw), math.sin(yaw), 0.0)
+        meas = _hover_meas(yaw, normal)
+        t = 0.1 + 0.15 * k
+        got = residual_references(t, 5, hover, meas, _ctrl(centred), _veh())
+        np.testing.assert_allclose(got, hover, rtol=0.0, atol=1e-12)  # round-off of |q| = 1
+        off = np.subtract(residual_references(t, 5, hover, meas, _ctrl(plain), _veh()), hover)
+        assert np.max(np.abs(off)) > 1e-3
+        moved = meas.copy()
+        moved[L.MS_X + L.X_VEL] = 0.5  # moving at 0.5 m/s: a correction again
+        off = np.subtract(residual_references(t, 5, hover, moved, _ctrl(centred), _veh()), hover)
+        assert np.max(np.abs(off)) > 1e-6  # far above the round-off at the hover
+
+
+@pytest.mark.parametrize("stage", [1, 2, 3, 4])
+def test_hover_centring_leaves_the_stages_before_the_hover_alone(stage):
+    """Before stage 5, a hover-centred policy is the same network as one that is not."""
+    q = euler_zyx_to_quat(0.2, -0.4, 1.0)
+    refs = (9.0, 0.7, -1.2)
+    for k in range(5):
+        centred = _ctrl(_random_policy(k, 8, 2.0, 5, True))
+        plain = _ctrl(_random_policy(k, 8, 2.0, 5))
+        a = residual_references(0.4, stage, refs, _meas(q), centred, _veh())
+        b = residual_references(0.4, stage, refs, _meas(q), plain, _veh())
+        assert a == b
+
+
+def test_the_compiled_hover_centred_network_is_the_numpy_one():
+    """residual_references == PolicyWeights.outputs (NumPy) for hover-centred policies, in
+    every stage; in stage 5 each correction is bounded by twice its scale."""
+    rng = np.random.default_rng(4)
+    for k in range(20):
+        p = _random_policy(k, hidden=int(rng.integers(1, 33)), scale=2.0, last_stage=5,
+                           centred=True)  # fmt: skip
+        q = euler_zyx_to_quat(*rng.uniform(-1.0, 1.0, 3))
+        meas = _meas(q, (-1.0, 0.0, 0.0))
+        refs = (float(rng.uniform(0, 20)), float(rng.normal()), float(rng.normal()))
+        stage = 5 if k % 2 else int(rng.integers(1, 5))
+        got = residual_references(0.5, stage, refs, meas, _ctrl(p), _veh())
+        o = p.outputs(features(0.5, stage, refs, meas, _veh()), gravity_m_s2=G)
+        want = (
+            max(0.0, refs[0] + p.thrust_scale * NAVI_MASS_KG * G * o[0]),
+            refs[1] + p.rate_scale_rad_s * o[1],
+            refs[2] + p.rate_scale_rad_s * o[2],
+        )
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+        assert np.all(np.abs(o) < 2.0)
+
+
+def test_hover_centring_round_trips_and_is_part_of_the_identity(tmp_path):
+    """Saved and read back; a file without it reads as not centred, with its old digest."""
+    plain = _random_policy(8, last_stage=5)
+    centred = _random_policy(8, last_stage=5, centred=True)
+    assert centred.sha256 != plain.sha256
+    q = load_policy(save_policy(centred, tmp_path / "c.npz"))
+    assert q.hover_centred and q.sha256 == centred.sha256
+    assert q.block()[RES.PB_HOVER_CENTRED] == 1.0 and plain.block()[RES.PB_HOVER_CENTRED] == 0.0
+    assert load_policy("learned").hover_centred is False
 
 
 def test_the_correction_is_bounded_whatever_the_weights():
@@ -225,6 +304,7 @@ def test_the_last_stage_round_trips_and_is_part_of_the_identity(tmp_path):
     [
         ({"last_stage": np.int64(3)}, "last_stage: must be one number, 4 or 5 (got 3)"),
         ({"last_stage": np.array([5, 5])}, "last_stage: must be one number, 4 or 5"),
+        ({"hover_centred": np.int64(2)}, "hover_centred: must be one number, 0 or 1 (got 2)"),
         ({"w1": np.zeros((4, 23))}, "w1: must be (4, 24)"),
         ({"b2": np.zeros(2)}, "b2: must be (3,)"),
         ({"w1": np.zeros((40, 24)), "b1": np.zeros(40), "w2": np.zeros((3, 40))}, "<= 32"),

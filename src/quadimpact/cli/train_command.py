@@ -70,6 +70,11 @@ __all__ = ["train"]
     "included (1-5), or up to the recovery (1-4, the shipped policy's).",
 )  # fmt: skip
 @click.option(
+    "--hover-centred", is_flag=True,
+    help="In the hover stage, correct by the network's outputs minus those at the hover "
+    "itself (level, at rest), so that the law's hover stays where it is.",
+)  # fmt: skip
+@click.option(
     "--shaping", type=float, default=0.1, show_default=True,
     help="Weight of the height-kept term added to the benchmark's success in the reward.",
 )  # fmt: skip
@@ -103,6 +108,7 @@ def train(
     thrust_scale: float,
     rate_scale_rad_s: float,
     stages: str,
+    hover_centred: bool,
     shaping: float,
     loss_weight: float,
     check: int,
@@ -148,6 +154,7 @@ def train(
         hidden=hidden, popsize=popsize, batch=batch, sigma=sigma, thrust_scale=thrust_scale,
         rate_scale_rad_s=rate_scale_rad_s, last_stage=5 if stages == "1-5" else 4,
         shaping=shaping, loss_weight=loss_weight, check=check, check_every=check_every,
+        hover_centred=hover_centred,
     )  # fmt: skip
     if workers < 1:
         raise InputError(f"--workers: must be >= 1 (got {workers})")

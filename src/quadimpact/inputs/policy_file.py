@@ -9,6 +9,8 @@ docs/LEARNING.md sections 12 and 14)::
     rate_scale_rad_s () the largest roll and pitch rate-reference correction, rad/s
     last_stage ()      optional: the last stage it acts in, 4 (the default: from the
                        detection to the recovery) or 5 (the hover too)
+    hover_centred ()   optional: 1 if its correction in the hover stage is zero at
+                       the hover itself (0, the default: not)
     meta ()            optional: a JSON text of how it was trained
 
 ``--policy learned`` names the policy shipped with quadimpact
@@ -39,6 +41,7 @@ __all__ = [
     "SHIPPED_POLICIES",
     "PolicyWeights",
     "checked_policy",
+    "hover_features",
     "initial_policy",
     "load_policy",
     "policy_path",
@@ -72,6 +75,10 @@ class PolicyWeights:
     last_stage : int
         The last stage of the law it corrects: 4 (stages 1-4, the law alone
         in the hover) or 5 (every stage from the detection on).
+    hover_centred : bool
+        In the hover stage, the correction minus its value at the hover itself
+        (vehicle level and at rest, ``core/controllers/residual.py``), so that
+        the law's hover stays where it is.
     meta : dict
         How the weights were made (training script, seeds, ...), as saved.
     sha256 : str
@@ -87,6 +94,7 @@ class PolicyWeights:
     thrust_scale: float
     rate_scale_rad_s: float
     last_stage: int = 4
+    hover_centred: bool = False
     meta: dict = field(default_factory=dict)
     sha256: str = ""
     path: str = ""
@@ -112,22 +120,31 @@ class PolicyWeights:
         new = replace(self, w1=w1.copy(), b1=b1.copy(), w2=w2.copy(), b2=b2.copy(), path="")
         return replace(new, meta={**self.meta, **meta}, sha256=_digest(new))
 
-    def outputs(self, features: np.ndarray) -> np.ndarray:
-        """The network's three outputs in (-1, 1) for ``features`` ``(..., 24)`` (NumPy only).
+    def outputs(self, features: np.ndarray, gravity_m_s2: float = 9.81) -> np.ndarray:
+        """The policy's three outputs for ``features`` ``(..., 24)`` (NumPy only).
 
-        The same arithmetic on every CPU (``quadimpact.linalg``'s sums in index order and
-        the C library's ``tanh``, as the compiled loop), not NumPy's vectorised kernels.
+        Each in (-1, 1), or for a hover-centred policy in the hover stage (feature
+        20 set) the network's outputs minus those at the hover (:func:`hover_features`,
+        with ``gravity_m_s2``, m/s^2), each in (-2, 2). The same arithmetic on every
+        CPU (``quadimpact.linalg``'s sums in index order and the C library's
+        ``tanh``, as the compiled loop), not NumPy's vectorised kernels.
         """
         f = np.asarray(features, dtype=float)
+        out = self._network(f)
+        if self.hover_centred:
+            hover = f[..., 20:21] > 0.5
+            out = np.where(hover, out - self._network(hover_features(f, gravity_m_s2)), out)
+        return out
+
+    def _network(self, f: np.ndarray) -> np.ndarray:
         h = _tanh(matvec(self.w1, f) + self.b1)
         return _tanh(matvec(self.w2, h) + self.b2)
 
     def block(self) -> np.ndarray:
-        """The compiled loop's block ``[nh, s_T, s_w, last stage, W1, b1, W2, b2]``
-        (residual.py)."""
-        head = np.array(
-            [self.hidden, self.thrust_scale, self.rate_scale_rad_s, self.last_stage], dtype=float
-        )
+        """The compiled loop's block ``[nh, s_T, s_w, last stage, hover-centred, W1, b1,
+        W2, b2]`` (residual.py)."""
+        head = [self.hidden, self.thrust_scale, self.rate_scale_rad_s, self.last_stage]
+        head = np.array([*head, float(self.hover_centred)], dtype=float)
         return np.concatenate([head, self.vector()])
 
 
@@ -139,11 +156,34 @@ def _tanh(x: np.ndarray) -> np.ndarray:
     return np.asarray(_tanh_object(x), dtype=float)
 
 
+#: The features' scale of the accelerometer's specific force, m/s^2 (residual.py).
+_F_SCALE_M_S2 = 16.0
+
+
+def hover_features(features: np.ndarray, gravity_m_s2: float) -> np.ndarray:
+    """``features`` ``(..., 24)`` with the vehicle level and at rest, at its hover.
+
+    The NumPy twin of ``core/controllers/residual.py``'s: gravity along body z,
+    no velocity or body rates, the accelerometer reading ``-g`` along body z
+    (``gravity_m_s2``, m/s^2), the law at its hover thrust with zero rate
+    references; the wall normal, the time and the stage kept.
+    """
+    h = np.array(features, dtype=float, copy=True)
+    h[..., 0:2] = 0.0
+    h[..., 2] = 1.0
+    h[..., 6:14] = 0.0
+    h[..., 14] = -gravity_m_s2 / _F_SCALE_M_S2
+    h[..., 21:24] = 0.0
+    return h
+
+
 def _digest(p: PolicyWeights) -> str:
     h = hashlib.sha256(np.ascontiguousarray(p.vector(), dtype="<f8").tobytes())
     h.update(np.array([p.thrust_scale, p.rate_scale_rad_s], dtype="<f8").tobytes())
     if p.last_stage != 4:  # a policy of stages 1-4 keeps the digest it had before last_stage
         h.update(np.array([p.last_stage], dtype="<f8").tobytes())
+    if p.hover_centred:  # and one not hover-centred the digest it had before that
+        h.update(b"hover_centred")
     return h.hexdigest()
 
 
@@ -237,6 +277,13 @@ def load_policy(name: str | Path) -> PolicyWeights:
             got = raw.tolist()
             raise InputError(f"{where}: last_stage: must be one number, 4 or 5 (got {got!r})")
         last_stage = int(raw)
+    hover_centred = False
+    if "hover_centred" in arrays:
+        raw = np.asarray(arrays["hover_centred"])
+        if raw.shape != () or raw.dtype.kind not in "biuf" or float(raw) not in (0.0, 1.0):
+            got = raw.tolist()
+            raise InputError(f"{where}: hover_centred: must be one number, 0 or 1 (got {got!r})")
+        hover_centred = bool(raw)
     meta: dict = {}
     if "meta" in arrays:
         try:
@@ -251,6 +298,7 @@ def load_policy(name: str | Path) -> PolicyWeights:
         float(w["thrust_scale"]),
         float(w["rate_scale_rad_s"]),
         last_stage=last_stage,
+        hover_centred=hover_centred,
         meta=meta,
         path=str(path),
     )
@@ -271,6 +319,7 @@ def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
         thrust_scale=np.float64(policy.thrust_scale),
         rate_scale_rad_s=np.float64(policy.rate_scale_rad_s),
         last_stage=np.int64(policy.last_stage),
+        hover_centred=np.int64(policy.hover_centred),
         meta=np.array(json.dumps(policy.meta, sort_keys=True)),
     )
     tmp.replace(path)
@@ -278,11 +327,16 @@ def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
 
 
 def initial_policy(
-    hidden: int, thrust_scale: float, rate_scale_rad_s: float, seed: int, last_stage: int = 4
+    hidden: int,
+    thrust_scale: float,
+    rate_scale_rad_s: float,
+    seed: int,
+    last_stage: int = 4,
+    hover_centred: bool = False,
 ) -> PolicyWeights:
     """A new policy that flies the law exactly: random ``w1`` (scale 1/sqrt(24)), a zero
-    output layer (``seed``: of ``w1``'s draw; the scales and ``last_stage`` as
-    :class:`PolicyWeights`')."""
+    output layer (``seed``: of ``w1``'s draw; the scales, ``last_stage`` and
+    ``hover_centred`` as :class:`PolicyWeights`')."""
     if last_stage not in LAST_STAGES:
         raise InputError(f"policy: last_stage: must be 4 or 5 (got {last_stage})")
     if not 1 <= hidden <= MAX_HIDDEN:
@@ -299,5 +353,6 @@ def initial_policy(
         float(thrust_scale),
         float(rate_scale_rad_s),
         last_stage=int(last_stage),
+        hover_centred=bool(hover_centred),
     )
     return replace(p, sha256=_digest(p))

@@ -17,8 +17,17 @@ the detector's wall normal and time, the law's stage)::
 
 so the correction is bounded by ``s_T`` times the hover thrust and ``s_w``
 rad/s whatever the weights, and a network whose ``W2`` and ``b2`` are zero
-flies the staged law exactly. Stage changes, the lean cut, the rate loop and
-the allocation are the law's.
+flies the staged law exactly. Stage changes, the lean cut, the rate loop
+and the allocation are the law's.
+
+A policy may be *hover-centred* (its block's ``PB_HOVER_CENTRED`` 1): in the
+hover stage (5) its outputs are then ``tanh(o(f)) - tanh(o(f*))``, where
+``f*`` is ``f`` with the vehicle at rest and level (gravity along body z, no
+velocity, no rates, the accelerometer reading ``-g`` along body z, the law at
+its hover thrust and zero rate references; the wall normal, the time and the
+stage as in ``f``). The correction is then zero at the hover itself: it may
+change how the law returns to its hover, never where the hover is
+(:func:`hover_features`). The bound becomes twice the scale.
 
 Features (body FRD axes; non-finite inputs read as 0):
 
@@ -34,9 +43,9 @@ Features (body FRD axes; non-finite inputs read as 0):
 22-23   the law's p_des, q_des / 8 rad/s
 ======  ==================================================================
 
-The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, last stage, W1
-(nh x 24, row-major), b1 (nh), W2 (3 x nh, row-major), b2 (3)]``; the last
-stage is 4 (stages 1-4; a 0 reads as 4) or 5 (stages 1-5). The weights come from
+The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, last stage,
+hover-centred, W1 (nh x 24, row-major), b1 (nh), W2 (3 x nh, row-major), b2
+(3)]``; the last stage is 4 (stages 1-4; a 0 reads as 4) or 5 (stages 1-5). The weights come from
 a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy forward pass of
 the same network is ``PolicyWeights.outputs``. The block's slots (``PB_*``) are
 declared below; the network's shape (``N_FEATURES``, ``N_OUTPUTS``,
@@ -74,6 +83,7 @@ PB_HIDDEN = _policy.slot("PB_HIDDEN")  # hidden width (0: no policy)
 PB_THRUST_SCALE = _policy.slot("PB_THRUST_SCALE")  # s_T: the largest thrust correction / (m g)
 PB_RATE_SCALE = _policy.slot("PB_RATE_SCALE")  # s_w, rad/s: the largest p, q reference correction
 PB_LAST_STAGE = _policy.slot("PB_LAST_STAGE")  # the last stage it acts in: 4 (0 reads as 4) or 5
+PB_HOVER_CENTRED = _policy.slot("PB_HOVER_CENTRED")  # 1: zero correction at the hover in stage 5
 PB_WEIGHTS = _policy.slot(  # W1 (nh x N_FEATURES, row-major), b1 (nh), W2 (N_OUTPUTS x nh), b2
     "PB_WEIGHTS", MAX_HIDDEN * (N_FEATURES + 1 + N_OUTPUTS) + N_OUTPUTS
 )
@@ -153,20 +163,32 @@ def residual_last_stage(ctrl: np.ndarray) -> int:
 
 
 @allocating
-def residual_references(
-    t: float,
-    stage: int,
-    refs: tuple[float, float, float],
-    meas: np.ndarray,
-    ctrl: np.ndarray,
-    veh: np.ndarray,
-) -> tuple[float, float, float]:
-    """The law's ``refs = (thrust N, p_des rad/s, q_des rad/s)`` corrected by the network.
+def hover_features(f: np.ndarray, gravity_m_s2: float) -> np.ndarray:
+    """The features ``f`` with the vehicle at rest and level, at its hover (m/s^2 for ``g``).
 
-    The network is the block at ``ctrl[C_POLICY:]`` (module docstring); the
-    result is ``(thrust, p_des, q_des)`` in the same units.
+    Gravity along body z, no velocity, no body rates, the accelerometer reading
+    ``-g`` along body z (FRD), the law's thrust at ``m g`` and its rate
+    references zero; the wall normal (3-5), the time (15) and the stage (16-20)
+    are kept from ``f``.
     """
-    f = features(t, stage, refs, meas, veh)
+    h = f.copy()
+    h[0] = 0.0
+    h[1] = 0.0
+    h[2] = 1.0
+    for k in range(6, 12):
+        h[k] = 0.0
+    h[12] = 0.0
+    h[13] = 0.0
+    h[14] = -gravity_m_s2 / _F_SCALE_M_S2
+    h[21] = 0.0
+    h[22] = 0.0
+    h[23] = 0.0
+    return h
+
+
+@compiled
+def network_outputs(f: np.ndarray, ctrl: np.ndarray) -> tuple[float, float, float]:
+    """The network at ``ctrl[C_POLICY:]`` on features ``f``: its 3 outputs in (-1, 1)."""
     b = C_POLICY
     nh = int(ctrl[b + PB_HIDDEN])
     w1 = b + PB_WEIGHTS
@@ -185,9 +207,34 @@ def residual_references(
         o0 += ctrl[w2 + j] * h
         o1 += ctrl[w2 + nh + j] * h
         o2 += ctrl[w2 + 2 * nh + j] * h
-    thrust = refs[0] + ctrl[b + PB_THRUST_SCALE] * veh[V_MASS] * veh[V_GRAVITY] * math.tanh(o0)
+    return math.tanh(o0), math.tanh(o1), math.tanh(o2)
+
+
+@allocating
+def residual_references(
+    t: float,
+    stage: int,
+    refs: tuple[float, float, float],
+    meas: np.ndarray,
+    ctrl: np.ndarray,
+    veh: np.ndarray,
+) -> tuple[float, float, float]:
+    """The law's ``refs = (thrust N, p_des rad/s, q_des rad/s)`` corrected by the network.
+
+    The network is the block at ``ctrl[C_POLICY:]`` (module docstring); the
+    result is ``(thrust, p_des, q_des)`` in the same units.
+    """
+    f = features(t, stage, refs, meas, veh)
+    b = C_POLICY
+    u0, u1, u2 = network_outputs(f, ctrl)
+    if stage == STAGE_HOVER and ctrl[b + PB_HOVER_CENTRED] > 0.5:
+        c0, c1, c2 = network_outputs(hover_features(f, veh[V_GRAVITY]), ctrl)
+        u0 -= c0
+        u1 -= c1
+        u2 -= c2
+    thrust = refs[0] + ctrl[b + PB_THRUST_SCALE] * veh[V_MASS] * veh[V_GRAVITY] * u0
     if thrust < 0.0:
         thrust = 0.0
-    p_des = refs[1] + ctrl[b + PB_RATE_SCALE] * math.tanh(o1)
-    q_des = refs[2] + ctrl[b + PB_RATE_SCALE] * math.tanh(o2)
+    p_des = refs[1] + ctrl[b + PB_RATE_SCALE] * u1
+    q_des = refs[2] + ctrl[b + PB_RATE_SCALE] * u2
     return thrust, p_des, q_des

@@ -102,6 +102,10 @@ class Settings:
         Trials of the check set (>= 1).
     check_every : int
         Generations between two checks (>= 1).
+    hover_centred : bool
+        The policy's correction in the hover stage is zero at the hover itself
+        (``core/controllers/residual.py``): it may change how the law reaches its
+        hover, not where it holds it.
     """
 
     hidden: int = 8
@@ -115,6 +119,7 @@ class Settings:
     loss_weight: float = 0.0
     check: int = 60
     check_every: int = 5
+    hover_centred: bool = False
 
     def __post_init__(self) -> None:
         from quadimpact.core.layout import MAX_HIDDEN
@@ -131,6 +136,11 @@ class Settings:
             "loss-weight": (self.loss_weight, _nonneg(self.loss_weight), "finite, >= 0"),
             "check": (self.check, self.check >= 1, ">= 1"),
             "check-every": (self.check_every, self.check_every >= 1, ">= 1"),
+            "hover-centred": (
+                self.hover_centred,
+                not self.hover_centred or self.last_stage == 5,
+                "given with --stages 1-5 (it acts in the hover stage)",
+            ),
         }
         for name, (value, ok, rule) in rules.items():
             if not ok:
@@ -247,7 +257,8 @@ def _new_state(problem: Problem, settings: Settings) -> dict[str, Any]:
     from quadimpact.inputs.policy_file import initial_policy
 
     pol = initial_policy(settings.hidden, settings.thrust_scale, settings.rate_scale_rad_s,
-                         problem.seed, settings.last_stage)  # fmt: skip
+                         problem.seed, settings.last_stage,
+                         settings.hover_centred)  # fmt: skip
     opts = {"seed": problem.seed, "popsize": settings.popsize, "verbose": -9}
     es = cma.CMAEvolutionStrategy(pol.vector(), settings.sigma, opts)
     return {
