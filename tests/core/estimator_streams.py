@@ -15,6 +15,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.estimators import estimate_sample, init_estimate
+from quadimpact.core.estimators import older_sensors as OS
 from quadimpact.core.estimators.ekf import covariance, ekf_dimension
 from quadimpact.core.records import new_data, new_output, new_work
 from quadimpact.inputs.scenarios import FlightScenario
@@ -107,8 +108,8 @@ class Harness:
         self.o.stats[:] = 0.0
         self.o.stats[L.ST_ONSET_T] = np.nan
         self.o.stats[L.ST_STAGE_T : L.ST_STAGE_T + L.N_STAGES] = np.nan
-        self.d.meas[L.MS_MAG_T] = np.nan
-        self.d.meas[L.MS_POSE_T] = np.nan
+        self.d.meas[OS.MAG_T] = np.nan
+        self.d.meas[OS.POSE_T] = np.nan
         init_estimate(self.m, self.d)
         self.i = 0
 
@@ -132,12 +133,12 @@ class Harness:
         meas[L.MS_IMU_W : L.MS_IMU_W + 3] = w
         meas[L.MS_IMU_T] = t
         if mag is not None:
-            meas[L.MS_MAG : L.MS_MAG + 3] = mag
-            meas[L.MS_MAG_T] = t
+            meas[OS.MAG : OS.MAG + 3] = mag
+            meas[OS.MAG_T] = t
         if pose is not None and np.all(np.isfinite(pose)):
-            meas[L.MS_POSE : L.MS_POSE + 3] = pose
-            meas[L.MS_POSE + 3 : L.MS_POSE + 7] = q_true
-            meas[L.MS_POSE_T] = t
+            meas[OS.POSE : OS.POSE + 3] = pose
+            meas[OS.POSE + 3 : OS.POSE + 7] = q_true
+            meas[OS.POSE_T] = t
         xs = self.d.x.copy()
         xs[L.X_QUAT : L.X_QUAT + 4] = q_true
         if pos is not None:

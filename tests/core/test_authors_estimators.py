@@ -14,6 +14,7 @@ from estimator_streams import Harness, constant_rotation, expmap, qmul
 
 from quadimpact.core import layout as L
 from quadimpact.core.estimators import ekf as EKF
+from quadimpact.core.estimators import older_sensors as OS
 from quadimpact.core.estimators.ekf_additive import _rotate_t, _transition
 from quadimpact.rotations import quat_to_matrix
 
@@ -23,7 +24,7 @@ MAG_2016 = {"dip_deg": 71.9, "norm": 0.99, "noise": 0.0}
 
 
 def _field(h: Harness) -> np.ndarray:
-    return h.m.scfg[L.SC_MAG_FIELD : L.SC_MAG_FIELD + 3].copy()
+    return h.m.scfg[OS.MAG_FIELD_I : OS.MAG_FIELD_I + 3].copy()
 
 
 def _mag(q: np.ndarray, field: np.ndarray) -> np.ndarray:

@@ -351,27 +351,19 @@ SC_IMPACT_F = _scfg.slot("SC_IMPACT_F")  # a0, m/s^2
 SC_IMPACT_W = _scfg.slot("SC_IMPACT_W")  # g0, rad/s
 SC_IMPACT_TAU = _scfg.slot("SC_IMPACT_TAU")  # tau, s (<= 0: off)
 SC_BIAS_WALK = _scfg.slot("SC_BIAS_WALK")  # gyro bias random walk, rad/s/sqrt(s) (0: off)
-SC_MAG = _scfg.slot("SC_MAG")  # 1: a magnetometer, sampled with the IMU
-SC_MAG_FIELD = _scfg.slot("SC_MAG_FIELD", 3)  # unit Earth field m_I, inertial NED
-SC_MAG_NOISE = _scfg.slot("SC_MAG_NOISE")  # magnetometer white-noise std per axis (unit field)
-SC_POSE = _scfg.slot("SC_POSE")  # 1: a pose sensor (motion capture, vision)
-SC_POSE_RATE = _scfg.slot("SC_POSE_RATE")  # Hz (taken at the first IMU sample at or after its time)
-SC_POSE_NOISE_P = _scfg.slot("SC_POSE_NOISE_P")  # position white-noise std per axis, m
-SC_POSE_ATT = _scfg.slot("SC_POSE_ATT")  # 1: it measures the attitude too
-SC_POSE_NOISE_A = _scfg.slot("SC_POSE_NOISE_A")  # attitude noise std per axis (rot. vector), rad
-SC_POSE_LAG = _scfg.slot("SC_POSE_LAG")  # latency, IMU samples (< MAX_POSE_LAG)
 SC_IMPACT_REPLACE = _scfg.slot("SC_IMPACT_REPLACE")  # 1: the impact noise replaces the nominal
 #   noise while it is the larger, restarting at each onset (the authors' model); 0: added
-SC_MAG_BIAS = _scfg.slot("SC_MAG_BIAS", 3)  # magnetometer static bias, body (drawn per run)
 # the sensor components' tails (core/sensors/registry.py): their sizes in this run's arrays
 SC_TAIL_ST = _scfg.slot("SC_TAIL_ST")  # numbers after NSST in sst
 SC_TAIL_MEAS = _scfg.slot("SC_TAIL_MEAS")  # numbers after NMEAS in meas
 SC_TAIL_REC = _scfg.slot("SC_TAIL_REC")  # columns after NIMU in each imu row
 NSCFG = _scfg.end("NSCFG")
-MAX_POSE_LAG = 64  # IMU samples
 MAX_AVERAGE_WINDOW = 64  # samples
 
-# ---- the added sensors' standard normal draws snoise (n_imu, NSN): row i for IMU sample i
+# ---- the added sensors' standard normal draws snoise (n_imu, NSN): row i for IMU sample i.
+# Frozen for good (every seeded run stays bit for bit): the magnetometer and the pose sensor,
+# now sensor components (core/sensors/magnetometer.py, pose.py), read their columns as a
+# legacy noise stream (LegacyColumns); a new sensor draws from a stream of its own (cnoise)
 _sn = Block("snoise", "SN_")
 SN_IMPACT = _sn.slot("SN_IMPACT", 6)  # impact disturbance (f_x, f_y, f_z, w_x, w_y, w_z)
 SN_WALK = _sn.slot("SN_WALK", 3)  # gyro bias random-walk increments
@@ -493,10 +485,6 @@ MS_T_DETECT = _ms.slot("MS_T_DETECT")  # s, time of the detecting sample (NaN: n
 MS_NORMAL = _ms.slot("MS_NORMAL", 3)  # wall-normal estimate at detection, inertial, unit
 MS_W_HAT = _ms.slot("MS_W_HAT", 3)  # estimated body rates (ideal: the gyro as measured), rad/s
 MS_BIAS_HAT = _ms.slot("MS_BIAS_HAT", 3)  # estimated gyro bias, rad/s
-MS_MAG = _ms.slot("MS_MAG", 3)  # latest magnetometer sample, body FRD (unit field)
-MS_MAG_T = _ms.slot("MS_MAG_T")  # s, its time (NaN: none)
-MS_POSE = _ms.slot("MS_POSE", 7)  # latest pose measurement: position (inertial, m), quaternion
-MS_POSE_T = _ms.slot("MS_POSE_T")  # s, the IMU sample at which it arrived (NaN: none)
 N_USER_MEAS = 8
 MS_USER = _ms.slot(
     "MS_USER", N_USER_MEAS
@@ -511,9 +499,6 @@ SS_DETECTOR = _sst.slot("SS_DETECTOR")  # the detector's state (core/sensors/det
 SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
 SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
 SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
-SS_POSE_NEXT_T = _sst.slot("SS_POSE_NEXT_T")  # s, time of the next pose measurement
-SS_POSE_N = _sst.slot("SS_POSE_N")  # pose measurements taken
-SS_POSE_RING = _sst.slot("SS_POSE_RING", 7 * MAX_POSE_LAG)  # true poses of the last samples
 NSST = _sst.end("NSST")
 
 # ---- estimator state est (NEST): the estimate after the latest IMU sample (what every
@@ -546,8 +531,6 @@ I_W = _imu.slot("I_W", 3)  # measured angular velocity, body FRD, rad/s
 I_F_TRUE = _imu.slot("I_F_TRUE", 3)  # true specific force at the IMU position, m/s^2
 I_W_TRUE = _imu.slot("I_W_TRUE", 3)  # true angular velocity, rad/s
 I_DETECTOR = _imu.slot("I_DETECTOR")  # the detector's column (core/sensors/detection.py)
-I_MAG = _imu.slot("I_MAG", 3)  # magnetometer sample, body FRD, unit field (NaN: none)
-I_POSE = _imu.slot("I_POSE", 7)  # pose measurement arrived here: position, quaternion (NaN: none)
 I_Q_HAT = _imu.slot("I_Q_HAT", 4)  # attitude estimate after this sample
 I_BIAS_HAT = _imu.slot("I_BIAS_HAT", 3)  # gyro bias estimate, rad/s
 I_VEL_HAT = _imu.slot("I_VEL_HAT", 3)  # velocity estimate, inertial, m/s

@@ -50,7 +50,6 @@ from quadimpact.core.layout import (
     MS_IMU_F,
     MS_IMU_T,
     MS_IMU_W,
-    MS_MAG,
     MS_NORMAL,
     MS_T,
     MS_T_DETECT,
@@ -70,6 +69,7 @@ from quadimpact.core.layout import (
     X_ROTOR,
     X_VEL,
 )
+from quadimpact.core.sensors.registry import measurement_address
 
 __all__ = [
     "MEASUREMENT_FIELDS",
@@ -102,6 +102,8 @@ __all__ = [
     "velocity_body",
     "wall_normal",
 ]
+
+MS_MAG = measurement_address("magnetometer", "field")  # a sensor component's slot
 
 
 # ----------------------------------------------------------- the measurement

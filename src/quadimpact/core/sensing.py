@@ -1,8 +1,8 @@
 """The sensor stage of the loop: one IMU sample, the estimator's update there, detection.
 
-At each IMU sample: the IMU (``imu.py``), the magnetometer and the pose
-sensor when the run has them (``magnetometer.py``, ``pose.py``), every
-sensor component (``sensors/registry.py``: the barometer...), the
+At each IMU sample: the IMU (``imu.py``), every sensor component
+(``sensors/registry.py``: the barometer..., the magnetometer and the pose
+sensor), the
 estimator's update (``core/estimators``), the detector with the estimated
 attitude (``detection.py``), then a plug-in sensor. The run loop takes the
 samples on the dense output of each step (so a sample at a control tick
@@ -21,8 +21,6 @@ from quadimpact.core.layout import LS_T0, SC_RATE, SS_N, SS_NEXT_T
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.sensors.detection import detect
 from quadimpact.core.sensors.imu import imu_sample
-from quadimpact.core.sensors.magnetometer import magnetometer_sample
-from quadimpact.core.sensors.pose import pose_sample
 from quadimpact.core.sensors.registry import sample_components
 
 
@@ -48,8 +46,6 @@ def take_sample(
     ``w.C`` must hold the rotation of ``xs``. Schedules the next sample.
     """
     imu_sample(t, xs, xd, w.C, m, d, o)
-    magnetometer_sample(t, w.C, m, d, o)
-    pose_sample(t, xs, m, d, o)
     sample_components(t, xs, xd, w.C, m, d, o)
     estimate_sample(t, xs, w.C, m, d, o, w)
     detect(t, xs, attitude_at_sample(t, xs, w.C, m, d, w), m, d, o)

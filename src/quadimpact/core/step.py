@@ -65,8 +65,6 @@ from quadimpact.core.layout import (
     LS_TF,
     MEM_STAGE,
     MS_IMU_T,
-    MS_MAG_T,
-    MS_POSE_T,
     MS_T_DETECT,
     N_STAGES,
     NEX,
@@ -171,8 +169,6 @@ def start(m: Model, d: Data, o: Output) -> None:
     d.meas[:] = 0.0
     d.meas[MS_IMU_T] = np.nan
     d.meas[MS_T_DETECT] = np.nan
-    d.meas[MS_MAG_T] = np.nan
-    d.meas[MS_POSE_T] = np.nan
     init_estimate(m, d)
     at_tick(t0, m, d)
     d.sst[:] = 0.0

@@ -46,6 +46,8 @@ from pydantic import (
     model_validator,
 )
 
+from quadimpact.core.sensors.magnetometer import Magnetometer
+from quadimpact.core.sensors.pose import PoseSensor
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3
 
 __all__ = [
@@ -89,41 +91,6 @@ class ImpactDisturbance(BaseModel):
         "several onsets add); 'replace': the latest onset's noise replaces the nominal noise "
         "while it is the larger (the authors' 2016 study).",
     )
-
-
-class Magnetometer(BaseModel):
-    """A magnetometer sampled with the IMU: the unit Earth field in body axes, with noise.
-
-    The field ``m_I`` points to magnetic north (+X) and dips ``dip_deg`` below
-    the horizon (down positive, NED), of length ``norm`` (1: a unit field);
-    a static bias of standard deviation ``bias`` per axis is drawn once per
-    run. Without a magnetometer yaw is unobservable and an estimator's heading
-    drifts with the gyro bias.
-    """
-
-    model_config = MODEL_CONFIG
-
-    dip_deg: Real = Field(60.0, ge=-90, le=90, description="Dip of the field, deg (down +).")
-    noise: Real = Field(7e-3, ge=0, description="White-noise std per axis, unit field.")
-    norm: Real = Field(1.0, gt=0, le=10, description="Length of the field (1: unit).")
-    bias: Real = Field(0.0, ge=0, description="Std of the static bias per axis (per run).")
-
-
-class PoseSensor(BaseModel):
-    """A pose sensor (motion capture or vision): position, and optionally attitude.
-
-    Measures at ``rate_hz`` (taken at the first IMU sample at or after each of
-    its times), with white noise, delivered ``latency_s`` later (rounded to
-    whole IMU samples, at most 63).
-    """
-
-    model_config = MODEL_CONFIG
-
-    rate_hz: Real = Field(100.0, gt=0, le=100000, description="Measurement rate, Hz.")
-    position_noise_m: Real = Field(1e-3, ge=0, description="Position noise std per axis, m.")
-    attitude: StrictBool = Field(True, description="Measure the attitude too.")
-    attitude_noise_deg: Real = Field(0.5, ge=0, description="Attitude noise std per axis, deg.")
-    latency_s: Real = Field(0.0, ge=0, le=1, description="Latency, s.")
 
 
 IMU_PRESETS: dict[str, dict[str, float | None]] = {
@@ -478,8 +445,12 @@ def _instruments(value: Any) -> dict[str, Any]:
         try:
             comp = component(str(name))
         except KeyError:
-            known = ", ".join(repr(c.name) for c in components())
+            known = ", ".join(repr(c.name) for c in components() if not c.scenario_key)
             raise ValueError(f"{name}: no such sensor component (registered: {known})") from None
+        if comp.scenario_key:
+            raise ValueError(
+                f"{name}: set it as the scenario's [{comp.scenario_key}] table, not in instruments"
+            )
         if table is False:
             continue
         if table is True:

@@ -11,9 +11,10 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from pydantic import BeforeValidator, ConfigDict
+from pydantic import BeforeValidator
 
 from quadimpact.core.layout import MAX_ROTORS
+from quadimpact.core.settings_types import MODEL_CONFIG, Real
 
 __all__ = [
     "MODEL_CONFIG",
@@ -29,17 +30,6 @@ __all__ = [
     "RotorSigns",
     "RotorReals",
 ]
-
-MODEL_CONFIG = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-"""The settings of every input model: unknown keys refused, immutable, finite numbers only."""
-
-
-def _real(value: Any) -> Any:
-    if hasattr(value, "item") and not isinstance(value, (list, tuple)):
-        value = value.item()
-    if isinstance(value, (bool, str)):
-        raise ValueError("must be a number")
-    return value
 
 
 def _int_sign(value: Any) -> Any:
@@ -109,9 +99,6 @@ def _rotor_list(value: Any) -> Any:
         )
     return value
 
-
-Real = Annotated[float, BeforeValidator(_real)]
-"""A finite float (finiteness is enforced by ``allow_inf_nan=False`` on the models)."""
 
 Sign = Annotated[int, BeforeValidator(_int_sign)]
 """An integer, meant to be +1 or -1 (checked by the model)."""

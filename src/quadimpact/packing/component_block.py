@@ -25,7 +25,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.sensors.component import PackContext
 from quadimpact.core.sensors.registry import addresses, components, tail_sizes
 
-__all__ = ["COMPONENT_STREAM", "draw_component_noise", "pack_components"]
+__all__ = ["COMPONENT_STREAM", "draw_component_noise", "named_components", "pack_components"]
 
 COMPONENT_STREAM = 4  # the streams 1-3 are the added sensors' and estimator's
 
@@ -59,6 +59,21 @@ def pack_components(
     return out
 
 
+def named_components(settings: Any, instruments: Mapping[str, Any]) -> dict[str, Any]:
+    """The components a run has, name -> settings: its ``instruments`` and the older sensors.
+
+    A component with a ``scenario_key`` (the magnetometer, the pose sensor)
+    takes its settings from that field of the run's ``settings`` (``None``: absent).
+    """
+    out = dict(instruments)
+    for c in components():
+        if c.scenario_key:
+            value = getattr(settings, c.scenario_key, None)
+            if value is not None:
+                out[c.name] = value
+    return out
+
+
 def draw_component_noise(instruments: Mapping[str, Any], seed: int, n_imu: int) -> np.ndarray:
     """The named components' standard normal draws, ``(n_imu, noise tail)``.
 
@@ -66,7 +81,11 @@ def draw_component_noise(instruments: Mapping[str, Any], seed: int, n_imu: int) 
     """
     n_noise = tail_sizes()[3]
     where = addresses()
-    named = [c for c in components() if c.name in instruments and c.sizes()[3] > 0]
+    named = [
+        c
+        for c in components()
+        if c.name in instruments and c.sizes()[3] > 0 and c.legacy_noise is None
+    ]
     if not named or n_imu <= 0:
         return np.zeros((0, n_noise))
     out = np.zeros((n_imu, n_noise))

@@ -33,6 +33,7 @@ from quadimpact.core.estimators import complementary as CF
 from quadimpact.core.estimators import ekf as EKF
 from quadimpact.core.estimators import ekf_additive as ADD
 from quadimpact.core.estimators import nav_ekf as NAV
+from quadimpact.core.sensors.registry import config_address
 from quadimpact.inputs.estimators import (
     AdditiveEkfParams,
     ComplementaryParams,
@@ -213,12 +214,12 @@ def _stream(seed: int, key: int) -> np.random.Generator:
 
 
 def pack_added_sensors(s: Any, imu: ResolvedImu, scfg: np.ndarray) -> bool:
-    """Fill ``scfg``'s slots of the added sensors (in place); whether any of them is noisy.
+    """Fill ``scfg``'s slots of the IMU's added noises (in place); whether ``snoise`` is drawn.
 
     The IMU's impact disturbance (m/s^2, rad/s, s) and gyro bias random walk
-    (rad/s/sqrt(s)), the magnetometer (its field in the inertial frame from
-    its dip, deg) and the pose sensor (rate, Hz; noises, m and rad; latency
-    in IMU samples). Noisy: one of them draws random numbers (``snoise``).
+    (rad/s/sqrt(s)). The magnetometer and the pose sensor are sensor
+    components (their config is packed with the others'), but their draws are
+    still columns of ``snoise``: noisy when one of the four draws random numbers.
     """
     dist = imu.impact_disturbance
     if dist is not None:
@@ -228,22 +229,7 @@ def pack_added_sensors(s: Any, imu: ResolvedImu, scfg: np.ndarray) -> bool:
         scfg[L.SC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
     scfg[L.SC_BIAS_WALK] = imu.gyro_bias_walk_rad_s_sqrt_s
     mag = s.magnetometer
-    if mag is not None:
-        dip = math.radians(mag.dip_deg)
-        scfg[L.SC_MAG] = 1.0
-        field = (math.cos(dip), 0.0, math.sin(dip))
-        if mag.norm != 1.0:
-            field = tuple(mag.norm * c for c in field)
-        scfg[L.SC_MAG_FIELD : L.SC_MAG_FIELD + 3] = field
-        scfg[L.SC_MAG_NOISE] = mag.noise
     pose = s.pose_sensor
-    if pose is not None:
-        scfg[L.SC_POSE] = 1.0
-        scfg[L.SC_POSE_RATE] = pose.rate_hz
-        scfg[L.SC_POSE_NOISE_P] = pose.position_noise_m
-        scfg[L.SC_POSE_ATT] = 1.0 if pose.attitude else 0.0
-        scfg[L.SC_POSE_NOISE_A] = math.radians(pose.attitude_noise_deg)
-        scfg[L.SC_POSE_LAG] = min(round(pose.latency_s * float(imu.rate_hz)), L.MAX_POSE_LAG - 1)
     return (
         (dist is not None and (dist.accel_m_s2 > 0.0 or dist.gyro_rad_s > 0.0))
         or imu.gyro_bias_walk_rad_s_sqrt_s > 0.0
@@ -358,5 +344,6 @@ def draw_estimation(
         draws = _stream(seed, EXTRA_STREAM).standard_normal(6) * est.extra_std
         ecfg[L.EC_INIT_EULER : L.EC_INIT_EULER + 3] = draws[0:3]
         if scfg is not None:
-            scfg[L.SC_MAG_BIAS : L.SC_MAG_BIAS + 3] = draws[3:6]
+            bias = config_address("magnetometer", "bias")
+            scfg[bias : bias + 3] = draws[3:6]
     return ecfg, snoise

@@ -28,7 +28,11 @@ from quadimpact.core.sensors.component import PackContext as ComponentContext
 from quadimpact.inputs.controllers import ControllerEntry, PackContext
 from quadimpact.inputs.resolved import ResolvedRun, ResolvedShared
 from quadimpact.inputs.sensors import ResolvedImu
-from quadimpact.packing.component_block import draw_component_noise, pack_components
+from quadimpact.packing.component_block import (
+    draw_component_noise,
+    named_components,
+    pack_components,
+)
 from quadimpact.packing.controller_block import pack_controller, pack_waypoint, set_references
 from quadimpact.packing.estimator_block import Estimation, draw_estimation, pack_estimation
 from quadimpact.packing.options_block import pack_run_options, pack_schedule
@@ -105,7 +109,7 @@ def pack_shared(r: ResolvedShared) -> SharedPacking:
     scfg, n_imu = pack_sensors(imu, s.detection, v, r.duration_s)
     scfg = pack_components(
         scfg,
-        r.instruments,
+        named_components(s, r.instruments),
         ComponentContext(
             gravity_m_s2=float(v.gravity_m_s2),
             imu_rate_hz=float(imu.rate_hz),

@@ -20,6 +20,7 @@ from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.excursion import DEG
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors.registry import config_address
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
 from quadimpact.results.summary_record import (
@@ -61,6 +62,8 @@ STATUS_NAMES = {
     L.STATUS_CRASHED: "crashed",
     L.STATUS_FAILED: "failed",
 }
+_MAG_ON = config_address("magnetometer", "on")  # sensor components' switches
+_POSE_ON = config_address("pose_sensor", "on")
 SPEED_CHECK_TOL_M_S = 1e-6  # reached impact speed vs request, warn beyond
 ONSET_TIME_TOL_S = 1e-6  # first contact time vs T_c, warn beyond
 
@@ -323,8 +326,8 @@ def _estimation(setup: RunSetup, scenario: Any, st: np.ndarray) -> dict[str, Any
         "estimator_settings": setup.estimator_settings,
         "sensors": getattr(scenario, "sensors", None),
         "impact_disturbance": bool(scfg[L.SC_IMPACT_TAU] > 0.0),
-        "magnetometer": bool(scfg[L.SC_MAG] > 0.5),
-        "pose_sensor": bool(scfg[L.SC_POSE] > 0.5),
+        "magnetometer": bool(scfg[_MAG_ON] > 0.5),
+        "pose_sensor": bool(scfg[_POSE_ON] > 0.5),
     }
     out.update(estimation_metrics(st))
     return out

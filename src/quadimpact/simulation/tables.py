@@ -17,7 +17,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.sensors import detection as DET
-from quadimpact.core.sensors.registry import record_columns
+from quadimpact.core.sensors.registry import record_address, record_columns
 from quadimpact.inputs.features import feature_column
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
 from quadimpact.rotations import body_to_inertial, quat_to_euler_zyx
@@ -267,6 +267,12 @@ def timeseries_columns(
     return {k: np.array(v, dtype=np.float64) for k, v in data.items()}
 
 
+# the magnetometer's and the pose sensor's columns (sensor components whose columns
+# are among the table's fixed ones, at their place: ``mx``..., ``pose_x_m``...)
+_MAG = record_address("magnetometer")
+_POSE = record_address("pose_sensor")
+
+
 def imu_columns(raw: np.ndarray, scfg: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """The columns of :func:`imu_frame` as NumPy arrays (no DataFrame).
 
@@ -279,12 +285,15 @@ def imu_columns(raw: np.ndarray, scfg: np.ndarray | None = None) -> dict[str, np
         L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
         L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
         DET.I_HORIZONTAL,
-        *range(L.I_MAG, L.I_MAG + 3), *range(L.I_POSE, L.I_POSE + 7),
+        *range(_MAG, _MAG + 3), *range(_POSE, _POSE + 7),
         *range(L.I_Q_HAT, L.I_Q_HAT + 4), *range(L.I_BIAS_HAT, L.I_BIAS_HAT + 3),
         *range(L.I_VEL_HAT, L.I_VEL_HAT + 3), *range(L.I_POS_HAT, L.I_POS_HAT + 3),
         *range(L.I_BIAS_TRUE, L.I_BIAS_TRUE + 3), *range(L.I_ERR, L.I_ERR + 4),
     )  # fmt: skip
-    out = {name: rows[:, col].copy() for name, col in zip(IMU_COLUMNS, sources, strict=True)}
+    out = {
+        name: rows[:, col].copy() if col < rows.shape[1] else np.full(len(rows), np.nan)
+        for name, col in zip(IMU_COLUMNS, sources, strict=True)
+    }
     if scfg is not None:
         for name, col, _unit in record_columns(scfg):
             out[name] = rows[:, col].copy() if col < rows.shape[1] else np.full(len(rows), np.nan)

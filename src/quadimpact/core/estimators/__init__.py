@@ -94,8 +94,9 @@ def plugin_estimator(t: float, dt: float, meas: np.ndarray, ecfg: np.ndarray, es
 
     At each IMU sample ``t`` (s), ``dt`` (s) after the previous one (0 at the
     first), it reads the measurement record ``meas`` (``MS_IMU_F``,
-    ``MS_IMU_W``; ``MS_MAG`` when ``meas[MS_MAG_T] == t``; ``MS_POSE`` when
-    ``meas[MS_POSE_T] == t``) and its parameters ``ecfg[EC_USER...]``, and
+    ``MS_IMU_W``; the magnetometer's and the pose sensor's slots, sensor
+    components' addresses: ``older_sensors.MAG`` when ``meas[MAG_T] == t``,
+    ``POSE`` when ``meas[POSE_T] == t``) and its parameters ``ecfg[EC_USER...]``, and
     updates its state ``est``: the estimate in ``ES_Q``, ``ES_BIAS``,
     ``ES_VEL``, ``ES_POS``, ``ES_W`` (the initial estimate is there at the
     first call), its own state in ``ES_USER``.

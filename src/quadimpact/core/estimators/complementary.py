@@ -48,6 +48,7 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T, POSE, POSE_ATT, POSE_T
 from quadimpact.core.layout import (
     EC_OWN,
     ES_BIAS,
@@ -58,13 +59,7 @@ from quadimpact.core.layout import (
     ES_W,
     MS_IMU_F,
     MS_IMU_W,
-    MS_MAG,
-    MS_MAG_T,
-    MS_POSE,
-    MS_POSE_T,
     N_OWN_ECFG,
-    SC_MAG_FIELD,
-    SC_POSE_ATT,
     V_GRAVITY,
     Block,
 )
@@ -128,8 +123,8 @@ def complementary_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) 
         ex = ay * vz - az * vy
         ey = az * vx - ax * vz
         ez = ax * vy - ay * vx
-    if meas[MS_MAG_T] == t and ecfg[EC_CF_RAW] < 0.5:
-        mm = meas[MS_MAG : MS_MAG + 3]
+    if meas[MAG_T] == t and ecfg[EC_CF_RAW] < 0.5:
+        mm = meas[MAG : MAG + 3]
         nn = math.sqrt(mm[0] * mm[0] + mm[1] * mm[1] + mm[2] * mm[2])
         if nn > 0.0:
             ux = mm[0] / nn
@@ -171,9 +166,9 @@ def _raw_errors(
         ex = f[1] * vz - f[2] * vy
         ey = f[2] * vx - f[0] * vz
         ez = f[0] * vy - f[1] * vx
-    if meas[MS_MAG_T] == t:
-        mm = meas[MS_MAG : MS_MAG + 3]
-        mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
+    if meas[MAG_T] == t:
+        mm = meas[MAG : MAG + 3]
+        mi = m.scfg[MAG_FIELD_I : MAG_FIELD_I + 3]
         wx = C[0, 0] * mi[0] + C[1, 0] * mi[1] + C[2, 0] * mi[2]
         wy = C[0, 1] * mi[0] + C[1, 1] * mi[1] + C[2, 1] * mi[2]
         wz = C[0, 2] * mi[0] + C[1, 2] * mi[1] + C[2, 2] * mi[2]
@@ -227,14 +222,14 @@ def _correct(
     rotate_by(q, wx_c * dt, wy_c * dt, wz_c * dt)
     dcm(q, C)
     integrate_navigation(est, C, f, g, dt)
-    if meas[MS_POSE_T] == t:
+    if meas[POSE_T] == t:
         kp = ecfg[EC_K_POS]
         kv = ecfg[EC_K_VEL]
         for a in range(3):
-            e = meas[MS_POSE + a] - est[ES_POS + a]
+            e = meas[POSE + a] - est[ES_POS + a]
             est[ES_POS + a] += kp * e
             est[ES_VEL + a] += kv * e
-        if m.scfg[SC_POSE_ATT] > 0.5:
-            px, py, pz = error_vector(q, meas[MS_POSE + 3 : MS_POSE + 7])
+        if m.scfg[POSE_ATT] > 0.5:
+            px, py, pz = error_vector(q, meas[POSE + 3 : POSE + 7])
             rotate_by(q, kp * px, kp * py, kp * pz)
             dcm(q, C)

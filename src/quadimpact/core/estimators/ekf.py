@@ -56,6 +56,7 @@ import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T, POSE, POSE_ATT, POSE_T
 from quadimpact.core.layout import (
     EC_OWN,
     ES_BIAS,
@@ -67,14 +68,8 @@ from quadimpact.core.layout import (
     ES_W,
     MS_IMU_F,
     MS_IMU_W,
-    MS_MAG,
-    MS_MAG_T,
-    MS_POSE,
-    MS_POSE_T,
     N_OWN_ECFG,
     N_OWN_EST,
-    SC_MAG_FIELD,
-    SC_POSE_ATT,
     V_GRAVITY,
     Block,
 )
@@ -342,27 +337,27 @@ def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
         kalman_update(est, W, n, y, r)
         dcm(q, C)
     # magnetometer: H_theta = [u_m x], u_m = C^T m_I
-    if meas[MS_MAG_T] == t:
-        mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
+    if meas[MAG_T] == t:
+        mi = m.scfg[MAG_FIELD_I : MAG_FIELD_I + 3]
         u0 = C[0, 0] * mi[0] + C[1, 0] * mi[1] + C[2, 0] * mi[2]
         u1 = C[0, 1] * mi[0] + C[1, 1] * mi[1] + C[2, 1] * mi[2]
         u2 = C[0, 2] * mi[0] + C[1, 2] * mi[1] + C[2, 2] * mi[2]
-        y[0] = meas[MS_MAG] - u0
-        y[1] = meas[MS_MAG + 1] - u1
-        y[2] = meas[MS_MAG + 2] - u2
+        y[0] = meas[MAG] - u0
+        y[1] = meas[MAG + 1] - u1
+        y[2] = meas[MAG + 2] - u2
         _skew(H, 1.0, u0, u1, u2)
         kalman_update(est, W, n, y, ecfg[EC_SIG_MAG] ** 2)
         dcm(q, C)
     # pose sensor: position (H_p = I), attitude (H_theta = I)
-    if meas[MS_POSE_T] == t:
+    if meas[POSE_T] == t:
         if n == N_EKF:
             _unit(H, 9)
             for k in range(3):
-                y[k] = meas[MS_POSE + k] - est[ES_POS + k]
+                y[k] = meas[POSE + k] - est[ES_POS + k]
             kalman_update(est, W, n, y, ecfg[EC_SIG_POS] ** 2)
-        if m.scfg[SC_POSE_ATT] > 0.5:
+        if m.scfg[POSE_ATT] > 0.5:
             _unit(H, 0)
-            y[0], y[1], y[2] = error_vector(q, meas[MS_POSE + 3 : MS_POSE + 7])
+            y[0], y[1], y[2] = error_vector(q, meas[POSE + 3 : POSE + 7])
             kalman_update(est, W, n, y, ecfg[EC_SIG_ATT] ** 2)
         dcm(q, C)
     for i in range(n):

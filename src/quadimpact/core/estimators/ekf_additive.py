@@ -35,6 +35,7 @@ import numpy as np
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.estimators.ekf import EC_GATE, ES_P, N_EKF, N_EKF_CFG
 from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T
 from quadimpact.core.layout import (
     EC_OWN,
     ES_BIAS,
@@ -43,10 +44,7 @@ from quadimpact.core.layout import (
     ES_W,
     MS_IMU_F,
     MS_IMU_W,
-    MS_MAG,
-    MS_MAG_T,
     N_OWN_ECFG,
-    SC_MAG_FIELD,
     V_GRAVITY,
     Block,
 )
@@ -223,11 +221,11 @@ def additive_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> No
         h = _rotate_t(q, (0.0, 0.0, -g), J, 0)
         for i in range(3):
             _scalar_update(P, J, i, f[i] - h[i], ecfg[EC_R_ACC], dx, T)
-    if meas[MS_MAG_T] == t:
-        mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
+    if meas[MAG_T] == t:
+        mi = m.scfg[MAG_FIELD_I : MAG_FIELD_I + 3]
         h = _rotate_t(q, (mi[0], mi[1], mi[2]), J, 3)
         for i in range(3):
-            _scalar_update(P, J, 3 + i, meas[MS_MAG + i] - h[i], ecfg[EC_R_MAG], dx, T)
+            _scalar_update(P, J, 3 + i, meas[MAG + i] - h[i], ecfg[EC_R_MAG], dx, T)
     for a in range(4):
         q[a] += dx[a]
     _normalise(q)

@@ -113,6 +113,7 @@ from quadimpact.core.estimators.ekf import (
     impact_noise_factor,
 )
 from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T
 from quadimpact.core.layout import (
     EC_INIT_BIAS_ZERO,
     EC_OWN,
@@ -124,12 +125,9 @@ from quadimpact.core.layout import (
     ES_W,
     MS_IMU_F,
     MS_IMU_W,
-    MS_MAG,
-    MS_MAG_T,
     N_OWN_ECFG,
     N_OWN_EST,
     SC_BIAS,
-    SC_MAG_FIELD,
     SC_RANGE_F,
     SC_RANGE_W,
     V_GRAVITY,
@@ -760,16 +758,16 @@ def nav_ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> Non
     _gravity(est, P, Wu, ecfg, fc, g, C, impact)
     dcm(q, C)
     # magnetometer: m = C^T m_I (H_theta = [u_m x], u_m = C^T m_I)
-    if meas[MS_MAG_T] == t:
-        mi = m.scfg[SC_MAG_FIELD : SC_MAG_FIELD + 3]
+    if meas[MAG_T] == t:
+        mi = m.scfg[MAG_FIELD_I : MAG_FIELD_I + 3]
         u0 = C[0, 0] * mi[0] + C[1, 0] * mi[1] + C[2, 0] * mi[2]
         u1 = C[0, 1] * mi[0] + C[1, 1] * mi[1] + C[2, 1] * mi[2]
         u2 = C[0, 2] * mi[0] + C[1, 2] * mi[1] + C[2, 2] * mi[2]
         _clear(H)
         _skew(H, 1.0, u0, u1, u2)
-        y[0] = meas[MS_MAG] - u0
-        y[1] = meas[MS_MAG + 1] - u1
-        y[2] = meas[MS_MAG + 2] - u2
+        y[0] = meas[MAG] - u0
+        y[1] = meas[MAG + 1] - u1
+        y[2] = meas[MAG + 2] - u2
         r[0] = r[1] = r[2] = ecfg[EC_SIG_MAG] ** 2
         norm = math.sqrt(mi[0] * mi[0] + mi[1] * mi[1] + mi[2] * mi[2])
         _fuse(t, SRC_MAG, est, P, Wu, 3, ecfg, I_TH, I_TH + 3, 1.0 / norm)

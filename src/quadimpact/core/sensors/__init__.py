@@ -5,11 +5,11 @@
 * ``imu.py``: the IMU (specific force with the lever-arm terms, gyro; noise,
   bias, saturation, low-pass), sampled by the run loop on the dense output;
 * ``detection.py``: impact detection from the IMU samples alone and the
-  wall-normal estimate (with the estimated attitude).
+  wall-normal estimate (with the estimated attitude);
+* sensor components (``component.py``, ``registry.py``): the barometer,
+  the rangefinder, the optical-flow camera, the magnetometer and the pose
+  sensor, each one module registered in one line.
 
-A new sensor is a module here with a ``*_sample`` function called from the
-loop where the IMU's is (``step.py``'s ``_sample_sensors``), its configuration
-slots (a ``Block`` in ``layout.py``), its fields in the measurement record,
-and its packing (``packing/sensor_block.py``); docs/ARCHITECTURE.md has the
-recipe.
+A new sensor is a component: docs/ARCHITECTURE.md 10 and
+docs/howto/add-a-sensor.md have the checklist.
 """

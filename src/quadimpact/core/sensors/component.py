@@ -47,7 +47,15 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 
-__all__ = ["PackContext", "SensorComponent", "Slot", "offsets", "sample_due", "size"]
+__all__ = [
+    "LegacyColumns",
+    "PackContext",
+    "SensorComponent",
+    "Slot",
+    "offsets",
+    "sample_due",
+    "size",
+]
 
 
 @dataclass(frozen=True)
@@ -78,6 +86,21 @@ def size(slots: tuple[Slot, ...]) -> int:
 
 
 @dataclass(frozen=True)
+class LegacyColumns:
+    """A legacy noise stream: columns ``start .. start + width`` of the frozen ``snoise``.
+
+    Only the sensors that predate components declare one (the magnetometer,
+    the pose sensor): their draws stay where they were, so every seeded run
+    is bit for bit what it was. ``snoise`` is drawn from the added sensors'
+    stream when one of the older sensors is noisy (``packing/estimator_block.py``).
+    A new component never declares one: it draws from a stream of its own.
+    """
+
+    start: int
+    width: int
+
+
+@dataclass(frozen=True)
 class SensorComponent:
     """An added sensor, as its module declares it.
 
@@ -98,6 +121,17 @@ class SensorComponent:
         Its blocks.
     doc : str
         One line: what it measures.
+    legacy_noise : LegacyColumns, optional
+        Its draws are columns of the frozen ``snoise`` matrix, not a block of
+        ``cnoise`` (only the sensors that predate components).
+    columns : tuple of str, optional
+        Its record columns' names, one per number, when they are among the
+        IMU table's fixed columns (``mx``...: kept from before components):
+        they are in every run's table at their place (NaN when off), not
+        ``<name>_<slot>`` columns after the fixed ones.
+    scenario_key : str, optional
+        The run settings' field that holds its settings (``magnetometer``),
+        when a scenario names it there and not in ``[instruments.<name>]``.
     """
 
     name: str
@@ -111,19 +145,34 @@ class SensorComponent:
     record: tuple[Slot, ...] = ()
     doc: str = ""
     plugin: bool = field(default=False, compare=False)
+    legacy_noise: LegacyColumns | None = None
+    columns: tuple[str, ...] = ()
+    scenario_key: str = ""
+
+    def __post_init__(self) -> None:
+        if self.legacy_noise is not None and self.legacy_noise.width != size(self.noise):
+            raise ValueError(f"sensor {self.name}: its legacy noise columns must match its noise")
+        if self.columns and len(self.columns) != size(self.record):
+            raise ValueError(f"sensor {self.name}: one column name per record number")
 
     def sizes(self) -> tuple[int, int, int, int, int]:
-        """Numbers of its config, state, measurement, noise and record blocks."""
+        """Numbers of its config, state, measurement, noise and record blocks.
+
+        The noise counts its block of ``cnoise``: 0 for a legacy stream.
+        """
         return (
             size(self.config),
             size(self.state),
             size(self.measurement),
-            size(self.noise),
+            0 if self.legacy_noise is not None else size(self.noise),
             size(self.record),
         )
 
     def record_columns(self) -> list[tuple[str, str]]:
         """Its record columns in order: ``(column name, unit)``, one per number."""
+        if self.columns:
+            units = [s.unit for s in self.record for _ in range(s.width)]
+            return list(zip(self.columns, units, strict=True))
         out = []
         for s in self.record:
             if s.width == 1:

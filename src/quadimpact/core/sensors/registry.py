@@ -29,7 +29,7 @@ from numba.core.errors import NumbaExperimentalFeatureWarning
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import NIMU, NMEAS, NSCFG, NSST, SS_N
 from quadimpact.core.records import Data, Model, Output
-from quadimpact.core.sensors import barometer, optical_flow, rangefinder
+from quadimpact.core.sensors import barometer, magnetometer, optical_flow, pose, rangefinder
 from quadimpact.core.sensors.component import SensorComponent, offsets
 
 __all__ = [
@@ -39,7 +39,9 @@ __all__ = [
     "addresses",
     "component",
     "components",
+    "config_address",
     "measurement_address",
+    "record_address",
     "record_columns",
     "register_sensor",
     "sample_components",
@@ -54,6 +56,8 @@ BUILTIN: tuple[SensorComponent, ...] = (
     barometer.SENSOR,  # altitude, white noise, bias walk
     rangefinder.SENSOR,  # slant range to the ground along the body's down axis
     optical_flow.SENSOR,  # the ground image's angular rate, with quality and delay
+    magnetometer.SENSOR,  # the Earth's field in body axes (draws: legacy snoise columns)
+    pose.SENSOR,  # position and attitude from motion capture (draws: legacy snoise columns)
 )
 """The built-in sensor components, one line each."""
 
@@ -86,7 +90,10 @@ def component(name: str) -> SensorComponent:
 
 
 def addresses(comps: tuple[SensorComponent, ...] | None = None) -> dict[str, Address]:
-    """Each component's blocks in the arrays' tails (offsets from the tail's start)."""
+    """Each component's blocks in the arrays' tails (offsets from the tail's start).
+
+    A legacy noise stream's span is its columns of ``snoise``, not of ``cnoise``.
+    """
     at = [0, 0, 0, 0, 0]
     out = {}
     for c in components() if comps is None else comps:
@@ -94,6 +101,9 @@ def addresses(comps: tuple[SensorComponent, ...] | None = None) -> dict[str, Add
         for k, n in enumerate(c.sizes()):
             spans.append((at[k], at[k] + n))
             at[k] += n
+        legacy = c.legacy_noise
+        if legacy is not None:
+            spans[3] = (legacy.start, legacy.start + legacy.width)
         out[c.name] = Address(*spans)
     return out
 
@@ -113,6 +123,18 @@ def measurement_address(name: str, slot: str) -> int:
     return NMEAS + addresses()[name].measurement[0] + offsets(c.measurement)[slot]
 
 
+def config_address(name: str, slot: str) -> int:
+    """The index in the sensor settings ``scfg`` of component ``name``'s config ``slot``."""
+    c = component(name)
+    return NSCFG + addresses()[name].config[0] + offsets(c.config)[slot]
+
+
+def record_address(name: str) -> int:
+    """The column of a raw IMU row where component ``name``'s record columns start."""
+    component(name)
+    return NIMU + addresses()[name].record[0]
+
+
 def active(scfg: np.ndarray) -> tuple[SensorComponent, ...]:
     """The components a run packed with ``scfg`` has (config block not all zeros)."""
     where = addresses()
@@ -126,10 +148,15 @@ def active(scfg: np.ndarray) -> tuple[SensorComponent, ...]:
 
 
 def record_columns(scfg: np.ndarray) -> list[tuple[str, int, str]]:
-    """The IMU table's columns of the run's components: ``(name, column of a raw row, unit)``."""
+    """The IMU table's columns of the run's components: ``(name, column of a raw row, unit)``.
+
+    A component whose columns are among the table's fixed ones (``columns``) is not listed.
+    """
     where = addresses()
     out = []
     for c in active(scfg):
+        if c.columns:
+            continue
         lo = where[c.name].record[0]
         for k, (name, unit) in enumerate(c.record_columns()):
             out.append((name, NIMU + lo + k, unit))
@@ -145,12 +172,18 @@ def register_sensor(comp: SensorComponent) -> None:
         Not a :class:`SensorComponent`, or its sample function not compiled.
     ValueError
         A component of that name is registered already (a built-in, or a
-        plug-in registered with other blocks).
+        plug-in registered with other blocks), or it declares a legacy
+        noise stream, fixed columns or a scenario key.
     """
     if not isinstance(comp, SensorComponent):
         raise TypeError("register_sensor: expected a SensorComponent")
     if not hasattr(comp.sample, "py_func"):
         raise TypeError(f"sensor {comp.name}: sample must be a numba.njit function")
+    if comp.legacy_noise is not None or comp.columns or comp.scenario_key:
+        raise ValueError(
+            f"sensor {comp.name}: legacy_noise, columns and scenario_key are for the "
+            "sensors that predate components; a plug-in draws from a stream of its own"
+        )
     for c in components():
         if c.name == comp.name:
             if c.plugin and c.sizes() == comp.sizes():
@@ -172,10 +205,14 @@ def plugin_sensors() -> tuple[SensorComponent, ...]:
 
 
 def entries(comps: tuple[SensorComponent, ...]) -> tuple:
-    """The dispatch's tuple: per component its sample function and block bounds."""
+    """The dispatch's tuple: per component its sample function, block bounds and noise source.
+
+    The last number is 1 when its noise is a legacy stream (columns of ``snoise``).
+    """
     out = []
     for c, a in zip(comps, addresses(comps).values(), strict=True):
-        out.append((c.sample, *a.config, *a.state, *a.measurement, *a.noise, *a.record))
+        legacy = 1 if c.legacy_noise is not None else 0
+        out.append((c.sample, *a.config, *a.state, *a.measurement, *a.noise, *a.record, legacy))
     return tuple(out)
 
 
@@ -204,7 +241,10 @@ def _sample_one(
         return
     empty = m.span[0:0]
     noise = empty
-    if 0 <= i < m.cnoise.shape[0] and m.cnoise.shape[1] >= e[8]:
+    if e[11] == 1:
+        if 0 <= i < m.snoise.shape[0]:
+            noise = m.snoise[i, e[7] : e[8]]
+    elif 0 <= i < m.cnoise.shape[0] and m.cnoise.shape[1] >= e[8]:
         noise = m.cnoise[i, e[7] : e[8]]
     rec = empty
     if 0 <= i < o.imu.shape[0] and o.imu.shape[1] >= NIMU + e[10]:
