@@ -92,7 +92,7 @@ def cache_is_warm(*entries: str) -> bool:
 #: simulator: the loop with its estimators, obstacle shapes and features; the learning
 #: environments: their own loop, with the simulator's functions already in the cache).
 COMPILED_PARTS: dict[str, tuple[tuple[str, ...], str, int]] = {
-    "simulator": (("kernel.run",), "the simulator", 110),
+    "simulator": (("kernel.run",), "the simulator", 100),
     "environments": (
         ("envs.stacked.reset_slot", "envs.stacked.step_batch"),
         "the learning environments' loop",

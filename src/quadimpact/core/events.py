@@ -114,7 +114,7 @@ def locate(
     return sb
 
 
-@compiled
+@compiled(inline="always")
 def contact_event(c: int, m: Model, d: Data, w: Work, h: float) -> float:
     """Fraction of the step at which pair ``c`` begins or ends (``NO_EVENT``: neither).
 

@@ -162,7 +162,7 @@ def _pending_onsets(d: Data, o: Output, w: Work) -> bool:
     return pending
 
 
-@compiled
+@compiled(inline="always")
 def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
     """A Dormand-Prince step of ``h`` (s) from ``d.x``: stages in ``w.K``, its end in ``w.x_new``.
 
@@ -182,7 +182,7 @@ def _trial_step(m: Model, d: Data, w: Work, h: float, fsal: bool) -> float:
     return error_norm(x[:na], w.x_new[:na], K, h, m.opts[O_RTOL], m.opts[O_ATOL])
 
 
-@compiled
+@compiled(inline="always")
 def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     """Earliest event of the accepted step of ``h`` (s), and the crash's (fractions; NO_EVENT)."""
     contact_values(w.x_new, m, d, w, w.g_b, w.gd_b, w.bnd_b)
@@ -204,7 +204,7 @@ def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     return sig_min, sig_crash
 
 
-@compiled
+@compiled(inline="always")
 def _dense_samples(
     m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, fsal: bool, i_out: int
 ) -> int:
@@ -227,7 +227,7 @@ def _dense_samples(
     return i_out
 
 
-@compiled
+@compiled(inline="always")
 def _track_peaks(m: Model, d: Data, o: Output, w: Work, t: float, h: float, sig: float) -> None:
     """Peaks of the active contacts over the step of ``h`` (s) from ``t`` up to fraction ``sig``."""
     for c in range(d.cs.shape[0]):
@@ -242,7 +242,7 @@ def _track_peaks(m: Model, d: Data, o: Output, w: Work, t: float, h: float, sig:
             observe_peak(m, d, o, w, e, c, sp, t, h)
 
 
-@compiled
+@compiled(inline="always")
 def _process_events(
     t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
 ) -> tuple[bool, bool]:
@@ -277,7 +277,7 @@ def _process_events(
     return any_event, ended
 
 
-@compiled
+@compiled(inline="always")
 def _arrive(
     uncut: bool, t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
 ) -> tuple[bool, bool]:
@@ -305,7 +305,7 @@ def _fail(stats: np.ndarray, reason: int) -> int:
     return FAILED
 
 
-@compiled
+@compiled(inline="always")
 def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w: Work) -> int:
     """Integrate from the tick ``t`` to ``t_next`` (s); ``RUNNING``, ``ENDED`` or ``FAILED``.
 
