@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from helpers import sigint_as_on_a_terminal
+
 pytest.importorskip("cma")
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
@@ -37,7 +39,8 @@ def _generations(out: Path) -> int:
 def test_train_stops_on_ctrl_c_resumes_and_its_policy_flies_in_the_benchmark(tmp_path):
     out = tmp_path / "train"
     proc = subprocess.Popen(_cli("train", *SMALL, "--out", str(out)), env=_env(),
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)  # fmt: skip
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=sigint_as_on_a_terminal)  # fmt: skip
     deadline = time.monotonic() + 600
     while _generations(out) < 1 and proc.poll() is None and time.monotonic() < deadline:
         time.sleep(0.2)
