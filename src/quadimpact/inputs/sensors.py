@@ -46,8 +46,7 @@ from pydantic import (
     model_validator,
 )
 
-from quadimpact.core.sensors.magnetometer import Magnetometer
-from quadimpact.core.sensors.pose import PoseSensor
+from quadimpact.core.sensors.older_settings import Magnetometer, PoseSensor
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3
 
 __all__ = [

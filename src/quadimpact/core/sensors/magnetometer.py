@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from pydantic import BaseModel, Field
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import SN_MAG
@@ -33,27 +32,9 @@ from quadimpact.core.sensors.component import (
     Slot,
     offsets,
 )
-from quadimpact.core.settings_types import MODEL_CONFIG, Real
+from quadimpact.core.sensors.older_settings import Magnetometer
 
 __all__ = ["SENSOR", "Magnetometer"]
-
-
-class Magnetometer(BaseModel):
-    """A magnetometer sampled with the IMU: the unit Earth field in body axes, with noise.
-
-    The field ``m_I`` points to magnetic north (+X) and dips ``dip_deg`` below
-    the horizon (down positive, NED), of length ``norm`` (1: a unit field);
-    a static bias of standard deviation ``bias`` per axis is drawn once per
-    run. Without a magnetometer yaw is unobservable and an estimator's heading
-    drifts with the gyro bias.
-    """
-
-    model_config = MODEL_CONFIG
-
-    dip_deg: Real = Field(60.0, ge=-90, le=90, description="Dip of the field, deg (down +).")
-    noise: Real = Field(7e-3, ge=0, description="White-noise std per axis, unit field.")
-    norm: Real = Field(1.0, gt=0, le=10, description="Length of the field (1: unit).")
-    bias: Real = Field(0.0, ge=0, description="Std of the static bias per axis (per run).")
 
 
 CONFIG = (

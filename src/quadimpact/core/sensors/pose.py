@@ -22,7 +22,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from pydantic import BaseModel, Field, StrictBool
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import SN_POSE, X_POS, X_QUAT
@@ -33,29 +32,12 @@ from quadimpact.core.sensors.component import (
     Slot,
     offsets,
 )
+from quadimpact.core.sensors.older_settings import PoseSensor
 from quadimpact.core.sensors.rotvec import rotate_by
-from quadimpact.core.settings_types import MODEL_CONFIG, Real
 
 __all__ = ["MAX_POSE_LAG", "SENSOR", "PoseSensor"]
 
 MAX_POSE_LAG = 64  # IMU samples: the ring of true poses (a latency is at most 63 of them)
-
-
-class PoseSensor(BaseModel):
-    """A pose sensor (motion capture or vision): position, and optionally attitude.
-
-    Measures at ``rate_hz`` (taken at the first IMU sample at or after each of
-    its times), with white noise, delivered ``latency_s`` later (rounded to
-    whole IMU samples, at most 63).
-    """
-
-    model_config = MODEL_CONFIG
-
-    rate_hz: Real = Field(100.0, gt=0, le=100000, description="Measurement rate, Hz.")
-    position_noise_m: Real = Field(1e-3, ge=0, description="Position noise std per axis, m.")
-    attitude: StrictBool = Field(True, description="Measure the attitude too.")
-    attitude_noise_deg: Real = Field(0.5, ge=0, description="Attitude noise std per axis, deg.")
-    latency_s: Real = Field(0.0, ge=0, le=1, description="Latency, s.")
 
 
 CONFIG = (
