@@ -187,6 +187,67 @@ def test_hover_centring_round_trips_and_is_part_of_the_identity(tmp_path):
     assert load_policy("learned").hover_centred is False
 
 
+def _faded(p: PolicyWeights, a: float, b: float) -> PolicyWeights:
+    return p.with_fade(a, b)
+
+
+def test_a_fading_policy_hands_the_hover_back_to_the_law():
+    """In stage 5 a fading policy's correction is the unfaded one's until ``from`` s after
+    the detection, then shrinks linearly (half of it midway) and is exactly zero from
+    ``to`` on: the law alone then holds its hover. Stages 1-4 are never faded."""
+    q = euler_zyx_to_quat(0.2, -0.4, 1.0)
+    refs = (9.0, 0.7, -1.2)
+    for k in range(10):
+        plain = _random_policy(k, 8, 2.0, 5, centred=bool(k % 2))
+        fading = _faded(plain, 0.5, 1.5)
+        for since, weight in ((0.2, 1.0), (0.5, 1.0), (1.0, 0.5), (1.25, 0.25), (1.5, 0.0),
+                              (3.0, 0.0)):  # fmt: skip
+            meas = _meas(q, t_detect=0.1)
+            t = 0.1 + since
+            full = np.subtract(residual_references(t, 5, refs, meas, _ctrl(plain), _veh()), refs)
+            got = np.subtract(residual_references(t, 5, refs, meas, _ctrl(fading), _veh()), refs)
+            # thrust is clipped at 0 after the correction; these refs keep it positive
+            np.testing.assert_allclose(got, weight * full, rtol=1e-12, atol=1e-12)
+            if weight == 0.0:
+                assert np.all(got == 0.0)
+            for stage in (1, 2, 3, 4):
+                a = residual_references(t, stage, refs, meas, _ctrl(plain), _veh())
+                b = residual_references(t, stage, refs, meas, _ctrl(fading), _veh())
+                assert a == b
+
+
+def test_the_compiled_fade_is_the_numpy_one():
+    """residual_references == PolicyWeights.outputs (NumPy) for fading policies."""
+    rng = np.random.default_rng(7)
+    for k in range(20):
+        p = _faded(_random_policy(k, 8, 2.0, 5, centred=bool(k % 3 == 0)), 0.3, 1.7)
+        q = euler_zyx_to_quat(*rng.uniform(-1.0, 1.0, 3))
+        meas = _meas(q, t_detect=0.1)
+        t = 0.1 + float(rng.uniform(0.0, 2.5))
+        refs = (float(rng.uniform(0, 20)), float(rng.normal()), float(rng.normal()))
+        stage = 5 if k % 2 else int(rng.integers(1, 5))
+        got = residual_references(t, stage, refs, meas, _ctrl(p), _veh())
+        o = p.outputs(features(t, stage, refs, meas, _veh()), gravity_m_s2=G)
+        want = (
+            max(0.0, refs[0] + p.thrust_scale * NAVI_MASS_KG * G * o[0]),
+            refs[1] + p.rate_scale_rad_s * o[1],
+            refs[2] + p.rate_scale_rad_s * o[2],
+        )
+        np.testing.assert_allclose(got, want, rtol=1e-12, atol=1e-12)
+
+
+def test_the_fade_round_trips_and_is_part_of_the_identity(tmp_path):
+    """Saved and read back; a file without it reads as no fade, with its old digest."""
+    plain = _random_policy(9, last_stage=5)
+    fading = _faded(plain, 1.0, 1.5)
+    assert fading.sha256 != plain.sha256
+    q = load_policy(save_policy(fading, tmp_path / "f.npz"))
+    assert q.hover_fade_s == (1.0, 1.5) and q.sha256 == fading.sha256
+    assert q.block()[RES.PB_FADE_TO_S] == 1.5 and plain.block()[RES.PB_FADE_TO_S] == 0.0
+    assert load_policy("learned").hover_fade_s == (0.0, 0.0)
+    assert load_policy("learned").sha256.startswith("3992ef0a")
+
+
 def test_the_correction_is_bounded_whatever_the_weights():
     """|dT| <= s_T m g and |dp|, |dq| <= s_w, even for weights of size 1000."""
     q = np.array([1.0, 0.0, 0.0, 0.0])
@@ -261,6 +322,48 @@ def test_the_residual_acts_in_its_stages_and_leaves_the_others_to_the_law(stage,
     assert (not np.array_equal(*cmds)) == acts
 
 
+@pytest.mark.parametrize(("hold_set", "acts"), [(0.0, True), (1.0, False)])
+def test_a_hand_over_policy_leaves_the_held_point_to_the_law(hold_set, acts):
+    """In stage 5 a hand-over policy corrects the law while it brakes (its hold point not
+    yet captured) and not once the point is captured: then the commands are the law's
+    alone, to the bit. Before stage 5 it acts as any policy."""
+    from quadimpact.core.controllers import recovery as CL
+    from quadimpact.core.controllers.recovery import recovery_step
+    from quadimpact.simulation.setup import prepare
+
+    setup = prepare(_trial())
+    for stage in (3, 5):
+        cmds = []
+        for policy in (None, _random_policy(7, 16, 3.0, 5).with_hand_over()):
+            ctrl = setup.ctrl.copy()
+            if policy is not None:
+                block = policy.block()
+                ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+            meas = np.zeros(L.NMEAS)
+            meas[L.MS_X : L.MS_X + L.NX] = setup.x0
+            meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
+            meas[L.MS_DETECTED] = 1.0
+            meas[L.MS_T_DETECT] = 0.1
+            meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+            mem = np.zeros(L.NMEM)
+            mem[L.MEM_STAGE] = stage
+            mem[CL.RM_HOLD_SET] = hold_set
+            cmd = np.zeros(4)
+            recovery_step(0.3, meas, ctrl, mem, setup.veh, 0.005, cmd)
+            cmds.append(cmd)
+        assert (not np.array_equal(*cmds)) == (acts or stage < 5)
+
+
+def test_hand_over_round_trips_and_is_part_of_the_identity(tmp_path):
+    """Saved and read back; a file without it reads as no hand-over, with its old digest."""
+    plain = _random_policy(10, last_stage=5)
+    handing = plain.with_hand_over()
+    assert handing.sha256 != plain.sha256 and handing.with_hand_over(False).sha256 == plain.sha256
+    q = load_policy(save_policy(handing, tmp_path / "h.npz"))
+    assert q.hover_hand_over and q.sha256 == handing.sha256
+    assert q.block()[RES.PB_HAND_OVER] == 1.0 and plain.block()[RES.PB_HAND_OVER] == 0.0
+
+
 def test_packing_writes_the_files_block(tmp_path):
     from quadimpact.simulation.setup import prepare
 
@@ -305,6 +408,10 @@ def test_the_last_stage_round_trips_and_is_part_of_the_identity(tmp_path):
         ({"last_stage": np.int64(3)}, "last_stage: must be one number, 4 or 5 (got 3)"),
         ({"last_stage": np.array([5, 5])}, "last_stage: must be one number, 4 or 5"),
         ({"hover_centred": np.int64(2)}, "hover_centred: must be one number, 0 or 1 (got 2)"),
+        ({"hover_fade_s": np.array([1.5, 1.0])}, "hover_fade_s: must be two numbers (from, to)"),
+        ({"hover_fade_s": np.array([0.5, 2.5])}, "0 <= from < to <= 2, or (0, 0) (got [0.5, 2.5])"),
+        ({"hover_fade_s": np.float64(1.0)}, "hover_fade_s: must be two numbers"),
+        ({"hover_hand_over": np.int64(3)}, "hover_hand_over: must be one number, 0 or 1"),
         ({"w1": np.zeros((4, 23))}, "w1: must be (4, 24)"),
         ({"b2": np.zeros(2)}, "b2: must be (3,)"),
         ({"w1": np.zeros((40, 24)), "b1": np.zeros(40), "w2": np.zeros((3, 40))}, "<= 32"),

@@ -179,6 +179,30 @@ def test_settings_are_checked_with_one_line():
         Settings(last_stage=3)
     with pytest.raises(InputError, match=r"--loss-weight: must be finite, >= 0 \(got -1.0\)"):
         Settings(loss_weight=-1.0)
+    with pytest.raises(InputError, match=r"--hover-fade: must be FROM,TO s with 0 <= FROM < TO"):
+        Settings(hover_fade_s=(1.5, 1.0))
+    with pytest.raises(InputError, match=r"given with --stages 1-5 \(got \(0.5, 1.0\)\)"):
+        Settings(last_stage=4, hover_fade_s=(0.5, 1.0))
+    assert Settings(hover_fade_s=(1, 2)).hover_fade_s == (1.0, 2.0)
+
+
+def test_a_start_from_a_policy_of_another_shape_is_refused():
+    """--init takes the weights of a policy whose width, scales and stages are the run's
+    (learned: 8 hidden units, 0.3 m g, 4 rad/s, stages 1-5); it is recorded by digest."""
+    from quadimpact.inputs.policy_file import initial_policy, load_policy
+    from quadimpact.studies.training.trainer import Settings, _initial_weights, init_settings
+
+    pol = initial_policy(8, 0.3, 4.0, 1, 5)
+    start = _initial_weights(pol, "learned")
+    np.testing.assert_array_equal(start.vector(), load_policy("learned").vector())
+    with pytest.raises(InputError, match="--init learned: its hidden is 8, the run's 4"):
+        _initial_weights(initial_policy(4, 0.3, 4.0, 1, 5), "learned")
+    with pytest.raises(InputError, match="--init learned: its stages is 5, the run's 4"):
+        _initial_weights(initial_policy(8, 0.3, 4.0, 1, 4), "learned")
+    s = init_settings(Settings(init="learned"))
+    assert s.init == "learned" and s.init_sha256 == load_policy("learned").sha256
+    with pytest.raises(InputError, match="no such file"):
+        init_settings(Settings(init="/nonexistent/p.npz"))
 
 
 @pytest.mark.slow

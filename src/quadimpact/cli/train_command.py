@@ -75,6 +75,21 @@ __all__ = ["train"]
     "itself (level, at rest), so that the law's hover stays where it is.",
 )  # fmt: skip
 @click.option(
+    "--hover-hand-over", is_flag=True,
+    help="In the hover stage, act only while the law brakes: once the law has captured the "
+    "point it holds, the law alone holds it.",
+)  # fmt: skip
+@click.option(
+    "--hover-fade", default=None, metavar="FROM,TO",
+    help="In the hover stage, fade the correction linearly to zero between FROM and TO "
+    "seconds after the detection (0 <= FROM < TO <= 2), so the law alone holds the hover.",
+)  # fmt: skip
+@click.option(
+    "--init", "init", default=None, metavar="learned|FILE",
+    help="Start from this policy's weights instead of the law (its width, scales and "
+    "stages must be the run's).",
+)  # fmt: skip
+@click.option(
     "--shaping", type=float, default=0.1, show_default=True,
     help="Weight of the height-kept term added to the benchmark's success in the reward.",
 )  # fmt: skip
@@ -109,6 +124,9 @@ def train(
     rate_scale_rad_s: float,
     stages: str,
     hover_centred: bool,
+    hover_hand_over: bool,
+    hover_fade: str | None,
+    init: str | None,
     shaping: float,
     loss_weight: float,
     check: int,
@@ -149,12 +167,24 @@ def train(
     from quadimpact.studies.training.trials import Problem
     from quadimpact.sweep import SweepInterrupted
 
+    fade = (0.0, 0.0)
+    if hover_fade is not None:
+        parts = hover_fade.split(",")
+        try:
+            if len(parts) != 2:
+                raise ValueError
+            fade = (float(parts[0]), float(parts[1]))
+        except ValueError:
+            raise InputError(
+                f"--hover-fade: must be two numbers FROM,TO in s (got {hover_fade!r})"
+            ) from None
     problem = Problem(vehicle=vehicle, tasks=parse_tasks(tasks), sensors=sensors, seed=seed)
     settings = Settings(
         hidden=hidden, popsize=popsize, batch=batch, sigma=sigma, thrust_scale=thrust_scale,
         rate_scale_rad_s=rate_scale_rad_s, last_stage=5 if stages == "1-5" else 4,
         shaping=shaping, loss_weight=loss_weight, check=check, check_every=check_every,
-        hover_centred=hover_centred,
+        hover_centred=hover_centred, hover_fade_s=fade, init=init,
+        hover_hand_over=hover_hand_over,
     )  # fmt: skip
     if workers < 1:
         raise InputError(f"--workers: must be >= 1 (got {workers})")

@@ -11,6 +11,11 @@ docs/LEARNING.md sections 12 and 14)::
                        detection to the recovery) or 5 (the hover too)
     hover_centred ()   optional: 1 if its correction in the hover stage is zero at
                        the hover itself (0, the default: not)
+    hover_hand_over () optional: 1 if in the hover stage it acts only until the law has
+                       captured the point it holds (0, the default: all through)
+    hover_fade_s (2,)  optional: ``(from, to)``, s after the detection: its correction
+                       in the hover stage fades linearly to 0 between them
+                       (``0 <= from < to <= 2``; (0, 0), the default: no fade)
     meta ()            optional: a JSON text of how it was trained
 
 ``--policy learned`` names the policy shipped with quadimpact
@@ -40,6 +45,7 @@ from quadimpact.linalg import matvec
 __all__ = [
     "SHIPPED_POLICIES",
     "PolicyWeights",
+    "checked_fade",
     "checked_policy",
     "hover_features",
     "initial_policy",
@@ -79,6 +85,13 @@ class PolicyWeights:
         In the hover stage, the correction minus its value at the hover itself
         (vehicle level and at rest, ``core/controllers/residual.py``), so that
         the law's hover stays where it is.
+    hover_hand_over : bool
+        In the hover stage, act only while the law brakes: no correction once
+        the law has captured the point it holds (``core/controllers/residual.py``).
+    hover_fade_s : tuple of float
+        ``(from, to)``, s after the detecting sample: in the hover stage the
+        correction is multiplied by a weight that is 1 until ``from`` and falls
+        linearly to 0 at ``to`` (``0 <= from < to <= 2``); ``(0, 0)``: no fade.
     meta : dict
         How the weights were made (training script, seeds, ...), as saved.
     sha256 : str
@@ -95,6 +108,8 @@ class PolicyWeights:
     rate_scale_rad_s: float
     last_stage: int = 4
     hover_centred: bool = False
+    hover_hand_over: bool = False
+    hover_fade_s: tuple[float, float] = (0.0, 0.0)
     meta: dict = field(default_factory=dict)
     sha256: str = ""
     path: str = ""
@@ -120,6 +135,18 @@ class PolicyWeights:
         new = replace(self, w1=w1.copy(), b1=b1.copy(), w2=w2.copy(), b2=b2.copy(), path="")
         return replace(new, meta={**self.meta, **meta}, sha256=_digest(new))
 
+    def with_hand_over(self, hand_over: bool = True) -> PolicyWeights:
+        """These weights with ``hover_hand_over`` set (see the class)."""
+        new = replace(self, hover_hand_over=bool(hand_over), path="")
+        return replace(new, sha256=_digest(new))
+
+    def with_fade(self, from_s: float, to_s: float) -> PolicyWeights:
+        """These weights with the hover stage's fade ``(from_s, to_s)`` (s after the
+        detection; ``(0, 0)``: none), checked as a file's ``hover_fade_s``."""
+        fade = checked_fade(np.array([from_s, to_s], dtype=float))
+        new = replace(self, hover_fade_s=fade, path="")
+        return replace(new, sha256=_digest(new))
+
     def outputs(self, features: np.ndarray, gravity_m_s2: float = 9.81) -> np.ndarray:
         """The policy's three outputs for ``features`` ``(..., 24)`` (NumPy only).
 
@@ -131,20 +158,32 @@ class PolicyWeights:
         """
         f = np.asarray(features, dtype=float)
         out = self._network(f)
+        hover = f[..., 20:21] > 0.5
         if self.hover_centred:
-            hover = f[..., 20:21] > 0.5
             out = np.where(hover, out - self._network(hover_features(f, gravity_m_s2)), out)
+        if self.hover_fade_s[1] > 0.0:
+            out = np.where(hover, out * self.fade_weight(f[..., 15:16]), out)
         return out
+
+    def fade_weight(self, since_s: np.ndarray) -> np.ndarray:
+        """The hover stage's weight ``since_s`` seconds after the detection (1: no fade)."""
+        a, b = self.hover_fade_s
+        t = np.asarray(since_s, dtype=float)
+        if b <= 0.0:
+            return np.ones_like(t)
+        w = np.where(t <= a, 1.0, (b - t) / (b - a))
+        return np.where(t >= b, 0.0, w)
 
     def _network(self, f: np.ndarray) -> np.ndarray:
         h = _tanh(matvec(self.w1, f) + self.b1)
         return _tanh(matvec(self.w2, h) + self.b2)
 
     def block(self) -> np.ndarray:
-        """The compiled loop's block ``[nh, s_T, s_w, last stage, hover-centred, W1, b1,
-        W2, b2]`` (residual.py)."""
+        """The compiled loop's block ``[nh, s_T, s_w, last stage, hover-centred, hand over,
+        fade from, fade to, W1, b1, W2, b2]`` (residual.py)."""
         head = [self.hidden, self.thrust_scale, self.rate_scale_rad_s, self.last_stage]
-        head = np.array([*head, float(self.hover_centred)], dtype=float)
+        flags = [float(self.hover_centred), float(self.hover_hand_over), *self.hover_fade_s]
+        head = np.array([*head, *flags], dtype=float)
         return np.concatenate([head, self.vector()])
 
 
@@ -158,6 +197,8 @@ def _tanh(x: np.ndarray) -> np.ndarray:
 
 #: The features' scale of the accelerometer's specific force, m/s^2 (residual.py).
 _F_SCALE_M_S2 = 16.0
+#: The features' cap on the time since the detection, s (residual.py): the latest fade end.
+_T_CAP_S = 2.0
 
 
 def hover_features(features: np.ndarray, gravity_m_s2: float) -> np.ndarray:
@@ -184,6 +225,10 @@ def _digest(p: PolicyWeights) -> str:
         h.update(np.array([p.last_stage], dtype="<f8").tobytes())
     if p.hover_centred:  # and one not hover-centred the digest it had before that
         h.update(b"hover_centred")
+    if p.hover_hand_over:  # and one that does not hand over the digest it had before that
+        h.update(b"hover_hand_over")
+    if p.hover_fade_s[1] > 0.0:  # and one without a fade the digest it had before that
+        h.update(np.array(p.hover_fade_s, dtype="<f8").tobytes())
     return h.hexdigest()
 
 
@@ -284,6 +329,16 @@ def load_policy(name: str | Path) -> PolicyWeights:
             got = raw.tolist()
             raise InputError(f"{where}: hover_centred: must be one number, 0 or 1 (got {got!r})")
         hover_centred = bool(raw)
+    hover_hand_over = False
+    if "hover_hand_over" in arrays:
+        raw = np.asarray(arrays["hover_hand_over"])
+        if raw.shape != () or raw.dtype.kind not in "biuf" or float(raw) not in (0.0, 1.0):
+            got = raw.tolist()
+            raise InputError(f"{where}: hover_hand_over: must be one number, 0 or 1 (got {got!r})")
+        hover_hand_over = bool(raw)
+    hover_fade_s = (0.0, 0.0)
+    if "hover_fade_s" in arrays:
+        hover_fade_s = checked_fade(arrays["hover_fade_s"], where)
     meta: dict = {}
     if "meta" in arrays:
         try:
@@ -299,10 +354,25 @@ def load_policy(name: str | Path) -> PolicyWeights:
         float(w["rate_scale_rad_s"]),
         last_stage=last_stage,
         hover_centred=hover_centred,
+        hover_hand_over=hover_hand_over,
+        hover_fade_s=hover_fade_s,
         meta=meta,
         path=str(path),
     )
     return replace(p, sha256=_digest(p))
+
+
+def checked_fade(value: Any, where: str = "policy") -> tuple[float, float]:
+    """``hover_fade_s`` checked: two numbers ``(from, to)`` s, ``0 <= from < to <= 2``, or
+    ``(0, 0)`` (no fade). Raises :class:`InputError` naming ``where`` and the rule."""
+    raw = np.asarray(value)
+    rule = "must be two numbers (from, to) s with 0 <= from < to <= 2, or (0, 0)"
+    if raw.shape != (2,) or raw.dtype.kind not in "iuf":
+        raise InputError(f"{where}: hover_fade_s: {rule} (got {raw.tolist()!r})")
+    a, b = (float(v) for v in raw)
+    if (a, b) != (0.0, 0.0) and not (0.0 <= a < b <= _T_CAP_S):
+        raise InputError(f"{where}: hover_fade_s: {rule} (got {[a, b]!r})")
+    return a, b
 
 
 def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
@@ -320,6 +390,8 @@ def save_policy(policy: PolicyWeights, path: str | Path) -> Path:
         rate_scale_rad_s=np.float64(policy.rate_scale_rad_s),
         last_stage=np.int64(policy.last_stage),
         hover_centred=np.int64(policy.hover_centred),
+        hover_hand_over=np.int64(policy.hover_hand_over),
+        hover_fade_s=np.array(policy.hover_fade_s, dtype=float),
         meta=np.array(json.dumps(policy.meta, sort_keys=True)),
     )
     tmp.replace(path)

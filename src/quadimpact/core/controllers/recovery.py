@@ -81,6 +81,7 @@ from quadimpact.core.controllers.common import (
 from quadimpact.core.controllers.hover import hover_acceleration, yaw_of
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.controllers.residual import (
+    PB_HAND_OVER,
     PB_HIDDEN,
     residual_last_stage,
     residual_references,
@@ -494,7 +495,13 @@ def recovery_step(
     thrust, p_des, q_des, r_des, qex, qey = law_references(
         stage, a_ref_on, x, normal, ctrl, veh, mem
     )
-    if ctrl[C_POLICY + PB_HIDDEN] > 0.5 and stage <= residual_last_stage(ctrl):
+    if (
+        ctrl[C_POLICY + PB_HIDDEN] > 0.5
+        and stage <= residual_last_stage(ctrl)
+        and not (
+            stage == STAGE_HOVER and ctrl[C_POLICY + PB_HAND_OVER] > 0.5 and mem[RM_HOLD_SET] > 0.5
+        )
+    ):
         thrust, p_des, q_des = residual_references(
             t, stage, (thrust, p_des, q_des), meas, ctrl, veh
         )

@@ -29,6 +29,18 @@ stage as in ``f``). The correction is then zero at the hover itself: it may
 change how the law returns to its hover, never where the hover is
 (:func:`hover_features`). The bound becomes twice the scale.
 
+A policy may also *fade* in the hover stage (its block's ``PB_FADE_FROM_S``
+and ``PB_FADE_TO_S``, ``0 <= from < to <= 2`` s; ``to`` 0: no fade): its
+stage-5 correction is then multiplied by a weight that is 1 until ``from``
+seconds after the detecting sample, falls linearly to 0 at ``to`` and stays
+0, so the law alone holds the hover it has reached. The time is feature 15,
+which the features cap at 2 s; hence ``to <= 2``.
+
+A policy may *hand over* the hover (its block's ``PB_HAND_OVER`` 1): in stage
+5 it acts only while the law brakes, and not once the law has captured the
+point it holds (``recovery.py``, ``RM_HOLD_SET``; the ``stop`` hold mode, the
+default). From then on the law alone holds its hover, as without a policy.
+
 Features (body FRD axes; non-finite inputs read as 0):
 
 ======  ==================================================================
@@ -43,12 +55,12 @@ Features (body FRD axes; non-finite inputs read as 0):
 22-23   the law's p_des, q_des / 8 rad/s
 ======  ==================================================================
 
-The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, last stage,
-hover-centred, W1 (nh x 24, row-major), b1 (nh), W2 (3 x nh, row-major), b2
-(3)]``; the last stage is 4 (stages 1-4; a 0 reads as 4) or 5 (stages 1-5). The weights come from
-a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy forward pass of
-the same network is ``PolicyWeights.outputs``. The block's slots (``PB_*``) are
-declared below; the network's shape (``N_FEATURES``, ``N_OUTPUTS``,
+The parameter block at ``ctrl[C_POLICY:]``: ``[nh, s_T, s_w, last stage, hover-centred,
+hand over, fade from (s), fade to (s), W1 (nh x 24, row-major), b1 (nh), W2 (3 x nh,
+row-major), b2 (3)]``; the last stage is 4 (stages 1-4; a 0 reads as 4) or 5 (stages
+1-5). The weights come from a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy
+forward pass of the same network is ``PolicyWeights.outputs``. The block's slots
+(``PB_*``) are declared below; the network's shape (``N_FEATURES``, ``N_OUTPUTS``,
 ``MAX_HIDDEN``) in ``core/layout.py``, which the policy file reads too.
 """
 
@@ -84,6 +96,9 @@ PB_THRUST_SCALE = _policy.slot("PB_THRUST_SCALE")  # s_T: the largest thrust cor
 PB_RATE_SCALE = _policy.slot("PB_RATE_SCALE")  # s_w, rad/s: the largest p, q reference correction
 PB_LAST_STAGE = _policy.slot("PB_LAST_STAGE")  # the last stage it acts in: 4 (0 reads as 4) or 5
 PB_HOVER_CENTRED = _policy.slot("PB_HOVER_CENTRED")  # 1: zero correction at the hover in stage 5
+PB_HAND_OVER = _policy.slot("PB_HAND_OVER")  # 1: none in stage 5 once the law holds its point
+PB_FADE_FROM_S = _policy.slot("PB_FADE_FROM_S")  # s after the detection: stage 5's fade begins
+PB_FADE_TO_S = _policy.slot("PB_FADE_TO_S")  # s: stage 5's correction 0 from here (0: no fade)
 PB_WEIGHTS = _policy.slot(  # W1 (nh x N_FEATURES, row-major), b1 (nh), W2 (N_OUTPUTS x nh), b2
     "PB_WEIGHTS", MAX_HIDDEN * (N_FEATURES + 1 + N_OUTPUTS) + N_OUTPUTS
 )
@@ -187,6 +202,19 @@ def hover_features(f: np.ndarray, gravity_m_s2: float) -> np.ndarray:
 
 
 @compiled
+def hover_fade_weight(since_s: float, from_s: float, to_s: float) -> float:
+    """The weight of the stage-5 correction ``since_s`` seconds after the detection.
+
+    1 up to ``from_s``, linear down to 0 at ``to_s`` (s, ``from_s < to_s``), 0 after.
+    """
+    if since_s >= to_s:
+        return 0.0
+    if since_s <= from_s:
+        return 1.0
+    return (to_s - since_s) / (to_s - from_s)
+
+
+@compiled
 def network_outputs(f: np.ndarray, ctrl: np.ndarray) -> tuple[float, float, float]:
     """The network at ``ctrl[C_POLICY:]`` on features ``f``: its 3 outputs in (-1, 1)."""
     b = C_POLICY
@@ -232,6 +260,11 @@ def residual_references(
         u0 -= c0
         u1 -= c1
         u2 -= c2
+    if stage == STAGE_HOVER and ctrl[b + PB_FADE_TO_S] > 0.0:
+        w = hover_fade_weight(f[15], ctrl[b + PB_FADE_FROM_S], ctrl[b + PB_FADE_TO_S])
+        u0 *= w
+        u1 *= w
+        u2 *= w
     thrust = refs[0] + ctrl[b + PB_THRUST_SCALE] * veh[V_MASS] * veh[V_GRAVITY] * u0
     if thrust < 0.0:
         thrust = 0.0

@@ -106,6 +106,19 @@ class Settings:
         The policy's correction in the hover stage is zero at the hover itself
         (``core/controllers/residual.py``): it may change how the law reaches its
         hover, not where it holds it.
+    hover_hand_over : bool
+        In the hover stage the policy acts only while the law brakes, not once
+        the law has captured the point it holds (the law alone holds it).
+    hover_fade_s : tuple of float
+        ``(from, to)``, s after the detection: the policy's correction in the
+        hover stage fades linearly to zero between them, so the law alone holds
+        the hover it reached (``0 <= from < to <= 2``; ``(0, 0)``: no fade).
+    init : str or None
+        A policy (``learned`` or a file) whose weights start the search instead
+        of the law (a zero output layer). Its hidden width, scales and last
+        stage must be these settings'; recorded with its weights' digest.
+    init_sha256 : str
+        The digest of ``init``'s weights (set from the file; part of the run's identity).
     """
 
     hidden: int = 8
@@ -120,6 +133,10 @@ class Settings:
     check: int = 60
     check_every: int = 5
     hover_centred: bool = False
+    hover_hand_over: bool = False
+    hover_fade_s: tuple[float, float] = (0.0, 0.0)
+    init: str | None = None
+    init_sha256: str = ""
 
     def __post_init__(self) -> None:
         from quadimpact.core.layout import MAX_HIDDEN
@@ -142,9 +159,21 @@ class Settings:
                 "given with --stages 1-5 (it acts in the hover stage)",
             ),
         }
+        rules["hover-hand-over"] = (
+            self.hover_hand_over,
+            not self.hover_hand_over or self.last_stage == 5,
+            "given with --stages 1-5 (it acts in the hover stage)",
+        )
+        fade = tuple(float(v) for v in self.hover_fade_s)
+        rules["hover-fade"] = (
+            fade,
+            fade == (0.0, 0.0) or (self.last_stage == 5 and 0.0 <= fade[0] < fade[1] <= 2.0),
+            "FROM,TO s with 0 <= FROM < TO <= 2, given with --stages 1-5",
+        )
         for name, (value, ok, rule) in rules.items():
             if not ok:
                 raise InputError(f"--{name}: must be {rule} (got {value})")
+        object.__setattr__(self, "hover_fade_s", fade)
 
 
 def _nonneg(x: float) -> bool:
@@ -259,6 +288,12 @@ def _new_state(problem: Problem, settings: Settings) -> dict[str, Any]:
     pol = initial_policy(settings.hidden, settings.thrust_scale, settings.rate_scale_rad_s,
                          problem.seed, settings.last_stage,
                          settings.hover_centred)  # fmt: skip
+    if settings.init is not None:
+        pol = _initial_weights(pol, settings.init)
+    if settings.hover_fade_s != (0.0, 0.0):
+        pol = pol.with_fade(*settings.hover_fade_s)
+    if settings.hover_hand_over:
+        pol = pol.with_hand_over()
     opts = {"seed": problem.seed, "popsize": settings.popsize, "verbose": -9}
     es = cma.CMAEvolutionStrategy(pol.vector(), settings.sigma, opts)
     return {
@@ -277,6 +312,35 @@ def _new_state(problem: Problem, settings: Settings) -> dict[str, Any]:
         "best": None,  # (success, score, generation, theta)
         "sessions": [],
     }
+
+
+def _initial_weights(pol: Any, init: str) -> Any:
+    """``pol`` with the weights of policy ``init``, whose shape and scales must be ``pol``'s."""
+    from quadimpact.inputs.policy_file import load_policy
+
+    start = load_policy(init)
+    for name, have, want in (
+        ("hidden", start.hidden, pol.hidden),
+        ("thrust-scale", start.thrust_scale, pol.thrust_scale),
+        ("rate-scale", start.rate_scale_rad_s, pol.rate_scale_rad_s),
+        ("stages", start.last_stage, pol.last_stage),
+    ):
+        if have != want:
+            raise InputError(f"--init {init}: its {name} is {have}, the run's {want}; "
+                             f"give --{name} to match it")  # fmt: skip
+    return pol.with_vector(start.vector())
+
+
+def init_settings(settings: Settings) -> Settings:
+    """``settings`` with its ``init`` policy's digest filled in (none: unchanged)."""
+    from dataclasses import replace
+
+    from quadimpact.inputs.policy_file import checked_policy
+
+    if settings.init is None:
+        return settings
+    ref, sha = checked_policy(settings.init)
+    return replace(settings, init=ref, init_sha256=sha)
 
 
 def _same_run(state: dict[str, Any], problem: Problem, settings: Settings, out: Path) -> None:
@@ -401,6 +465,7 @@ def train(
         raise InputError(f"--minutes: must be > 0 (got {minutes})")
     if generations is not None and generations < 1:
         raise InputError(f"--generations: must be >= 1 (got {generations})")
+    settings = init_settings(settings)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     with _folder_lock(out):
