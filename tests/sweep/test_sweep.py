@@ -367,9 +367,7 @@ def test_parallel_table_is_identical(serial_table, tmp_path):
     assert_same_table(table, serial_table)
 
 
-def test_trials_run_here_leave_what_the_process_held_out_of_its_collections(
-    monkeypatch, tmp_path
-):
+def test_trials_run_here_leave_what_the_process_held_out_of_its_collections(monkeypatch, tmp_path):
     """Python's full collection walks every object of the process and is paid by whichever
     trial triggers it: 60 to 230 ms in a study's process, 20 to 50 times a wall trial. The
     trials a sweep runs in its own process run with the process's objects frozen (left
