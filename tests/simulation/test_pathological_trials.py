@@ -92,11 +92,11 @@ def level_first():
 
 @pytest.mark.slow
 def test_a_vehicle_pinned_to_the_pole_by_friction_takes_steps_for_its_physics(level_first):
-    """The plain law pins the vehicle against the pole from 0.73 s to the end: four rings in
-    contact, friction in its stiff sticking range, re-excited at every 5-ms tick. That costs
-    about five steps a tick (one rejected) for 3.3 s: 5,635 steps with 20 contact onsets.
-    Chattering between onset and release would count hundreds of onsets; an event storm,
-    tens of thousands of steps (docs/NUMERICS.md, "A sustained contact")."""
+    """The plain law pins the vehicle against the pole from 0.73 s to the end, four rings in
+    contact. The tolerance sets the step there: about five steps a 5-ms tick (one of them
+    rejected) for 3.3 s, 5,635 steps with 20 contact onsets. Chattering between onset and
+    release would count hundreds of onsets; an event storm, tens of thousands of steps
+    (docs/NUMERICS.md, "A sustained contact")."""
     summary = simulate(_level_first_trial("pole", "ideal", -30.0, 0.0)).summary
     assert summary["status"] == "completed"
     assert summary["n_episodes"] <= 40
