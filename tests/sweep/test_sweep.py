@@ -369,7 +369,7 @@ def test_parallel_table_is_identical(serial_table, tmp_path):
 
 def test_trials_run_here_leave_what_the_process_held_out_of_its_collections(monkeypatch, tmp_path):
     """Python's full collection walks every object of the process and is paid by whichever
-    trial triggers it: 60 to 230 ms in a study's process, 20 to 50 times a wall trial. The
+    trial triggers it: 80 to 110 ms in a study's process, over 20 times a wall trial. The
     trials a sweep runs in its own process run with the process's objects frozen (left
     out of the collector's scans), and the sweep gives them back when it ends."""
     import gc

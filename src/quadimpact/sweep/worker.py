@@ -167,7 +167,7 @@ def freeze_heap() -> None:
     in whichever trial allocates the one too many. After the imports and the
     warm-up a process tracks about 144,000 objects, and a full collection
     costs about 70 ms of CPU, 0.01 ms once they are frozen. With a study's
-    tables besides, it cost a trial up to 230 ms, 50 times a wall trial's
+    tables besides, it cost a trial 80 to 110 ms, over 20 times a wall trial's
     (docs/PERFORMANCE.md, "The slowest trial").
     Frozen objects are still freed when no longer referenced; only the cycle
     detector skips them. A worker forked from a frozen server inherits the
