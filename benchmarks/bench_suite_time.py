@@ -14,7 +14,17 @@ per row, task and sensor set:
 * the share of the cell's CPU spent in trials costing more than ``--slow``
   times its median (the slow tail);
 * the cell's CPU in the whole suite: its mean per trial times the whole
-  suite's trials of the task (10,000 on the wall, 3,266 per grid).
+  suite's trials of the task (10,000 on the wall, 3,266 per grid);
+* below a cell whose slowest trial costs more than 20 times its median: that
+  trial's id, its loop's CPU, its steps, rejected steps and contact onsets,
+  and its status (why it cost so much).
+
+A trial's CPU is its own: every process loads the compiled code before its
+first trial (a warm-up run that is no trial), and a sweep's processes leave
+the objects they held before the trials out of Python's full collections
+(``sweep.worker.freeze_heap``). A trial that costs much more in all than in
+its loop paid for something else of its process (docs/PERFORMANCE.md, "The
+slowest trial").
 
 The totals compare the trials' CPU with the command's: give the command's
 own CPU and wall time (``/usr/bin/time -v``) to see what imports, compiling,
@@ -43,7 +53,8 @@ def cells(folder: Path) -> list[tuple[str, str, str, pd.DataFrame]]:
     for path in sorted(folder.glob("cells/*/*/sweep/runs.parquet")):
         row, cell = path.parts[-4], path.parts[-3]
         task, _, sensors = cell.partition("-")
-        cols = ["cost__kernel_cpu_s", "cost__total_cpu_s"]
+        cols = ["run_id", "cost__kernel_cpu_s", "cost__total_cpu_s", "integrator__steps",
+                "integrator__rejected_steps", "n_episodes", "status", "reason"]  # fmt: skip
         found.append((row, task, sensors, pd.read_parquet(path, columns=cols)))
     return found
 
@@ -85,6 +96,12 @@ def main(argv: list[str] | None = None) -> int:
               f"{r['loop_cpu_s']:>8.1f}{r['median_ms']:>8.2f}{r['p99_ms']:>8.1f}{r['max_ms']:>8.1f}"
               f"{ratio:>7.2f}{r['max_to_median']:>8.1f}{100 * r['tail_share']:>7.1f}"
               f"{r['whole_suite_cpu_s']:>9.1f}{flag}")  # fmt: skip
+        if flag:
+            w = d.iloc[int(np.argmax(c))]
+            why = w["status"] + (f" ({w['reason']})" if w["reason"] else "")
+            print(f"{'':<18}slowest: run {w['run_id']}, loop {1e3 * w['cost__kernel_cpu_s']:.1f} "
+                  f"ms, {w['integrator__steps']} steps, {w['integrator__rejected_steps']} "
+                  f"rejected, {w['n_episodes']} onsets, {why}")  # fmt: skip
     print(f"\n{n} trials: {total:.1f} s of CPU ({loops:.1f} s in their loops); "
           f"{100 * tail / total:.1f} % of it in trials costing more than {a.slow:g}x their "
           f"cell's median; on 2 idle cores {total / 2:.1f} s")  # fmt: skip

@@ -67,3 +67,60 @@ def test_the_example_plug_ins_pole_trial_takes_a_bounded_step_count():
         unregister_controller("level-first")
     assert summary["status"] == "completed"
     assert _steps(summary) < 30_000
+
+
+def _level_first_trial(task_name: str, sensors: str, pitch_deg: float, offset_m: float):
+    """The example plug-in's quick-suite trial (suite 3) and its subject."""
+    subject = Subject("level-first", controller="level-first")
+    spec = subject.spec(task(task_name), True, sensor_set(sensors), version="3")
+    for i in range(spec.n_runs):
+        v = spec.inputs(i)
+        if v["pitch_deg"] == pitch_deg and abs(v["lateral_offset_m"] - offset_m) < 1e-9:
+            return scenario_from_dict(spec.scenario_dict(i))
+    raise AssertionError(f"no point ({pitch_deg}, {offset_m}) in the {task_name} grid")
+
+
+@pytest.fixture(scope="module")
+def level_first():
+    """The example plug-in registered (its step compiles alone: a few s of CPU)."""
+    from quadimpact.inputs.controllers import unregister_controller
+
+    load_example("benchmark_controller.py")  # registers "level-first"
+    yield
+    unregister_controller("level-first")
+
+
+@pytest.mark.slow
+def test_a_vehicle_pinned_to_the_pole_by_friction_takes_steps_for_its_physics(level_first):
+    """The plain law pins the vehicle against the pole from 0.73 s to the end, four rings in
+    contact. The tolerance sets the step there: about five steps a 5-ms tick (one of them
+    rejected) for 3.3 s, 5,635 steps with 20 contact onsets. Chattering between onset and
+    release would count hundreds of onsets; an event storm, tens of thousands of steps
+    (docs/NUMERICS.md, "A sustained contact")."""
+    summary = simulate(_level_first_trial("pole", "ideal", -30.0, 0.0)).summary
+    assert summary["status"] == "completed"
+    assert summary["n_episodes"] <= 40
+    assert _steps(summary) < 10_000
+
+
+@pytest.mark.slow
+def test_a_trial_over_the_step_budget_fails_and_is_no_success(level_first):
+    """The same trial with a budget of 2,000 steps (it needs 5,635): it ends at the budget,
+    failed with the reason, and the benchmark counts it as no success."""
+    import pandas as pd
+
+    from quadimpact.core import layout as L
+    from quadimpact.simulation.setup import prepare
+    from quadimpact.simulation.simulate import run_setup
+    from quadimpact.studies.benchmark.cells import held_hover_success
+
+    scenario = _level_first_trial("pole", "ideal", -30.0, 0.0)
+    setup = prepare(scenario)
+    setup.opts[L.O_MAX_STEPS] = 2_000
+    summary = run_setup(setup, scenario).summary
+    assert (summary["status"], summary["reason"]) == ("failed", "step budget exhausted")
+    assert _steps(summary) <= 2_000
+    row = pd.DataFrame([{"status": summary["status"], "valid": True, "held_hover": True,
+                         "touched_after_hover": False, "height_lost_m": 0.0,
+                         "crash_time_s": None}])  # fmt: skip
+    assert not held_hover_success(row)[0]

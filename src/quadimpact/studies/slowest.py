@@ -106,7 +106,7 @@ def slowest_lines(slowest: dict[str, Any] | None, title: str = "## Slowest trial
         "",
         f"CPU per trial ({slowest['cpu_column']}): median {slowest['median_cpu_ms']:.1f} ms. "
         "Steps: accepted and rejected integration steps. Onsets: contact onsets (episodes). "
-        "A worker's first trial also loads the compiled code.",
+        "Each process loads the compiled code before its first trial, apart from the trials.",
         "",
         "| " + " | ".join([*ids, "CPU (ms)", "x median", "steps", "rejected", "onsets",
                           "status"]) + " |",

@@ -45,7 +45,7 @@ from quadimpact.sweep.store import (
     schema_of,
 )
 from quadimpact.sweep.values import LARGE_RUNS, check_size
-from quadimpact.sweep.worker import warm_up
+from quadimpact.sweep.worker import frozen_heap, warm_up
 
 LARGE_SWEEP_RUNS = LARGE_RUNS
 """Sweeps with more runs than this need ``allow_large=True`` (``--allow-large``)."""
@@ -358,7 +358,10 @@ class _FolderSweep:
                 bar.update(len(rows))
 
         try:
-            return self._place(todo, self.spec.n_runs - n_before, sink, stop, bar)
+            # the trials run here do not pay for scanning what the process held before
+            # (a study's earlier tables): docs/PERFORMANCE.md, "The slowest trial"
+            with frozen_heap() if self.client is None else contextlib.nullcontext():
+                return self._place(todo, self.spec.n_runs - n_before, sink, stop, bar)
         finally:
             writer.flush()  # also on Ctrl-C or an error: keep every finished run
             bar.close()
@@ -382,6 +385,7 @@ class _FolderSweep:
             return f"dask, {self.threads} threads"
         if self.n_workers == 1 or n_todo == 1:
             self.placed()
+            warm_up()  # the kernel loaded before the first trial, not in its CPU time
             run_serial(make_chunks(spec, todo, 16), sink)
             return "serial"
         n_here, n_workers = 0, self.n_workers

@@ -335,8 +335,9 @@ def _slowest_trials(out: Path, study: Any) -> list[str]:
         "",
         f"The slowest trial of each of {study.subject.name}'s cells: its CPU in the "
         "compiled loop, against the cell's median, and what the integrator did (accepted "
-        "and rejected steps, contact onsets). A worker's first trial also loads the "
-        "compiled code. A trial that would exceed the step budget fails (docs/NUMERICS.md).",
+        "and rejected steps, contact onsets). Each process loads the compiled code "
+        "before its first trial, apart from the trials. A trial that would exceed the "
+        "step budget fails (docs/NUMERICS.md).",
         "",
         "| task | sensors | run | CPU (ms) | x median | steps | rejected | onsets | status |",
         "|---|---|---|---|---|---|---|---|---|",
