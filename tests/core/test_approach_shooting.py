@@ -15,6 +15,10 @@ import pytest
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
 from quadimpact.core.approach import (
+    AP_RUNS,
+    AP_STATUS,
+    AP_T0,
+    APPROACH_SOLVED,
     APPROACH_TOL_M_S,
     LATE_START_END_GAP_S,
     LATE_START_MAXITER,
@@ -67,8 +71,8 @@ def test_a_late_start_without_a_bracket_is_an_error(monkeypatch):
 def _runs(monkeypatch: pytest.MonkeyPatch, scenario: WallApproach) -> tuple[int, float]:
     """Free-flight runs the shooting flew for ``scenario``, and the start time it found."""
     ap = approach_py.shooting_record(**_solve_inputs(monkeypatch, scenario))
-    assert ap[L.AP_STATUS] == L.APPROACH_SOLVED
-    return int(ap[L.AP_RUNS]), float(ap[L.AP_T0])
+    assert ap[AP_STATUS] == APPROACH_SOLVED
+    return int(ap[AP_RUNS]), float(ap[AP_T0])
 
 
 def _speed_at_impact_from_rest(kw: dict, t: float) -> float:

@@ -21,6 +21,7 @@ from quadimpact.core.records import new_data, new_output, new_work
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
     "quadimpact.core.layout",
+    "quadimpact.core.approach",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
     "quadimpact.core.controllers.residual",

@@ -397,28 +397,6 @@ SPAN_T0 = _span.slot("SPAN_T0")  # s, start
 SPAN_TF = _span.slot("SPAN_TF")  # s, end
 NSPAN = _span.end("NSPAN")
 
-# ---- the wall approach's shooting ap (NAP): its inputs, then what it found
-# (core/approach.py); inertial NED, the wall's normal along -X
-_ap = Block("approach", "AP_")
-AP_TC = _ap.slot("AP_TC")  # s, T_c: the first contact's time
-AP_VC = _ap.slot("AP_VC")  # m/s, V_c: the speed toward the wall at T_c (inertial X)
-AP_LATE_RULE = _ap.slot("AP_LATE_RULE")  # 1: start later at rest whenever v0 < 0 is needed
-AP_START = _ap.slot("AP_START", 3)  # m, the initial CM position before the X shift
-AP_Q = _ap.slot("AP_Q", 4)  # the attitude held (quaternion, body FRD to inertial)
-AP_ROTORS = _ap.slot("AP_ROTORS", MAX_ROTORS)  # rad/s, initial rotor speeds
-AP_X0 = _ap.slot("AP_X0", NX)  # found: the initial state (layout X_*)
-AP_T0 = _ap.slot("AP_T0")  # s, found: the start time (0 unless a late start)
-AP_V0 = _ap.slot("AP_V0")  # m/s, found: the start speed (inertial X)
-AP_DV = _ap.slot("AP_DV")  # m/s, found: the speed residual at T_c
-AP_LATE = _ap.slot("AP_LATE")  # found: 1 if the vehicle starts later, at rest
-AP_STATUS = _ap.slot("AP_STATUS")  # APPROACH_*
-AP_REASON = _ap.slot("AP_REASON")  # REASON_* of a failed shooting run
-AP_RUNS = _ap.slot("AP_RUNS")  # found: the free-flight runs the shooting flew
-NAP = _ap.end("NAP")
-APPROACH_SOLVED = 0
-APPROACH_RUN_FAILED = 1  # a shooting run failed (AP_REASON) or sampled no state at T_c
-APPROACH_NO_BRACKET = 2  # the late start's speed residual has one sign over [0, T_c)
-
 # ==========================================================================
 # Data: what the loop carries from one control tick to the next
 # ==========================================================================
