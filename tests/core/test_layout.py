@@ -22,6 +22,7 @@ from quadimpact.core.records import new_data, new_output, new_work
 DECLARING = (
     "quadimpact.core.layout",
     "quadimpact.core.approach",
+    "quadimpact.core.impacts",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
     "quadimpact.core.controllers.residual",

@@ -548,15 +548,6 @@ E_T_PEAK_FORCE = _ep.slot("E_T_PEAK_FORCE")  # s
 E_OPEN = _ep.slot("E_OPEN")  # 1 if the episode had not ended when the run stopped
 NEP = _ep.end("NEP")
 
-# ---- a run's impacts (n_impacts, NIM): core/impacts.py, one row per impact (a
-# group of chained episodes, docs/STUDIES.md 2), members in start order
-_im = Block("impacts", "IM_")
-IM_START = _im.slot("IM_START")  # s, earliest start of its episodes
-IM_END = _im.slot("IM_END")  # s, latest end of its episodes (run end if one is open)
-IM_PEAK_DELTA = _im.slot("IM_PEAK_DELTA")  # m, largest peak deflection of its episodes
-IM_PEAK_FORCE = _im.slot("IM_PEAK_FORCE")  # N, largest peak normal force of its episodes
-NIM = _im.end("NIM")
-
 # ---- attitude excursion over the output samples (NEX), a part of stats
 # (ST_EXCURSION): core/excursion.py
 _ex = Block("stats.excursion", "EX_")
