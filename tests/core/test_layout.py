@@ -17,12 +17,14 @@ import pytest
 
 from quadimpact.core import layout as L
 from quadimpact.core.records import new_data, new_output, new_work
+from quadimpact.core.rotors import NRIN
 
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
     "quadimpact.core.layout",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
+    "quadimpact.core.rotors",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
     "quadimpact.core.controllers.residual",
@@ -130,7 +132,7 @@ def test_the_factories_allocate_the_declared_sizes():
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (L.NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
         (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)

@@ -425,15 +425,6 @@ CS_LAMBDA = _cs.slot("CS_LAMBDA")  # damping coefficient fixed at the episode's 
 CS_EPISODE = _cs.slot("CS_EPISODE")  # row of its episode in `episodes` (-1: none / dropped)
 NCS = _cs.end("NCS")
 
-# ---- rotor inputs over the current sub-interval rin (NRIN)
-_rin = Block("rin", "RIN_")
-RIN_CMD = _rin.slot("RIN_CMD", MAX_ROTORS)  # speed command in force (rad/s)
-RIN_RATE = _rin.slot("RIN_RATE", MAX_ROTORS)  # prescribed d(Omega)/dt of the rotor states
-RIN_FF = _rin.slot("RIN_FF", MAX_ROTORS)  # Omega_dot used in the reaction torque
-RIN_FIRST_ORDER = _rin.slot("RIN_FIRST_ORDER")  # 1: rotor states follow (cmd - Omega) / tau
-RIN_PREV_CMD = _rin.slot("RIN_PREV_CMD", MAX_ROTORS)  # the previous tick's command, limited
-NRIN = _rin.end("NRIN")
-
 # ---- controller memory mem (NMEM), zeroed at the start; each controller
 # lays out its slots with a Block of array "mem.<name>". The last slot is
 # reserved: a controller with stages writes its current stage there.

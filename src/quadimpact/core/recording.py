@@ -46,7 +46,6 @@ from quadimpact.core.layout import (
     OUT_X,
     PR_FEATURE,
     PR_SHAPE,
-    RIN_CMD,
     ST_CRASH_T,
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
@@ -65,7 +64,10 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Output, Work
-from quadimpact.core.rotors import active_states
+from quadimpact.core.rotors import (
+    RIN_CMD,
+    active_states,
+)
 from quadimpact.core.sensors.disturbance import impact_onset
 
 

@@ -51,7 +51,6 @@ from quadimpact.core.layout import (
     NMEAS,
     NMEM,
     NOUT,
-    NRIN,
     NSCFG,
     NSN,
     NSPAN,
@@ -67,6 +66,7 @@ from quadimpact.core.layout import (
     ST_N_IMU,
     ST_N_OUT,
 )
+from quadimpact.core.rotors import NRIN
 
 __all__ = [
     "Data",
