@@ -26,6 +26,7 @@ from quadimpact.core.approach import (
     LATE_START_XTOL_S,
     _inertial_vx,
 )
+from quadimpact.core.geometry import NPAIR
 from quadimpact.core.kernel import execute
 from quadimpact.core.roots import brentq
 from quadimpact.simulation import approach as approach_py
@@ -88,7 +89,7 @@ def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
         x0=x0,
         span=span,
         shapes=np.zeros((0, L.NSHAPE)),
-        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=kw["free_opts"],
         scfg=np.zeros(L.NSCFG),
         noise=np.zeros((0, 6)),

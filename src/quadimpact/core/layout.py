@@ -259,15 +259,6 @@ SH_HALF = _shape.slot("SH_HALF", 3)  # m: half-extents along the shape's own axe
 SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components: row i is axis i
 NSHAPE = _shape.end("NSHAPE")
 
-# ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,
-# shape) pair, shape-major (pair c = shape * n_features + feature); built
-# once per run, the geometry function chosen by the two kinds (core/geometry)
-_pair = Block("pairs", "PR_")
-PR_FEATURE = _pair.slot("PR_FEATURE")  # row of feat
-PR_SHAPE = _pair.slot("PR_SHAPE")  # row of shapes
-PR_GEOMETRY = _pair.slot("PR_GEOMETRY")  # GEOM_* of core/geometry: the pair's function
-NPAIR = _pair.end("NPAIR")
-
 # ---- options opts (NOPT): model switches, integrator settings
 _opt = Block("opts", "O_")
 O_YAW_REACTION_PAPER = _opt.slot("O_YAW_REACTION_PAPER")  # 1: replica drag +s dt W^2

@@ -41,7 +41,13 @@ from quadimpact.core.approach import (
     APPROACH_TOL_M_S,
     NAP,
 )
-from quadimpact.core.geometry import pair_depths, pair_table
+from quadimpact.core.geometry import (
+    NPAIR,
+    PR_FEATURE,
+    PR_SHAPE,
+    pair_depths,
+    pair_table,
+)
 from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
@@ -100,11 +106,11 @@ def pair_depths_at(
     plugins = plugin_shapes()
     if plugins:
         for c in range(pairs.shape[0]):
-            s = int(pairs[c, L.PR_SHAPE])
+            s = int(pairs[c, PR_SHAPE])
             comp = by_kind(int(shapes[s, L.SH_KIND]))
             if comp is None or comp not in plugins:
                 continue
-            f = int(pairs[c, L.PR_FEATURE])
+            f = int(pairs[c, PR_FEATURE])
             contact = comp.contacts.get(int(feat[f, L.F_KIND]))
             if contact is not None:
                 depths[c] = float(contact(xq, C, feat, f, shapes, s)[0])
@@ -199,7 +205,7 @@ def shooting_record(
         x0=np.zeros(L.NX),
         span=np.zeros(L.NSPAN),
         shapes=np.zeros((0, L.NSHAPE)),
-        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=free_opts,
         scfg=np.zeros(L.NSCFG),
         noise=np.zeros((0, 6)),
