@@ -13,7 +13,10 @@ state, time, the run's options, the records' common heads); a component
 declares its own blocks in its own module, after the head it extends (the
 controllers' parameter and memory blocks in ``core/controllers/``, the
 estimators' configuration and state in ``core/estimators/``, the detector's
-and the sensor components' in ``core/sensors/``). Numba reads these module-level integers
+and the sensor components' in ``core/sensors/``), and a stage that alone owns
+an array declares it (the wall approach's record in ``core/approach.py``, the
+impact rows in ``core/impacts.py``, the rotor inputs in ``core/rotors.py``, the
+contact-pair table in ``core/geometry``). Numba reads these module-level integers
 as compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
