@@ -39,6 +39,7 @@ import numpy as np
 
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
+from quadimpact.core.approach import AP_RUNS
 from quadimpact.core.kernel import execute
 from quadimpact.simulation import approach as approach_py
 from quadimpact.simulation import setup as setup_py
@@ -157,7 +158,7 @@ def shooting_runs(case: str) -> int:
         prepare(scenario(case))
     finally:
         setup_py.solve_approach = real
-    return int(approach_py.shooting_record(**seen)[L.AP_RUNS])
+    return int(approach_py.shooting_record(**seen)[AP_RUNS])
 
 
 def bench_cpu(case: str, repeat: int) -> dict:

@@ -15,6 +15,10 @@ import pytest
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
 from quadimpact.core.approach import (
+    AP_RUNS,
+    AP_STATUS,
+    AP_T0,
+    APPROACH_SOLVED,
     APPROACH_TOL_M_S,
     LATE_START_END_GAP_S,
     LATE_START_MAXITER,
@@ -22,6 +26,7 @@ from quadimpact.core.approach import (
     LATE_START_XTOL_S,
     _inertial_vx,
 )
+from quadimpact.core.geometry import NPAIR
 from quadimpact.core.kernel import execute
 from quadimpact.core.roots import brentq
 from quadimpact.simulation import approach as approach_py
@@ -67,8 +72,8 @@ def test_a_late_start_without_a_bracket_is_an_error(monkeypatch):
 def _runs(monkeypatch: pytest.MonkeyPatch, scenario: WallApproach) -> tuple[int, float]:
     """Free-flight runs the shooting flew for ``scenario``, and the start time it found."""
     ap = approach_py.shooting_record(**_solve_inputs(monkeypatch, scenario))
-    assert ap[L.AP_STATUS] == L.APPROACH_SOLVED
-    return int(ap[L.AP_RUNS]), float(ap[L.AP_T0])
+    assert ap[AP_STATUS] == APPROACH_SOLVED
+    return int(ap[AP_RUNS]), float(ap[AP_T0])
 
 
 def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
@@ -84,7 +89,7 @@ def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
         x0=x0,
         span=span,
         shapes=np.zeros((0, L.NSHAPE)),
-        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=kw["free_opts"],
         scfg=np.zeros(L.NSCFG),
         noise=np.zeros((0, 6)),

@@ -16,11 +16,17 @@ import numpy as np
 import pytest
 
 from quadimpact.core import layout as L
+from quadimpact.core.geometry import NPAIR
 from quadimpact.core.records import new_data, new_output, new_work
+from quadimpact.core.rotors import NRIN
 
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
     "quadimpact.core.layout",
+    "quadimpact.core.approach",
+    "quadimpact.core.impacts",
+    "quadimpact.core.rotors",
+    "quadimpact.core.geometry",
     "quadimpact.core.controllers.common",
     "quadimpact.core.controllers.recovery",
     "quadimpact.core.controllers.residual",
@@ -122,13 +128,13 @@ def test_the_factories_allocate_the_declared_sizes():
     m = model(
         x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
         feat=np.zeros((m_feat, L.NFEAT)), shapes=np.zeros((n_shapes, L.NSHAPE)),
-        pairs=np.zeros((m_feat * n_shapes, L.NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
+        pairs=np.zeros((m_feat * n_shapes, NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
         ctrl=np.zeros(L.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
     )  # fmt: skip
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (L.NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
         (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)

@@ -26,6 +26,7 @@ from scipy.integrate import solve_ivp
 
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
+from quadimpact.core.geometry import PR_GEOMETRY
 from quadimpact.core.geometry.contact_record import material_record
 from quadimpact.core.kernel import make_kernel
 from quadimpact.core.records import model, new_output
@@ -157,7 +158,7 @@ def test_a_registered_feature_shape_sensor_and_controller_run_in_one_loop(regist
     kernel = make_kernel(brace, geometry=True, sensor=proximity)
     v_in, k, n, e, rate = 1.0, 400.0, 0.66, 0.8, 200.0
     m = _ball_drop(v_in, k, n, e, rate)
-    assert m.pairs[0, L.PR_GEOMETRY] == registered
+    assert m.pairs[0, PR_GEOMETRY] == registered
     o = new_output(m, int(0.6 * rate) + 2, 16)
     kernel.run(m, o)
     st = o.stats

@@ -10,6 +10,7 @@ import pytest
 import quadimpact.envs as E
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
+from quadimpact.core.rotors import RIN_CMD
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS
 
 
@@ -111,7 +112,7 @@ def test_reward_is_the_documented_cost():
         from quadimpact.rotations import quat_to_matrix
 
         vz = (quat_to_matrix(q) @ x[L.X_VEL : L.X_VEL + 3])[2]
-        cmd = s.D.rin[0, L.RIN_CMD : L.RIN_CMD + 4]
+        cmd = s.D.rin[0, RIN_CMD : RIN_CMD + 4]
         cost = (
             w.tilt * (1 - c22) / 2
             + w.rate * min(np.linalg.norm(x[L.X_OMEGA : L.X_OMEGA + 3]) / 10.0, 1.0)

@@ -1,7 +1,7 @@
 """Actuators: rotor command limits and slew, rotor modes, and motor power-off schedules.
 
 Per control tick, :func:`apply_command` turns the controller's four speed
-commands into the rotor inputs of the interval (``rin``, layout ``RIN_*``):
+commands into the rotor inputs of the interval (``rin``, slots ``RIN_*`` of ``core/rotors.py``):
 the generic slew limit, speed range and zero floor (options ``O_SLEW_MAX``,
 ``O_OMEGA_MIN``, ``O_OMEGA_MAX``), then
 
@@ -50,16 +50,18 @@ from quadimpact.core.layout import (
     O_OMEGA_MAX,
     O_OMEGA_MIN,
     O_SLEW_MAX,
-    RIN_CMD,
-    RIN_FF,
-    RIN_FIRST_ORDER,
-    RIN_PREV_CMD,
-    RIN_RATE,
     V_N_ROTORS,
     V_TAU_M,
     X_ROTOR,
 )
 from quadimpact.core.records import Data, Model
+from quadimpact.core.rotors import (
+    RIN_CMD,
+    RIN_FF,
+    RIN_FIRST_ORDER,
+    RIN_PREV_CMD,
+    RIN_RATE,
+)
 
 ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
 

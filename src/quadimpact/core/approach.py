@@ -20,7 +20,7 @@ solve's first (``AP_RUNS`` counts the runs).
 runs are the loop's own ``start`` and ``advance`` (so a plug-in kernel's
 copy, ``core.kernel.make_kernel``, shoots with the plug-in controller), the
 depths the contact geometry's. It reads its inputs from and writes what it
-found to one array (``ap``, slots ``AP_*`` in ``core/layout.py``);
+found to one array (``ap``, slots ``AP_*``, declared below);
 ``quadimpact.simulation.approach`` packs it and reads it back.
 """
 
@@ -33,23 +33,6 @@ import numpy as np
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.geometry import pair_contact
 from quadimpact.core.layout import (
-    AP_DV,
-    AP_LATE,
-    AP_LATE_RULE,
-    AP_Q,
-    AP_REASON,
-    AP_ROTORS,
-    AP_RUNS,
-    AP_START,
-    AP_STATUS,
-    AP_T0,
-    AP_TC,
-    AP_V0,
-    AP_VC,
-    AP_X0,
-    APPROACH_NO_BRACKET,
-    APPROACH_RUN_FAILED,
-    APPROACH_SOLVED,
     MAX_ROTORS,
     NX,
     OUT_X,
@@ -63,6 +46,7 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_ROTOR,
     X_VEL,
+    Block,
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Model, Output, new_data
@@ -70,6 +54,28 @@ from quadimpact.core.roots import BR_X, BRENT_ASK, BRENT_NO_BRACKET, NBR, brent_
 from quadimpact.core.step import advance, start
 
 __all__ = ["APPROACH_MAX_ITER", "APPROACH_TOL_M_S", "solve_approach"]
+
+# ---- the shooting's record ap (NAP): its inputs, then what it found; inertial NED,
+# the wall's normal along -X
+_ap = Block("approach", "AP_")
+AP_TC = _ap.slot("AP_TC")  # s, T_c: the first contact's time
+AP_VC = _ap.slot("AP_VC")  # m/s, V_c: the speed toward the wall at T_c (inertial X)
+AP_LATE_RULE = _ap.slot("AP_LATE_RULE")  # 1: start later at rest whenever v0 < 0 is needed
+AP_START = _ap.slot("AP_START", 3)  # m, the initial CM position before the X shift
+AP_Q = _ap.slot("AP_Q", 4)  # the attitude held (quaternion, body FRD to inertial)
+AP_ROTORS = _ap.slot("AP_ROTORS", MAX_ROTORS)  # rad/s, initial rotor speeds
+AP_X0 = _ap.slot("AP_X0", NX)  # found: the initial state (layout X_*)
+AP_T0 = _ap.slot("AP_T0")  # s, found: the start time (0 unless a late start)
+AP_V0 = _ap.slot("AP_V0")  # m/s, found: the start speed (inertial X)
+AP_DV = _ap.slot("AP_DV")  # m/s, found: the speed residual at T_c
+AP_LATE = _ap.slot("AP_LATE")  # found: 1 if the vehicle starts later, at rest
+AP_STATUS = _ap.slot("AP_STATUS")  # APPROACH_*
+AP_REASON = _ap.slot("AP_REASON")  # REASON_* of a failed shooting run
+AP_RUNS = _ap.slot("AP_RUNS")  # found: the free-flight runs the shooting flew
+NAP = _ap.end("NAP")
+APPROACH_SOLVED = 0
+APPROACH_RUN_FAILED = 1  # a shooting run failed (AP_REASON) or sampled no state at T_c
+APPROACH_NO_BRACKET = 2  # the late start's speed residual has one sign over [0, T_c)
 
 APPROACH_TOL_M_S = 1e-12  # shooting residuals (speed m/s, depth m)
 APPROACH_MAX_ITER = 4

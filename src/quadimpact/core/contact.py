@@ -30,7 +30,12 @@ import numpy as np
 from numba import njit
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.geometry import pair_contact, shape_distance
+from quadimpact.core.geometry import (
+    PR_FEATURE,
+    PR_SHAPE,
+    pair_contact,
+    shape_distance,
+)
 from quadimpact.core.layout import (
     CS_ACTIVE,
     CS_LAMBDA,
@@ -42,8 +47,6 @@ from quadimpact.core.layout import (
     O_CONTACT_GATE,
     O_DOUBLE_BUMPER1_YAW,
     O_V_REG,
-    PR_FEATURE,
-    PR_SHAPE,
     X_POS,
 )
 from quadimpact.core.records import Model

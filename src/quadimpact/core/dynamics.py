@@ -13,8 +13,6 @@ from quadimpact.core.contact import contact_wrench
 from quadimpact.core.layout import (
     O_SPINUP_PAPER,
     O_YAW_REACTION_PAPER,
-    RIN_FF,
-    RIN_FIRST_ORDER,
     V_GRAVITY,
     V_MASS,
     V_N_ROTORS,
@@ -24,7 +22,11 @@ from quadimpact.core.layout import (
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Work
 from quadimpact.core.rigid_body import rigid_body_derivative
-from quadimpact.core.rotors import rotor_wrench
+from quadimpact.core.rotors import (
+    RIN_FF,
+    RIN_FIRST_ORDER,
+    rotor_wrench,
+)
 
 
 @compiled(inline="always")

@@ -10,7 +10,7 @@ force times duration) is below ``graze_fraction`` times the largest of the
 counted episodes'.
 
 :func:`find_impacts` does all of it over the raw episode rows the loop
-recorded (layout ``E_*``) and writes one row per impact (``IM_*``): its
+recorded (layout ``E_*``) and writes one row per impact (``IM_*``, below): its
 start, end, largest peak deflection and largest peak force. It is the same
 computation, in the same order of the same IEEE operations, as the Python
 reference of ``quadimpact.simulation.metrics`` (``impacts_in`` and
@@ -36,11 +36,17 @@ from quadimpact.core.layout import (
     E_SHAPE,
     E_T_END,
     E_T_START,
-    IM_END,
-    IM_PEAK_DELTA,
-    IM_PEAK_FORCE,
-    IM_START,
+    Block,
 )
+
+# ---- a run's impacts (n_impacts, NIM): one row per impact (a group of chained
+# episodes, docs/STUDIES.md 2), members in start order
+_im = Block("impacts", "IM_")
+IM_START = _im.slot("IM_START")  # s, earliest start of its episodes
+IM_END = _im.slot("IM_END")  # s, latest end of its episodes (run end if one is open)
+IM_PEAK_DELTA = _im.slot("IM_PEAK_DELTA")  # m, largest peak deflection of its episodes
+IM_PEAK_FORCE = _im.slot("IM_PEAK_FORCE")  # N, largest peak normal force of its episodes
+NIM = _im.end("NIM")
 
 EXCLUDED = -1
 """``impact_of[k]`` of an episode on an excluded shape."""

@@ -22,7 +22,7 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_gap
 from quadimpact.core.dynamics import state_derivative
 from quadimpact.core.events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
-from quadimpact.core.geometry import has_bound, pair_bound, pair_depth
+from quadimpact.core.geometry import PR_SHAPE, has_bound, pair_bound, pair_depth
 from quadimpact.core.integrator import (
     all_finite,
     copy_into,
@@ -55,7 +55,6 @@ from quadimpact.core.layout import (
     O_POWER_OFF_T,
     O_RTOL,
     O_STOP_ON_CRASH,
-    PR_SHAPE,
     REASON_MAX_STEPS,
     REASON_NOT_FINITE,
     REASON_STEP_TOO_SMALL,

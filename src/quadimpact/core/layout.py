@@ -13,7 +13,10 @@ state, time, the run's options, the records' common heads); a component
 declares its own blocks in its own module, after the head it extends (the
 controllers' parameter and memory blocks in ``core/controllers/``, the
 estimators' configuration and state in ``core/estimators/``, the detector's
-and the sensor components' in ``core/sensors/``). Numba reads these module-level integers
+and the sensor components' in ``core/sensors/``), and a stage that alone owns
+an array declares it (the wall approach's record in ``core/approach.py``, the
+impact rows in ``core/impacts.py``, the rotor inputs in ``core/rotors.py``, the
+contact-pair table in ``core/geometry``). Numba reads these module-level integers
 as compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
@@ -259,15 +262,6 @@ SH_HALF = _shape.slot("SH_HALF", 3)  # m: half-extents along the shape's own axe
 SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components: row i is axis i
 NSHAPE = _shape.end("NSHAPE")
 
-# ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,
-# shape) pair, shape-major (pair c = shape * n_features + feature); built
-# once per run, the geometry function chosen by the two kinds (core/geometry)
-_pair = Block("pairs", "PR_")
-PR_FEATURE = _pair.slot("PR_FEATURE")  # row of feat
-PR_SHAPE = _pair.slot("PR_SHAPE")  # row of shapes
-PR_GEOMETRY = _pair.slot("PR_GEOMETRY")  # GEOM_* of core/geometry: the pair's function
-NPAIR = _pair.end("NPAIR")
-
 # ---- options opts (NOPT): model switches, integrator settings
 _opt = Block("opts", "O_")
 O_YAW_REACTION_PAPER = _opt.slot("O_YAW_REACTION_PAPER")  # 1: replica drag +s dt W^2
@@ -397,28 +391,6 @@ SPAN_T0 = _span.slot("SPAN_T0")  # s, start
 SPAN_TF = _span.slot("SPAN_TF")  # s, end
 NSPAN = _span.end("NSPAN")
 
-# ---- the wall approach's shooting ap (NAP): its inputs, then what it found
-# (core/approach.py); inertial NED, the wall's normal along -X
-_ap = Block("approach", "AP_")
-AP_TC = _ap.slot("AP_TC")  # s, T_c: the first contact's time
-AP_VC = _ap.slot("AP_VC")  # m/s, V_c: the speed toward the wall at T_c (inertial X)
-AP_LATE_RULE = _ap.slot("AP_LATE_RULE")  # 1: start later at rest whenever v0 < 0 is needed
-AP_START = _ap.slot("AP_START", 3)  # m, the initial CM position before the X shift
-AP_Q = _ap.slot("AP_Q", 4)  # the attitude held (quaternion, body FRD to inertial)
-AP_ROTORS = _ap.slot("AP_ROTORS", MAX_ROTORS)  # rad/s, initial rotor speeds
-AP_X0 = _ap.slot("AP_X0", NX)  # found: the initial state (layout X_*)
-AP_T0 = _ap.slot("AP_T0")  # s, found: the start time (0 unless a late start)
-AP_V0 = _ap.slot("AP_V0")  # m/s, found: the start speed (inertial X)
-AP_DV = _ap.slot("AP_DV")  # m/s, found: the speed residual at T_c
-AP_LATE = _ap.slot("AP_LATE")  # found: 1 if the vehicle starts later, at rest
-AP_STATUS = _ap.slot("AP_STATUS")  # APPROACH_*
-AP_REASON = _ap.slot("AP_REASON")  # REASON_* of a failed shooting run
-AP_RUNS = _ap.slot("AP_RUNS")  # found: the free-flight runs the shooting flew
-NAP = _ap.end("NAP")
-APPROACH_SOLVED = 0
-APPROACH_RUN_FAILED = 1  # a shooting run failed (AP_REASON) or sampled no state at T_c
-APPROACH_NO_BRACKET = 2  # the late start's speed residual has one sign over [0, T_c)
-
 # ==========================================================================
 # Data: what the loop carries from one control tick to the next
 # ==========================================================================
@@ -446,15 +418,6 @@ CS_ACTIVE = _cs.slot("CS_ACTIVE")  # 1 while the pair is in a contact episode (f
 CS_LAMBDA = _cs.slot("CS_LAMBDA")  # damping coefficient fixed at the episode's onset
 CS_EPISODE = _cs.slot("CS_EPISODE")  # row of its episode in `episodes` (-1: none / dropped)
 NCS = _cs.end("NCS")
-
-# ---- rotor inputs over the current sub-interval rin (NRIN)
-_rin = Block("rin", "RIN_")
-RIN_CMD = _rin.slot("RIN_CMD", MAX_ROTORS)  # speed command in force (rad/s)
-RIN_RATE = _rin.slot("RIN_RATE", MAX_ROTORS)  # prescribed d(Omega)/dt of the rotor states
-RIN_FF = _rin.slot("RIN_FF", MAX_ROTORS)  # Omega_dot used in the reaction torque
-RIN_FIRST_ORDER = _rin.slot("RIN_FIRST_ORDER")  # 1: rotor states follow (cmd - Omega) / tau
-RIN_PREV_CMD = _rin.slot("RIN_PREV_CMD", MAX_ROTORS)  # the previous tick's command, limited
-NRIN = _rin.end("NRIN")
 
 # ---- controller memory mem (NMEM), zeroed at the start; each controller
 # lays out its slots with a Block of array "mem.<name>". The last slot is
@@ -569,15 +532,6 @@ E_PEAK_FORCE = _ep.slot("E_PEAK_FORCE")  # N
 E_T_PEAK_FORCE = _ep.slot("E_T_PEAK_FORCE")  # s
 E_OPEN = _ep.slot("E_OPEN")  # 1 if the episode had not ended when the run stopped
 NEP = _ep.end("NEP")
-
-# ---- a run's impacts (n_impacts, NIM): core/impacts.py, one row per impact (a
-# group of chained episodes, docs/STUDIES.md 2), members in start order
-_im = Block("impacts", "IM_")
-IM_START = _im.slot("IM_START")  # s, earliest start of its episodes
-IM_END = _im.slot("IM_END")  # s, latest end of its episodes (run end if one is open)
-IM_PEAK_DELTA = _im.slot("IM_PEAK_DELTA")  # m, largest peak deflection of its episodes
-IM_PEAK_FORCE = _im.slot("IM_PEAK_FORCE")  # N, largest peak normal force of its episodes
-NIM = _im.end("NIM")
 
 # ---- attitude excursion over the output samples (NEX), a part of stats
 # (ST_EXCURSION): core/excursion.py

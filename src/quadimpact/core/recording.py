@@ -14,7 +14,13 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
 from quadimpact.core.excursion import excursion_add
-from quadimpact.core.geometry import has_bound, pair_bound, pair_depth
+from quadimpact.core.geometry import (
+    PR_FEATURE,
+    PR_SHAPE,
+    has_bound,
+    pair_bound,
+    pair_depth,
+)
 from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import (
     C_PHI_REF,
@@ -44,9 +50,6 @@ from quadimpact.core.layout import (
     OUT_STAGE,
     OUT_T,
     OUT_X,
-    PR_FEATURE,
-    PR_SHAPE,
-    RIN_CMD,
     ST_CRASH_T,
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
@@ -65,7 +68,10 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Output, Work
-from quadimpact.core.rotors import active_states
+from quadimpact.core.rotors import (
+    RIN_CMD,
+    active_states,
+)
 from quadimpact.core.sensors.disturbance import impact_onset
 
 

@@ -17,7 +17,9 @@ spirit of MuJoCo MJX's ``Model``/``Data``:
   can be read);
 * :class:`Work`: scratch space of one control tick.
 
-Every slot of every field is named in ``core/layout.py``. The factories
+Every slot of every field is named in ``core/layout.py`` or, for a field a
+stage owns, in that stage's module (``rin``: ``core/rotors.py``; ``pairs``:
+``core/geometry``). The factories
 ``new_data`` and ``new_work`` are compiled, so the compiled ``run`` and the
 Python side allocate through the same code; ``new_output`` (what the caller
 allocates) is plain NumPy;
@@ -51,7 +53,6 @@ from quadimpact.core.layout import (
     NMEAS,
     NMEM,
     NOUT,
-    NRIN,
     NSCFG,
     NSN,
     NSPAN,
@@ -67,6 +68,7 @@ from quadimpact.core.layout import (
     ST_N_IMU,
     ST_N_OUT,
 )
+from quadimpact.core.rotors import NRIN
 
 __all__ = [
     "Data",

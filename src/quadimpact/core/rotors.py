@@ -21,6 +21,7 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import (
+    MAX_ROTORS,
     N_RIGID,
     V_DT,
     V_JR,
@@ -30,7 +31,19 @@ from quadimpact.core.layout import (
     V_SPIN,
     X_OMEGA,
     X_ROTOR,
+    Block,
 )
+
+# ---- the rotor inputs over the current sub-interval rin (NRIN), a field of Data: the
+# actuators write them at each tick and power-off segment (core/actuators.py), the
+# right-hand side reads the rotors' rates and reaction-torque Omega_dot from them
+_rin = Block("rin", "RIN_")
+RIN_CMD = _rin.slot("RIN_CMD", MAX_ROTORS)  # speed command in force (rad/s)
+RIN_RATE = _rin.slot("RIN_RATE", MAX_ROTORS)  # prescribed d(Omega)/dt of the rotor states
+RIN_FF = _rin.slot("RIN_FF", MAX_ROTORS)  # Omega_dot used in the reaction torque
+RIN_FIRST_ORDER = _rin.slot("RIN_FIRST_ORDER")  # 1: rotor states follow (cmd - Omega) / tau
+RIN_PREV_CMD = _rin.slot("RIN_PREV_CMD", MAX_ROTORS)  # the previous tick's command, limited
+NRIN = _rin.end("NRIN")
 
 
 @compiled(inline="always")

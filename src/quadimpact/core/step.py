@@ -75,9 +75,6 @@ from quadimpact.core.layout import (
     O_H_MAX,
     O_POWER_OFF_T,
     O_ROTOR_MODE,
-    RIN_CMD,
-    RIN_FIRST_ORDER,
-    RIN_PREV_CMD,
     ROTOR_FIRST_ORDER,
     SC_RATE,
     SPAN_T0,
@@ -116,6 +113,11 @@ from quadimpact.core.plugin_call import call_controller
 from quadimpact.core.quaternion import normalise_quaternion
 from quadimpact.core.recording import record_crash, write_sample
 from quadimpact.core.records import Data, Model, Output, Work, new_work
+from quadimpact.core.rotors import (
+    RIN_CMD,
+    RIN_FIRST_ORDER,
+    RIN_PREV_CMD,
+)
 from quadimpact.core.sensing import sample_at
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4

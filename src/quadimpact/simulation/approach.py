@@ -21,8 +21,33 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.approach import APPROACH_MAX_ITER, APPROACH_TOL_M_S
-from quadimpact.core.geometry import pair_depths, pair_table
+from quadimpact.core.approach import (
+    AP_DV,
+    AP_LATE,
+    AP_LATE_RULE,
+    AP_Q,
+    AP_REASON,
+    AP_ROTORS,
+    AP_START,
+    AP_STATUS,
+    AP_T0,
+    AP_TC,
+    AP_V0,
+    AP_VC,
+    AP_X0,
+    APPROACH_MAX_ITER,
+    APPROACH_NO_BRACKET,
+    APPROACH_RUN_FAILED,
+    APPROACH_TOL_M_S,
+    NAP,
+)
+from quadimpact.core.geometry import (
+    NPAIR,
+    PR_FEATURE,
+    PR_SHAPE,
+    pair_depths,
+    pair_table,
+)
 from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
@@ -81,11 +106,11 @@ def pair_depths_at(
     plugins = plugin_shapes()
     if plugins:
         for c in range(pairs.shape[0]):
-            s = int(pairs[c, L.PR_SHAPE])
+            s = int(pairs[c, PR_SHAPE])
             comp = by_kind(int(shapes[s, L.SH_KIND]))
             if comp is None or comp not in plugins:
                 continue
-            f = int(pairs[c, L.PR_FEATURE])
+            f = int(pairs[c, PR_FEATURE])
             contact = comp.contacts.get(int(feat[f, L.F_KIND]))
             if contact is not None:
                 depths[c] = float(contact(xq, C, feat, f, shapes, s)[0])
@@ -171,7 +196,7 @@ def shooting_record(
     kernel: Kernel | None = None,
     clock: CpuClock | None = None,
 ) -> np.ndarray:
-    """The compiled shooting's record (layout ``AP_*``) after its call, unchecked.
+    """The compiled shooting's record (``AP_*``) after its call, unchecked.
 
     The arguments are :func:`solve_approach`'s. Besides what that function
     reads back, the record counts the free-flight runs flown (``AP_RUNS``).
@@ -180,7 +205,7 @@ def shooting_record(
         x0=np.zeros(L.NX),
         span=np.zeros(L.NSPAN),
         shapes=np.zeros((0, L.NSHAPE)),
-        pairs=np.zeros((0, L.NPAIR), dtype=np.int64),
+        pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=free_opts,
         scfg=np.zeros(L.NSCFG),
         noise=np.zeros((0, 6)),
@@ -200,38 +225,38 @@ def shooting_record(
 def _shooting_inputs(
     q: np.ndarray, rotors: np.ndarray, start: np.ndarray, tc: float, vc: float, late: bool
 ) -> np.ndarray:
-    """The shooting's record (layout ``AP_*``) before the call: ``T_c`` (``tc``, s),
+    """The shooting's record (``AP_*``) before the call: ``T_c`` (``tc``, s),
     ``V_c`` (``vc``, m/s), the late-start rule (``late``), the start position before the X
     shift (inertial NED, m), the attitude held ``q`` and the initial rotor speeds."""
-    ap = np.zeros(L.NAP)
-    ap[L.AP_TC] = tc
-    ap[L.AP_VC] = vc
-    ap[L.AP_LATE_RULE] = 1.0 if late else 0.0
-    ap[L.AP_START : L.AP_START + 3] = start
-    ap[L.AP_Q : L.AP_Q + 4] = q
-    ap[L.AP_ROTORS : L.AP_ROTORS + len(rotors)] = rotors
+    ap = np.zeros(NAP)
+    ap[AP_TC] = tc
+    ap[AP_VC] = vc
+    ap[AP_LATE_RULE] = 1.0 if late else 0.0
+    ap[AP_START : AP_START + 3] = start
+    ap[AP_Q : AP_Q + 4] = q
+    ap[AP_ROTORS : AP_ROTORS + len(rotors)] = rotors
     return ap
 
 
 def _shooting_result(ap: np.ndarray) -> tuple[np.ndarray, float, dict[str, Any]]:
-    """What the shooting found in its record ``ap`` (layout ``AP_*``): the initial state,
+    """What the shooting found in its record ``ap`` (``AP_*``): the initial state,
     the start time (s) and the summary's ``approach`` (:func:`solve_approach`); a failed
     run (``RuntimeError``) or no late start reaching the speed (``ValueError``) raised."""
-    status = int(ap[L.AP_STATUS])
-    if status == L.APPROACH_RUN_FAILED:
-        reason = L.REASON_TEXT.get(int(ap[L.AP_REASON]), "") or "no state sampled at T_c"
+    status = int(ap[AP_STATUS])
+    if status == APPROACH_RUN_FAILED:
+        reason = L.REASON_TEXT.get(int(ap[AP_REASON]), "") or "no state sampled at T_c"
         raise RuntimeError("approach shooting run failed: " + reason)
-    if status == L.APPROACH_NO_BRACKET:
+    if status == APPROACH_NO_BRACKET:
         raise ValueError(
             "approach: no late start reaches the wall at the speed asked "
             "(the speed residual has one sign over [0, T_c))"
         )
-    x0 = ap[L.AP_X0 : L.AP_X0 + L.NX].copy()
+    x0 = ap[AP_X0 : AP_X0 + L.NX].copy()
     approach = {
-        "start_time_s": float(ap[L.AP_T0]),
+        "start_time_s": float(ap[AP_T0]),
         "start_x_m": float(x0[L.X_POS]),
-        "start_speed_m_s": float(ap[L.AP_V0]),
-        "late_start": bool(ap[L.AP_LATE]),
-        "speed_residual_m_s": float(ap[L.AP_DV]),
+        "start_speed_m_s": float(ap[AP_V0]),
+        "late_start": bool(ap[AP_LATE]),
+        "speed_residual_m_s": float(ap[AP_DV]),
     }
-    return x0, float(ap[L.AP_T0]), approach
+    return x0, float(ap[AP_T0]), approach

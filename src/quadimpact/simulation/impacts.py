@@ -23,7 +23,16 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
-from quadimpact.core.impacts import GRAZE, find_impacts, sort_and_find_impacts
+from quadimpact.core.impacts import (
+    GRAZE,
+    IM_END,
+    IM_PEAK_DELTA,
+    IM_PEAK_FORCE,
+    IM_START,
+    NIM,
+    find_impacts,
+    sort_and_find_impacts,
+)
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
     IMPACT_COLUMNS,
@@ -114,7 +123,7 @@ def run_episodes(
     ground = [1.0 if name == GROUND_NAME else 0.0 for name in names]
     order = np.empty(n, dtype=np.int64)
     impact_of = np.empty(n, dtype=np.int64)
-    found = np.empty((n, L.NIM))
+    found = np.empty((n, NIM))
     excluded = np.array(ground)
     count = sort_and_find_impacts(
         raw, n, n_features, excluded, GRAZE_IMPULSE_FRACTION, order, impact_of, found
@@ -159,8 +168,8 @@ def _impacts(
         n_episodes=n_all,
         n_grazes=n_grazes,
         bumpers=groups,
-        start_s=table[L.IM_START],
-        end_s=table[L.IM_END],
-        peak_delta_m=table[L.IM_PEAK_DELTA],
-        peak_force_n=table[L.IM_PEAK_FORCE],
+        start_s=table[IM_START],
+        end_s=table[IM_END],
+        peak_delta_m=table[IM_PEAK_DELTA],
+        peak_force_n=table[IM_PEAK_FORCE],
     )

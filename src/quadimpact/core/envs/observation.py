@@ -44,7 +44,6 @@ from quadimpact.core.layout import (
     MS_X,
     NX,
     O_DT_CONTROL,
-    RIN_CMD,
     X_OMEGA,
     X_POS,
     X_QUAT,
@@ -53,6 +52,7 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.quaternion import normalise_quaternion, rotation_matrix
 from quadimpact.core.records import Data, Model
+from quadimpact.core.rotors import RIN_CMD
 
 
 @allocating

@@ -34,7 +34,6 @@ from quadimpact.core.envs.episode_layout import (
 from quadimpact.core.layout import (
     C_OMEGA_MAX,
     C_OMEGA_MIN,
-    RIN_CMD,
     V_GRAVITY,
     V_KT,
     V_MASS,
@@ -44,6 +43,7 @@ from quadimpact.core.layout import (
     X_VEL,
 )
 from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.rotors import RIN_CMD
 
 
 @allocating

@@ -87,17 +87,23 @@ from quadimpact.core.layout import (
     FEAT_POINT,
     FEAT_RING,
     FEAT_SPHERE,
-    NPAIR,
-    PR_FEATURE,
-    PR_GEOMETRY,
-    PR_SHAPE,
     SH_KIND,
     SHAPE_BOX,
     SHAPE_CYLINDER,
     SHAPE_PLANE,
+    Block,
     FeatureKind,
     ShapeKind,
 )
+
+# ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,
+# shape) pair, shape-major (pair c = shape * n_features + feature); built
+# once per run, the geometry function chosen by the two kinds (pair_table)
+_pair = Block("pairs", "PR_")
+PR_FEATURE = _pair.slot("PR_FEATURE")  # row of feat
+PR_SHAPE = _pair.slot("PR_SHAPE")  # row of shapes
+PR_GEOMETRY = _pair.slot("PR_GEOMETRY")  # GEOM_* below: the pair's function
+NPAIR = _pair.end("NPAIR")
 
 __all__ = [
     "GEOMETRIES",
