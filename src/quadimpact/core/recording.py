@@ -14,7 +14,8 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
 from quadimpact.core.excursion import excursion_add
-from quadimpact.core.geometry import has_bound, pair_bound, pair_depth
+from quadimpact.core.geometry import GEOM_RING_PLANE, has_bound, pair_bound, pair_depth
+from quadimpact.core.geometry.plane import ring_plane
 from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import (
     C_PHI_REF,
@@ -45,6 +46,7 @@ from quadimpact.core.layout import (
     OUT_T,
     OUT_X,
     PR_FEATURE,
+    PR_GEOMETRY,
     PR_SHAPE,
     RIN_CMD,
     ST_CRASH_T,
@@ -82,6 +84,9 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     deflection and normal force, from the contact geometry of every pair)
     only where the rows have their columns
     (``records.new_output(..., contact_columns=False)`` skips that work).
+    A ring out of contact with a plane adds its depth alone: the closed form
+    (``geometry.plane.ring_plane``) inlined here, its depth rate and force
+    never computed (an inactive pair adds no force).
     """
     out = o.out
     st = o.stats
@@ -113,6 +118,11 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     for c in range(d.cs.shape[0]):
         f = m.pairs[c, PR_FEATURE]
         active = d.cs[c, CS_ACTIVE] > 0.5
+        if not active and m.pairs[c, PR_GEOMETRY] == GEOM_RING_PLANE:
+            dp = ring_plane(xs, w.C, m.feat, f, m.shapes, m.pairs[c, PR_SHAPE])[0]
+            if dp > out[row, OUT_DELTA + f]:
+                out[row, OUT_DELTA + f] = dp
+            continue
         if not active and has_bound(m.pairs, c):
             if pair_bound(xs, w.C, m.feat, m.shapes, m.pairs, c)[0] < 0.0:
                 continue  # apart (the broad phase): no deflection, no force

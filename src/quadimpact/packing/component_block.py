@@ -88,7 +88,8 @@ def _drawing() -> tuple[int, dict[str, Any], tuple[Any, ...]]:
     """
     comps = components()
     kept = _DRAWING[0]
-    if kept is None or len(kept) != len(comps) or any(a is not b for a, b in zip(kept, comps)):
+    same = kept is not None and len(kept) == len(comps)
+    if not (same and all(a is b for a, b in zip(kept, comps, strict=True))):
         drawing = tuple(c for c in comps if c.sizes()[3] > 0 and c.legacy_noise is None)
         _DRAWING[:] = [comps, (tail_sizes()[3], addresses(comps), drawing)]
     return _DRAWING[1]
