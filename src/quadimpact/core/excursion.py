@@ -81,6 +81,25 @@ def new_max(d: float, dev: float, cos_d: float, sin_d: float) -> tuple[float, fl
 
 
 @compiled
+def new_max_at(
+    d: float, dev: float, cos_d: float, sin_d: float, a: float, b: float, cu: float, su: float
+) -> tuple[float, float, float]:
+    """:func:`new_max` for a departure ``dev`` that is the angle between ``(a, b)`` and the
+    unit ``(cu, su)``: when it is the new largest, its cosine and sine from the vectors.
+
+    They are those of ``dev`` within a few rounding errors (1e-15), far inside
+    :func:`may_reach`'s slack of 1e-12, and cost a square root and two
+    divisions instead of a cosine and a sine. Only the pruning reads them: the
+    largest departure itself is ``dev`` (the same bits as :func:`new_max`).
+    """
+    m = max(d, dev)
+    if m != d:
+        r = math.sqrt(a * a + b * b)
+        return m, (a * cu + b * su) / r, abs(b * cu - a * su) / r
+    return m, cos_d, sin_d
+
+
+@compiled
 def euler_of(
     c00: float, c10: float, c20: float, c21: float, c22: float, c01: float, c11: float
 ) -> tuple[float, float, float]:
@@ -152,17 +171,28 @@ def excursion_add(
         d_pitch, cos_p, sin_p = new_max(d_pitch, abs(pitch - pitch_ref), cos_p, sin_p)
         d_yaw, cos_y, sin_y = new_max(d_yaw, abs(wrap_pi(yaw - yaw_ref)), cos_y, sin_y)
     else:  # away from gimbal lock: roll = atan2(C32, C33), yaw = atan2(C21, C11)
-        if may_reach(c22, c21, e[EX_REF_TRIG], e[EX_REF_TRIG + 1], cos_r, sin_r):
+        # a new largest departure takes its cosine and sine from the sample's vectors
+        # (new_max_at); the pitch's only where its vector's angle is the departure
+        cu, su = e[EX_REF_TRIG], e[EX_REF_TRIG + 1]
+        if may_reach(c22, c21, cu, su, cos_r, sin_r):
             roll = wrap_pi(math.atan2(c21, c22)) * DEG * RAD
-            d_roll, cos_r, sin_r = new_max(d_roll, abs(wrap_pi(roll - roll_ref)), cos_r, sin_r)
-        if not abs(pitch_ref) <= 0.5 * math.pi or may_reach(
-            math.sqrt(s2), -c20, e[EX_REF_TRIG + 2], e[EX_REF_TRIG + 3], cos_p, sin_p
-        ):
+            dev = abs(wrap_pi(roll - roll_ref))
+            d_roll, cos_r, sin_r = new_max_at(d_roll, dev, cos_r, sin_r, c22, c21, cu, su)
+        cu, su = e[EX_REF_TRIG + 2], e[EX_REF_TRIG + 3]
+        if not abs(pitch_ref) <= 0.5 * math.pi:
             pitch = math.atan2(-c20, math.hypot(c00, c10)) * DEG * RAD
             d_pitch, cos_p, sin_p = new_max(d_pitch, abs(pitch - pitch_ref), cos_p, sin_p)
-        if may_reach(c00, c10, e[EX_REF_TRIG + 4], e[EX_REF_TRIG + 5], cos_y, sin_y):
+        elif may_reach(math.sqrt(s2), -c20, cu, su, cos_p, sin_p):
+            pitch = math.atan2(-c20, math.hypot(c00, c10)) * DEG * RAD
+            dev = abs(pitch - pitch_ref)
+            d_pitch, cos_p, sin_p = new_max_at(
+                d_pitch, dev, cos_p, sin_p, math.sqrt(s2), -c20, cu, su
+            )
+        cu, su = e[EX_REF_TRIG + 4], e[EX_REF_TRIG + 5]
+        if may_reach(c00, c10, cu, su, cos_y, sin_y):
             yaw = wrap_pi(math.atan2(c10, c00)) * DEG * RAD
-            d_yaw, cos_y, sin_y = new_max(d_yaw, abs(wrap_pi(yaw - yaw_ref)), cos_y, sin_y)
+            dev = abs(wrap_pi(yaw - yaw_ref))
+            d_yaw, cos_y, sin_y = new_max_at(d_yaw, dev, cos_y, sin_y, c00, c10, cu, su)
     e[EX_DEV], e[EX_DEV + 1], e[EX_DEV + 2] = d_roll, d_pitch, d_yaw
     e[EX_DEV_TRIG], e[EX_DEV_TRIG + 1] = cos_r, sin_r
     e[EX_DEV_TRIG + 2], e[EX_DEV_TRIG + 3] = cos_p, sin_p

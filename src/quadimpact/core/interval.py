@@ -22,7 +22,16 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_gap
 from quadimpact.core.dynamics import state_derivative
 from quadimpact.core.events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
-from quadimpact.core.geometry import PR_SHAPE, has_bound, pair_bound, pair_depth
+from quadimpact.core.geometry import (
+    GEOM_RING_PLANE,
+    PR_FEATURE,
+    PR_GEOMETRY,
+    PR_SHAPE,
+    has_bound,
+    pair_bound,
+    pair_depth,
+)
+from quadimpact.core.geometry.plane import ring_plane
 from quadimpact.core.integrator import (
     all_finite,
     copy_into,
@@ -110,10 +119,18 @@ def contact_values(
     apart, ``g[c]`` and ``gd[c]`` hold the bounds (its gap is at most
     ``g[c] < 0``, its rate at most ``gd[c]`` in size) and ``bnd[c] = 1``.
     ``events.contact_event`` decides from them only what they prove and
-    computes the values otherwise, so no result changes (bit for bit).
+    computes the values otherwise, so no result changes (bit for bit). A ring
+    against a plane takes its depth and rate from the closed form inlined here
+    (``geometry.plane.ring_plane``: the rest of its record is not computed).
     """
     rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
     for c in range(g.shape[0]):
+        if m.pairs[c, PR_GEOMETRY] == GEOM_RING_PLANE:
+            rec = ring_plane(x, w.C, m.feat, m.pairs[c, PR_FEATURE], m.shapes, m.pairs[c, PR_SHAPE])
+            g[c] = contact_gap(x, rec[0], m, c)
+            gd[c] = rec[1]
+            bnd[c] = 0.0
+            continue
         if d.cs[c, CS_ACTIVE] < 0.5 and has_bound(m.pairs, c):
             gu, vu = pair_bound(x, w.C, m.feat, m.shapes, m.pairs, c)
             if gu < 0.0:

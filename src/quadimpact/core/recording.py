@@ -15,12 +15,15 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
 from quadimpact.core.excursion import excursion_add
 from quadimpact.core.geometry import (
+    GEOM_RING_PLANE,
     PR_FEATURE,
+    PR_GEOMETRY,
     PR_SHAPE,
     has_bound,
     pair_bound,
     pair_depth,
 )
+from quadimpact.core.geometry.plane import ring_plane
 from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import (
     C_PHI_REF,
@@ -88,6 +91,9 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     deflection and normal force, from the contact geometry of every pair)
     only where the rows have their columns
     (``records.new_output(..., contact_columns=False)`` skips that work).
+    A ring against a plane takes its depth (and, in contact, its rate) from
+    the closed form inlined here (``geometry.plane.ring_plane``): the rest of
+    its record is not computed, nor its force out of contact.
     """
     out = o.out
     st = o.stats
@@ -119,6 +125,14 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     for c in range(d.cs.shape[0]):
         f = m.pairs[c, PR_FEATURE]
         active = d.cs[c, CS_ACTIVE] > 0.5
+        if m.pairs[c, PR_GEOMETRY] == GEOM_RING_PLANE:  # the closed form, inlined
+            rec = ring_plane(xs, w.C, m.feat, f, m.shapes, m.pairs[c, PR_SHAPE])
+            if rec[0] > out[row, OUT_DELTA + f]:
+                out[row, OUT_DELTA + f] = rec[0]
+            if active:
+                lam = d.cs[c, CS_LAMBDA]
+                out[row, OUT_DELTA + nf + f] += pair_normal_force(m, c, rec[0], rec[1], lam)
+            continue
         if not active and has_bound(m.pairs, c):
             if pair_bound(xs, w.C, m.feat, m.shapes, m.pairs, c)[0] < 0.0:
                 continue  # apart (the broad phase): no deflection, no force

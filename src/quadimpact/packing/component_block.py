@@ -74,18 +74,34 @@ def named_components(settings: Any, instruments: Mapping[str, Any]) -> dict[str,
     return out
 
 
+_DRAWING: list[Any] = [None, None]
+"""The registry's components (the tuple of one call) and what :func:`_drawing` made of
+them: kept while the registry holds the same components."""
+
+
+def _drawing() -> tuple[int, dict[str, Any], tuple[Any, ...]]:
+    """The noise tail's size, the components' addresses and the components that draw
+    from a stream of their own (noise block, no legacy columns), once per registry.
+
+    Each run's packing asks (``draw_component_noise``); the registry changes only
+    when a sensor is registered, which makes a new tuple of components.
+    """
+    comps = components()
+    kept = _DRAWING[0]
+    same = kept is not None and len(kept) == len(comps)
+    if not (same and all(a is b for a, b in zip(kept, comps, strict=True))):
+        drawing = tuple(c for c in comps if c.sizes()[3] > 0 and c.legacy_noise is None)
+        _DRAWING[:] = [comps, (tail_sizes()[3], addresses(comps), drawing)]
+    return _DRAWING[1]
+
+
 def draw_component_noise(instruments: Mapping[str, Any], seed: int, n_imu: int) -> np.ndarray:
     """The named components' standard normal draws, ``(n_imu, noise tail)``.
 
     ``(0, noise tail)`` when no named component draws any.
     """
-    n_noise = tail_sizes()[3]
-    where = addresses()
-    named = [
-        c
-        for c in components()
-        if c.name in instruments and c.sizes()[3] > 0 and c.legacy_noise is None
-    ]
+    n_noise, where, drawing = _drawing()
+    named = [c for c in drawing if c.name in instruments]
     if not named or n_imu <= 0:
         return np.zeros((0, n_noise))
     out = np.zeros((n_imu, n_noise))

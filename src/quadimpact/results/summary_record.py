@@ -103,6 +103,18 @@ def _field_layout(cls: type) -> tuple[tuple[str, bool], ...]:
     return layout
 
 
+_PLAIN: dict[type, tuple[tuple[str, ...], bool]] = {}
+
+
+def _plain_layout(cls: type) -> tuple[tuple[str, ...], bool]:
+    """A part class's field names in order and whether any is a nested table, kept per class."""
+    plain = _PLAIN.get(cls)
+    if plain is None:
+        layout = _field_layout(cls)
+        plain = _PLAIN[cls] = (tuple(n for n, _ in layout), any(t for _, t in layout))
+    return plain
+
+
 class Part:
     """A part of the summary: a dataclass of :func:`metric` and :func:`table` fields."""
 
@@ -124,9 +136,13 @@ class Part:
 
     def to_dict(self) -> dict[str, Any]:
         """The part's keys and values, nested tables as dicts (a table left None stays None)."""
+        values = self.__dict__  # a dataclass's fields (read here without getattr: every run)
+        names, tables = _plain_layout(type(self))
+        if not tables:
+            return {name: values[name] for name in names}
         out: dict[str, Any] = {}
         for name, is_table in _field_layout(type(self)):
-            value = getattr(self, name)
+            value = values[name]
             out[name] = value.to_dict() if is_table and isinstance(value, Part) else value
         return out
 
@@ -469,12 +485,19 @@ class Summary:
         """The summary as ``summary.json`` holds it: the parts' keys in order; a part that
         does not apply adds nothing, a table left None in a part adds nothing either."""
         out: dict[str, Any] = {}
+        parts = self.__dict__
         for name, _, _ in self.PARTS:
-            part = getattr(self, name)
+            part = parts[name]
             if part is None:
                 continue
+            values = part.__dict__  # its fields, read without getattr (every run)
+            names, tables = _plain_layout(type(part))
+            if not tables:
+                for key in names:
+                    out[key] = values[key]
+                continue
             for key, is_table in _field_layout(type(part)):
-                value = getattr(part, key)
+                value = values[key]
                 if is_table:
                     if value is None:
                         continue

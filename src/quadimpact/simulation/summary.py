@@ -75,7 +75,7 @@ def _nan_to_none(v: float) -> float | None:
 def build_summary(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray) -> dict[str, Any]:
     """The summary (docs/STUDIES.md section 2, docs/RECOVERY.md section 6) of a run, as
     ``summary.json`` holds it: :func:`summary_record`'s parts, in order."""
-    return summary_record(setup, scenario, episodes, st).to_dict()
+    return _summary_dict(setup, scenario, episodes, st)[1]
 
 
 @dataclass(frozen=True)
@@ -99,6 +99,14 @@ def summary_record(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray
     or a table of them); no time series. The parts a scenario kind adds are
     :data:`KIND_PARTS`'s.
     """
+    return _summary_dict(setup, scenario, episodes, st)[0]
+
+
+def _summary_dict(
+    setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray
+) -> tuple[Summary, dict[str, Any]]:
+    """:func:`summary_record` and its ``to_dict()``, the dict made once: the outcome
+    sentence reads it, then takes its place in it (the last key but the counters')."""
     obstacles = _obstacle_names(setup)
     if not isinstance(episodes, RunEpisodes):
         episodes = RunEpisodes.of_table(episodes, obstacles)
@@ -145,10 +153,10 @@ def summary_record(setup: RunSetup, scenario: Any, episodes: Any, st: np.ndarray
         outcome=OutcomePart(),
     )
     rings = setup.vehicle.features is None
-    summary.outcome.outcome = describe_outcome(
-        summary.to_dict(), None if rings else setup.feature_names
-    )
-    return summary
+    out = summary.to_dict()
+    outcome = describe_outcome(out, None if rings else setup.feature_names)
+    summary.outcome.outcome = out["outcome"] = outcome
+    return summary, out
 
 
 def _onset(setup: RunSetup, episodes: RunEpisodes, st: np.ndarray) -> _Onset:
