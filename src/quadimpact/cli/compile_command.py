@@ -11,10 +11,8 @@ __all__ = ["compile_command"]
 
 
 def _simulator() -> None:
-    """A short run of each kind, through the sweeps' path and ``simulate``'s (tables too), and
-    the ring's search against a cylinder or a box (called by address: it is compiled alone)."""
+    """A short run of each kind, through the sweeps' path and ``simulate``'s (tables too)."""
     from quadimpact import ImpactTrial, WallApproach, simulate
-    from quadimpact.core.geometry.ring_entry import ensure_ring_solid
     from quadimpact.sweep.worker import warm_up
 
     warm_up()

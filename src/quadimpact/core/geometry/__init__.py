@@ -73,7 +73,6 @@ from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
 from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
 from quadimpact.core.geometry.plane import plane_distance, point_plane, ring_plane, sphere_plane
 from quadimpact.core.geometry.ring import ring_solid, ring_solid_bound
-from quadimpact.core.geometry.ring_entry import call_ring_solid, ensure_ring_solid
 from quadimpact.core.geometry.shape_component import ShapeComponent
 from quadimpact.core.geometry.shapes import BUILTIN as BUILTIN_SHAPES
 from quadimpact.core.geometry.shapes import (
@@ -192,8 +191,8 @@ def pair_contact(
     g = pairs[c, PR_GEOMETRY]
     if g == GEOM_RING_PLANE:
         return ring_plane(x, C, feat, f, shapes, s)
-    if g == GEOM_RING_CYLINDER or g == GEOM_RING_BOX:  # by address: ring_entry.py
-        return call_ring_solid(x, C, feat, f, shapes, s)
+    if g == GEOM_RING_CYLINDER or g == GEOM_RING_BOX:
+        return ring_solid(x, C, feat, f, shapes, s)
     if g == GEOM_SPHERE_PLANE:
         return sphere_plane(x, C, feat, f, shapes, s)
     if g == GEOM_POINT_PLANE:
@@ -341,11 +340,6 @@ def pair_table(feat: np.ndarray, shapes: np.ndarray) -> np.ndarray:
             pairs[c, PR_FEATURE] = f
             pairs[c, PR_SHAPE] = s
             pairs[c, PR_GEOMETRY] = geometry_id(feat[f, F_KIND], shapes[s, SH_KIND])
-    ring_solid_pairs = (pairs[:, PR_GEOMETRY] == GEOM_RING_CYLINDER) | (
-        pairs[:, PR_GEOMETRY] == GEOM_RING_BOX
-    )
-    if ring_solid_pairs.any():
-        ensure_ring_solid()  # the search, called by address (ring_entry.py)
     return pairs
 
 
@@ -359,8 +353,6 @@ def contact_record(
     """
     kind = (int(feat[f, F_KIND]), int(shapes[s, SH_KIND]))
     pairs = np.array([[f, s, geometry_id(*kind)]], dtype=np.int64)
-    if pairs[0, PR_GEOMETRY] in (GEOM_RING_CYLINDER, GEOM_RING_BOX):
-        ensure_ring_solid()  # the search, called by address (ring_entry.py)
     return _contact_record(
         np.ascontiguousarray(x, dtype=np.float64),
         np.ascontiguousarray(C, dtype=np.float64),
