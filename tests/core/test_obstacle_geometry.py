@@ -457,21 +457,3 @@ def test_closed_form_pairs_have_no_broad_phase():
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert not geometry.has_bound(pairs, 0)
         assert geometry.pair_bound(x, C, feat, row[None, :], pairs, 0) == (math.inf, math.inf)
-
-
-def test_the_ring_search_called_by_address_is_the_search_itself():
-    """``pair_contact`` calls the ring's search against a cylinder or a box through its entry
-    point's address (``ring_entry.py``): the record is the search's own, bit for bit."""
-    from quadimpact.core.geometry.ring import ring_solid
-
-    rng = np.random.default_rng(7)
-    for shape in ("box", "cylinder", "infinite cylinder"):
-        for _ in range(10):
-            row = random_shape(rng, shape)
-            x = _state(rng)
-            normal = rng.standard_normal(3)
-            feat = _feature("ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), normal)
-            C = _rotation(x)
-            by_address = geometry.contact_record(x, C, feat, row[None, :], 0, 0)
-            direct = ring_solid(x, C, feat, 0, row[None, :], 0)
-            assert np.array_equal(np.array(by_address), np.array(direct))

@@ -18,7 +18,6 @@ def _simulator() -> None:
     warm_up()
     simulate(WallApproach(final_time_s=0.6))
     simulate(ImpactTrial(final_time_s=0.05))
-    ensure_ring_solid()  # last: compiled first, its type inference took twice the CPU
 
 
 def _environments() -> None:
