@@ -528,7 +528,7 @@ def test_a_cold_numba_cache_is_announced(tmp_path: Path, monkeypatch) -> None:
     run_py = str(Path(core.__file__).parent / "kernel.py")
     where = tmp_path / UserProvidedCacheLocator.get_suitable_cache_subpath(run_py)
     where.mkdir(parents=True)
-    (where / "kernel.run-44.py311.nbi").write_bytes(b"")
+    (where / "step.advance-44.py311.nbi").write_bytes(b"")
     assert core.cache_is_warm()
     core._checked.clear()
     assert not core.announce_compilation(say=said.append)

@@ -146,7 +146,7 @@ def test_the_learning_environments_name_what_they_compile(cold_cache: Path, noti
     kernel_py = str(Path(core.__file__).parent / "kernel.py")
     where = cold_cache / UserProvidedCacheLocator.get_suitable_cache_subpath(kernel_py)
     where.mkdir(parents=True)
-    (where / "kernel.run-48.py311.nbi").write_bytes(b"")
+    (where / "step.advance-48.py311.nbi").write_bytes(b"")
     core._checked.clear()
     ImpactRecoveryEnv()
     assert len(notices) == 2 and notices[1].startswith(

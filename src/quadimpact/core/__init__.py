@@ -75,11 +75,11 @@ def cache_is_warm(*entries: str) -> bool:
     """Whether compiled entry points are in Numba's on-disk cache (else their first use compiles).
 
     ``entries``: functions named by their module under ``quadimpact.core`` and
-    their name, ``"kernel.run"`` (the default: the run loop) or
+    their name, ``"step.advance"`` (the default: the run loop) or
     ``"envs.stacked.step_batch"``. Cheap: looks for each one's index file
     (no Numba import).
     """
-    for entry in entries or ("kernel.run",):
+    for entry in entries or ("step.advance",):
         module, _, function = entry.rpartition(".")
         *packages, stem = module.split(".")
         if not any(_numba_dir(_HERE.joinpath(*packages)).glob(f"{stem}.{function}-*.nbi")):
@@ -92,7 +92,7 @@ def cache_is_warm(*entries: str) -> bool:
 #: simulator: the loop with its estimators, obstacle shapes and features; the learning
 #: environments: their own loop, with the simulator's functions already in the cache).
 COMPILED_PARTS: dict[str, tuple[tuple[str, ...], str, int]] = {
-    "simulator": (("kernel.run",), "the simulator", 100),
+    "simulator": (("step.advance",), "the simulator", 100),
     "environments": (
         ("envs.stacked.reset_slot", "envs.stacked.step_batch"),
         "the learning environments' loop",

@@ -16,21 +16,25 @@ the first solve stops at a correction that leaves v0 far below 0 (the late
 start replaces it), and the search's last run, at the root, is the late
 solve's first (``AP_RUNS`` counts the runs).
 
-:func:`solve_approach` does all of it in one compiled call: the free-flight
-runs are the loop's own ``start`` and ``advance`` (so a plug-in kernel's
-copy, ``core.kernel.make_kernel``, shoots with the plug-in controller), the
-depths the contact geometry's. It reads its inputs from and writes what it
-found to one array (``ap``, slots ``AP_*``, declared below);
+:func:`solve_approach` drives it from Python: the free-flight runs are the
+loop's own compiled ``start`` and ``advance`` (so a plug-in kernel's copies,
+``core.kernel.make_kernel``, shoot with the plug-in controller), the depths
+the contact geometry's. It is not compiled itself: a compiled driver would
+link a second copy of the whole loop into its own machine code, about 15 s
+of the simulator's cold compile (docs/PERFORMANCE.md), for a few Python
+calls per run. It reads its inputs from and writes what it found to one
+array (``ap``, slots ``AP_*``, declared below);
 ``quadimpact.simulation.approach`` packs it and reads it back.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
-from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.compiled import compiled
 from quadimpact.core.geometry import pair_contact
 from quadimpact.core.layout import (
     MAX_ROTORS,
@@ -90,12 +94,20 @@ LATE_START_SECANT_MAXITER = 12  # secant runs before the search falls back to Br
 LATE_START_DECIDED_M_S = -1e-6
 
 
-@allocating(inline="always")
-def _shoot(t0: float, v0: float, x_start: float, m: Model, o: Output, ap: np.ndarray) -> bool:
+def _shoot(
+    t0: float,
+    v0: float,
+    x_start: float,
+    m: Model,
+    o: Output,
+    ap: np.ndarray,
+    loop: tuple[Callable, Callable],
+) -> bool:
     """Fly ``m`` from ``t0`` to ``T_c``, starting at ``V_X = v0`` and ``X0 + x_start``.
 
     The initial state goes to ``m.x0`` and ``ap[AP_X0]``, the state at ``T_c``
     to ``o.out[0]``; False if the run failed or sampled no state at ``T_c``.
+    ``loop``: the compiled ``start`` and ``advance`` that fly it.
     """
     x0 = m.x0
     C = np.empty((3, 3))
@@ -117,6 +129,7 @@ def _shoot(t0: float, v0: float, x_start: float, m: Model, o: Output, ap: np.nda
     m.span[SPAN_TF] = ap[AP_TC]
     d = new_data(m)
     ap[AP_RUNS] += 1.0
+    start, advance = loop
     start(m, d, o)
     advance(-1, m, d, o)
     if o.stats[ST_STATUS] == STATUS_FAILED or o.stats[ST_N_OUT] != 1:
@@ -149,7 +162,6 @@ def _deepest(
     return best
 
 
-@allocating(inline="always")
 def _solve_from(
     t0: float,
     v0: float,
@@ -160,6 +172,7 @@ def _solve_from(
     ap: np.ndarray,
     flown: bool,
     v0_below: float,
+    loop: tuple[Callable, Callable],
 ) -> bool:
     """Correct v0 (unless at rest after ``t0 > 0``) and X0 until the residuals vanish.
 
@@ -176,7 +189,7 @@ def _solve_from(
     x_start = 0.0
     dv = 0.0
     for k in range(APPROACH_MAX_ITER):
-        if not (flown and k == 0) and not _shoot(t0, v0, x_start, m, o, ap):
+        if not (flown and k == 0) and not _shoot(t0, v0, x_start, m, o, ap, loop):
             return False
         xe[:] = o.out[0, OUT_X : OUT_X + NX]
         dv = vc - _inertial_vx(xe, C)
@@ -195,8 +208,9 @@ def _solve_from(
     return True
 
 
-@allocating(inline="always")
-def _late_start_secant(m: Model, o: Output, ap: np.ndarray) -> float:
+def _late_start_secant(
+    m: Model, o: Output, ap: np.ndarray, loop: tuple[Callable, Callable]
+) -> float:
     """The late start ``t0`` (s) by the secant method on ``V_X(T_c; t0) = V_c``; NaN if
     it leaves ``[0, T_c)`` or does not converge (``AP_STATUS`` tells a failed run).
 
@@ -218,7 +232,7 @@ def _late_start_secant(m: Model, o: Output, ap: np.ndarray) -> float:
     for _ in range(LATE_START_SECANT_MAXITER):
         if not (0.0 <= b <= end):
             return math.nan
-        if not _shoot(b, 0.0, 0.0, m, o, ap):
+        if not _shoot(b, 0.0, 0.0, m, o, ap, loop):
             return math.nan
         xe[:] = o.out[0, OUT_X : OUT_X + NX]
         fb = _inertial_vx(xe, C) - vc
@@ -235,9 +249,15 @@ def _late_start_secant(m: Model, o: Output, ap: np.ndarray) -> float:
     return math.nan
 
 
-@allocating
 def solve_approach(
-    m: Model, o: Output, wall: np.ndarray, pairs: np.ndarray, ap: np.ndarray
+    m: Model,
+    o: Output,
+    wall: np.ndarray,
+    pairs: np.ndarray,
+    ap: np.ndarray,
+    *,
+    start: Callable = start,
+    advance: Callable = advance,
 ) -> None:
     """Find the initial state and time that bring the first contact at ``T_c`` with ``V_c``.
 
@@ -258,7 +278,11 @@ def solve_approach(
         ``AP_ROTORS``. Out: ``AP_X0``, ``AP_T0``, ``AP_V0``, ``AP_DV``,
         ``AP_LATE``, ``AP_STATUS`` (``APPROACH_*``; ``AP_REASON`` for a
         failed run) and ``AP_RUNS`` (the free-flight runs flown).
+    start, advance : compiled functions
+        The loop's ``core.step.start`` and ``core.step.advance`` (a plug-in
+        kernel's copies: ``core.kernel.make_kernel``), which fly every run.
     """
+    loop = (start, advance)
     ap[AP_STATUS] = APPROACH_SOLVED
     ap[AP_REASON] = 0.0
     ap[AP_T0] = 0.0
@@ -266,7 +290,7 @@ def solve_approach(
     ap[AP_RUNS] = 0.0
     vc = ap[AP_VC]
     decided = LATE_START_DECIDED_M_S if ap[AP_LATE_RULE] != 0.0 else -math.inf
-    if not _solve_from(0.0, vc, m, o, wall, pairs, ap, False, decided):
+    if not _solve_from(0.0, vc, m, o, wall, pairs, ap, False, decided, loop):
         return
     late = False
     if ap[AP_V0] < 0.0:
@@ -276,13 +300,13 @@ def solve_approach(
             late = _deepest(x0, np.empty((3, 3)), m.feat, wall, pairs) > 0.0
     if not late:
         return
-    t0 = _late_start_secant(m, o, ap)
+    t0 = _late_start_secant(m, o, ap, loop)
     if ap[AP_STATUS] == APPROACH_RUN_FAILED:
         return
     if t0 == t0:
         ap[AP_T0] = t0
         ap[AP_LATE] = 1.0
-        _solve_from(t0, 0.0, m, o, wall, pairs, ap, True, -math.inf)
+        _solve_from(t0, 0.0, m, o, wall, pairs, ap, True, -math.inf, loop)
         return
     br = np.empty(NBR)
     xe = np.empty(NX)
@@ -299,7 +323,7 @@ def solve_approach(
     last = math.nan  # the start time of the search's last run
     while code == BRENT_ASK:
         last = br[BR_X]
-        if not _shoot(last, 0.0, 0.0, m, o, ap):
+        if not _shoot(last, 0.0, 0.0, m, o, ap, loop):
             return
         xe[:] = o.out[0, OUT_X : OUT_X + NX]
         code = brent_next(br, _inertial_vx(xe, C) - vc)
@@ -309,4 +333,4 @@ def solve_approach(
     t0 = br[BR_X]
     ap[AP_T0] = t0
     ap[AP_LATE] = 1.0
-    _solve_from(t0, 0.0, m, o, wall, pairs, ap, t0 == last, -math.inf)
+    _solve_from(t0, 0.0, m, o, wall, pairs, ap, t0 == last, -math.inf, loop)

@@ -1,6 +1,6 @@
 """A whole run, the kernels that run it, and its Python entry.
 
-:func:`run` (compiled, cached on disk) is ``step.start`` plus ``step.advance``
+:func:`run` (Python; its parts compiled and cached on disk) is ``step.start`` plus ``step.advance``
 to the end with the built-in controllers and geometry: it takes the run's
 :class:`~quadimpact.core.records.Model` and fills its
 :class:`~quadimpact.core.records.Output`. A :class:`Kernel` bundles the
@@ -29,6 +29,7 @@ on the same records.
 
 from __future__ import annotations
 
+import functools
 import inspect
 import itertools
 import math
@@ -48,19 +49,33 @@ from quadimpact.core.records import Model, Output, RawRecord, new_data, new_outp
 from quadimpact.core.sensors import registry as _sensor_registry
 from quadimpact.core.step import advance, start
 
-__all__ = ["BUILTIN", "Kernel", "execute", "make_kernel", "run", "specialise"]
+__all__ = ["BUILTIN", "Kernel", "execute", "loop_drivers", "make_kernel", "run", "specialise"]
 
 
-@njit(cache=True)
 def run(m: Model, o: Output) -> None:
     """Run ``m`` from ``(t0, x0)`` to ``tf`` with the built-in controllers and geometry.
 
     The loop state is allocated here and dropped at the end; everything the
-    caller needs is in ``o``.
+    caller needs is in ``o``. Three compiled calls from Python (``new_data``,
+    ``start``, ``advance``), not one compiled function: that would link a
+    third copy of the whole loop into its machine code, about 10 s of the
+    cold compile, against some 20 microseconds per run.
     """
     d = new_data(m)
     start(m, d, o)
     advance(-1, m, d, o)
+
+
+def loop_drivers(start: Callable, advance: Callable) -> tuple[Callable, Callable]:
+    """:func:`run` and the approach's shooting (``core.approach.solve_approach``) flown
+    by a kernel's own ``start`` and ``advance``."""
+
+    def run(m: Model, o: Output) -> None:
+        d = new_data(m)
+        start(m, d, o)
+        advance(-1, m, d, o)
+
+    return run, functools.partial(solve_approach, start=start, advance=advance)
 
 
 @dataclass(frozen=True)
@@ -279,12 +294,11 @@ def make_kernel(
     if not replacements:
         return BUILTIN
     memo: dict[Dispatcher, Dispatcher] = {}
+    own_start = specialise(start, replacements, memo)
+    own_advance = specialise(advance, replacements, memo)
+    own_run, own_approach = loop_drivers(own_start, own_advance)
     return Kernel(
-        run=specialise(run, replacements, memo),
-        start=specialise(start, replacements, memo),
-        advance=specialise(advance, replacements, memo),
-        approach=specialise(solve_approach, replacements, memo),
-        step=step,
+        run=own_run, start=own_start, advance=own_advance, approach=own_approach, step=step
     )
 
 

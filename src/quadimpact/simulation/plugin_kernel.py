@@ -33,7 +33,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from quadimpact.core.kernel import Kernel
+from quadimpact.core.kernel import Kernel, loop_drivers
 from quadimpact.core.plugin_call import entry_address
 from quadimpact.errors import InputError, one_line
 from quadimpact.results.costs import cpu_time
@@ -211,10 +211,15 @@ class _Guard:
         return PluginError(f"{self.who()} {verb} {raised}: a plug-in's step must not raise")
 
     def wrap(self, fn: Callable, entry: str) -> Callable:
-        """``fn`` (a Numba dispatcher) compiled, announced and timed on its first call."""
+        """``fn`` (a Numba dispatcher) compiled, announced and timed on its first call.
 
-        def call(*args: Any) -> Any:
-            if self.compiles and not fn.overloads:  # the first call in this process compiles
+        A Python driver of the loop (``run``, ``approach``) is only guarded
+        for errors: :func:`guarded` gives it the guarded ``start`` and ``advance``.
+        """
+        dispatcher = hasattr(fn, "overloads")
+
+        def call(*args: Any, **kwargs: Any) -> Any:
+            if self.compiles and dispatcher and not fn.overloads:  # the first call compiles
                 self.announce()
                 started = cpu_time()
                 try:
@@ -224,7 +229,9 @@ class _Guard:
                 finally:
                     _COMPILE_CPU[0] += cpu_time() - started
             try:
-                return fn(*args)
+                return fn(*args, **kwargs)
+            except PluginError:
+                raise  # said by the guarded entry point it called
             except Exception as exc:
                 raise self.error(exc, entry) from None
 
@@ -241,11 +248,16 @@ def guarded(kernel: Kernel, plugins: Iterable[PluginStep], *, compiles: bool = T
     cached loop, which calls plug-in steps by address (only their errors named).
     """
     guard = _Guard(tuple(plugins), compiles)
+    start = guard.wrap(kernel.start, "start")
+    advance = guard.wrap(kernel.advance, "advance")
+    run, approach = kernel.run, kernel.approach
+    if compiles:  # the Python drivers fly the guarded loop: its compile announced and timed
+        run, approach = loop_drivers(start, advance)
     return Kernel(
-        run=guard.wrap(kernel.run, "run"),
-        start=guard.wrap(kernel.start, "start"),
-        advance=guard.wrap(kernel.advance, "advance"),
-        approach=guard.wrap(kernel.approach, "approach"),
+        run=guard.wrap(run, "run"),
+        start=start,
+        advance=advance,
+        approach=guard.wrap(approach, "approach"),
         step=kernel.step,
     )
 
