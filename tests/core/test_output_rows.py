@@ -8,6 +8,7 @@ import pytest
 
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
+from quadimpact.core.geometry import PR_FEATURE, PR_GEOMETRY
 from quadimpact.core.kernel import execute
 from quadimpact.simulation.approach import pair_depths_at
 from quadimpact.simulation.setup import prepare
@@ -34,8 +35,8 @@ def test_a_rows_deflection_is_the_deepest_pair_at_its_state(model):
         x = np.ascontiguousarray(row[L.OUT_X : L.OUT_X + L.NX])
         depths = pair_depths_at(x, setup.feat, setup.shapes, pairs)
         for f in range(nf):
-            deepest = max(0.0, *depths[pairs[:, L.PR_FEATURE] == f])
+            deepest = max(0.0, *depths[pairs[:, PR_FEATURE] == f])
             assert row[L.OUT_DELTA + f] == deepest  # the same bits
             touching += deepest > 0.0
     assert touching > 10  # rows in contact were checked too
-    assert (pairs[:, L.PR_GEOMETRY] == 0).all()  # every pair a ring against a plane
+    assert (pairs[:, PR_GEOMETRY] == 0).all()  # every pair a ring against a plane
