@@ -124,3 +124,21 @@ def test_a_trial_over_the_step_budget_fails_and_is_no_success(level_first):
                          "touched_after_hover": False, "height_lost_m": 0.0,
                          "crash_time_s": None}])  # fmt: skip
     assert not held_hover_success(row)[0]
+
+
+def test_a_vehicle_chattering_at_the_recovery_replicas_contact_gate_fails_as_an_event_storm():
+    """Run 5797 of the whole wall task (``recovery-replica`` row, ideal sensors) leans on the
+    wall at the replica's contact gate: the bumper's force switches on and off in episodes of
+    ~70 us, up to 100 onsets per 5-ms tick. The step budget ended it at 80,000 steps; the
+    event budget ends it after a few thousand, failed with its own reason (docs/NUMERICS.md,
+    "Event budget"). The count is of steps, not time."""
+    from quadimpact.core.layout import MAX_INTERVAL_EVENTS, REASON_EVENT_STORM, REASON_TEXT
+
+    subject = Subject("recovery-replica", model="recovery-replica")
+    spec = subject.spec(task("wall"), False, sensor_set("ideal"))
+    summary = simulate(scenario_from_dict(spec.scenario_dict(5797))).summary
+    assert summary["status"] == "failed"
+    assert summary["reason"] == REASON_TEXT[REASON_EVENT_STORM]
+    assert f"more than {MAX_INTERVAL_EVENTS} events" in summary["reason"]
+    assert _steps(summary) < 8_000  # 3,057 with the event budget; 80,000 without
+    assert summary["n_episodes"] > MAX_INTERVAL_EVENTS // 2

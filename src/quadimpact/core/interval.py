@@ -51,6 +51,7 @@ from quadimpact.core.layout import (
     LS_PO_T,
     LS_T,
     LS_T_SCHED,
+    MAX_INTERVAL_EVENTS,
     MS_DETECTED,
     NX,
     O_ATOL,
@@ -64,6 +65,7 @@ from quadimpact.core.layout import (
     O_POWER_OFF_T,
     O_RTOL,
     O_STOP_ON_CRASH,
+    REASON_EVENT_STORM,
     REASON_MAX_STEPS,
     REASON_NOT_FINITE,
     REASON_STEP_TOO_SMALL,
@@ -261,19 +263,20 @@ def _track_peaks(m: Model, d: Data, o: Output, w: Work, t: float, h: float, sig:
 @compiled(inline="always")
 def _process_events(
     t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
-) -> tuple[bool, bool]:
+) -> tuple[int, bool]:
     """Onsets and ends located at ``t`` (fraction ``sig`` of the step, within ``tol_sig``).
 
     ``d.x`` is the state there and ``w.g_a``, ``w.gd_a`` its gaps and rates.
-    Returns (any event, the run ends: a ground onset with stop-on-crash).
+    Returns (the number of events, one per pair; the run ends: a ground onset
+    with stop-on-crash).
     """
     stats = o.stats
-    any_event = False
+    n_events = 0
     ended = False
     for c in range(d.cs.shape[0]):
         if w.ev_sig[c] >= NO_EVENT or w.ev_sig[c] > sig + tol_sig:
             continue
-        any_event = True
+        n_events += 1
         if d.cs[c, CS_ACTIVE] >= 0.5:
             close_episode(c, t, d, o)
             continue
@@ -290,19 +293,19 @@ def _process_events(
             first_contact = m.opts[O_POWER_OFF_T] < 0.0 and d.ls[LS_PO_ACTIVE] < 0.5
             if m.sched_t.shape[0] > 0 and first_contact:
                 d.ls[LS_T_SCHED] = t  # power-off triggered by the first contact
-    return any_event, ended
+    return n_events, ended
 
 
 @compiled(inline="always")
 def _arrive(
     uncut: bool, t: float, sig: float, tol_sig: float, m: Model, d: Data, o: Output, w: Work
-) -> tuple[bool, bool]:
+) -> tuple[int, bool]:
     """At the new state ``d.x`` (time ``t``): extremes, the pairs' gaps, the events there.
 
     ``uncut``: ``d.x`` is the end of the step just accepted, bit for bit, and
     no contact changed state since the step's events computed its gaps
     (``w.g_b``): they are the gaps at ``d.x`` and are taken, not computed again.
-    Returns :func:`_process_events`'s (any event, the run ends).
+    Returns :func:`_process_events`'s (number of events, the run ends).
     """
     track_extremes(d.x, d.meas[MS_DETECTED] > 0.5, o.stats)
     if uncut:
@@ -322,10 +325,25 @@ def _fail(stats: np.ndarray, reason: int) -> int:
 
 
 @compiled(inline="always")
+def _after_events(result: int, ended: bool, n_events: int, stats: np.ndarray) -> int:
+    """The run's state after the events at a cut: ``ENDED`` (``ended``), ``FAILED`` (more
+    than ``MAX_INTERVAL_EVENTS`` events, ``n_events``, in the interval so far) or ``result``."""
+    if ended:
+        return ENDED
+    if n_events > MAX_INTERVAL_EVENTS:
+        return _fail(stats, REASON_EVENT_STORM)
+    return result
+
+
+@compiled(inline="always")
 def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w: Work) -> int:
     """Integrate from the tick ``t`` to ``t_next`` (s); ``RUNNING``, ``ENDED`` or ``FAILED``.
 
     ``w.g_a``, ``w.gd_a`` hold the pairs' gaps and rates at ``(t, d.x)``.
+    The interval's contact events (onsets and ends, one per pair) are
+    counted: more than ``MAX_INTERVAL_EVENTS`` fail the run
+    (``REASON_EVENT_STORM``: a contact chattering at a discontinuous force,
+    docs/NUMERICS.md, "Event budget").
     """
     ls = d.ls
     stats = o.stats
@@ -338,6 +356,7 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
     n_rhs = int(stats[ST_N_RHS])
     result = RUNNING
     fsal = False
+    n_events = 0  # located events in this interval
     tiny = 1e-12 * max(1.0, abs(t_next))  # boundaries closer than this coincide
     while result == RUNNING:
         if t_next - t <= tiny:
@@ -407,11 +426,10 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
             break
         h = h_new
         # fsal after a trial step: it ended uncut, at d.x
-        any_event, ended = _arrive(fsal and not pending, t, sig_min, tol_sig, m, d, o, w)
-        if any_event:
-            fsal = False
-        if ended:
-            result = ENDED
+        n_here, ended = _arrive(fsal and not pending, t, sig_min, tol_sig, m, d, o, w)
+        fsal = fsal and n_here == 0
+        n_events += n_here
+        result = _after_events(result, ended, n_events, stats)
     ls[LS_T] = t
     ls[LS_H] = h
     stats[ST_T_END] = t

@@ -163,6 +163,7 @@ class Reason(IntEnum):
     STEP_TOO_SMALL = 1
     MAX_STEPS = 2
     NOT_FINITE = 3
+    EVENT_STORM = 4
 
 
 FEAT_RING = int(FeatureKind.RING)
@@ -197,11 +198,19 @@ REASON_NONE = int(Reason.NONE)
 REASON_STEP_TOO_SMALL = int(Reason.STEP_TOO_SMALL)
 REASON_MAX_STEPS = int(Reason.MAX_STEPS)
 REASON_NOT_FINITE = int(Reason.NOT_FINITE)
+REASON_EVENT_STORM = int(Reason.EVENT_STORM)
+# contact events (onsets and ends, one per pair) one control
+# interval may hold; one more fails the run (core/interval.py, docs/NUMERICS.md)
+MAX_INTERVAL_EVENTS = 64
 REASON_TEXT = {
     REASON_NONE: "",
     REASON_STEP_TOO_SMALL: "step size fell below the floor (stiff or singular dynamics)",
     REASON_MAX_STEPS: "step budget exhausted",
     REASON_NOT_FINITE: "state became NaN or infinite",
+    REASON_EVENT_STORM: (
+        f"event storm: more than {MAX_INTERVAL_EVENTS} events in one control interval"
+        " (contact chattering)"
+    ),
 }
 
 # ==========================================================================

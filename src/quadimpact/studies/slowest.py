@@ -3,7 +3,9 @@
 Every study reports its slowest trials (issue 59), so that a trial costing many times the
 median is seen, with what the integrator did: its accepted and rejected steps and its contact
 onsets (the episodes). A trial that would exceed the kernel's step budget ends as ``failed``
-with the reason "step budget exhausted" (docs/NUMERICS.md, "Step budget").
+with the reason "step budget exhausted" (docs/NUMERICS.md, "Step budget"); one whose contact
+chatters (more than 64 events in a control interval) ends sooner, failed as an "event storm"
+(docs/NUMERICS.md, "Event budget").
 """
 
 from __future__ import annotations
