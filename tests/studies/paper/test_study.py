@@ -10,6 +10,7 @@ import pytest
 from quadimpact.simulation.response_types import RESPONSE_TYPES
 from quadimpact.studies.paper import paper_study as study
 from quadimpact.studies.paper.paper_study import reproduce
+from quadimpact.studies.recovery.recovery_analysis import EXCLUDED_CLASSES
 from quadimpact.studies.statistics import rate_text
 
 from helpers import assert_same_table
@@ -91,7 +92,10 @@ def test_reproduce_writes_a_report_with_computed_verdicts(tmp_path, monkeypatch,
         assert f"| {variant} | 40 | {rate_text(numbers['success'])} |" in text
     trials = pd.read_parquet(tmp_path / "recovery_trials.parquet")
     navi = trials[trials["study"] == "navi, default"]
-    assert len(navi) == 40 and part.monte_carlo["default"]["success"].k == navi["recovered"].sum()
+    # a success: stage 4 reached and never below altitude 0 (the recovery study's classes)
+    won = navi["recovered"].fillna(False).astype(bool) & (navi["min_altitude_m"] >= 0.0)
+    won &= ~navi["outcome_class"].astype(str).isin(EXCLUDED_CLASSES)  # valid trials only
+    assert len(navi) == 40 and part.monte_carlo["default"]["success"].k == won.sum()
     estimators = {"estimator ideal", "estimator complementary", "estimator ekf"}
     assert set(trials["study"]) == {"navi, default", "navi, recovery-replica", "navi, noisy IMU",
                                     "spiri"} | estimators  # fmt: skip

@@ -66,7 +66,12 @@ def test_the_report_numbers_are_the_tables(study_dir) -> None:
     out, result = study_dir
     table = pd.read_parquet(out / "trials.parquet")
     text = (out / "report.md").read_text()
-    k, n = int(table["recovered"].fillna(False).sum()), len(table)
+    # a success: stage 4 reached and never below altitude 0, over the valid trials (a
+    # steep impact may tumble down the wall and recover 10 m lower: not a success)
+    valid = ~table["outcome_class"].astype(str).isin(analysis.EXCLUDED_CLASSES)
+    above = table["min_altitude_m"] >= 0.0
+    k = int((table["recovered"].fillna(False).astype(bool) & above & valid).sum())
+    n = int(valid.sum())
     lo, hi = wilson_interval(k, n)
     assert (f"**{k} / {n} = {percent(k / n)} [{percent(lo)}, {percent(hi)}]**") in text
     assert f"**Trials**: {N} impact trials" in text and "study seed 5" in text
