@@ -288,6 +288,32 @@ def test_a_policy_changes_the_flight_only_after_the_detection(tmp_path):
     assert not law[cols].equals(res[cols])
 
 
+def _tick_commands(policy: PolicyWeights | None, stage: int, hold_set: float) -> np.ndarray:
+    """One tick of recovery_step in ``stage`` (the law's hold point captured or not), moving
+    at (0.5, 0, 0.3) m/s after a detection on a wall of normal -x: the rotor speeds, rad/s."""
+    from quadimpact.core.controllers import recovery as CL
+    from quadimpact.core.controllers.recovery import recovery_step
+    from quadimpact.simulation.setup import prepare
+
+    setup = prepare(_trial())
+    ctrl = setup.ctrl.copy()
+    if policy is not None:
+        block = policy.block()
+        ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+    meas = np.zeros(L.NMEAS)
+    meas[L.MS_X : L.MS_X + L.NX] = setup.x0
+    meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
+    meas[L.MS_DETECTED] = 1.0
+    meas[L.MS_T_DETECT] = 0.1
+    meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+    mem = np.zeros(L.NMEM)
+    mem[L.MEM_STAGE] = stage
+    mem[CL.RM_HOLD_SET] = hold_set
+    cmd = np.zeros(4)
+    recovery_step(0.3, meas, ctrl, mem, setup.veh, 0.005, cmd)
+    return cmd
+
+
 @pytest.mark.parametrize(
     ("stage", "last_stage", "acts"),
     [(1, 4, True), (3, 4, True), (5, 4, False), (1, 5, True), (4, 5, True), (5, 5, True)],
@@ -296,30 +322,9 @@ def test_the_residual_acts_in_its_stages_and_leaves_the_others_to_the_law(stage,
     """One tick of recovery_step in a stage, with and without a strong policy: the commands
     differ in stages 1-4, and in stage 5 (the law's return to hover) only for a policy whose
     last stage is 5."""
-    from quadimpact.core.controllers import recovery as CL
-    from quadimpact.core.controllers.recovery import recovery_step
-    from quadimpact.simulation.setup import prepare
-
-    setup = prepare(_trial())
-    cmds = []
-    for policy in (None, _random_policy(7, hidden=16, scale=3.0, last_stage=last_stage)):
-        ctrl = setup.ctrl.copy()
-        if policy is not None:
-            block = policy.block()
-            ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
-        meas = np.zeros(L.NMEAS)
-        meas[L.MS_X : L.MS_X + L.NX] = setup.x0
-        meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
-        meas[L.MS_DETECTED] = 1.0
-        meas[L.MS_T_DETECT] = 0.1
-        meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
-        mem = np.zeros(L.NMEM)
-        mem[L.MEM_STAGE] = stage
-        mem[CL.RM_HOLD_SET] = 1.0
-        cmd = np.zeros(4)
-        recovery_step(0.3, meas, ctrl, mem, setup.veh, 0.005, cmd)
-        cmds.append(cmd)
-    assert (not np.array_equal(*cmds)) == acts
+    policy = _random_policy(7, hidden=16, scale=3.0, last_stage=last_stage)
+    law, corrected = _tick_commands(None, stage, 1.0), _tick_commands(policy, stage, 1.0)
+    assert (not np.array_equal(law, corrected)) == acts
 
 
 @pytest.mark.parametrize(("hold_set", "acts"), [(0.0, True), (1.0, False)])
@@ -327,31 +332,11 @@ def test_a_hand_over_policy_leaves_the_held_point_to_the_law(hold_set, acts):
     """In stage 5 a hand-over policy corrects the law while it brakes (its hold point not
     yet captured) and not once the point is captured: then the commands are the law's
     alone, to the bit. Before stage 5 it acts as any policy."""
-    from quadimpact.core.controllers import recovery as CL
-    from quadimpact.core.controllers.recovery import recovery_step
-    from quadimpact.simulation.setup import prepare
-
-    setup = prepare(_trial())
+    policy = _random_policy(7, 16, 3.0, 5).with_hand_over()
     for stage in (3, 5):
-        cmds = []
-        for policy in (None, _random_policy(7, 16, 3.0, 5).with_hand_over()):
-            ctrl = setup.ctrl.copy()
-            if policy is not None:
-                block = policy.block()
-                ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
-            meas = np.zeros(L.NMEAS)
-            meas[L.MS_X : L.MS_X + L.NX] = setup.x0
-            meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
-            meas[L.MS_DETECTED] = 1.0
-            meas[L.MS_T_DETECT] = 0.1
-            meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
-            mem = np.zeros(L.NMEM)
-            mem[L.MEM_STAGE] = stage
-            mem[CL.RM_HOLD_SET] = hold_set
-            cmd = np.zeros(4)
-            recovery_step(0.3, meas, ctrl, mem, setup.veh, 0.005, cmd)
-            cmds.append(cmd)
-        assert (not np.array_equal(*cmds)) == (acts or stage < 5)
+        law = _tick_commands(None, stage, hold_set)
+        corrected = _tick_commands(policy, stage, hold_set)
+        assert (not np.array_equal(law, corrected)) == (acts or stage < 5)
 
 
 def test_hand_over_round_trips_and_is_part_of_the_identity(tmp_path):

@@ -322,20 +322,8 @@ def load_policy(name: str | Path) -> PolicyWeights:
             got = raw.tolist()
             raise InputError(f"{where}: last_stage: must be one number, 4 or 5 (got {got!r})")
         last_stage = int(raw)
-    hover_centred = False
-    if "hover_centred" in arrays:
-        raw = np.asarray(arrays["hover_centred"])
-        if raw.shape != () or raw.dtype.kind not in "biuf" or float(raw) not in (0.0, 1.0):
-            got = raw.tolist()
-            raise InputError(f"{where}: hover_centred: must be one number, 0 or 1 (got {got!r})")
-        hover_centred = bool(raw)
-    hover_hand_over = False
-    if "hover_hand_over" in arrays:
-        raw = np.asarray(arrays["hover_hand_over"])
-        if raw.shape != () or raw.dtype.kind not in "biuf" or float(raw) not in (0.0, 1.0):
-            got = raw.tolist()
-            raise InputError(f"{where}: hover_hand_over: must be one number, 0 or 1 (got {got!r})")
-        hover_hand_over = bool(raw)
+    hover_centred = _optional_flag(arrays, "hover_centred", where)
+    hover_hand_over = _optional_flag(arrays, "hover_hand_over", where)
     hover_fade_s = (0.0, 0.0)
     if "hover_fade_s" in arrays:
         hover_fade_s = checked_fade(arrays["hover_fade_s"], where)
@@ -360,6 +348,16 @@ def load_policy(name: str | Path) -> PolicyWeights:
         path=str(path),
     )
     return replace(p, sha256=_digest(p))
+
+
+def _optional_flag(arrays: dict[str, np.ndarray], name: str, where: str) -> bool:
+    """A file's optional 0-or-1 array ``name`` (absent: False); one-line error otherwise."""
+    if name not in arrays:
+        return False
+    raw = np.asarray(arrays[name])
+    if raw.shape != () or raw.dtype.kind not in "biuf" or float(raw) not in (0.0, 1.0):
+        raise InputError(f"{where}: {name}: must be one number, 0 or 1 (got {raw.tolist()!r})")
+    return bool(raw)
 
 
 def checked_fade(value: Any, where: str = "policy") -> tuple[float, float]:
