@@ -97,7 +97,8 @@ def test_rerunning_resumes_and_gives_the_same_table(study_dir) -> None:
     assert {p: p.stat().st_mtime_ns for p in drawn} == drawn
     assert again.numbers["success"] == first.numbers["success"]
     first_sweep = first.run_info["elapsed_s"]
-    assert f"the trials were run {N} in {first_sweep:.1f} s (serial)" in again.report.read_text()
+    # a finished study's rerun says so and leaves its report as the first run wrote it
+    assert f"{N} trials run now in {first_sweep:.1f} s (serial)" in again.report.read_text()
     pd.testing.assert_frame_equal(pd.read_parquet(out / "trials.parquet"), before)
     # an interrupted sweep: keep its first 10 runs; the rerun does only the other 20
     runs = out / "sweep" / "runs.parquet"
