@@ -30,9 +30,17 @@ from quadimpact.studies.benchmark.suite import sensor_set, task
 from helpers import load_example
 
 
-def _trial(subject: Subject, task_name: str, sensors: str, pitch_deg: float, offset_m: float):
-    """The quick suite's grid trial at (pitch, offset), as the benchmark builds it."""
-    spec = subject.spec(task(task_name), True, sensor_set(sensors), version="1")
+def _trial(
+    subject: Subject,
+    task_name: str,
+    sensors: str,
+    pitch_deg: float,
+    offset_m: float,
+    version: str = "1",
+):
+    """The quick suite's grid trial at (pitch, offset), as the benchmark (suite ``version``)
+    builds it."""
+    spec = subject.spec(task(task_name), True, sensor_set(sensors), version=version)
     for i in range(spec.n_runs):
         v = spec.inputs(i)
         if v["pitch_deg"] == pitch_deg and abs(v["lateral_offset_m"] - offset_m) < 1e-9:
@@ -70,14 +78,9 @@ def test_the_example_plug_ins_pole_trial_takes_a_bounded_step_count():
 
 
 def _level_first_trial(task_name: str, sensors: str, pitch_deg: float, offset_m: float):
-    """The example plug-in's quick-suite trial (suite 3) and its subject."""
+    """The example plug-in's quick-suite trial (suite 3)."""
     subject = Subject("level-first", controller="level-first")
-    spec = subject.spec(task(task_name), True, sensor_set(sensors), version="3")
-    for i in range(spec.n_runs):
-        v = spec.inputs(i)
-        if v["pitch_deg"] == pitch_deg and abs(v["lateral_offset_m"] - offset_m) < 1e-9:
-            return scenario_from_dict(spec.scenario_dict(i))
-    raise AssertionError(f"no point ({pitch_deg}, {offset_m}) in the {task_name} grid")
+    return _trial(subject, task_name, sensors, pitch_deg, offset_m, version="3")
 
 
 @pytest.fixture(scope="module")
