@@ -94,49 +94,69 @@ LATE_START_SECANT_MAXITER = 12  # secant runs before the search falls back to Br
 LATE_START_DECIDED_M_S = -1e-6
 
 
-def _shoot(
-    t0: float,
-    v0: float,
-    x_start: float,
-    m: Model,
-    o: Output,
-    ap: np.ndarray,
-    loop: tuple[Callable, Callable],
-) -> bool:
-    """Fly ``m`` from ``t0`` to ``T_c``, starting at ``V_X = v0`` and ``X0 + x_start``.
+class _Flights:
+    """The free-flight runs of one solve: the run ``m`` and its output ``o``, flown by
+    the loop's compiled ``start`` and ``advance`` (``loop``), and what every run shares.
 
-    The initial state goes to ``m.x0`` and ``ap[AP_X0]``, the state at ``T_c``
-    to ``o.out[0]``; False if the run failed or sampled no state at ``T_c``.
-    ``loop``: the compiled ``start`` and ``advance`` that fly it.
+    One loop state ``d`` serves every run (``start`` initialises each of its
+    arrays from the run's ``x0`` and ``span``), and the attitude held is turned
+    into its rotation ``C`` once: the runs are the same to the bit as with a
+    fresh state each, for two compiled calls fewer per run.
     """
-    x0 = m.x0
-    C = np.empty((3, 3))
-    rotation_matrix(ap[AP_Q : AP_Q + 4], C)
-    x0[:] = 0.0  # omega 0: the vehicle starts at rest in rotation
-    # the start shifted by (x_start, 0, 0) and the body velocity C^T (v0, 0, 0), with
-    # every term of the vector sums (the + 0.0 and * 0.0 turn -0.0 into +0.0 as the
-    # vector arithmetic does: the state is the same to the bit as from
-    # simulation.approach.initial_state)
-    x0[X_POS] = ap[AP_START] + x_start
-    x0[X_POS + 1] = ap[AP_START + 1] + 0.0
-    x0[X_POS + 2] = ap[AP_START + 2] + 0.0
-    for j in range(3):
-        x0[X_VEL + j] = C[0, j] * v0 + C[1, j] * 0.0 + C[2, j] * 0.0
-    x0[X_QUAT : X_QUAT + 4] = ap[AP_Q : AP_Q + 4]
-    x0[X_ROTOR : X_ROTOR + MAX_ROTORS] = ap[AP_ROTORS : AP_ROTORS + MAX_ROTORS]
-    ap[AP_X0 : AP_X0 + NX] = x0
-    m.span[SPAN_T0] = t0
-    m.span[SPAN_TF] = ap[AP_TC]
-    d = new_data(m)
-    ap[AP_RUNS] += 1.0
-    start, advance = loop
-    start(m, d, o)
-    advance(-1, m, d, o)
-    if o.stats[ST_STATUS] == STATUS_FAILED or o.stats[ST_N_OUT] != 1:
-        ap[AP_STATUS] = APPROACH_RUN_FAILED
-        ap[AP_REASON] = o.stats[ST_REASON]
-        return False
-    return True
+
+    __slots__ = ("m", "o", "ap", "d", "C", "xe", "Ce", "start", "advance")
+
+    def __init__(self, m: Model, o: Output, ap: np.ndarray, loop: tuple[Callable, Callable]):
+        self.m = m
+        self.o = o
+        self.ap = ap
+        self.d = new_data(m)
+        self.C = np.empty((3, 3))
+        rotation_matrix(ap[AP_Q : AP_Q + 4], self.C)
+        self.xe = np.empty(NX)  # a run's state at T_c
+        self.Ce = np.empty((3, 3))  # its rotation
+        self.start, self.advance = loop
+
+    def shoot(self, t0: float, v0: float, x_start: float) -> bool:
+        """Fly ``m`` from ``t0`` to ``T_c``, starting at ``V_X = v0`` and ``X0 + x_start``.
+
+        The initial state goes to ``m.x0`` and ``ap[AP_X0]``, the state at
+        ``T_c`` to ``xe``; False if the run failed or sampled no state at ``T_c``.
+        """
+        m = self.m
+        o = self.o
+        ap = self.ap
+        C = self.C
+        x0 = m.x0
+        x0[:] = 0.0  # omega 0: the vehicle starts at rest in rotation
+        # the start shifted by (x_start, 0, 0) and the body velocity C^T (v0, 0, 0), with
+        # every term of the vector sums (the + 0.0 and * 0.0 turn -0.0 into +0.0 as the
+        # vector arithmetic does: the state is the same to the bit as from
+        # simulation.approach.initial_state)
+        x0[X_POS] = ap[AP_START] + x_start
+        x0[X_POS + 1] = ap[AP_START + 1] + 0.0
+        x0[X_POS + 2] = ap[AP_START + 2] + 0.0
+        for j in range(3):
+            x0[X_VEL + j] = C[0, j] * v0 + C[1, j] * 0.0 + C[2, j] * 0.0
+        x0[X_QUAT : X_QUAT + 4] = ap[AP_Q : AP_Q + 4]
+        x0[X_ROTOR : X_ROTOR + MAX_ROTORS] = ap[AP_ROTORS : AP_ROTORS + MAX_ROTORS]
+        ap[AP_X0 : AP_X0 + NX] = x0
+        m.span[SPAN_T0] = t0
+        m.span[SPAN_TF] = ap[AP_TC]
+        ap[AP_RUNS] += 1.0
+        self.start(m, self.d, o)
+        self.advance(-1, m, self.d, o)
+        stats = o.stats
+        if stats[ST_STATUS] == STATUS_FAILED or stats[ST_N_OUT] != 1:
+            ap[AP_STATUS] = APPROACH_RUN_FAILED
+            ap[AP_REASON] = stats[ST_REASON]
+            return False
+        self.xe[:] = o.out[0, OUT_X : OUT_X + NX]
+        return True
+
+    def vx(self) -> float:
+        """Inertial X velocity (m/s) of the last run at ``T_c``."""
+        return _inertial_vx(self.xe, self.Ce)
 
 
 @compiled
@@ -165,35 +185,30 @@ def _deepest(
 def _solve_from(
     t0: float,
     v0: float,
-    m: Model,
-    o: Output,
+    f: _Flights,
     wall: np.ndarray,
     pairs: np.ndarray,
-    ap: np.ndarray,
     flown: bool,
     v0_below: float,
-    loop: tuple[Callable, Callable],
 ) -> bool:
     """Correct v0 (unless at rest after ``t0 > 0``) and X0 until the residuals vanish.
 
     ``flown``: the first run (``t0``, ``v0``, no X shift) has flown already,
-    its state at ``T_c`` is in ``o.out[0]`` and its start in ``AP_X0`` (the late
+    its state at ``T_c`` is in ``f.xe`` and its start in ``AP_X0`` (the late
     start search's last run, when the root is the last time it asked). A
     correction that leaves v0 below ``v0_below`` (m/s) ends the solve (a late
     start follows). Writes ``AP_X0``, ``AP_V0``, ``AP_DV``; False if a run failed.
     """
+    ap = f.ap
     tc = ap[AP_TC]
     vc = ap[AP_VC]
-    xe = np.empty(NX)
-    C = np.empty((3, 3))
     x_start = 0.0
     dv = 0.0
     for k in range(APPROACH_MAX_ITER):
-        if not (flown and k == 0) and not _shoot(t0, v0, x_start, m, o, ap, loop):
+        if not (flown and k == 0) and not f.shoot(t0, v0, x_start):
             return False
-        xe[:] = o.out[0, OUT_X : OUT_X + NX]
-        dv = vc - _inertial_vx(xe, C)
-        depth = _deepest(xe, C, m.feat, wall, pairs)
+        dv = vc - f.vx()
+        depth = _deepest(f.xe, f.Ce, f.m.feat, wall, pairs)
         if abs(dv) <= APPROACH_TOL_M_S and abs(depth) <= APPROACH_TOL_M_S:
             break
         if t0 == 0.0 or v0 != 0.0:
@@ -208,9 +223,7 @@ def _solve_from(
     return True
 
 
-def _late_start_secant(
-    m: Model, o: Output, ap: np.ndarray, loop: tuple[Callable, Callable]
-) -> float:
+def _late_start_secant(f: _Flights) -> float:
     """The late start ``t0`` (s) by the secant method on ``V_X(T_c; t0) = V_c``; NaN if
     it leaves ``[0, T_c)`` or does not converge (``AP_STATUS`` tells a failed run).
 
@@ -220,6 +233,7 @@ def _late_start_secant(
     stops as Brent's did, when the step is below ``xtol + rtol |t0|``, at a time
     it flew: its last run is the late start's run from rest at the root.
     """
+    ap = f.ap
     tc = ap[AP_TC]
     vc = ap[AP_VC]
     end = tc - LATE_START_END_GAP_S
@@ -227,15 +241,12 @@ def _late_start_secant(
     a = tc
     fa = -vc
     b = tc * (1.0 - vc / gain)
-    xe = np.empty(NX)
-    C = np.empty((3, 3))
     for _ in range(LATE_START_SECANT_MAXITER):
         if not (0.0 <= b <= end):
             return math.nan
-        if not _shoot(b, 0.0, 0.0, m, o, ap, loop):
+        if not f.shoot(b, 0.0, 0.0):
             return math.nan
-        xe[:] = o.out[0, OUT_X : OUT_X + NX]
-        fb = _inertial_vx(xe, C) - vc
+        fb = f.vx() - vc
         if fb == 0.0:
             return b
         if fb == fa or fb != fb:
@@ -282,7 +293,7 @@ def solve_approach(
         The loop's ``core.step.start`` and ``core.step.advance`` (a plug-in
         kernel's copies: ``core.kernel.make_kernel``), which fly every run.
     """
-    loop = (start, advance)
+    f = _Flights(m, o, ap, (start, advance))
     ap[AP_STATUS] = APPROACH_SOLVED
     ap[AP_REASON] = 0.0
     ap[AP_T0] = 0.0
@@ -290,7 +301,7 @@ def solve_approach(
     ap[AP_RUNS] = 0.0
     vc = ap[AP_VC]
     decided = LATE_START_DECIDED_M_S if ap[AP_LATE_RULE] != 0.0 else -math.inf
-    if not _solve_from(0.0, vc, m, o, wall, pairs, ap, False, decided, loop):
+    if not _solve_from(0.0, vc, f, wall, pairs, False, decided):
         return
     late = False
     if ap[AP_V0] < 0.0:
@@ -300,17 +311,15 @@ def solve_approach(
             late = _deepest(x0, np.empty((3, 3)), m.feat, wall, pairs) > 0.0
     if not late:
         return
-    t0 = _late_start_secant(m, o, ap, loop)
+    t0 = _late_start_secant(f)
     if ap[AP_STATUS] == APPROACH_RUN_FAILED:
         return
     if t0 == t0:
         ap[AP_T0] = t0
         ap[AP_LATE] = 1.0
-        _solve_from(t0, 0.0, m, o, wall, pairs, ap, True, -math.inf, loop)
+        _solve_from(t0, 0.0, f, wall, pairs, True, -math.inf)
         return
     br = np.empty(NBR)
-    xe = np.empty(NX)
-    C = np.empty((3, 3))
     brent_start(
         br,
         0.0,
@@ -323,14 +332,13 @@ def solve_approach(
     last = math.nan  # the start time of the search's last run
     while code == BRENT_ASK:
         last = br[BR_X]
-        if not _shoot(last, 0.0, 0.0, m, o, ap, loop):
+        if not f.shoot(last, 0.0, 0.0):
             return
-        xe[:] = o.out[0, OUT_X : OUT_X + NX]
-        code = brent_next(br, _inertial_vx(xe, C) - vc)
+        code = brent_next(br, f.vx() - vc)
     if code == BRENT_NO_BRACKET:
         ap[AP_STATUS] = APPROACH_NO_BRACKET
         return
     t0 = br[BR_X]
     ap[AP_T0] = t0
     ap[AP_LATE] = 1.0
-    _solve_from(t0, 0.0, m, o, wall, pairs, ap, t0 == last, -math.inf, loop)
+    _solve_from(t0, 0.0, f, wall, pairs, t0 == last, -math.inf)
