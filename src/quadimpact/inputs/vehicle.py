@@ -544,6 +544,8 @@ class Vehicle(BaseModel):
         InputError
             For an unknown field or a value that breaks a rule.
         """
+        if not fields:  # the vehicle itself (a frozen model), its message unformatted
+            return self
         return self.apply_overrides(fields, where=f"vehicle {self.name} overrides")
 
     def apply_overrides(
@@ -640,6 +642,18 @@ _OVERRIDDEN: dict[tuple[int, str], tuple[Vehicle, Vehicle]] = {}
 _CACHE_LIMIT = 64
 
 
+@functools.cache
+def _bundled_file(name: str) -> Any:
+    """The file of the bundled vehicle ``name``: its absolute path (a ``str``) where the
+    package is a folder, else its importlib.resources Traversable. Once per process per
+    name (``pathlib`` and ``os.path.abspath`` cost more than the ``stat`` that follows)."""
+    resource = _vehicle_folder().joinpath(f"{name}.toml")
+    try:
+        return os.path.abspath(os.fspath(resource))
+    except TypeError:  # not a file system path (a zipped package): read through resources
+        return resource
+
+
 def _file_key(path: Any) -> tuple[str, int, int] | None:
     """(absolute path, modification time ns, size) of a real file, else ``None``."""
     try:
@@ -700,8 +714,9 @@ def load_vehicle(name_or_path: str | Path | None = None) -> Vehicle:
     if name_or_path is None:
         name_or_path = "spiri"
     if isinstance(name_or_path, str) and name_or_path in _bundled_names():
-        resource = _vehicle_folder().joinpath(f"{name_or_path}.toml")
-        return _read_vehicle(resource, f"vehicle {name_or_path}.toml", name_or_path)
+        return _read_vehicle(
+            _bundled_file(name_or_path), f"vehicle {name_or_path}.toml", name_or_path
+        )
     path = Path(name_or_path)
     where = f"vehicle {path}"
     if not path.is_file():

@@ -134,7 +134,7 @@ def _summary_dict(
             reason=L.REASON_TEXT[int(st[L.ST_REASON])],
             warnings=warnings,
             model=scenario.model,
-            model_options=ModelOptionsTable(**setup.options.model_dump()),
+            model_options=ModelOptionsTable(**_options_fields(setup.options)),
             controller=scenario.controller,
             vehicle=setup.vehicle.name,
         ),
@@ -157,6 +157,21 @@ def _summary_dict(
     outcome = describe_outcome(out, None if rings else setup.feature_names)
     summary.outcome.outcome = out["outcome"] = outcome
     return summary, out
+
+
+_OPTIONS_FIELDS: dict[int, tuple[Any, dict[str, Any]]] = {}
+
+
+def _options_fields(options: Any) -> dict[str, Any]:
+    """``options.model_dump()``, once per resolved options object (``inputs.model`` keeps
+    them, frozen, per variant and overrides): a copy of the kept dict."""
+    hit = _OPTIONS_FIELDS.get(id(options))
+    if hit is None or hit[0] is not options:
+        if len(_OPTIONS_FIELDS) >= 256:
+            _OPTIONS_FIELDS.pop(next(iter(_OPTIONS_FIELDS)))
+        hit = (options, options.model_dump())  # holds options, so its id stays its own
+        _OPTIONS_FIELDS[id(options)] = hit
+    return dict(hit[1])
 
 
 def _onset(setup: RunSetup, episodes: RunEpisodes, st: np.ndarray) -> _Onset:
