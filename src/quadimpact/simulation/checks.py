@@ -139,6 +139,8 @@ def check_initial_contact(scenario: Any, setup: Any) -> None:
     if n_features == 0:
         return
     every = pair_depths_at(setup.x0, setup.feat, setup.shapes, setup.pair_table())
+    if not every.max(initial=-np.inf) > 0.0:  # no feature in any surface (NaN looks below)
+        return
     for s, name in enumerate(setup.shape_names):
         depths = every[s * n_features : (s + 1) * n_features]  # pair c = s * n_features + f
         deepest = int(np.argmax(depths))
