@@ -13,11 +13,14 @@ import numpy as np
 import pytest
 
 from quadimpact import WallApproach
+from quadimpact.core import approach as core_approach
 from quadimpact.core import layout as L
 from quadimpact.core.approach import (
+    AP_LATE,
     AP_RUNS,
     AP_STATUS,
     AP_T0,
+    AP_X0,
     APPROACH_SOLVED,
     APPROACH_TOL_M_S,
     LATE_START_END_GAP_S,
@@ -115,7 +118,8 @@ def test_a_late_start_finds_brents_root_in_a_few_runs(monkeypatch):
     replaces it). The secant search from the constant-acceleration guess finds
     the start time that Brent's method finds on the same runs, to Brent's
     tolerance, in at most four runs; its last run, at the root, is the late
-    solve's first, which adds one run (the check of the X shift)."""
+    solve's first, and its X shift needs no run of its own (the authors'
+    controller reads no X: the test below)."""
     scenario = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75)
     runs, t0 = _runs(monkeypatch, scenario)
     assert 0.0 < t0 < T_C
@@ -131,5 +135,34 @@ def test_a_late_start_finds_brents_root_in_a_few_runs(monkeypatch):
     brent_runs = len(searched)
     assert abs(t0 - root) <= LATE_START_XTOL_S + LATE_START_RTOL * root
     assert abs(speed_gap(t0)) <= APPROACH_TOL_M_S
-    assert runs <= 1 + 4 + 1
+    assert runs <= 1 + 4
     assert runs < brent_runs  # the whole shooting, against Brent's search alone
+
+
+def test_a_late_starts_x_shift_is_exact_when_nothing_in_the_flight_reads_x(monkeypatch):
+    """The authors' controller with the ideal estimator reads no position along X, so the
+    late start's X shift moves the depth at T_c one to one and the speed not at all: the
+    shooting takes it without flying it again. The run it skips would find the same
+    start, the same speed residual and no depth, to the bit."""
+    scenario = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75)
+    kw = _solve_inputs(monkeypatch, scenario)
+    assert core_approach._ignores_x(kw["run"])
+    skipped = approach_py.shooting_record(**kw)
+    monkeypatch.setattr(core_approach, "_ignores_x", lambda m: False)  # fly the check
+    checked = approach_py.shooting_record(**kw)
+    assert skipped[AP_T0] > 0.0  # a late start
+    assert skipped[AP_RUNS] == checked[AP_RUNS] - 1
+    found = slice(AP_X0, AP_LATE + 1)  # the start, its time, v0, the speed residual, late
+    assert np.array_equal(skipped[found], checked[found])
+
+
+def test_a_controller_that_may_read_x_keeps_the_check_of_the_x_shift(monkeypatch):
+    """Only the authors' controller with the ideal estimator is known to ignore X."""
+    kw = _solve_inputs(monkeypatch, WallApproach(heading_deg=45, inclination_deg=15,
+                                                 speed_m_s=0.75))  # fmt: skip
+    ctrl = kw["run"].ctrl.copy()
+    ctrl[L.C_KIND] = L.CTRL_CASCADE_PID
+    assert not core_approach._ignores_x(kw["run"]._replace(ctrl=ctrl))
+    ecfg = kw["run"].ecfg.copy()
+    ecfg[L.EC_KIND] = L.EST_EKF
+    assert not core_approach._ignores_x(kw["run"]._replace(ecfg=ecfg))

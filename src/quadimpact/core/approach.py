@@ -14,7 +14,10 @@ run per evaluation, from the guess of a constant acceleration (Brent's method,
 ``core/roots.py``, if the secant leaves ``[0, T_c)``). No run is flown twice:
 the first solve stops at a correction that leaves v0 far below 0 (the late
 start replaces it), and the search's last run, at the root, is the late
-solve's first (``AP_RUNS`` counts the runs).
+solve's first (``AP_RUNS`` counts the runs). Nor is the late start's X shift
+flown to be checked when nothing in the free flight reads X (the authors'
+controller with the ideal estimator, :func:`_ignores_x`): its run would give
+the same speed residual, to the bit, and a depth of zero.
 
 :func:`solve_approach` drives it from Python: the free-flight runs are the
 loop's own compiled ``start`` and ``advance`` (so a plug-in kernel's copies,
@@ -37,6 +40,12 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.geometry import pair_contact
 from quadimpact.core.layout import (
+    C_KIND,
+    C_STEP,
+    CTRL_PAPER,
+    EC_KIND,
+    EC_STEP,
+    EST_IDEAL,
     MAX_ROTORS,
     NX,
     OUT_X,
@@ -117,17 +126,11 @@ class _Flights:
         self.Ce = np.empty((3, 3))  # its rotation
         self.start, self.advance = loop
 
-    def shoot(self, t0: float, v0: float, x_start: float) -> bool:
-        """Fly ``m`` from ``t0`` to ``T_c``, starting at ``V_X = v0`` and ``X0 + x_start``.
-
-        The initial state goes to ``m.x0`` and ``ap[AP_X0]``, the state at
-        ``T_c`` to ``xe``; False if the run failed or sampled no state at ``T_c``.
-        """
-        m = self.m
-        o = self.o
+    def start_state(self, v0: float, x_start: float) -> None:
+        """The start at ``V_X = v0`` and ``X0 + x_start``, into ``m.x0`` and ``ap[AP_X0]``."""
         ap = self.ap
         C = self.C
-        x0 = m.x0
+        x0 = self.m.x0
         x0[:] = 0.0  # omega 0: the vehicle starts at rest in rotation
         # the start shifted by (x_start, 0, 0) and the body velocity C^T (v0, 0, 0), with
         # every term of the vector sums (the + 0.0 and * 0.0 turn -0.0 into +0.0 as the
@@ -141,6 +144,18 @@ class _Flights:
         x0[X_QUAT : X_QUAT + 4] = ap[AP_Q : AP_Q + 4]
         x0[X_ROTOR : X_ROTOR + MAX_ROTORS] = ap[AP_ROTORS : AP_ROTORS + MAX_ROTORS]
         ap[AP_X0 : AP_X0 + NX] = x0
+
+    def shoot(self, t0: float, v0: float, x_start: float) -> bool:
+        """Fly ``m`` from ``t0`` to ``T_c``, starting at ``V_X = v0`` and ``X0 + x_start``.
+
+        The initial state goes to ``m.x0`` and ``ap[AP_X0]`` (:meth:`start_state`),
+        the state at ``T_c`` to ``xe``; False if the run failed or sampled no
+        state at ``T_c``.
+        """
+        m = self.m
+        o = self.o
+        ap = self.ap
+        self.start_state(v0, x_start)
         m.span[SPAN_T0] = t0
         m.span[SPAN_TF] = ap[AP_TC]
         ap[AP_RUNS] += 1.0
@@ -182,6 +197,25 @@ def _deepest(
     return best
 
 
+def _ignores_x(m: Model) -> bool:
+    """True if nothing in the free flight of ``m`` reads the position along X.
+
+    The dynamics never do (no drag, no shape in a free flight); the authors'
+    controller reads the attitude, the altitude and the climb rate, and the
+    ideal estimator gives it the state. Another controller may hold a
+    position (``hover``, ``waypoint``, the recovery controller's hold, a plug-in),
+    and another estimator may carry one.
+    """
+    ctrl = m.ctrl
+    ecfg = m.ecfg
+    return (
+        int(ctrl[C_KIND]) == CTRL_PAPER
+        and ctrl[C_STEP] == 0.0
+        and int(ecfg[EC_KIND]) == EST_IDEAL
+        and ecfg[EC_STEP] == 0.0
+    )
+
+
 def _solve_from(
     t0: float,
     v0: float,
@@ -204,6 +238,7 @@ def _solve_from(
     vc = ap[AP_VC]
     x_start = 0.0
     dv = 0.0
+    x_free = _ignores_x(f.m)
     for k in range(APPROACH_MAX_ITER):
         if not (flown and k == 0) and not f.shoot(t0, v0, x_start):
             return False
@@ -218,6 +253,9 @@ def _solve_from(
                 break
         else:
             x_start -= depth
+            if x_free:  # the shifted run would give the same dv to the bit, the depth 0
+                f.start_state(v0, x_start)
+                break
     ap[AP_V0] = v0
     ap[AP_DV] = dv
     return True
