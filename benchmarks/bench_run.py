@@ -14,6 +14,8 @@ V_c = 0.75 m/s, 3-s scenario) in both model variants it reports
   calls alternated: the kernel with its IMU record, ``simulate()``, and the
   ratio of the two (best and median: issue 59's target is 1.2); ``prepare``
   and its approach shooting, and how many free-flight runs the shooting flew;
+  the rest, the Python (``simulate()`` less the kernel and the shooting, best
+  of each, and its share of the kernel);
 * cold start in fresh subprocesses: ``import quadimpact`` + the first
   ``simulate()``, (i) with Numba's on-disk cache warm (run twice, the second
   is reported) and (ii) with ``NUMBA_CACHE_DIR`` pointing to a fresh empty
@@ -189,6 +191,8 @@ def bench_cpu(case: str, repeat: int) -> dict:
         "cpu_ratio_median": statistics.median(whole) / statistics.median(kernel),
         "cpu_prepare_best_s": min(prep),
         "cpu_shooting_best_s": min(shoot),
+        # what is neither loop: resolving, packing, checks, the summary (best of each)
+        "cpu_python_best_s": min(whole) - min(kernel) - min(shoot),
         "shooting_runs": shooting_runs(case),
     }
 
@@ -226,6 +230,12 @@ def fmt_ms(s: float) -> str:
 
 def ms_pair(a: float, b: float) -> str:
     return f"{a * 1e3:.2f} / {b * 1e3:.2f} ms"
+
+
+def python_share(r: dict) -> str:
+    """The Python around the loops (best CPU time) and its share of the kernel's."""
+    python = r["cpu_python_best_s"]
+    return f"{fmt_ms(python)} ({python / r['cpu_kernel_best_s']:.2f})"
 
 
 def report(info: dict, results: dict, repeat: int, cold: bool) -> str:
@@ -275,6 +285,7 @@ def report(info: dict, results: dict, repeat: int, cold: bool) -> str:
     row("  prepare best", lambda r: fmt_ms(r["cpu_prepare_best_s"]))
     row("  of which shooting", lambda r: fmt_ms(r["cpu_shooting_best_s"]))
     row("  shooting runs", lambda r: str(r["shooting_runs"]))
+    row("  Python (simulate-kernel-shooting)", python_share)
     if cold:
         results = {k: v for k, v in results.items() if "cold" in v}
         row(
