@@ -93,6 +93,10 @@ class Settings:
         The last stage the policy acts in: 5 (every stage, the hover too) or 4.
     shaping : float
         The weight of the height-kept term in the reward (>= 0).
+    drift_weight : float
+        The weight of the held hover's drift in the reward (>= 0; 0: none): a
+        success scores ``1 - drift_weight * min(drift / 0.1 m, 1)``
+        (``flying.rewards``), and the check set then keeps the best mean reward.
     loss_weight : float
         A candidate's penalty for each training trial the law succeeds in and it
         fails (>= 0; 0: none). The law flies every batch beside the candidates, so
@@ -129,6 +133,7 @@ class Settings:
     rate_scale_rad_s: float = 4.0
     last_stage: int = 5
     shaping: float = 0.1
+    drift_weight: float = 0.0
     loss_weight: float = 0.0
     check: int = 60
     check_every: int = 5
@@ -150,6 +155,7 @@ class Settings:
             "rate-scale": (self.rate_scale_rad_s, _nonneg(self.rate_scale_rad_s), "finite, >= 0"),
             "stages": (self.last_stage, self.last_stage in (4, 5), "4 or 5"),
             "shaping": (self.shaping, _nonneg(self.shaping), "finite, >= 0"),
+            "drift-weight": (self.drift_weight, _nonneg(self.drift_weight), "finite, >= 0"),
             "loss-weight": (self.loss_weight, _nonneg(self.loss_weight), "finite, >= 0"),
             "check": (self.check, self.check >= 1, ">= 1"),
             "check-every": (self.check_every, self.check_every >= 1, ">= 1"),
@@ -204,12 +210,16 @@ def _worker_init() -> None:
     signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
-def fly_job(job: tuple[list[tuple[str, dict[str, Any]]], list[np.ndarray | None], float]) -> tuple:
-    """Fly every block on every trial of ``job``: (rewards, successes), each (blocks, trials)."""
-    trials_data, blocks, shaping = job
-    flyer = _WORKER.get("flyer")
+def fly_job(job: tuple[list[tuple[str, dict[str, Any]]], list[np.ndarray | None], tuple]) -> tuple:
+    """Fly every block on every trial of ``job``: (rewards, successes), each (blocks, trials).
+
+    The job's third part is the reward's terms, ``(shaping, drift_weight)``.
+    """
+    trials_data, blocks, (shaping, drift_weight) = job
+    key = f"flyer-{drift_weight > 0}"
+    flyer = _WORKER.get(key)
     if flyer is None:
-        flyer = _WORKER["flyer"] = Flyer()
+        flyer = _WORKER[key] = Flyer(drift=drift_weight > 0)
     prepared = [prepare_trial(task, data) for task, data in trials_data]
     altitudes = [float(d.get("altitude_m", 5.0)) if p is None else p.altitude_m
                  for p, (_, d) in zip(prepared, trials_data, strict=True)]  # fmt: skip
@@ -217,7 +227,7 @@ def fly_job(job: tuple[list[tuple[str, dict[str, Any]]], list[np.ndarray | None]
     s = np.zeros((len(blocks), len(prepared)), dtype=bool)
     for b, block in enumerate(blocks):
         summaries = [None if p is None else flyer.fly(p, block) for p in prepared]
-        r[b], s[b] = rewards(summaries, altitudes, shaping)
+        r[b], s[b] = rewards(summaries, altitudes, shaping, drift_weight)
     return r, s
 
 
@@ -231,11 +241,11 @@ class _Evaluator:
         if self.workers > 1:
             self.pool = mp.get_context("spawn").Pool(self.workers, initializer=_worker_init)
 
-    def __call__(self, trials: list, blocks: list, shaping: float) -> tuple:
+    def __call__(self, trials: list, blocks: list, terms: tuple[float, float]) -> tuple:
         if self.pool is None:
-            return fly_job((trials, blocks, shaping))
+            return fly_job((trials, blocks, terms))
         parts = [trials[w :: self.workers] for w in range(self.workers)]
-        jobs = [(p, blocks, shaping) for p in parts if p]
+        jobs = [(p, blocks, terms) for p in parts if p]
         with self.stop.polled():
             pending = self.pool.map_async(fly_job, jobs)
             while not pending.ready():
@@ -527,13 +537,19 @@ def _train(problem, settings, out, minutes, generations, workers, progress, stre
         evaluate = _Evaluator(workers, stop)
         try:
             if state["law_check"] is None:
-                r, s = evaluate(check_trials, [None], settings.shaping)
-                state["runs"] += len(check_trials)
-                state["law_check"] = (float(s.mean()), float(r.mean()))
-                state["best"] = (float(s.mean()), float(r.mean()), 0, state["es"].mean.copy())
+                # the law, and the start's weights when they are not the law's (--init)
+                theta0 = np.array(state["es"].mean, dtype=float)
+                blocks = [None]
+                if settings.init is not None:
+                    blocks.append(state["policy"].with_vector(theta0).block())
+                r, s = evaluate(check_trials, blocks, _terms(settings))
+                state["runs"] += len(blocks) * len(check_trials)
+                state["law_check"] = (float(s[0].mean()), float(r[0].mean()))
+                state["best"] = (float(s[-1].mean()), float(r[-1].mean()), 0, theta0)
                 state["curve"].append({"generation": 0, "runs": state["runs"],
-                                       "minutes": elapsed(), "check_success": float(s.mean()),
-                                       "check_score": float(r.mean())})  # fmt: skip
+                                       "minutes": elapsed(),
+                                       "check_success": state["law_check"][0],
+                                       "check_score": state["law_check"][1]})  # fmt: skip
                 state["minutes"] = elapsed()
                 state["np_random"] = np.random.get_state()  # noqa: NPY002
                 _save_state(out, state)
@@ -578,7 +594,7 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     xs = es.ask()
     trials = problem.batch(PURPOSE_TRAIN, (gen - 1) * settings.batch, settings.batch)
     blocks = [None] + [pol.with_vector(x).block() for x in xs]  # the law first: a yardstick
-    r, s = evaluate(trials, blocks, settings.shaping)
+    r, s = evaluate(trials, blocks, _terms(settings))
     law = float(r[0].mean())
     scores = candidate_scores(r, s, settings.loss_weight)
     es.tell(xs, [-float(v) for v in scores])
@@ -591,6 +607,17 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     if gen % settings.check_every == 0:
         _check(state, problem, settings, evaluate, check_trials)
         row["runs"] = state["runs"]
+
+
+def _terms(settings: Settings) -> tuple[float, float]:
+    """The reward's terms: (shaping, drift weight)."""
+    return (settings.shaping, settings.drift_weight)
+
+
+def _check_key(got: tuple[float, float], settings: Settings) -> tuple[float, ...]:
+    """How the check set ranks (success, mean reward): success first, or, with a drift
+    weight, the mean reward, which holds the drift."""
+    return (got[1], got[0]) if settings.drift_weight > 0 else got
 
 
 def candidate_scores(rewards: np.ndarray, successes: np.ndarray, loss_weight: float) -> np.ndarray:
@@ -617,12 +644,12 @@ def _check(state, problem, settings, evaluate, check_trials) -> None:
     reward)."""
     theta = np.array(state["es"].mean, dtype=float)
     block = state["policy"].with_vector(theta).block()
-    r, s = evaluate(check_trials, [block], settings.shaping)
+    r, s = evaluate(check_trials, [block], _terms(settings))
     state["runs"] += len(check_trials)
     got = (float(s.mean()), float(r.mean()))
     row = state["curve"][-1]
     row["check_success"], row["check_score"] = got
-    if got > state["best"][:2]:
+    if _check_key(got, settings) > _check_key(state["best"][:2], settings):
         state["best"] = (*got, state["generation"], theta.copy())
 
 
