@@ -273,7 +273,8 @@ def test_a_run_started_from_a_policy_keeps_that_policy_until_one_beats_it(tmp_pa
     law's score under its weights); stopped before generation 1, it is the policy written."""
     from quadimpact.inputs.policy_file import load_policy
     from quadimpact.studies.training import trainer
-    from quadimpact.studies.training.trainer import Settings, fly_job, init_settings, train
+    from quadimpact.studies.training.trainer import Settings, init_settings, train
+    from quadimpact.studies.training.workers import fly_job
     from quadimpact.sweep import SweepInterrupted
 
     a, b = tmp_path / "a", tmp_path / "b"
@@ -329,10 +330,11 @@ def test_an_interrupt_keeps_the_last_whole_generation_and_resumes(tmp_path, monk
     """A stop signal during generation 2 (raised by the evaluator, as the signal handler
     does): generation 1's state, curve and policy are saved; the rerun goes on from 1."""
     from quadimpact.studies.training import trainer
+    from quadimpact.studies.training.workers import Evaluator
     from quadimpact.sweep import SweepInterrupted
 
     settings = trainer.Settings(**_SMALL)
-    real = trainer._Evaluator.__call__
+    real = Evaluator.__call__
     calls = {"n": 0}
 
     def flaky(self, trials, blocks, shaping):
@@ -341,13 +343,13 @@ def test_an_interrupt_keeps_the_last_whole_generation_and_resumes(tmp_path, monk
             raise SweepInterrupted(2)
         return real(self, trials, blocks, shaping)
 
-    monkeypatch.setattr(trainer._Evaluator, "__call__", flaky)
+    monkeypatch.setattr(Evaluator, "__call__", flaky)
     with pytest.raises(SweepInterrupted, match="interrupted at generation 1"):
         trainer.train(_problem(), settings, tmp_path, None, 3, progress=False)
     assert trainer.load_state(tmp_path)["generation"] == 1
     assert (tmp_path / "policy.npz").is_file()
     assert json.loads((tmp_path / "train.json").read_text())["finished"] is False
-    monkeypatch.setattr(trainer._Evaluator, "__call__", real)
+    monkeypatch.setattr(Evaluator, "__call__", real)
     res = trainer.train(_problem(), settings, tmp_path, None, 3, progress=False)
     assert res.resumed_from == 1 and res.generations == 3 and res.finished
 
@@ -409,7 +411,7 @@ def test_the_trainers_success_is_the_benchmarks_on_the_same_trials(tmp_path, tas
     from quadimpact.studies.benchmark.cells import cell_table
     from quadimpact.studies.benchmark.subject import Subject
     from quadimpact.studies.benchmark.suite import TASKS, sensor_set
-    from quadimpact.studies.training.trainer import fly_job
+    from quadimpact.studies.training.workers import fly_job
     from quadimpact.sweep import read_runs, run_sweep
 
     task = TASKS[task_name]
