@@ -151,6 +151,68 @@ def test_the_reward_is_the_benchmarks_held_hover_success_plus_height_kept():
     assert math.isclose(climb, 1.1)  # a climb above the start earns nothing more
 
 
+def test_a_success_scores_less_by_its_hover_drift_and_a_failure_does_not():
+    """With a drift weight w a success scores 1 - w min(drift / 0.1 m, 1): linear in the
+    drift, whole at 0.1 m and beyond; a failure's score and w = 0 ignore the drift."""
+    cases = [_summary(hover_drift_m=d) for d in (0.0, 0.02, 0.05, 0.1, 0.4)]
+    cases.append(_summary(held_hover=False, hover_drift_m=None))
+    kept = 0.1 * math.exp(-0.5)
+    r, s = rewards(cases, [5.0] * len(cases), 0.1, drift_weight=0.5)
+    np.testing.assert_allclose(r, [1 + kept, 0.9 + kept, 0.75 + kept, 0.5 + kept,
+                                   0.5 + kept, kept])  # fmt: skip
+    assert list(s) == [True] * 5 + [False]  # the success itself is the benchmark's
+    r0, _ = rewards(cases, [5.0] * len(cases), 0.1)
+    np.testing.assert_allclose(r0, [1 + kept] * 5 + [kept])
+
+
+def test_hover_drift_is_the_farthest_horizontal_distance_from_the_hover_point():
+    """Rows before the hover began do not count, nor does height; after it the CM circles
+    the hover point at 3 cm and once reaches 4 cm east and 3 cm north: 5 cm."""
+    from quadimpact.core import layout as L
+    from quadimpact.studies.training.flying import hover_drift_m
+
+    t = np.linspace(0.0, 4.0, 4001)
+    out = np.zeros((t.size, L.NOUT))
+    out[:, L.OUT_T] = t
+    stats = np.zeros(L.NSTAT)
+    stats[L.ST_T_HELD] = 2.0
+    stats[L.ST_HELD_X : L.ST_HELD_X + 3] = (1.0, -2.0, 5.0)
+    p = L.OUT_X + L.X_POS
+    out[:, p] = 1.0 + 0.03 * np.cos(t)
+    out[:, p + 1] = -2.0 + 0.03 * np.sin(t)
+    out[:, p + 2] = 5.0 - 3.0 * t  # falling: no horizontal drift
+    out[t < 2.0, p] = 50.0  # before the hover: ignored
+    assert math.isclose(hover_drift_m(out, stats), 0.03, rel_tol=1e-12)
+    out[3500, p : p + 2] = (1.04, -1.97)
+    assert math.isclose(hover_drift_m(out, stats), 0.05, rel_tol=1e-12)
+    stats[L.ST_T_HELD] = np.nan
+    assert hover_drift_m(out, stats) is None
+
+
+def test_the_trainers_drift_is_the_time_series_drift_of_the_same_run():
+    """One held hover flown by the trainer (its rows) and by ``simulate`` (its table): the
+    same farthest distance from where the hover began, to 1e-9 m."""
+    from quadimpact import simulate
+    from quadimpact.inputs.scenarios import scenario_from_dict
+    from quadimpact.studies.training.flying import Flyer, prepare_trial
+
+    trials = _problem().batch(PURPOSE_CHECK, 0, 8)
+    flyer = Flyer(drift=True)
+    for task, data in trials:
+        summary = flyer.fly(prepare_trial(task, data), None)
+        if summary["hover_drift_m"] is not None:
+            break
+    else:
+        pytest.fail("no held hover in 8 ideal wall trials")
+    r = simulate(scenario_from_dict(data))
+    t_h = r.summary["first_contact_s"] + r.summary["time_to_held_hover_s"]
+    ts = r.timeseries[r.timeseries["t_s"] >= t_h - 1e-9]
+    xy = ts[["x_m", "y_m"]].to_numpy()
+    want = float(np.linalg.norm(xy - xy[0], axis=1).max())
+    assert 0.0 < summary["hover_drift_m"] < 0.2
+    assert math.isclose(summary["hover_drift_m"], want, abs_tol=1e-9)
+
+
 # ------------------------------------------------------------------ state and resume
 _SMALL = dict(hidden=2, popsize=3, batch=2, check=2, check_every=1, sigma=0.5)
 
@@ -206,6 +268,35 @@ def test_a_start_from_a_policy_of_another_shape_is_refused():
 
 
 @pytest.mark.slow
+def test_a_run_started_from_a_policy_keeps_that_policy_until_one_beats_it(tmp_path, monkeypatch):
+    """--init: generation 0's best is the starting policy flown on the check set (not the
+    law's score under its weights); stopped before generation 1, it is the policy written."""
+    from quadimpact.inputs.policy_file import load_policy
+    from quadimpact.studies.training import trainer
+    from quadimpact.studies.training.trainer import Settings, init_settings, train
+    from quadimpact.studies.training.workers import fly_job
+    from quadimpact.sweep import SweepInterrupted
+
+    a, b = tmp_path / "a", tmp_path / "b"
+    train(_problem(), Settings(**_SMALL), a, None, 2, progress=False)
+    start = load_policy(a / "policy.npz")
+    settings = init_settings(Settings(**{**_SMALL, "init": str(a / "policy.npz")}))
+
+    def stop(*args, **kwargs):
+        raise SweepInterrupted(2)
+
+    monkeypatch.setattr(trainer, "_generation", stop)
+    with pytest.raises(SweepInterrupted, match="interrupted at generation 0"):
+        train(_problem(), settings, b, None, 3, progress=False)
+    written = load_policy(b / "policy.npz")
+    np.testing.assert_array_equal(written.vector(), start.vector())
+    checks = _problem().batch(PURPOSE_CHECK, 0, settings.check)
+    r, _ = fly_job((checks, [None, start.block()], (settings.shaping, 0.0)))
+    assert written.meta["check_score_policy"] == float(r[1].mean())
+    assert written.meta["check_score_law"] == float(r[0].mean())
+
+
+@pytest.mark.slow
 def test_a_resumed_run_continues_the_same_optimiser(tmp_path):
     """Two generations straight, or one and then a resume to two: the same CMA-ES state,
     the same curve, the same policy; another setting is refused."""
@@ -239,10 +330,11 @@ def test_an_interrupt_keeps_the_last_whole_generation_and_resumes(tmp_path, monk
     """A stop signal during generation 2 (raised by the evaluator, as the signal handler
     does): generation 1's state, curve and policy are saved; the rerun goes on from 1."""
     from quadimpact.studies.training import trainer
+    from quadimpact.studies.training.workers import Evaluator
     from quadimpact.sweep import SweepInterrupted
 
     settings = trainer.Settings(**_SMALL)
-    real = trainer._Evaluator.__call__
+    real = Evaluator.__call__
     calls = {"n": 0}
 
     def flaky(self, trials, blocks, shaping):
@@ -251,13 +343,13 @@ def test_an_interrupt_keeps_the_last_whole_generation_and_resumes(tmp_path, monk
             raise SweepInterrupted(2)
         return real(self, trials, blocks, shaping)
 
-    monkeypatch.setattr(trainer._Evaluator, "__call__", flaky)
+    monkeypatch.setattr(Evaluator, "__call__", flaky)
     with pytest.raises(SweepInterrupted, match="interrupted at generation 1"):
         trainer.train(_problem(), settings, tmp_path, None, 3, progress=False)
     assert trainer.load_state(tmp_path)["generation"] == 1
     assert (tmp_path / "policy.npz").is_file()
     assert json.loads((tmp_path / "train.json").read_text())["finished"] is False
-    monkeypatch.setattr(trainer._Evaluator, "__call__", real)
+    monkeypatch.setattr(Evaluator, "__call__", real)
     res = trainer.train(_problem(), settings, tmp_path, None, 3, progress=False)
     assert res.resumed_from == 1 and res.generations == 3 and res.finished
 
@@ -319,7 +411,7 @@ def test_the_trainers_success_is_the_benchmarks_on_the_same_trials(tmp_path, tas
     from quadimpact.studies.benchmark.cells import cell_table
     from quadimpact.studies.benchmark.subject import Subject
     from quadimpact.studies.benchmark.suite import TASKS, sensor_set
-    from quadimpact.studies.training.trainer import fly_job
+    from quadimpact.studies.training.workers import fly_job
     from quadimpact.sweep import read_runs, run_sweep
 
     task = TASKS[task_name]
@@ -327,7 +419,7 @@ def test_the_trainers_success_is_the_benchmarks_on_the_same_trials(tmp_path, tas
     run_sweep(spec, tmp_path / "sweep", workers=1)
     table = cell_table(read_runs(tmp_path / "sweep"), spec, task)
     trials = [(task_name, spec.scenario_dict(i)) for i in range(spec.n_runs)]
-    _, success = fly_job((trials, [None], 0.1))
+    _, success = fly_job((trials, [None], (0.1, 0.0)))
     want = table.sort_values("run_id")["success"].to_numpy(dtype=bool)
     assert list(success[0]) == list(want)
     assert 0 < want.sum() < len(want)  # successes and failures both compared

@@ -94,6 +94,11 @@ __all__ = ["train"]
     help="Weight of the height-kept term added to the benchmark's success in the reward.",
 )  # fmt: skip
 @click.option(
+    "--drift-weight", type=float, default=0.0, show_default=True,
+    help="Weight of the held hover's drift in the reward: a success scores 1 - W min(drift / "
+    "0.1 m, 1), the drift being the CM's farthest from the hover point (0: none).",
+)  # fmt: skip
+@click.option(
     "--loss-weight", type=float, default=0.0, show_default=True,
     help="Penalty in the reward for each trial the law succeeds in and the candidate fails "
     "(0: none).",
@@ -128,6 +133,7 @@ def train(
     hover_fade: str | None,
     init: str | None,
     shaping: float,
+    drift_weight: float,
     loss_weight: float,
     check: int,
     check_every: int,
@@ -182,8 +188,8 @@ def train(
     settings = Settings(
         hidden=hidden, popsize=popsize, batch=batch, sigma=sigma, thrust_scale=thrust_scale,
         rate_scale_rad_s=rate_scale_rad_s, last_stage=5 if stages == "1-5" else 4,
-        shaping=shaping, loss_weight=loss_weight, check=check, check_every=check_every,
-        hover_centred=hover_centred, hover_fade_s=fade, init=init,
+        shaping=shaping, drift_weight=drift_weight, loss_weight=loss_weight, check=check,
+        check_every=check_every, hover_centred=hover_centred, hover_fade_s=fade, init=init,
         hover_hand_over=hover_hand_over,
     )  # fmt: skip
     if workers < 1:

@@ -38,6 +38,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core.controllers.residual import F_SCALE_M_S2, T_CAP_S
 from quadimpact.core.layout import MAX_HIDDEN, N_FEATURES, N_OUTPUTS
 from quadimpact.errors import InputError, short_path
 from quadimpact.linalg import matvec
@@ -195,10 +196,6 @@ def _tanh(x: np.ndarray) -> np.ndarray:
     return np.asarray(_tanh_object(x), dtype=float)
 
 
-#: The features' scale of the accelerometer's specific force, m/s^2 (residual.py).
-_F_SCALE_M_S2 = 16.0
-#: The features' cap on the time since the detection, s (residual.py): the latest fade end.
-_T_CAP_S = 2.0
 
 
 def hover_features(features: np.ndarray, gravity_m_s2: float) -> np.ndarray:
@@ -213,7 +210,7 @@ def hover_features(features: np.ndarray, gravity_m_s2: float) -> np.ndarray:
     h[..., 0:2] = 0.0
     h[..., 2] = 1.0
     h[..., 6:14] = 0.0
-    h[..., 14] = -gravity_m_s2 / _F_SCALE_M_S2
+    h[..., 14] = -gravity_m_s2 / F_SCALE_M_S2
     h[..., 21:24] = 0.0
     return h
 
@@ -368,7 +365,7 @@ def checked_fade(value: Any, where: str = "policy") -> tuple[float, float]:
     if raw.shape != (2,) or raw.dtype.kind not in "iuf":
         raise InputError(f"{where}: hover_fade_s: {rule} (got {raw.tolist()!r})")
     a, b = (float(v) for v in raw)
-    if (a, b) != (0.0, 0.0) and not (0.0 <= a < b <= _T_CAP_S):
+    if (a, b) != (0.0, 0.0) and not (0.0 <= a < b <= T_CAP_S):
         raise InputError(f"{where}: hover_fade_s: {rule} (got {[a, b]!r})")
     return a, b
 

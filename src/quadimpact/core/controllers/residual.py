@@ -106,8 +106,10 @@ N_POLICY_BLOCK = _policy.end("N_POLICY_BLOCK")
 
 _V_SCALE_M_S = 2.0
 _W_SCALE_RAD_S = 8.0
-_F_SCALE_M_S2 = 16.0
-_T_CAP_S = 2.0
+#: The features' scale of the accelerometer's specific force, m/s^2.
+F_SCALE_M_S2 = 16.0
+#: The features' cap on the time since the detection, s (also the latest fade's end).
+T_CAP_S = 2.0
 
 
 @allocating
@@ -155,9 +157,9 @@ def features(
     for k in range(3):
         f[6 + k] = x[X_VEL + k] / _V_SCALE_M_S
         f[9 + k] = meas[MS_W_HAT + k] / _W_SCALE_RAD_S
-        f[12 + k] = meas[MS_IMU_F + k] / _F_SCALE_M_S2
+        f[12 + k] = meas[MS_IMU_F + k] / F_SCALE_M_S2
     since = t - meas[MS_T_DETECT]
-    f[15] = min(max(since, 0.0), _T_CAP_S)
+    f[15] = min(max(since, 0.0), T_CAP_S)
     if 1 <= stage <= 5:
         f[15 + stage] = 1.0
     f[21] = refs[0] / (veh[V_MASS] * veh[V_GRAVITY]) - 1.0
@@ -194,7 +196,7 @@ def hover_features(f: np.ndarray, gravity_m_s2: float) -> np.ndarray:
         h[k] = 0.0
     h[12] = 0.0
     h[13] = 0.0
-    h[14] = -gravity_m_s2 / _F_SCALE_M_S2
+    h[14] = -gravity_m_s2 / F_SCALE_M_S2
     h[21] = 0.0
     h[22] = 0.0
     h[23] = 0.0

@@ -13,8 +13,12 @@ same function on the same columns): a held hover reached (true speed below
 than 2 m of height lost (the start altitude minus the lowest), the ground
 never touched and no contact once the hover began. To it is added a small
 term of height kept, ``shaping * exp(-lost / 1 m)`` (lost >= 0), which ranks
-the failures. A trial that is not valid for the benchmark (started in
-contact, a bumper beyond its model) or cannot be prepared scores 0.
+the failures. With a drift weight ``w > 0`` a success scores
+``1 - w min(drift / 0.1 m, 1)`` instead of 1: ``drift`` is the true
+horizontal distance of the CM from the hover point (where the held hover
+began) at its farthest, from then to the run's end (:func:`hover_drift_m`).
+A trial that is not valid for the benchmark (started in contact, a bumper
+beyond its model) or cannot be prepared scores 0.
 """
 
 from __future__ import annotations
@@ -25,7 +29,10 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["Flyer", "PreparedTrial", "prepare_trial", "rewards"]
+__all__ = ["DRIFT_SCALE_M", "Flyer", "PreparedTrial", "hover_drift_m", "prepare_trial", "rewards"]
+
+#: The drift at which a success's drift penalty is whole, m (``rewards``).
+DRIFT_SCALE_M = 0.1
 
 
 @dataclass
@@ -53,12 +60,19 @@ def prepare_trial(task: str, data: dict[str, Any]) -> PreparedTrial | None:
 
 
 class Flyer:
-    """Flies prepared trials with a policy block (or none), keeping the output buffers."""
+    """Flies prepared trials with a policy block (or none), keeping the output buffers.
 
-    def __init__(self) -> None:
+    ``drift=True``: the loop also writes its output rows (time and state, no
+    contact columns), and each summary gains ``hover_drift_m``
+    (:func:`hover_drift_m`; None without a held hover).
+    """
+
+    def __init__(self, drift: bool = False) -> None:
         from quadimpact.simulation.batch import _Buffers
 
         self.buffers = _Buffers(1024)
+        self.drift = bool(drift)
+        self._rows: Any = None
 
     def fly(self, trial: PreparedTrial, block: np.ndarray | None) -> dict[str, Any]:
         """The trial's summary flown with ``block`` at ``ctrl[C_POLICY:]`` (None: the law)."""
@@ -75,11 +89,58 @@ class Flyer:
         if block is not None:
             ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
         m = setup.model(ctrl=ctrl)
-        o = self.buffers.output(m, int(setup.n_imu))
+        o = self._output_rows(m, int(setup.n_imu)) if self.drift else None
+        if o is None:
+            o = self.buffers.output(m, int(setup.n_imu))
         start = time.perf_counter()
         (setup.kernel or BUILTIN).run(m, o)
         wall = time.perf_counter() - start
-        return analyse(setup, trial.scenario, raw_record(o), wall).summary
+        raw = raw_record(o)
+        summary = analyse(setup, trial.scenario, raw, wall).summary
+        if self.drift:
+            summary = {**summary, "hover_drift_m": hover_drift_m(raw.out, raw.stats)}
+        return summary
+
+    def _output_rows(self, m: Any, n_imu: int) -> Any:
+        """Outputs with a row per output time (no contact columns), reused while they fit."""
+        from quadimpact.core.records import new_output
+
+        o = self._rows
+        n_out = int(m.t_out.shape[0])
+        if o is None or o.out.shape[0] != n_out or o.imu.shape[0] < n_imu:
+            o = self._rows = new_output(m, n_imu, self.buffers.max_episodes,
+                                        contact_columns=False)  # fmt: skip
+        return o._replace(imu=o.imu[:n_imu])
+
+
+def hover_drift_m(out: np.ndarray, stats: np.ndarray) -> float | None:
+    """The held hover's drift: the CM's largest horizontal distance from the hover point.
+
+    Parameters
+    ----------
+    out : ndarray, shape (rows, >= NOUT)
+        The run's output rows (``OUT_T`` time, s; ``OUT_X`` state, inertial position first).
+    stats : ndarray
+        The run's stats: ``ST_T_HELD`` (s, when the held hover began) and
+        ``ST_HELD_X`` (m, the CM there, inertial).
+
+    Returns
+    -------
+    float or None
+        m, over the rows from the hover's start to the run's end; None without
+        a held hover.
+    """
+    from quadimpact.core import layout as L
+
+    t_held = float(stats[L.ST_T_HELD])
+    if not math.isfinite(t_held):
+        return None
+    after = out[out[:, L.OUT_T] >= t_held]
+    if after.shape[0] == 0:
+        return 0.0
+    dx = after[:, L.OUT_X + L.X_POS] - stats[L.ST_HELD_X]
+    dy = after[:, L.OUT_X + L.X_POS + 1] - stats[L.ST_HELD_X + 1]
+    return float(np.sqrt(dx * dx + dy * dy).max())
 
 
 _COLUMNS = ("status", "reason", "bumper_model_valid", "held_hover", "touched_after_hover",
@@ -87,9 +148,15 @@ _COLUMNS = ("status", "reason", "bumper_model_valid", "held_hover", "touched_aft
 
 
 def rewards(
-    summaries: list[dict[str, Any] | None], altitudes_m: list[float], shaping: float
+    summaries: list[dict[str, Any] | None],
+    altitudes_m: list[float],
+    shaping: float,
+    drift_weight: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Each trial's reward and success (module docstring); ``None``: a trial not prepared.
+
+    ``drift_weight > 0`` needs ``hover_drift_m`` in the successes' summaries
+    (``Flyer(drift=True)``).
 
     Returns
     -------
@@ -115,7 +182,12 @@ def rewards(
     success = held_hover_success(t) if n else np.zeros(0, dtype=bool)
     lost = t["height_lost_m"].to_numpy(dtype=float)
     kept = np.where(np.isfinite(lost), libm.exp(-np.maximum(lost, 0.0)), 0.0)  # same on any CPU
-    reward = np.where(t["valid"].to_numpy(dtype=bool), success + shaping * kept, 0.0)
+    score = success.astype(float)
+    if drift_weight > 0.0:
+        drift = np.array([finite((s or {}).get("hover_drift_m")) for s in summaries])
+        penalty = drift_weight * np.minimum(np.nan_to_num(drift, nan=0.0) / DRIFT_SCALE_M, 1.0)
+        score = np.where(success, 1.0 - penalty, 0.0)
+    reward = np.where(t["valid"].to_numpy(dtype=bool), score + shaping * kept, 0.0)
     return reward.astype(float), success.astype(bool)
 
 

@@ -40,17 +40,12 @@ on its saved state, so a resumed run continues the same sequence.
 from __future__ import annotations
 
 import contextlib
-import csv
-import io
 import json
 import math
-import multiprocessing as mp
 import pickle
-import signal
-import sys
 import time
 from collections.abc import Iterator
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
@@ -58,8 +53,10 @@ import numpy as np
 
 from quadimpact.errors import InputError
 from quadimpact.results.files import atomic_write
-from quadimpact.studies.training.flying import Flyer, prepare_trial, rewards
+from quadimpact.studies.training.curve import Progress, plot_curve, progress_bar, write_curve
+from quadimpact.studies.training.settings import Settings, TrainingResult
 from quadimpact.studies.training.trials import PURPOSE_CHECK, PURPOSE_TRAIN, Problem
+from quadimpact.studies.training.workers import Evaluator
 
 __all__ = ["STATE_FILE", "Settings", "TrainingResult", "candidate_scores", "load_state", "train"]
 
@@ -67,192 +64,6 @@ STATE_FILE = "state.pkl"
 STATE_VERSION = 1
 #: The files a training folder holds (a folder with others is refused for a new run).
 OWN_FILES = ("state.pkl", "policy.npz", "curve.csv", "curve.png", "train.json", "train.lock")
-CURVE_COLUMNS = ("generation", "runs", "minutes", "batch_mean", "batch_best", "batch_law",
-                 "sigma", "check_success", "check_score")  # fmt: skip
-
-
-@dataclass(frozen=True)
-class Settings:
-    """How a policy is trained (module docstring; ``quadimpact train --help``).
-
-    Attributes
-    ----------
-    hidden : int
-        Hidden units of the network (1-32); ``hidden * 28 + 3`` parameters.
-    popsize : int
-        Candidates per generation (>= 2).
-    batch : int
-        Training trials per generation, each flown by every candidate (>= 1).
-    sigma : float
-        CMA-ES's initial step size, in weight units (> 0).
-    thrust_scale : float
-        The largest thrust correction, a fraction of ``m g`` (>= 0).
-    rate_scale_rad_s : float
-        The largest roll and pitch rate-reference correction, rad/s (>= 0).
-    last_stage : int
-        The last stage the policy acts in: 5 (every stage, the hover too) or 4.
-    shaping : float
-        The weight of the height-kept term in the reward (>= 0).
-    loss_weight : float
-        A candidate's penalty for each training trial the law succeeds in and it
-        fails (>= 0; 0: none). The law flies every batch beside the candidates, so
-        this is free; it pushes the search toward policies that win trials without
-        losing others.
-    check : int
-        Trials of the check set (>= 1).
-    check_every : int
-        Generations between two checks (>= 1).
-    hover_centred : bool
-        The policy's correction in the hover stage is zero at the hover itself
-        (``core/controllers/residual.py``): it may change how the law reaches its
-        hover, not where it holds it.
-    hover_hand_over : bool
-        In the hover stage the policy acts only while the law brakes, not once
-        the law has captured the point it holds (the law alone holds it).
-    hover_fade_s : tuple of float
-        ``(from, to)``, s after the detection: the policy's correction in the
-        hover stage fades linearly to zero between them, so the law alone holds
-        the hover it reached (``0 <= from < to <= 2``; ``(0, 0)``: no fade).
-    init : str or None
-        A policy (``learned`` or a file) whose weights start the search instead
-        of the law (a zero output layer). Its hidden width, scales and last
-        stage must be these settings'; recorded with its weights' digest.
-    init_sha256 : str
-        The digest of ``init``'s weights (set from the file; part of the run's identity).
-    """
-
-    hidden: int = 8
-    popsize: int = 12
-    batch: int = 24
-    sigma: float = 0.05
-    thrust_scale: float = 0.3
-    rate_scale_rad_s: float = 4.0
-    last_stage: int = 5
-    shaping: float = 0.1
-    loss_weight: float = 0.0
-    check: int = 60
-    check_every: int = 5
-    hover_centred: bool = False
-    hover_hand_over: bool = False
-    hover_fade_s: tuple[float, float] = (0.0, 0.0)
-    init: str | None = None
-    init_sha256: str = ""
-
-    def __post_init__(self) -> None:
-        from quadimpact.core.layout import MAX_HIDDEN
-
-        rules = {
-            "hidden": (self.hidden, 1 <= self.hidden <= MAX_HIDDEN, f"in 1..{MAX_HIDDEN}"),
-            "popsize": (self.popsize, self.popsize >= 2, ">= 2"),
-            "batch": (self.batch, self.batch >= 1, ">= 1"),
-            "sigma": (self.sigma, math.isfinite(self.sigma) and self.sigma > 0, "finite, > 0"),
-            "thrust-scale": (self.thrust_scale, _nonneg(self.thrust_scale), "finite, >= 0"),
-            "rate-scale": (self.rate_scale_rad_s, _nonneg(self.rate_scale_rad_s), "finite, >= 0"),
-            "stages": (self.last_stage, self.last_stage in (4, 5), "4 or 5"),
-            "shaping": (self.shaping, _nonneg(self.shaping), "finite, >= 0"),
-            "loss-weight": (self.loss_weight, _nonneg(self.loss_weight), "finite, >= 0"),
-            "check": (self.check, self.check >= 1, ">= 1"),
-            "check-every": (self.check_every, self.check_every >= 1, ">= 1"),
-            "hover-centred": (
-                self.hover_centred,
-                not self.hover_centred or self.last_stage == 5,
-                "given with --stages 1-5 (it acts in the hover stage)",
-            ),
-        }
-        rules["hover-hand-over"] = (
-            self.hover_hand_over,
-            not self.hover_hand_over or self.last_stage == 5,
-            "given with --stages 1-5 (it acts in the hover stage)",
-        )
-        fade = tuple(float(v) for v in self.hover_fade_s)
-        rules["hover-fade"] = (
-            fade,
-            fade == (0.0, 0.0) or (self.last_stage == 5 and 0.0 <= fade[0] < fade[1] <= 2.0),
-            "FROM,TO s with 0 <= FROM < TO <= 2, given with --stages 1-5",
-        )
-        for name, (value, ok, rule) in rules.items():
-            if not ok:
-                raise InputError(f"--{name}: must be {rule} (got {value})")
-        object.__setattr__(self, "hover_fade_s", fade)
-
-
-def _nonneg(x: float) -> bool:
-    return math.isfinite(x) and x >= 0.0
-
-
-@dataclass
-class TrainingResult:
-    """What a training run (or its part up to an interrupt) made."""
-
-    out: Path
-    generations: int
-    runs: int
-    minutes: float
-    law_check: float
-    best_check: float
-    best_generation: int
-    finished: bool
-    resumed_from: int
-
-
-# ------------------------------------------------------------------ flying in workers
-_WORKER: dict[str, Any] = {}
-
-
-def _worker_init() -> None:
-    """A pool worker: Ctrl-C is the parent's to handle (it stops the pool)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-def fly_job(job: tuple[list[tuple[str, dict[str, Any]]], list[np.ndarray | None], float]) -> tuple:
-    """Fly every block on every trial of ``job``: (rewards, successes), each (blocks, trials)."""
-    trials_data, blocks, shaping = job
-    flyer = _WORKER.get("flyer")
-    if flyer is None:
-        flyer = _WORKER["flyer"] = Flyer()
-    prepared = [prepare_trial(task, data) for task, data in trials_data]
-    altitudes = [float(d.get("altitude_m", 5.0)) if p is None else p.altitude_m
-                 for p, (_, d) in zip(prepared, trials_data, strict=True)]  # fmt: skip
-    r = np.zeros((len(blocks), len(prepared)))
-    s = np.zeros((len(blocks), len(prepared)), dtype=bool)
-    for b, block in enumerate(blocks):
-        summaries = [None if p is None else flyer.fly(p, block) for p in prepared]
-        r[b], s[b] = rewards(summaries, altitudes, shaping)
-    return r, s
-
-
-class _Evaluator:
-    """Flies blocks on trials in this process (1 worker) or in a pool of spawned workers."""
-
-    def __init__(self, workers: int, stop: Any) -> None:
-        self.workers = max(1, int(workers))
-        self.stop = stop
-        self.pool = None
-        if self.workers > 1:
-            self.pool = mp.get_context("spawn").Pool(self.workers, initializer=_worker_init)
-
-    def __call__(self, trials: list, blocks: list, shaping: float) -> tuple:
-        if self.pool is None:
-            return fly_job((trials, blocks, shaping))
-        parts = [trials[w :: self.workers] for w in range(self.workers)]
-        jobs = [(p, blocks, shaping) for p in parts if p]
-        with self.stop.polled():
-            pending = self.pool.map_async(fly_job, jobs)
-            while not pending.ready():
-                pending.wait(0.2)
-                self.stop.check()
-        res = pending.get()
-        r = np.zeros((len(blocks), len(trials)))
-        s = np.zeros((len(blocks), len(trials)), dtype=bool)
-        for w, (rw, sw) in enumerate(res):
-            r[:, w :: self.workers], s[:, w :: self.workers] = rw, sw
-        return r, s
-
-    def close(self, terminate: bool = False) -> None:
-        if self.pool is not None:
-            (self.pool.terminate if terminate else self.pool.close)()
-            self.pool.join()
-            self.pool = None
 
 
 # ------------------------------------------------------------------ state
@@ -355,91 +166,6 @@ def _same_run(state: dict[str, Any], problem: Problem, settings: Settings, out: 
                          "give the same settings to resume it, or another --out")  # fmt: skip
 
 
-# ------------------------------------------------------------------ the curve
-def _write_curve(out: Path, curve: list[dict[str, Any]]) -> None:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(CURVE_COLUMNS)
-    for row in curve:
-        w.writerow(["" if row.get(c) is None else _fmt(row[c]) for c in CURVE_COLUMNS])
-    text = buf.getvalue()
-    atomic_write(out / "curve.csv", lambda tmp: tmp.write_text(text, encoding="utf-8"))
-
-
-def _fmt(v: Any) -> str:
-    if isinstance(v, float):
-        return f"{v:.6g}"
-    return str(v)
-
-
-def plot_curve(curve_csv: Path, png: Path) -> Path:
-    """The learning curve as a figure: above, the check set's success of the distribution's
-    mean against the law's (generation 0); below, each generation's mean candidate reward
-    minus the law's on the same training trials, and its 5-generation mean."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    import pandas as pd
-
-    c = pd.read_csv(curve_csv)
-    fig, (top, low) = plt.subplots(2, 1, figsize=(7.0, 5.2), sharex=True,
-                                   constrained_layout=True)  # fmt: skip
-    check = c.dropna(subset=["check_success"])
-    if len(check):
-        top.plot(check["generation"], check["check_success"], "o-", color="C0", ms=3,
-                 label="the policy (CMA-ES's mean): success on the check set")  # fmt: skip
-        top.axhline(check["check_success"].iloc[0], color="C3", ls="--", lw=1,
-                    label="the staged law on the check set")  # fmt: skip
-    top.set_ylabel("benchmark success")
-    top.legend(fontsize=8, loc="best", framealpha=0.8)
-    top.grid(alpha=0.3)
-    batch = c.dropna(subset=["batch_mean"])
-    gain = batch["batch_mean"] - batch["batch_law"]
-    low.plot(batch["generation"], gain, ".-", color="0.7", lw=0.8, ms=3,
-             label="mean candidate minus the law, same trials")  # fmt: skip
-    low.plot(batch["generation"], gain.rolling(5, min_periods=1).mean(), color="0.2", lw=1.5,
-             label="the same, 5-generation mean")  # fmt: skip
-    low.axhline(0.0, color="C3", ls="--", lw=1)
-    low.set_xlabel("generation")
-    low.set_ylabel("training reward\nminus the law's")
-    low.legend(fontsize=8, loc="best", framealpha=0.8)
-    low.grid(alpha=0.3)
-    fig.savefig(png, dpi=110)
-    plt.close(fig)
-    return png
-
-
-# ------------------------------------------------------------------ progress
-class _Progress:
-    """One line on stderr: redrawn in place on a terminal, printed at each check otherwise."""
-
-    def __init__(self, enabled: bool, stream: Any = None) -> None:
-        self.stream = stream if stream is not None else sys.stderr
-        self.enabled = enabled
-        isatty = getattr(self.stream, "isatty", None)
-        self.tty = bool(isatty and isatty())
-
-    def show(self, text: str, checked: bool) -> None:
-        if not self.enabled:
-            return
-        if self.tty:
-            self.stream.write("\r" + text.ljust(110)[:110])
-        elif checked:
-            self.stream.write(text + "\n")
-        self.stream.flush()
-
-    def end(self) -> None:
-        if self.enabled and self.tty:
-            self.stream.write("\n")
-            self.stream.flush()
-
-
-def _bar(done: float, total: float, width: int = 20) -> str:
-    k = int(width * min(max(done / total, 0.0), 1.0)) if total > 0 else width
-    return "[" + "#" * k + "." * (width - k) + "]"
-
-
 # ------------------------------------------------------------------ training
 def train(
     problem: Problem,
@@ -508,7 +234,7 @@ def _train(problem, settings, out, minutes, generations, workers, progress, stre
         _same_run(state, problem, settings, out)
     resumed_from = int(state["generation"])
     np.random.set_state(state["np_random"])  # noqa: NPY002 - cma draws from it
-    bar = _Progress(progress, stream)
+    bar = Progress(progress, stream)
     session_start = time.perf_counter()
     spent_before = float(state["minutes"])
     state["sessions"].append({"from_generation": resumed_from, "workers": int(workers)})
@@ -524,16 +250,22 @@ def _train(problem, settings, out, minutes, generations, workers, progress, stre
     check_trials = problem.batch(PURPOSE_CHECK, 0, settings.check)
     finished = False
     with stop_signals(restore_after_stop=False) as stop:
-        evaluate = _Evaluator(workers, stop)
+        evaluate = Evaluator(workers, stop)
         try:
             if state["law_check"] is None:
-                r, s = evaluate(check_trials, [None], settings.shaping)
-                state["runs"] += len(check_trials)
-                state["law_check"] = (float(s.mean()), float(r.mean()))
-                state["best"] = (float(s.mean()), float(r.mean()), 0, state["es"].mean.copy())
+                # the law, and the start's weights when they are not the law's (--init)
+                theta0 = np.array(state["es"].mean, dtype=float)
+                blocks = [None]
+                if settings.init is not None:
+                    blocks.append(state["policy"].with_vector(theta0).block())
+                r, s = evaluate(check_trials, blocks, _terms(settings))
+                state["runs"] += len(blocks) * len(check_trials)
+                state["law_check"] = (float(s[0].mean()), float(r[0].mean()))
+                state["best"] = (float(s[-1].mean()), float(r[-1].mean()), 0, theta0)
                 state["curve"].append({"generation": 0, "runs": state["runs"],
-                                       "minutes": elapsed(), "check_success": float(s.mean()),
-                                       "check_score": float(r.mean())})  # fmt: skip
+                                       "minutes": elapsed(),
+                                       "check_success": state["law_check"][0],
+                                       "check_score": state["law_check"][1]})  # fmt: skip
                 state["minutes"] = elapsed()
                 state["np_random"] = np.random.get_state()  # noqa: NPY002
                 _save_state(out, state)
@@ -542,7 +274,7 @@ def _train(problem, settings, out, minutes, generations, workers, progress, stre
                 state["minutes"] = elapsed()
                 state["np_random"] = np.random.get_state()  # noqa: NPY002
                 _save_state(out, state)
-                _write_curve(out, state["curve"])
+                write_curve(out, state["curve"])
                 _show(bar, state, minutes, generations)
             if state["curve"] and state["curve"][-1].get("check_success") is None:
                 _check(state, problem, settings, evaluate, check_trials)
@@ -578,7 +310,7 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     xs = es.ask()
     trials = problem.batch(PURPOSE_TRAIN, (gen - 1) * settings.batch, settings.batch)
     blocks = [None] + [pol.with_vector(x).block() for x in xs]  # the law first: a yardstick
-    r, s = evaluate(trials, blocks, settings.shaping)
+    r, s = evaluate(trials, blocks, _terms(settings))
     law = float(r[0].mean())
     scores = candidate_scores(r, s, settings.loss_weight)
     es.tell(xs, [-float(v) for v in scores])
@@ -591,6 +323,17 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     if gen % settings.check_every == 0:
         _check(state, problem, settings, evaluate, check_trials)
         row["runs"] = state["runs"]
+
+
+def _terms(settings: Settings) -> tuple[float, float]:
+    """The reward's terms: (shaping, drift weight)."""
+    return (settings.shaping, settings.drift_weight)
+
+
+def _check_key(got: tuple[float, float], settings: Settings) -> tuple[float, ...]:
+    """How the check set ranks (success, mean reward): success first, or, with a drift
+    weight, the mean reward, which holds the drift."""
+    return (got[1], got[0]) if settings.drift_weight > 0 else got
 
 
 def candidate_scores(rewards: np.ndarray, successes: np.ndarray, loss_weight: float) -> np.ndarray:
@@ -617,16 +360,16 @@ def _check(state, problem, settings, evaluate, check_trials) -> None:
     reward)."""
     theta = np.array(state["es"].mean, dtype=float)
     block = state["policy"].with_vector(theta).block()
-    r, s = evaluate(check_trials, [block], settings.shaping)
+    r, s = evaluate(check_trials, [block], _terms(settings))
     state["runs"] += len(check_trials)
     got = (float(s.mean()), float(r.mean()))
     row = state["curve"][-1]
     row["check_success"], row["check_score"] = got
-    if got > state["best"][:2]:
+    if _check_key(got, settings) > _check_key(state["best"][:2], settings):
         state["best"] = (*got, state["generation"], theta.copy())
 
 
-def _show(bar: _Progress, state: dict[str, Any], minutes: float | None,
+def _show(bar: Progress, state: dict[str, Any], minutes: float | None,
           generations: int | None) -> None:  # fmt: skip
     row = state["curve"][-1]
     if generations is not None:
@@ -636,7 +379,7 @@ def _show(bar: _Progress, state: dict[str, Any], minutes: float | None,
     law = state["law_check"][0]
     best = state["best"]
     checked = row.get("check_success") is not None
-    text = (f"train {_bar(done, total)} gen {state['generation']} ({state['minutes']:.1f}"
+    text = (f"train {progress_bar(done, total)} gen {state['generation']} ({state['minutes']:.1f}"
             f"{unit if generations is None else ' min, ' + str(done) + unit}), "
             f"{state['runs']} runs, batch {row['batch_mean']:.3f}, check best {best[0]:.3f} "
             f"(law {law:.3f})")  # fmt: skip
@@ -650,7 +393,7 @@ def _finish(out: Path, state: dict[str, Any], problem: Problem, settings: Settin
 
     from quadimpact.inputs.policy_file import save_policy
 
-    _write_curve(out, state["curve"])
+    write_curve(out, state["curve"])
     if state["best"] is None:
         return TrainingResult(out, 0, state["runs"], state["minutes"], math.nan, math.nan, 0,
                               finished, resumed_from)  # fmt: skip
@@ -681,8 +424,3 @@ def _finish(out: Path, state: dict[str, Any], problem: Problem, settings: Settin
     atomic_write(out / "train.json", lambda tmp: tmp.write_text(text, encoding="utf-8"))
     return TrainingResult(out, state["generation"], state["runs"], state["minutes"],
                           law_success, best_success, best_gen, finished, resumed_from)  # fmt: skip
-
-
-def settings_fields() -> tuple[str, ...]:
-    """The names of :class:`Settings`' fields."""
-    return tuple(f.name for f in fields(Settings))
