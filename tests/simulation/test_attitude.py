@@ -79,7 +79,7 @@ def test_a_settled_step_leaves_the_excursion_as_it_is() -> None:
             excursion_add(np.ascontiguousarray(quat_to_matrix(q)), *refs, z, e)
         q0 = q_ref + rng.normal(size=4) * 0.02
         C0 = np.ascontiguousarray(quat_to_matrix(q0))
-        dc = 10.0 ** rng.uniform(-5, -0.5)
+        dc = 10.0 ** rng.uniform(-4, 0.3)
         if not settled(C0, dc, refs[1], z, e):
             refused += 1
             continue
