@@ -33,7 +33,7 @@ from quadimpact.core.geometry import (
     pair_bound,
     pair_depth,
 )
-from quadimpact.core.geometry.plane import ring_plane, ring_plane_bound
+from quadimpact.core.geometry.plane import ring_plane, ring_plane_bound, ring_reach
 from quadimpact.core.integrator import (
     all_finite,
     copy_into,
@@ -133,16 +133,23 @@ def contact_values(
     against a plane takes its depth and rate from the closed form inlined here
     (``geometry.plane.ring_plane``: the rest of its record is not computed),
     after a broad phase of its own out of contact (``geometry.plane.ring_plane_bound``:
-    the CM's distance from the plane against the ring's reach).
+    the CM's distance from the plane against the ring's reach), tried only where the
+    last values in ``g``, ``bnd`` say it may succeed (near the plane it would only add
+    to the closed form).
     """
     rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
-    speed = math.sqrt(x[X_VEL] ** 2 + x[X_VEL + 1] ** 2 + x[X_VEL + 2] ** 2)
-    spin = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
+    speed = -1.0  # the norms of the velocity and the angular velocity, when first needed
+    spin = 0.0
     for c in range(g.shape[0]):
         if m.pairs[c, PR_GEOMETRY] == GEOM_RING_PLANE:
             f = m.pairs[c, PR_FEATURE]
             s = m.pairs[c, PR_SHAPE]
-            if d.cs[c, CS_ACTIVE] < 0.5:
+            # bounded where the last values in these slots say it may prove the ring apart
+            # (proved apart, or a gap below twice its reach); the closed form otherwise
+            if d.cs[c, CS_ACTIVE] < 0.5 and (bnd[c] > 0.5 or g[c] < -2.0 * ring_reach(m.feat, f)):
+                if speed < 0.0:
+                    speed = math.sqrt(x[X_VEL] ** 2 + x[X_VEL + 1] ** 2 + x[X_VEL + 2] ** 2)
+                    spin = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
                 gu, vu = ring_plane_bound(x, speed, spin, m.feat, f, m.shapes, s)
                 if gu < 0.0:
                     g[c] = gu

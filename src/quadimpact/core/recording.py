@@ -23,7 +23,7 @@ from quadimpact.core.geometry import (
     pair_bound,
     pair_depth,
 )
-from quadimpact.core.geometry.plane import ring_plane, ring_plane_bound
+from quadimpact.core.geometry.plane import ring_plane
 from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import (
     C_PHI_REF,
@@ -149,9 +149,7 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     (``records.new_output(..., contact_columns=False)`` skips that work).
     A ring against a plane takes its depth (and, in contact, its rate) from
     the closed form inlined here (``geometry.plane.ring_plane``): the rest of
-    its record is not computed, nor its force out of contact; out of contact
-    it is first bounded (``geometry.plane.ring_plane_bound``): proved apart,
-    its deflection is 0 without the closed form.
+    its record is not computed, nor its force out of contact.
     """
     out = o.out
     nf = m.feat.shape[0]
@@ -174,11 +172,7 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
         f = m.pairs[c, PR_FEATURE]
         active = d.cs[c, CS_ACTIVE] > 0.5
         if m.pairs[c, PR_GEOMETRY] == GEOM_RING_PLANE:  # the closed form, inlined
-            s = m.pairs[c, PR_SHAPE]
-            # its broad phase: a ring proved apart has no deflection
-            if not active and ring_plane_bound(xs, 0.0, 0.0, m.feat, f, m.shapes, s)[0] < 0.0:
-                continue
-            rec = ring_plane(xs, w.C, m.feat, f, m.shapes, s)
+            rec = ring_plane(xs, w.C, m.feat, f, m.shapes, m.pairs[c, PR_SHAPE])
             if rec[0] > out[row, OUT_DELTA + f]:
                 out[row, OUT_DELTA + f] = rec[0]
             if active:

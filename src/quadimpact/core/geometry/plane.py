@@ -105,6 +105,16 @@ def ring_plane(
 
 
 @njit(cache=True, inline="always")
+def ring_reach(feat: np.ndarray, f: int) -> float:
+    """An upper bound (m) on the distance of ring ``f``'s points from the CM, without a
+    square root: ``|c_b|_1 + R`` (at least ``|c_b| + R``)."""
+    return (
+        abs(feat[f, F_CENTRE]) + abs(feat[f, F_CENTRE + 1]) + abs(feat[f, F_CENTRE + 2])
+        + feat[f, F_RADIUS]
+    )  # fmt: skip
+
+
+@njit(cache=True, inline="always")
 def ring_plane_bound(
     x: np.ndarray, speed: float, spin: float, feat: np.ndarray, f: int, shapes: np.ndarray, s: int
 ) -> tuple[float, float]:
