@@ -250,36 +250,53 @@ def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     return sig_min, sig_crash
 
 
+@compiled
+def _rowless_samples(
+    m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, i_out: int
+) -> int:
+    """The samples in ``(t, t_b]`` of the step of ``h`` (s) that have no row; the next one.
+
+    A sweep's run (``o.out`` has no rows). A sample that is not the step's last
+    only joins the attitude excursion: its quaternion alone is interpolated
+    (``recording.add_attitude``), and not even that where the step is proved
+    unable to change the excursion (``recording.attitude_settled``: the same
+    bits). The step's last sample is written in full, so the last state kept is
+    the run's last sample's. Not inlined: the loop's own code stays as it was.
+    """
+    t_out = m.t_out
+    n_out = t_out.shape[0]
+    settled = False  # proved: no sample of the step changes the excursion
+    if i_out + 1 < n_out and t_out[i_out + 1] <= t_b:
+        settled = attitude_settled(d.x, w.Q, h, m, o, w)
+    while i_out + 1 < n_out and t_out[i_out + 1] <= t_b:
+        if not settled:
+            dense_eval_part(d.x, w.Q, h, (t_out[i_out] - t) / h, w.xs, X_QUAT, X_QUAT + 4)
+            add_attitude(w.xs, m, o, w)
+        i_out += 1
+    if i_out < n_out and t_out[i_out] <= t_b:
+        dense_eval(d.x[: active_states(m.veh)], w.Q, h, (t_out[i_out] - t) / h, w.xs)
+        if settled:
+            keep_last_state(w.xs, o)
+        else:
+            write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)
+        i_out += 1
+    return i_out
+
+
 @compiled(inline="always")
 def _dense_samples(
     m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, fsal: bool, i_out: int
 ) -> int:
     """Output rows and IMU samples in ``(t, t_b]`` of the step of ``h`` (s); the next row.
 
-    A sample without a row (a sweep's run: ``o.out`` has none) that is not the
-    step's last only joins the attitude excursion: its quaternion alone is
-    interpolated (``recording.add_attitude``), and not even that where the
-    step is proved unable to change the excursion (``recording.attitude_settled``:
-    the same bits). The step's last sample is written in full, so the last
-    state kept is the run's last sample's.
+    Samples without a row (a sweep's run): :func:`_rowless_samples`.
     """
     t_out = m.t_out
-    n_out = t_out.shape[0]
-    settled = False  # proved: no sample of the step changes the excursion
-    if i_out >= o.out.shape[0] and i_out + 1 < n_out and t_out[i_out + 1] <= t_b:
-        settled = attitude_settled(d.x, w.Q, h, m, o, w)
-    while i_out < n_out and t_out[i_out] <= t_b:
-        sigma = (t_out[i_out] - t) / h
-        if i_out >= o.out.shape[0] and i_out + 1 < n_out and t_out[i_out + 1] <= t_b:
-            if not settled:
-                dense_eval_part(d.x, w.Q, h, sigma, w.xs, X_QUAT, X_QUAT + 4)
-                add_attitude(w.xs, m, o, w)
-        else:
-            dense_eval(d.x[: active_states(m.veh)], w.Q, h, sigma, w.xs)
-            if settled:  # no row: only the state, kept as the last one
-                keep_last_state(w.xs, o)
-            else:
-                write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)
+    if i_out >= o.out.shape[0]:
+        i_out = _rowless_samples(m, d, o, w, t, h, t_b, i_out)
+    while i_out < t_out.shape[0] and t_out[i_out] <= t_b:
+        dense_eval(d.x[: active_states(m.veh)], w.Q, h, (t_out[i_out] - t) / h, w.xs)
+        write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)
         i_out += 1
     sst = d.sst
     while sst[SS_NEXT_T] <= t_b:
