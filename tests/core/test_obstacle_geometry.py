@@ -37,6 +37,7 @@ from geometry_reference import (
 
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
+from quadimpact.core.geometry.plane import ring_plane_bound
 from quadimpact.core.geometry.ring import ring_deepest
 from quadimpact.core.geometry.ring_box import ring_box_exact
 
@@ -445,8 +446,31 @@ def test_the_broad_phase_bounds_a_rings_depth_and_rate(shape):
     assert 30 < proved_apart < 270  # both cases were met (apart and not proved apart)
 
 
+def test_the_plane_broad_phase_bounds_a_rings_depth_and_rate():
+    """A ring against a plane: the CM's distance against the ring's reach never claims a
+    ring apart that touches, and its rate bound is above the size of the depth's rate."""
+    rng = np.random.default_rng(55)
+    proved_apart = 0
+    for _ in range(300):
+        row = _shape(rng, "plane")
+        x = _state(rng)
+        x[L.X_POS : L.X_POS + 3] = rng.uniform(-0.4, 0.4, 3)  # from behind to well apart
+        feat = _feature(
+            "ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), rng.standard_normal(3)
+        )
+        _, delta, delta_dot, *_ = _record(x, feat, row)
+        speed = float(np.linalg.norm(x[L.X_VEL : L.X_VEL + 3]))
+        spin = float(np.linalg.norm(x[L.X_OMEGA : L.X_OMEGA + 3]))
+        bound, rate = ring_plane_bound(x, speed, spin, feat, 0, row[None, :], 0)
+        assert delta <= bound
+        assert abs(delta_dot) <= rate
+        proved_apart += bound < 0.0
+    assert 30 < proved_apart < 270  # both cases were met (apart and not proved apart)
+
+
 def test_closed_form_pairs_have_no_broad_phase():
-    """A sphere, a point, or a ring against a plane: the record is as cheap as a bound."""
+    """A sphere, a point, or a ring against a plane: no search to bound (the ring against a
+    plane has its own broad phase in the event checks, ``plane.ring_plane_bound``)."""
     rng = np.random.default_rng(54)
     x = _state(rng)
     C = _rotation(x)

@@ -58,3 +58,38 @@ def test_excursion_of_a_known_rotation() -> None:
     assert out[1] == pytest.approx(0.0, abs=1e-12)
     assert out[2] == pytest.approx(0.0, abs=1e-12)
     assert out[3] == pytest.approx(30.0, abs=1e-6)
+
+
+def test_a_settled_step_leaves_the_excursion_as_it_is() -> None:
+    """``excursion.settled``: where it proves that no rotation within ``dc`` of ``C`` (each
+    entry) can change the excursion, adding any such rotation leaves it bit for bit; it
+    proves it for small moves near the references after a tumble, not for large ones."""
+    from quadimpact.core import layout as L
+    from quadimpact.core.excursion import excursion_add, excursion_start, settled
+
+    rng = np.random.default_rng(11)
+    proved = refused = 0
+    for _ in range(60):
+        refs = rng.uniform(-0.5, 0.5, 3)
+        q_ref = euler_zyx_to_quat(*refs)
+        z = np.ascontiguousarray(quat_to_matrix(q_ref)[:, 2])
+        e = np.zeros(L.NEX)
+        excursion_start(*refs, e)
+        for q in q_ref + np.cumsum(rng.normal(size=(int(rng.integers(1, 60)), 4)) * 0.05, axis=0):
+            excursion_add(np.ascontiguousarray(quat_to_matrix(q)), *refs, z, e)
+        q0 = q_ref + rng.normal(size=4) * 0.02
+        C0 = np.ascontiguousarray(quat_to_matrix(q0))
+        dc = 10.0 ** rng.uniform(-4, 0.3)
+        if not settled(C0, dc, refs[1], z, e):
+            refused += 1
+            continue
+        proved += 1
+        for _ in range(200):
+            q = q0 + rng.normal(size=4) * dc * 0.3
+            C = np.ascontiguousarray(quat_to_matrix(q))
+            if np.max(np.abs(C - C0)) > dc:
+                continue
+            after = e.copy()
+            excursion_add(C, *refs, z, after)
+            assert np.array_equal(after, e)
+    assert proved >= 10 and refused >= 10

@@ -118,6 +118,61 @@ def euler_of(
     return roll, pitch * DEG * RAD, yaw
 
 
+SETTLED_MARGIN = 1e-12
+"""Added to :func:`settled`'s bounds: far above the rounding of a sample's values (1e-15)."""
+
+
+@compiled(inline="always")
+def _reach_g(a: float, b: float, cu: float, su: float, cos_t: float, sin_t: float) -> float:
+    """:func:`may_reach`'s test as one number: it says False exactly where this is below 0."""
+    dot = a * cu + b * su
+    cross = abs(b * cu - a * su)
+    return cross * cos_t - dot * sin_t + SLACK * (cross + abs(dot))
+
+
+@compiled
+def settled(C: np.ndarray, dc: float, pitch_ref: float, z_ref: np.ndarray, e: np.ndarray) -> bool:
+    """Whether no sample within ``dc`` of the rotation ``C`` can change the excursion ``e``.
+
+    ``dc`` bounds how far each entry of a sample's rotation lies from ``C``'s.
+    True only where, for every such sample, :func:`excursion_add` would find
+    the tilt's cosine at or above the lowest so far, no angle that
+    :func:`may_reach` the largest so far, and no gimbal lock: it would leave
+    ``e`` as it is, bit for bit. Each quantity moves by at most a multiple of
+    ``dc`` (its Lipschitz constant: the tilt's cosine ``sqrt(3) |z_ref|``,
+    :func:`may_reach`'s test 1.5 per unit of its vector, which moves by
+    ``sqrt(2) dc``, the pitch's ``sqrt(3) dc``), plus :data:`SETTLED_MARGIN`.
+    NaN: False.
+    """
+    if not abs(pitch_ref) <= 0.5 * math.pi:
+        return False
+    c00 = C[0, 0]
+    c10 = C[1, 0]
+    c20 = C[2, 0]
+    c21 = C[2, 1]
+    c22 = C[2, 2]
+    zn = math.sqrt(z_ref[0] * z_ref[0] + z_ref[1] * z_ref[1] + z_ref[2] * z_ref[2])
+    c = C[0, 2] * z_ref[0] + C[1, 2] * z_ref[1] + c22 * z_ref[2]
+    if not c - 1.7321 * zn * dc - SETTLED_MARGIN >= e[EX_COS_TILT]:
+        return False
+    hs = math.sqrt(c00 * c00 + c10 * c10)
+    if not hs - 1.4143 * dc - SETTLED_MARGIN > 2.0 * math.sqrt(NEAR_LOCK_S2):
+        return False
+    move = 1.5 * 1.4143 * dc + SETTLED_MARGIN
+    g = _reach_g(c22, c21, e[EX_REF_TRIG], e[EX_REF_TRIG + 1], e[EX_DEV_TRIG], e[EX_DEV_TRIG + 1])
+    if not g + move < 0.0:
+        return False
+    g = _reach_g(
+        c00, c10, e[EX_REF_TRIG + 4], e[EX_REF_TRIG + 5], e[EX_DEV_TRIG + 4], e[EX_DEV_TRIG + 5]
+    )
+    if not g + move < 0.0:
+        return False
+    g = _reach_g(
+        hs, -c20, e[EX_REF_TRIG + 2], e[EX_REF_TRIG + 3], e[EX_DEV_TRIG + 2], e[EX_DEV_TRIG + 3]
+    )
+    return g + 1.5 * 1.7321 * dc + SETTLED_MARGIN < 0.0
+
+
 @compiled
 def excursion_start(roll_ref: float, pitch_ref: float, yaw_ref: float, e: np.ndarray) -> None:
     """Start an excursion ``e`` (``EX_*``, NEX) against the references (rad): nothing yet."""

@@ -157,6 +157,19 @@ def dense_eval(x_old: np.ndarray, Q: np.ndarray, h: float, sigma: float, out: np
         out[i] = x_old[i] + h * (Q[i, 0] * s1 + Q[i, 1] * s2 + Q[i, 2] * s3 + Q[i, 3] * s4)
 
 
+@compiled(inline="always")
+def dense_eval_part(
+    x_old: np.ndarray, Q: np.ndarray, h: float, sigma: float, out: np.ndarray, lo: int, hi: int
+) -> None:
+    """:func:`dense_eval` of the components ``lo`` to ``hi - 1`` only (the same bits for them)."""
+    s1 = sigma
+    s2 = s1 * sigma
+    s3 = s2 * sigma
+    s4 = s3 * sigma
+    for i in range(lo, hi):
+        out[i] = x_old[i] + h * (Q[i, 0] * s1 + Q[i, 1] * s2 + Q[i, 2] * s3 + Q[i, 3] * s4)
+
+
 @compiled
 def copy_into(dst: np.ndarray, src: np.ndarray) -> None:
     """``dst[:] = src`` element by element (no temporary: the arrays never overlap here)."""

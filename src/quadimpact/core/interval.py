@@ -15,6 +15,8 @@ force at step ends and mid-steps). Contact state changes only at located
 events, so a trial step never integrates a force switched on mid-step.
 """
 
+import math
+
 import numpy as np
 
 from quadimpact.core.actuators import apply_segment, next_boundary, segment_at
@@ -31,12 +33,13 @@ from quadimpact.core.geometry import (
     pair_bound,
     pair_depth,
 )
-from quadimpact.core.geometry.plane import ring_plane
+from quadimpact.core.geometry.plane import ring_plane, ring_plane_bound, ring_reach
 from quadimpact.core.integrator import (
     all_finite,
     copy_into,
     dense_coefficients,
     dense_eval,
+    dense_eval_part,
     error_norm,
     stage_state,
     step_factor,
@@ -85,13 +88,18 @@ from quadimpact.core.layout import (
     ST_T_END,
     STATUS_FAILED,
     V_N_ROTORS,
+    X_OMEGA,
     X_POS,
     X_QUAT,
     X_ROTOR,
+    X_VEL,
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.recording import (
+    add_attitude,
+    attitude_settled,
     close_episode,
+    keep_last_state,
     observe_peak,
     open_episode,
     record_crash,
@@ -123,12 +131,32 @@ def contact_values(
     ``events.contact_event`` decides from them only what they prove and
     computes the values otherwise, so no result changes (bit for bit). A ring
     against a plane takes its depth and rate from the closed form inlined here
-    (``geometry.plane.ring_plane``: the rest of its record is not computed).
+    (``geometry.plane.ring_plane``: the rest of its record is not computed),
+    after a broad phase of its own out of contact (``geometry.plane.ring_plane_bound``:
+    the CM's distance from the plane against the ring's reach), tried only where the
+    last values in ``g``, ``bnd`` say it may succeed (near the plane it would only add
+    to the closed form).
     """
     rotation_matrix(x[X_QUAT : X_QUAT + 4], w.C)
+    speed = -1.0  # the norms of the velocity and the angular velocity, when first needed
+    spin = 0.0
     for c in range(g.shape[0]):
         if m.pairs[c, PR_GEOMETRY] == GEOM_RING_PLANE:
-            rec = ring_plane(x, w.C, m.feat, m.pairs[c, PR_FEATURE], m.shapes, m.pairs[c, PR_SHAPE])
+            f = m.pairs[c, PR_FEATURE]
+            s = m.pairs[c, PR_SHAPE]
+            # bounded where the last values in these slots say it may prove the ring apart
+            # (proved apart, or a gap below twice its reach); the closed form otherwise
+            if d.cs[c, CS_ACTIVE] < 0.5 and (bnd[c] > 0.5 or g[c] < -2.0 * ring_reach(m.feat, f)):
+                if speed < 0.0:
+                    speed = math.sqrt(x[X_VEL] ** 2 + x[X_VEL + 1] ** 2 + x[X_VEL + 2] ** 2)
+                    spin = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
+                gu, vu = ring_plane_bound(x, speed, spin, m.feat, f, m.shapes, s)
+                if gu < 0.0:
+                    g[c] = gu
+                    gd[c] = vu
+                    bnd[c] = 1.0
+                    continue
+            rec = ring_plane(x, w.C, m.feat, f, m.shapes, s)
             g[c] = contact_gap(x, rec[0], m, c)
             gd[c] = rec[1]
             bnd[c] = 0.0
@@ -222,12 +250,50 @@ def _step_events(m: Model, d: Data, w: Work, h: float) -> tuple[float, float]:
     return sig_min, sig_crash
 
 
+@compiled
+def _rowless_samples(
+    m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, i_out: int
+) -> int:
+    """The samples in ``(t, t_b]`` of the step of ``h`` (s) that have no row; the next one.
+
+    A sweep's run (``o.out`` has no rows). A sample that is not the step's last
+    only joins the attitude excursion: its quaternion alone is interpolated
+    (``recording.add_attitude``), and not even that where the step is proved
+    unable to change the excursion (``recording.attitude_settled``: the same
+    bits). The step's last sample is written in full, so the last state kept is
+    the run's last sample's. Not inlined: the loop's own code stays as it was.
+    """
+    t_out = m.t_out
+    n_out = t_out.shape[0]
+    settled = False  # proved: no sample of the step changes the excursion
+    if i_out + 1 < n_out and t_out[i_out + 1] <= t_b:
+        settled = attitude_settled(d.x, w.Q, h, m, o, w)
+    while i_out + 1 < n_out and t_out[i_out + 1] <= t_b:
+        if not settled:
+            dense_eval_part(d.x, w.Q, h, (t_out[i_out] - t) / h, w.xs, X_QUAT, X_QUAT + 4)
+            add_attitude(w.xs, m, o, w)
+        i_out += 1
+    if i_out < n_out and t_out[i_out] <= t_b:
+        dense_eval(d.x[: active_states(m.veh)], w.Q, h, (t_out[i_out] - t) / h, w.xs)
+        if settled:
+            keep_last_state(w.xs, o)
+        else:
+            write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)
+        i_out += 1
+    return i_out
+
+
 @compiled(inline="always")
 def _dense_samples(
     m: Model, d: Data, o: Output, w: Work, t: float, h: float, t_b: float, fsal: bool, i_out: int
 ) -> int:
-    """Output rows and IMU samples in ``(t, t_b]`` of the step of ``h`` (s); the next row."""
+    """Output rows and IMU samples in ``(t, t_b]`` of the step of ``h`` (s); the next row.
+
+    Samples without a row (a sweep's run): :func:`_rowless_samples`.
+    """
     t_out = m.t_out
+    if i_out >= o.out.shape[0]:
+        i_out = _rowless_samples(m, d, o, w, t, h, t_b, i_out)
     while i_out < t_out.shape[0] and t_out[i_out] <= t_b:
         dense_eval(d.x[: active_states(m.veh)], w.Q, h, (t_out[i_out] - t) / h, w.xs)
         write_sample(i_out, t_out[i_out], w.xs, m, d, o, w)

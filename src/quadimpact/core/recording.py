@@ -13,7 +13,7 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
-from quadimpact.core.excursion import excursion_add
+from quadimpact.core.excursion import excursion_add, settled
 from quadimpact.core.geometry import (
     GEOM_RING_PLANE,
     PR_FEATURE,
@@ -78,6 +78,62 @@ from quadimpact.core.rotors import (
 from quadimpact.core.sensors.disturbance import impact_onset
 
 
+@compiled(inline="always")
+def add_attitude(xs: np.ndarray, m: Model, o: Output, w: Work) -> None:
+    """A sample's attitude (the quaternion of ``xs``, its rotation into ``w.C``) joins the
+    run's excursion (``ST_EXCURSION``): all of a sample that has no row and is not kept as
+    the last state (:func:`write_sample`'s first part, which reads only the quaternion)."""
+    rotation_matrix(xs[X_QUAT : X_QUAT + 4], w.C)
+    excursion_add(
+        w.C,
+        m.ctrl[C_PHI_REF],
+        m.ctrl[C_THETA_REF],
+        m.ctrl[C_PSI_REF],
+        m.ctrl[C_Z_REF : C_Z_REF + 3],
+        o.stats[ST_EXCURSION : ST_EXCURSION + NEX],
+    )
+
+
+@compiled(inline="always")
+def keep_last_state(xs: np.ndarray, o: Output) -> None:
+    """The sample's state ``xs`` kept as the last one (``ST_X_LAST``, what the summary reads)."""
+    for i in range(NX):
+        o.stats[ST_X_LAST + i] = xs[i]
+
+
+@compiled
+def attitude_settled(x: np.ndarray, Q: np.ndarray, h: float, m: Model, o: Output, w: Work) -> bool:
+    """Whether no sample of the step of ``h`` (s) from ``x`` can change the run's excursion.
+
+    The step's dense output (coefficients ``Q``) moves the quaternion from
+    ``x``'s by at most ``r = |h| sqrt(sum_i (sum_k |Q[i, k]|)^2)`` (its
+    components ``i``, its powers ``k``; ``sigma`` in [0, 1]); the unit
+    quaternions by at most ``2 r / |q|``, and a rotation's entries by at most
+    4 times that (their gradients on the unit ball). ``excursion.settled``
+    then says whether any sample within that reach of ``x``'s rotation
+    (``w.C`` receives it) could change the excursion. True: the step's samples
+    without a row can be left out of it, bit for bit.
+    """
+    r2 = 0.0
+    for i in range(X_QUAT, X_QUAT + 4):
+        ri = abs(h) * (abs(Q[i, 0]) + abs(Q[i, 1]) + abs(Q[i, 2]) + abs(Q[i, 3]))
+        r2 += ri * ri
+    q = x[X_QUAT : X_QUAT + 4]
+    nq = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    r = math.sqrt(r2)
+    if not r < 0.1 * nq:
+        return False
+    rotation_matrix(q, w.C)
+    dc = 8.0 * r / nq
+    return settled(
+        w.C,
+        dc,
+        m.ctrl[C_THETA_REF],
+        m.ctrl[C_Z_REF : C_Z_REF + 3],
+        o.stats[ST_EXCURSION : ST_EXCURSION + NEX],
+    )
+
+
 @compiled
 def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
     """The output sample ``row`` at time ``t`` (s) of the state ``xs``.
@@ -96,19 +152,9 @@ def write_sample(row: int, t: float, xs: np.ndarray, m: Model, d: Data, o: Outpu
     its record is not computed, nor its force out of contact.
     """
     out = o.out
-    st = o.stats
     nf = m.feat.shape[0]
-    rotation_matrix(xs[X_QUAT : X_QUAT + 4], w.C)
-    excursion_add(
-        w.C,
-        m.ctrl[C_PHI_REF],
-        m.ctrl[C_THETA_REF],
-        m.ctrl[C_PSI_REF],
-        m.ctrl[C_Z_REF : C_Z_REF + 3],
-        st[ST_EXCURSION : ST_EXCURSION + NEX],
-    )
-    for i in range(NX):
-        st[ST_X_LAST + i] = xs[i]
+    add_attitude(xs, m, o, w)
+    keep_last_state(xs, o)
     if row >= out.shape[0]:
         return
     out[row, OUT_T] = t
