@@ -196,8 +196,6 @@ def _tanh(x: np.ndarray) -> np.ndarray:
     return np.asarray(_tanh_object(x), dtype=float)
 
 
-
-
 def hover_features(features: np.ndarray, gravity_m_s2: float) -> np.ndarray:
     """``features`` ``(..., 24)`` with the vehicle level and at rest, at its hover.
 
