@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from quadimpact.core import layout as L
+from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
 from quadimpact.core.records import new_data, new_output, new_work
 from quadimpact.core.rotors import NRIN
@@ -23,6 +24,7 @@ from quadimpact.core.rotors import NRIN
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
     "quadimpact.core.layout",
+    "quadimpact.core.contact_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
     "quadimpact.core.rotors",
@@ -134,7 +136,7 @@ def test_the_factories_allocate_the_declared_sizes():
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
         (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)

@@ -26,6 +26,7 @@ import pytest
 
 import quadimpact
 from quadimpact.core import layout as L
+from quadimpact.core.contact_slots import NCS
 from quadimpact.core.records import data_row, new_data, set_row, stacked
 from quadimpact.inputs.scenarios import ImpactTrial
 from quadimpact.simulation.setup import prepare
@@ -165,7 +166,7 @@ def test_a_new_per_run_array_touches_three_files(tmp_path: Path, jit: bool):
 def test_compiled_factories_and_stacked_rows_agree():
     m = prepare(ImpactTrial(pitch_deg=-10, speed_m_s=1.0, final_time_s=0.1)).model()
     d = new_data(m)
-    assert np.array_equal(d.x, m.x0) and d.cs.shape == (m.pairs.shape[0], L.NCS)
+    assert np.array_equal(d.x, m.x0) and d.cs.shape == (m.pairs.shape[0], NCS)
     stack = stacked(d, 3)
     assert type(stack) is type(d) and stack.x.shape == (3, L.NX)
     set_row(stack, 1, d)

@@ -22,8 +22,8 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.contact_slots import CS_ACTIVE
 from quadimpact.core.layout import (
-    CS_ACTIVE,
     ST_HELD_RUN_T,
     ST_HELD_RUN_X,
     ST_HELD_X,

@@ -30,64 +30,11 @@ Everything is SI; frames as in docs/MODEL.md section 1 (inertial NED, body FRD).
 from __future__ import annotations
 
 import math
-import sys
-from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import ClassVar
+
+from quadimpact.core.block import Block
 
 __all__ = ["Block"]  # and every slot constant below
-
-
-@dataclass
-class Block:
-    """Consecutive slots of one array (or of a part of one), declared in order.
-
-    Parameters
-    ----------
-    array : str
-        What the slots index: a record field (``"veh"``, ``"stats"``...), or
-        ``"ctrl.params.<controller>"`` for a parameter block inside ``ctrl``.
-    prefix : str
-        The prefix of every slot constant of the block (``"V_"``).
-    start : int
-        Offset of the first slot (a block may continue another one).
-    capacity : int, optional
-        An upper bound the block must fit in (a controller's parameter block
-        must fit in ``NPARAM``).
-    """
-
-    array: str
-    prefix: str
-    start: int = 0
-    capacity: int | None = None
-    slots: dict[str, tuple[int, int]] = field(default_factory=dict)
-    size_name: str | None = None
-    module: str = ""
-    registry: ClassVar[dict[str, Block]] = {}
-
-    def __post_init__(self) -> None:
-        self.next = self.start
-        if not self.module:  # the declaring module: the caller of the generated __init__
-            self.module = sys._getframe(2).f_globals.get("__name__", "")
-        Block.registry[f"{self.array}:{self.prefix}"] = self  # a module reloaded: the new one
-
-    def slot(self, name: str, width: int = 1) -> int:
-        """Declare the next slot (``width`` consecutive numbers); return its offset."""
-        if not name.startswith(self.prefix):
-            raise ValueError(f"layout: slot {name} must start with {self.prefix}")
-        if name in self.slots or width < 1:
-            raise ValueError(f"layout: slot {name} declared twice or with width < 1")
-        offset = self.next
-        self.slots[name] = (offset, width)
-        self.next += width
-        if self.capacity is not None and self.next > self.capacity:
-            raise ValueError(f"layout: block {self.array} overflows its {self.capacity} slots")
-        return offset
-
-    def end(self, size_name: str) -> int:
-        """Close the block; return its size (the first offset after its last slot)."""
-        self.size_name = size_name
-        return self.next
 
 
 # --------------------------------------------------------------------------
@@ -420,13 +367,6 @@ LS_STAGE = _ls.slot("LS_STAGE")  # the controller's stage in force (MEM_STAGE at
 LS_EXT = _ls.slot("LS_EXT")  # 1: the next tick applies LS_EXT_CMD instead of the controller
 LS_EXT_CMD = _ls.slot("LS_EXT_CMD", MAX_ROTORS)  # external rotor speed command (rad/s)
 NLS = _ls.end("NLS")
-
-# ---- contact pairs cs (n_pairs, NCS); changed only at located events
-_cs = Block("cs", "CS_")
-CS_ACTIVE = _cs.slot("CS_ACTIVE")  # 1 while the pair is in a contact episode (force applied)
-CS_LAMBDA = _cs.slot("CS_LAMBDA")  # damping coefficient fixed at the episode's onset
-CS_EPISODE = _cs.slot("CS_EPISODE")  # row of its episode in `episodes` (-1: none / dropped)
-NCS = _cs.end("NCS")
 
 # ---- controller memory mem (NMEM), zeroed at the start; each controller
 # lays out its slots with a Block of array "mem.<name>". The last slot is

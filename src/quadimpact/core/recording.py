@@ -13,6 +13,7 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
 from quadimpact.core.excursion import excursion_add
 from quadimpact.core.geometry import (
     GEOM_RING_PLANE,
@@ -30,9 +31,6 @@ from quadimpact.core.layout import (
     C_PSI_REF,
     C_THETA_REF,
     C_Z_REF,
-    CS_ACTIVE,
-    CS_EPISODE,
-    CS_LAMBDA,
     E_FEATURE,
     E_OPEN,
     E_PEAK_DELTA,
@@ -71,10 +69,7 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Output, Work
-from quadimpact.core.rotors import (
-    RIN_CMD,
-    active_states,
-)
+from quadimpact.core.rotors import RIN_CMD, active_states
 from quadimpact.core.sensors.disturbance import impact_onset
 
 

@@ -41,10 +41,10 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from quadimpact.core.contact_slots import NCS
 from quadimpact.core.layout import (
     MAX_AVERAGE_WINDOW,
     MAX_ROTORS,
-    NCS,
     NECFG,
     NEP,
     NEST,

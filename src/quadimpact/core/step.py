@@ -32,6 +32,7 @@ import numpy as np
 
 from quadimpact.core.actuators import apply_command, cut_step
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
 from quadimpact.core.controllers import builtin_step
 from quadimpact.core.estimators import at_tick, init_estimate
 from quadimpact.core.excursion import excursion_start
@@ -44,9 +45,6 @@ from quadimpact.core.layout import (
     C_STEP,
     C_THETA_REF,
     CRASH_PAPER_TICKS,
-    CS_ACTIVE,
-    CS_EPISODE,
-    CS_LAMBDA,
     CTRL_USER,
     E_OPEN,
     E_PEAK_DELTA,
@@ -113,11 +111,7 @@ from quadimpact.core.plugin_call import call_controller
 from quadimpact.core.quaternion import normalise_quaternion
 from quadimpact.core.recording import record_crash, write_sample
 from quadimpact.core.records import Data, Model, Output, Work, new_work
-from quadimpact.core.rotors import (
-    RIN_CMD,
-    RIN_FIRST_ORDER,
-    RIN_PREV_CMD,
-)
+from quadimpact.core.rotors import RIN_CMD, RIN_FIRST_ORDER, RIN_PREV_CMD
 from quadimpact.core.sensing import sample_at
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
