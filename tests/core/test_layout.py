@@ -18,6 +18,7 @@ import pytest
 from quadimpact.core import layout as L
 from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
+from quadimpact.core.recording_slots import NEP, NOUT, out_width
 from quadimpact.core.records import new_data, new_output, new_work
 from quadimpact.core.rotors import NRIN
 
@@ -25,6 +26,7 @@ from quadimpact.core.rotors import NRIN
 DECLARING = (
     "quadimpact.core.layout",
     "quadimpact.core.contact_slots",
+    "quadimpact.core.recording_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
     "quadimpact.core.rotors",
@@ -140,8 +142,8 @@ def test_the_factories_allocate_the_declared_sizes():
         (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)
-    assert o.out.shape == (n_out, L.out_width(m_feat)) == (n_out, L.NOUT + 2 * m_feat)
-    assert o.imu.shape == (7, L.NIMU) and o.episodes.shape == (11, L.NEP)
+    assert o.out.shape == (n_out, out_width(m_feat)) == (n_out, NOUT + 2 * m_feat)
+    assert o.imu.shape == (7, L.NIMU) and o.episodes.shape == (11, NEP)
     assert o.stats.shape == (L.NSTAT,)
     w = new_work(4)
     assert w.K.shape == (7, L.NX) and w.ev_sig.shape == (4,)

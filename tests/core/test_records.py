@@ -97,6 +97,7 @@ NEW_FILES = {
 CHECK = """
 import numpy as np
 from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import new_data, new_output
 from quadimpact.core.step import advance, start
 from quadimpact.inputs.scenarios import ImpactTrial
@@ -114,7 +115,7 @@ assert np.array_equal(o.baro[:n, 0], o.imu[:n, L.I_T]), "sampled with the IMU"
 assert o.baro[0, 1] == 5.0, "the trial starts at 5 m"
 assert d.baro[1] == o.baro[n - 1, 0] and d.baro[0] == o.baro[n - 1, 1], "the state is the last"
 # the altitude at the final output row (the run's end) is the last sample's
-assert abs(o.baro[n - 1, 1] + o.out[-1, L.OUT_X + L.X_POS + 2]) < 1e-12
+assert abs(o.baro[n - 1, 1] + o.out[-1, OUT_X + L.X_POS + 2]) < 1e-12
 print("ok", n)
 """
 

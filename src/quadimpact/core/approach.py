@@ -39,7 +39,6 @@ from quadimpact.core.geometry import pair_contact
 from quadimpact.core.layout import (
     MAX_ROTORS,
     NX,
-    OUT_X,
     SPAN_T0,
     SPAN_TF,
     ST_N_OUT,
@@ -53,6 +52,7 @@ from quadimpact.core.layout import (
     Block,
 )
 from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import Model, Output, new_data
 from quadimpact.core.roots import BR_X, BRENT_ASK, BRENT_NO_BRACKET, NBR, brent_next, brent_start
 from quadimpact.core.step import advance, start

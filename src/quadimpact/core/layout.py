@@ -451,37 +451,6 @@ I_BIAS_TRUE = _imu.slot("I_BIAS_TRUE", 3)  # the gyro's true bias (constant + wa
 I_ERR = _imu.slot("I_ERR", 4)  # errors: attitude deg, velocity m/s, bias rad/s, position m
 NIMU = _imu.end("NIMU")
 
-# ---- time series out (n_out, NOUT + 2 n_features): the fixed columns, then
-# per feature its deflection (max over shapes, >= 0, m), then per feature its
-# normal force (sum over shapes, N); out_width() gives the row length
-_out = Block("out", "OUT_")
-OUT_T = _out.slot("OUT_T")  # s
-OUT_X = _out.slot("OUT_X", NX)  # state
-OUT_CMD = _out.slot("OUT_CMD", MAX_ROTORS)  # rotor speed command in force (rad/s)
-OUT_STAGE = _out.slot("OUT_STAGE")  # the controller's stage in force (MEM_STAGE)
-NOUT = _out.end("NOUT")
-OUT_DELTA = NOUT  # feature f's deflection at OUT_DELTA + f
-
-
-def out_width(n_features: int) -> int:
-    """Columns of an output row for ``n_features`` contact features."""
-    return NOUT + 2 * n_features
-
-
-# ---- contact episodes episodes (max_episodes, NEP)
-_ep = Block("episodes", "E_")
-E_FEATURE = _ep.slot("E_FEATURE")  # row of feat
-E_SHAPE = _ep.slot("E_SHAPE")  # row of shapes
-E_T_START = _ep.slot("E_T_START")  # s, located onset
-E_T_END = _ep.slot("E_T_END")  # s, located end (run end if still open)
-E_V_I = _ep.slot("E_V_I")  # m/s, penetration rate at onset (before the v_min floor)
-E_PEAK_DELTA = _ep.slot("E_PEAK_DELTA")  # m
-E_T_PEAK = _ep.slot("E_T_PEAK")  # s
-E_PEAK_FORCE = _ep.slot("E_PEAK_FORCE")  # N
-E_T_PEAK_FORCE = _ep.slot("E_T_PEAK_FORCE")  # s
-E_OPEN = _ep.slot("E_OPEN")  # 1 if the episode had not ended when the run stopped
-NEP = _ep.end("NEP")
-
 # ---- attitude excursion over the output samples (NEX), a part of stats
 # (ST_EXCURSION): core/excursion.py
 _ex = Block("stats.excursion", "EX_")

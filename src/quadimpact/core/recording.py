@@ -1,8 +1,8 @@
 """What the loop records: output rows, contact episodes and their peaks, extremes, the crash.
 
 All functions write into the run's :class:`~quadimpact.core.records.Output`
-(layouts ``OUT_*``, ``E_*``, ``ST_*`` in ``core/layout.py``); none changes the
-dynamics. Per contact feature an output row holds its deflection (the
+(layouts ``OUT_*`` and ``E_*`` in ``core/recording_slots.py``, ``ST_*`` in
+``core/layout.py``); none changes the dynamics. Per contact feature an output row holds its deflection (the
 deepest of its pairs, >= 0, m) and its normal force (the sum over its
 active pairs, N).
 """
@@ -31,26 +31,11 @@ from quadimpact.core.layout import (
     C_PSI_REF,
     C_THETA_REF,
     C_Z_REF,
-    E_FEATURE,
-    E_OPEN,
-    E_PEAK_DELTA,
-    E_PEAK_FORCE,
-    E_SHAPE,
-    E_T_END,
-    E_T_PEAK,
-    E_T_PEAK_FORCE,
-    E_T_START,
-    E_V_I,
     LS_STAGE,
     MAX_ROTORS,
     NEX,
     NX,
     O_V_MIN,
-    OUT_CMD,
-    OUT_DELTA,
-    OUT_STAGE,
-    OUT_T,
-    OUT_X,
     ST_CRASH_T,
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
@@ -68,6 +53,23 @@ from quadimpact.core.layout import (
     X_QUAT,
 )
 from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.recording_slots import (
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_PEAK,
+    E_T_PEAK_FORCE,
+    E_T_START,
+    E_V_I,
+    OUT_CMD,
+    OUT_DELTA,
+    OUT_STAGE,
+    OUT_T,
+    OUT_X,
+)
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.rotors import RIN_CMD, active_states
 from quadimpact.core.sensors.disturbance import impact_onset

@@ -46,9 +46,6 @@ from quadimpact.core.layout import (
     C_THETA_REF,
     CRASH_PAPER_TICKS,
     CTRL_USER,
-    E_OPEN,
-    E_PEAK_DELTA,
-    E_T_END,
     LS_DONE,
     LS_EXT,
     LS_EXT_CMD,
@@ -110,6 +107,7 @@ from quadimpact.core.layout import (
 from quadimpact.core.plugin_call import call_controller
 from quadimpact.core.quaternion import normalise_quaternion
 from quadimpact.core.recording import record_crash, write_sample
+from quadimpact.core.recording_slots import E_OPEN, E_PEAK_DELTA, E_T_END
 from quadimpact.core.records import Data, Model, Output, Work, new_work
 from quadimpact.core.rotors import RIN_CMD, RIN_FIRST_ORDER, RIN_PREV_CMD
 from quadimpact.core.sensing import sample_at
