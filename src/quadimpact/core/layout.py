@@ -33,6 +33,7 @@ import math
 from enum import IntEnum
 
 from quadimpact.core.block import Block
+from quadimpact.core.excursion_slots import NEX
 
 __all__ = ["Block"]  # and every slot constant below
 
@@ -451,15 +452,6 @@ I_BIAS_TRUE = _imu.slot("I_BIAS_TRUE", 3)  # the gyro's true bias (constant + wa
 I_ERR = _imu.slot("I_ERR", 4)  # errors: attitude deg, velocity m/s, bias rad/s, position m
 NIMU = _imu.end("NIMU")
 
-# ---- attitude excursion over the output samples (NEX), a part of stats
-# (ST_EXCURSION): core/excursion.py
-_ex = Block("stats.excursion", "EX_")
-EX_DEV = _ex.slot("EX_DEV", 3)  # rad, largest roll, pitch, yaw departures from the references
-EX_COS_TILT = _ex.slot("EX_COS_TILT")  # lowest cos of the body z axis from the reference's
-EX_DEV_TRIG = _ex.slot("EX_DEV_TRIG", 6)  # cos, sin of each largest departure so far
-EX_REF_TRIG = _ex.slot("EX_REF_TRIG", 6)  # cos, sin of the roll, pitch, yaw references
-NEX = _ex.end("NEX")
-
 # ---- run statistics stats (NSTAT)
 _st = Block("stats", "ST_")
 ST_STATUS = _st.slot("ST_STATUS")  # STATUS_*
@@ -496,7 +488,8 @@ N_PHASES = 3  # before the first contact, the crash (to stage 4), after stage 4
 ST_EST_ERR = _st.slot("ST_EST_ERR", 3 * N_EST_ERR * N_PHASES)  # (sum of squares, max, samples)
 ST_HOVER_RUN_T = _st.slot("ST_HOVER_RUN_T")  # s, first tick of the hover condition's run (NaN)
 ST_T_HOVER = _st.slot("ST_T_HOVER")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
-ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion (EX_*)
+ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion:
+#   its EX_* slots, declared by core/excursion_slots.py
 ST_X_LAST = _st.slot("ST_X_LAST", NX)  # the state of the last output sample
 # the held hover of the benchmark's suite 2 (core/hover_tracking.py track_held_hover)
 ST_HELD_RUN_T = _st.slot("ST_HELD_RUN_T")  # s, first tick of the held-hover condition's run (NaN)

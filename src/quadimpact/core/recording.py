@@ -2,9 +2,9 @@
 
 All functions write into the run's :class:`~quadimpact.core.records.Output`
 (layouts ``OUT_*`` and ``E_*`` in ``core/recording_slots.py``, ``ST_*`` in
-``core/layout.py``); none changes the dynamics. Per contact feature an output row holds its deflection (the
-deepest of its pairs, >= 0, m) and its normal force (the sum over its
-active pairs, N).
+``core/layout.py``); none changes the dynamics. Per contact feature an output
+row holds its deflection (the deepest of its pairs, >= 0, m) and its normal
+force (the sum over its active pairs, N).
 """
 
 import math
@@ -15,6 +15,7 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
 from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
 from quadimpact.core.excursion import excursion_add
+from quadimpact.core.excursion_slots import NEX
 from quadimpact.core.geometry import (
     GEOM_RING_PLANE,
     PR_FEATURE,
@@ -33,7 +34,6 @@ from quadimpact.core.layout import (
     C_Z_REF,
     LS_STAGE,
     MAX_ROTORS,
-    NEX,
     NX,
     O_V_MIN,
     ST_CRASH_T,

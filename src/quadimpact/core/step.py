@@ -36,6 +36,7 @@ from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
 from quadimpact.core.controllers import builtin_step
 from quadimpact.core.estimators import at_tick, init_estimate
 from quadimpact.core.excursion import excursion_start
+from quadimpact.core.excursion_slots import NEX
 from quadimpact.core.hover_tracking import track_held_hover, track_hover
 from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
 from quadimpact.core.layout import (
@@ -62,7 +63,6 @@ from quadimpact.core.layout import (
     MS_IMU_T,
     MS_T_DETECT,
     N_STAGES,
-    NEX,
     O_CRASH_ALTITUDE,
     O_CRASH_RULE,
     O_DT_CONTROL,
