@@ -27,6 +27,8 @@ DECLARING = (
     "quadimpact.core.layout",
     "quadimpact.core.contact_slots",
     "quadimpact.core.recording_slots",
+    "quadimpact.core.excursion_slots",
+    "quadimpact.core.hover_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
     "quadimpact.core.rotors",

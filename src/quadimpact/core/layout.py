@@ -34,6 +34,7 @@ from enum import IntEnum
 
 from quadimpact.core.block import Block
 from quadimpact.core.excursion_slots import NEX
+from quadimpact.core.hover_slots import NHELD, NHOVER
 
 __all__ = ["Block"]  # and every slot constant below
 
@@ -486,16 +487,13 @@ ST_IMPACT_T = _st.slot("ST_IMPACT_T")  # s, the latest contact onset (NaN: none)
 N_EST_ERR = 4  # estimation errors: attitude (deg), velocity (m/s), gyro bias (rad/s), position (m)
 N_PHASES = 3  # before the first contact, the crash (to stage 4), after stage 4
 ST_EST_ERR = _st.slot("ST_EST_ERR", 3 * N_EST_ERR * N_PHASES)  # (sum of squares, max, samples)
-ST_HOVER_RUN_T = _st.slot("ST_HOVER_RUN_T")  # s, first tick of the hover condition's run (NaN)
-ST_T_HOVER = _st.slot("ST_T_HOVER")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
+ST_HOVER = _st.slot("ST_HOVER", NHOVER)  # the time to hover's ticks (core/hover_tracking.py
+#   track_hover): its HV_* slots, declared by core/hover_slots.py
 ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion:
 #   its EX_* slots, declared by core/excursion_slots.py
 ST_X_LAST = _st.slot("ST_X_LAST", NX)  # the state of the last output sample
-# the held hover of the benchmark's suite 2 (core/hover_tracking.py track_held_hover)
-ST_HELD_RUN_T = _st.slot("ST_HELD_RUN_T")  # s, first tick of the held-hover condition's run (NaN)
-ST_HELD_RUN_X = _st.slot("ST_HELD_RUN_X", 3)  # m, CM position at that tick, inertial
-ST_T_HELD = _st.slot("ST_T_HELD")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
-ST_HELD_X = _st.slot("ST_HELD_X", 3)  # m, CM position there (the hover point), inertial
+ST_HELD = _st.slot("ST_HELD", NHELD)  # the held hover of the benchmark's suite 2
+#   (core/hover_tracking.py track_held_hover): its HH_* slots, declared by core/hover_slots.py
 ST_LAST_ONSET_T = _st.slot("ST_LAST_ONSET_T")  # s, the latest contact onset, any shape (NaN)
 NSTAT = _st.end("NSTAT")
 

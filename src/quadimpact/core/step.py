@@ -37,7 +37,7 @@ from quadimpact.core.controllers import builtin_step
 from quadimpact.core.estimators import at_tick, init_estimate
 from quadimpact.core.excursion import excursion_start
 from quadimpact.core.excursion_slots import NEX
-from quadimpact.core.hover_tracking import track_held_hover, track_hover
+from quadimpact.core.hover_tracking import start_hover_tracking, track_held_hover, track_hover
 from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
 from quadimpact.core.layout import (
     C_KIND,
@@ -77,8 +77,6 @@ from quadimpact.core.layout import (
     SS_NEXT_T,
     ST_CRASH_T,
     ST_EXCURSION,
-    ST_HELD_RUN_T,
-    ST_HOVER_RUN_T,
     ST_IMPACT_T,
     ST_LAST_ONSET_T,
     ST_MAX_DELTA,
@@ -94,8 +92,6 @@ from quadimpact.core.layout import (
     ST_STATUS,
     ST_T_DETECT,
     ST_T_END,
-    ST_T_HELD,
-    ST_T_HOVER,
     STATUS_COMPLETED,
     STATUS_CRASHED,
     STATUS_FAILED,
@@ -129,8 +125,9 @@ def start(m: Model, d: Data, o: Output) -> None:
     stats[:] = 0.0
     for i in (ST_CRASH_T, ST_ONSET_T, ST_POWER_OFF_T, ST_T_DETECT):
         stats[i] = np.nan
-    for i in (ST_IMPACT_T, ST_HOVER_RUN_T, ST_T_HOVER, ST_HELD_RUN_T, ST_T_HELD, ST_LAST_ONSET_T):
+    for i in (ST_IMPACT_T, ST_LAST_ONSET_T):
         stats[i] = np.nan
+    start_hover_tracking(stats)
     stats[ST_STAGE_T : ST_STAGE_T + N_STAGES] = np.nan
     stats[ST_T_END] = t0
     stats[ST_MIN_ALT] = -x[X_POS + 2]
