@@ -127,6 +127,18 @@ def test_a_component_block_stays_inside_the_region_it_extends():
     assert seen == set(regions)
 
 
+def test_each_part_of_stats_fills_the_region_placed_for_it():
+    """``layout.py`` places the excursion's and the hover tests' slots, declared by their
+    owners, in ``stats`` at regions as wide as their declared sizes."""
+    _blocks()
+    regions = L.Block.registry["stats:ST_"].slots
+    parts = {"ST_EXCURSION": "stats.excursion:EX_", "ST_HOVER": "stats.hover:HV_"}
+    parts["ST_HELD"] = "stats.held:HH_"
+    for region, key in parts.items():
+        part = L.Block.registry[key]
+        assert part.start == 0 and regions[region][1] == part.next, region
+
+
 def test_the_factories_allocate_the_declared_sizes():
     m_feat, n_shapes, n_out = 3, 2, 5
     from quadimpact.core.records import model

@@ -2,7 +2,8 @@
 
 The compiled loop takes no Python objects: it takes a few named records of
 ``float64`` arrays (``core/records.py``), and every slot of those arrays is
-declared here, block by block, with :class:`Block`. A block hands out
+declared here or by its component, block by block, with :class:`Block`
+(``core/block.py``). A block hands out
 consecutive offsets in the order its slots are declared, so two slots of a
 block cannot overlap and its size always covers them;
 ``tests/core/test_layout.py`` checks every registered block (the
@@ -16,8 +17,15 @@ estimators' configuration and state in ``core/estimators/``, the detector's
 and the sensor components' in ``core/sensors/``), and a stage that alone owns
 an array declares it (the wall approach's record in ``core/approach.py``, the
 impact rows in ``core/impacts.py``, the rotor inputs in ``core/rotors.py``, the
-contact-pair table in ``core/geometry``). Numba reads these module-level integers
-as compile-time constants.
+contact-pair table in ``core/geometry``). A component whose sizes
+``records.py`` or this module need declares its blocks in a declaration module
+next to it, which holds no compiled code: the contact pairs' ``cs``
+(``core/contact_slots.py``), the output rows and episodes
+(``core/recording_slots.py``), and the parts of ``stats`` this module places
+at addresses computed from their declared sizes (``ST_EXCURSION`` from
+``core/excursion_slots.py``, ``ST_HOVER`` and ``ST_HELD`` from
+``core/hover_slots.py``). Numba reads these module-level integers as
+compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
 reason) are plain integer constants for the compiled code (Numba cannot
