@@ -18,6 +18,7 @@ import psutil
 import quadimpact
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
+from quadimpact.core.recording_slots import OUT_X
 from quadimpact.simulation.setup import RunSetup
 
 #: The repository's examples folder.
@@ -43,7 +44,7 @@ def run_packed(setup: RunSetup, **changes: np.ndarray) -> tuple[np.ndarray, np.n
 
 def states(out: np.ndarray) -> np.ndarray:
     """The NX state columns of an output array."""
-    return out[:, L.OUT_X : L.OUT_X + L.NX]
+    return out[:, OUT_X : OUT_X + L.NX]
 
 
 def run_cli(*args: str, cwd, timeout: float = 120, env: dict | None = None, umask=None):

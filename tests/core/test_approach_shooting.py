@@ -31,6 +31,7 @@ from quadimpact.core.approach import (
 )
 from quadimpact.core.geometry import NPAIR
 from quadimpact.core.kernel import execute
+from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.roots import brentq
 from quadimpact.simulation import approach as approach_py
 from quadimpact.simulation import setup as setup_py
@@ -99,7 +100,7 @@ def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
         t_out=np.array([float(kw["impact_time_s"])]),
     )
     out = execute(free, kernel=kw["kernel"]).out
-    return _inertial_vx(np.ascontiguousarray(out[0, L.OUT_X : L.OUT_X + L.NX]), np.empty((3, 3)))
+    return _inertial_vx(np.ascontiguousarray(out[0, OUT_X : OUT_X + L.NX]), np.empty((3, 3)))
 
 
 def test_an_approach_without_late_start_flies_a_run_and_its_check(monkeypatch):

@@ -9,6 +9,7 @@ from scipy.integrate import solve_ivp
 from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
+from quadimpact.core.recording_slots import E_FEATURE, E_V_I, OUT_X
 from quadimpact.inputs.world import GROUND, Plane
 from quadimpact.packing.vehicle_block import pack_features
 from quadimpact.packing.world_block import pack_surfaces
@@ -201,10 +202,10 @@ def test_point_mass_impact_restitution_matches_one_dof(speed):
     ctrl = setup.ctrl.copy()
     ctrl[L.C_KIND] = L.CTRL_NONE
     out, ep, stats = run_packed(setup, veh=veh, ctrl=ctrl)
-    assert ep.shape[0] == 1 and int(ep[0, L.E_FEATURE]) == 3  # bumper 4, once
-    assert ep[0, L.E_V_I] == pytest.approx(speed, rel=1e-9)
-    q = out[-1, L.OUT_X + 6 : L.OUT_X + 10]
-    v_after = quat_to_matrix(q) @ out[-1, L.OUT_X + 3 : L.OUT_X + 6]
+    assert ep.shape[0] == 1 and int(ep[0, E_FEATURE]) == 3  # bumper 4, once
+    assert ep[0, E_V_I] == pytest.approx(speed, rel=1e-9)
+    q = out[-1, OUT_X + 6 : OUT_X + 10]
+    v_after = quat_to_matrix(q) @ out[-1, OUT_X + 3 : OUT_X + 6]
     e_sim = -v_after[0] / speed
     v = SPIRI
     e_1dof = one_dof_restitution(

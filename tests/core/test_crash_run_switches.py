@@ -17,6 +17,7 @@ import pytest
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.contact import contact_wrench
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_LAMBDA, NCS
 from quadimpact.simulation.setup import prepare
 
 T_P = 0.1025  # between the ticks at 0.100 and 0.105 s
@@ -116,10 +117,10 @@ def test_bumper_force_scale_scales_that_bumper_only():
 
     def wrench(active, scale=(1.0, 1.0, 1.0, 1.0)):
         m = setup.model()
-        cs = np.zeros((m.pairs.shape[0], L.NCS))
+        cs = np.zeros((m.pairs.shape[0], NCS))
         for j in active:
-            cs[j, L.CS_ACTIVE] = 1.0
-            cs[j, L.CS_LAMBDA] = 3.0
+            cs[j, CS_ACTIVE] = 1.0
+            cs[j, CS_LAMBDA] = 3.0
         feat = m.feat.copy()
         feat[:, L.F_FORCE_SCALE] = scale
         return np.array(contact_wrench(x, C, m._replace(feat=feat), cs))

@@ -10,7 +10,7 @@ import pytest
 
 from quadimpact import FlightScenario, ImpactTrial, WallApproach, simulate
 from quadimpact.core import excursion as E
-from quadimpact.core.layout import EX_COS_TILT, EX_DEV, NEX
+from quadimpact.core.excursion_slots import EX_COS_TILT, EX_DEV, NEX
 from quadimpact.inputs.world import Cylinder
 from quadimpact.rotations import GIMBAL_LOCK_COS
 from quadimpact.simulation.metrics import attitude_excursion_deg

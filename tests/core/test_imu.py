@@ -10,6 +10,7 @@ import pytest
 from quadimpact import FlightScenario
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
+from quadimpact.core.recording_slots import OUT_DELTA, OUT_T, OUT_X
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 
@@ -85,11 +86,11 @@ def test_wall_contact_body_x_reading_is_the_contact_force_over_mass():
     out, imu = rec.out, rec.imu
     assert len(rec.episodes) >= 2  # bumpers 1 and 4 (the contact really happened)
     # the output grid (1 kHz) and the IMU samples (1 kHz) coincide
-    np.testing.assert_allclose(out[:, L.OUT_T], imu[:, L.I_T], atol=1e-12)
+    np.testing.assert_allclose(out[:, OUT_T], imu[:, L.I_T], atol=1e-12)
     nf = setup.feat.shape[0]
-    force = out[:, L.OUT_DELTA + nf : L.OUT_DELTA + 2 * nf].sum(axis=1)
+    force = out[:, OUT_DELTA + nf : OUT_DELTA + 2 * nf].sum(axis=1)
     assert force.max() > 1.0
-    quat = out[:, L.OUT_X + L.X_QUAT : L.OUT_X + L.X_QUAT + 4]
+    quat = out[:, OUT_X + L.X_QUAT : OUT_X + L.X_QUAT + 4]
     # contact force along -X (inertial) in body axes, over the mass
     f_body = np.einsum("nji,j->ni", quat_to_matrix(quat), np.array([-1.0, 0.0, 0.0]))
     expected = f_body * (force / veh[L.V_MASS])[:, None]

@@ -16,13 +16,19 @@ import numpy as np
 import pytest
 
 from quadimpact.core import layout as L
+from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
+from quadimpact.core.recording_slots import NEP, NOUT, out_width
 from quadimpact.core.records import new_data, new_output, new_work
 from quadimpact.core.rotors import NRIN
 
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
     "quadimpact.core.layout",
+    "quadimpact.core.contact_slots",
+    "quadimpact.core.recording_slots",
+    "quadimpact.core.excursion_slots",
+    "quadimpact.core.hover_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
     "quadimpact.core.rotors",
@@ -121,6 +127,18 @@ def test_a_component_block_stays_inside_the_region_it_extends():
     assert seen == set(regions)
 
 
+def test_each_part_of_stats_fills_the_region_placed_for_it():
+    """``layout.py`` places the excursion's and the hover tests' slots, declared by their
+    owners, in ``stats`` at regions as wide as their declared sizes."""
+    _blocks()
+    regions = L.Block.registry["stats:ST_"].slots
+    parts = {"ST_EXCURSION": "stats.excursion:EX_", "ST_HOVER": "stats.hover:HV_"}
+    parts["ST_HELD"] = "stats.held:HH_"
+    for region, key in parts.items():
+        part = L.Block.registry[key]
+        assert part.start == 0 and regions[region][1] == part.next, region
+
+
 def test_the_factories_allocate_the_declared_sizes():
     m_feat, n_shapes, n_out = 3, 2, 5
     from quadimpact.core.records import model
@@ -134,12 +152,12 @@ def test_the_factories_allocate_the_declared_sizes():
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, L.NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
         (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)
-    assert o.out.shape == (n_out, L.out_width(m_feat)) == (n_out, L.NOUT + 2 * m_feat)
-    assert o.imu.shape == (7, L.NIMU) and o.episodes.shape == (11, L.NEP)
+    assert o.out.shape == (n_out, out_width(m_feat)) == (n_out, NOUT + 2 * m_feat)
+    assert o.imu.shape == (7, L.NIMU) and o.episodes.shape == (11, NEP)
     assert o.stats.shape == (L.NSTAT,)
     w = new_work(4)
     assert w.K.shape == (7, L.NX) and w.ev_sig.shape == (4,)

@@ -8,6 +8,7 @@ import pytest
 from quadimpact import FlightScenario, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
+from quadimpact.core.recording_slots import E_FEATURE, E_T_END, E_T_START, OUT_CMD, OUT_T, OUT_X
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
 from quadimpact.simulation.simulate import run_setup
@@ -50,11 +51,11 @@ def test_ground_as_contact_surface_bounces_and_records_the_crash():
     assert st[L.ST_STATUS] == L.STATUS_CRASHED and st[L.ST_T_END] == 2.0  # goes on
     assert setup.shape_names == ("ground",)
     # level vehicle: the four bumpers touch the ground together, then it bounces up
-    first = ep[ep[:, L.E_T_START] < ep[0, L.E_T_START] + 1e-6]
-    assert sorted(first[:, L.E_FEATURE].astype(int)) == [0, 1, 2, 3]
-    assert st[L.ST_CRASH_T] == pytest.approx(ep[0, L.E_T_START])
+    first = ep[ep[:, E_T_START] < ep[0, E_T_START] + 1e-6]
+    assert sorted(first[:, E_FEATURE].astype(int)) == [0, 1, 2, 3]
+    assert st[L.ST_CRASH_T] == pytest.approx(ep[0, E_T_START])
     h = -states(out)[:, L.X_POS + 2]
-    after = h[out[:, L.OUT_T] > ep[0, L.E_T_END] + 0.05]
+    after = h[out[:, OUT_T] > ep[0, E_T_END] + 0.05]
     assert after.max() > 0.5  # bounced well up (restitution 0.9 of a 2 m drop)
 
 
@@ -108,11 +109,11 @@ def test_first_order_rotors_follow_their_time_constant():
     opts = setup.opts.copy()
     opts[L.O_OMEGA_MIN], opts[L.O_OMEGA_MAX], opts[L.O_SLEW_MAX] = 600.0, 0.0, 0.0
     out = execute(setup.model(veh=veh, opts=opts)).out
-    assert np.all(out[1:, L.OUT_CMD : L.OUT_CMD + 4] == 600.0)
-    t = out[:, L.OUT_T]
+    assert np.all(out[1:, OUT_CMD : OUT_CMD + 4] == 600.0)
+    t = out[:, OUT_T]
     tau = setup.vehicle.motor_time_constant_s
     expected = 600.0 - 100.0 * np.exp(-t / tau)
-    np.testing.assert_allclose(out[:, L.OUT_X + L.X_ROTOR], expected, atol=1e-6)
+    np.testing.assert_allclose(out[:, OUT_X + L.X_ROTOR], expected, atol=1e-6)
 
 
 def test_speed_and_slew_limits_bound_the_commands():

@@ -10,6 +10,7 @@ from quadimpact import WallApproach
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import PR_FEATURE, PR_GEOMETRY
 from quadimpact.core.kernel import execute
+from quadimpact.core.recording_slots import OUT_DELTA, OUT_X
 from quadimpact.simulation.approach import pair_depths_at
 from quadimpact.simulation.setup import prepare
 
@@ -32,11 +33,11 @@ def test_a_rows_deflection_is_the_deepest_pair_at_its_state(model):
     pairs = setup.pair_table()
     touching = 0
     for row in rows:
-        x = np.ascontiguousarray(row[L.OUT_X : L.OUT_X + L.NX])
+        x = np.ascontiguousarray(row[OUT_X : OUT_X + L.NX])
         depths = pair_depths_at(x, setup.feat, setup.shapes, pairs)
         for f in range(nf):
             deepest = max(0.0, *depths[pairs[:, PR_FEATURE] == f])
-            assert row[L.OUT_DELTA + f] == deepest  # the same bits
+            assert row[OUT_DELTA + f] == deepest  # the same bits
             touching += deepest > 0.0
     assert touching > 10  # rows in contact were checked too
     assert (pairs[:, PR_GEOMETRY] == 0).all()  # every pair a ring against a plane

@@ -29,6 +29,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.geometry import PR_GEOMETRY
 from quadimpact.core.geometry.contact_record import material_record
 from quadimpact.core.kernel import make_kernel
+from quadimpact.core.recording_slots import E_FEATURE, E_SHAPE, E_T_START, E_V_I, OUT_X
 from quadimpact.core.records import model, new_output
 
 FEAT_BALL = 50  # the new feature kind: a sphere of radius F_RADIUS at F_CENTRE
@@ -166,11 +167,11 @@ def test_a_registered_feature_shape_sensor_and_controller_run_in_one_loop(regist
     # one contact episode of the ball with the sphere, onset located at the analytic time
     assert int(st[L.ST_N_EPISODES]) == 1
     ep = o.episodes[0]
-    assert ep[L.E_FEATURE] == 0 and ep[L.E_SHAPE] == 0
-    assert ep[L.E_T_START] == pytest.approx(0.2 / v_in, abs=1e-9)
-    assert ep[L.E_V_I] == pytest.approx(v_in, rel=1e-9)
+    assert ep[E_FEATURE] == 0 and ep[E_SHAPE] == 0
+    assert ep[E_T_START] == pytest.approx(0.2 / v_in, abs=1e-9)
+    assert ep[E_V_I] == pytest.approx(v_in, rel=1e-9)
     # the rebound: the 1-DOF restitution, straight up, no spin
-    x_end = o.out[-1, L.OUT_X : L.OUT_X + L.NX]
+    x_end = o.out[-1, OUT_X : OUT_X + L.NX]
     assert -x_end[L.X_VEL + 2] / v_in == pytest.approx(
         _restitution_1dof(k, n, e, 1.0, v_in), rel=1e-6
     )

@@ -26,6 +26,7 @@ import pytest
 
 import quadimpact
 from quadimpact.core import layout as L
+from quadimpact.core.contact_slots import NCS
 from quadimpact.core.records import data_row, new_data, set_row, stacked
 from quadimpact.inputs.scenarios import ImpactTrial
 from quadimpact.simulation.setup import prepare
@@ -96,6 +97,7 @@ NEW_FILES = {
 CHECK = """
 import numpy as np
 from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import new_data, new_output
 from quadimpact.core.step import advance, start
 from quadimpact.inputs.scenarios import ImpactTrial
@@ -113,7 +115,7 @@ assert np.array_equal(o.baro[:n, 0], o.imu[:n, L.I_T]), "sampled with the IMU"
 assert o.baro[0, 1] == 5.0, "the trial starts at 5 m"
 assert d.baro[1] == o.baro[n - 1, 0] and d.baro[0] == o.baro[n - 1, 1], "the state is the last"
 # the altitude at the final output row (the run's end) is the last sample's
-assert abs(o.baro[n - 1, 1] + o.out[-1, L.OUT_X + L.X_POS + 2]) < 1e-12
+assert abs(o.baro[n - 1, 1] + o.out[-1, OUT_X + L.X_POS + 2]) < 1e-12
 print("ok", n)
 """
 
@@ -165,7 +167,7 @@ def test_a_new_per_run_array_touches_three_files(tmp_path: Path, jit: bool):
 def test_compiled_factories_and_stacked_rows_agree():
     m = prepare(ImpactTrial(pitch_deg=-10, speed_m_s=1.0, final_time_s=0.1)).model()
     d = new_data(m)
-    assert np.array_equal(d.x, m.x0) and d.cs.shape == (m.pairs.shape[0], L.NCS)
+    assert np.array_equal(d.x, m.x0) and d.cs.shape == (m.pairs.shape[0], NCS)
     stack = stacked(d, 3)
     assert type(stack) is type(d) and stack.x.shape == (3, L.NX)
     set_row(stack, 1, d)

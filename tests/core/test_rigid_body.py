@@ -3,6 +3,7 @@
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import OUT_T
 from quadimpact.inputs.scenarios import FlightScenario
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
@@ -33,7 +34,7 @@ def tumble(final_time_s: float = 10.0, **kw):
 def test_torque_free_tumble_conserves_energy_and_momentum():
     setup, out, stats = tumble()
     assert stats[L.ST_STATUS] == L.STATUS_COMPLETED
-    assert out[-1, L.OUT_T] == 10.0
+    assert out[-1, OUT_T] == 10.0
     x = states(out)
     inertia = setup.vehicle.inertia
     w = x[:, L.X_OMEGA : L.X_OMEGA + 3]
@@ -53,5 +54,5 @@ def test_free_body_translates_uniformly():
     x = states(out)
     v_inertial = np.einsum("nij,nj->ni", quat_to_matrix(x[:, 6:10]), x[:, 3:6])
     np.testing.assert_allclose(v_inertial, np.tile([0.3, -0.2, 0.1], (len(x), 1)), atol=1e-9)
-    t = out[:, L.OUT_T]
+    t = out[:, OUT_T]
     np.testing.assert_allclose(x[:, 0], 0.3 * t, atol=1e-9)

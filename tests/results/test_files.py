@@ -9,7 +9,17 @@ import pandas as pd
 import pyarrow.parquet as pq
 import pytest
 
-from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import (
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_START,
+    E_V_I,
+    NEP,
+)
 from quadimpact.results.files import (
     EPISODES_LEADING_COLUMNS,
     TIMESERIES_COLUMNS,
@@ -39,11 +49,11 @@ def make_timeseries(n: int = 50) -> pd.DataFrame:
 
 
 def make_episodes() -> pd.DataFrame:
-    raw = np.zeros((3, L.NEP))
-    raw[0, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END]] = [3, 0, 0.5, 0.52]
-    raw[0, [L.E_V_I, L.E_PEAK_DELTA, L.E_PEAK_FORCE]] = [0.75, 0.0312345678901234, 50.5]
-    raw[1, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END, L.E_OPEN]] = [1, 1, 0.9, 1.0, 1]
-    raw[1, L.E_V_I] = np.nan
+    raw = np.zeros((3, NEP))
+    raw[0, [E_FEATURE, E_SHAPE, E_T_START, E_T_END]] = [3, 0, 0.5, 0.52]
+    raw[0, [E_V_I, E_PEAK_DELTA, E_PEAK_FORCE]] = [0.75, 0.0312345678901234, 50.5]
+    raw[1, [E_FEATURE, E_SHAPE, E_T_START, E_T_END, E_OPEN]] = [1, 1, 0.9, 1.0, 1]
+    raw[1, E_V_I] = np.nan
     return episodes_frame(raw, 2, ["wall", "ground"])
 
 
@@ -150,7 +160,7 @@ def test_write_read_round_trip(tmp_path: Path) -> None:
 
 
 def test_round_trip_without_episodes(tmp_path: Path) -> None:
-    res = make_result(episodes=episodes_frame(np.zeros((1, L.NEP)), 0, ["wall"]))
+    res = make_result(episodes=episodes_frame(np.zeros((1, NEP)), 0, ["wall"]))
     back = read_result(res.write(tmp_path))
     assert len(back.episodes) == 0
     assert list(back.episodes.columns) == list(res.episodes.columns)

@@ -7,6 +7,24 @@ import pandas as pd
 import pytest
 
 from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import (
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_PEAK,
+    E_T_PEAK_FORCE,
+    E_T_START,
+    E_V_I,
+    NEP,
+    OUT_CMD,
+    OUT_DELTA,
+    OUT_T,
+    OUT_X,
+    out_width,
+)
 from quadimpact.results.files import EPISODE_COLUMNS, TIMESERIES_COLUMNS
 from quadimpact.rotations import euler_zyx_to_quat
 from quadimpact.simulation.metrics import (
@@ -30,18 +48,18 @@ D = math.pi / 180.0
 
 def raw_episodes(*eps: dict, extra_rows: int = 2) -> np.ndarray:
     """Kernel-style episode buffer; ``bumper`` given 1-based here, stored 0-based."""
-    raw = np.full((len(eps) + extra_rows, L.NEP), -999.0)  # garbage beyond n
+    raw = np.full((len(eps) + extra_rows, NEP), -999.0)  # garbage beyond n
     for i, e in enumerate(eps):
-        raw[i, L.E_FEATURE] = e["bumper"] - 1
-        raw[i, L.E_SHAPE] = SURFACES.index(e.get("surface", "wall"))
-        raw[i, L.E_T_START] = e["t0"]
-        raw[i, L.E_T_END] = e["t1"]
-        raw[i, L.E_V_I] = e.get("v_i", 0.7)
-        raw[i, L.E_PEAK_DELTA] = e.get("peak", 0.01)
-        raw[i, L.E_T_PEAK] = 0.5 * (e["t0"] + e["t1"])
-        raw[i, L.E_PEAK_FORCE] = e.get("force", 10.0)
-        raw[i, L.E_T_PEAK_FORCE] = 0.5 * (e["t0"] + e["t1"])
-        raw[i, L.E_OPEN] = 1.0 if e.get("open", False) else 0.0
+        raw[i, E_FEATURE] = e["bumper"] - 1
+        raw[i, E_SHAPE] = SURFACES.index(e.get("surface", "wall"))
+        raw[i, E_T_START] = e["t0"]
+        raw[i, E_T_END] = e["t1"]
+        raw[i, E_V_I] = e.get("v_i", 0.7)
+        raw[i, E_PEAK_DELTA] = e.get("peak", 0.01)
+        raw[i, E_T_PEAK] = 0.5 * (e["t0"] + e["t1"])
+        raw[i, E_PEAK_FORCE] = e.get("force", 10.0)
+        raw[i, E_T_PEAK_FORCE] = 0.5 * (e["t0"] + e["t1"])
+        raw[i, E_OPEN] = 1.0 if e.get("open", False) else 0.0
     return raw
 
 
@@ -73,7 +91,7 @@ def test_episodes_frame_columns_mapping_and_sorting() -> None:
 
 
 def test_episodes_frame_empty_has_contract_columns() -> None:
-    df = episodes_frame(np.zeros((5, L.NEP)), 0, SURFACES)
+    df = episodes_frame(np.zeros((5, NEP)), 0, SURFACES)
     assert len(df) == 0
     assert tuple(df.columns) == EPISODE_COLUMNS
 
@@ -82,11 +100,11 @@ def test_episodes_frame_empty_has_contract_columns() -> None:
 def test_episodes_frame_rejects_bad_indices(build) -> None:
     """The table and the summary's lists refuse the same records, with the same words."""
     raw = raw_episodes(ep(1, 0.5, 0.6))
-    raw[0, L.E_SHAPE] = 5
+    raw[0, E_SHAPE] = 5
     with pytest.raises(ValueError, match=r"surface index outside 0\.\.1 \(got \[5\]\)"):
         build(raw, 1, SURFACES)
     raw = raw_episodes(ep(1, 0.5, 0.6))
-    raw[0, L.E_FEATURE] = 3.6  # rounds to 4: bumper 5 of a four-bumper vehicle
+    raw[0, E_FEATURE] = 3.6  # rounds to 4: bumper 5 of a four-bumper vehicle
     with pytest.raises(ValueError, match=r"feature index outside 0\.\.3 \(got \[4\]\)"):
         build(raw, 1, SURFACES)
     with pytest.raises(ValueError, match="row count"):
@@ -140,18 +158,18 @@ def test_the_impacts_of_episode_lists_are_found_once_per_exclusion() -> None:
 
 def test_timeseries_frame_columns_and_derived_quantities() -> None:
     n = 3
-    raw = np.zeros((n + 2, L.out_width(4)))
+    raw = np.zeros((n + 2, out_width(4)))
     q = euler_zyx_to_quat(10 * D, -15 * D, 90 * D)
     for i in range(n):
-        raw[i, L.OUT_T] = 0.001 * i
-        raw[i, L.OUT_X + L.X_POS : L.OUT_X + L.X_POS + 3] = [1.0 + i, 0.5, -2.0]
-        raw[i, L.OUT_X + L.X_VEL : L.OUT_X + L.X_VEL + 3] = [0.75, 0.0, 0.0]
-        raw[i, L.OUT_X + L.X_QUAT : L.OUT_X + L.X_QUAT + 4] = q
-        raw[i, L.OUT_X + L.X_OMEGA : L.OUT_X + L.X_OMEGA + 3] = [0.1, 0.2, 0.3]
-        raw[i, L.OUT_X + L.X_ROTOR : L.OUT_X + L.X_ROTOR + 4] = [600, 610, 620, 630]
-        raw[i, L.OUT_DELTA : L.OUT_DELTA + 4] = [0.001, 0.002, 0.003, 0.004]
-        raw[i, L.OUT_DELTA + 4 : L.OUT_DELTA + 8] = [1.0, 2.0, 3.0, 4.0]
-        raw[i, L.OUT_CMD : L.OUT_CMD + 4] = [700, 710, 720, 730]
+        raw[i, OUT_T] = 0.001 * i
+        raw[i, OUT_X + L.X_POS : OUT_X + L.X_POS + 3] = [1.0 + i, 0.5, -2.0]
+        raw[i, OUT_X + L.X_VEL : OUT_X + L.X_VEL + 3] = [0.75, 0.0, 0.0]
+        raw[i, OUT_X + L.X_QUAT : OUT_X + L.X_QUAT + 4] = q
+        raw[i, OUT_X + L.X_OMEGA : OUT_X + L.X_OMEGA + 3] = [0.1, 0.2, 0.3]
+        raw[i, OUT_X + L.X_ROTOR : OUT_X + L.X_ROTOR + 4] = [600, 610, 620, 630]
+        raw[i, OUT_DELTA : OUT_DELTA + 4] = [0.001, 0.002, 0.003, 0.004]
+        raw[i, OUT_DELTA + 4 : OUT_DELTA + 8] = [1.0, 2.0, 3.0, 4.0]
+        raw[i, OUT_CMD : OUT_CMD + 4] = [700, 710, 720, 730]
     ts = timeseries_frame(raw, n)
     assert tuple(ts.columns) == TIMESERIES_COLUMNS
     assert len(ts) == n
@@ -176,7 +194,7 @@ def test_timeseries_frame_columns_and_derived_quantities() -> None:
 
 
 def test_timeseries_frame_empty() -> None:
-    ts = timeseries_frame(np.zeros((4, L.out_width(4))), 0)
+    ts = timeseries_frame(np.zeros((4, out_width(4))), 0)
     assert tuple(ts.columns) == TIMESERIES_COLUMNS and len(ts) == 0
 
 

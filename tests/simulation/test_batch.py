@@ -15,6 +15,7 @@ import numpy as np
 from quadimpact import FlightScenario, ImpactTrial, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
+from quadimpact.core.recording_slots import NOUT, OUT_DELTA, OUT_X
 from quadimpact.core.records import new_output
 from quadimpact.inputs.world import Cylinder
 from quadimpact.simulation.batch import GROUP_MAX, GROUP_S, BatchRunner, simulate_batch
@@ -103,9 +104,9 @@ def test_rows_without_contact_columns_leave_the_run_unchanged():
     lean = new_output(m, prepare(s).n_imu, 64, contact_columns=False)
     BUILTIN.run(m, full)
     BUILTIN.run(m, lean)
-    assert lean.out.shape[1] == L.NOUT < full.out.shape[1]
-    assert np.any(full.out[:, L.OUT_DELTA :] != 0.0)  # the contacts were there to skip
-    assert np.array_equal(full.out[:, : L.NOUT], lean.out)
+    assert lean.out.shape[1] == NOUT < full.out.shape[1]
+    assert np.any(full.out[:, OUT_DELTA:] != 0.0)  # the contacts were there to skip
+    assert np.array_equal(full.out[:, :NOUT], lean.out)
     for a, b in ((full.episodes, lean.episodes), (full.imu, lean.imu), (full.stats, lean.stats)):
         assert np.array_equal(a, b, equal_nan=True)
 
@@ -131,5 +132,5 @@ def test_runs_without_rows_sample_the_same_and_keep_what_the_summary_reads():
         assert np.array_equal(full.stats, none.stats, equal_nan=True)
         n_out = int(none.stats[L.ST_N_OUT])
         assert n_out == m.t_out.shape[0] or none.stats[L.ST_STATUS] != L.STATUS_COMPLETED
-        last = full.out[n_out - 1, L.OUT_X : L.OUT_X + L.NX]
+        last = full.out[n_out - 1, OUT_X : OUT_X + L.NX]
         assert np.array_equal(none.stats[L.ST_X_LAST : L.ST_X_LAST + L.NX], last)

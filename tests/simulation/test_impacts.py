@@ -18,6 +18,19 @@ import pytest
 from quadimpact import WallApproach
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
+from quadimpact.core.recording_slots import (
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_PEAK,
+    E_T_PEAK_FORCE,
+    E_T_START,
+    E_V_I,
+    NEP,
+)
 from quadimpact.simulation.impacts import RunEpisodes, run_episodes
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
@@ -40,20 +53,20 @@ def _shapes(ground_flags: tuple[bool, ...]) -> np.ndarray:
 
 def _random_record(rng: np.random.Generator, n: int) -> np.ndarray:
     """Episodes on a coarse time grid (many equal starts and chained ends), some grazes."""
-    raw = np.full((n + 3, L.NEP), -7.0)  # rows beyond n: never read
+    raw = np.full((n + 3, NEP), -7.0)  # rows beyond n: never read
     for i in range(n):
         start = rng.integers(0, 12) * 0.01
         length = rng.choice([0.0, 0.005, 0.01, 0.02, 0.05])
-        raw[i, L.E_FEATURE] = rng.integers(0, 4)
-        raw[i, L.E_SHAPE] = rng.choice([0, 0, 1, 2])
-        raw[i, L.E_T_START] = start
-        raw[i, L.E_T_END] = start + length
-        raw[i, L.E_V_I] = rng.uniform(0.1, 2.0)
-        raw[i, L.E_PEAK_DELTA] = math.nan if rng.random() < 0.05 else rng.uniform(0.0, 0.03)
-        raw[i, L.E_T_PEAK] = start
-        raw[i, L.E_PEAK_FORCE] = rng.choice([0.05, 1.0, 40.0, 300.0]) * rng.uniform(0.5, 1.5)
-        raw[i, L.E_T_PEAK_FORCE] = start
-        raw[i, L.E_OPEN] = float(rng.random() < 0.1)
+        raw[i, E_FEATURE] = rng.integers(0, 4)
+        raw[i, E_SHAPE] = rng.choice([0, 0, 1, 2])
+        raw[i, E_T_START] = start
+        raw[i, E_T_END] = start + length
+        raw[i, E_V_I] = rng.uniform(0.1, 2.0)
+        raw[i, E_PEAK_DELTA] = math.nan if rng.random() < 0.05 else rng.uniform(0.0, 0.03)
+        raw[i, E_T_PEAK] = start
+        raw[i, E_PEAK_FORCE] = rng.choice([0.05, 1.0, 40.0, 300.0]) * rng.uniform(0.5, 1.5)
+        raw[i, E_T_PEAK_FORCE] = start
+        raw[i, E_OPEN] = float(rng.random() < 0.1)
     return raw
 
 
@@ -105,10 +118,10 @@ def test_a_chain_is_one_impact_until_a_gap_and_a_graze_is_left_out():
         (2, 0, 0.70, 0.72, 0.010, 30.0),
         (1, 2, 0.90, 0.95, 0.002, 5.0),
     ]
-    raw = np.zeros((len(rows), L.NEP))
+    raw = np.zeros((len(rows), NEP))
     for i, (f, s, t0, t1, d, force) in enumerate(rows):
-        raw[i, [L.E_FEATURE, L.E_SHAPE, L.E_T_START, L.E_T_END]] = f, s, t0, t1
-        raw[i, [L.E_PEAK_DELTA, L.E_PEAK_FORCE]] = d, force
+        raw[i, [E_FEATURE, E_SHAPE, E_T_START, E_T_END]] = f, s, t0, t1
+        raw[i, [E_PEAK_DELTA, E_PEAK_FORCE]] = d, force
     found = run_episodes(raw, len(rows), NAMES, 4, _shapes((False, False, True)))
     imp = found.impacts
     assert imp.bumpers == [[4, 1, 2], [3]]
@@ -125,13 +138,13 @@ def test_a_chain_is_one_impact_until_a_gap_and_a_graze_is_left_out():
 
 def test_a_record_the_compiled_pass_cannot_group_takes_the_definition_and_its_error():
     """A NaN start: the reference path, which refuses it with the same message."""
-    raw = np.zeros((2, L.NEP))
-    raw[:, L.E_T_START] = [0.5, math.nan]
-    raw[:, L.E_T_END] = [0.6, 0.7]
+    raw = np.zeros((2, NEP))
+    raw[:, E_T_START] = [0.5, math.nan]
+    raw[:, E_T_END] = [0.6, 0.7]
     with pytest.raises(ValueError, match="t_start_s must be finite"):
         run_episodes(raw, 2, NAMES, 4, _shapes((False, False, True)))
-    raw[1, L.E_T_START] = 0.55
-    raw[1, L.E_SHAPE] = 5.0  # no such surface
+    raw[1, E_T_START] = 0.55
+    raw[1, E_SHAPE] = 5.0  # no such surface
     with pytest.raises(ValueError, match="surface index outside"):
         run_episodes(raw, 2, NAMES, 4, _shapes((False, False, True)))
 

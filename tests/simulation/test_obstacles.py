@@ -23,6 +23,7 @@ from scipy.integrate import solve_ivp
 from quadimpact import simulate
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
+from quadimpact.core.recording_slots import E_OPEN, E_T_END, E_T_START, OUT_T, OUT_X
 from quadimpact.core.records import new_output
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, scenario_from_dict
 from quadimpact.inputs.world import Box, Cylinder
@@ -156,9 +157,9 @@ def _elastic_run(obstacle, position, velocity, euler=(0.0, 0.0, 0.0)):
     o = new_output(m, 0, 64)
     BUILTIN.run(m, o)
     n_out = int(o.stats[L.ST_N_OUT])
-    states = o.out[:n_out, L.OUT_X : L.OUT_X + L.NX]
+    states = o.out[:n_out, OUT_X : OUT_X + L.NX]
     episodes = o.episodes[: int(o.stats[L.ST_N_EPISODES])]
-    return setup, states, episodes, o.out[:n_out, L.OUT_T]
+    return setup, states, episodes, o.out[:n_out, OUT_T]
 
 
 @pytest.mark.parametrize(
@@ -175,9 +176,9 @@ def test_an_elastic_contact_conserves_energy(where):
         )  # fmt: skip
         pos, vel = (-0.5, 0.02, -2.0), (2.0, 0.0, 0.0)
     setup, states, episodes, t = _elastic_run(obstacle, pos, vel)
-    assert len(episodes) >= 1 and not episodes[:, L.E_OPEN].any()
+    assert len(episodes) >= 1 and not episodes[:, E_OPEN].any()
     energy = np.array([_energy(x, setup.veh) for x in states])
-    after = t > episodes[:, L.E_T_END].max() + 1e-3
+    after = t > episodes[:, E_T_END].max() + 1e-3
     assert after.any()
     e0 = energy[0]
     assert np.abs(energy[after] - e0).max() < 1e-7 * e0
@@ -227,8 +228,8 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     BUILTIN.run(m, o)
     assert int(o.stats[L.ST_N_EPISODES]) == 1
     ep = o.episodes[0]
-    assert ep[L.E_T_START] == pytest.approx((0.5 - 0.33) / 1.0, abs=1e-9)
-    x_end = o.out[int(o.stats[L.ST_N_OUT]) - 1, L.OUT_X : L.OUT_X + L.NX]
+    assert ep[E_T_START] == pytest.approx((0.5 - 0.33) / 1.0, abs=1e-9)
+    x_end = o.out[int(o.stats[L.ST_N_OUT]) - 1, OUT_X : OUT_X + L.NX]
     f = setup.feat[0]
     expected = _restitution_1dof(f[L.F_K], f[L.F_N], f[L.F_E], veh[L.V_MASS], 1.0)
     assert -x_end[L.X_VEL + 2] == pytest.approx(expected, rel=1e-6)

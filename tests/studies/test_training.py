@@ -169,15 +169,17 @@ def test_hover_drift_is_the_farthest_horizontal_distance_from_the_hover_point():
     """Rows before the hover began do not count, nor does height; after it the CM circles
     the hover point at 3 cm and once reaches 4 cm east and 3 cm north: 5 cm."""
     from quadimpact.core import layout as L
+    from quadimpact.core.hover_slots import HH_HELD_X, HH_T_HELD
+    from quadimpact.core.recording_slots import NOUT, OUT_T, OUT_X
     from quadimpact.studies.training.flying import hover_drift_m
 
     t = np.linspace(0.0, 4.0, 4001)
-    out = np.zeros((t.size, L.NOUT))
-    out[:, L.OUT_T] = t
+    out = np.zeros((t.size, NOUT))
+    out[:, OUT_T] = t
     stats = np.zeros(L.NSTAT)
-    stats[L.ST_T_HELD] = 2.0
-    stats[L.ST_HELD_X : L.ST_HELD_X + 3] = (1.0, -2.0, 5.0)
-    p = L.OUT_X + L.X_POS
+    stats[L.ST_HELD + HH_T_HELD] = 2.0
+    stats[L.ST_HELD + HH_HELD_X : L.ST_HELD + HH_HELD_X + 3] = (1.0, -2.0, 5.0)
+    p = OUT_X + L.X_POS
     out[:, p] = 1.0 + 0.03 * np.cos(t)
     out[:, p + 1] = -2.0 + 0.03 * np.sin(t)
     out[:, p + 2] = 5.0 - 3.0 * t  # falling: no horizontal drift
@@ -185,7 +187,7 @@ def test_hover_drift_is_the_farthest_horizontal_distance_from_the_hover_point():
     assert math.isclose(hover_drift_m(out, stats), 0.03, rel_tol=1e-12)
     out[3500, p : p + 2] = (1.04, -1.97)
     assert math.isclose(hover_drift_m(out, stats), 0.05, rel_tol=1e-12)
-    stats[L.ST_T_HELD] = np.nan
+    stats[L.ST_HELD + HH_T_HELD] = np.nan
     assert hover_drift_m(out, stats) is None
 
 

@@ -48,7 +48,6 @@ from quadimpact.core.layout import (
     EST_IDEAL,
     MAX_ROTORS,
     NX,
-    OUT_X,
     SPAN_T0,
     SPAN_TF,
     ST_N_OUT,
@@ -62,6 +61,7 @@ from quadimpact.core.layout import (
     Block,
 )
 from quadimpact.core.quaternion import rotation_matrix
+from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import Model, Output, new_data
 from quadimpact.core.roots import BR_X, BRENT_ASK, BRENT_NO_BRACKET, NBR, brent_next, brent_start
 from quadimpact.core.step import advance, start

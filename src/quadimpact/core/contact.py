@@ -30,15 +30,9 @@ import numpy as np
 from numba import njit
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.geometry import (
-    PR_FEATURE,
-    PR_SHAPE,
-    pair_contact,
-    shape_distance,
-)
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_LAMBDA
+from quadimpact.core.geometry import PR_FEATURE, PR_SHAPE, pair_contact, shape_distance
 from quadimpact.core.layout import (
-    CS_ACTIVE,
-    CS_LAMBDA,
     F_E,
     F_FORCE_SCALE,
     F_K,

@@ -18,9 +18,10 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_gap
+from quadimpact.core.contact_slots import CS_ACTIVE
 from quadimpact.core.geometry import pair_depth
 from quadimpact.core.integrator import dense_eval
-from quadimpact.core.layout import CS_ACTIVE, O_EVENT_TOL, X_POS, X_QUAT
+from quadimpact.core.layout import O_EVENT_TOL, X_POS, X_QUAT
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Work
 from quadimpact.core.rotors import active_states

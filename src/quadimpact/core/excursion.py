@@ -5,8 +5,9 @@ pitch and yaw departures from the references and the largest tilt of the
 body z axis from the reference's, over every output sample. The loop adds
 each sample as it writes it (``recording.write_sample``, from the rotation
 matrix it has just computed), into the ``EX_*`` slots of the run's stats
-(``ST_EXCURSION``), so a run's summary needs no pass over its samples and a
-sweep's runs need not keep them at all. ``quadimpact.simulation.attitude``
+(``ST_EXCURSION``; declared in ``core/excursion_slots.py``), so a run's
+summary needs no pass over its samples and a sweep's runs need not keep them
+at all. ``quadimpact.simulation.attitude``
 runs the same update over a table's quaternions.
 
 The angles follow :func:`quadimpact.rotations.quat_to_euler_zyx` (ZYX,
@@ -24,7 +25,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import EX_COS_TILT, EX_DEV, EX_DEV_TRIG, EX_REF_TRIG
+from quadimpact.core.excursion_slots import EX_COS_TILT, EX_DEV, EX_DEV_TRIG, EX_REF_TRIG
 
 GIMBAL_LOCK_COS = 1e-9
 """``cos(pitch)`` below which only the rotation about the vertical is defined (as

@@ -5,8 +5,8 @@ first control tick from which, for :data:`HOVER_HOLD_S`, the true CM speed
 stays below :data:`HOVER_SPEED_M_S` and the tilt of the body z axis from
 vertical below :data:`HOVER_TILT_DEG`, tested at every control tick
 (5 ms resolution) on the true state. The loop keeps the first tick of the
-current run of the condition (``ST_HOVER_RUN_T``) and the first tick of the
-first run that lasted long enough (``ST_T_HOVER``).
+current run of the condition (``HV_HOVER_RUN_T``) and the first tick of the
+first run that lasted long enough (``HV_T_HOVER``), in ``stats[ST_HOVER:]``.
 
 The **held hover** (:func:`track_held_hover`, the benchmark's success from
 suite 2 on, docs/BENCHMARK.md 1) adds two conditions and starts elsewhere:
@@ -14,7 +14,9 @@ the body rate below :data:`HELD_RATE_RAD_S`, and no contact open (a hover touche
 nothing); it is tested from the first contact
 with an obstacle (``ST_ONSET_T``) on, whatever the controller declares or
 detects. The loop keeps the first tick of its first run that lasted
-:data:`HOVER_HOLD_S` (``ST_T_HELD``) and the CM position there (``ST_HELD_X``).
+:data:`HOVER_HOLD_S` (``HH_T_HELD``) and the CM position there (``HH_HELD_X``),
+in ``stats[ST_HELD:]``. The slots of both are declared in ``core/hover_slots.py``
+(no compiled code), which ``core/layout.py`` reads their sizes from.
 """
 
 import math
@@ -22,16 +24,20 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.contact_slots import CS_ACTIVE
+from quadimpact.core.hover_slots import (
+    HH_HELD_RUN_T,
+    HH_HELD_RUN_X,
+    HH_HELD_X,
+    HH_T_HELD,
+    HV_HOVER_RUN_T,
+    HV_T_HOVER,
+)
 from quadimpact.core.layout import (
-    CS_ACTIVE,
-    ST_HELD_RUN_T,
-    ST_HELD_RUN_X,
-    ST_HELD_X,
-    ST_HOVER_RUN_T,
+    ST_HELD,
+    ST_HOVER,
     ST_ONSET_T,
     ST_T_DETECT,
-    ST_T_HELD,
-    ST_T_HOVER,
     X_OMEGA,
     X_POS,
     X_QUAT,
@@ -59,17 +65,26 @@ def _slow_and_level(x: np.ndarray) -> bool:
 
 
 @compiled
+def start_hover_tracking(stats: np.ndarray) -> None:
+    """Start both hover tests of a run: no run of either condition, no hover yet (NaN)."""
+    stats[ST_HOVER + HV_HOVER_RUN_T] = np.nan
+    stats[ST_HOVER + HV_T_HOVER] = np.nan
+    stats[ST_HELD + HH_HELD_RUN_T] = np.nan
+    stats[ST_HELD + HH_T_HELD] = np.nan
+
+
+@compiled
 def track_hover(t: float, x: np.ndarray, stats: np.ndarray) -> None:
     """The hover condition at the tick ``t`` (s) of the true state ``x`` (after a detection)."""
-    if np.isnan(stats[ST_T_DETECT]) or not np.isnan(stats[ST_T_HOVER]):
+    if np.isnan(stats[ST_T_DETECT]) or not np.isnan(stats[ST_HOVER + HV_T_HOVER]):
         return
     if not _slow_and_level(x):
-        stats[ST_HOVER_RUN_T] = np.nan
+        stats[ST_HOVER + HV_HOVER_RUN_T] = np.nan
         return
-    if np.isnan(stats[ST_HOVER_RUN_T]):
-        stats[ST_HOVER_RUN_T] = t
-    if t - stats[ST_HOVER_RUN_T] >= HOVER_HOLD_S - 1e-9:
-        stats[ST_T_HOVER] = stats[ST_HOVER_RUN_T]
+    if np.isnan(stats[ST_HOVER + HV_HOVER_RUN_T]):
+        stats[ST_HOVER + HV_HOVER_RUN_T] = t
+    if t - stats[ST_HOVER + HV_HOVER_RUN_T] >= HOVER_HOLD_S - 1e-9:
+        stats[ST_HOVER + HV_T_HOVER] = stats[ST_HOVER + HV_HOVER_RUN_T]
 
 
 @compiled
@@ -89,17 +104,17 @@ def track_held_hover(t: float, x: np.ndarray, cs: np.ndarray, stats: np.ndarray)
     rate below :data:`HELD_RATE_RAD_S` and no contact open (``cs``: the pairs'
     contact state): a hover touches nothing.
     """
-    if np.isnan(stats[ST_ONSET_T]) or not np.isnan(stats[ST_T_HELD]):
+    if np.isnan(stats[ST_ONSET_T]) or not np.isnan(stats[ST_HELD + HH_T_HELD]):
         return
     rate = math.sqrt(x[X_OMEGA] ** 2 + x[X_OMEGA + 1] ** 2 + x[X_OMEGA + 2] ** 2)
     if not (_slow_and_level(x) and rate < HELD_RATE_RAD_S) or _touching(cs):
-        stats[ST_HELD_RUN_T] = np.nan
+        stats[ST_HELD + HH_HELD_RUN_T] = np.nan
         return
-    if np.isnan(stats[ST_HELD_RUN_T]):
-        stats[ST_HELD_RUN_T] = t
+    if np.isnan(stats[ST_HELD + HH_HELD_RUN_T]):
+        stats[ST_HELD + HH_HELD_RUN_T] = t
         for i in range(3):
-            stats[ST_HELD_RUN_X + i] = x[X_POS + i]
-    if t - stats[ST_HELD_RUN_T] >= HOVER_HOLD_S - 1e-9:
-        stats[ST_T_HELD] = stats[ST_HELD_RUN_T]
+            stats[ST_HELD + HH_HELD_RUN_X + i] = x[X_POS + i]
+    if t - stats[ST_HELD + HH_HELD_RUN_T] >= HOVER_HOLD_S - 1e-9:
+        stats[ST_HELD + HH_T_HELD] = stats[ST_HELD + HH_HELD_RUN_T]
         for i in range(3):
-            stats[ST_HELD_X + i] = stats[ST_HELD_RUN_X + i]
+            stats[ST_HELD + HH_HELD_X + i] = stats[ST_HELD + HH_HELD_RUN_X + i]

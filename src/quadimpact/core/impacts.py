@@ -29,14 +29,14 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import (
+from quadimpact.core.layout import Block
+from quadimpact.core.recording_slots import (
     E_FEATURE,
     E_PEAK_DELTA,
     E_PEAK_FORCE,
     E_SHAPE,
     E_T_END,
     E_T_START,
-    Block,
 )
 
 # ---- a run's impacts (n_impacts, NIM): one row per impact (a group of chained

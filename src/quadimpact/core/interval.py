@@ -22,6 +22,7 @@ import numpy as np
 from quadimpact.core.actuators import apply_segment, next_boundary, segment_at
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_gap
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE
 from quadimpact.core.dynamics import state_derivative
 from quadimpact.core.events import EV_ALTITUDE, EV_RATE, NO_EVENT, contact_event, locate
 from quadimpact.core.geometry import (
@@ -46,8 +47,6 @@ from quadimpact.core.integrator import (
 )
 from quadimpact.core.layout import (
     CRASH_CM_GROUND,
-    CS_ACTIVE,
-    CS_EPISODE,
     LS_H,
     LS_PO_ACTIVE,
     LS_PO_SEG,

@@ -2,7 +2,8 @@
 
 The compiled loop takes no Python objects: it takes a few named records of
 ``float64`` arrays (``core/records.py``), and every slot of those arrays is
-declared here, block by block, with :class:`Block`. A block hands out
+declared here or by its component, block by block, with :class:`Block`
+(``core/block.py``). A block hands out
 consecutive offsets in the order its slots are declared, so two slots of a
 block cannot overlap and its size always covers them;
 ``tests/core/test_layout.py`` checks every registered block (the
@@ -16,8 +17,15 @@ estimators' configuration and state in ``core/estimators/``, the detector's
 and the sensor components' in ``core/sensors/``), and a stage that alone owns
 an array declares it (the wall approach's record in ``core/approach.py``, the
 impact rows in ``core/impacts.py``, the rotor inputs in ``core/rotors.py``, the
-contact-pair table in ``core/geometry``). Numba reads these module-level integers
-as compile-time constants.
+contact-pair table in ``core/geometry``). A component whose sizes
+``records.py`` or this module need declares its blocks in a declaration module
+next to it, which holds no compiled code: the contact pairs' ``cs``
+(``core/contact_slots.py``), the output rows and episodes
+(``core/recording_slots.py``), and the parts of ``stats`` this module places
+at addresses computed from their declared sizes (``ST_EXCURSION`` from
+``core/excursion_slots.py``, ``ST_HOVER`` and ``ST_HELD`` from
+``core/hover_slots.py``). Numba reads these module-level integers as
+compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
 reason) are plain integer constants for the compiled code (Numba cannot
@@ -30,64 +38,13 @@ Everything is SI; frames as in docs/MODEL.md section 1 (inertial NED, body FRD).
 from __future__ import annotations
 
 import math
-import sys
-from dataclasses import dataclass, field
 from enum import IntEnum
-from typing import ClassVar
+
+from quadimpact.core.block import Block
+from quadimpact.core.excursion_slots import NEX
+from quadimpact.core.hover_slots import NHELD, NHOVER
 
 __all__ = ["Block"]  # and every slot constant below
-
-
-@dataclass
-class Block:
-    """Consecutive slots of one array (or of a part of one), declared in order.
-
-    Parameters
-    ----------
-    array : str
-        What the slots index: a record field (``"veh"``, ``"stats"``...), or
-        ``"ctrl.params.<controller>"`` for a parameter block inside ``ctrl``.
-    prefix : str
-        The prefix of every slot constant of the block (``"V_"``).
-    start : int
-        Offset of the first slot (a block may continue another one).
-    capacity : int, optional
-        An upper bound the block must fit in (a controller's parameter block
-        must fit in ``NPARAM``).
-    """
-
-    array: str
-    prefix: str
-    start: int = 0
-    capacity: int | None = None
-    slots: dict[str, tuple[int, int]] = field(default_factory=dict)
-    size_name: str | None = None
-    module: str = ""
-    registry: ClassVar[dict[str, Block]] = {}
-
-    def __post_init__(self) -> None:
-        self.next = self.start
-        if not self.module:  # the declaring module: the caller of the generated __init__
-            self.module = sys._getframe(2).f_globals.get("__name__", "")
-        Block.registry[f"{self.array}:{self.prefix}"] = self  # a module reloaded: the new one
-
-    def slot(self, name: str, width: int = 1) -> int:
-        """Declare the next slot (``width`` consecutive numbers); return its offset."""
-        if not name.startswith(self.prefix):
-            raise ValueError(f"layout: slot {name} must start with {self.prefix}")
-        if name in self.slots or width < 1:
-            raise ValueError(f"layout: slot {name} declared twice or with width < 1")
-        offset = self.next
-        self.slots[name] = (offset, width)
-        self.next += width
-        if self.capacity is not None and self.next > self.capacity:
-            raise ValueError(f"layout: block {self.array} overflows its {self.capacity} slots")
-        return offset
-
-    def end(self, size_name: str) -> int:
-        """Close the block; return its size (the first offset after its last slot)."""
-        self.size_name = size_name
-        return self.next
 
 
 # --------------------------------------------------------------------------
@@ -421,13 +378,6 @@ LS_EXT = _ls.slot("LS_EXT")  # 1: the next tick applies LS_EXT_CMD instead of th
 LS_EXT_CMD = _ls.slot("LS_EXT_CMD", MAX_ROTORS)  # external rotor speed command (rad/s)
 NLS = _ls.end("NLS")
 
-# ---- contact pairs cs (n_pairs, NCS); changed only at located events
-_cs = Block("cs", "CS_")
-CS_ACTIVE = _cs.slot("CS_ACTIVE")  # 1 while the pair is in a contact episode (force applied)
-CS_LAMBDA = _cs.slot("CS_LAMBDA")  # damping coefficient fixed at the episode's onset
-CS_EPISODE = _cs.slot("CS_EPISODE")  # row of its episode in `episodes` (-1: none / dropped)
-NCS = _cs.end("NCS")
-
 # ---- controller memory mem (NMEM), zeroed at the start; each controller
 # lays out its slots with a Block of array "mem.<name>". The last slot is
 # reserved: a controller with stages writes its current stage there.
@@ -511,46 +461,6 @@ I_BIAS_TRUE = _imu.slot("I_BIAS_TRUE", 3)  # the gyro's true bias (constant + wa
 I_ERR = _imu.slot("I_ERR", 4)  # errors: attitude deg, velocity m/s, bias rad/s, position m
 NIMU = _imu.end("NIMU")
 
-# ---- time series out (n_out, NOUT + 2 n_features): the fixed columns, then
-# per feature its deflection (max over shapes, >= 0, m), then per feature its
-# normal force (sum over shapes, N); out_width() gives the row length
-_out = Block("out", "OUT_")
-OUT_T = _out.slot("OUT_T")  # s
-OUT_X = _out.slot("OUT_X", NX)  # state
-OUT_CMD = _out.slot("OUT_CMD", MAX_ROTORS)  # rotor speed command in force (rad/s)
-OUT_STAGE = _out.slot("OUT_STAGE")  # the controller's stage in force (MEM_STAGE)
-NOUT = _out.end("NOUT")
-OUT_DELTA = NOUT  # feature f's deflection at OUT_DELTA + f
-
-
-def out_width(n_features: int) -> int:
-    """Columns of an output row for ``n_features`` contact features."""
-    return NOUT + 2 * n_features
-
-
-# ---- contact episodes episodes (max_episodes, NEP)
-_ep = Block("episodes", "E_")
-E_FEATURE = _ep.slot("E_FEATURE")  # row of feat
-E_SHAPE = _ep.slot("E_SHAPE")  # row of shapes
-E_T_START = _ep.slot("E_T_START")  # s, located onset
-E_T_END = _ep.slot("E_T_END")  # s, located end (run end if still open)
-E_V_I = _ep.slot("E_V_I")  # m/s, penetration rate at onset (before the v_min floor)
-E_PEAK_DELTA = _ep.slot("E_PEAK_DELTA")  # m
-E_T_PEAK = _ep.slot("E_T_PEAK")  # s
-E_PEAK_FORCE = _ep.slot("E_PEAK_FORCE")  # N
-E_T_PEAK_FORCE = _ep.slot("E_T_PEAK_FORCE")  # s
-E_OPEN = _ep.slot("E_OPEN")  # 1 if the episode had not ended when the run stopped
-NEP = _ep.end("NEP")
-
-# ---- attitude excursion over the output samples (NEX), a part of stats
-# (ST_EXCURSION): core/excursion.py
-_ex = Block("stats.excursion", "EX_")
-EX_DEV = _ex.slot("EX_DEV", 3)  # rad, largest roll, pitch, yaw departures from the references
-EX_COS_TILT = _ex.slot("EX_COS_TILT")  # lowest cos of the body z axis from the reference's
-EX_DEV_TRIG = _ex.slot("EX_DEV_TRIG", 6)  # cos, sin of each largest departure so far
-EX_REF_TRIG = _ex.slot("EX_REF_TRIG", 6)  # cos, sin of the roll, pitch, yaw references
-NEX = _ex.end("NEX")
-
 # ---- run statistics stats (NSTAT)
 _st = Block("stats", "ST_")
 ST_STATUS = _st.slot("ST_STATUS")  # STATUS_*
@@ -585,15 +495,13 @@ ST_IMPACT_T = _st.slot("ST_IMPACT_T")  # s, the latest contact onset (NaN: none)
 N_EST_ERR = 4  # estimation errors: attitude (deg), velocity (m/s), gyro bias (rad/s), position (m)
 N_PHASES = 3  # before the first contact, the crash (to stage 4), after stage 4
 ST_EST_ERR = _st.slot("ST_EST_ERR", 3 * N_EST_ERR * N_PHASES)  # (sum of squares, max, samples)
-ST_HOVER_RUN_T = _st.slot("ST_HOVER_RUN_T")  # s, first tick of the hover condition's run (NaN)
-ST_T_HOVER = _st.slot("ST_T_HOVER")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
-ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion (EX_*)
+ST_HOVER = _st.slot("ST_HOVER", NHOVER)  # the time to hover's ticks (core/hover_tracking.py
+#   track_hover): its HV_* slots, declared by core/hover_slots.py
+ST_EXCURSION = _st.slot("ST_EXCURSION", NEX)  # the output samples' attitude excursion:
+#   its EX_* slots, declared by core/excursion_slots.py
 ST_X_LAST = _st.slot("ST_X_LAST", NX)  # the state of the last output sample
-# the held hover of the benchmark's suite 2 (core/hover_tracking.py track_held_hover)
-ST_HELD_RUN_T = _st.slot("ST_HELD_RUN_T")  # s, first tick of the held-hover condition's run (NaN)
-ST_HELD_RUN_X = _st.slot("ST_HELD_RUN_X", 3)  # m, CM position at that tick, inertial
-ST_T_HELD = _st.slot("ST_T_HELD")  # s, first tick of its first run of HOVER_HOLD_S (NaN)
-ST_HELD_X = _st.slot("ST_HELD_X", 3)  # m, CM position there (the hover point), inertial
+ST_HELD = _st.slot("ST_HELD", NHELD)  # the held hover of the benchmark's suite 2
+#   (core/hover_tracking.py track_held_hover): its HH_* slots, declared by core/hover_slots.py
 ST_LAST_ONSET_T = _st.slot("ST_LAST_ONSET_T")  # s, the latest contact onset, any shape (NaN)
 NSTAT = _st.end("NSTAT")
 

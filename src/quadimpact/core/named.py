@@ -299,13 +299,17 @@ MEASUREMENT_FIELDS: tuple[Field, ...] = (
 )
 
 
-def block_fields(array: str, prefix: str) -> tuple[Field, ...]:
-    """A block's slots as fields, named after their constants (``ST_T_END`` -> ``t_end``)."""
+def block_fields(array: str, prefix: str, at: int = 0) -> tuple[Field, ...]:
+    """A block's slots as fields, named after their constants (``ST_T_END`` -> ``t_end``).
+
+    ``at``: the offset of the region the block lies in (a part of ``stats``
+    declared by its owner, at ``ST_HOVER``...); its fields' offsets add it.
+    """
     from quadimpact.core.layout import Block
 
     block = Block.registry[f"{array}:{prefix}"]
     return tuple(
-        Field(name.removeprefix(prefix).lower(), offset, width, "", f"slot {name} of {array}")
+        Field(name.removeprefix(prefix).lower(), at + offset, width, "", f"slot {name} of {array}")
         for name, (offset, width) in block.slots.items()
     )
 

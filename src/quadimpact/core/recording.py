@@ -1,10 +1,10 @@
 """What the loop records: output rows, contact episodes and their peaks, extremes, the crash.
 
 All functions write into the run's :class:`~quadimpact.core.records.Output`
-(layouts ``OUT_*``, ``E_*``, ``ST_*`` in ``core/layout.py``); none changes the
-dynamics. Per contact feature an output row holds its deflection (the
-deepest of its pairs, >= 0, m) and its normal force (the sum over its
-active pairs, N).
+(layouts ``OUT_*`` and ``E_*`` in ``core/recording_slots.py``, ``ST_*`` in
+``core/layout.py``); none changes the dynamics. Per contact feature an output
+row holds its deflection (the deepest of its pairs, >= 0, m) and its normal
+force (the sum over its active pairs, N).
 """
 
 import math
@@ -13,7 +13,9 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
 from quadimpact.core.excursion import excursion_add, settled
+from quadimpact.core.excursion_slots import NEX
 from quadimpact.core.geometry import (
     GEOM_RING_PLANE,
     PR_FEATURE,
@@ -30,29 +32,10 @@ from quadimpact.core.layout import (
     C_PSI_REF,
     C_THETA_REF,
     C_Z_REF,
-    CS_ACTIVE,
-    CS_EPISODE,
-    CS_LAMBDA,
-    E_FEATURE,
-    E_OPEN,
-    E_PEAK_DELTA,
-    E_PEAK_FORCE,
-    E_SHAPE,
-    E_T_END,
-    E_T_PEAK,
-    E_T_PEAK_FORCE,
-    E_T_START,
-    E_V_I,
     LS_STAGE,
     MAX_ROTORS,
-    NEX,
     NX,
     O_V_MIN,
-    OUT_CMD,
-    OUT_DELTA,
-    OUT_STAGE,
-    OUT_T,
-    OUT_X,
     ST_CRASH_T,
     ST_CRASH_X,
     ST_EPISODES_DROPPED,
@@ -70,11 +53,25 @@ from quadimpact.core.layout import (
     X_QUAT,
 )
 from quadimpact.core.quaternion import rotation_matrix
-from quadimpact.core.records import Data, Model, Output, Work
-from quadimpact.core.rotors import (
-    RIN_CMD,
-    active_states,
+from quadimpact.core.recording_slots import (
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_PEAK,
+    E_T_PEAK_FORCE,
+    E_T_START,
+    E_V_I,
+    OUT_CMD,
+    OUT_DELTA,
+    OUT_STAGE,
+    OUT_T,
+    OUT_X,
 )
+from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.rotors import RIN_CMD, active_states
 from quadimpact.core.sensors.disturbance import impact_onset
 
 

@@ -19,7 +19,9 @@ spirit of MuJoCo MJX's ``Model``/``Data``:
 
 Every slot of every field is named in ``core/layout.py`` or, for a field a
 stage owns, in that stage's module (``rin``: ``core/rotors.py``; ``pairs``:
-``core/geometry``). The factories
+``core/geometry``) or its declaration module, which holds no compiled code
+(``cs``: ``core/contact_slots.py``; ``out`` and ``episodes``:
+``core/recording_slots.py``). The factories
 ``new_data`` and ``new_work`` are compiled, so the compiled ``run`` and the
 Python side allocate through the same code; ``new_output`` (what the caller
 allocates) is plain NumPy;
@@ -41,18 +43,16 @@ from typing import NamedTuple
 import numpy as np
 from numba import njit
 
+from quadimpact.core.contact_slots import NCS
 from quadimpact.core.layout import (
     MAX_AVERAGE_WINDOW,
     MAX_ROTORS,
-    NCS,
     NECFG,
-    NEP,
     NEST,
     NIMU,
     NLS,
     NMEAS,
     NMEM,
-    NOUT,
     NSCFG,
     NSN,
     NSPAN,
@@ -68,6 +68,7 @@ from quadimpact.core.layout import (
     ST_N_IMU,
     ST_N_OUT,
 )
+from quadimpact.core.recording_slots import NEP, NOUT
 from quadimpact.core.rotors import NRIN
 
 __all__ = [
@@ -193,7 +194,7 @@ def new_output(
     output): handing the whole :class:`Model` to a compiled factory cost
     more than its four allocations (Numba unboxes every field of the record).
     """
-    width = NOUT + 2 * m.feat.shape[0] if contact_columns else NOUT  # layout.out_width
+    width = NOUT + 2 * m.feat.shape[0] if contact_columns else NOUT  # recording_slots.out_width
     return Output(
         np.zeros((m.t_out.shape[0] if rows else 0, width)),
         np.zeros((max(n_imu, 0), NIMU + tail_size(m.scfg, SC_TAIL_REC))),
@@ -348,7 +349,8 @@ class RawRecord:
     """What one compiled run returns: the filled parts of its output arrays.
 
     ``out`` (n_out, out_width(n_features)), ``episodes`` (n_episodes, NEP),
-    ``stats`` (NSTAT) and ``imu`` (n_imu, NIMU), layouts in ``core.layout``.
+    ``stats`` (NSTAT) and ``imu`` (n_imu, NIMU), layouts in ``core.recording_slots``
+    (``out``, ``episodes``) and ``core.layout``.
     """
 
     out: np.ndarray

@@ -32,10 +32,12 @@ import numpy as np
 
 from quadimpact.core.actuators import apply_command, cut_step
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
 from quadimpact.core.controllers import builtin_step
 from quadimpact.core.estimators import at_tick, init_estimate
 from quadimpact.core.excursion import excursion_start
-from quadimpact.core.hover_tracking import track_held_hover, track_hover
+from quadimpact.core.excursion_slots import NEX
+from quadimpact.core.hover_tracking import start_hover_tracking, track_held_hover, track_hover
 from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
 from quadimpact.core.layout import (
     C_KIND,
@@ -44,13 +46,7 @@ from quadimpact.core.layout import (
     C_STEP,
     C_THETA_REF,
     CRASH_PAPER_TICKS,
-    CS_ACTIVE,
-    CS_EPISODE,
-    CS_LAMBDA,
     CTRL_USER,
-    E_OPEN,
-    E_PEAK_DELTA,
-    E_T_END,
     LS_DONE,
     LS_EXT,
     LS_EXT_CMD,
@@ -67,7 +63,6 @@ from quadimpact.core.layout import (
     MS_IMU_T,
     MS_T_DETECT,
     N_STAGES,
-    NEX,
     O_CRASH_ALTITUDE,
     O_CRASH_RULE,
     O_DT_CONTROL,
@@ -82,8 +77,6 @@ from quadimpact.core.layout import (
     SS_NEXT_T,
     ST_CRASH_T,
     ST_EXCURSION,
-    ST_HELD_RUN_T,
-    ST_HOVER_RUN_T,
     ST_IMPACT_T,
     ST_LAST_ONSET_T,
     ST_MAX_DELTA,
@@ -99,8 +92,6 @@ from quadimpact.core.layout import (
     ST_STATUS,
     ST_T_DETECT,
     ST_T_END,
-    ST_T_HELD,
-    ST_T_HOVER,
     STATUS_COMPLETED,
     STATUS_CRASHED,
     STATUS_FAILED,
@@ -112,12 +103,9 @@ from quadimpact.core.layout import (
 from quadimpact.core.plugin_call import call_controller
 from quadimpact.core.quaternion import normalise_quaternion
 from quadimpact.core.recording import record_crash, write_sample
+from quadimpact.core.recording_slots import E_OPEN, E_PEAK_DELTA, E_T_END
 from quadimpact.core.records import Data, Model, Output, Work, new_work
-from quadimpact.core.rotors import (
-    RIN_CMD,
-    RIN_FIRST_ORDER,
-    RIN_PREV_CMD,
-)
+from quadimpact.core.rotors import RIN_CMD, RIN_FIRST_ORDER, RIN_PREV_CMD
 from quadimpact.core.sensing import sample_at
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
@@ -137,8 +125,9 @@ def start(m: Model, d: Data, o: Output) -> None:
     stats[:] = 0.0
     for i in (ST_CRASH_T, ST_ONSET_T, ST_POWER_OFF_T, ST_T_DETECT):
         stats[i] = np.nan
-    for i in (ST_IMPACT_T, ST_HOVER_RUN_T, ST_T_HOVER, ST_HELD_RUN_T, ST_T_HELD, ST_LAST_ONSET_T):
+    for i in (ST_IMPACT_T, ST_LAST_ONSET_T):
         stats[i] = np.nan
+    start_hover_tracking(stats)
     stats[ST_STAGE_T : ST_STAGE_T + N_STAGES] = np.nan
     stats[ST_T_END] = t0
     stats[ST_MIN_ALT] = -x[X_POS + 2]

@@ -20,15 +20,8 @@ from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.envs.episode_layout import ENV_ROTORS
-from quadimpact.core.records import (
-    Data,
-    Output,
-    new_data,
-    new_output,
-    raw_record,
-    set_row,
-    stacked,
-)
+from quadimpact.core.recording_slots import OUT_X
+from quadimpact.core.records import Data, Output, new_data, new_output, raw_record, set_row, stacked
 from quadimpact.core.step import finish
 from quadimpact.envs.settings import TrialDistribution
 from quadimpact.errors import InputError
@@ -290,7 +283,7 @@ class Slots:
         # (as analyse reads it), else the state reached
         n_out = int(st[L.ST_N_OUT])
         if n_out == self.M.t_out.shape[1]:
-            final = self.O.out[k, n_out - 1, L.OUT_X : L.OUT_X + L.NX].copy()
+            final = self.O.out[k, n_out - 1, OUT_X : OUT_X + L.NX].copy()
         else:
             final = self.D.x[k].copy()
         out = recovery_metrics(

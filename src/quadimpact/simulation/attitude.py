@@ -21,14 +21,8 @@ import math
 import numpy as np
 from numba import njit
 
-from quadimpact.core import layout as L
-from quadimpact.core.excursion import (
-    DEG,
-    euler_of,
-    excursion_add,
-    excursion_start,
-    wrap_pi,
-)
+from quadimpact.core.excursion import DEG, euler_of, excursion_add, excursion_start, wrap_pi
+from quadimpact.core.excursion_slots import EX_COS_TILT, EX_DEV, NEX
 from quadimpact.core.quaternion import rotation_matrix
 
 __all__ = ["excursion_from_quaternions", "excursion_full"]
@@ -63,17 +57,17 @@ def excursion_from_quaternions(
     which evaluates a row's angles only where they may reach the largest so
     far); the value is that of :func:`excursion_full`, bit for bit.
     """
-    e = np.zeros(L.NEX)
+    e = np.zeros(NEX)
     C = np.empty((3, 3))
     excursion_start(roll_ref, pitch_ref, yaw_ref, e)
     for i in range(quat.shape[0]):
         rotation_matrix(quat[i], C)
         excursion_add(C, roll_ref, pitch_ref, yaw_ref, z_ref, e)
     return (
-        e[L.EX_DEV] * DEG,
-        e[L.EX_DEV + 1] * DEG,
-        e[L.EX_DEV + 2] * DEG,
-        math.acos(e[L.EX_COS_TILT]) * DEG,
+        e[EX_DEV] * DEG,
+        e[EX_DEV + 1] * DEG,
+        e[EX_DEV + 2] * DEG,
+        math.acos(e[EX_COS_TILT]) * DEG,
     )
 
 

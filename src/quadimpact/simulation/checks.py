@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import out_width
 from quadimpact.errors import InputError
 from quadimpact.linalg import norm
 
@@ -199,7 +200,7 @@ def record_size_bytes(scenario: Any, n_features: int | None = None) -> int:
     samples = math.ceil(max(duration, 0.0) * float(imu_rate)) + 1
     if n_features is None:
         n_features = vehicle_feature_count(scenario)
-    return 8 * (rows * L.out_width(n_features) + samples * L.NIMU)
+    return 8 * (rows * out_width(n_features) + samples * L.NIMU)
 
 
 def check_record_size(

@@ -33,6 +33,7 @@ from quadimpact.core.impacts import (
     find_impacts,
     sort_and_find_impacts,
 )
+from quadimpact.core.recording_slots import E_FEATURE, E_SHAPE
 from quadimpact.simulation.metrics import (
     GRAZE_IMPULSE_FRACTION,
     IMPACT_COLUMNS,
@@ -142,9 +143,9 @@ def run_episodes(
         obstacle_impacts = _impacts(sorted_rows, impact_of, found, count)
     first = None
     for row in sorted_rows:
-        shape = round(row[L.E_SHAPE])
+        shape = round(row[E_SHAPE])
         if not not_obstacle[shape]:
-            first = (round(row[L.E_FEATURE]) + 1, names[shape])
+            first = (round(row[E_FEATURE]) + 1, names[shape])
             break
     return RunEpisodes(impacts, obstacle_impacts, first, table)
 
@@ -158,7 +159,7 @@ def _impacts(
     n_all = n_grazes = 0
     for g, row in zip(impact_of.tolist(), sorted_rows, strict=True):
         if g >= 0:
-            groups[g].append(round(row[L.E_FEATURE]) + 1)
+            groups[g].append(round(row[E_FEATURE]) + 1)
             n_all += 1
         elif g == GRAZE:
             n_all += 1

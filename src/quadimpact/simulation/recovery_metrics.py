@@ -19,6 +19,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
+from quadimpact.core.hover_slots import HH_HELD_X, HH_T_HELD, HV_T_HOVER
 from quadimpact.linalg import dot, norm
 from quadimpact.results.summary_record import RecoveryPart
 from quadimpact.rotations import quat_to_matrix
@@ -197,7 +198,7 @@ def recovery_metrics(
     out.update(_stage_travel(st))
     if out["recovered"]:
         out["time_to_recover_s"] = float(st[L.ST_STAGE_T + RECOVERED_STAGE]) - t_detect
-    t_hover = float(st[L.ST_T_HOVER])
+    t_hover = float(st[L.ST_HOVER + HV_T_HOVER])
     if math.isfinite(t_hover):
         out["time_to_hover_s"] = t_hover - t_detect
     out["max_tilt_deg"] = math.degrees(math.acos(min(max(float(st[L.ST_MIN_TILT_COS]), -1.0), 1.0)))
@@ -246,12 +247,12 @@ def held_hover_metrics(st: np.ndarray) -> dict[str, Any]:
         ``touched_after_hover`` (bool: a contact onset at or after the hover's
         start); the floats None without a held hover.
     """
-    t_held = float(st[L.ST_T_HELD])
+    t_held = float(st[L.ST_HELD + HH_T_HELD])
     if not math.isfinite(t_held):
         return {"held_hover": False, "time_to_held_hover_s": None,
                 "held_hover_distance_m": None, "touched_after_hover": False}  # fmt: skip
     onset = st[L.ST_ONSET_X + L.X_POS : L.ST_ONSET_X + L.X_POS + 2]
-    held = st[L.ST_HELD_X : L.ST_HELD_X + 2]
+    held = st[L.ST_HELD + HH_HELD_X : L.ST_HELD + HH_HELD_X + 2]
     last_onset = float(st[L.ST_LAST_ONSET_T])
     return {
         "held_hover": True,

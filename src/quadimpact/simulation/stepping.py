@@ -37,7 +37,11 @@ from quadimpact.simulation.simulate import analyse
 
 __all__ = ["Simulation"]
 
-_STATS_FIELDS = block_fields("stats", "ST_")
+_STATS_FIELDS = (
+    block_fields("stats", "ST_")
+    + block_fields("stats.hover", "HV_", at=L.ST_HOVER)
+    + block_fields("stats.held", "HH_", at=L.ST_HELD)
+)  # the hover tests' slots keep their names in stats (t_hover, held_x...)
 
 
 class Simulation:

@@ -19,6 +19,7 @@ import numpy as np
 from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core.excursion import DEG
+from quadimpact.core.excursion_slots import EX_COS_TILT, EX_DEV, NEX
 from quadimpact.core.sensors import detection as DET
 from quadimpact.core.sensors.registry import config_address
 from quadimpact.inputs.scenarios import WallApproach
@@ -332,12 +333,12 @@ def excursion_deg(st: np.ndarray) -> dict[str, float]:
     """The output samples' attitude excursion (degrees), as
     :func:`~quadimpact.simulation.metrics.attitude_excursion_deg` of the time series
     gives it: the loop's ``ST_EXCURSION`` (``core/excursion.py``) in degrees."""
-    e = st[L.ST_EXCURSION : L.ST_EXCURSION + L.NEX].tolist()
+    e = st[L.ST_EXCURSION : L.ST_EXCURSION + NEX].tolist()
     return {
-        "roll_excursion_deg": e[L.EX_DEV] * DEG,
-        "pitch_excursion_deg": e[L.EX_DEV + 1] * DEG,
-        "yaw_excursion_deg": e[L.EX_DEV + 2] * DEG,
-        "tilt_max_deg": math.acos(e[L.EX_COS_TILT]) * DEG,
+        "roll_excursion_deg": e[EX_DEV] * DEG,
+        "pitch_excursion_deg": e[EX_DEV + 1] * DEG,
+        "yaw_excursion_deg": e[EX_DEV + 2] * DEG,
+        "tilt_max_deg": math.acos(e[EX_COS_TILT]) * DEG,
     }
 
 

@@ -16,6 +16,25 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core.recording_slots import (
+    E_FEATURE,
+    E_OPEN,
+    E_PEAK_DELTA,
+    E_PEAK_FORCE,
+    E_SHAPE,
+    E_T_END,
+    E_T_PEAK,
+    E_T_PEAK_FORCE,
+    E_T_START,
+    E_V_I,
+    NEP,
+    OUT_CMD,
+    OUT_DELTA,
+    OUT_STAGE,
+    OUT_T,
+    OUT_X,
+    out_width,
+)
 from quadimpact.core.sensors import detection as DET
 from quadimpact.core.sensors.registry import record_address, record_columns
 from quadimpact.inputs.features import feature_column
@@ -38,13 +57,13 @@ __all__ = [
 
 # Raw episode columns -> table columns (float-valued ones).
 _EPISODE_FLOAT_SOURCES: tuple[tuple[str, int], ...] = (
-    ("t_start_s", L.E_T_START),
-    ("t_end_s", L.E_T_END),
-    ("v_i_m_s", L.E_V_I),
-    ("peak_delta_m", L.E_PEAK_DELTA),
-    ("t_peak_s", L.E_T_PEAK),
-    ("peak_force_n", L.E_PEAK_FORCE),
-    ("t_peak_force_s", L.E_T_PEAK_FORCE),
+    ("t_start_s", E_T_START),
+    ("t_end_s", E_T_END),
+    ("v_i_m_s", E_V_I),
+    ("peak_delta_m", E_PEAK_DELTA),
+    ("t_peak_s", E_T_PEAK),
+    ("peak_force_n", E_PEAK_FORCE),
+    ("t_peak_force_s", E_T_PEAK_FORCE),
 )
 
 
@@ -76,25 +95,25 @@ def episode_columns(
     raw: np.ndarray, n: int, surface_names: Sequence[str], n_features: int = len(BUMPERS)
 ) -> dict[str, np.ndarray]:
     """The columns of :func:`episodes_frame` as NumPy arrays (no DataFrame), same order."""
-    rows = _rows(raw, n, L.NEP, "episodes")
-    bumper_idx = np.rint(rows[:, L.E_FEATURE]).astype(np.int64)
+    rows = _rows(raw, n, NEP, "episodes")
+    bumper_idx = np.rint(rows[:, E_FEATURE]).astype(np.int64)
     if np.any((bumper_idx < 0) | (bumper_idx >= n_features)):
         got = sorted(set(bumper_idx.tolist()))
         raise ValueError(f"episodes: feature index outside 0..{n_features - 1} (got {got})")
-    surf_idx = np.rint(rows[:, L.E_SHAPE]).astype(np.int64)
+    surf_idx = np.rint(rows[:, E_SHAPE]).astype(np.int64)
     names = list(surface_names)
     if np.any((surf_idx < 0) | (surf_idx >= len(names))):
         got = sorted(set(surf_idx.tolist()))
         raise ValueError(f"episodes: surface index outside 0..{len(names) - 1} (got {got})")
     # sorted by start, then bumper; ties keep the kernel's order (a stable sort)
-    order = np.lexsort((bumper_idx, rows[:, L.E_T_START]))
+    order = np.lexsort((bumper_idx, rows[:, E_T_START]))
     data: dict[str, np.ndarray] = {
         "bumper": bumper_idx[order] + 1,
         "surface": np.array([str(names[i]) for i in surf_idx[order]], dtype=object),
     }
     for name, col in _EPISODE_FLOAT_SOURCES:
         data[name] = rows[order, col].copy()
-    data["open"] = rows[order, L.E_OPEN] > 0.5
+    data["open"] = rows[order, E_OPEN] > 0.5
     return {name: data[name] for name in EPISODE_COLUMNS}
 
 
@@ -107,14 +126,14 @@ def episode_lists_of(
     them (one conversion of the raw rows) cost less than NumPy columns.
     ``surface`` holds names, ``bumper`` the feature 1-based, ``open`` bools.
     """
-    rows = _rows(raw, n, L.NEP, "episodes").tolist()
+    rows = _rows(raw, n, NEP, "episodes").tolist()
     names = [str(name) for name in surface_names]
-    start = [r[L.E_T_START] for r in rows]
+    start = [r[E_T_START] for r in rows]
     if any(t != t for t in start):  # NaN starts: sorted as NumPy sorts them
         cols = episode_columns(raw, n, surface_names, n_features)
         return EpisodeLists({k: v.tolist() for k, v in cols.items()})
-    feature = [_index(r[L.E_FEATURE], n_features, "feature", rows, L.E_FEATURE) for r in rows]
-    surface = [_index(r[L.E_SHAPE], len(names), "surface", rows, L.E_SHAPE) for r in rows]
+    feature = [_index(r[E_FEATURE], n_features, "feature", rows, E_FEATURE) for r in rows]
+    surface = [_index(r[E_SHAPE], len(names), "surface", rows, E_SHAPE) for r in rows]
     # by start, then feature; ties keep the kernel's order (a stable sort)
     order = sorted(range(len(rows)), key=lambda i: (start[i], feature[i]))
     data: dict[str, list[Any]] = {
@@ -123,7 +142,7 @@ def episode_lists_of(
     }
     for name, col in _EPISODE_FLOAT_SOURCES:
         data[name] = [rows[i][col] for i in order]
-    data["open"] = [rows[i][L.E_OPEN] > 0.5 for i in order]
+    data["open"] = [rows[i][E_OPEN] > 0.5 for i in order]
     return EpisodeLists({name: data[name] for name in EPISODE_COLUMNS})
 
 
@@ -145,7 +164,7 @@ def episodes_frame(
     Parameters
     ----------
     raw : numpy.ndarray, shape (max_episodes, NEP)
-        Episode records with the ``E_*`` columns of :mod:`quadimpact.core.layout`
+        Episode records with the ``E_*`` columns of :mod:`quadimpact.core.recording_slots`
         (feature 0-based, surface as an index into the run's shapes).
     n : int
         Number of valid rows (``stats[ST_N_EPISODES]``, capped by the buffer).
@@ -184,7 +203,7 @@ def timeseries_frame(
     Parameters
     ----------
     raw : numpy.ndarray, shape (max_out, out_width(n_features))
-        Output samples with the ``OUT_*`` columns of :mod:`quadimpact.core.layout`.
+        Output samples with the ``OUT_*`` columns of :mod:`quadimpact.core.recording_slots`.
     n : int
         Number of valid rows (``stats[ST_N_OUT]``).
     feature_names : sequence of str
@@ -219,8 +238,8 @@ def timeseries_columns(
     """The columns of :func:`timeseries_frame` as NumPy arrays (no DataFrame)."""
     names = list(feature_names)
     nf = len(names)
-    rows = _rows(raw, n, L.out_width(nf), "timeseries")
-    x0 = L.OUT_X
+    rows = _rows(raw, n, out_width(nf), "timeseries")
+    x0 = OUT_X
     pos = rows[:, x0 + L.X_POS : x0 + L.X_POS + 3]
     vel_b = rows[:, x0 + L.X_VEL : x0 + L.X_VEL + 3]
     quat = rows[:, x0 + L.X_QUAT : x0 + L.X_QUAT + 4]
@@ -233,7 +252,7 @@ def timeseries_columns(
         vel_i = np.empty((0, 3))
         roll = pitch = yaw = np.empty(0)
     data: dict[str, np.ndarray] = {
-        "t_s": rows[:, L.OUT_T],
+        "t_s": rows[:, OUT_T],
         "x_m": pos[:, 0],
         "y_m": pos[:, 1],
         "z_m": pos[:, 2],
@@ -254,16 +273,16 @@ def timeseries_columns(
     for j in range(1, rotors + 1):
         data[f"omega{j}_rad_s"] = rotor[:, j - 1]
     for j in range(1, rotors + 1):
-        data[f"omega_cmd{j}_rad_s"] = rows[:, L.OUT_CMD + j - 1]
+        data[f"omega_cmd{j}_rad_s"] = rows[:, OUT_CMD + j - 1]
     data["roll_deg"] = np.degrees(roll)
     data["pitch_deg"] = np.degrees(pitch)
     data["yaw_deg"] = np.degrees(yaw)
     data["altitude_m"] = -pos[:, 2]
     for f, name in enumerate(names):
-        data[feature_column("delta", name, "m")] = rows[:, L.OUT_DELTA + f]
+        data[feature_column("delta", name, "m")] = rows[:, OUT_DELTA + f]
     for f, name in enumerate(names):
-        data[feature_column("force", name, "n")] = rows[:, L.OUT_DELTA + nf + f]
-    data["stage"] = rows[:, L.OUT_STAGE]
+        data[feature_column("force", name, "n")] = rows[:, OUT_DELTA + nf + f]
+    data["stage"] = rows[:, OUT_STAGE]
     return {k: np.array(v, dtype=np.float64) for k, v in data.items()}
 
 

@@ -5,7 +5,10 @@ The record :class:`Env` (stacked like the runs' records: row ``k`` is run
 the parameters shared by the runs (``EP_*``), the action and observation
 modes (``ACT_*``, ``OBS_*``) and the observation lengths, declared as
 :class:`~quadimpact.core.layout.Block`s like the core's own slots
-(``tests/core/test_layout.py``). No compiled code.
+(``tests/core/test_layout.py``). No compiled code: this is the environment's
+declaration module, imported by its four stages (``stacked.py``,
+``actions.py``, ``observation.py``, ``reward.py``) and its packer
+(``packing/episode_block.py``), so none of them owns the blocks alone.
 """
 
 from typing import NamedTuple

@@ -121,8 +121,8 @@ def hover_drift_m(out: np.ndarray, stats: np.ndarray) -> float | None:
     out : ndarray, shape (rows, >= NOUT)
         The run's output rows (``OUT_T`` time, s; ``OUT_X`` state, inertial position first).
     stats : ndarray
-        The run's stats: ``ST_T_HELD`` (s, when the held hover began) and
-        ``ST_HELD_X`` (m, the CM there, inertial).
+        The run's stats: at ``ST_HELD``, ``HH_T_HELD`` (s, when the held hover
+        began) and ``HH_HELD_X`` (m, the CM there, inertial).
 
     Returns
     -------
@@ -131,15 +131,18 @@ def hover_drift_m(out: np.ndarray, stats: np.ndarray) -> float | None:
         a held hover.
     """
     from quadimpact.core import layout as L
+    from quadimpact.core.hover_slots import HH_HELD_X, HH_T_HELD
+    from quadimpact.core.recording_slots import OUT_T, OUT_X
 
-    t_held = float(stats[L.ST_T_HELD])
+    t_held = float(stats[L.ST_HELD + HH_T_HELD])
     if not math.isfinite(t_held):
         return None
-    after = out[out[:, L.OUT_T] >= t_held]
+    after = out[out[:, OUT_T] >= t_held]
     if after.shape[0] == 0:
         return 0.0
-    dx = after[:, L.OUT_X + L.X_POS] - stats[L.ST_HELD_X]
-    dy = after[:, L.OUT_X + L.X_POS + 1] - stats[L.ST_HELD_X + 1]
+    held = L.ST_HELD + HH_HELD_X
+    dx = after[:, OUT_X + L.X_POS] - stats[held]
+    dy = after[:, OUT_X + L.X_POS + 1] - stats[held + 1]
     return float(np.sqrt(dx * dx + dy * dy).max())
 
 
