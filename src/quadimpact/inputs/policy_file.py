@@ -38,8 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core.controllers.residual import F_SCALE_M_S2, T_CAP_S
-from quadimpact.core.layout import MAX_HIDDEN, N_FEATURES, N_OUTPUTS
+from quadimpact.core.layout import F_SCALE_M_S2, MAX_HIDDEN, N_FEATURES, N_OUTPUTS, T_CAP_S
 from quadimpact.errors import InputError, short_path
 from quadimpact.linalg import matvec
 

@@ -71,6 +71,7 @@ import numpy as np
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.layout import (
     C_POLICY,
+    F_SCALE_M_S2,
     MAX_HIDDEN,
     MS_IMU_F,
     MS_NORMAL,
@@ -82,6 +83,7 @@ from quadimpact.core.layout import (
     NPOLICY,
     STAGE_HOVER,
     STAGE_RECOVERED,
+    T_CAP_S,
     V_GRAVITY,
     V_MASS,
     X_QUAT,
@@ -106,10 +108,6 @@ N_POLICY_BLOCK = _policy.end("N_POLICY_BLOCK")
 
 _V_SCALE_M_S = 2.0
 _W_SCALE_RAD_S = 8.0
-#: The features' scale of the accelerometer's specific force, m/s^2.
-F_SCALE_M_S2 = 16.0
-#: The features' cap on the time since the detection, s (also the latest fade's end).
-T_CAP_S = 2.0
 
 
 @allocating
