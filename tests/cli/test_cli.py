@@ -138,6 +138,24 @@ def test_flags_override_file_values(tmp_path: Path) -> None:
     assert options.yaw_reaction == "paper"
 
 
+def test_sensors_and_estimator_flags_set_the_scenarios_sensing(tmp_path: Path) -> None:
+    """--sensors fills the sensors a file leaves unset (its own IMU stays); --estimator
+    overrides the file's; an unknown name is refused in one line naming the flag."""
+    from quadimpact.cli import build_scenario
+
+    path = tmp_path / "trial.toml"
+    path.write_text('kind = "impact-trial"\nvehicle = "navi"\nimu = "noisy"\nestimator = "ekf"\n')
+    s = build_scenario(path, {"sensors": "onboard", "estimator": "nav-ekf"})
+    assert (s.sensors, s.estimator, s.imu.preset) == ("onboard", "nav-ekf", "noisy")
+    assert s.magnetometer is not None
+    assert set(s.instruments) == {"barometer", "rangefinder", "optical_flow"}
+    assert build_scenario(path, {"sensors": None, "estimator": None}).estimator == "ekf"
+    with pytest.raises(InputError, match="--sensors: unknown preset of sensors 'bogus'"):
+        build_scenario(path, {"sensors": "bogus"})
+    with pytest.raises(InputError, match="--estimator: must be one of"):
+        build_scenario(path, {"estimator": "nope"})
+
+
 def test_authors_approach_from_flags_and_list_valued_switches(tmp_path: Path) -> None:
     """--start-altitude, --roll, --pitch: the authors' approach of a crash run; --option takes
     numbers and lists ([2], 1,2,1,1) for the crash-run switches."""

@@ -49,9 +49,13 @@ _FLAGS: dict[str, tuple[str, str]] = {
     "start_distance": ("start_distance_m", "--start-distance"),
     "imu": ("imu", "--imu"),
     "seed": ("seed", "--seed"),
+    "sensors": ("sensors", "--sensors"),
+    "estimator": ("estimator", "--estimator"),
 }
 #: Scenario field -> its flag as typed (in error messages).
 _FLAG_OF = {field: flag for field, flag in _FLAGS.values()}
+#: The fields a preset of sensors (``--sensors``) fills where the scenario leaves them unset.
+_PRESET_FIELDS = ("imu", "magnetometer", "pose_sensor", "instruments")
 _WALL_ONLY = {
     "heading_deg",
     "inclination_deg",
@@ -139,6 +143,22 @@ def _flag(flag: str, metavar: str | None, help: str, type: Any = None) -> Any:
     "PRESET",
     "IMU preset: 'ideal' or 'noisy' (docs/RECOVERY.md 1.4). [default: ideal]",
     type=click.Choice(["ideal", "noisy"]),
+)
+@_flag(
+    "--sensors",
+    "PRESET",
+    "A preset of sensors: ideal, noisy, impact, indoor (impact + magnetometer + pose "
+    "sensor), onboard (impact + magnetometer, barometer, rangefinder, optical flow) or "
+    "one a plug-in registers; it fills the sensors the scenario leaves unset "
+    "(docs/ESTIMATION.md). [default: the IMU alone]",
+    type=click.STRING,
+)
+@_flag(
+    "--estimator",
+    "NAME",
+    "State estimator the controller reads: ideal (the true state), complementary, ekf, "
+    "nav-ekf (with the onboard sensors) or a registered one. [default: ideal]",
+    type=click.STRING,
 )
 @_flag(
     "--seed",
@@ -396,11 +416,15 @@ def build_scenario(
         read_toml_file(scenario_path)
     from quadimpact.inputs.scenarios import _KINDS
 
-    data = _file_fields(scenario_path, kind)
+    data, explicit = _file_fields(scenario_path, kind)
     kind = data.get("kind", "wall-approach")
     cls = _KINDS[kind]
     given = {_FLAGS[key][0]: value for key, value in flags.items() if value is not None}
     _check_flags_apply(given, cls, kind, scenario_path)
+    if "sensors" in given:  # --sensors fills what the file does not set itself, as in a file
+        for field in _PRESET_FIELDS:
+            if field not in explicit:
+                data.pop(field, None)
     parsed_params: dict[str, Any] = {}
     if params:
         parsed_params = _parse_options(params, "--param")
@@ -411,20 +435,22 @@ def build_scenario(
     return _validated(cls, data, scenario_path, given, parsed_params)
 
 
-def _file_fields(scenario_path: Path | None, kind: str | None) -> dict[str, Any]:
-    """The scenario file's fields (validated, defaults filled in); without a file, only
-    ``--kind``'s (none without it). A file's kind other than ``--kind`` is refused."""
+def _file_fields(scenario_path: Path | None, kind: str | None) -> tuple[dict[str, Any], set[str]]:
+    """The scenario file's fields (validated, defaults filled in) and the names of those it
+    sets itself; without a file, only ``--kind``'s (none without it). A file's kind other
+    than ``--kind`` is refused."""
     from quadimpact.inputs.scenarios import load_scenario_file
 
     if scenario_path is None:
-        return {} if kind is None else {"kind": kind}
-    data = load_scenario_file(scenario_path).model_dump()
+        return ({} if kind is None else {"kind": kind}), set()
+    loaded = load_scenario_file(scenario_path)
+    data = loaded.model_dump()
     if kind is not None and data.get("kind", "wall-approach") != kind:
         raise InputError(
             f"--kind {kind}: {scenario_path} has kind = {data.get('kind')!r} (a file sets "
             "its own kind; leave --kind out)"
         )
-    return data
+    return data, set(loaded.model_fields_set)
 
 
 def _check_flags_apply(
