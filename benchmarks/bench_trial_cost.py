@@ -78,17 +78,24 @@ print(json.dumps(out))
 """
 
 
-def measure(checkout: Path, what: list) -> dict:
-    """One pass over the trials in a fresh interpreter importing ``checkout/src``."""
+def run_in_checkout(checkout: Path, snippet: str, what: list) -> dict:
+    """``snippet`` run with the JSON of ``what`` in a fresh interpreter importing
+    ``checkout/src``; its last line of output, read as JSON (``compare_trial_bits.py``
+    uses it too)."""
     env = dict(os.environ)
     env["PYTHONPATH"] = str(checkout / "src")
     proc = subprocess.run(
-        [sys.executable, "-c", SNIPPET, json.dumps(what)],
+        [sys.executable, "-c", snippet, json.dumps(what)],
         env=env, capture_output=True, text=True, cwd=checkout,
     )  # fmt: skip
     if proc.returncode != 0:
-        raise SystemExit(f"{checkout}: the trials failed:\n{proc.stderr[-3000:]}")
+        raise SystemExit(f"{checkout}: the runs failed:\n{proc.stderr[-3000:]}")
     return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def measure(checkout: Path, what: list) -> dict:
+    """One pass over the trials in a fresh interpreter importing ``checkout/src``."""
+    return run_in_checkout(checkout, SNIPPET, what)
 
 
 def least_over_rounds(rounds: list[dict]) -> dict:

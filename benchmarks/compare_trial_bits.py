@@ -30,9 +30,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parents[1]
@@ -102,15 +99,9 @@ print(json.dumps(out))
 
 def run(checkout: Path, what: list) -> dict:
     """The results of ``checkout`` (a fresh interpreter importing its ``src``)."""
-    env = dict(os.environ)
-    env["PYTHONPATH"] = str(checkout / "src")
-    proc = subprocess.run(
-        [sys.executable, "-c", SNIPPET, json.dumps(what)],
-        env=env, capture_output=True, text=True, cwd=checkout,
-    )  # fmt: skip
-    if proc.returncode != 0:
-        raise SystemExit(f"{checkout}: the runs failed:\n{proc.stderr[-3000:]}")
-    return json.loads(proc.stdout.strip().splitlines()[-1])
+    from bench_trial_cost import run_in_checkout  # benchmarks/ is the script's path
+
+    return run_in_checkout(checkout, SNIPPET, what)
 
 
 def _is_time(name: str) -> bool:
