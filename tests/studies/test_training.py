@@ -163,6 +163,8 @@ def test_a_success_scores_less_by_its_hover_drift_and_a_failure_does_not():
     assert list(s) == [True] * 5 + [False]  # the success itself is the benchmark's
     r0, _ = rewards(cases, [5.0] * len(cases), 0.1)
     np.testing.assert_allclose(r0, [1 + kept] * 5 + [kept])
+    with pytest.raises(ValueError, match="a success without its hover_drift_m"):
+        rewards([_summary()], [5.0], 0.1, drift_weight=0.5)  # flown without its rows
 
 
 def test_hover_drift_is_the_farthest_horizontal_distance_from_the_hover_point():

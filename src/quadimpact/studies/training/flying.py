@@ -89,9 +89,8 @@ class Flyer:
         if block is not None:
             ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
         m = setup.model(ctrl=ctrl)
-        o = self._output_rows(m, int(setup.n_imu)) if self.drift else None
-        if o is None:
-            o = self.buffers.output(m, int(setup.n_imu))
+        n_imu = int(setup.n_imu)
+        o = self._output_rows(m, n_imu) if self.drift else self.buffers.output(m, n_imu)
         start = time.perf_counter()
         (setup.kernel or BUILTIN).run(m, o)
         wall = time.perf_counter() - start
@@ -188,6 +187,8 @@ def rewards(
     score = success.astype(float)
     if drift_weight > 0.0:
         drift = np.array([finite((s or {}).get("hover_drift_m")) for s in summaries])
+        if np.isnan(drift[success]).any():
+            raise ValueError("rewards: a success without its hover_drift_m (Flyer(drift=True))")
         penalty = drift_weight * np.minimum(np.nan_to_num(drift, nan=0.0) / DRIFT_SCALE_M, 1.0)
         score = np.where(success, 1.0 - penalty, 0.0)
     reward = np.where(t["valid"].to_numpy(dtype=bool), score + shaping * kept, 0.0)
