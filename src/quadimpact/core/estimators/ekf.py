@@ -138,13 +138,32 @@ def covariance(est: np.ndarray, n: int) -> np.ndarray:
 @compiled
 def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool) -> None:
     """``W[o, :n, :m] = W[a, :n, :k] W[b, :k, :m]`` (``W[b]^T`` when ``bt``), in a fixed
-    order of operations (no BLAS: the same bits on every CPU)."""
-    for i in range(n):
+    order of operations (no BLAS: the same bits on every CPU).
+
+    Each entry is the sum over ``r = 0, 1, ...`` in that order, from ``+0.0``. The
+    terms whose structural factor is exactly zero are skipped: ``W[a]``'s, or
+    ``W[b]``'s when ``bt`` (``Phi``, ``H`` and ``I - K H`` are mostly zeros).
+    Adding a zero product never changes a sum that starts at ``+0.0``, so the
+    bits are the same for finite inputs. ``o`` differs from ``a`` and ``b``.
+    """
+    if bt:
         for j in range(m):
-            s = 0.0
+            for i in range(n):
+                W[o, i, j] = 0.0
             for r in range(k):
-                s += W[a, i, r] * (W[b, j, r] if bt else W[b, r, j])
-            W[o, i, j] = s
+                y = W[b, j, r]
+                if y != 0.0:
+                    for i in range(n):
+                        W[o, i, j] += W[a, i, r] * y
+    else:
+        for i in range(n):
+            for j in range(m):
+                W[o, i, j] = 0.0
+            for r in range(k):
+                x = W[a, i, r]
+                if x != 0.0:
+                    for j in range(m):
+                        W[o, i, j] += x * W[b, r, j]
 
 
 @compiled
