@@ -33,6 +33,7 @@ from quadimpact.core.geometry import NPAIR
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.roots import brentq
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.simulation import approach as approach_py
 from quadimpact.simulation import setup as setup_py
 from quadimpact.simulation.setup import prepare
@@ -95,7 +96,7 @@ def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
         shapes=np.zeros((0, L.NSHAPE)),
         pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=kw["free_opts"],
-        scfg=np.zeros(L.NSCFG),
+        scfg=np.zeros(IMS.NSCFG),
         noise=np.zeros((0, 6)),
         t_out=np.array([float(kw["impact_time_s"])]),
     )

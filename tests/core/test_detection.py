@@ -8,6 +8,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.detection import detect
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
@@ -16,8 +17,8 @@ G = 9.81
 
 def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=0.0):
     """Run the detector over specific-force samples (body, m/s^2) at 200 Hz."""
-    scfg = np.zeros(L.NSCFG)
-    scfg[L.SC_RATE] = 200.0
+    scfg = np.zeros(IMS.NSCFG)
+    scfg[IMS.SC_RATE] = 200.0
     scfg[DET.SC_DET_THRESHOLD] = threshold
     scfg[DET.SC_DET_PERSIST] = persist
     scfg[DET.SC_DET_WORLD] = 1.0 if world else 0.0

@@ -31,6 +31,7 @@ from quadimpact.core.geometry.contact_record import material_record
 from quadimpact.core.kernel import make_kernel
 from quadimpact.core.recording_slots import E_FEATURE, E_SHAPE, E_T_START, E_V_I, OUT_X
 from quadimpact.core.records import model, new_output
+from quadimpact.core.sensors import imu_slots as IMS
 
 FEAT_BALL = 50  # the new feature kind: a sphere of radius F_RADIUS at F_CENTRE
 SHAPE_SPHERE = 60  # the new shape kind: a sphere of radius SH_RADIUS at SH_POINT
@@ -127,8 +128,8 @@ def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
     opts[[L.O_V_MIN, L.O_V_REG, L.O_POWER_OFF_T]] = (1e-3, 1e-2, np.inf)
     ctrl = np.zeros(L.NCTRL)
     ctrl[L.C_KIND] = L.CTRL_USER
-    scfg = np.zeros(L.NSCFG)
-    scfg[L.SC_RATE] = rate_hz
+    scfg = np.zeros(IMS.NSCFG)
+    scfg[IMS.SC_RATE] = rate_hz
     return model(
         x0=x0, t0=0.0, tf=0.6, veh=veh, feat=feat, shapes=shapes,
         pairs=geometry.pair_table(feat, shapes), opts=opts, ctrl=ctrl, scfg=scfg,

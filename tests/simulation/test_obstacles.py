@@ -25,6 +25,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.recording_slots import E_OPEN, E_T_END, E_T_START, OUT_T, OUT_X
 from quadimpact.core.records import new_output
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, scenario_from_dict
 from quadimpact.inputs.world import Box, Cylinder
 from quadimpact.simulation.setup import prepare
@@ -153,7 +154,7 @@ def _elastic_run(obstacle, position, velocity, euler=(0.0, 0.0, 0.0)):
     ctrl[L.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
     x0[L.X_ROTOR : L.X_ROTOR + 4] = 0.0
-    m = setup.model(x0=x0, feat=feat, ctrl=ctrl, scfg=np.zeros(L.NSCFG))
+    m = setup.model(x0=x0, feat=feat, ctrl=ctrl, scfg=np.zeros(IMS.NSCFG))
     o = new_output(m, 0, 64)
     BUILTIN.run(m, o)
     n_out = int(o.stats[L.ST_N_OUT])
@@ -223,7 +224,7 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     ctrl[L.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
     x0[L.X_ROTOR : L.X_ROTOR + 4] = 0.0
-    m = setup.model(x0=x0, veh=veh, ctrl=ctrl, scfg=np.zeros(L.NSCFG))
+    m = setup.model(x0=x0, veh=veh, ctrl=ctrl, scfg=np.zeros(IMS.NSCFG))
     o = new_output(m, 0, 16)
     BUILTIN.run(m, o)
     assert int(o.stats[L.ST_N_EPISODES]) == 1

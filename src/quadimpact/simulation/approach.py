@@ -51,6 +51,7 @@ from quadimpact.core.geometry import (
 from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.inputs.resolve import (  # defined with the rest of a run's start; names kept
     PAPER_FIT_OFFSET_RAD,
     PAPER_FIT_SCALE,
@@ -207,7 +208,7 @@ def shooting_record(
         shapes=np.zeros((0, L.NSHAPE)),
         pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=free_opts,
-        scfg=np.zeros(L.NSCFG),
+        scfg=np.zeros(IMS.NSCFG),
         noise=np.zeros((0, 6)),
         t_out=np.array([float(impact_time_s)]),
     )
