@@ -21,7 +21,8 @@ contact-pair table in ``core/geometry``). A component whose sizes
 ``records.py`` or this module need declares its blocks in a declaration module
 next to it, which holds no compiled code: the contact pairs' ``cs``
 (``core/contact_slots.py``), the output rows and episodes
-(``core/recording_slots.py``), and the parts of ``stats`` this module places
+(``core/recording_slots.py``), the IMU's ``scfg`` and ``imu``
+(``core/sensors/imu_slots.py``), and the parts of ``stats`` this module places
 at addresses computed from their declared sizes (``ST_EXCURSION`` from
 ``core/excursion_slots.py``, ``ST_HOVER`` and ``ST_HELD`` from
 ``core/hover_slots.py``). Numba reads these module-level integers as
