@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
@@ -27,7 +28,7 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
     veh = np.zeros(L.NVEH)
     veh[L.V_GRAVITY] = G
-    feat = np.zeros((0, L.NFEAT))
+    feat = np.zeros((0, FS.NFEAT))
     shapes = np.zeros((0, L.NSHAPE))
     m = model(x0=x, t0=0.0, tf=1.0, veh=veh, feat=feat, shapes=shapes,
               pairs=pair_table(feat, shapes), opts=np.zeros(L.NOPT), ctrl=np.zeros(L.NCTRL),

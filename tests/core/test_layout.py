@@ -15,6 +15,7 @@ from collections import defaultdict
 import numpy as np
 import pytest
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
@@ -146,7 +147,7 @@ def test_the_factories_allocate_the_declared_sizes():
 
     m = model(
         x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
-        feat=np.zeros((m_feat, L.NFEAT)), shapes=np.zeros((n_shapes, L.NSHAPE)),
+        feat=np.zeros((m_feat, FS.NFEAT)), shapes=np.zeros((n_shapes, L.NSHAPE)),
         pairs=np.zeros((m_feat * n_shapes, NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
         ctrl=np.zeros(L.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
     )  # fmt: skip

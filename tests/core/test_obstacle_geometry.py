@@ -35,6 +35,7 @@ from geometry_reference import (
     rotation,
 )
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
 from quadimpact.core.geometry.plane import ring_plane_bound
@@ -73,12 +74,12 @@ def _rotation(x):
 
 
 def _feature(kind, centre, radius=0.0, normal=(0.0, 0.0, -1.0)):
-    feat = np.zeros((1, L.NFEAT))
-    feat[0, L.F_KIND] = {"ring": L.FEAT_RING, "sphere": L.FEAT_SPHERE, "point": L.FEAT_POINT}[kind]
-    feat[0, L.F_CENTRE : L.F_CENTRE + 3] = centre
-    feat[0, L.F_NORMAL : L.F_NORMAL + 3] = np.asarray(normal) / np.linalg.norm(normal)
-    feat[0, L.F_RADIUS] = radius
-    feat[0, [L.F_K, L.F_N, L.F_E]] = (100.0, 1.0, 0.9)
+    feat = np.zeros((1, FS.NFEAT))
+    feat[0, FS.F_KIND] = {"ring": L.FEAT_RING, "sphere": L.FEAT_SPHERE, "point": L.FEAT_POINT}[kind]
+    feat[0, FS.F_CENTRE : FS.F_CENTRE + 3] = centre
+    feat[0, FS.F_NORMAL : FS.F_NORMAL + 3] = np.asarray(normal) / np.linalg.norm(normal)
+    feat[0, FS.F_RADIUS] = radius
+    feat[0, [FS.F_K, FS.F_N, FS.F_E]] = (100.0, 1.0, 0.9)
     return feat
 
 
@@ -135,7 +136,7 @@ def test_points_against_the_reference_depth(shape):
         x = _state(rng)
         feat = _feature("point", rng.uniform(-0.25, 0.25, 3))
         C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
-        p = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+        p = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
         np.testing.assert_allclose(x[L.X_POS : L.X_POS + 3] + C @ rc, p, atol=1e-12)
         assert delta == pytest.approx(float(depth(p, row)), abs=1e-12)
         np.testing.assert_allclose(n, _numerical_normal(p, row), atol=1e-8)
@@ -158,7 +159,7 @@ def test_spheres_against_brute_force(shape):
         radius = float(rng.uniform(0.03, 0.15))
         feat = _feature("sphere", rng.uniform(-0.3, 0.3, 3), radius)
         C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
-        c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+        c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
         assert delta == pytest.approx(radius + float(depth(c, row)), abs=1e-12)
         p = x[L.X_POS : L.X_POS + 3] + C @ rc
         assert np.linalg.norm(p - c) == pytest.approx(radius, abs=1e-12)
@@ -206,9 +207,9 @@ def test_ring_records_carry_the_point_normal_and_velocity():
             feat = _feature("ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), normal)
             C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
             p = x[L.X_POS : L.X_POS + 3] + C @ rc
-            centre = C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3] + x[L.X_POS : L.X_POS + 3]
-            nrm = C @ feat[0, L.F_NORMAL : L.F_NORMAL + 3]
-            assert np.linalg.norm(p - centre) == pytest.approx(feat[0, L.F_RADIUS], abs=1e-12)
+            centre = C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3] + x[L.X_POS : L.X_POS + 3]
+            nrm = C @ feat[0, FS.F_NORMAL : FS.F_NORMAL + 3]
+            assert np.linalg.norm(p - centre) == pytest.approx(feat[0, FS.F_RADIUS], abs=1e-12)
             assert (p - centre) @ nrm == pytest.approx(0.0, abs=1e-12)
             assert float(depth(p, row)) == pytest.approx(delta, abs=1e-12)
             if abs(float(depth(p, row))) > 1e-6:
@@ -385,7 +386,7 @@ def test_spheres_and_points_agree_with_python_fcl(shape):
             x = _state(rng)
             feat = _feature(kind, rng.uniform(-0.2, 0.2, 3), radius if kind == "sphere" else 0)
             C, delta, _, rc, _, n = _record(x, feat, row)
-            c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+            c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
             geom, tf = _fcl_shape(fcl, row)
             req = fcl.CollisionRequest(enable_contact=True, num_max_contacts=1)
             res = fcl.CollisionResult()
@@ -436,7 +437,7 @@ def test_the_broad_phase_bounds_a_rings_depth_and_rate(shape):
             "ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), rng.standard_normal(3)
         )
         C, delta, delta_dot, *_ = _record(x, feat, row)
-        kind = (int(feat[0, L.F_KIND]), int(row[L.SH_KIND]))
+        kind = (int(feat[0, FS.F_KIND]), int(row[L.SH_KIND]))
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert geometry.has_bound(pairs, 0)
         bound, rate = geometry.pair_bound(x, C, feat, row[None, :], pairs, 0)
@@ -477,7 +478,7 @@ def test_closed_form_pairs_have_no_broad_phase():
     for feature, shape in (("sphere", "box"), ("point", "cylinder"), ("ring", "plane")):
         feat = _feature(feature, (0.1, 0.0, 0.0), 0.1)
         row = _shape(rng, shape)
-        kind = (int(feat[0, L.F_KIND]), int(row[L.SH_KIND]))
+        kind = (int(feat[0, FS.F_KIND]), int(row[L.SH_KIND]))
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert not geometry.has_bound(pairs, 0)
         assert geometry.pair_bound(x, C, feat, row[None, :], pairs, 0) == (math.inf, math.inf)

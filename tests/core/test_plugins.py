@@ -24,6 +24,7 @@ import pytest
 from numba import njit
 from scipy.integrate import solve_ivp
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import PR_GEOMETRY
@@ -45,7 +46,7 @@ def ball_sphere(x, C, feat, f, shapes, s):  # pragma: no cover - compiled
     Copies the centre (an allocation, as every plug-in here makes one: the loop
     is compiled without reference counting, its plug-ins with it).
     """
-    cb = feat[f, L.F_CENTRE : L.F_CENTRE + 3].copy()
+    cb = feat[f, FS.F_CENTRE : FS.F_CENTRE + 3].copy()
     ox = C[0, 0] * cb[0] + C[0, 1] * cb[1] + C[0, 2] * cb[2]
     oy = C[1, 0] * cb[0] + C[1, 1] * cb[1] + C[1, 2] * cb[2]
     oz = C[2, 0] * cb[0] + C[2, 1] * cb[1] + C[2, 2] * cb[2]
@@ -54,7 +55,7 @@ def ball_sphere(x, C, feat, f, shapes, s):  # pragma: no cover - compiled
     rz = x[L.X_POS + 2] + oz - shapes[s, L.SH_POINT + 2]
     dist = math.sqrt(rx * rx + ry * ry + rz * rz)
     nx, ny, nz = rx / dist, ry / dist, rz / dist  # out of the obstacle, toward the ball
-    rf = feat[f, L.F_RADIUS]
+    rf = feat[f, FS.F_RADIUS]
     delta = rf + shapes[s, L.SH_RADIUS] - dist
     return material_record(x, C, delta, ox - rf * nx, oy - rf * ny, oz - rf * nz, nx, ny, nz)
 
@@ -74,7 +75,7 @@ def proximity(t, x, xdot, C, m, d):  # pragma: no cover - compiled
     p = x[L.X_POS : L.X_POS + 3].copy()
     for s in range(m.shapes.shape[0]):
         g = sphere_distance(p[0], p[1], p[2], m.shapes, s)
-        gap = min(gap, g - m.feat[0, L.F_RADIUS])
+        gap = min(gap, g - m.feat[0, FS.F_RADIUS])
     d.meas[L.MS_USER] = gap
     d.meas[L.MS_USER + 1] = t
 
@@ -109,9 +110,9 @@ def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
     veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
     veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
     veh[L.V_SPIN : L.V_SPIN + 4] = (-1.0, 1.0, -1.0, 1.0)
-    feat = np.zeros((1, L.NFEAT))
-    feat[0, L.F_KIND] = FEAT_BALL
-    feat[0, [L.F_RADIUS, L.F_K, L.F_N, L.F_E]] = (0.1, k, n, e)
+    feat = np.zeros((1, FS.NFEAT))
+    feat[0, FS.F_KIND] = FEAT_BALL
+    feat[0, [FS.F_RADIUS, FS.F_K, FS.F_N, FS.F_E]] = (0.1, k, n, e)
     shapes = np.zeros((1, L.NSHAPE))
     shapes[0, L.SH_KIND] = SHAPE_SPHERE
     shapes[0, L.SH_POINT : L.SH_POINT + 3] = (0.0, 0.0, 0.5)  # top at Z = 0 (NED, down)

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, load_scenario_file, simulate
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.inputs.vehicle import load_vehicle
 from quadimpact.packing.vehicle_block import allocation_matrix
@@ -37,7 +38,7 @@ def test_initial_state(roll, pitch, yaw, model):
     np.testing.assert_array_equal(wall, [[0, 0, 0, -1, 0, 0]])
     assert setup.opts[L.O_CRASH_RULE] == L.CRASH_NONE
     assert setup.opts[L.O_SLEW_MAX] == pytest.approx(70_000 * math.pi / 30)
-    np.testing.assert_array_equal(setup.feat[:, L.F_MU], [0.3] * len(setup.feature_names))
+    np.testing.assert_array_equal(setup.feat[:, FS.F_MU], [0.3] * len(setup.feature_names))
     assert setup.tf == 3.0
     assert s.resolved_pre_impact() == "spin-down"
 

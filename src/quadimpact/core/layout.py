@@ -202,19 +202,8 @@ V_GRAVITY = _veh.slot("V_GRAVITY")  # m/s^2
 V_TAU_M = _veh.slot("V_TAU_M")  # motor time constant, s (first-order rotor mode)
 NVEH = _veh.end("NVEH")
 
-# ---- contact features feat (n_features, NFEAT): the vehicle's protective
-# structure, body frame, each with its own contact law parameters
-_feat = Block("feat", "F_")
-F_KIND = _feat.slot("F_KIND")  # FEAT_*
-F_CENTRE = _feat.slot("F_CENTRE", 3)  # ring or sphere centre, point position (body, m)
-F_NORMAL = _feat.slot("F_NORMAL", 3)  # ring plane unit normal (body)
-F_RADIUS = _feat.slot("F_RADIUS")  # ring or sphere radius, m
-F_K = _feat.slot("F_K")  # contact stiffness, N/m^n
-F_N = _feat.slot("F_N")  # contact exponent
-F_E = _feat.slot("F_E")  # coefficient of restitution
-F_MU = _feat.slot("F_MU")  # friction coefficient (0: frictionless)
-F_FORCE_SCALE = _feat.slot("F_FORCE_SCALE")  # factor on the normal force (<= 0 or 1: none)
-NFEAT = _feat.end("NFEAT")
+# ---- contact features feat (n_features, NFEAT): declared by the contact law in
+# core/feature_slots.py
 
 # ---- world shapes shapes (n_shapes, NSHAPE), inertial frame; each kind
 # reads the slots it needs (core/geometry/<kind>.py)

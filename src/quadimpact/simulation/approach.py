@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.approach import (
     AP_DV,
@@ -112,7 +113,7 @@ def pair_depths_at(
             if comp is None or comp not in plugins:
                 continue
             f = int(pairs[c, PR_FEATURE])
-            contact = comp.contacts.get(int(feat[f, L.F_KIND]))
+            contact = comp.contacts.get(int(feat[f, FS.F_KIND]))
             if contact is not None:
                 depths[c] = float(contact(xq, C, feat, f, shapes, s)[0])
     return depths

@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
@@ -389,7 +390,7 @@ class Scene:
         points, depths, normals = contact_points(x, self.drawing, self.surf)
         marks: list[ContactMark] = []
         for j in range(self.drawing.packed.shape[0]):
-            n_exp = float(self.drawing.packed[j, L.F_N])
+            n_exp = float(self.drawing.packed[j, FS.F_N])
             if not (deltas[j] > 0.0 or forces[j] > 0.0):
                 continue  # the simulation had no active contact on this bumper
             touching = [s for s in range(self.surf.shape[0]) if depths[j, s] > 0.0]
