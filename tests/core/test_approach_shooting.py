@@ -15,6 +15,7 @@ import pytest
 from quadimpact import WallApproach
 from quadimpact.core import approach as core_approach
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.approach import (
     AP_LATE,
     AP_RUNS,
@@ -93,7 +94,7 @@ def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
     free = kw["run"]._replace(
         x0=x0,
         span=span,
-        shapes=np.zeros((0, L.NSHAPE)),
+        shapes=np.zeros((0, SHP.NSHAPE)),
         pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=kw["free_opts"],
         scfg=np.zeros(IMS.NSCFG),

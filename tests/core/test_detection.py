@@ -6,6 +6,7 @@ import numpy as np
 
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
 from quadimpact.core.sensors import detection as DET
@@ -29,7 +30,7 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     veh = np.zeros(L.NVEH)
     veh[L.V_GRAVITY] = G
     feat = np.zeros((0, FS.NFEAT))
-    shapes = np.zeros((0, L.NSHAPE))
+    shapes = np.zeros((0, SHP.NSHAPE))
     m = model(x0=x, t0=0.0, tf=1.0, veh=veh, feat=feat, shapes=shapes,
               pairs=pair_table(feat, shapes), opts=np.zeros(L.NOPT), ctrl=np.zeros(L.NCTRL),
               t_out=np.zeros(0), scfg=scfg)  # fmt: skip

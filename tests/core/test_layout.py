@@ -17,6 +17,7 @@ import pytest
 
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
 from quadimpact.core.recording_slots import NEP, NOUT, out_width
@@ -147,7 +148,7 @@ def test_the_factories_allocate_the_declared_sizes():
 
     m = model(
         x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
-        feat=np.zeros((m_feat, FS.NFEAT)), shapes=np.zeros((n_shapes, L.NSHAPE)),
+        feat=np.zeros((m_feat, FS.NFEAT)), shapes=np.zeros((n_shapes, SHP.NSHAPE)),
         pairs=np.zeros((m_feat * n_shapes, NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
         ctrl=np.zeros(L.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
     )  # fmt: skip

@@ -38,6 +38,7 @@ from geometry_reference import (
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry.plane import ring_plane_bound
 from quadimpact.core.geometry.ring import ring_deepest
 from quadimpact.core.geometry.ring_box import ring_box_exact
@@ -247,9 +248,11 @@ def test_rings_around_a_bar_take_the_branch_and_bound_and_stay_exact():
 
 def _ring_at_a_corner(rng, row, off):
     """A circle centred near a corner of the box ``row`` (within ``off``), any orientation."""
-    axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
+    axes = row[SHP.SH_ROT : SHP.SH_ROT + 9].reshape(3, 3)
     signs = rng.choice([-1.0, 1.0], 3)
-    corner = row[L.SH_POINT : L.SH_POINT + 3] + axes.T @ (signs * row[L.SH_HALF : L.SH_HALF + 3])
+    corner = row[SHP.SH_POINT : SHP.SH_POINT + 3] + axes.T @ (
+        signs * row[SHP.SH_HALF : SHP.SH_HALF + 3]
+    )
     ring = random_ring(rng, spread=off)
     return (*(np.array(ring[:3]) + corner), *ring[3:])
 
@@ -352,23 +355,23 @@ def _fcl():
 
 def _fcl_shape(fcl, row):
     """The fcl geometry and transform of a shape row (an infinite cylinder: 100 m long)."""
-    kind = int(row[L.SH_KIND])
-    o = row[L.SH_POINT : L.SH_POINT + 3]
+    kind = int(row[SHP.SH_KIND])
+    o = row[SHP.SH_POINT : SHP.SH_POINT + 3]
     if kind == L.SHAPE_PLANE:
-        n = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+        n = row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
         # fcl's halfspace n . p <= d is the solid: ours is behind the outward normal
         return fcl.Halfspace(n, float(n @ o)), fcl.Transform()
     if kind == L.SHAPE_BOX:
-        axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
-        half = row[L.SH_HALF : L.SH_HALF + 3]
+        axes = row[SHP.SH_ROT : SHP.SH_ROT + 9].reshape(3, 3)
+        half = row[SHP.SH_HALF : SHP.SH_HALF + 3]
         return fcl.Box(*(2 * half)), fcl.Transform(axes.T, o)
-    e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+    e = row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
     k = np.eye(3)[np.argmin(np.abs(e))]
     a = np.cross(e, k)
     a /= np.linalg.norm(a)
     R = np.column_stack([a, np.cross(e, a), e])  # fcl's cylinder axis is its local z
-    length = row[L.SH_LENGTH] if np.isfinite(row[L.SH_LENGTH]) else 100.0
-    return fcl.Cylinder(row[L.SH_RADIUS], length), fcl.Transform(R, o)
+    length = row[SHP.SH_LENGTH] if np.isfinite(row[SHP.SH_LENGTH]) else 100.0
+    return fcl.Cylinder(row[SHP.SH_RADIUS], length), fcl.Transform(R, o)
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -380,7 +383,7 @@ def test_spheres_and_points_agree_with_python_fcl(shape):
     for _ in range(200):
         row = _shape(rng, shape)
         if shape == "plane":
-            row[L.SH_POINT : L.SH_POINT + 3] = 0.0
+            row[SHP.SH_POINT : SHP.SH_POINT + 3] = 0.0
         for kind in ("sphere", "point"):
             radius = float(rng.uniform(0.03, 0.15)) if kind == "sphere" else 1e-4
             x = _state(rng)
@@ -437,7 +440,7 @@ def test_the_broad_phase_bounds_a_rings_depth_and_rate(shape):
             "ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), rng.standard_normal(3)
         )
         C, delta, delta_dot, *_ = _record(x, feat, row)
-        kind = (int(feat[0, FS.F_KIND]), int(row[L.SH_KIND]))
+        kind = (int(feat[0, FS.F_KIND]), int(row[SHP.SH_KIND]))
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert geometry.has_bound(pairs, 0)
         bound, rate = geometry.pair_bound(x, C, feat, row[None, :], pairs, 0)
@@ -478,7 +481,7 @@ def test_closed_form_pairs_have_no_broad_phase():
     for feature, shape in (("sphere", "box"), ("point", "cylinder"), ("ring", "plane")):
         feat = _feature(feature, (0.1, 0.0, 0.0), 0.1)
         row = _shape(rng, shape)
-        kind = (int(feat[0, FS.F_KIND]), int(row[L.SH_KIND]))
+        kind = (int(feat[0, FS.F_KIND]), int(row[SHP.SH_KIND]))
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert not geometry.has_bound(pairs, 0)
         assert geometry.pair_bound(x, C, feat, row[None, :], pairs, 0) == (math.inf, math.inf)

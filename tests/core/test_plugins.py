@@ -27,6 +27,7 @@ from scipy.integrate import solve_ivp
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry import PR_GEOMETRY
 from quadimpact.core.geometry.contact_record import material_record
 from quadimpact.core.kernel import make_kernel
@@ -50,22 +51,22 @@ def ball_sphere(x, C, feat, f, shapes, s):  # pragma: no cover - compiled
     ox = C[0, 0] * cb[0] + C[0, 1] * cb[1] + C[0, 2] * cb[2]
     oy = C[1, 0] * cb[0] + C[1, 1] * cb[1] + C[1, 2] * cb[2]
     oz = C[2, 0] * cb[0] + C[2, 1] * cb[1] + C[2, 2] * cb[2]
-    rx = x[L.X_POS] + ox - shapes[s, L.SH_POINT]
-    ry = x[L.X_POS + 1] + oy - shapes[s, L.SH_POINT + 1]
-    rz = x[L.X_POS + 2] + oz - shapes[s, L.SH_POINT + 2]
+    rx = x[L.X_POS] + ox - shapes[s, SHP.SH_POINT]
+    ry = x[L.X_POS + 1] + oy - shapes[s, SHP.SH_POINT + 1]
+    rz = x[L.X_POS + 2] + oz - shapes[s, SHP.SH_POINT + 2]
     dist = math.sqrt(rx * rx + ry * ry + rz * rz)
     nx, ny, nz = rx / dist, ry / dist, rz / dist  # out of the obstacle, toward the ball
     rf = feat[f, FS.F_RADIUS]
-    delta = rf + shapes[s, L.SH_RADIUS] - dist
+    delta = rf + shapes[s, SHP.SH_RADIUS] - dist
     return material_record(x, C, delta, ox - rf * nx, oy - rf * ny, oz - rf * nz, nx, ny, nz)
 
 
 @njit
 def sphere_distance(px, py, pz, shapes, s):  # pragma: no cover - compiled
-    dx = px - shapes[s, L.SH_POINT]
-    dy = py - shapes[s, L.SH_POINT + 1]
-    dz = pz - shapes[s, L.SH_POINT + 2]
-    return math.sqrt(dx * dx + dy * dy + dz * dz) - shapes[s, L.SH_RADIUS]
+    dx = px - shapes[s, SHP.SH_POINT]
+    dy = py - shapes[s, SHP.SH_POINT + 1]
+    dz = pz - shapes[s, SHP.SH_POINT + 2]
+    return math.sqrt(dx * dx + dy * dy + dz * dz) - shapes[s, SHP.SH_RADIUS]
 
 
 @njit
@@ -113,10 +114,10 @@ def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
     feat = np.zeros((1, FS.NFEAT))
     feat[0, FS.F_KIND] = FEAT_BALL
     feat[0, [FS.F_RADIUS, FS.F_K, FS.F_N, FS.F_E]] = (0.1, k, n, e)
-    shapes = np.zeros((1, L.NSHAPE))
-    shapes[0, L.SH_KIND] = SHAPE_SPHERE
-    shapes[0, L.SH_POINT : L.SH_POINT + 3] = (0.0, 0.0, 0.5)  # top at Z = 0 (NED, down)
-    shapes[0, L.SH_RADIUS] = 0.5
+    shapes = np.zeros((1, SHP.NSHAPE))
+    shapes[0, SHP.SH_KIND] = SHAPE_SPHERE
+    shapes[0, SHP.SH_POINT : SHP.SH_POINT + 3] = (0.0, 0.0, 0.5)  # top at Z = 0 (NED, down)
+    shapes[0, SHP.SH_RADIUS] = 0.5
     x0 = np.zeros(L.NX)
     x0[L.X_POS + 2] = -0.3  # the ball's bottom 0.2 m above the sphere
     x0[L.X_QUAT] = 1.0

@@ -205,18 +205,8 @@ NVEH = _veh.end("NVEH")
 # ---- contact features feat (n_features, NFEAT): declared by the contact law in
 # core/feature_slots.py
 
-# ---- world shapes shapes (n_shapes, NSHAPE), inertial frame; each kind
-# reads the slots it needs (core/geometry/<kind>.py)
-_shape = Block("shapes", "SH_")
-SH_KIND = _shape.slot("SH_KIND")  # SHAPE_*
-SH_IS_GROUND = _shape.slot("SH_IS_GROUND")  # 1: the ground (its first onset is the crash)
-SH_POINT = _shape.slot("SH_POINT", 3)  # a point: on a plane, on an axis, a centre (m)
-SH_NORMAL = _shape.slot("SH_NORMAL", 3)  # a unit vector: a plane's outward normal, an axis
-SH_RADIUS = _shape.slot("SH_RADIUS")  # m: a radius (cylinder, sphere)
-SH_LENGTH = _shape.slot("SH_LENGTH")  # m: a length along SH_NORMAL (inf: unbounded)
-SH_HALF = _shape.slot("SH_HALF", 3)  # m: half-extents along the shape's own axes (box)
-SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components: row i is axis i
-NSHAPE = _shape.end("NSHAPE")
+# ---- world shapes shapes (n_shapes, NSHAPE): declared by the obstacle geometry in
+# core/shape_slots.py
 
 # ---- options opts (NOPT): model switches, integrator settings
 _opt = Block("opts", "O_")

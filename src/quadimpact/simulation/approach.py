@@ -22,6 +22,7 @@ import numpy as np
 
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.approach import (
     AP_DV,
     AP_LATE,
@@ -109,7 +110,7 @@ def pair_depths_at(
     if plugins:
         for c in range(pairs.shape[0]):
             s = int(pairs[c, PR_SHAPE])
-            comp = by_kind(int(shapes[s, L.SH_KIND]))
+            comp = by_kind(int(shapes[s, SHP.SH_KIND]))
             if comp is None or comp not in plugins:
                 continue
             f = int(pairs[c, PR_FEATURE])
@@ -206,7 +207,7 @@ def shooting_record(
     free = run._replace(
         x0=np.zeros(L.NX),
         span=np.zeros(L.NSPAN),
-        shapes=np.zeros((0, L.NSHAPE)),
+        shapes=np.zeros((0, SHP.NSHAPE)),
         pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=free_opts,
         scfg=np.zeros(IMS.NSCFG),

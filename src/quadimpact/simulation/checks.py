@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.recording_slots import out_width
 from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.errors import InputError
@@ -148,7 +148,7 @@ def check_initial_contact(scenario: Any, setup: Any) -> None:
         deepest = int(np.argmax(depths))
         depth = float(depths[deepest])
         feature = _feature_label(setup.feature_names[deepest])
-        ground = setup.shapes[s, L.SH_IS_GROUND] > 0.5
+        ground = setup.shapes[s, SHP.SH_IS_GROUND] > 0.5
         if kind == "impact-trial" and not ground and depth > 0.0:
             raise InputError(
                 f"impact trial: {STARTED_IN_CONTACT}: {feature} is "

@@ -18,6 +18,7 @@ import numpy as np
 
 from quadimpact import __version__
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.excursion import DEG
 from quadimpact.core.excursion_slots import EX_COS_TILT, EX_DEV, NEX
 from quadimpact.core.sensors import detection as DET
@@ -396,7 +397,7 @@ def _short_contact_warning(setup: RunSetup, episodes: RunEpisodes) -> str:
 
 def _obstacle_names(setup: RunSetup) -> list[str]:
     """Names of the packed shapes that are obstacles (not the ground)."""
-    return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, L.SH_IS_GROUND] < 0.5]
+    return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, SHP.SH_IS_GROUND] < 0.5]
 
 
 def episode_count(s: Mapping[str, Any]) -> int | None:

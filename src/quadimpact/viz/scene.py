@@ -42,6 +42,7 @@ import pandas as pd
 
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
 from quadimpact.packing.world_block import pack_surface_records, pack_surfaces
@@ -248,7 +249,7 @@ class Scene:
         elif self.surfaces:
             self.surf = pack_surfaces(self.surfaces)
         else:
-            self.surf = np.zeros((0, L.NSHAPE))
+            self.surf = np.zeros((0, SHP.NSHAPE))
         ts = _drawable_rows(timeseries)
         self.t = ts["t_s"].to_numpy(dtype=float)
         self.states = np.zeros((len(ts), L.NX))

@@ -89,13 +89,15 @@ from quadimpact.core.layout import (
     FEAT_POINT,
     FEAT_RING,
     FEAT_SPHERE,
-    SH_KIND,
     SHAPE_BOX,
     SHAPE_CYLINDER,
     SHAPE_PLANE,
     Block,
     FeatureKind,
     ShapeKind,
+)
+from quadimpact.core.shape_slots import (
+    SH_KIND,
 )
 
 # ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,

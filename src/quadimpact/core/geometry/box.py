@@ -36,10 +36,12 @@ from quadimpact.core.feature_slots import (
 )
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
 from quadimpact.core.layout import (
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
     SH_HALF,
     SH_POINT,
     SH_ROT,
-    X_POS,
 )
 
 OUTSIDE = -1  # the piece id of a point outside (the depth is smooth there)

@@ -39,11 +39,13 @@ from quadimpact.core.feature_slots import (
 )
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
 from quadimpact.core.layout import (
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
     SH_LENGTH,
     SH_NORMAL,
     SH_POINT,
     SH_RADIUS,
-    X_POS,
 )
 
 OUTSIDE = -1  # the piece id of a point outside (the depth is smooth there)

@@ -31,9 +31,11 @@ from quadimpact.core.feature_slots import (
 )
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
 from quadimpact.core.layout import (
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
     SH_NORMAL,
     SH_POINT,
-    X_POS,
 )
 
 PARALLEL_EPS = 1e-12  # |w| below this: the circle is parallel to the plane

@@ -39,9 +39,11 @@ from quadimpact.core.layout import (
     FEAT_POINT,
     FEAT_RING,
     FEAT_SPHERE,
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
     SH_POINT,
     SH_RADIUS,
-    X_POS,
 )
 
 __all__ = ["SHAPE", "SphereObstacle"]
