@@ -22,7 +22,9 @@ contact-pair table in ``core/geometry``). A component whose sizes
 next to it, which holds no compiled code: the contact pairs' ``cs``
 (``core/contact_slots.py``), the output rows and episodes
 (``core/recording_slots.py``), the IMU's ``scfg`` and ``imu``
-(``core/sensors/imu_slots.py``), and the parts of ``stats`` this module places
+(``core/sensors/imu_slots.py``), the features' ``feat``
+(``core/feature_slots.py``), the shapes' ``shapes``
+(``core/shape_slots.py``), and the parts of ``stats`` this module places
 at addresses computed from their declared sizes (``ST_EXCURSION`` from
 ``core/excursion_slots.py``, ``ST_HOVER`` and ``ST_HELD`` from
 ``core/hover_slots.py``). Numba reads these module-level integers as
