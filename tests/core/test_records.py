@@ -97,6 +97,7 @@ NEW_FILES = {
 CHECK = """
 import numpy as np
 from quadimpact.core import layout as L
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import new_data, new_output
 from quadimpact.core.step import advance, start
