@@ -40,6 +40,9 @@ DECLARATIONS = {
     "quadimpact.core.recording_slots": "quadimpact.core.recording",
     "quadimpact.core.excursion_slots": "quadimpact.core.excursion",
     "quadimpact.core.hover_slots": "quadimpact.core.hover_tracking",
+    "quadimpact.core.sensors.imu_slots": "quadimpact.core.sensors.imu",
+    "quadimpact.core.feature_slots": "quadimpact.core.contact",
+    "quadimpact.core.shape_slots": "quadimpact.core.geometry",
     "quadimpact.core.envs.episode_layout": "quadimpact.core.envs.stacked",
 }
 #: What a declaration module may import of quadimpact.

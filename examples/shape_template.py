@@ -34,17 +34,21 @@ import numpy as np
 from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
+from quadimpact.core.feature_slots import (
+    F_RADIUS,
+)
 from quadimpact.core.geometry import register_shape
 from quadimpact.core.geometry.contact_record import feature_offset, material_record
 from quadimpact.core.geometry.shape_component import ShapeComponent, ShapeSlot
 from quadimpact.core.layout import (
-    F_RADIUS,
     FEAT_POINT,
     FEAT_SPHERE,
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
     SH_HALF,
     SH_POINT,
     SH_RADIUS,
-    X_POS,
 )
 
 

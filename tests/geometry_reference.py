@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 
 
 def rotation(rng: np.random.Generator) -> np.ndarray:
@@ -30,53 +31,53 @@ def rotation(rng: np.random.Generator) -> np.ndarray:
 
 
 def plane_row(point, normal) -> np.ndarray:
-    row = np.zeros(L.NSHAPE)
-    row[L.SH_KIND] = L.SHAPE_PLANE
-    row[L.SH_POINT : L.SH_POINT + 3] = point
-    row[L.SH_NORMAL : L.SH_NORMAL + 3] = np.asarray(normal, float) / np.linalg.norm(normal)
+    row = np.zeros(SHP.NSHAPE)
+    row[SHP.SH_KIND] = L.SHAPE_PLANE
+    row[SHP.SH_POINT : SHP.SH_POINT + 3] = point
+    row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3] = np.asarray(normal, float) / np.linalg.norm(normal)
     return row
 
 
 def cylinder_row(point, axis, radius, length=math.inf) -> np.ndarray:
-    row = np.zeros(L.NSHAPE)
-    row[L.SH_KIND] = L.SHAPE_CYLINDER
-    row[L.SH_POINT : L.SH_POINT + 3] = point
-    row[L.SH_NORMAL : L.SH_NORMAL + 3] = np.asarray(axis, float) / np.linalg.norm(axis)
-    row[L.SH_RADIUS] = radius
-    row[L.SH_LENGTH] = length
+    row = np.zeros(SHP.NSHAPE)
+    row[SHP.SH_KIND] = L.SHAPE_CYLINDER
+    row[SHP.SH_POINT : SHP.SH_POINT + 3] = point
+    row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3] = np.asarray(axis, float) / np.linalg.norm(axis)
+    row[SHP.SH_RADIUS] = radius
+    row[SHP.SH_LENGTH] = length
     return row
 
 
 def box_row(centre, half, axes) -> np.ndarray:
-    row = np.zeros(L.NSHAPE)
-    row[L.SH_KIND] = L.SHAPE_BOX
-    row[L.SH_POINT : L.SH_POINT + 3] = centre
-    row[L.SH_HALF : L.SH_HALF + 3] = half
-    row[L.SH_ROT : L.SH_ROT + 9] = np.asarray(axes, float).ravel()
+    row = np.zeros(SHP.NSHAPE)
+    row[SHP.SH_KIND] = L.SHAPE_BOX
+    row[SHP.SH_POINT : SHP.SH_POINT + 3] = centre
+    row[SHP.SH_HALF : SHP.SH_HALF + 3] = half
+    row[SHP.SH_ROT : SHP.SH_ROT + 9] = np.asarray(axes, float).ravel()
     return row
 
 
 def depth(p: np.ndarray, row: np.ndarray) -> np.ndarray:
     """Depth (minus the signed distance, m) of the points ``p`` (..., 3) in the shape ``row``."""
     p = np.asarray(p, float)
-    kind = int(row[L.SH_KIND])
-    o = row[L.SH_POINT : L.SH_POINT + 3]
+    kind = int(row[SHP.SH_KIND])
+    o = row[SHP.SH_POINT : SHP.SH_POINT + 3]
     if kind == L.SHAPE_PLANE:
-        return -(p - o) @ row[L.SH_NORMAL : L.SH_NORMAL + 3]
+        return -(p - o) @ row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
     if kind == L.SHAPE_CYLINDER:
-        e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+        e = row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
         z = (p - o) @ e
         rho = np.linalg.norm((p - o) - z[..., None] * e, axis=-1)
-        a_r = rho - row[L.SH_RADIUS]
-        if not np.isfinite(row[L.SH_LENGTH]):
+        a_r = rho - row[SHP.SH_RADIUS]
+        if not np.isfinite(row[SHP.SH_LENGTH]):
             return -a_r
-        a_z = np.abs(z) - 0.5 * row[L.SH_LENGTH]
+        a_z = np.abs(z) - 0.5 * row[SHP.SH_LENGTH]
         inside = np.minimum(np.maximum(a_r, a_z), 0.0)
         outside = np.hypot(np.maximum(a_r, 0.0), np.maximum(a_z, 0.0))
         return -(inside + outside)
-    axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
+    axes = row[SHP.SH_ROT : SHP.SH_ROT + 9].reshape(3, 3)
     q = (p - o) @ axes.T
-    a = np.abs(q) - row[L.SH_HALF : L.SH_HALF + 3]
+    a = np.abs(q) - row[SHP.SH_HALF : SHP.SH_HALF + 3]
     inside = np.minimum(a.max(axis=-1), 0.0)
     outside = np.linalg.norm(np.maximum(a, 0.0), axis=-1)
     return -(inside + outside)

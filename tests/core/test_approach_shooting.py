@@ -15,6 +15,7 @@ import pytest
 from quadimpact import WallApproach
 from quadimpact.core import approach as core_approach
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.approach import (
     AP_LATE,
     AP_RUNS,
@@ -33,6 +34,7 @@ from quadimpact.core.geometry import NPAIR
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.roots import brentq
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.simulation import approach as approach_py
 from quadimpact.simulation import setup as setup_py
 from quadimpact.simulation.setup import prepare
@@ -92,10 +94,10 @@ def _speed_at_impact_from_rest(kw: dict, t: float) -> float:
     free = kw["run"]._replace(
         x0=x0,
         span=span,
-        shapes=np.zeros((0, L.NSHAPE)),
+        shapes=np.zeros((0, SHP.NSHAPE)),
         pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=kw["free_opts"],
-        scfg=np.zeros(L.NSCFG),
+        scfg=np.zeros(IMS.NSCFG),
         noise=np.zeros((0, 6)),
         t_out=np.array([float(kw["impact_time_s"])]),
     )

@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, WallApproach, simulate
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.contact import contact_wrench
 from quadimpact.core.contact_slots import CS_ACTIVE, CS_LAMBDA, NCS
@@ -113,7 +114,7 @@ def test_bumper_force_scale_scales_that_bumper_only():
     from quadimpact.rotations import quat_to_matrix
 
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
-    assert (setup.feat[:, L.F_FORCE_SCALE] == 1.0).all()
+    assert (setup.feat[:, FS.F_FORCE_SCALE] == 1.0).all()
 
     def wrench(active, scale=(1.0, 1.0, 1.0, 1.0)):
         m = setup.model()
@@ -122,7 +123,7 @@ def test_bumper_force_scale_scales_that_bumper_only():
             cs[j, CS_ACTIVE] = 1.0
             cs[j, CS_LAMBDA] = 3.0
         feat = m.feat.copy()
-        feat[:, L.F_FORCE_SCALE] = scale
+        feat[:, FS.F_FORCE_SCALE] = scale
         return np.array(contact_wrench(x, C, m._replace(feat=feat), cs))
 
     both, b2, b3 = wrench((1, 2)), wrench((1,)), wrench((2,))
@@ -135,9 +136,9 @@ def test_bumper_force_scale_scales_that_bumper_only():
 def test_bumper_force_scale_is_packed_into_the_feature_table():
     o = {"bumper_force_scale": (1.0, 2.0, 1.0, 1.0)}
     feat = prepare(WallApproach(heading_deg=180.0, model_options=o)).feat
-    np.testing.assert_array_equal(feat[:, L.F_FORCE_SCALE], [1.0, 2.0, 1.0, 1.0])
+    np.testing.assert_array_equal(feat[:, FS.F_FORCE_SCALE], [1.0, 2.0, 1.0, 1.0])
     plain = prepare(WallApproach(heading_deg=180.0)).feat
-    same = [i for i in range(L.NFEAT) if i != L.F_FORCE_SCALE]
+    same = [i for i in range(FS.NFEAT) if i != FS.F_FORCE_SCALE]
     np.testing.assert_array_equal(feat[:, same], plain[:, same])
 
 

@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.detection import detect
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
@@ -16,8 +19,8 @@ G = 9.81
 
 def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=0.0):
     """Run the detector over specific-force samples (body, m/s^2) at 200 Hz."""
-    scfg = np.zeros(L.NSCFG)
-    scfg[L.SC_RATE] = 200.0
+    scfg = np.zeros(IMS.NSCFG)
+    scfg[IMS.SC_RATE] = 200.0
     scfg[DET.SC_DET_THRESHOLD] = threshold
     scfg[DET.SC_DET_PERSIST] = persist
     scfg[DET.SC_DET_WORLD] = 1.0 if world else 0.0
@@ -26,8 +29,8 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
     veh = np.zeros(L.NVEH)
     veh[L.V_GRAVITY] = G
-    feat = np.zeros((0, L.NFEAT))
-    shapes = np.zeros((0, L.NSHAPE))
+    feat = np.zeros((0, FS.NFEAT))
+    shapes = np.zeros((0, SHP.NSHAPE))
     m = model(x0=x, t0=0.0, tf=1.0, veh=veh, feat=feat, shapes=shapes,
               pairs=pair_table(feat, shapes), opts=np.zeros(L.NOPT), ctrl=np.zeros(L.NCTRL),
               t_out=np.zeros(0), scfg=scfg)  # fmt: skip

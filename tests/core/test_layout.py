@@ -15,12 +15,15 @@ from collections import defaultdict
 import numpy as np
 import pytest
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
 from quadimpact.core.recording_slots import NEP, NOUT, out_width
 from quadimpact.core.records import new_data, new_output, new_work
 from quadimpact.core.rotors import NRIN
+from quadimpact.core.sensors import imu_slots as IMS
 
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
@@ -29,6 +32,9 @@ DECLARING = (
     "quadimpact.core.recording_slots",
     "quadimpact.core.excursion_slots",
     "quadimpact.core.hover_slots",
+    "quadimpact.core.feature_slots",
+    "quadimpact.core.shape_slots",
+    "quadimpact.core.sensors.imu_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
     "quadimpact.core.rotors",
@@ -112,9 +118,9 @@ def test_a_component_block_stays_inside_the_region_it_extends():
     regions = {
         "ecfg.": (L.EC_OWN, L.EC_OWN + L.N_OWN_ECFG),
         "est.": (L.ES_OWN, L.ES_OWN + L.N_OWN_EST),
-        "scfg.detector": (L.SC_DETECTOR, L.SC_DETECTOR + L.N_DETECTOR_CFG),
+        "scfg.detector": (IMS.SC_DETECTOR, IMS.SC_DETECTOR + L.N_DETECTOR_CFG),
         "sst.detector": (L.SS_DETECTOR, L.SS_DETECTOR + 1),
-        "imu.detector": (L.I_DETECTOR, L.I_DETECTOR + 1),
+        "imu.detector": (IMS.I_DETECTOR, IMS.I_DETECTOR + 1),
     }
     seen = set()
     for b in _blocks():
@@ -145,11 +151,11 @@ def test_the_factories_allocate_the_declared_sizes():
 
     m = model(
         x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
-        feat=np.zeros((m_feat, L.NFEAT)), shapes=np.zeros((n_shapes, L.NSHAPE)),
+        feat=np.zeros((m_feat, FS.NFEAT)), shapes=np.zeros((n_shapes, SHP.NSHAPE)),
         pairs=np.zeros((m_feat * n_shapes, NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
         ctrl=np.zeros(L.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
     )  # fmt: skip
-    assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (L.NSCFG,)
+    assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (IMS.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
         (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
@@ -157,7 +163,7 @@ def test_the_factories_allocate_the_declared_sizes():
     ]  # fmt: skip
     o = new_output(m, 7, 11)
     assert o.out.shape == (n_out, out_width(m_feat)) == (n_out, NOUT + 2 * m_feat)
-    assert o.imu.shape == (7, L.NIMU) and o.episodes.shape == (11, NEP)
+    assert o.imu.shape == (7, IMS.NIMU) and o.episodes.shape == (11, NEP)
     assert o.stats.shape == (L.NSTAT,)
     w = new_work(4)
     assert w.K.shape == (7, L.NX) and w.ev_sig.shape == (4,)

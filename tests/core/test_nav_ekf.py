@@ -26,6 +26,7 @@ from scipy.stats import chi2
 
 from quadimpact.core import layout as L
 from quadimpact.core.estimators import nav_ekf as N
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.registry import measurement_address
 from quadimpact.rotations import quat_to_matrix
 
@@ -427,7 +428,7 @@ def test_a_clipped_accelerometer_sample_inflates_the_velocity_covariance():
     h = Harness("nav-ekf", 10, imu="noisy", q0=fl.q, pos0=(0.0, 0.0, -1.5),
                 params={"gate_m_s2": 0.0})  # fmt: skip
     dt = 0.002
-    rng_f = h.m.scfg[L.SC_RANGE_F]
+    rng_f = h.m.scfg[IMS.SC_RANGE_F]
     sa = h.m.ecfg[N.EC_SIG_ACC]
     g = np.array([0.0, 0.0, -G])
     h.sample(0.0, g, np.zeros(3), fl.q)

@@ -35,8 +35,10 @@ from geometry_reference import (
     rotation,
 )
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry.plane import ring_plane_bound
 from quadimpact.core.geometry.ring import ring_deepest
 from quadimpact.core.geometry.ring_box import ring_box_exact
@@ -73,12 +75,12 @@ def _rotation(x):
 
 
 def _feature(kind, centre, radius=0.0, normal=(0.0, 0.0, -1.0)):
-    feat = np.zeros((1, L.NFEAT))
-    feat[0, L.F_KIND] = {"ring": L.FEAT_RING, "sphere": L.FEAT_SPHERE, "point": L.FEAT_POINT}[kind]
-    feat[0, L.F_CENTRE : L.F_CENTRE + 3] = centre
-    feat[0, L.F_NORMAL : L.F_NORMAL + 3] = np.asarray(normal) / np.linalg.norm(normal)
-    feat[0, L.F_RADIUS] = radius
-    feat[0, [L.F_K, L.F_N, L.F_E]] = (100.0, 1.0, 0.9)
+    feat = np.zeros((1, FS.NFEAT))
+    feat[0, FS.F_KIND] = {"ring": L.FEAT_RING, "sphere": L.FEAT_SPHERE, "point": L.FEAT_POINT}[kind]
+    feat[0, FS.F_CENTRE : FS.F_CENTRE + 3] = centre
+    feat[0, FS.F_NORMAL : FS.F_NORMAL + 3] = np.asarray(normal) / np.linalg.norm(normal)
+    feat[0, FS.F_RADIUS] = radius
+    feat[0, [FS.F_K, FS.F_N, FS.F_E]] = (100.0, 1.0, 0.9)
     return feat
 
 
@@ -135,7 +137,7 @@ def test_points_against_the_reference_depth(shape):
         x = _state(rng)
         feat = _feature("point", rng.uniform(-0.25, 0.25, 3))
         C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
-        p = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+        p = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
         np.testing.assert_allclose(x[L.X_POS : L.X_POS + 3] + C @ rc, p, atol=1e-12)
         assert delta == pytest.approx(float(depth(p, row)), abs=1e-12)
         np.testing.assert_allclose(n, _numerical_normal(p, row), atol=1e-8)
@@ -158,7 +160,7 @@ def test_spheres_against_brute_force(shape):
         radius = float(rng.uniform(0.03, 0.15))
         feat = _feature("sphere", rng.uniform(-0.3, 0.3, 3), radius)
         C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
-        c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+        c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
         assert delta == pytest.approx(radius + float(depth(c, row)), abs=1e-12)
         p = x[L.X_POS : L.X_POS + 3] + C @ rc
         assert np.linalg.norm(p - c) == pytest.approx(radius, abs=1e-12)
@@ -206,9 +208,9 @@ def test_ring_records_carry_the_point_normal_and_velocity():
             feat = _feature("ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), normal)
             C, delta, delta_dot, rc, vc, n = _record(x, feat, row)
             p = x[L.X_POS : L.X_POS + 3] + C @ rc
-            centre = C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3] + x[L.X_POS : L.X_POS + 3]
-            nrm = C @ feat[0, L.F_NORMAL : L.F_NORMAL + 3]
-            assert np.linalg.norm(p - centre) == pytest.approx(feat[0, L.F_RADIUS], abs=1e-12)
+            centre = C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3] + x[L.X_POS : L.X_POS + 3]
+            nrm = C @ feat[0, FS.F_NORMAL : FS.F_NORMAL + 3]
+            assert np.linalg.norm(p - centre) == pytest.approx(feat[0, FS.F_RADIUS], abs=1e-12)
             assert (p - centre) @ nrm == pytest.approx(0.0, abs=1e-12)
             assert float(depth(p, row)) == pytest.approx(delta, abs=1e-12)
             if abs(float(depth(p, row))) > 1e-6:
@@ -246,9 +248,11 @@ def test_rings_around_a_bar_take_the_branch_and_bound_and_stay_exact():
 
 def _ring_at_a_corner(rng, row, off):
     """A circle centred near a corner of the box ``row`` (within ``off``), any orientation."""
-    axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
+    axes = row[SHP.SH_ROT : SHP.SH_ROT + 9].reshape(3, 3)
     signs = rng.choice([-1.0, 1.0], 3)
-    corner = row[L.SH_POINT : L.SH_POINT + 3] + axes.T @ (signs * row[L.SH_HALF : L.SH_HALF + 3])
+    corner = row[SHP.SH_POINT : SHP.SH_POINT + 3] + axes.T @ (
+        signs * row[SHP.SH_HALF : SHP.SH_HALF + 3]
+    )
     ring = random_ring(rng, spread=off)
     return (*(np.array(ring[:3]) + corner), *ring[3:])
 
@@ -351,23 +355,23 @@ def _fcl():
 
 def _fcl_shape(fcl, row):
     """The fcl geometry and transform of a shape row (an infinite cylinder: 100 m long)."""
-    kind = int(row[L.SH_KIND])
-    o = row[L.SH_POINT : L.SH_POINT + 3]
+    kind = int(row[SHP.SH_KIND])
+    o = row[SHP.SH_POINT : SHP.SH_POINT + 3]
     if kind == L.SHAPE_PLANE:
-        n = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+        n = row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
         # fcl's halfspace n . p <= d is the solid: ours is behind the outward normal
         return fcl.Halfspace(n, float(n @ o)), fcl.Transform()
     if kind == L.SHAPE_BOX:
-        axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
-        half = row[L.SH_HALF : L.SH_HALF + 3]
+        axes = row[SHP.SH_ROT : SHP.SH_ROT + 9].reshape(3, 3)
+        half = row[SHP.SH_HALF : SHP.SH_HALF + 3]
         return fcl.Box(*(2 * half)), fcl.Transform(axes.T, o)
-    e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
+    e = row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
     k = np.eye(3)[np.argmin(np.abs(e))]
     a = np.cross(e, k)
     a /= np.linalg.norm(a)
     R = np.column_stack([a, np.cross(e, a), e])  # fcl's cylinder axis is its local z
-    length = row[L.SH_LENGTH] if np.isfinite(row[L.SH_LENGTH]) else 100.0
-    return fcl.Cylinder(row[L.SH_RADIUS], length), fcl.Transform(R, o)
+    length = row[SHP.SH_LENGTH] if np.isfinite(row[SHP.SH_LENGTH]) else 100.0
+    return fcl.Cylinder(row[SHP.SH_RADIUS], length), fcl.Transform(R, o)
 
 
 @pytest.mark.parametrize("shape", SHAPES)
@@ -379,13 +383,13 @@ def test_spheres_and_points_agree_with_python_fcl(shape):
     for _ in range(200):
         row = _shape(rng, shape)
         if shape == "plane":
-            row[L.SH_POINT : L.SH_POINT + 3] = 0.0
+            row[SHP.SH_POINT : SHP.SH_POINT + 3] = 0.0
         for kind in ("sphere", "point"):
             radius = float(rng.uniform(0.03, 0.15)) if kind == "sphere" else 1e-4
             x = _state(rng)
             feat = _feature(kind, rng.uniform(-0.2, 0.2, 3), radius if kind == "sphere" else 0)
             C, delta, _, rc, _, n = _record(x, feat, row)
-            c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
+            c = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
             geom, tf = _fcl_shape(fcl, row)
             req = fcl.CollisionRequest(enable_contact=True, num_max_contacts=1)
             res = fcl.CollisionResult()
@@ -436,7 +440,7 @@ def test_the_broad_phase_bounds_a_rings_depth_and_rate(shape):
             "ring", rng.uniform(-0.15, 0.15, 3), rng.uniform(0.05, 0.15), rng.standard_normal(3)
         )
         C, delta, delta_dot, *_ = _record(x, feat, row)
-        kind = (int(feat[0, L.F_KIND]), int(row[L.SH_KIND]))
+        kind = (int(feat[0, FS.F_KIND]), int(row[SHP.SH_KIND]))
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert geometry.has_bound(pairs, 0)
         bound, rate = geometry.pair_bound(x, C, feat, row[None, :], pairs, 0)
@@ -477,7 +481,7 @@ def test_closed_form_pairs_have_no_broad_phase():
     for feature, shape in (("sphere", "box"), ("point", "cylinder"), ("ring", "plane")):
         feat = _feature(feature, (0.1, 0.0, 0.0), 0.1)
         row = _shape(rng, shape)
-        kind = (int(feat[0, L.F_KIND]), int(row[L.SH_KIND]))
+        kind = (int(feat[0, FS.F_KIND]), int(row[SHP.SH_KIND]))
         pairs = np.array([[0, 0, geometry.geometry_id(*kind)]], dtype=np.int64)
         assert not geometry.has_bound(pairs, 0)
         assert geometry.pair_bound(x, C, feat, row[None, :], pairs, 0) == (math.inf, math.inf)

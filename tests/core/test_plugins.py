@@ -24,13 +24,16 @@ import pytest
 from numba import njit
 from scipy.integrate import solve_ivp
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry import PR_GEOMETRY
 from quadimpact.core.geometry.contact_record import material_record
 from quadimpact.core.kernel import make_kernel
 from quadimpact.core.recording_slots import E_FEATURE, E_SHAPE, E_T_START, E_V_I, OUT_X
 from quadimpact.core.records import model, new_output
+from quadimpact.core.sensors import imu_slots as IMS
 
 FEAT_BALL = 50  # the new feature kind: a sphere of radius F_RADIUS at F_CENTRE
 SHAPE_SPHERE = 60  # the new shape kind: a sphere of radius SH_RADIUS at SH_POINT
@@ -44,26 +47,26 @@ def ball_sphere(x, C, feat, f, shapes, s):  # pragma: no cover - compiled
     Copies the centre (an allocation, as every plug-in here makes one: the loop
     is compiled without reference counting, its plug-ins with it).
     """
-    cb = feat[f, L.F_CENTRE : L.F_CENTRE + 3].copy()
+    cb = feat[f, FS.F_CENTRE : FS.F_CENTRE + 3].copy()
     ox = C[0, 0] * cb[0] + C[0, 1] * cb[1] + C[0, 2] * cb[2]
     oy = C[1, 0] * cb[0] + C[1, 1] * cb[1] + C[1, 2] * cb[2]
     oz = C[2, 0] * cb[0] + C[2, 1] * cb[1] + C[2, 2] * cb[2]
-    rx = x[L.X_POS] + ox - shapes[s, L.SH_POINT]
-    ry = x[L.X_POS + 1] + oy - shapes[s, L.SH_POINT + 1]
-    rz = x[L.X_POS + 2] + oz - shapes[s, L.SH_POINT + 2]
+    rx = x[L.X_POS] + ox - shapes[s, SHP.SH_POINT]
+    ry = x[L.X_POS + 1] + oy - shapes[s, SHP.SH_POINT + 1]
+    rz = x[L.X_POS + 2] + oz - shapes[s, SHP.SH_POINT + 2]
     dist = math.sqrt(rx * rx + ry * ry + rz * rz)
     nx, ny, nz = rx / dist, ry / dist, rz / dist  # out of the obstacle, toward the ball
-    rf = feat[f, L.F_RADIUS]
-    delta = rf + shapes[s, L.SH_RADIUS] - dist
+    rf = feat[f, FS.F_RADIUS]
+    delta = rf + shapes[s, SHP.SH_RADIUS] - dist
     return material_record(x, C, delta, ox - rf * nx, oy - rf * ny, oz - rf * nz, nx, ny, nz)
 
 
 @njit
 def sphere_distance(px, py, pz, shapes, s):  # pragma: no cover - compiled
-    dx = px - shapes[s, L.SH_POINT]
-    dy = py - shapes[s, L.SH_POINT + 1]
-    dz = pz - shapes[s, L.SH_POINT + 2]
-    return math.sqrt(dx * dx + dy * dy + dz * dz) - shapes[s, L.SH_RADIUS]
+    dx = px - shapes[s, SHP.SH_POINT]
+    dy = py - shapes[s, SHP.SH_POINT + 1]
+    dz = pz - shapes[s, SHP.SH_POINT + 2]
+    return math.sqrt(dx * dx + dy * dy + dz * dz) - shapes[s, SHP.SH_RADIUS]
 
 
 @njit
@@ -73,7 +76,7 @@ def proximity(t, x, xdot, C, m, d):  # pragma: no cover - compiled
     p = x[L.X_POS : L.X_POS + 3].copy()
     for s in range(m.shapes.shape[0]):
         g = sphere_distance(p[0], p[1], p[2], m.shapes, s)
-        gap = min(gap, g - m.feat[0, L.F_RADIUS])
+        gap = min(gap, g - m.feat[0, FS.F_RADIUS])
     d.meas[L.MS_USER] = gap
     d.meas[L.MS_USER + 1] = t
 
@@ -108,13 +111,13 @@ def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
     veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
     veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
     veh[L.V_SPIN : L.V_SPIN + 4] = (-1.0, 1.0, -1.0, 1.0)
-    feat = np.zeros((1, L.NFEAT))
-    feat[0, L.F_KIND] = FEAT_BALL
-    feat[0, [L.F_RADIUS, L.F_K, L.F_N, L.F_E]] = (0.1, k, n, e)
-    shapes = np.zeros((1, L.NSHAPE))
-    shapes[0, L.SH_KIND] = SHAPE_SPHERE
-    shapes[0, L.SH_POINT : L.SH_POINT + 3] = (0.0, 0.0, 0.5)  # top at Z = 0 (NED, down)
-    shapes[0, L.SH_RADIUS] = 0.5
+    feat = np.zeros((1, FS.NFEAT))
+    feat[0, FS.F_KIND] = FEAT_BALL
+    feat[0, [FS.F_RADIUS, FS.F_K, FS.F_N, FS.F_E]] = (0.1, k, n, e)
+    shapes = np.zeros((1, SHP.NSHAPE))
+    shapes[0, SHP.SH_KIND] = SHAPE_SPHERE
+    shapes[0, SHP.SH_POINT : SHP.SH_POINT + 3] = (0.0, 0.0, 0.5)  # top at Z = 0 (NED, down)
+    shapes[0, SHP.SH_RADIUS] = 0.5
     x0 = np.zeros(L.NX)
     x0[L.X_POS + 2] = -0.3  # the ball's bottom 0.2 m above the sphere
     x0[L.X_QUAT] = 1.0
@@ -127,8 +130,8 @@ def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
     opts[[L.O_V_MIN, L.O_V_REG, L.O_POWER_OFF_T]] = (1e-3, 1e-2, np.inf)
     ctrl = np.zeros(L.NCTRL)
     ctrl[L.C_KIND] = L.CTRL_USER
-    scfg = np.zeros(L.NSCFG)
-    scfg[L.SC_RATE] = rate_hz
+    scfg = np.zeros(IMS.NSCFG)
+    scfg[IMS.SC_RATE] = rate_hz
     return model(
         x0=x0, t0=0.0, tf=0.6, veh=veh, feat=feat, shapes=shapes,
         pairs=geometry.pair_table(feat, shapes), opts=opts, ctrl=ctrl, scfg=scfg,

@@ -97,6 +97,7 @@ NEW_FILES = {
 CHECK = """
 import numpy as np
 from quadimpact.core import layout as L
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import new_data, new_output
 from quadimpact.core.step import advance, start
@@ -111,7 +112,7 @@ start(m, d, o)
 advance(-1, m, d, o)
 n = int(o.stats[L.ST_N_IMU])
 assert n > 2 and o.baro.shape == (setup.n_imu, 2)
-assert np.array_equal(o.baro[:n, 0], o.imu[:n, L.I_T]), "sampled with the IMU"
+assert np.array_equal(o.baro[:n, 0], o.imu[:n, IMS.I_T]), "sampled with the IMU"
 assert o.baro[0, 1] == 5.0, "the trial starts at 5 m"
 assert d.baro[1] == o.baro[n - 1, 0] and d.baro[0] == o.baro[n - 1, 1], "the state is the last"
 # the altitude at the final output row (the run's end) is the last sample's

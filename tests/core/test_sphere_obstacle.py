@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from quadimpact import simulate
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record, geometry_id
 from quadimpact.core.geometry.shapes import by_name, kind_of
@@ -37,23 +38,23 @@ def _state(rng):
 
 
 def _ring(rng):
-    feat = np.zeros((1, L.NFEAT))
-    feat[0, L.F_KIND] = L.FEAT_RING
-    feat[0, L.F_CENTRE : L.F_CENTRE + 3] = rng.normal(0.0, 0.1, 3)
+    feat = np.zeros((1, FS.NFEAT))
+    feat[0, FS.F_KIND] = L.FEAT_RING
+    feat[0, FS.F_CENTRE : FS.F_CENTRE + 3] = rng.normal(0.0, 0.1, 3)
     a = rng.normal(size=3)
-    feat[0, L.F_NORMAL : L.F_NORMAL + 3] = a / np.linalg.norm(a)
-    feat[0, L.F_RADIUS] = 0.12
+    feat[0, FS.F_NORMAL : FS.F_NORMAL + 3] = a / np.linalg.norm(a)
+    feat[0, FS.F_RADIUS] = 0.12
     return feat
 
 
 def _ring_points(x, C, feat, n=20000):
-    o = x[L.X_POS : L.X_POS + 3] + C @ feat[0, L.F_CENTRE : L.F_CENTRE + 3]
-    a = C @ feat[0, L.F_NORMAL : L.F_NORMAL + 3]
+    o = x[L.X_POS : L.X_POS + 3] + C @ feat[0, FS.F_CENTRE : FS.F_CENTRE + 3]
+    a = C @ feat[0, FS.F_NORMAL : FS.F_NORMAL + 3]
     u = np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0])
     u /= np.linalg.norm(u)
     v = np.cross(a, u)
     b = np.linspace(0.0, 2.0 * math.pi, n, endpoint=False)
-    return o + feat[0, L.F_RADIUS] * (np.outer(np.cos(b), u) + np.outer(np.sin(b), v))
+    return o + feat[0, FS.F_RADIUS] * (np.outer(np.cos(b), u) + np.outer(np.sin(b), v))
 
 
 def test_ring_depth_is_the_deepest_point_of_the_ring():
@@ -115,12 +116,12 @@ def test_point_and_sphere_features_are_exact():
     x = np.zeros(L.NX)
     x[L.X_QUAT] = 1.0
     C = np.eye(3)
-    feat = np.zeros((2, L.NFEAT))
-    feat[0, L.F_KIND] = L.FEAT_POINT
-    feat[0, L.F_CENTRE : L.F_CENTRE + 3] = (0.3, 0.0, 0.0)
-    feat[1, L.F_KIND] = L.FEAT_SPHERE
-    feat[1, L.F_CENTRE : L.F_CENTRE + 3] = (0.3, 0.0, 0.0)
-    feat[1, L.F_RADIUS] = 0.05
+    feat = np.zeros((2, FS.NFEAT))
+    feat[0, FS.F_KIND] = L.FEAT_POINT
+    feat[0, FS.F_CENTRE : FS.F_CENTRE + 3] = (0.3, 0.0, 0.0)
+    feat[1, FS.F_KIND] = L.FEAT_SPHERE
+    feat[1, FS.F_CENTRE : FS.F_CENTRE + 3] = (0.3, 0.0, 0.0)
+    feat[1, FS.F_RADIUS] = 0.05
     shapes = _row((0.5, 0.0, 0.0), 0.25)[None, :]
     assert contact_record(x, C, feat, shapes, 0, 0)[0] == pytest.approx(0.05, abs=1e-15)
     rec = contact_record(x, C, feat, shapes, 1, 0)

@@ -10,6 +10,7 @@ from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
 from quadimpact.core.records import new_data, new_output
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.step import advance, start
 from quadimpact.simulation.setup import prepare
 
@@ -20,8 +21,8 @@ def test_tick_by_tick_equals_the_whole_run(model, controller):
     s = WallApproach(heading_deg=45, inclination_deg=15, speed_m_s=0.75, model=model,
                      controller=controller)  # fmt: skip
     setup = prepare(s)
-    scfg = np.zeros(L.NSCFG)
-    scfg[L.SC_RATE] = 200.0
+    scfg = np.zeros(IMS.NSCFG)
+    scfg[IMS.SC_RATE] = 200.0
     scfg[DET.SC_DET_THRESHOLD] = 0.5 * 9.81
     m = setup.model(scfg=scfg, noise=np.zeros((0, 6)))
     whole = execute(m, n_imu=1000, max_episodes=64)

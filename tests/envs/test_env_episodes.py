@@ -11,6 +11,7 @@ import quadimpact.envs as E
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.rotors import RIN_CMD
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.simulation.recovery_metrics import RECOVERY_KEYS
 
 
@@ -189,4 +190,4 @@ def test_given_trials_and_their_checks():
     cm = E.ImpactRecoveryEnv(trials=E.TrialDistribution(overrides=table))
     cm.reset(seed=2)
     scfg = cm.run_setup.scfg
-    assert scfg[L.SC_NOISE_F] == 1.0 and np.all(scfg[L.SC_POS : L.SC_POS + 3] == 0)
+    assert scfg[IMS.SC_NOISE_F] == 1.0 and np.all(scfg[IMS.SC_POS : IMS.SC_POS + 3] == 0)

@@ -10,6 +10,7 @@ import pytest
 
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.kernel import execute
 from quadimpact.core.sensors import detection as DET
 from quadimpact.simulation.setup import prepare
@@ -32,7 +33,7 @@ def test_wall_approaches_without_the_wall_never_detect():
         off_cm = {"imu_position_m": (0.02, 0.01, -0.05)}
         setup = prepare(WallApproach(heading_deg=heading, inclination_deg=incl, speed_m_s=speed,
                                      model=model, vehicle_overrides=off_cm))  # fmt: skip
-        no_wall = np.zeros((0, L.NSHAPE))
+        no_wall = np.zeros((0, SHP.NSHAPE))
         rec = execute(setup.model(shapes=no_wall), n_imu=setup.n_imu)
         assert rec.stats[L.ST_N_DETECTIONS] == 0 and math.isnan(rec.stats[L.ST_T_DETECT])
         assert rec.imu[:, DET.I_HORIZONTAL].max() < 0.1 * 0.5 * G

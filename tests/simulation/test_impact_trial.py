@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, load_scenario_file, simulate
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.inputs.vehicle import load_vehicle
 from quadimpact.packing.vehicle_block import allocation_matrix
 from quadimpact.rotations import quat_to_matrix
@@ -33,11 +35,11 @@ def test_initial_state(roll, pitch, yaw, model):
     np.testing.assert_allclose(vel, (1.2, 0.0, 0.0), atol=1e-15)
     np.testing.assert_array_equal(x[L.X_OMEGA : L.X_OMEGA + 3], 0.0)
     # the wall X = 0, normal -X, no ground; the vehicle's slew limit; friction 0.3; 3 s
-    wall = setup.shapes[:, L.SH_POINT : L.SH_NORMAL + 3]
+    wall = setup.shapes[:, SHP.SH_POINT : SHP.SH_NORMAL + 3]
     np.testing.assert_array_equal(wall, [[0, 0, 0, -1, 0, 0]])
     assert setup.opts[L.O_CRASH_RULE] == L.CRASH_NONE
     assert setup.opts[L.O_SLEW_MAX] == pytest.approx(70_000 * math.pi / 30)
-    np.testing.assert_array_equal(setup.feat[:, L.F_MU], [0.3] * len(setup.feature_names))
+    np.testing.assert_array_equal(setup.feat[:, FS.F_MU], [0.3] * len(setup.feature_names))
     assert setup.tf == 3.0
     assert s.resolved_pre_impact() == "spin-down"
 

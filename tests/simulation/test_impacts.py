@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from quadimpact import WallApproach
-from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import (
     E_FEATURE,
@@ -46,8 +46,8 @@ NAMES = ("wall", "pole", "ground")
 
 
 def _shapes(ground_flags: tuple[bool, ...]) -> np.ndarray:
-    shapes = np.zeros((len(ground_flags), L.NSHAPE))
-    shapes[:, L.SH_IS_GROUND] = [1.0 if g else 0.0 for g in ground_flags]
+    shapes = np.zeros((len(ground_flags), SHP.NSHAPE))
+    shapes[:, SHP.SH_IS_GROUND] = [1.0 if g else 0.0 for g in ground_flags]
     return shapes
 
 

@@ -21,10 +21,12 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from quadimpact import simulate
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.recording_slots import E_OPEN, E_T_END, E_T_START, OUT_T, OUT_X
 from quadimpact.core.records import new_output
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, scenario_from_dict
 from quadimpact.inputs.world import Box, Cylinder
 from quadimpact.simulation.setup import prepare
@@ -147,13 +149,13 @@ def _elastic_run(obstacle, position, velocity, euler=(0.0, 0.0, 0.0)):
     )
     setup = prepare(scenario)
     feat = setup.feat.copy()
-    feat[:, L.F_E] = 1.0
-    feat[:, L.F_MU] = 0.0
+    feat[:, FS.F_E] = 1.0
+    feat[:, FS.F_MU] = 0.0
     ctrl = np.zeros(L.NCTRL)
     ctrl[L.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
     x0[L.X_ROTOR : L.X_ROTOR + 4] = 0.0
-    m = setup.model(x0=x0, feat=feat, ctrl=ctrl, scfg=np.zeros(L.NSCFG))
+    m = setup.model(x0=x0, feat=feat, ctrl=ctrl, scfg=np.zeros(IMS.NSCFG))
     o = new_output(m, 0, 64)
     BUILTIN.run(m, o)
     n_out = int(o.stats[L.ST_N_OUT])
@@ -223,7 +225,7 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     ctrl[L.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
     x0[L.X_ROTOR : L.X_ROTOR + 4] = 0.0
-    m = setup.model(x0=x0, veh=veh, ctrl=ctrl, scfg=np.zeros(L.NSCFG))
+    m = setup.model(x0=x0, veh=veh, ctrl=ctrl, scfg=np.zeros(IMS.NSCFG))
     o = new_output(m, 0, 16)
     BUILTIN.run(m, o)
     assert int(o.stats[L.ST_N_EPISODES]) == 1
@@ -231,7 +233,7 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     assert ep[E_T_START] == pytest.approx((0.5 - 0.33) / 1.0, abs=1e-9)
     x_end = o.out[int(o.stats[L.ST_N_OUT]) - 1, OUT_X : OUT_X + L.NX]
     f = setup.feat[0]
-    expected = _restitution_1dof(f[L.F_K], f[L.F_N], f[L.F_E], veh[L.V_MASS], 1.0)
+    expected = _restitution_1dof(f[FS.F_K], f[FS.F_N], f[FS.F_E], veh[L.V_MASS], 1.0)
     assert -x_end[L.X_VEL + 2] == pytest.approx(expected, rel=1e-6)
     assert np.abs(x_end[L.X_OMEGA : L.X_OMEGA + 3]).max() < 1e-12
     assert not math.isnan(expected)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, Plane, Simulation, WallApproach, read_result, simulate
-from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.inputs.controllers import RecoveryParams
 from quadimpact.inputs.model import recovery_law_params, resolve_model_options
 from quadimpact.inputs.scenarios import scenario_from_dict
@@ -91,7 +91,7 @@ def test_the_surfaces_are_the_packed_ones_bit_for_bit(flight_result, tmp_path: P
         ("slope", False, "plane"), ("side", False, "plane"), ("ground", True, "plane")
     ]  # fmt: skip
     np.testing.assert_array_equal(pack_surface_records(records), surf)
-    normals = surf[:, L.SH_NORMAL : L.SH_NORMAL + 3]
+    normals = surf[:, SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
     np.testing.assert_allclose(np.linalg.norm(normals, axis=1), 1.0, rtol=1e-15)
     # through the file: the same numbers (floats are written in full)
     back = read_result(flight_result.write(tmp_path / "run"))

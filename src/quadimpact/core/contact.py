@@ -31,13 +31,15 @@ from numba import njit
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact_slots import CS_ACTIVE, CS_LAMBDA
-from quadimpact.core.geometry import PR_FEATURE, PR_SHAPE, pair_contact, shape_distance
-from quadimpact.core.layout import (
+from quadimpact.core.feature_slots import (
     F_E,
     F_FORCE_SCALE,
     F_K,
     F_MU,
     F_N,
+)
+from quadimpact.core.geometry import PR_FEATURE, PR_SHAPE, pair_contact, shape_distance
+from quadimpact.core.layout import (
     O_CONTACT_GATE,
     O_DOUBLE_BUMPER1_YAW,
     O_V_REG,

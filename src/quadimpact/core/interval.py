@@ -71,7 +71,6 @@ from quadimpact.core.layout import (
     REASON_MAX_STEPS,
     REASON_NOT_FINITE,
     REASON_STEP_TOO_SMALL,
-    SH_IS_GROUND,
     SS_NEXT_T,
     ST_CRASH_T,
     ST_MISSED_ONSETS,
@@ -108,6 +107,9 @@ from quadimpact.core.recording import (
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.rotors import active_states
 from quadimpact.core.sensing import sample_at, take_sample
+from quadimpact.core.shape_slots import (
+    SH_IS_GROUND,
+)
 
 MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
 

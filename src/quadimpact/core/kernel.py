@@ -44,9 +44,11 @@ from quadimpact.core import geometry as _geometry
 from quadimpact.core.approach import solve_approach
 from quadimpact.core.geometry import shapes as _shapes
 from quadimpact.core.geometry.contact_record import no_contact
-from quadimpact.core.layout import SH_KIND
 from quadimpact.core.records import Model, Output, RawRecord, new_data, new_output, raw_record
 from quadimpact.core.sensors import registry as _sensor_registry
+from quadimpact.core.shape_slots import (
+    SH_KIND,
+)
 from quadimpact.core.step import advance, start
 
 __all__ = ["BUILTIN", "Kernel", "execute", "loop_drivers", "make_kernel", "run", "specialise"]

@@ -21,7 +21,10 @@ contact-pair table in ``core/geometry``). A component whose sizes
 ``records.py`` or this module need declares its blocks in a declaration module
 next to it, which holds no compiled code: the contact pairs' ``cs``
 (``core/contact_slots.py``), the output rows and episodes
-(``core/recording_slots.py``), and the parts of ``stats`` this module places
+(``core/recording_slots.py``), the IMU's ``scfg`` and ``imu``
+(``core/sensors/imu_slots.py``), the features' ``feat``
+(``core/feature_slots.py``), the shapes' ``shapes``
+(``core/shape_slots.py``), and the parts of ``stats`` this module places
 at addresses computed from their declared sizes (``ST_EXCURSION`` from
 ``core/excursion_slots.py``, ``ST_HOVER`` and ``ST_HELD`` from
 ``core/hover_slots.py``). Numba reads these module-level integers as
@@ -201,32 +204,11 @@ V_GRAVITY = _veh.slot("V_GRAVITY")  # m/s^2
 V_TAU_M = _veh.slot("V_TAU_M")  # motor time constant, s (first-order rotor mode)
 NVEH = _veh.end("NVEH")
 
-# ---- contact features feat (n_features, NFEAT): the vehicle's protective
-# structure, body frame, each with its own contact law parameters
-_feat = Block("feat", "F_")
-F_KIND = _feat.slot("F_KIND")  # FEAT_*
-F_CENTRE = _feat.slot("F_CENTRE", 3)  # ring or sphere centre, point position (body, m)
-F_NORMAL = _feat.slot("F_NORMAL", 3)  # ring plane unit normal (body)
-F_RADIUS = _feat.slot("F_RADIUS")  # ring or sphere radius, m
-F_K = _feat.slot("F_K")  # contact stiffness, N/m^n
-F_N = _feat.slot("F_N")  # contact exponent
-F_E = _feat.slot("F_E")  # coefficient of restitution
-F_MU = _feat.slot("F_MU")  # friction coefficient (0: frictionless)
-F_FORCE_SCALE = _feat.slot("F_FORCE_SCALE")  # factor on the normal force (<= 0 or 1: none)
-NFEAT = _feat.end("NFEAT")
+# ---- contact features feat (n_features, NFEAT): declared by the contact law in
+# core/feature_slots.py
 
-# ---- world shapes shapes (n_shapes, NSHAPE), inertial frame; each kind
-# reads the slots it needs (core/geometry/<kind>.py)
-_shape = Block("shapes", "SH_")
-SH_KIND = _shape.slot("SH_KIND")  # SHAPE_*
-SH_IS_GROUND = _shape.slot("SH_IS_GROUND")  # 1: the ground (its first onset is the crash)
-SH_POINT = _shape.slot("SH_POINT", 3)  # a point: on a plane, on an axis, a centre (m)
-SH_NORMAL = _shape.slot("SH_NORMAL", 3)  # a unit vector: a plane's outward normal, an axis
-SH_RADIUS = _shape.slot("SH_RADIUS")  # m: a radius (cylinder, sphere)
-SH_LENGTH = _shape.slot("SH_LENGTH")  # m: a length along SH_NORMAL (inf: unbounded)
-SH_HALF = _shape.slot("SH_HALF", 3)  # m: half-extents along the shape's own axes (box)
-SH_ROT = _shape.slot("SH_ROT", 9)  # the shape's axes in inertial components: row i is axis i
-NSHAPE = _shape.end("NSHAPE")
+# ---- world shapes shapes (n_shapes, NSHAPE): declared by the obstacle geometry in
+# core/shape_slots.py
 
 # ---- options opts (NOPT): model switches, integrator settings
 _opt = Block("opts", "O_")
@@ -293,33 +275,9 @@ C_STEP = _ctrl.slot("C_STEP")  # a plug-in's step: its entry address in this pro
 #   core/plugin_call.py), set when a run is prepared, never packed from a scenario
 NCTRL = _ctrl.end("NCTRL")
 
-# ---- sensors scfg (NSCFG): the IMU and the impact detector; noise, bias,
-# saturation and filtering are off when their slots are 0
-_scfg = Block("scfg", "SC_")
-SC_RATE = _scfg.slot("SC_RATE")  # Hz, IMU sample rate (0: no IMU, no detection)
-SC_POS = _scfg.slot("SC_POS", 3)  # IMU position from the CM, body FRD, m
-SC_NOISE_F = _scfg.slot("SC_NOISE_F")  # accelerometer white-noise std per axis, m/s^2
-SC_NOISE_W = _scfg.slot("SC_NOISE_W")  # gyro white-noise std per axis, rad/s
-SC_BIAS = _scfg.slot("SC_BIAS", 6)  # constant biases (f_x, f_y, f_z, w_x, w_y, w_z)
-SC_RANGE_F = _scfg.slot("SC_RANGE_F")  # m/s^2, accelerometer range (<= 0: none)
-SC_RANGE_W = _scfg.slot("SC_RANGE_W")  # rad/s, gyro range (<= 0: none)
-SC_FILTER = _scfg.slot("SC_FILTER")  # FILTER_*
-SC_FILTER_PARAM = _scfg.slot("SC_FILTER_PARAM")  # first-order: tau, s; moving average: window
-N_DETECTOR_CFG = 3
-SC_DETECTOR = _scfg.slot("SC_DETECTOR", N_DETECTOR_CFG)  # the detector's (sensors/detection.py)
-# the IMU's impact disturbance: from each contact onset t_c, extra white noise of std
-# a0 exp(-(t - t_c)/tau) (accelerometer) and g0 exp(-(t - t_c)/tau) (gyro); off when tau <= 0
-SC_IMPACT_F = _scfg.slot("SC_IMPACT_F")  # a0, m/s^2
-SC_IMPACT_W = _scfg.slot("SC_IMPACT_W")  # g0, rad/s
-SC_IMPACT_TAU = _scfg.slot("SC_IMPACT_TAU")  # tau, s (<= 0: off)
-SC_BIAS_WALK = _scfg.slot("SC_BIAS_WALK")  # gyro bias random walk, rad/s/sqrt(s) (0: off)
-SC_IMPACT_REPLACE = _scfg.slot("SC_IMPACT_REPLACE")  # 1: the impact noise replaces the nominal
-#   noise while it is the larger, restarting at each onset (the authors' model); 0: added
-# the sensor components' tails (core/sensors/registry.py): their sizes in this run's arrays
-SC_TAIL_ST = _scfg.slot("SC_TAIL_ST")  # numbers after NSST in sst
-SC_TAIL_MEAS = _scfg.slot("SC_TAIL_MEAS")  # numbers after NMEAS in meas
-SC_TAIL_REC = _scfg.slot("SC_TAIL_REC")  # columns after NIMU in each imu row
-NSCFG = _scfg.end("NSCFG")
+N_DETECTOR_CFG = 3  # the detector's config slots (core/sensors/detection.py)
+# ---- sensors scfg (NSCFG), the IMU and the impact detector: declared by the IMU in
+# core/sensors/imu_slots.py
 MAX_AVERAGE_WINDOW = 64  # samples
 
 # ---- the added sensors' standard normal draws snoise (n_imu, NSN): row i for IMU sample i.
@@ -447,21 +405,7 @@ NEST = _est.end("NEST")
 # Output: what a run returns
 # ==========================================================================
 
-# ---- IMU samples imu (n_imu, NIMU)
-_imu = Block("imu", "I_")
-I_T = _imu.slot("I_T")  # s
-I_F = _imu.slot("I_F", 3)  # measured specific force, body FRD, m/s^2
-I_W = _imu.slot("I_W", 3)  # measured angular velocity, body FRD, rad/s
-I_F_TRUE = _imu.slot("I_F_TRUE", 3)  # true specific force at the IMU position, m/s^2
-I_W_TRUE = _imu.slot("I_W_TRUE", 3)  # true angular velocity, rad/s
-I_DETECTOR = _imu.slot("I_DETECTOR")  # the detector's column (core/sensors/detection.py)
-I_Q_HAT = _imu.slot("I_Q_HAT", 4)  # attitude estimate after this sample
-I_BIAS_HAT = _imu.slot("I_BIAS_HAT", 3)  # gyro bias estimate, rad/s
-I_VEL_HAT = _imu.slot("I_VEL_HAT", 3)  # velocity estimate, inertial, m/s
-I_POS_HAT = _imu.slot("I_POS_HAT", 3)  # position estimate, inertial, m
-I_BIAS_TRUE = _imu.slot("I_BIAS_TRUE", 3)  # the gyro's true bias (constant + walk), rad/s
-I_ERR = _imu.slot("I_ERR", 4)  # errors: attitude deg, velocity m/s, bias rad/s, position m
-NIMU = _imu.end("NIMU")
+# ---- IMU samples imu (n_imu, NIMU): declared by the IMU in core/sensors/imu_slots.py
 
 # ---- run statistics stats (NSTAT)
 _st = Block("stats", "ST_")

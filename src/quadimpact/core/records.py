@@ -49,19 +49,14 @@ from quadimpact.core.layout import (
     MAX_ROTORS,
     NECFG,
     NEST,
-    NIMU,
     NLS,
     NMEAS,
     NMEM,
-    NSCFG,
     NSN,
     NSPAN,
     NSST,
     NSTAT,
     NX,
-    SC_TAIL_MEAS,
-    SC_TAIL_REC,
-    SC_TAIL_ST,
     SPAN_T0,
     SPAN_TF,
     ST_N_EPISODES,
@@ -70,6 +65,13 @@ from quadimpact.core.layout import (
 )
 from quadimpact.core.recording_slots import NEP, NOUT
 from quadimpact.core.rotors import NRIN
+from quadimpact.core.sensors.imu_slots import (
+    NIMU,
+    NSCFG,
+    SC_TAIL_MEAS,
+    SC_TAIL_REC,
+    SC_TAIL_ST,
+)
 
 __all__ = [
     "Data",

@@ -71,7 +71,6 @@ from quadimpact.core.layout import (
     O_POWER_OFF_T,
     O_ROTOR_MODE,
     ROTOR_FIRST_ORDER,
-    SC_RATE,
     SPAN_T0,
     SPAN_TF,
     SS_NEXT_T,
@@ -107,6 +106,9 @@ from quadimpact.core.recording_slots import E_OPEN, E_PEAK_DELTA, E_T_END
 from quadimpact.core.records import Data, Model, Output, Work, new_work
 from quadimpact.core.rotors import RIN_CMD, RIN_FIRST_ORDER, RIN_PREV_CMD
 from quadimpact.core.sensing import sample_at
+from quadimpact.core.sensors.imu_slots import (
+    SC_RATE,
+)
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
 controller_step = builtin_step  # rebound by kernel.make_kernel(step=...) (a loop of its own)

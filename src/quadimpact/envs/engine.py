@@ -18,6 +18,7 @@ import numpy as np
 
 from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.envs.episode_layout import ENV_ROTORS
 from quadimpact.core.recording_slots import OUT_X
@@ -278,7 +279,7 @@ class Slots:
         st = self.O.stats[k].copy()
         n_ep = int(st[L.ST_N_EPISODES])
         episodes = episode_columns(self.O.episodes[k], n_ep, s.shape_names, len(s.feature_names))
-        obstacles = [n for i, n in enumerate(s.shape_names) if s.shapes[i, L.SH_IS_GROUND] < 0.5]
+        obstacles = [n for i, n in enumerate(s.shape_names) if s.shapes[i, SHP.SH_IS_GROUND] < 0.5]
         # the state at the end: the output row at the final time when the run got there
         # (as analyse reads it), else the state reached
         n_out = int(st[L.ST_N_OUT])

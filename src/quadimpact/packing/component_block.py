@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core import layout as L
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.component import PackContext
 from quadimpact.core.sensors.registry import addresses, components, tail_sizes
 
@@ -39,11 +39,11 @@ def pack_components(
     scenario names; the others are off).
     """
     n_cfg, n_st, n_meas, _, n_rec = tail_sizes()
-    out = np.zeros(L.NSCFG + n_cfg)
-    out[: L.NSCFG] = scfg[: L.NSCFG]
-    out[L.SC_TAIL_ST] = n_st
-    out[L.SC_TAIL_MEAS] = n_meas
-    out[L.SC_TAIL_REC] = n_rec
+    out = np.zeros(IMS.NSCFG + n_cfg)
+    out[: IMS.NSCFG] = scfg[: IMS.NSCFG]
+    out[IMS.SC_TAIL_ST] = n_st
+    out[IMS.SC_TAIL_MEAS] = n_meas
+    out[IMS.SC_TAIL_REC] = n_rec
     where = addresses()
     for c in components():
         if c.name not in instruments:
@@ -55,7 +55,7 @@ def pack_components(
                 f"sensor {c.name}: pack returned {block.shape[0]} numbers, "
                 f"its config block declares {hi - lo}"
             )
-        out[L.NSCFG + lo : L.NSCFG + hi] = block
+        out[IMS.NSCFG + lo : IMS.NSCFG + hi] = block
     return out
 
 

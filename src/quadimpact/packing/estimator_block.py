@@ -33,6 +33,7 @@ from quadimpact.core.estimators import complementary as CF
 from quadimpact.core.estimators import ekf as EKF
 from quadimpact.core.estimators import ekf_additive as ADD
 from quadimpact.core.estimators import nav_ekf as NAV
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.registry import config_address
 from quadimpact.inputs.estimators import (
     AdditiveEkfParams,
@@ -223,11 +224,11 @@ def pack_added_sensors(s: Any, imu: ResolvedImu, scfg: np.ndarray) -> bool:
     """
     dist = imu.impact_disturbance
     if dist is not None:
-        scfg[L.SC_IMPACT_F] = dist.accel_m_s2
-        scfg[L.SC_IMPACT_W] = dist.gyro_rad_s
-        scfg[L.SC_IMPACT_TAU] = dist.time_constant_s
-        scfg[L.SC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
-    scfg[L.SC_BIAS_WALK] = imu.gyro_bias_walk_rad_s_sqrt_s
+        scfg[IMS.SC_IMPACT_F] = dist.accel_m_s2
+        scfg[IMS.SC_IMPACT_W] = dist.gyro_rad_s
+        scfg[IMS.SC_IMPACT_TAU] = dist.time_constant_s
+        scfg[IMS.SC_IMPACT_REPLACE] = 1.0 if dist.mode == "replace" else 0.0
+    scfg[IMS.SC_BIAS_WALK] = imu.gyro_bias_walk_rad_s_sqrt_s
     mag = s.magnetometer
     pose = s.pose_sensor
     return (

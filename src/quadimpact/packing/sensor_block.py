@@ -7,6 +7,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.inputs.sensors import DetectionSettings, ResolvedImu
 from quadimpact.inputs.vehicle import Vehicle
 
@@ -29,24 +30,24 @@ def pack_sensors(
     n_imu : int
         Samples the run takes at most: ``t0`` and every ``1/rate`` to the end.
     """
-    scfg = np.zeros(L.NSCFG)
+    scfg = np.zeros(IMS.NSCFG)
     rate = float(imu.rate_hz)
     n_imu = int(np.floor(duration_s * rate + 1e-9)) + 2
-    scfg[L.SC_RATE] = rate
-    scfg[L.SC_POS : L.SC_POS + 3] = imu.position_m
-    scfg[L.SC_NOISE_F] = imu.accel_noise_m_s2
-    scfg[L.SC_NOISE_W] = imu.gyro_noise_rad_s
-    scfg[L.SC_RANGE_F] = imu.accel_range_m_s2 or 0.0
-    scfg[L.SC_RANGE_W] = imu.gyro_range_rad_s or 0.0
-    scfg[L.SC_FILTER] = {
+    scfg[IMS.SC_RATE] = rate
+    scfg[IMS.SC_POS : IMS.SC_POS + 3] = imu.position_m
+    scfg[IMS.SC_NOISE_F] = imu.accel_noise_m_s2
+    scfg[IMS.SC_NOISE_W] = imu.gyro_noise_rad_s
+    scfg[IMS.SC_RANGE_F] = imu.accel_range_m_s2 or 0.0
+    scfg[IMS.SC_RANGE_W] = imu.gyro_range_rad_s or 0.0
+    scfg[IMS.SC_FILTER] = {
         "none": L.FILTER_NONE,
         "first-order": L.FILTER_FIRST_ORDER,
         "moving-average": L.FILTER_MOVING_AVERAGE,
     }[imu.filter]
     if imu.filter == "first-order":
-        scfg[L.SC_FILTER_PARAM] = float(imu.filter_time_constant_s)
+        scfg[IMS.SC_FILTER_PARAM] = float(imu.filter_time_constant_s)
     elif imu.filter == "moving-average":
-        scfg[L.SC_FILTER_PARAM] = float(imu.filter_window)
+        scfg[IMS.SC_FILTER_PARAM] = float(imu.filter_window)
     if detection.enabled:
         scfg[DET.SC_DET_THRESHOLD] = detection.threshold_g * v.gravity_m_s2
     scfg[DET.SC_DET_WORLD] = 1.0 if detection.frame == "world" else 0.0
@@ -71,5 +72,5 @@ def draw_imu_noise(imu: ResolvedImu, seed: int, n_imu: int, scfg: np.ndarray) ->
         return np.zeros((0, 6))
     rng = np.random.default_rng(seed)
     sigma_bias = np.array([imu.accel_bias_m_s2] * 3 + [imu.gyro_bias_rad_s] * 3)
-    scfg[L.SC_BIAS : L.SC_BIAS + 6] = rng.standard_normal(6) * sigma_bias
+    scfg[IMS.SC_BIAS : IMS.SC_BIAS + 6] = rng.standard_normal(6) * sigma_bias
     return rng.standard_normal((n_imu, 6))

@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.allocation import (  # here too: the packing's names of them
@@ -75,29 +76,29 @@ def pack_features(
     1-4 of a four-ring vehicle); None or all ones: the contact law itself.
     """
     feat = vehicle_memo("feat", v, lambda: _pack_features(v.contact_features()))
-    feat[np.isnan(feat[:, L.F_MU]), L.F_MU] = friction_coefficient
+    feat[np.isnan(feat[:, FS.F_MU]), FS.F_MU] = friction_coefficient
     if force_scale is not None and any(f != 1.0 for f in force_scale):
         if len(force_scale) != feat.shape[0]:
             raise InputError(
                 f"bumper_force_scale: {len(force_scale)} factors for the {feat.shape[0]} contact "
                 "features of this vehicle"
             )
-        feat[:, L.F_FORCE_SCALE] = force_scale
+        feat[:, FS.F_FORCE_SCALE] = force_scale
     return feat
 
 
 def _pack_features(features: Sequence[ContactFeature]) -> np.ndarray:
-    feat = np.zeros((len(features), L.NFEAT))
+    feat = np.zeros((len(features), FS.NFEAT))
     for i, f in enumerate(features):
-        feat[i, L.F_KIND] = FEATURE_KINDS[f.kind]
-        feat[i, L.F_CENTRE : L.F_CENTRE + 3] = f.centre_m
-        feat[i, L.F_NORMAL : L.F_NORMAL + 3] = f.normal
-        feat[i, L.F_RADIUS] = f.radius_m
-        feat[i, L.F_K] = f.stiffness
-        feat[i, L.F_N] = f.exponent
-        feat[i, L.F_E] = f.restitution
-        feat[i, L.F_MU] = np.nan if f.friction_coefficient is None else f.friction_coefficient
-        feat[i, L.F_FORCE_SCALE] = 1.0
+        feat[i, FS.F_KIND] = FEATURE_KINDS[f.kind]
+        feat[i, FS.F_CENTRE : FS.F_CENTRE + 3] = f.centre_m
+        feat[i, FS.F_NORMAL : FS.F_NORMAL + 3] = f.normal
+        feat[i, FS.F_RADIUS] = f.radius_m
+        feat[i, FS.F_K] = f.stiffness
+        feat[i, FS.F_N] = f.exponent
+        feat[i, FS.F_E] = f.restitution
+        feat[i, FS.F_MU] = np.nan if f.friction_coefficient is None else f.friction_coefficient
+        feat[i, FS.F_FORCE_SCALE] = 1.0
     return feat
 
 
@@ -111,21 +112,21 @@ def feature_records(feat: np.ndarray, names: Sequence[str]) -> list[dict[str, An
     kinds = {v: k for k, v in FEATURE_KINDS.items()}
     out = []
     for name, row in zip(names, feat, strict=True):
-        kind = kinds[int(row[L.F_KIND])]
+        kind = kinds[int(row[FS.F_KIND])]
         rec: dict[str, Any] = {
             "name": str(name),
             "kind": kind,
-            "centre_m": [float(c) for c in row[L.F_CENTRE : L.F_CENTRE + 3]],
+            "centre_m": [float(c) for c in row[FS.F_CENTRE : FS.F_CENTRE + 3]],
         }
         if kind == "ring":
-            rec["normal"] = [float(c) for c in row[L.F_NORMAL : L.F_NORMAL + 3]]
+            rec["normal"] = [float(c) for c in row[FS.F_NORMAL : FS.F_NORMAL + 3]]
         if kind != "point":
-            rec["radius_m"] = float(row[L.F_RADIUS])
+            rec["radius_m"] = float(row[FS.F_RADIUS])
         rec.update(
-            stiffness=float(row[L.F_K]),
-            exponent=float(row[L.F_N]),
-            restitution=float(row[L.F_E]),
-            friction_coefficient=float(row[L.F_MU]),
+            stiffness=float(row[FS.F_K]),
+            exponent=float(row[FS.F_N]),
+            restitution=float(row[FS.F_E]),
+            friction_coefficient=float(row[FS.F_MU]),
         )
         out.append(rec)
     return out

@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry.shapes import by_kind, by_name, components, kind_of
 from quadimpact.inputs.world import Box, Cylinder, Plane
 from quadimpact.linalg import norm
@@ -36,31 +37,31 @@ def pack_surfaces(surfaces: Sequence[Plane | Cylinder | Box]) -> np.ndarray:
     the columns of its ZYX rotation, stored as the rows of ``SH_ROT``; an
     infinite cylinder has ``SH_LENGTH = inf``.
     """
-    surf = np.zeros((len(surfaces), L.NSHAPE))
+    surf = np.zeros((len(surfaces), SHP.NSHAPE))
     for i, s in enumerate(surfaces):
         comp = by_name(getattr(s, "kind", ""))
         if comp is not None:  # a shape component: its declared slots
             surf[i] = comp.pack(s, kind_of(comp))
             continue
-        surf[i, L.SH_IS_GROUND] = 1.0 if getattr(s, "is_ground", False) else 0.0
+        surf[i, SHP.SH_IS_GROUND] = 1.0 if getattr(s, "is_ground", False) else 0.0
         if isinstance(s, Cylinder):
             e = np.asarray(s.axis, dtype=float)
-            surf[i, L.SH_KIND] = L.SHAPE_CYLINDER
-            surf[i, L.SH_POINT : L.SH_POINT + 3] = s.point_m
-            surf[i, L.SH_NORMAL : L.SH_NORMAL + 3] = e / norm(e)
-            surf[i, L.SH_RADIUS] = s.radius_m
-            surf[i, L.SH_LENGTH] = np.inf if s.length_m is None else s.length_m
+            surf[i, SHP.SH_KIND] = L.SHAPE_CYLINDER
+            surf[i, SHP.SH_POINT : SHP.SH_POINT + 3] = s.point_m
+            surf[i, SHP.SH_NORMAL : SHP.SH_NORMAL + 3] = e / norm(e)
+            surf[i, SHP.SH_RADIUS] = s.radius_m
+            surf[i, SHP.SH_LENGTH] = np.inf if s.length_m is None else s.length_m
             continue
         if isinstance(s, Box):
-            surf[i, L.SH_KIND] = L.SHAPE_BOX
-            surf[i, L.SH_POINT : L.SH_POINT + 3] = s.centre_m
-            surf[i, L.SH_HALF : L.SH_HALF + 3] = s.half_extents_m
-            surf[i, L.SH_ROT : L.SH_ROT + 9] = np.asarray(s.axes(), dtype=float).ravel()
+            surf[i, SHP.SH_KIND] = L.SHAPE_BOX
+            surf[i, SHP.SH_POINT : SHP.SH_POINT + 3] = s.centre_m
+            surf[i, SHP.SH_HALF : SHP.SH_HALF + 3] = s.half_extents_m
+            surf[i, SHP.SH_ROT : SHP.SH_ROT + 9] = np.asarray(s.axes(), dtype=float).ravel()
             continue
         n = np.asarray(s.normal, dtype=float)
-        surf[i, L.SH_POINT : L.SH_POINT + 3] = s.point_m
-        surf[i, L.SH_NORMAL : L.SH_NORMAL + 3] = n / norm(n)
-        surf[i, L.SH_KIND] = L.SHAPE_PLANE
+        surf[i, SHP.SH_POINT : SHP.SH_POINT + 3] = s.point_m
+        surf[i, SHP.SH_NORMAL : SHP.SH_NORMAL + 3] = n / norm(n)
+        surf[i, SHP.SH_KIND] = L.SHAPE_PLANE
     return surf
 
 
@@ -92,38 +93,40 @@ def surface_records(surf: np.ndarray, names: Sequence[str]) -> list[dict[str, An
     kinds = {v: k for k, v in surface_kinds().items()}
     out: list[dict[str, Any]] = []
     for name, row in zip(names, surf, strict=True):
-        kind = kinds[int(row[L.SH_KIND])]
-        comp = by_kind(int(row[L.SH_KIND]))
+        kind = kinds[int(row[SHP.SH_KIND])]
+        comp = by_kind(int(row[SHP.SH_KIND]))
         if comp is not None:
             out.append(comp.record(row, name))
             continue
         if kind == "plane":
             rec: dict[str, Any] = {
                 "name": str(name),
-                "point_m": _floats(row[L.SH_POINT : L.SH_POINT + 3]),
-                "normal": _floats(row[L.SH_NORMAL : L.SH_NORMAL + 3]),
-                "is_ground": bool(row[L.SH_IS_GROUND] > 0.5),
+                "point_m": _floats(row[SHP.SH_POINT : SHP.SH_POINT + 3]),
+                "normal": _floats(row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]),
+                "is_ground": bool(row[SHP.SH_IS_GROUND] > 0.5),
                 "kind": kind,
             }
         elif kind == "cylinder":
-            length = float(row[L.SH_LENGTH])
+            length = float(row[SHP.SH_LENGTH])
             rec = {
                 "name": str(name),
                 "kind": kind,
-                "point_m": _floats(row[L.SH_POINT : L.SH_POINT + 3]),
-                "axis": _floats(row[L.SH_NORMAL : L.SH_NORMAL + 3]),
-                "radius_m": float(row[L.SH_RADIUS]),
+                "point_m": _floats(row[SHP.SH_POINT : SHP.SH_POINT + 3]),
+                "axis": _floats(row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]),
+                "radius_m": float(row[SHP.SH_RADIUS]),
                 "length_m": length if np.isfinite(length) else None,
-                "is_ground": bool(row[L.SH_IS_GROUND] > 0.5),
+                "is_ground": bool(row[SHP.SH_IS_GROUND] > 0.5),
             }
         else:
             rec = {
                 "name": str(name),
                 "kind": kind,
-                "centre_m": _floats(row[L.SH_POINT : L.SH_POINT + 3]),
-                "half_extents_m": _floats(row[L.SH_HALF : L.SH_HALF + 3]),
-                "axes": [_floats(row[L.SH_ROT + 3 * i : L.SH_ROT + 3 * i + 3]) for i in range(3)],
-                "is_ground": bool(row[L.SH_IS_GROUND] > 0.5),
+                "centre_m": _floats(row[SHP.SH_POINT : SHP.SH_POINT + 3]),
+                "half_extents_m": _floats(row[SHP.SH_HALF : SHP.SH_HALF + 3]),
+                "axes": [
+                    _floats(row[SHP.SH_ROT + 3 * i : SHP.SH_ROT + 3 * i + 3]) for i in range(3)
+                ],
+                "is_ground": bool(row[SHP.SH_IS_GROUND] > 0.5),
             }
         out.append(rec)
     return out
@@ -137,7 +140,7 @@ def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
     ValueError
         A record with a kind not in :data:`SURFACE_KINDS`.
     """
-    surf = np.zeros((len(records), L.NSHAPE))
+    surf = np.zeros((len(records), SHP.NSHAPE))
     for i, r in enumerate(records):
         kind = r.get("kind", "plane")
         if kind not in surface_kinds():
@@ -148,19 +151,19 @@ def pack_surface_records(records: Sequence[Mapping[str, Any]]) -> np.ndarray:
         if comp is not None:
             surf[i] = comp.unpack(r, kind_of(comp))
             continue
-        surf[i, L.SH_IS_GROUND] = 1.0 if r.get("is_ground") else 0.0
-        surf[i, L.SH_KIND] = SURFACE_KINDS[kind]
+        surf[i, SHP.SH_IS_GROUND] = 1.0 if r.get("is_ground") else 0.0
+        surf[i, SHP.SH_KIND] = SURFACE_KINDS[kind]
         if kind == "cylinder":
-            surf[i, L.SH_POINT : L.SH_POINT + 3] = [float(c) for c in r["point_m"]]
-            surf[i, L.SH_NORMAL : L.SH_NORMAL + 3] = [float(c) for c in r["axis"]]
-            surf[i, L.SH_RADIUS] = float(r["radius_m"])
+            surf[i, SHP.SH_POINT : SHP.SH_POINT + 3] = [float(c) for c in r["point_m"]]
+            surf[i, SHP.SH_NORMAL : SHP.SH_NORMAL + 3] = [float(c) for c in r["axis"]]
+            surf[i, SHP.SH_RADIUS] = float(r["radius_m"])
             length = r.get("length_m")
-            surf[i, L.SH_LENGTH] = np.inf if length is None else float(length)
+            surf[i, SHP.SH_LENGTH] = np.inf if length is None else float(length)
         elif kind == "box":
-            surf[i, L.SH_POINT : L.SH_POINT + 3] = [float(c) for c in r["centre_m"]]
-            surf[i, L.SH_HALF : L.SH_HALF + 3] = [float(c) for c in r["half_extents_m"]]
-            surf[i, L.SH_ROT : L.SH_ROT + 9] = [float(c) for row in r["axes"] for c in row]
+            surf[i, SHP.SH_POINT : SHP.SH_POINT + 3] = [float(c) for c in r["centre_m"]]
+            surf[i, SHP.SH_HALF : SHP.SH_HALF + 3] = [float(c) for c in r["half_extents_m"]]
+            surf[i, SHP.SH_ROT : SHP.SH_ROT + 9] = [float(c) for row in r["axes"] for c in row]
         else:
-            surf[i, L.SH_POINT : L.SH_POINT + 3] = [float(c) for c in r["point_m"]]
-            surf[i, L.SH_NORMAL : L.SH_NORMAL + 3] = [float(c) for c in r["normal"]]
+            surf[i, SHP.SH_POINT : SHP.SH_POINT + 3] = [float(c) for c in r["point_m"]]
+            surf[i, SHP.SH_NORMAL : SHP.SH_NORMAL + 3] = [float(c) for c in r["normal"]]
     return surf

@@ -20,7 +20,9 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.approach import (
     AP_DV,
     AP_LATE,
@@ -51,6 +53,7 @@ from quadimpact.core.geometry import (
 from quadimpact.core.geometry.shapes import by_kind, plugin_shapes
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.records import Model, new_output
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.inputs.resolve import (  # defined with the rest of a run's start; names kept
     PAPER_FIT_OFFSET_RAD,
     PAPER_FIT_SCALE,
@@ -107,11 +110,11 @@ def pair_depths_at(
     if plugins:
         for c in range(pairs.shape[0]):
             s = int(pairs[c, PR_SHAPE])
-            comp = by_kind(int(shapes[s, L.SH_KIND]))
+            comp = by_kind(int(shapes[s, SHP.SH_KIND]))
             if comp is None or comp not in plugins:
                 continue
             f = int(pairs[c, PR_FEATURE])
-            contact = comp.contacts.get(int(feat[f, L.F_KIND]))
+            contact = comp.contacts.get(int(feat[f, FS.F_KIND]))
             if contact is not None:
                 depths[c] = float(contact(xq, C, feat, f, shapes, s)[0])
     return depths
@@ -204,10 +207,10 @@ def shooting_record(
     free = run._replace(
         x0=np.zeros(L.NX),
         span=np.zeros(L.NSPAN),
-        shapes=np.zeros((0, L.NSHAPE)),
+        shapes=np.zeros((0, SHP.NSHAPE)),
         pairs=np.zeros((0, NPAIR), dtype=np.int64),
         opts=free_opts,
-        scfg=np.zeros(L.NSCFG),
+        scfg=np.zeros(IMS.NSCFG),
         noise=np.zeros((0, 6)),
         t_out=np.array([float(impact_time_s)]),
     )

@@ -30,8 +30,9 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.recording_slots import out_width
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.errors import InputError
 from quadimpact.linalg import norm
 
@@ -85,10 +86,10 @@ def check_imu(setup: Any) -> None:
     from quadimpact.core.sensors import detection as DET
 
     scfg = setup.scfg
-    if scfg is None or not scfg[L.SC_RATE] > 0.0:
+    if scfg is None or not scfg[IMS.SC_RATE] > 0.0:
         return
     vehicle = setup.vehicle
-    position = np.asarray(scfg[L.SC_POS : L.SC_POS + 3], dtype=float)
+    position = np.asarray(scfg[IMS.SC_POS : IMS.SC_POS + 3], dtype=float)
     reach = vehicle.reach_m()
     distance = float(norm(np.asarray(position, dtype=np.float64)))
     if distance > reach:
@@ -98,7 +99,7 @@ def check_imu(setup: Any) -> None:
             f"rotors and bumpers reach {reach:.3g} m): the IMU must sit on the vehicle"
         )
     g = float(vehicle.gravity_m_s2)
-    accel_range = float(scfg[L.SC_RANGE_F])
+    accel_range = float(scfg[IMS.SC_RANGE_F])
     if accel_range <= 0.0:
         return
     if accel_range < g:
@@ -147,7 +148,7 @@ def check_initial_contact(scenario: Any, setup: Any) -> None:
         deepest = int(np.argmax(depths))
         depth = float(depths[deepest])
         feature = _feature_label(setup.feature_names[deepest])
-        ground = setup.shapes[s, L.SH_IS_GROUND] > 0.5
+        ground = setup.shapes[s, SHP.SH_IS_GROUND] > 0.5
         if kind == "impact-trial" and not ground and depth > 0.0:
             raise InputError(
                 f"impact trial: {STARTED_IN_CONTACT}: {feature} is "
@@ -200,7 +201,7 @@ def record_size_bytes(scenario: Any, n_features: int | None = None) -> int:
     samples = math.ceil(max(duration, 0.0) * float(imu_rate)) + 1
     if n_features is None:
         n_features = vehicle_feature_count(scenario)
-    return 8 * (rows * out_width(n_features) + samples * L.NIMU)
+    return 8 * (rows * out_width(n_features) + samples * IMS.NIMU)
 
 
 def check_record_size(

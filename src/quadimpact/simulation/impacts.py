@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.impacts import (
     GRAZE,
     IM_END,
@@ -114,7 +114,7 @@ def run_episodes(
         The packed shapes (``SH_IS_GROUND`` says which are not obstacles).
     """
     names = list(surface_names)
-    not_obstacle = [float(not flag < 0.5) for flag in shapes[:, L.SH_IS_GROUND].tolist()]
+    not_obstacle = [float(not flag < 0.5) for flag in shapes[:, SHP.SH_IS_GROUND].tolist()]
 
     def table() -> Table:
         return episode_lists_of(raw, n, names, n_features)

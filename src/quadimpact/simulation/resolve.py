@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry import shape_distance
 from quadimpact.core.geometry.shapes import by_kind
 from quadimpact.core.plugin_call import CONTROLLER_SIGNATURE, ESTIMATOR_SIGNATURE
@@ -132,15 +133,15 @@ def obstacle_front(obstacle: Any) -> tuple[float, np.ndarray]:
         The obstacle does not face the vehicle (a plane whose normal has no -X part).
     """
     row = pack_surfaces([obstacle])
-    centre = np.array(row[0, L.SH_POINT : L.SH_POINT + 3])
-    if row[0, L.SH_KIND] == L.SHAPE_PLANE:
-        if not row[0, L.SH_NORMAL] < -1e-9:
+    centre = np.array(row[0, SHP.SH_POINT : SHP.SH_POINT + 3])
+    if row[0, SHP.SH_KIND] == L.SHAPE_PLANE:
+        if not row[0, SHP.SH_NORMAL] < -1e-9:
             raise InputError(
                 f"obstacles: obstacle 1 ({obstacle.name!r}): an impact trial flies along +X, "
                 "so its plane's normal must point toward -X"
             )
         return float(centre[0]), centre
-    comp = by_kind(int(row[0, L.SH_KIND]))  # a shape component: its own distance
+    comp = by_kind(int(row[0, SHP.SH_KIND]))  # a shape component: its own distance
     distance = comp.distance if comp is not None else shape_distance
     inside = 0.0
     outside = 1.0

@@ -18,9 +18,11 @@ import numpy as np
 
 from quadimpact import __version__
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.excursion import DEG
 from quadimpact.core.excursion_slots import EX_COS_TILT, EX_DEV, NEX
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.registry import config_address
 from quadimpact.inputs.scenarios import WallApproach
 from quadimpact.linalg import dot, matvec
@@ -349,7 +351,7 @@ def _estimation(setup: RunSetup, scenario: Any, st: np.ndarray) -> dict[str, Any
         "estimator": setup.estimator,
         "estimator_settings": setup.estimator_settings,
         "sensors": getattr(scenario, "sensors", None),
-        "impact_disturbance": bool(scfg[L.SC_IMPACT_TAU] > 0.0),
+        "impact_disturbance": bool(scfg[IMS.SC_IMPACT_TAU] > 0.0),
         "magnetometer": bool(scfg[_MAG_ON] > 0.5),
         "pose_sensor": bool(scfg[_POSE_ON] > 0.5),
     }
@@ -380,7 +382,7 @@ def _short_contact_warning(setup: RunSetup, episodes: RunEpisodes) -> str:
     Such an impact can fall between two IMU samples: the IMU (and the
     detection) may not see it at all (docs/STUDIES.md 2.2).
     """
-    rate = float(setup.scfg[L.SC_RATE])
+    rate = float(setup.scfg[IMS.SC_RATE])
     if not rate > 0.0:
         return ""
     count, shortest = short_impacts_of(episodes.impacts, 1.0 / rate)
@@ -395,7 +397,7 @@ def _short_contact_warning(setup: RunSetup, episodes: RunEpisodes) -> str:
 
 def _obstacle_names(setup: RunSetup) -> list[str]:
     """Names of the packed shapes that are obstacles (not the ground)."""
-    return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, L.SH_IS_GROUND] < 0.5]
+    return [n for k, n in enumerate(setup.shape_names) if setup.shapes[k, SHP.SH_IS_GROUND] < 0.5]
 
 
 def episode_count(s: Mapping[str, Any]) -> int | None:

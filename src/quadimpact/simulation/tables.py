@@ -36,6 +36,7 @@ from quadimpact.core.recording_slots import (
     out_width,
 )
 from quadimpact.core.sensors import detection as DET
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors.registry import record_address, record_columns
 from quadimpact.inputs.features import feature_column
 from quadimpact.results.files import BUMPERS, EPISODE_COLUMNS, IMU_COLUMNS
@@ -299,15 +300,16 @@ def imu_columns(raw: np.ndarray, scfg: np.ndarray | None = None) -> dict[str, np
     their record columns (``<name>_<slot>``) after the fixed ones.
     """
     rows = np.asarray(raw, dtype=np.float64)
-    rows = rows.reshape(-1, rows.shape[-1] if rows.ndim == 2 else L.NIMU)
+    rows = rows.reshape(-1, rows.shape[-1] if rows.ndim == 2 else IMS.NIMU)
     sources = (
-        L.I_T, L.I_F, L.I_F + 1, L.I_F + 2, L.I_W, L.I_W + 1, L.I_W + 2,
-        L.I_F_TRUE, L.I_F_TRUE + 1, L.I_F_TRUE + 2, L.I_W_TRUE, L.I_W_TRUE + 1, L.I_W_TRUE + 2,
+        IMS.I_T, IMS.I_F, IMS.I_F + 1, IMS.I_F + 2, IMS.I_W, IMS.I_W + 1, IMS.I_W + 2,
+        IMS.I_F_TRUE, IMS.I_F_TRUE + 1, IMS.I_F_TRUE + 2,
+        IMS.I_W_TRUE, IMS.I_W_TRUE + 1, IMS.I_W_TRUE + 2,
         DET.I_HORIZONTAL,
         *range(_MAG, _MAG + 3), *range(_POSE, _POSE + 7),
-        *range(L.I_Q_HAT, L.I_Q_HAT + 4), *range(L.I_BIAS_HAT, L.I_BIAS_HAT + 3),
-        *range(L.I_VEL_HAT, L.I_VEL_HAT + 3), *range(L.I_POS_HAT, L.I_POS_HAT + 3),
-        *range(L.I_BIAS_TRUE, L.I_BIAS_TRUE + 3), *range(L.I_ERR, L.I_ERR + 4),
+        *range(IMS.I_Q_HAT, IMS.I_Q_HAT + 4), *range(IMS.I_BIAS_HAT, IMS.I_BIAS_HAT + 3),
+        *range(IMS.I_VEL_HAT, IMS.I_VEL_HAT + 3), *range(IMS.I_POS_HAT, IMS.I_POS_HAT + 3),
+        *range(IMS.I_BIAS_TRUE, IMS.I_BIAS_TRUE + 3), *range(IMS.I_ERR, IMS.I_ERR + 4),
     )  # fmt: skip
     out = {
         name: rows[:, col].copy() if col < rows.shape[1] else np.full(len(rows), np.nan)

@@ -20,6 +20,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import FancyArrowPatch, Polygon
 
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.viz.camera import Camera
 from quadimpact.viz.scene import Scene
 from quadimpact.viz.world_drawing import plane_axes, plane_grid, shape_lines
@@ -127,10 +128,10 @@ class SceneArtists:
         self.planes: list[tuple[np.ndarray, np.ndarray, Any, Polygon, LineCollection]] = []
         sf = scene.surf
         planes = [
-            (sf[k, L.SH_POINT : L.SH_POINT + 3], sf[k, L.SH_NORMAL : L.SH_NORMAL + 3],
-             sf[k, L.SH_IS_GROUND] > 0.5, s.name)
+            (sf[k, SHP.SH_POINT : SHP.SH_POINT + 3], sf[k, SHP.SH_NORMAL : SHP.SH_NORMAL + 3],
+             sf[k, SHP.SH_IS_GROUND] > 0.5, s.name)
             for k, s in enumerate(scene.surfaces)
-            if int(sf[k, L.SH_KIND]) == L.SHAPE_PLANE
+            if int(sf[k, SHP.SH_KIND]) == L.SHAPE_PLANE
         ]  # fmt: skip
         if not any(getattr(s, "is_ground", False) for s in scene.surfaces):
             planes.append(((0.0, 0.0, 0.0), (0.0, 0.0, -1.0), True, ""))
@@ -159,7 +160,9 @@ class SceneArtists:
             self.planes.append((p, m, (wall_range(m, forward, right), name), poly, grid))
         # cylinders and boxes: their rims, generators and edges
         self.solids = [
-            k for k in range(scene.surf.shape[0]) if int(scene.surf[k, L.SH_KIND]) != L.SHAPE_PLANE
+            k
+            for k in range(scene.surf.shape[0])
+            if int(scene.surf[k, SHP.SH_KIND]) != L.SHAPE_PLANE
         ]
         self.solid_lines = LineCollection(
             [], colors="#59636e", linewidths=0.9 * lw / 2, alpha=0.8, zorder=2

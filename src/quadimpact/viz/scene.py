@@ -40,7 +40,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.inputs.vehicle import Vehicle
 from quadimpact.inputs.world import Plane
 from quadimpact.packing.world_block import pack_surface_records, pack_surfaces
@@ -247,7 +249,7 @@ class Scene:
         elif self.surfaces:
             self.surf = pack_surfaces(self.surfaces)
         else:
-            self.surf = np.zeros((0, L.NSHAPE))
+            self.surf = np.zeros((0, SHP.NSHAPE))
         ts = _drawable_rows(timeseries)
         self.t = ts["t_s"].to_numpy(dtype=float)
         self.states = np.zeros((len(ts), L.NX))
@@ -389,7 +391,7 @@ class Scene:
         points, depths, normals = contact_points(x, self.drawing, self.surf)
         marks: list[ContactMark] = []
         for j in range(self.drawing.packed.shape[0]):
-            n_exp = float(self.drawing.packed[j, L.F_N])
+            n_exp = float(self.drawing.packed[j, FS.F_N])
             if not (deltas[j] > 0.0 or forces[j] > 0.0):
                 continue  # the simulation had no active contact on this bumper
             touching = [s for s in range(self.surf.shape[0]) if depths[j, s] > 0.0]

@@ -19,6 +19,7 @@ import numpy as np
 import pandas as pd
 
 from quadimpact.core import layout as L
+from quadimpact.core import shape_slots as SHP
 from quadimpact.core.geometry.shapes import by_kind, by_name
 from quadimpact.inputs.world import GROUND, Box, Cylinder, Plane, obstacle_from
 
@@ -95,12 +96,12 @@ def shape_lines(row: np.ndarray, centre: np.ndarray, extent: float = 1.5) -> lis
     ``centre``'s axial coordinate) and eight generators; a box: its twelve
     edges.
     """
-    kind = int(row[L.SH_KIND])
-    o = row[L.SH_POINT : L.SH_POINT + 3]
+    kind = int(row[SHP.SH_KIND])
+    o = row[SHP.SH_POINT : SHP.SH_POINT + 3]
     if kind == L.SHAPE_CYLINDER:
-        e = row[L.SH_NORMAL : L.SH_NORMAL + 3]
-        r = float(row[L.SH_RADIUS])
-        length = float(row[L.SH_LENGTH])
+        e = row[SHP.SH_NORMAL : SHP.SH_NORMAL + 3]
+        r = float(row[SHP.SH_RADIUS])
+        length = float(row[SHP.SH_LENGTH])
         if np.isfinite(length):
             z0, z1 = -0.5 * length, 0.5 * length
         else:
@@ -116,8 +117,8 @@ def shape_lines(row: np.ndarray, centre: np.ndarray, extent: float = 1.5) -> lis
             lines.append(np.array([p + z0 * e, p + z1 * e]))
         return lines
     if kind == L.SHAPE_BOX:
-        axes = row[L.SH_ROT : L.SH_ROT + 9].reshape(3, 3)
-        half = row[L.SH_HALF : L.SH_HALF + 3]
+        axes = row[SHP.SH_ROT : SHP.SH_ROT + 9].reshape(3, 3)
+        half = row[SHP.SH_HALF : SHP.SH_HALF + 3]
         lines = []
         for i in range(3):
             j, k = (i + 1) % 3, (i + 2) % 3

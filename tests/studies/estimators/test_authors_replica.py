@@ -12,6 +12,7 @@ import pytest
 
 from quadimpact import FlightScenario, simulate
 from quadimpact.core import layout as L
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.inputs.estimators import estimator_entry
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.simulation.setup import prepare
@@ -28,11 +29,11 @@ def _trial(index: int, label: str = "ekf-as-written") -> dict:
 def test_the_replica_runs_everything_at_100_hz() -> None:
     setup = prepare(scenario_from_dict(_trial(0)))
     assert setup.opts[L.O_DT_CONTROL] == pytest.approx(0.01)  # the controller: 100 Hz
-    assert setup.scfg[L.SC_RATE] == 100.0  # the IMU, hence the filters: 100 Hz
+    assert setup.scfg[IMS.SC_RATE] == 100.0  # the IMU, hence the filters: 100 Hz
     # set back ("rate"): quadimpact's 200 Hz, for the controller and the sensors alike
     back = EstimatorStudy(scenario="authors-2016", n=1, back=("rate",)).scenario_dict(0)
     setup = prepare(scenario_from_dict(back))
-    assert setup.opts[L.O_DT_CONTROL] == pytest.approx(0.005) and setup.scfg[L.SC_RATE] == 200.0
+    assert setup.opts[L.O_DT_CONTROL] == pytest.approx(0.005) and setup.scfg[IMS.SC_RATE] == 200.0
     # quadimpact's own trial keeps its 200 Hz
     own = EstimatorStudy(scenario="impact", n=1).scenario_dict(0)
     assert prepare(scenario_from_dict(own)).opts[L.O_DT_CONTROL] == pytest.approx(0.005)
@@ -46,7 +47,10 @@ def test_the_control_rate_sets_the_ticks() -> None:
 
 def test_the_accelerometer_bias_is_drawn_and_not_estimated() -> None:
     draws = np.array(
-        [prepare(scenario_from_dict(_trial(i))).scfg[L.SC_BIAS : L.SC_BIAS + 3] for i in range(40)]
+        [
+            prepare(scenario_from_dict(_trial(i))).scfg[IMS.SC_BIAS : IMS.SC_BIAS + 3]
+            for i in range(40)
+        ]
     )  # m/s^2, per axis, 40 trials
     assert 0.08 < draws.std() < 0.12 and abs(draws.mean()) < 0.03  # N(0, 0.1^2) per axis
     assert len({tuple(d) for d in draws}) == 40  # a draw per trial

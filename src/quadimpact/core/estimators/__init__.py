@@ -73,7 +73,6 @@ from quadimpact.core.layout import (
     MS_W_HAT,
     MS_X,
     NX,
-    SC_BIAS,
     X_OMEGA,
     X_POS,
     X_QUAT,
@@ -82,6 +81,9 @@ from quadimpact.core.layout import (
 from quadimpact.core.plugin_call import call_estimator
 from quadimpact.core.quaternion import euler_zyx
 from quadimpact.core.records import Data, Model, Output, Work
+from quadimpact.core.sensors.imu_slots import (
+    SC_BIAS,
+)
 from quadimpact.core.sensors.measurement import measure
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
 

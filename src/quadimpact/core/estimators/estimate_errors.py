@@ -27,15 +27,8 @@ from quadimpact.core.layout import (
     ES_POS,
     ES_Q,
     ES_VEL,
-    I_BIAS_HAT,
-    I_BIAS_TRUE,
-    I_ERR,
-    I_POS_HAT,
-    I_Q_HAT,
-    I_VEL_HAT,
     N_EST_ERR,
     N_PHASES,
-    SC_BIAS,
     SS_N,
     SS_WALK,
     ST_EST_ERR,
@@ -46,6 +39,15 @@ from quadimpact.core.layout import (
     X_VEL,
 )
 from quadimpact.core.records import Data, Model, Output
+from quadimpact.core.sensors.imu_slots import (
+    I_BIAS_HAT,
+    I_BIAS_TRUE,
+    I_ERR,
+    I_POS_HAT,
+    I_Q_HAT,
+    I_VEL_HAT,
+    SC_BIAS,
+)
 from quadimpact.core.sensors.rotvec import error_angle
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's

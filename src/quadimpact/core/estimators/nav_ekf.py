@@ -127,13 +127,15 @@ from quadimpact.core.layout import (
     MS_IMU_W,
     N_OWN_ECFG,
     N_OWN_EST,
-    SC_BIAS,
-    SC_RANGE_F,
-    SC_RANGE_W,
     V_GRAVITY,
     Block,
 )
 from quadimpact.core.records import Data, Model
+from quadimpact.core.sensors.imu_slots import (
+    SC_BIAS,
+    SC_RANGE_F,
+    SC_RANGE_W,
+)
 from quadimpact.core.sensors.registry import measurement_address
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
 

@@ -68,6 +68,9 @@ import numpy as np
 from numba import literal_unroll, njit
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.feature_slots import (
+    F_KIND,
+)
 from quadimpact.core.geometry.box import box_distance, point_box, sphere_box
 from quadimpact.core.geometry.contact_record import ContactRecord, no_contact
 from quadimpact.core.geometry.cylinder import cylinder_distance, point_cylinder, sphere_cylinder
@@ -83,17 +86,18 @@ from quadimpact.core.geometry.shapes import (
     geometry_rows,
 )
 from quadimpact.core.layout import (
-    F_KIND,
     FEAT_POINT,
     FEAT_RING,
     FEAT_SPHERE,
-    SH_KIND,
     SHAPE_BOX,
     SHAPE_CYLINDER,
     SHAPE_PLANE,
     Block,
     FeatureKind,
     ShapeKind,
+)
+from quadimpact.core.shape_slots import (
+    SH_KIND,
 )
 
 # ---- contact pairs pairs (n_pairs, NPAIR), int64: one row per (feature,

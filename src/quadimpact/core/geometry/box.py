@@ -31,8 +31,18 @@ import math
 import numpy as np
 from numba import njit
 
+from quadimpact.core.feature_slots import (
+    F_RADIUS,
+)
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
-from quadimpact.core.layout import F_RADIUS, SH_HALF, SH_POINT, SH_ROT, X_POS
+from quadimpact.core.layout import (
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
+    SH_HALF,
+    SH_POINT,
+    SH_ROT,
+)
 
 OUTSIDE = -1  # the piece id of a point outside (the depth is smooth there)
 

@@ -24,7 +24,13 @@ shape or a feature's geometry itself.
 import numpy as np
 from numba import njit
 
-from quadimpact.core.layout import F_CENTRE, X_OMEGA, X_VEL
+from quadimpact.core.feature_slots import (
+    F_CENTRE,
+)
+from quadimpact.core.layout import (
+    X_OMEGA,
+    X_VEL,
+)
 
 ContactRecord = tuple[float, float, float, float, float, float, float, float, float, float, float]
 """(delta, delta_dot, rcx, rcy, rcz, vcx, vcy, vcz, nx, ny, nz)."""

@@ -34,8 +34,19 @@ import math
 import numpy as np
 from numba import njit
 
+from quadimpact.core.feature_slots import (
+    F_RADIUS,
+)
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
-from quadimpact.core.layout import F_RADIUS, SH_LENGTH, SH_NORMAL, SH_POINT, SH_RADIUS, X_POS
+from quadimpact.core.layout import (
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
+    SH_LENGTH,
+    SH_NORMAL,
+    SH_POINT,
+    SH_RADIUS,
+)
 
 OUTSIDE = -1  # the piece id of a point outside (the depth is smooth there)
 AXIS_EPS = 1e-300  # rho below this: the point is on the axis

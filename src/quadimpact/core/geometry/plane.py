@@ -24,8 +24,19 @@ import math
 import numpy as np
 from numba import njit
 
+from quadimpact.core.feature_slots import (
+    F_CENTRE,
+    F_NORMAL,
+    F_RADIUS,
+)
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
-from quadimpact.core.layout import F_CENTRE, F_NORMAL, F_RADIUS, SH_NORMAL, SH_POINT, X_POS
+from quadimpact.core.layout import (
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
+    SH_NORMAL,
+    SH_POINT,
+)
 
 PARALLEL_EPS = 1e-12  # |w| below this: the circle is parallel to the plane
 BOUND_MARGIN = 1e-9  # m: added to the broad phase's depth bound (rounding), as ring.py's

@@ -65,24 +65,28 @@ import numpy as np
 from numba import njit
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.feature_slots import (
+    F_CENTRE,
+    F_NORMAL,
+    F_RADIUS,
+)
 from quadimpact.core.geometry.box import box_depth, box_piece
 from quadimpact.core.geometry.contact_record import ContactRecord, material_record
 from quadimpact.core.geometry.cylinder import cylinder_depth, cylinder_piece
 from quadimpact.core.geometry.plane import plane_depth, plane_distance
 from quadimpact.core.geometry.ring_box import ring_box_exact
 from quadimpact.core.layout import (
-    F_CENTRE,
-    F_NORMAL,
-    F_RADIUS,
-    SH_KIND,
-    SH_LENGTH,
-    SH_NORMAL,
-    SH_POINT,
     SHAPE_BOX,
     SHAPE_CYLINDER,
     X_OMEGA,
     X_POS,
     X_VEL,
+)
+from quadimpact.core.shape_slots import (
+    SH_KIND,
+    SH_LENGTH,
+    SH_NORMAL,
+    SH_POINT,
 )
 
 TOL = 1e-13  # m: how far the returned depth may be below the circle's maximum

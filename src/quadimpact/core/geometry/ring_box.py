@@ -54,7 +54,11 @@ from numba import njit
 
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.geometry.box import box_depth
-from quadimpact.core.layout import SH_HALF, SH_POINT, SH_ROT
+from quadimpact.core.shape_slots import (
+    SH_HALF,
+    SH_POINT,
+    SH_ROT,
+)
 
 MAX_CANDIDATES = 160
 HARD = 1e-6  # relative size of c1, c2 or lam2 - lam1 below which both signs are tried

@@ -25,7 +25,11 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core.layout import NSHAPE, SH_IS_GROUND, SH_KIND
+from quadimpact.core.shape_slots import (
+    NSHAPE,
+    SH_IS_GROUND,
+    SH_KIND,
+)
 
 __all__ = ["ShapeComponent", "ShapeSlot"]
 

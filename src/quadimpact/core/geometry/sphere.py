@@ -29,17 +29,21 @@ from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.feature_slots import (
+    F_NORMAL,
+    F_RADIUS,
+)
 from quadimpact.core.geometry.contact_record import ContactRecord, feature_offset, material_record
 from quadimpact.core.geometry.shape_component import ShapeComponent, ShapeSlot
 from quadimpact.core.layout import (
-    F_NORMAL,
-    F_RADIUS,
     FEAT_POINT,
     FEAT_RING,
     FEAT_SPHERE,
+    X_POS,
+)
+from quadimpact.core.shape_slots import (
     SH_POINT,
     SH_RADIUS,
-    X_POS,
 )
 
 __all__ = ["SHAPE", "SphereObstacle"]

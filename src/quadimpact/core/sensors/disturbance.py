@@ -26,7 +26,13 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import SC_IMPACT_TAU, ST_IMPACT_T, ST_IMPACT_V
+from quadimpact.core.layout import (
+    ST_IMPACT_T,
+    ST_IMPACT_V,
+)
+from quadimpact.core.sensors.imu_slots import (
+    SC_IMPACT_TAU,
+)
 
 
 @compiled

@@ -42,15 +42,29 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import (
     FILTER_FIRST_ORDER,
     FILTER_MOVING_AVERAGE,
+    MAX_AVERAGE_WINDOW,
+    MS_IMU_F,
+    MS_IMU_T,
+    MS_IMU_W,
+    SN_IMPACT,
+    SN_WALK,
+    SS_FILT,
+    SS_N,
+    SS_RING,
+    SS_WALK,
+    ST_N_IMU,
+    V_GRAVITY,
+    X_OMEGA,
+    X_VEL,
+)
+from quadimpact.core.records import Data, Model, Output
+from quadimpact.core.sensors.disturbance import impact_factor
+from quadimpact.core.sensors.imu_slots import (
     I_F,
     I_F_TRUE,
     I_T,
     I_W,
     I_W_TRUE,
-    MAX_AVERAGE_WINDOW,
-    MS_IMU_F,
-    MS_IMU_T,
-    MS_IMU_W,
     SC_BIAS,
     SC_BIAS_WALK,
     SC_FILTER,
@@ -65,19 +79,7 @@ from quadimpact.core.layout import (
     SC_RANGE_F,
     SC_RANGE_W,
     SC_RATE,
-    SN_IMPACT,
-    SN_WALK,
-    SS_FILT,
-    SS_N,
-    SS_RING,
-    SS_WALK,
-    ST_N_IMU,
-    V_GRAVITY,
-    X_OMEGA,
-    X_VEL,
 )
-from quadimpact.core.records import Data, Model, Output
-from quadimpact.core.sensors.disturbance import impact_factor
 
 
 @compiled
