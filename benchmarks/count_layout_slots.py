@@ -44,6 +44,7 @@ DECLARATIONS = {
     "quadimpact.core.feature_slots": "quadimpact.core.contact",
     "quadimpact.core.shape_slots": "quadimpact.core.geometry",
     "quadimpact.core.envs.episode_layout": "quadimpact.core.envs.stacked",
+    "quadimpact.core.controller_slots": "quadimpact.core.controllers",
 }
 #: What a declaration module may import of quadimpact.
 DECLARATION_IMPORTS = {"quadimpact.core.block", "quadimpact.core.layout"}
@@ -59,6 +60,17 @@ def _imports(module: str) -> set[str]:
         elif isinstance(node, ast.Import):
             out.update(a.name for a in node.names)
     return {m for m in out if m.startswith("quadimpact")}
+
+
+def _imports_name(module: str, package: str, name: str) -> bool:
+    """Whether ``module`` has ``from package import name`` (a module imported by its package)."""
+    tree = ast.parse(Path(inspect.getfile(importlib.import_module(module))).read_text())
+    return any(
+        isinstance(node, ast.ImportFrom)
+        and node.module == package
+        and any(a.name == name for a in node.names)
+        for node in ast.walk(tree)
+    )
 
 
 def _compiled(module: str) -> bool:
@@ -87,7 +99,8 @@ def check_declaration(module: str, owner: str) -> None:
     package = module.rsplit(".", 1)[0]
     if not owner.startswith(package + "."):
         raise SystemExit(f"{module}: its owner {owner} is not next to it or in its package")
-    if module not in _imports(owner):
+    package_, leaf = module.rsplit(".", 1)
+    if module not in _imports(owner) and not _imports_name(owner, package_, leaf):
         raise SystemExit(f"{module}: its owner {owner} does not import it")
     layout = importlib.import_module("quadimpact.core.layout")
     for b in Block.registry.values():

@@ -585,7 +585,7 @@ def test_wrong_folders_and_files_are_refused_before_the_simulator_loads(tmp_path
     """A missing result folder, scenario file, an unusable --out or a bad value is said
     before the simulator (the compiled kernel's driver), the drawing code (Matplotlib) or
     Numba is imported: the inputs and a sweep's checks pack and validate without the
-    compiled code (the controllers' slots are in ``core/layout.py``)."""
+    compiled code (the controllers' slots are in ``core/controller_slots.py``)."""
     afile = tmp_path / "a-file"
     afile.write_text("not a folder\n")
     cases = [

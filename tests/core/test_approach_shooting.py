@@ -14,6 +14,7 @@ import pytest
 
 from quadimpact import WallApproach
 from quadimpact.core import approach as core_approach
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
 from quadimpact.core.approach import (
@@ -164,7 +165,7 @@ def test_a_controller_that_may_read_x_keeps_the_check_of_the_x_shift(monkeypatch
     kw = _solve_inputs(monkeypatch, WallApproach(heading_deg=45, inclination_deg=15,
                                                  speed_m_s=0.75))  # fmt: skip
     ctrl = kw["run"].ctrl.copy()
-    ctrl[L.C_KIND] = L.CTRL_CASCADE_PID
+    ctrl[CTL.C_KIND] = L.CTRL_CASCADE_PID
     assert not core_approach._ignores_x(kw["run"]._replace(ctrl=ctrl))
     ecfg = kw["run"].ecfg.copy()
     ecfg[L.EC_KIND] = L.EST_EKF

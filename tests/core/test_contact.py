@@ -7,6 +7,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from quadimpact import FlightScenario, load_vehicle
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import contact_record
 from quadimpact.core.recording_slots import E_FEATURE, E_V_I, OUT_X
@@ -200,7 +201,7 @@ def test_point_mass_impact_restitution_matches_one_dof(speed):
     veh = setup.veh.copy()
     veh[L.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
-    ctrl[L.C_KIND] = L.CTRL_NONE
+    ctrl[CTL.C_KIND] = L.CTRL_NONE
     out, ep, stats = run_packed(setup, veh=veh, ctrl=ctrl)
     assert ep.shape[0] == 1 and int(ep[0, E_FEATURE]) == 3  # bumper 4, once
     assert ep[0, E_V_I] == pytest.approx(speed, rel=1e-9)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
@@ -32,7 +33,7 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     feat = np.zeros((0, FS.NFEAT))
     shapes = np.zeros((0, SHP.NSHAPE))
     m = model(x0=x, t0=0.0, tf=1.0, veh=veh, feat=feat, shapes=shapes,
-              pairs=pair_table(feat, shapes), opts=np.zeros(L.NOPT), ctrl=np.zeros(L.NCTRL),
+              pairs=pair_table(feat, shapes), opts=np.zeros(L.NOPT), ctrl=np.zeros(CTL.NCTRL),
               t_out=np.zeros(0), scfg=scfg)  # fmt: skip
     d = new_data(m)
     o = new_output(m, len(samples), 0)

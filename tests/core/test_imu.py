@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import OUT_DELTA, OUT_T, OUT_X
@@ -48,7 +49,7 @@ def test_free_fall_reads_zero():
     setup = prepare(FlightScenario(position_m=(0, 0, -50), euler_deg=(20, -10, 30),
                                    rotor_speeds_rad_s=(0, 0, 0, 0), final_time_s=1.0))  # fmt: skip
     ctrl = setup.ctrl.copy()
-    ctrl[L.C_KIND] = L.CTRL_NONE  # rotors stay stopped
+    ctrl[CTL.C_KIND] = L.CTRL_NONE  # rotors stay stopped
     imu = _run(setup, _scfg(position=(0.1, -0.05, 0.02)), ctrl=ctrl).imu
     np.testing.assert_allclose(imu[:, IMS.I_F : IMS.I_F + 3], 0.0, atol=1e-12)
 
@@ -65,7 +66,7 @@ def test_constant_spin_off_the_cm_reads_the_centripetal_term():
     veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
     veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
     ctrl = setup.ctrl.copy()
-    ctrl[L.C_KIND] = L.CTRL_NONE
+    ctrl[CTL.C_KIND] = L.CTRL_NONE
     imu = _run(setup, _scfg(1000.0, r), veh=veh, ctrl=ctrl).imu
     expected = np.cross(omega, np.cross(omega, r))
     np.testing.assert_allclose(imu[:, IMS.I_F : IMS.I_F + 3], np.tile(expected, (len(imu), 1)),
@@ -84,7 +85,7 @@ def test_wall_contact_body_x_reading_is_the_contact_force_over_mass():
     veh = setup.veh.copy()
     veh[L.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
-    ctrl[L.C_KIND] = L.CTRL_NONE
+    ctrl[CTL.C_KIND] = L.CTRL_NONE
     rec = _run(setup, _scfg(1000.0), veh=veh, ctrl=ctrl)
     out, imu = rec.out, rec.imu
     assert len(rec.episodes) >= 2  # bumpers 1 and 4 (the contact really happened)

@@ -15,6 +15,7 @@ from collections import defaultdict
 import numpy as np
 import pytest
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
@@ -34,6 +35,7 @@ DECLARING = (
     "quadimpact.core.hover_slots",
     "quadimpact.core.feature_slots",
     "quadimpact.core.shape_slots",
+    "quadimpact.core.controller_slots",
     "quadimpact.core.sensors.imu_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
@@ -153,7 +155,7 @@ def test_the_factories_allocate_the_declared_sizes():
         x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
         feat=np.zeros((m_feat, FS.NFEAT)), shapes=np.zeros((n_shapes, SHP.NSHAPE)),
         pairs=np.zeros((m_feat * n_shapes, NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
-        ctrl=np.zeros(L.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
+        ctrl=np.zeros(CTL.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),
     )  # fmt: skip
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (IMS.NSCFG,)
     d = new_data(m)

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import E_FEATURE, E_T_END, E_T_START, OUT_CMD, OUT_T, OUT_X
@@ -24,7 +25,7 @@ def rotors_off(setup, gravity=True):
     if not gravity:
         veh[L.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
-    ctrl[L.C_KIND] = L.CTRL_NONE
+    ctrl[CTL.C_KIND] = L.CTRL_NONE
     return run_packed(setup, veh=veh, ctrl=ctrl)
 
 
@@ -62,7 +63,7 @@ def test_ground_as_contact_surface_bounces_and_records_the_crash():
 def test_ground_episodes_are_not_impacts():
     scenario = FlightScenario(rotor_speeds_rad_s=(0, 0, 0, 0), ground="contact", final_time_s=1.0)
     setup = prepare(scenario)
-    setup.ctrl[L.C_KIND] = L.CTRL_NONE  # the rotors held at their speeds: off, as they start
+    setup.ctrl[CTL.C_KIND] = L.CTRL_NONE  # the rotors held at their speeds: off, as they start
     r = run_setup(setup, scenario)
     assert r.summary["crash_time_s"] is not None
     assert (r.episodes["surface"] == "ground").any()
@@ -105,7 +106,7 @@ def test_first_order_rotors_follow_their_time_constant():
     )
     veh = setup.veh.copy()
     veh[L.V_GRAVITY] = 0.0
-    setup.ctrl[L.C_KIND] = L.CTRL_NONE
+    setup.ctrl[CTL.C_KIND] = L.CTRL_NONE
     opts = setup.opts.copy()
     opts[L.O_OMEGA_MIN], opts[L.O_OMEGA_MAX], opts[L.O_SLEW_MAX] = 600.0, 0.0, 0.0
     out = execute(setup.model(veh=veh, opts=opts)).out

@@ -24,6 +24,7 @@ import pytest
 from numba import njit
 from scipy.integrate import solve_ivp
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
@@ -128,8 +129,8 @@ def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
         0.005, 1e-10, 1e-12, 1e6, 1e-12
     )  # fmt: skip
     opts[[L.O_V_MIN, L.O_V_REG, L.O_POWER_OFF_T]] = (1e-3, 1e-2, np.inf)
-    ctrl = np.zeros(L.NCTRL)
-    ctrl[L.C_KIND] = L.CTRL_USER
+    ctrl = np.zeros(CTL.NCTRL)
+    ctrl[CTL.C_KIND] = L.CTRL_USER
     scfg = np.zeros(IMS.NSCFG)
     scfg[IMS.SC_RATE] = rate_hz
     return model(

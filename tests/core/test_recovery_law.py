@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import recovery as CL
 from quadimpact.core.controllers import recovery as R
@@ -46,13 +47,13 @@ def _packed(mass=1.0, g=9.81):
     veh[L.V_MASS] = mass
     veh[L.V_GRAVITY] = g
     veh[L.V_INERTIA : L.V_INERTIA + 9] = np.diag([0.01, 0.01, 0.02]).ravel()
-    ctrl = np.zeros(L.NCTRL)
+    ctrl = np.zeros(CTL.NCTRL)
     # an identity "allocation" so cmd^2 = (T, tau_x, tau_y, tau_z) can be read back
-    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16] = np.eye(4).ravel()
-    ctrl[L.C_N_ROTORS] = veh[L.V_N_ROTORS] = 4  # a quadrotor
-    ctrl[L.C_OMEGA_MIN] = 0.0
-    ctrl[L.C_OMEGA_MAX] = 1e9
-    p = L.C_PARAMS
+    ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 16] = np.eye(4).ravel()
+    ctrl[CTL.C_N_ROTORS] = veh[L.V_N_ROTORS] = 4  # a quadrotor
+    ctrl[CTL.C_OMEGA_MIN] = 0.0
+    ctrl[CTL.C_OMEGA_MAX] = 1e9
+    p = CTL.C_PARAMS
     ctrl[p + CL.R_K_ATT] = 20.0
     ctrl[p + CL.R_K_RATE : p + CL.R_K_RATE + 3] = (20.0, 20.0, 2.0)
     ctrl[p + CL.R_A_MAG] = g
@@ -119,7 +120,7 @@ def test_tilted_vehicle_gets_a_rate_command_back_to_level():
 def _tilt_inputs(level_test, q_tol=0.15, euler_tol=0.2, qe=(0.0, 0.0)):
     """ctrl with the stage tests' switches, and mem with the previous tick's q_e."""
     _, ctrl = _packed()
-    p = L.C_PARAMS
+    p = CTL.C_PARAMS
     ctrl[p + CL.R_Q_TOL] = q_tol
     ctrl[p + CL.R_LEVEL_TEST] = level_test
     ctrl[p + CL.R_EULER_TOL] = euler_tol
@@ -203,7 +204,7 @@ def test_stage3_ends_below_the_pole_replicas_w(w, expected):
 def test_stage1_reference_a_mag_sets_the_tilt_away():
     """a_ref = a_mag n: the target leans atan(a_mag / g) away from the wall (4.8: ~26 deg)."""
     veh, ctrl = _packed()
-    ctrl[L.C_PARAMS + CL.R_A_MAG] = 4.8
+    ctrl[CTL.C_PARAMS + CL.R_A_MAG] = 4.8
     normal = np.array([-1.0, 0.0, 0.0])
     qex, qey = R.staged_law(1, True, _state(), np.zeros(3), normal, ctrl, veh, np.zeros(4))
     tilt = math.atan2(4.8, 9.81)

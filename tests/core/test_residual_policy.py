@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import residual as RES
 from quadimpact.core.controllers.residual import features, residual_references
@@ -57,9 +58,9 @@ def _random_policy(
 
 
 def _ctrl(p: PolicyWeights) -> np.ndarray:
-    ctrl = np.zeros(L.NCTRL)
+    ctrl = np.zeros(CTL.NCTRL)
     block = p.block()
-    ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+    ctrl[CTL.C_POLICY : CTL.C_POLICY + block.size] = block
     return ctrl
 
 
@@ -299,7 +300,7 @@ def _tick_commands(policy: PolicyWeights | None, stage: int, hold_set: float) ->
     ctrl = setup.ctrl.copy()
     if policy is not None:
         block = policy.block()
-        ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+        ctrl[CTL.C_POLICY : CTL.C_POLICY + block.size] = block
     meas = np.zeros(L.NMEAS)
     meas[L.MS_X : L.MS_X + L.NX] = setup.x0
     meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
@@ -356,10 +357,10 @@ def test_packing_writes_the_files_block(tmp_path):
     path = save_policy(p, tmp_path / "p.npz")
     ctrl = prepare(_trial(controller_params={"policy": str(path)})).ctrl
     block = p.block()
-    np.testing.assert_array_equal(ctrl[L.C_POLICY : L.C_POLICY + block.size], block)
-    assert not ctrl[L.C_POLICY + block.size : L.C_POLICY + L.NPOLICY].any()
-    assert not prepare(_trial()).ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY].any()
-    assert int(ctrl[L.C_POLICY + RES.PB_HIDDEN]) == p.hidden
+    np.testing.assert_array_equal(ctrl[CTL.C_POLICY : CTL.C_POLICY + block.size], block)
+    assert not ctrl[CTL.C_POLICY + block.size : CTL.C_POLICY + CTL.NPOLICY].any()
+    assert not prepare(_trial()).ctrl[CTL.C_POLICY : CTL.C_POLICY + CTL.NPOLICY].any()
+    assert int(ctrl[CTL.C_POLICY + RES.PB_HIDDEN]) == p.hidden
 
 
 def test_a_policy_file_round_trips_with_its_digest(tmp_path):

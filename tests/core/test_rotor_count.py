@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, ImpactTrial, simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers.common import allocate
 from quadimpact.core.rotors import rotor_wrench
@@ -42,10 +43,12 @@ def hexa():
 
 def _hexa_ctrl(hexa) -> np.ndarray:
     """A packed ``ctrl`` head for the hexacopter (the physical yaw row)."""
-    ctrl = np.zeros(L.NCTRL)
+    ctrl = np.zeros(CTL.NCTRL)
     n = hexa.rotor_count
-    ctrl[L.C_N_ROTORS] = n
-    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + L.N_WRENCH * n] = allocation_inverse(hexa, False).ravel()
+    ctrl[CTL.C_N_ROTORS] = n
+    ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + CTL.N_WRENCH * n] = allocation_inverse(
+        hexa, False
+    ).ravel()
     return ctrl
 
 
@@ -115,7 +118,7 @@ def test_allocation_reproduces_feasible_wrenches(hexa):
         )
         clipped = allocate(ctrl, *wrench, cmd)
         w2 = cmd[:6] ** 2
-        exact = ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 24].reshape(6, 4) @ wrench
+        exact = ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 24].reshape(6, 4) @ wrench
         assert clipped == bool(np.any(exact < 0.0))
         assert np.all(cmd[6:] == 0.0)  # rotors beyond the sixth: never written
         if clipped:
@@ -134,7 +137,7 @@ def test_allocation_clips_negative_squares_outside_the_feasible_set(hexa):
     cmd = np.full(L.MAX_ROTORS, -1.0)
     wrench = (0.2 * weight, 2.0, 0.0, 0.0)  # tau_x = 2 N m on 0.2 m g of thrust
     assert allocate(ctrl, *wrench, cmd)
-    exact = ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 24].reshape(6, 4) @ np.array(wrench)
+    exact = ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 24].reshape(6, 4) @ np.array(wrench)
     neg = exact < 0.0
     assert neg.any() and (~neg).any()
     assert np.all(cmd[:6][neg] == 0.0)  # clipped squares are 0
@@ -163,8 +166,8 @@ def test_quadrotor_allocation_is_the_exact_inverse():
                 final_time_s=0.1,
             )
             ctrl = prepare(s).ctrl
-            assert ctrl[L.C_N_ROTORS] == 4
-            packed = ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + L.N_WRENCH * L.MAX_ROTORS]
+            assert ctrl[CTL.C_N_ROTORS] == 4
+            packed = ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + CTL.N_WRENCH * L.MAX_ROTORS]
             assert np.array_equal(packed[:16].reshape(4, 4), inv)
             assert np.all(packed[16:] == 0.0)
 

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import quadimpact.envs as E
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.rotors import RIN_CMD
@@ -103,7 +104,7 @@ def test_reward_is_the_documented_cost():
     s = env._slots
     veh = s.M.veh[0]
     hover = math.sqrt(veh[L.V_MASS] * veh[L.V_GRAVITY] / (4 * veh[L.V_KT]))
-    span = s.M.ctrl[0, L.C_OMEGA_MAX] - s.M.ctrl[0, L.C_OMEGA_MIN]
+    span = s.M.ctrl[0, CTL.C_OMEGA_MAX] - s.M.ctrl[0, CTL.C_OMEGA_MIN]
     rng = np.random.default_rng(0)
     for _ in range(30):
         obs, r, term, trunc, _ = env.step(rng.uniform(-0.2, 0.4, 4))

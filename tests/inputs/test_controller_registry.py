@@ -31,6 +31,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from quadimpact import load_scenario_file, load_vehicle, read_result, simulate
 from quadimpact.cli import cli
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.controllers import (
@@ -59,7 +60,7 @@ class ConstantThrustParams(BaseModel):
 
 
 def pack_constant_thrust(params: ConstantThrustParams, context: object) -> np.ndarray:
-    block = np.zeros(L.NPARAM)
+    block = np.zeros(CTL.NPARAM)
     block[0] = params.thrust_n
     return block
 
@@ -67,7 +68,7 @@ def pack_constant_thrust(params: ConstantThrustParams, context: object) -> np.nd
 @njit
 def constant_thrust_step(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compiled
     for j in range(4):  # Omega_j^2 = (A^-1)[j, 0] T: thrust T, zero torques
-        cmd[j] = np.sqrt(max(ctrl[L.C_ALLOC_INV + 4 * j] * ctrl[L.C_PARAMS], 0.0))
+        cmd[j] = np.sqrt(max(ctrl[CTL.C_ALLOC_INV + 4 * j] * ctrl[CTL.C_PARAMS], 0.0))
 
 
 @pytest.fixture(scope="module")
@@ -122,8 +123,8 @@ def test_a_scenario_file_selects_the_plugin_and_its_parameter(plugin, tmp_path: 
     scenario = load_scenario_file(scenario_toml(tmp_path / "flight.toml"))
     assert scenario.controller == NAME
     setup = prepare(scenario)
-    assert setup.ctrl[L.C_KIND] == L.CTRL_USER
-    assert setup.ctrl[L.C_PARAMS] == THRUST  # the parameter reached its packed block
+    assert setup.ctrl[CTL.C_KIND] == L.CTRL_USER
+    assert setup.ctrl[CTL.C_PARAMS] == THRUST  # the parameter reached its packed block
     assert setup.kernel is plugin.kernel_cache["kernel"]
     result = simulate(scenario)
     assert result.summary["status"] == "completed" and result.summary["controller"] == NAME

@@ -16,6 +16,7 @@ from numba import njit
 from pydantic import BaseModel
 
 from quadimpact import FlightScenario, Simulation
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core import named
 from quadimpact.inputs.controllers import param_index, param_slots, register_controller
@@ -39,7 +40,7 @@ def _records(scenario: FlightScenario):
 
 def _wrench(m, cmd: np.ndarray) -> np.ndarray:
     """[thrust N, torques N m] that the commands ask for (the allocation's inverse, inverted)."""
-    a_inv = m.ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16].reshape(4, 4)
+    a_inv = m.ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 16].reshape(4, 4)
     return np.linalg.solve(a_inv, cmd**2)
 
 
@@ -91,7 +92,7 @@ def test_an_attitude_error_asks_for_the_torque_that_removes_it(template, axis, e
 
 def test_each_named_quantity_is_its_slots() -> None:
     meas = np.arange(L.NMEAS, dtype=float)
-    ctrl = np.arange(L.NCTRL, dtype=float)
+    ctrl = np.arange(CTL.NCTRL, dtype=float)
     veh = np.arange(L.NVEH, dtype=float)
 
     @njit
@@ -114,10 +115,10 @@ def test_each_named_quantity_is_its_slots() -> None:
     assert got[4].tolist() == list(range(L.MS_IMU_F, L.MS_IMU_F + 3))
     assert got[5].tolist() == list(range(L.MS_NORMAL, L.MS_NORMAL + 3))
     assert (got[6], got[7]) == (L.MS_T, L.MS_T_DETECT)
-    assert got[8].tolist() == [L.C_PARAMS, L.C_PARAMS + 1, L.C_PARAMS + 2]
-    assert got[9] == L.C_ALLOC_INV + 6
-    assert got[10] == (L.C_H_REF, L.C_PHI_REF, L.C_THETA_REF, L.C_PSI_REF)
-    assert got[11] == (L.C_OMEGA_MIN, L.C_OMEGA_MAX)
+    assert got[8].tolist() == [CTL.C_PARAMS, CTL.C_PARAMS + 1, CTL.C_PARAMS + 2]
+    assert got[9] == CTL.C_ALLOC_INV + 6
+    assert got[10] == (CTL.C_H_REF, CTL.C_PHI_REF, CTL.C_THETA_REF, CTL.C_PSI_REF)
+    assert got[11] == (CTL.C_OMEGA_MIN, CTL.C_OMEGA_MAX)
     assert got[12:] == (L.V_MASS, L.V_INERTIA + 7, L.V_GRAVITY, L.V_KT)
 
 

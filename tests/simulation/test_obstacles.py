@@ -21,6 +21,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from quadimpact import simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
@@ -151,8 +152,8 @@ def _elastic_run(obstacle, position, velocity, euler=(0.0, 0.0, 0.0)):
     feat = setup.feat.copy()
     feat[:, FS.F_E] = 1.0
     feat[:, FS.F_MU] = 0.0
-    ctrl = np.zeros(L.NCTRL)
-    ctrl[L.C_KIND] = L.CTRL_NONE
+    ctrl = np.zeros(CTL.NCTRL)
+    ctrl[CTL.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
     x0[L.X_ROTOR : L.X_ROTOR + 4] = 0.0
     m = setup.model(x0=x0, feat=feat, ctrl=ctrl, scfg=np.zeros(IMS.NSCFG))
@@ -221,8 +222,8 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     setup = prepare(scenario)
     veh = setup.veh.copy()
     veh[L.V_GRAVITY] = 0.0  # the 1-DOF law alone
-    ctrl = np.zeros(L.NCTRL)
-    ctrl[L.C_KIND] = L.CTRL_NONE
+    ctrl = np.zeros(CTL.NCTRL)
+    ctrl[CTL.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
     x0[L.X_ROTOR : L.X_ROTOR + 4] = 0.0
     m = setup.model(x0=x0, veh=veh, ctrl=ctrl, scfg=np.zeros(IMS.NSCFG))

@@ -17,6 +17,7 @@ import pytest
 from numba import njit
 
 from quadimpact import ImpactTrial, WallApproach, simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.kernel import BUILTIN, execute
@@ -83,7 +84,7 @@ def test_the_paper_law_as_a_plugin_flies_the_builtin_run_bit_for_bit(plugins):
     example = {"heading_deg": 45.0, "inclination_deg": 15.0, "speed_m_s": 0.75}
     built_in = prepare(WallApproach(**example, controller="paper"))
     plugged = prepare(WallApproach(**example, controller=name))
-    assert plugged.ctrl[L.C_STEP] != 0.0 and built_in.ctrl[L.C_STEP] == 0.0
+    assert plugged.ctrl[CTL.C_STEP] != 0.0 and built_in.ctrl[CTL.C_STEP] == 0.0
     assert plugged.run.x0.tobytes() == built_in.run.x0.tobytes()  # the shooting flew it too
     assert plugged.run.span.tobytes() == built_in.run.span.tobytes()
     mine = execute(plugged.model(), n_imu=plugged.n_imu, kernel=plugged.kernel)

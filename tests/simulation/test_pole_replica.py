@@ -18,7 +18,7 @@ from click.testing import CliRunner
 
 from quadimpact import ImpactTrial, simulate
 from quadimpact.cli import cli
-from quadimpact.core import layout as L
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core.controllers import recovery as CL
 from quadimpact.inputs.model import CLASSIC_LAW, MODEL_VARIANTS, RECOVERY_LAWS
 from quadimpact.inputs.scenarios import load_scenario_file, scenario_from_dict
@@ -66,12 +66,12 @@ POLE = {
 
 
 def _slots(scenario) -> dict[int, float]:
-    c = prepare(scenario).ctrl[L.C_PARAMS :]
+    c = prepare(scenario).ctrl[CTL.C_PARAMS :]
     return {slot: float(c[slot]) for slot in POLE_TABLE}
 
 
 def _pre_impact(scenario) -> int:
-    return int(prepare(scenario).ctrl[L.C_PARAMS + CL.R_PRE_IMPACT])
+    return int(prepare(scenario).ctrl[CTL.C_PARAMS + CL.R_PRE_IMPACT])
 
 
 def test_the_variant_is_the_default_model_with_the_pole_law_and_hold():
@@ -99,7 +99,7 @@ def test_the_variant_resolves_to_the_table():
     trial = ImpactTrial(model="pole-replica", **POLE)
     assert _slots(trial) == POLE_TABLE
     # k_z of stages 1-4 unchanged: 10 1/s in stage 3; the gains too
-    c = prepare(trial).ctrl[L.C_PARAMS :]
+    c = prepare(trial).ctrl[CTL.C_PARAMS :]
     assert tuple(c[CL.R_K_Z : CL.R_K_Z + 4]) == (0.0, 0.0, 10.0, 10.0)
     assert c[CL.R_K_ATT] == 20.0 and tuple(c[CL.R_K_RATE : CL.R_K_RATE + 3]) == (20, 20, 2)
     # before the detection: hold, whatever the scenario says

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, Simulation, simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import recovery as CL
 from quadimpact.inputs.controllers import RecoveryParams
@@ -93,14 +94,14 @@ def test_defaults_are_the_documented_table():
     assert (p.tilt_error_tol, p.rate_tol_rad_s, p.w_tol_m_s) == (0.3, 1.0, 0.3)
     assert (p.lean_cut_deg, p.lean_cut_force_m_s2) == (40.0, 2.4525)
     setup = prepare(FlightScenario(vehicle="navi", controller="recovery"))
-    c = setup.ctrl[L.C_PARAMS :]
+    c = setup.ctrl[CTL.C_PARAMS :]
     assert c[CL.R_K_ATT] == 20.0 and tuple(c[CL.R_K_RATE : CL.R_K_RATE + 3]) == (20.0, 20.0, 2.0)
     assert c[CL.R_A_MAG] == 4.8 and tuple(c[CL.R_K_Z : CL.R_K_Z + 4]) == (2.5, 2.5, 10.0, 10.0)
     assert (c[CL.R_Q_TOL], c[CL.R_RATE_TOL], c[CL.R_W_TOL]) == (0.3, 1.0, 0.3)
     assert c[CL.R_LEAN_CUT] == math.sin(math.radians(40.0)) and c[CL.R_LEAN_FORCE] == 2.4525
     # the classic law (the defaults before the benchmark): the table as it was
     c = prepare(FlightScenario(vehicle="navi", controller="recovery", model="classic")).ctrl
-    c = c[L.C_PARAMS :]
+    c = c[CTL.C_PARAMS :]
     assert c[CL.R_A_MAG] == 9.81 and tuple(c[CL.R_K_Z : CL.R_K_Z + 4]) == (0.0, 0.0, 10.0, 10.0)
     assert (c[CL.R_Q_TOL], c[CL.R_RATE_TOL], c[CL.R_W_TOL]) == (0.3, 0.5, 0.3)
     assert c[CL.R_LEAN_CUT] > 1.0  # never
@@ -110,9 +111,9 @@ def test_defaults_are_the_documented_table():
     setup = prepare(FlightScenario(vehicle="navi", controller="recovery", controller_params={
         "k_att_1_s": 11, "k_rate_1_s": [12, 13, 14], "a_mag_m_s2": 5, "k_z_1_s": [1, 2, 3, 4],
         "tilt_error_tol": 0.2, "rate_tol_rad_s": 0.4, "w_tol_m_s": 0.1}))  # fmt: skip
-    c = setup.ctrl[L.C_PARAMS :]
+    c = setup.ctrl[CTL.C_PARAMS :]
     assert list(c[CL.R_K_ATT : CL.R_K_ATT + 12]) == [11, 12, 13, 14, 5, 1, 2, 3, 4, 0.2, 0.4, 0.1]
     # the vehicle's rotor range limits the staged law's commands
     lo, hi = setup.vehicle.rotor_speed_range_rpm
-    assert setup.ctrl[L.C_OMEGA_MIN] == pytest.approx(lo * math.pi / 30)
-    assert setup.ctrl[L.C_OMEGA_MAX] == pytest.approx(hi * math.pi / 30)
+    assert setup.ctrl[CTL.C_OMEGA_MIN] == pytest.approx(lo * math.pi / 30)
+    assert setup.ctrl[CTL.C_OMEGA_MAX] == pytest.approx(hi * math.pi / 30)

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from quadimpact import ImpactTrial, simulate
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import recovery as CL
 from quadimpact.core.rotors import rotor_wrench
@@ -59,8 +60,8 @@ def test_drag_and_spinup_senses_are_separate(drag, spinup):
 def test_yaw_reaction_flips_the_allocation_yaw_row():
     phys = prepare(ImpactTrial(**TRIAL))
     paper = prepare(ImpactTrial(**TRIAL, model_options={"yaw_reaction": "paper"}))
-    a = np.linalg.inv(phys.ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16].reshape(4, 4))
-    b = np.linalg.inv(paper.ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16].reshape(4, 4))
+    a = np.linalg.inv(phys.ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 16].reshape(4, 4))
+    b = np.linalg.inv(paper.ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 16].reshape(4, 4))
     np.testing.assert_allclose(a[:3], b[:3], rtol=1e-12)
     np.testing.assert_allclose(a[3], -b[3], rtol=1e-12)
 
@@ -126,10 +127,10 @@ def test_pre_impact_spin_down_overrides_the_scenario():
     forced = prepare(ImpactTrial(**TRIAL, pre_impact="hold",
                                  model_options={"pre_impact": "spin-down"}))  # fmt: skip
 
-    assert hold.ctrl[L.C_PARAMS + CL.R_PRE_IMPACT] == CL.PRE_HOLD
-    assert forced.ctrl[L.C_PARAMS + CL.R_PRE_IMPACT] == CL.PRE_SPIN_DOWN
-    np.testing.assert_array_equal(np.delete(hold.ctrl, L.C_PARAMS + CL.R_PRE_IMPACT),
-                                  np.delete(forced.ctrl, L.C_PARAMS + CL.R_PRE_IMPACT))  # fmt: skip
+    assert hold.ctrl[CTL.C_PARAMS + CL.R_PRE_IMPACT] == CL.PRE_HOLD
+    assert forced.ctrl[CTL.C_PARAMS + CL.R_PRE_IMPACT] == CL.PRE_SPIN_DOWN
+    pre = CTL.C_PARAMS + CL.R_PRE_IMPACT
+    np.testing.assert_array_equal(np.delete(hold.ctrl, pre), np.delete(forced.ctrl, pre))
     np.testing.assert_array_equal(hold.opts, forced.opts)
     # and in the run: the first interval runs at the trimmed speed minus one slew step
     r = simulate(ImpactTrial(**TRIAL, pre_impact="hold", model_options={"pre_impact": "spin-down"}))

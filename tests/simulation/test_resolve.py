@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 from pydantic import BaseModel
 
-from quadimpact.core import layout as L
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core.controllers import recovery as REC
 from quadimpact.core.geometry.sphere import SphereObstacle
 from quadimpact.inputs.estimators import BUILTIN as BUILTIN_ESTIMATORS
@@ -137,8 +137,8 @@ def test_the_recovery_law_push_of_none_is_the_vehicles_g_decided_when_resolved()
     assert r.shared.controller.params.a_mag_m_s2 == 9.5
     assert r.shared.controller.params.hover_a_max_m_s2 == 4.75
     ctrl = prepare(trial).ctrl
-    assert ctrl[L.C_PARAMS + REC.R_A_MAG] == 9.5
-    assert ctrl[L.C_PARAMS + REC.R_HOVER_GAINS + 3] == 4.75
+    assert ctrl[CTL.C_PARAMS + REC.R_A_MAG] == 9.5
+    assert ctrl[CTL.C_PARAMS + REC.R_HOVER_GAINS + 3] == 4.75
 
 
 def _fingerprint(r: ResolvedShared) -> bytes:

@@ -38,10 +38,9 @@ from collections.abc import Callable
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.controller_slots import C_KIND, C_STEP
 from quadimpact.core.geometry import pair_contact
 from quadimpact.core.layout import (
-    C_KIND,
-    C_STEP,
     CTRL_PAPER,
     EC_KIND,
     EC_STEP,

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from quadimpact.core.compiled import allocating
-from quadimpact.core.layout import (
+from quadimpact.core.controller_slots import (
     C_ALLOC_INV,
     C_H_REF,
     C_OMEGA_MAX,
@@ -44,6 +44,10 @@ from quadimpact.core.layout import (
     C_PHI_REF,
     C_PSI_REF,
     C_THETA_REF,
+    N_WRENCH,
+    NPARAM,
+)
+from quadimpact.core.layout import (
     MAX_ROTORS,
     MS_BIAS_HAT,
     MS_DETECTED,
@@ -55,8 +59,6 @@ from quadimpact.core.layout import (
     MS_T_DETECT,
     MS_W_HAT,
     MS_X,
-    N_WRENCH,
-    NPARAM,
     NX,
     V_GRAVITY,
     V_INERTIA,

@@ -14,6 +14,7 @@ import numpy as np
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import pair_damping, pair_normal_force
 from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
+from quadimpact.core.controller_slots import C_PHI_REF, C_PSI_REF, C_THETA_REF, C_Z_REF
 from quadimpact.core.excursion import excursion_add, settled
 from quadimpact.core.excursion_slots import NEX
 from quadimpact.core.geometry import (
@@ -28,10 +29,6 @@ from quadimpact.core.geometry import (
 from quadimpact.core.geometry.plane import ring_plane
 from quadimpact.core.integrator import dense_eval
 from quadimpact.core.layout import (
-    C_PHI_REF,
-    C_PSI_REF,
-    C_THETA_REF,
-    C_Z_REF,
     LS_STAGE,
     MAX_ROTORS,
     NX,

@@ -33,6 +33,7 @@ import numpy as np
 from quadimpact.core.actuators import apply_command, cut_step
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.contact_slots import CS_ACTIVE, CS_EPISODE, CS_LAMBDA
+from quadimpact.core.controller_slots import C_KIND, C_PHI_REF, C_PSI_REF, C_STEP, C_THETA_REF
 from quadimpact.core.controllers import builtin_step
 from quadimpact.core.estimators import at_tick, init_estimate
 from quadimpact.core.excursion import excursion_start
@@ -40,11 +41,6 @@ from quadimpact.core.excursion_slots import NEX
 from quadimpact.core.hover_tracking import start_hover_tracking, track_held_hover, track_hover
 from quadimpact.core.interval import FAILED, RUNNING, contact_values, integrate_interval
 from quadimpact.core.layout import (
-    C_KIND,
-    C_PHI_REF,
-    C_PSI_REF,
-    C_STEP,
-    C_THETA_REF,
     CRASH_PAPER_TICKS,
     CTRL_USER,
     LS_DONE,

@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
 
@@ -144,7 +145,7 @@ class HoverPolicy:
             if s.par[B.EP_ACTION] == B.ACT_CTBR:
                 a[k, 0] = B.affine_inverse(weight, 0.0, B.max_thrust(veh, ctrl))[0]
                 continue
-            inv = ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + 16].reshape(4, 4)
+            inv = ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 16].reshape(4, 4)
             speeds = np.sqrt(np.clip(inv[:, 0] * weight, 0.0, None))
             lo, hi = B.rotor_range(ctrl, s.par)
             a[k] = [B.affine_inverse(float(w), lo, hi)[0] for w in speeds]

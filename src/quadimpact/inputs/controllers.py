@@ -28,6 +28,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, StrictBool, field_validator
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.registry import Registry
@@ -279,8 +280,8 @@ def param_slots(params: type[BaseModel]) -> dict[str, tuple[int, int]]:
             )
         slots[name] = (offset, width)
         offset += width
-    if offset > L.NPARAM:
-        raise TypeError(f"{params.__name__}: {offset} parameter slots, more than {L.NPARAM}")
+    if offset > CTL.NPARAM:
+        raise TypeError(f"{params.__name__}: {offset} parameter slots, more than {CTL.NPARAM}")
     return slots
 
 

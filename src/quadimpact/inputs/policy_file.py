@@ -38,7 +38,13 @@ from typing import Any
 
 import numpy as np
 
-from quadimpact.core.layout import F_SCALE_M_S2, MAX_HIDDEN, N_FEATURES, N_OUTPUTS, T_CAP_S
+from quadimpact.core.controller_slots import (
+    F_SCALE_M_S2,
+    MAX_HIDDEN,
+    N_FEATURES,
+    N_OUTPUTS,
+    T_CAP_S,
+)
 from quadimpact.errors import InputError, short_path
 from quadimpact.linalg import matvec
 

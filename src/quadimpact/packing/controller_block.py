@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import common as PID
 from quadimpact.core.controllers import recovery as REC
@@ -52,25 +53,25 @@ def pack_controller(
     and the controller's parameter block (its registry entry's packer).
     """
     v: Vehicle = context.vehicle
-    ctrl = np.zeros(L.NCTRL)
-    ctrl[L.C_KIND] = entry.kind
+    ctrl = np.zeros(CTL.NCTRL)
+    ctrl[CTL.C_KIND] = entry.kind
     n = v.rotor_count
-    ctrl[L.C_N_ROTORS] = n
-    ctrl[L.C_ALLOC_INV : L.C_ALLOC_INV + L.N_WRENCH * n] = vehicle_memo(
+    ctrl[CTL.C_N_ROTORS] = n
+    ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + CTL.N_WRENCH * n] = vehicle_memo(
         f"alloc-inv-{yaw_paper}", v, lambda: allocation_inverse(v, yaw_paper).ravel()
     )
     lo, hi = v.rotor_speed_range_rpm
-    ctrl[L.C_OMEGA_MIN] = lo * RPM
-    ctrl[L.C_OMEGA_MAX] = hi * RPM
+    ctrl[CTL.C_OMEGA_MIN] = lo * RPM
+    ctrl[CTL.C_OMEGA_MAX] = hi * RPM
     pack = entry.pack or BUILTIN_PACKERS.get(entry.kind, pack_fields)
     block = np.asarray(pack(params, context), dtype=float)
-    if block.shape != (L.NPARAM,):
-        raise ValueError(f"controller {entry.name!r}: its packer must return {L.NPARAM} numbers")
+    if block.shape != (CTL.NPARAM,):
+        raise ValueError(f"controller {entry.name!r}: its packer must return {CTL.NPARAM} numbers")
     refuse_nan(block, f"controller {entry.name!r}: its parameter block")
-    ctrl[L.C_PARAMS : L.C_PARAMS + L.NPARAM] = block
+    ctrl[CTL.C_PARAMS : CTL.C_PARAMS + CTL.NPARAM] = block
     policy = getattr(params, "policy", None) if entry.kind == L.CTRL_RECOVERY else None
     if policy is not None:
-        ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY] = policy_block(policy)
+        ctrl[CTL.C_POLICY : CTL.C_POLICY + CTL.NPOLICY] = policy_block(policy)
     return ctrl
 
 
@@ -95,7 +96,7 @@ def refuse_nan(block: np.ndarray, what: str) -> None:
 def policy_block(policy: str) -> np.ndarray:
     """The ``C_POLICY`` block of a learned residual (``learned`` or a ``.npz`` file), in
     ``core/controllers/residual.py``'s layout, zero-padded to ``NPOLICY``."""
-    block = np.zeros(L.NPOLICY)
+    block = np.zeros(CTL.NPOLICY)
     weights = load_policy(policy).block()
     block[: weights.size] = weights
     return block
@@ -108,21 +109,21 @@ def set_references(ctrl: np.ndarray, refs: Mapping[str, float]) -> None:
     the only slots of the controller's vector that depend on them (with the
     reference's body z axis, :func:`reference_z_axis`).
     """
-    ctrl[L.C_H_REF] = refs["altitude_m"]
-    ctrl[L.C_PHI_REF] = refs["roll_rad"]
-    ctrl[L.C_THETA_REF] = refs["pitch_rad"]
-    ctrl[L.C_PSI_REF] = refs["yaw_rad"]
-    ctrl[L.C_Z_REF : L.C_Z_REF + 3] = reference_z_axis(refs)
+    ctrl[CTL.C_H_REF] = refs["altitude_m"]
+    ctrl[CTL.C_PHI_REF] = refs["roll_rad"]
+    ctrl[CTL.C_THETA_REF] = refs["pitch_rad"]
+    ctrl[CTL.C_PSI_REF] = refs["yaw_rad"]
+    ctrl[CTL.C_Z_REF : CTL.C_Z_REF + 3] = reference_z_axis(refs)
 
 
 def pack_waypoint(ctrl: np.ndarray, waypoint: Any, start_m: Any) -> None:
     """The waypoint flight's slots of a ``C_*`` vector, in place (``waypoint``: a
     :class:`~quadimpact.inputs.waypoint.Waypoint`; ``start_m``: the position held first)."""
-    ctrl[L.C_WAYPOINT_ON] = 1.0
-    ctrl[L.C_HOLD_POS : L.C_HOLD_POS + 3] = start_m
-    ctrl[L.C_WAYPOINT : L.C_WAYPOINT + 3] = (waypoint.x_m, waypoint.y_m, 0.0)
-    ctrl[L.C_WAYPOINT_T] = waypoint.time_s
-    ctrl[L.C_POS_GAINS : L.C_POS_GAINS + 4] = (
+    ctrl[CTL.C_WAYPOINT_ON] = 1.0
+    ctrl[CTL.C_HOLD_POS : CTL.C_HOLD_POS + 3] = start_m
+    ctrl[CTL.C_WAYPOINT : CTL.C_WAYPOINT + 3] = (waypoint.x_m, waypoint.y_m, 0.0)
+    ctrl[CTL.C_WAYPOINT_T] = waypoint.time_s
+    ctrl[CTL.C_POS_GAINS : CTL.C_POS_GAINS + 4] = (
         waypoint.kp_1_s,
         waypoint.kv_1_s,
         waypoint.v_max_m_s,
@@ -140,7 +141,7 @@ def reference_z_axis(refs: Mapping[str, float]) -> np.ndarray:
 
 def pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
     """The default packing: the model's fields in order (:func:`param_slots`)."""
-    block = np.zeros(L.NPARAM)
+    block = np.zeros(CTL.NPARAM)
     for name, (offset, width) in param_slots(type(params)).items():
         value = getattr(params, name)
         block[offset : offset + width] = np.asarray(value, dtype=float).reshape(width)
@@ -148,7 +149,7 @@ def pack_fields(params: BaseModel, ctx: PackContext) -> np.ndarray:
 
 
 def _pack_pid(params: BaseModel, ctx: PackContext) -> np.ndarray:
-    block = np.zeros(L.NPARAM)
+    block = np.zeros(CTL.NPARAM)
     block[PID.P_GAINS : PID.P_GAINS + 15] = params.gains()
     if isinstance(params, CascadePidParams):  # the paper's law has no floor (slot unread)
         block[PID.P_THRUST_COS_FLOOR] = params.thrust_cos_floor

@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import Model, model, model_array, model_span
@@ -119,7 +120,7 @@ def pack_shared(r: ResolvedShared) -> SharedPacking:
     est = pack_estimation(r, scfg)
     ctrl = pack_controller(c.entry, c.params, context, o.yaw_reaction == "paper")
     if c.step_address:
-        ctrl[L.C_STEP] = c.step_address
+        ctrl[CTL.C_STEP] = c.step_address
     feat = pack_features(v, s.friction_coefficient, o.bumper_force_scale)
     shapes = pack_surfaces(list(r.surfaces))
     tf = r.final_time_s

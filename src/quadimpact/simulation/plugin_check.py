@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import new_data, new_output
@@ -182,7 +183,7 @@ def _first_tick(scenario: Any, plugins: list[tuple[PluginStep, Any]], kind_of: d
         ) from None
     m = setup.model()
     m = m._replace(ctrl=m.ctrl.copy(), ecfg=m.ecfg.copy())
-    m.ctrl[L.C_STEP] = m.ecfg[L.EC_STEP] = 0.0  # the loop's start calls no plug-in here
+    m.ctrl[CTL.C_STEP] = m.ecfg[L.EC_STEP] = 0.0  # the loop's start calls no plug-in here
     d = new_data(m)
     o = new_output(m, 0, 16, contact_columns=False, rows=False)
     BUILTIN.start(m, d, o)  # the records at t0: the measurement, the initial estimate

@@ -35,11 +35,11 @@ the cached loop calls it by its address (``ctrl[C_STEP]``,
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.controller_slots import C_KIND
 from quadimpact.core.controllers.cascade_pid import cascade_pid_step
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.controllers.recovery import recovery_step
 from quadimpact.core.layout import (
-    C_KIND,
     CTRL_CASCADE_PID,
     CTRL_PAPER,
     CTRL_RECOVERY,

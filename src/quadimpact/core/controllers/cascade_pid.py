@@ -13,6 +13,16 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.controller_slots import (
+    C_H_REF,
+    C_OMEGA_MAX,
+    C_OMEGA_MIN,
+    C_PARAMS,
+    C_PHI_REF,
+    C_PSI_REF,
+    C_THETA_REF,
+    C_WAYPOINT_ON,
+)
 from quadimpact.core.controllers.common import (
     G_ALT,
     G_ATT,
@@ -40,22 +50,7 @@ from quadimpact.core.controllers.common import (
     linearised_torques,
 )
 from quadimpact.core.controllers.waypoint import waypoint_references
-from quadimpact.core.layout import (
-    C_H_REF,
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
-    C_PARAMS,
-    C_PHI_REF,
-    C_PSI_REF,
-    C_THETA_REF,
-    C_WAYPOINT_ON,
-    MS_X,
-    NX,
-    V_GRAVITY,
-    V_MASS,
-    V_N_ROTORS,
-    X_OMEGA,
-)
+from quadimpact.core.layout import MS_X, NX, V_GRAVITY, V_MASS, V_N_ROTORS, X_OMEGA
 from quadimpact.core.quaternion import wrap_pi
 
 FADE_POWER = 4.0  # thrust fade beyond the tilt floor (tilt_compensation)

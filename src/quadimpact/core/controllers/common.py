@@ -12,19 +12,8 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.layout import (
-    C_ALLOC_INV,
-    C_N_ROTORS,
-    MEM_STAGE,
-    N_WRENCH,
-    NPARAM,
-    V_INERTIA,
-    X_OMEGA,
-    X_POS,
-    X_QUAT,
-    X_VEL,
-    Block,
-)
+from quadimpact.core.controller_slots import C_ALLOC_INV, C_N_ROTORS, N_WRENCH, NPARAM
+from quadimpact.core.layout import MEM_STAGE, V_INERTIA, X_OMEGA, X_POS, X_QUAT, X_VEL, Block
 from quadimpact.core.quaternion import euler_zyx
 
 # ---- the PID laws' blocks

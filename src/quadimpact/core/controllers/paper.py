@@ -17,6 +17,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.controller_slots import C_H_REF, C_PARAMS, C_PHI_REF, C_PSI_REF, C_THETA_REF
 from quadimpact.core.controllers.common import (
     G_ALT,
     G_ATT,
@@ -35,18 +36,7 @@ from quadimpact.core.controllers.common import (
     attitude_altitude,
     linearised_torques,
 )
-from quadimpact.core.layout import (
-    C_H_REF,
-    C_PARAMS,
-    C_PHI_REF,
-    C_PSI_REF,
-    C_THETA_REF,
-    MS_X,
-    NX,
-    V_GRAVITY,
-    V_MASS,
-    X_OMEGA,
-)
+from quadimpact.core.layout import MS_X, NX, V_GRAVITY, V_MASS, X_OMEGA
 from quadimpact.core.quaternion import wrap_pi
 
 

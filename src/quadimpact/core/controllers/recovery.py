@@ -71,6 +71,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.controller_slots import C_OMEGA_MAX, C_OMEGA_MIN, C_PARAMS, C_POLICY, NPARAM
 from quadimpact.core.controllers.cascade_pid import cascade_pid_step
 from quadimpact.core.controllers.common import (
     N_PID_MEM,
@@ -87,10 +88,6 @@ from quadimpact.core.controllers.residual import (
     residual_references,
 )
 from quadimpact.core.layout import (
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
-    C_PARAMS,
-    C_POLICY,
     CTRL_CASCADE_PID,
     MEM_STAGE,
     MS_DETECTED,
@@ -98,7 +95,6 @@ from quadimpact.core.layout import (
     MS_NORMAL,
     MS_W_HAT,
     MS_X,
-    NPARAM,
     NX,
     STAGE_DETECTED,
     STAGE_HOVER,

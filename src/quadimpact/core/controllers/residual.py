@@ -69,21 +69,23 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.layout import (
+from quadimpact.core.controller_slots import (
     C_POLICY,
     F_SCALE_M_S2,
     MAX_HIDDEN,
+    N_FEATURES,
+    N_OUTPUTS,
+    NPOLICY,
+    T_CAP_S,
+)
+from quadimpact.core.layout import (
     MS_IMU_F,
     MS_NORMAL,
     MS_T_DETECT,
     MS_W_HAT,
     MS_X,
-    N_FEATURES,
-    N_OUTPUTS,
-    NPOLICY,
     STAGE_HOVER,
     STAGE_RECOVERED,
-    T_CAP_S,
     V_GRAVITY,
     V_MASS,
     X_QUAT,

@@ -22,15 +22,8 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import (
-    C_HOLD_POS,
-    C_POS_GAINS,
-    C_WAYPOINT,
-    C_WAYPOINT_T,
-    X_POS,
-    X_QUAT,
-    X_VEL,
-)
+from quadimpact.core.controller_slots import C_HOLD_POS, C_POS_GAINS, C_WAYPOINT, C_WAYPOINT_T
+from quadimpact.core.layout import X_POS, X_QUAT, X_VEL
 
 
 @compiled

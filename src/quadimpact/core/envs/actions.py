@@ -11,6 +11,7 @@ loop ``recovery.rate_loop``. Rotor speeds in rad/s.
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.controller_slots import C_OMEGA_MAX, C_OMEGA_MIN
 from quadimpact.core.controllers.recovery import (
     rate_loop,
 )
@@ -21,12 +22,7 @@ from quadimpact.core.envs.episode_layout import (
     EP_RATE_MAX,
     EP_ZERO_LOW,
 )
-from quadimpact.core.layout import (
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
-    MS_W_HAT,
-    V_KT,
-)
+from quadimpact.core.layout import MS_W_HAT, V_KT
 
 
 # ---------------------------------------------------------------- action maps

@@ -8,6 +8,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.controller_slots import C_OMEGA_MAX, C_OMEGA_MIN
 from quadimpact.core.envs.episode_layout import (
     B_H_REF,
     B_X_REF,
@@ -31,17 +32,7 @@ from quadimpact.core.envs.episode_layout import (
     OC_RUNNING,
     OC_TILT,
 )
-from quadimpact.core.layout import (
-    C_OMEGA_MAX,
-    C_OMEGA_MIN,
-    V_GRAVITY,
-    V_KT,
-    V_MASS,
-    X_OMEGA,
-    X_POS,
-    X_QUAT,
-    X_VEL,
-)
+from quadimpact.core.layout import V_GRAVITY, V_KT, V_MASS, X_OMEGA, X_POS, X_QUAT, X_VEL
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.rotors import RIN_CMD
 

@@ -50,6 +50,7 @@ is reached and the recovered condition has held for the window.
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.controller_slots import C_PARAMS
 from quadimpact.core.controllers.recovery import (
     R_FIRST_TICK_LEVEL,
     R_Q_TOL,
@@ -153,7 +154,6 @@ from quadimpact.core.envs.reward import (
 )
 from quadimpact.core.integrator import all_finite, copy_into
 from quadimpact.core.layout import (
-    C_PARAMS,
     LS_DONE,
     LS_EXT,
     LS_EXT_CMD,

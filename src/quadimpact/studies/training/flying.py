@@ -78,16 +78,16 @@ class Flyer:
         """The trial's summary flown with ``block`` at ``ctrl[C_POLICY:]`` (None: the law)."""
         import time
 
-        from quadimpact.core import layout as L
+        from quadimpact.core import controller_slots as CTL
         from quadimpact.core.kernel import BUILTIN
         from quadimpact.core.records import raw_record
         from quadimpact.simulation.simulate import analyse
 
         setup = trial.setup
         ctrl = setup.ctrl.copy()
-        ctrl[L.C_POLICY : L.C_POLICY + L.NPOLICY] = 0.0
+        ctrl[CTL.C_POLICY : CTL.C_POLICY + CTL.NPOLICY] = 0.0
         if block is not None:
-            ctrl[L.C_POLICY : L.C_POLICY + block.size] = block
+            ctrl[CTL.C_POLICY : CTL.C_POLICY + block.size] = block
         m = setup.model(ctrl=ctrl)
         n_imu = int(setup.n_imu)
         o = self._output_rows(m, n_imu) if self.drift else self.buffers.output(m, n_imu)

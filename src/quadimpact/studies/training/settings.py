@@ -84,7 +84,7 @@ class Settings:
     init_sha256: str = ""
 
     def __post_init__(self) -> None:
-        from quadimpact.core.layout import MAX_HIDDEN
+        from quadimpact.core.controller_slots import MAX_HIDDEN
 
         rules = {
             "hidden": (self.hidden, 1 <= self.hidden <= MAX_HIDDEN, f"in 1..{MAX_HIDDEN}"),
