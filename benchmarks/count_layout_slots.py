@@ -45,6 +45,7 @@ DECLARATIONS = {
     "quadimpact.core.shape_slots": "quadimpact.core.geometry",
     "quadimpact.core.envs.episode_layout": "quadimpact.core.envs.stacked",
     "quadimpact.core.controller_slots": "quadimpact.core.controllers",
+    "quadimpact.core.estimator_slots": "quadimpact.core.estimators",
 }
 #: What a declaration module may import of quadimpact.
 DECLARATION_IMPORTS = {"quadimpact.core.block", "quadimpact.core.layout"}

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.core.estimators import estimate_sample, init_estimate
 from quadimpact.core.estimators import older_sensors as OS
@@ -118,10 +119,10 @@ class Harness:
         return self.d.est
 
     def q_hat(self) -> np.ndarray:
-        return self.d.est[L.ES_Q : L.ES_Q + 4].copy()
+        return self.d.est[ESL.ES_Q : ESL.ES_Q + 4].copy()
 
     def bias_hat(self) -> np.ndarray:
-        return self.d.est[L.ES_BIAS : L.ES_BIAS + 3].copy()
+        return self.d.est[ESL.ES_BIAS : ESL.ES_BIAS + 3].copy()
 
     def P(self) -> np.ndarray:
         return covariance(self.d.est, ekf_dimension(self.m.ecfg))

@@ -15,6 +15,7 @@ import pytest
 from quadimpact import WallApproach
 from quadimpact.core import approach as core_approach
 from quadimpact.core import controller_slots as CTL
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
 from quadimpact.core.approach import (
@@ -168,5 +169,5 @@ def test_a_controller_that_may_read_x_keeps_the_check_of_the_x_shift(monkeypatch
     ctrl[CTL.C_KIND] = L.CTRL_CASCADE_PID
     assert not core_approach._ignores_x(kw["run"]._replace(ctrl=ctrl))
     ecfg = kw["run"].ecfg.copy()
-    ecfg[L.EC_KIND] = L.EST_EKF
+    ecfg[ESL.EC_KIND] = L.EST_EKF
     assert not core_approach._ignores_x(kw["run"]._replace(ecfg=ecfg))

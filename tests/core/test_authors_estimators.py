@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from estimator_streams import Harness, constant_rotation, expmap, qmul
 
-from quadimpact.core import layout as L
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core.estimators import ekf as EKF
 from quadimpact.core.estimators import older_sensors as OS
 from quadimpact.core.estimators.ekf_additive import _rotate_t, _transition
@@ -78,7 +78,7 @@ def test_the_raw_complementary_filter_corrects_a_tilt_at_k_p_w_a_g2_over_2():
     s = constant_rotation(np.zeros(3), q_true, n, DT)
     h = Harness("complementary", n, params={"form": "raw"}, q0=q_true, dt=DT)
     delta = np.radians(1.0)
-    h.d.est[L.ES_Q : L.ES_Q + 4] = expmap(np.array([delta, 0.0, 0.0]))
+    h.d.est[ESL.ES_Q : ESL.ES_Q + 4] = expmap(np.array([delta, 0.0, 0.0]))
     err = np.radians(h.run(s))
     k_p, w_a = 0.1, 0.5
     rate = k_p * w_a * G * G / 2.0

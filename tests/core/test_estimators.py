@@ -20,7 +20,7 @@ from estimator_streams import (
     qmul,
 )
 
-from quadimpact.core import layout as L
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.rotations import quat_to_matrix
 
 DT = 0.005
@@ -74,7 +74,7 @@ def test_ekf_bias_estimate_converges_with_the_magnetometer():
     h = Harness("ekf", len(s.t), q0=q0, imu="noisy", magnetometer={},
                 params={"initial_bias_std_rad_s": 0.03, "maneuver_accel_m_s2": 0.0,
                         "gate_m_s2": 1e9})  # fmt: skip
-    h.est[L.ES_BIAS : L.ES_BIAS + 3] = 0.0  # it starts knowing nothing of the bias
+    h.est[ESL.ES_BIAS : ESL.ES_BIAS + 3] = 0.0  # it starts knowing nothing of the bias
     err = h.run(s)
     assert np.abs(h.bias_hat() - bias).max() < 3e-4
     assert err[-1000:].max() < 0.4  # deg, with a noisy IMU
@@ -87,7 +87,7 @@ def test_without_the_magnetometer_yaw_drifts_with_the_bias():
     bias = np.array([0.0, 0.0, 0.02])
     q0, s = _biased_hover(4000, bias, rng, mag=False)
     h = Harness("ekf", len(s.t), q0=q0, imu="noisy", params={"initial_bias_std_rad_s": 0.03})
-    h.est[L.ES_BIAS : L.ES_BIAS + 3] = 0.0
+    h.est[ESL.ES_BIAS : ESL.ES_BIAS + 3] = 0.0
     h.run(s)
     phi = np.degrees(error_vector(h.q_hat(), s.q[-1]))
     body_z = quat_to_matrix(h.q_hat()).T @ np.array([0.0, 0.0, 1.0])  # inertial Z in body axes
@@ -119,8 +119,8 @@ def test_ekf_is_consistent_on_long_noisy_hovers():
             "magnetometer_noise": sm, "gyro_bias_walk_rad_s_sqrt_s": sw,
             "initial_attitude_std_deg": 2.0, "initial_bias_std_rad_s": p0_b, "gate_m_s2": 1e9,
         })  # fmt: skip
-        h.est[L.ES_Q : L.ES_Q + 4] = qmul(q0, expmap(rng.normal(0.0, p0_att, 3)))
-        h.est[L.ES_BIAS : L.ES_BIAS + 3] = b[0] + rng.normal(0.0, p0_b, 3)
+        h.est[ESL.ES_Q : ESL.ES_Q + 4] = qmul(q0, expmap(rng.normal(0.0, p0_att, 3)))
+        h.est[ESL.ES_BIAS : ESL.ES_BIAS + 3] = b[0] + rng.normal(0.0, p0_b, 3)
         for i in range(n):
             h.sample(s.t[i], f[i], w[i], q0, mag=mag[i])
             e = np.concatenate([error_vector(h.q_hat(), q0), b[i] - h.bias_hat()])
@@ -150,12 +150,12 @@ def test_the_pose_sensor_bounds_velocity_and_position(estimator):
     for with_pose in (False, True):
         h = Harness(estimator, n, q0=q0, pose_sensor={"attitude": False} if with_pose else None,
                     params={"initial_velocity_error_m_s": 0.0})  # fmt: skip
-        h.est[L.ES_VEL : L.ES_VEL + 3] = (0.3, -0.2, 0.1)
-        h.est[L.ES_POS : L.ES_POS + 3] = pos + (0.1, 0.05, -0.05)
+        h.est[ESL.ES_VEL : ESL.ES_VEL + 3] = (0.3, -0.2, 0.1)
+        h.est[ESL.ES_POS : ESL.ES_POS + 3] = pos + (0.1, 0.05, -0.05)
         s.pose = pose if with_pose else None
         h.run(s)
-        errs[with_pose] = (np.linalg.norm(h.est[L.ES_VEL : L.ES_VEL + 3]),
-                           np.linalg.norm(h.est[L.ES_POS : L.ES_POS + 3] - pos))  # fmt: skip
+        errs[with_pose] = (np.linalg.norm(h.est[ESL.ES_VEL : ESL.ES_VEL + 3]),
+                           np.linalg.norm(h.est[ESL.ES_POS : ESL.ES_POS + 3] - pos))  # fmt: skip
     assert errs[True][0] < 0.05 and errs[True][1] < 0.01
     assert errs[False][0] > 0.2 and errs[False][1] > 1.0
 
@@ -201,7 +201,7 @@ def test_complementary_agrees_with_ahrs_mahony(marg):
     def run(q, f, w, mag):
         h = Harness("complementary", n, q0=q[0], params=params,
                     magnetometer={"noise": 5e-3} if marg else None)  # fmt: skip
-        h.est[L.ES_BIAS : L.ES_BIAS + 3] = 0.0
+        h.est[ESL.ES_BIAS : ESL.ES_BIAS + 3] = 0.0
         ref = ahrs.filters.Mahony(k_P=kp, k_I=ki, frequency=1.0 / DT)
         qr = qmul(turn, q[0]) if marg else q[0].copy()
         diff, err_mine, err_ref = (np.zeros(n) for _ in range(3))
@@ -252,7 +252,7 @@ def test_ekf_agrees_with_ahrs_ekf():
         "magnetometer_noise": sm, "gate_m_s2": 1e9, "initial_attitude_std_deg": 1.0,
         "initial_bias_std_rad_s": 1e-9, "gyro_bias_walk_rad_s_sqrt_s": 1e-12,
     })  # fmt: skip
-    h.est[L.ES_BIAS : L.ES_BIAS + 3] = 0.0
+    h.est[ESL.ES_BIAS : ESL.ES_BIAS + 3] = 0.0
     ref = ahrs.filters.EKF(mag=mag, frequency=1.0 / DT, frame="NED", magnetic_ref=M_I,
                            noises=[sg**2, (sa / 9.81) ** 2, sm**2], q0=q[0],
                            P=np.eye(4) * (np.radians(1.0) / 2) ** 2)  # fmt: skip

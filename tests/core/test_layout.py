@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from quadimpact.core import controller_slots as CTL
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
@@ -36,6 +37,7 @@ DECLARING = (
     "quadimpact.core.feature_slots",
     "quadimpact.core.shape_slots",
     "quadimpact.core.controller_slots",
+    "quadimpact.core.estimator_slots",
     "quadimpact.core.sensors.imu_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
@@ -118,8 +120,8 @@ def test_a_component_block_stays_inside_the_region_it_extends():
     (``ecfg[EC_OWN:]``, ``est[ES_OWN:]``, the detector's ``scfg``, ``sst`` and ``imu``
     regions): its capacity says so."""
     regions = {
-        "ecfg.": (L.EC_OWN, L.EC_OWN + L.N_OWN_ECFG),
-        "est.": (L.ES_OWN, L.ES_OWN + L.N_OWN_EST),
+        "ecfg.": (ESL.EC_OWN, ESL.EC_OWN + ESL.N_OWN_ECFG),
+        "est.": (ESL.ES_OWN, ESL.ES_OWN + ESL.N_OWN_EST),
         "scfg.detector": (IMS.SC_DETECTOR, IMS.SC_DETECTOR + L.N_DETECTOR_CFG),
         "sst.detector": (L.SS_DETECTOR, L.SS_DETECTOR + 1),
         "imu.detector": (IMS.I_DETECTOR, IMS.I_DETECTOR + 1),
@@ -160,7 +162,7 @@ def test_the_factories_allocate_the_declared_sizes():
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (IMS.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (L.NEST,), (L.NMEAS,),
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (ESL.NEST,), (L.NMEAS,),
         (L.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)

@@ -24,6 +24,7 @@ import pytest
 from estimator_streams import Harness, error_vector, expmap, qmul
 from scipy.stats import chi2
 
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.core.estimators import nav_ekf as N
 from quadimpact.core.sensors import imu_slots as IMS
@@ -120,10 +121,10 @@ def _perturb(h, fl, rng, sn, scale=1.0):
         P0["pos"] * rng.standard_normal(3), P0["bg"] * rng.standard_normal(3),
         P0["ba"] * rng.standard_normal(3), [P0["bb"] * rng.standard_normal()],
     ])  # fmt: skip
-    est[L.ES_Q : L.ES_Q + 4] = qmul(fl.q, expmap(-e[0:3]))
-    est[L.ES_VEL : L.ES_VEL + 3] = fl.vel(0.0) - e[3:6]
-    est[L.ES_POS : L.ES_POS + 3] = fl.pos(0.0) - e[6:9]
-    est[L.ES_BIAS : L.ES_BIAS + 3] = sn.bg - e[9:12]
+    est[ESL.ES_Q : ESL.ES_Q + 4] = qmul(fl.q, expmap(-e[0:3]))
+    est[ESL.ES_VEL : ESL.ES_VEL + 3] = fl.vel(0.0) - e[3:6]
+    est[ESL.ES_POS : ESL.ES_POS + 3] = fl.pos(0.0) - e[6:9]
+    est[ESL.ES_BIAS : ESL.ES_BIAS + 3] = sn.bg - e[9:12]
     est[N.ES_ACC_BIAS : N.ES_ACC_BIAS + 3] = sn.ba - e[12:15]
     est[N.ES_BARO_BIAS] = sn.bb - e[15]
 
@@ -132,8 +133,8 @@ def _error(h, fl, t):
     """The error state's attitude, velocity and position parts (9)."""
     est = h.est
     return np.concatenate([
-        error_vector(h.q_hat(), fl.q), fl.vel(t) - est[L.ES_VEL : L.ES_VEL + 3],
-        fl.pos(t) - est[L.ES_POS : L.ES_POS + 3],
+        error_vector(h.q_hat(), fl.q), fl.vel(t) - est[ESL.ES_VEL : ESL.ES_VEL + 3],
+        fl.pos(t) - est[ESL.ES_POS : ESL.ES_POS + 3],
     ])  # fmt: skip
 
 
@@ -250,7 +251,7 @@ def test_velocity_is_observable_from_the_flow_at_constant_height():
         # it accelerates: the gravity measurement needs its maneuvering term (the default)
         h = _harness(n, fl, flow=flow, params=MANEUVERING)
         _perturb(h, fl, rng, sn, 0.0)
-        h.est[L.ES_VEL : L.ES_VEL + 2] += (0.3, -0.2)
+        h.est[ESL.ES_VEL : ESL.ES_VEL + 2] += (0.3, -0.2)
         errs = np.zeros(n)
 
         def score(i, t, h=h, fl=fl, errs=errs):
@@ -280,9 +281,9 @@ def _converge(flow, params=None):
           "initial_position_std_m": 0.5}  # fmt: skip
     h = _harness(n, fl, flow=flow, params={**p0, **(params or {})})
     _perturb(h, fl, rng, sn, 0.0)
-    h.est[L.ES_Q : L.ES_Q + 4] = qmul(fl.q, expmap(np.radians([4.0, -4.0, 6.0])))
-    h.est[L.ES_VEL : L.ES_VEL + 3] += (0.4, -0.4, 0.3)
-    h.est[L.ES_POS + 2] += 0.5
+    h.est[ESL.ES_Q : ESL.ES_Q + 4] = qmul(fl.q, expmap(np.radians([4.0, -4.0, 6.0])))
+    h.est[ESL.ES_VEL : ESL.ES_VEL + 3] += (0.4, -0.4, 0.3)
+    h.est[ESL.ES_POS + 2] += 0.5
     _fly(h, fl, sn, n, dt, flow=flow)
     return h, fl, _error(h, fl, n * dt)
 
@@ -320,7 +321,7 @@ def _dropout(reacquire_s):
 
     def knock(i, t):
         if i == 500:  # t = 2.5 s, in the dropout
-            h.est[L.ES_VEL : L.ES_VEL + 2] += (0.6, -0.5)
+            h.est[ESL.ES_VEL : ESL.ES_VEL + 2] += (0.6, -0.5)
         errs[i] = np.linalg.norm(_error(h, fl, t)[3:5])
 
     _fly(h, fl, sn, n, dt, flow_on=lambda t: not 2.0 <= t < 3.0, on_sample=knock)
@@ -356,7 +357,7 @@ def test_the_barometer_is_reacquired_after_a_step():
     def step(i, t):
         if i == 199:
             sn.bb = 2.0  # from t = 1 s on
-        heights[i] = -h.est[L.ES_POS + 2]
+        heights[i] = -h.est[ESL.ES_POS + 2]
 
     _fly(h, fl, sn, n, dt, on_sample=step, flow=False)
     t = np.arange(n) * dt
@@ -374,7 +375,7 @@ def test_packer_takes_the_sensors_noise_and_documents_defaults():
     h = Harness("nav-ekf", 10, imu="noisy", magnetometer={"noise": 0.02},
                 instruments={"barometer": baro})  # fmt: skip
     e = h.m.ecfg
-    assert e[L.EC_KIND] == L.EST_NAV_EKF
+    assert e[ESL.EC_KIND] == L.EST_NAV_EKF
     assert e[N.EC_SIG_ACC] == 1.0 and e[N.EC_SIG_GYRO] == pytest.approx(1.8e-3)
     assert e[N.EC_SIG_MAG] == 0.02
     assert tuple(e[N.EC_NAV_BARO : N.EC_NAV_BARO + 2]) == (0.3, 0.02)
@@ -499,7 +500,7 @@ def _spin(lever: str, n: int = 1200, dt: float = 0.005):
             meas[BARO_T] = t
             meas[N.BARO_N] = i // 4 + 1
         h.sample(t, f, w, q, mag=C.T @ M_I, pos=fl.pos(t), vel=np.zeros(3))
-        errs[i] = np.linalg.norm(h.est[L.ES_VEL : L.ES_VEL + 2])
+        errs[i] = np.linalg.norm(h.est[ESL.ES_VEL : ESL.ES_VEL + 2])
         yaw += rate * dt + 0.5 * acc * dt * dt
         rate += acc * dt
     return errs

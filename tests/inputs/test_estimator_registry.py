@@ -19,6 +19,7 @@ from numba import njit
 from pydantic import BaseModel, ConfigDict, Field
 
 from quadimpact import simulate
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.errors import InputError
 from quadimpact.inputs.estimators import (
@@ -38,8 +39,8 @@ class GyroOnlyParams(BaseModel):
 
 
 def _pack(params: GyroOnlyParams, ctx) -> np.ndarray:
-    e = np.zeros(L.NECFG)
-    e[L.EC_USER] = params.bias_rad_s
+    e = np.zeros(ESL.NECFG)
+    e[ESL.EC_USER] = params.bias_rad_s
     return e
 
 
@@ -47,21 +48,21 @@ def _pack(params: GyroOnlyParams, ctx) -> np.ndarray:
 def gyro_only(t, dt, meas, ecfg, est):  # pragma: no cover - compiled
     w0 = meas[L.MS_IMU_W]
     w1 = meas[L.MS_IMU_W + 1]
-    w2 = meas[L.MS_IMU_W + 2] - ecfg[L.EC_USER]
-    est[L.ES_W] = w0
-    est[L.ES_W + 1] = w1
-    est[L.ES_W + 2] = w2
+    w2 = meas[L.MS_IMU_W + 2] - ecfg[ESL.EC_USER]
+    est[ESL.ES_W] = w0
+    est[ESL.ES_W + 1] = w1
+    est[ESL.ES_W + 2] = w2
     a = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2) * dt
     if a == 0.0:
         return
     s = math.sin(0.5 * a) / a * dt
     c = math.cos(0.5 * a)
-    q0, q1, q2, q3 = est[L.ES_Q], est[L.ES_Q + 1], est[L.ES_Q + 2], est[L.ES_Q + 3]
+    q0, q1, q2, q3 = est[ESL.ES_Q], est[ESL.ES_Q + 1], est[ESL.ES_Q + 2], est[ESL.ES_Q + 3]
     bx, by, bz = s * w0, s * w1, s * w2
-    est[L.ES_Q] = q0 * c - q1 * bx - q2 * by - q3 * bz
-    est[L.ES_Q + 1] = q0 * bx + q1 * c + q2 * bz - q3 * by
-    est[L.ES_Q + 2] = q0 * by - q1 * bz + q2 * c + q3 * bx
-    est[L.ES_Q + 3] = q0 * bz + q1 * by - q2 * bx + q3 * c
+    est[ESL.ES_Q] = q0 * c - q1 * bx - q2 * by - q3 * bz
+    est[ESL.ES_Q + 1] = q0 * bx + q1 * c + q2 * bz - q3 * by
+    est[ESL.ES_Q + 2] = q0 * by - q1 * bz + q2 * c + q3 * bx
+    est[ESL.ES_Q + 3] = q0 * bz + q1 * by - q2 * bx + q3 * c
 
 
 @pytest.fixture(scope="module")

@@ -39,11 +39,10 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.controller_slots import C_KIND, C_STEP
+from quadimpact.core.estimator_slots import EC_KIND, EC_STEP
 from quadimpact.core.geometry import pair_contact
 from quadimpact.core.layout import (
     CTRL_PAPER,
-    EC_KIND,
-    EC_STEP,
     EST_IDEAL,
     MAX_ROTORS,
     NX,

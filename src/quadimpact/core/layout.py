@@ -256,25 +256,7 @@ SN_MAG = _sn.slot("SN_MAG", 3)  # magnetometer noise
 SN_POSE = _sn.slot("SN_POSE", 6)  # pose sensor: position (3), attitude rotation vector (3)
 NSN = _sn.end("NSN")
 
-# ---- estimator ecfg (NECFG): what every estimator has (its kind, the initial estimate's
-# error), a plug-in's block, then EC_OWN: the built-in estimator's own block, which it
-# declares in its module (core/estimators/*.py; one estimator per run: the built-ins'
-# blocks are alternatives over the same numbers)
-_ecfg = Block("ecfg", "EC_")
-EC_KIND = _ecfg.slot("EC_KIND")  # EST_*
-EC_INIT_ATT = _ecfg.slot("EC_INIT_ATT", 3)  # initial attitude error, rotation vector (body), rad
-EC_INIT_VEL = _ecfg.slot("EC_INIT_VEL", 3)  # initial velocity error, inertial, m/s
-EC_INIT_POS = _ecfg.slot("EC_INIT_POS", 3)  # initial position error, inertial, m
-EC_INIT_BIAS = _ecfg.slot("EC_INIT_BIAS", 3)  # initial gyro bias error, rad/s
-EC_OBSERVER = _ecfg.slot("EC_OBSERVER")  # 1: out of the loop (controller, detector read the truth)
-EC_INIT_EULER = _ecfg.slot("EC_INIT_EULER", 3)  # initial ZYX Euler errors (roll, pitch, yaw), rad
-EC_INIT_BIAS_ZERO = _ecfg.slot("EC_INIT_BIAS_ZERO")  # 1: the gyro bias estimate starts at 0
-N_USER_ECFG = 16
-EC_USER = _ecfg.slot("EC_USER", N_USER_ECFG)  # a plug-in estimator's parameters
-EC_STEP = _ecfg.slot("EC_STEP")  # a plug-in estimator's step: its entry address (as C_STEP)
-N_OWN_ECFG = 48
-EC_OWN = _ecfg.slot("EC_OWN", N_OWN_ECFG)  # a built-in's own block (core/estimators/*.py)
-NECFG = _ecfg.end("NECFG")
+# ---- estimator ecfg (NECFG): declared by the estimators in core/estimator_slots.py
 
 # ---- the span of the run: span (NSPAN)
 _span = Block("span", "SPAN_")
@@ -348,23 +330,7 @@ SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
 SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
 NSST = _sst.end("NSST")
 
-# ---- estimator state est (NEST): the estimate after the latest IMU sample (what every
-# estimator writes), a plug-in's state, then ES_OWN: a built-in's own state, declared in
-# its module (core/estimators/*.py; alternatives over the same numbers, as EC_OWN)
-_est = Block("est", "ES_")
-ES_Q = _est.slot("ES_Q", 4)  # attitude estimate, body -> inertial, scalar first
-ES_BIAS = _est.slot("ES_BIAS", 3)  # gyro bias estimate, rad/s
-ES_VEL = _est.slot("ES_VEL", 3)  # CM velocity estimate, inertial, m/s
-ES_POS = _est.slot("ES_POS", 3)  # CM position estimate, inertial, m
-ES_W = _est.slot("ES_W", 3)  # estimated body rates (gyro minus bias) at the latest sample, rad/s
-ES_T = _est.slot("ES_T")  # s, time of the latest sample processed (NaN: none)
-ES_N = _est.slot("ES_N")  # samples processed
-ES_GATED = _est.slot("ES_GATED")  # 1: the accelerometer correction was gated at the latest sample
-N_USER_EST = 32
-ES_USER = _est.slot("ES_USER", N_USER_EST)  # a plug-in estimator's own state
-N_OWN_EST = 1920
-ES_OWN = _est.slot("ES_OWN", N_OWN_EST)  # a built-in's own state (core/estimators/*.py)
-NEST = _est.end("NEST")
+# ---- estimator state est (NEST): declared by the estimators in core/estimator_slots.py
 
 # ==========================================================================
 # Output: what a run returns

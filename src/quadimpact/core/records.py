@@ -44,11 +44,10 @@ import numpy as np
 from numba import njit
 
 from quadimpact.core.contact_slots import NCS
+from quadimpact.core.estimator_slots import NECFG, NEST
 from quadimpact.core.layout import (
     MAX_AVERAGE_WINDOW,
     MAX_ROTORS,
-    NECFG,
-    NEST,
     NLS,
     NMEAS,
     NMEM,

@@ -34,6 +34,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, StrictBool, field_validator
 
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.inputs.registry import Registry
 from quadimpact.inputs.types import MODEL_CONFIG, Real, Vec3, Vec4
@@ -374,7 +375,7 @@ class EstimatorEntry:
 
 
 def _empty(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    return np.zeros(L.NECFG)
+    return np.zeros(ESL.NECFG)
 
 
 BUILTIN = ("ideal", "complementary", "ekf", "ekf-additive", "nav-ekf")

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.core.estimators import complementary as CF
 from quadimpact.core.estimators import ekf as EKF
@@ -89,7 +90,7 @@ class Estimation:
 
 def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: ComplementaryParams = params  # type: ignore[assignment]
-    e = np.zeros(L.NECFG)
+    e = np.zeros(ESL.NECFG)
     e[CF.EC_K_ACC] = p.k_acc_1_s
     e[CF.EC_K_MAG] = p.k_mag_1_s
     e[CF.EC_K_BIAS] = p.k_bias_1_s2
@@ -108,7 +109,7 @@ def _pack_complementary(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
 
 def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: AdditiveEkfParams = params  # type: ignore[assignment]
-    e = np.zeros(L.NECFG)
+    e = np.zeros(ESL.NECFG)
     e[ADD.EC_AS_WRITTEN] = 1.0 if p.transition == "as-written" else 0.0
     e[ADD.EC_R_ACC] = p.accel_variance
     e[ADD.EC_R_MAG] = p.magnetometer_variance
@@ -122,7 +123,7 @@ def _pack_additive(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
 
 def _pack_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: EkfParams = params  # type: ignore[assignment]  # resolved: every noise a number
-    e = np.zeros(L.NECFG)
+    e = np.zeros(ESL.NECFG)
     _pack_filter_noises(p, e)
     e[EKF.EC_SIG_POS] = p.pose_position_noise_m
     e[EKF.EC_SIG_ATT] = math.radians(p.pose_attitude_noise_deg)
@@ -167,7 +168,7 @@ def _pack_impact(p: Any, ctx: EstimatorContext, e: np.ndarray) -> None:
 def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
     p: NavEkfParams = params  # type: ignore[assignment]  # resolved: every noise a number
     imu = ctx.imu
-    e = np.zeros(L.NECFG)
+    e = np.zeros(ESL.NECFG)
     _pack_filter_noises(p, e)
     e[NAV.EC_NAV_ACC_WALK] = p.accel_bias_walk_m_s2_sqrt_s
     e[EKF.EC_GATE] = p.gate_m_s2
@@ -198,7 +199,7 @@ def _pack_nav_ekf(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
 
 
 def _zeros(params: BaseModel, ctx: EstimatorContext) -> np.ndarray:
-    return np.zeros(L.NECFG)
+    return np.zeros(ESL.NECFG)
 
 
 #: The built-in estimators' packers, by kind (a plug-in's is its registry entry's).
@@ -258,7 +259,7 @@ def _initial_errors(
     initial_std = None
     if isinstance(params, EstimatorParams) and kind != L.EST_IDEAL:
         extra[:3] = np.radians(params.initial_euler_error_deg)
-        ecfg[L.EC_INIT_BIAS_ZERO] = 1.0 if params.initial_bias == "zero" else 0.0
+        ecfg[ESL.EC_INIT_BIAS_ZERO] = 1.0 if params.initial_bias == "zero" else 0.0
         std = np.repeat(
             [
                 math.radians(params.initial_attitude_error_deg),
@@ -287,13 +288,13 @@ def pack_estimation(r: ResolvedShared, scfg: np.ndarray) -> Estimation:
     entry = est.entry
     pack = entry.pack if entry.pack is not None else BUILTIN_PACKERS.get(entry.kind, _zeros)
     ecfg = np.array(pack(est.params, est.context), dtype=float)
-    if ecfg.shape != (L.NECFG,):
-        raise ValueError(f"estimator {entry.name!r}: its pack must return ({L.NECFG},) floats")
+    if ecfg.shape != (ESL.NECFG,):
+        raise ValueError(f"estimator {entry.name!r}: its pack must return ({ESL.NECFG},) floats")
     refuse_nan(ecfg, f"estimator {entry.name!r}: its settings")
-    ecfg[L.EC_KIND] = entry.kind
-    ecfg[L.EC_OBSERVER] = 0.0 if s.estimate_in_loop else 1.0
+    ecfg[ESL.EC_KIND] = entry.kind
+    ecfg[ESL.EC_OBSERVER] = 0.0 if s.estimate_in_loop else 1.0
     if est.step_address:
-        ecfg[L.EC_STEP] = est.step_address
+        ecfg[ESL.EC_STEP] = est.step_address
     initial_std, extra_std = _initial_errors(est.params, entry.kind, mag, ecfg)
     return Estimation(
         ecfg=ecfg,
@@ -336,14 +337,14 @@ def draw_estimation(
     if est.initial_std is not None:
         ecfg = ecfg.copy()
         draws = _stream(seed, INIT_STREAM).standard_normal(12) * est.initial_std
-        ecfg[L.EC_INIT_ATT : L.EC_INIT_ATT + 3] = draws[0:3]
-        ecfg[L.EC_INIT_VEL : L.EC_INIT_VEL + 3] = draws[3:6]
-        ecfg[L.EC_INIT_POS : L.EC_INIT_POS + 3] = draws[6:9]
-        ecfg[L.EC_INIT_BIAS : L.EC_INIT_BIAS + 3] = draws[9:12]
+        ecfg[ESL.EC_INIT_ATT : ESL.EC_INIT_ATT + 3] = draws[0:3]
+        ecfg[ESL.EC_INIT_VEL : ESL.EC_INIT_VEL + 3] = draws[3:6]
+        ecfg[ESL.EC_INIT_POS : ESL.EC_INIT_POS + 3] = draws[6:9]
+        ecfg[ESL.EC_INIT_BIAS : ESL.EC_INIT_BIAS + 3] = draws[9:12]
     if est.extra_std is not None:
         ecfg = ecfg.copy() if ecfg is est.ecfg else ecfg
         draws = _stream(seed, EXTRA_STREAM).standard_normal(6) * est.extra_std
-        ecfg[L.EC_INIT_EULER : L.EC_INIT_EULER + 3] = draws[0:3]
+        ecfg[ESL.EC_INIT_EULER : ESL.EC_INIT_EULER + 3] = draws[0:3]
         if scfg is not None:
             bias = config_address("magnetometer", "bias")
             scfg[bias : bias + 3] = draws[3:6]

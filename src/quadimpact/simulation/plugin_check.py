@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from quadimpact.core import controller_slots as CTL
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import new_data, new_output
@@ -57,11 +58,11 @@ SIGNATURES: dict[str, tuple[tuple[str, ...], str]] = {
 }
 #: The estimate's slots an estimator's step must leave finite.
 _ESTIMATE = (
-    ("ES_Q", L.ES_Q, 4),
-    ("ES_VEL", L.ES_VEL, 3),
-    ("ES_POS", L.ES_POS, 3),
-    ("ES_BIAS", L.ES_BIAS, 3),
-    ("ES_W", L.ES_W, 3),
+    ("ES_Q", ESL.ES_Q, 4),
+    ("ES_VEL", ESL.ES_VEL, 3),
+    ("ES_POS", ESL.ES_POS, 3),
+    ("ES_BIAS", ESL.ES_BIAS, 3),
+    ("ES_W", ESL.ES_W, 3),
 )
 
 
@@ -183,7 +184,7 @@ def _first_tick(scenario: Any, plugins: list[tuple[PluginStep, Any]], kind_of: d
         ) from None
     m = setup.model()
     m = m._replace(ctrl=m.ctrl.copy(), ecfg=m.ecfg.copy())
-    m.ctrl[CTL.C_STEP] = m.ecfg[L.EC_STEP] = 0.0  # the loop's start calls no plug-in here
+    m.ctrl[CTL.C_STEP] = m.ecfg[ESL.EC_STEP] = 0.0  # the loop's start calls no plug-in here
     d = new_data(m)
     o = new_output(m, 0, 16, contact_columns=False, rows=False)
     BUILTIN.start(m, d, o)  # the records at t0: the measurement, the initial estimate

@@ -26,6 +26,7 @@ import numpy as np
 
 from quadimpact.core import announce_compilation
 from quadimpact.core import controller_slots as CTL
+from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.geometry.shapes import plugin_shapes
@@ -293,7 +294,7 @@ def _prepared(r: ResolvedRun, kernel: Kernel | None = None, plugins: bool = True
     if not plugins:  # copies: the packed arrays may be shared with other runs
         m = setup.run
         setup.run = m._replace(ctrl=m.ctrl.copy(), ecfg=m.ecfg.copy())
-        setup.run.ctrl[CTL.C_STEP] = setup.run.ecfg[L.EC_STEP] = 0.0
+        setup.run.ctrl[CTL.C_STEP] = setup.run.ecfg[ESL.EC_STEP] = 0.0
     if r.shot is not None:
         _shoot(setup, r.shot, packed.free_opts)
     return setup

@@ -41,12 +41,7 @@ import numpy as np
 from numba import njit
 
 from quadimpact.core.compiled import allocating, compiled
-from quadimpact.core.estimators.complementary import complementary_sample
-from quadimpact.core.estimators.ekf import ES_T_IMPACT, ekf_init, ekf_sample
-from quadimpact.core.estimators.ekf_additive import additive_init, additive_sample
-from quadimpact.core.estimators.estimate_errors import record_estimate
-from quadimpact.core.estimators.nav_ekf import nav_ekf_sample, nav_init
-from quadimpact.core.layout import (
+from quadimpact.core.estimator_slots import (
     EC_INIT_ATT,
     EC_INIT_BIAS,
     EC_INIT_BIAS_ZERO,
@@ -63,6 +58,13 @@ from quadimpact.core.layout import (
     ES_T,
     ES_VEL,
     ES_W,
+)
+from quadimpact.core.estimators.complementary import complementary_sample
+from quadimpact.core.estimators.ekf import ES_T_IMPACT, ekf_init, ekf_sample
+from quadimpact.core.estimators.ekf_additive import additive_init, additive_sample
+from quadimpact.core.estimators.estimate_errors import record_estimate
+from quadimpact.core.estimators.nav_ekf import nav_ekf_sample, nav_init
+from quadimpact.core.layout import (
     EST_COMPLEMENTARY,
     EST_EKF,
     EST_EKF_ADDITIVE,

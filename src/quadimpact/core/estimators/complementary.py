@@ -47,9 +47,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.estimators.navigation import integrate_navigation
-from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T, POSE, POSE_ATT, POSE_T
-from quadimpact.core.layout import (
+from quadimpact.core.estimator_slots import (
     EC_OWN,
     ES_BIAS,
     ES_GATED,
@@ -57,12 +55,11 @@ from quadimpact.core.layout import (
     ES_Q,
     ES_VEL,
     ES_W,
-    MS_IMU_F,
-    MS_IMU_W,
     N_OWN_ECFG,
-    V_GRAVITY,
-    Block,
 )
+from quadimpact.core.estimators.navigation import integrate_navigation
+from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T, POSE, POSE_ATT, POSE_T
+from quadimpact.core.layout import MS_IMU_F, MS_IMU_W, V_GRAVITY, Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
 

@@ -22,11 +22,8 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
+from quadimpact.core.estimator_slots import ES_BIAS, ES_POS, ES_Q, ES_VEL
 from quadimpact.core.layout import (
-    ES_BIAS,
-    ES_POS,
-    ES_Q,
-    ES_VEL,
     N_EST_ERR,
     N_PHASES,
     SS_N,

@@ -96,6 +96,18 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
+from quadimpact.core.estimator_slots import (
+    EC_INIT_BIAS_ZERO,
+    EC_OWN,
+    ES_BIAS,
+    ES_OWN,
+    ES_POS,
+    ES_Q,
+    ES_VEL,
+    ES_W,
+    N_OWN_ECFG,
+    N_OWN_EST,
+)
 from quadimpact.core.estimators.ekf import (
     EC_IMPACT_F,
     EC_IMPACT_REPLACE,
@@ -114,22 +126,7 @@ from quadimpact.core.estimators.ekf import (
 )
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T
-from quadimpact.core.layout import (
-    EC_INIT_BIAS_ZERO,
-    EC_OWN,
-    ES_BIAS,
-    ES_OWN,
-    ES_POS,
-    ES_Q,
-    ES_VEL,
-    ES_W,
-    MS_IMU_F,
-    MS_IMU_W,
-    N_OWN_ECFG,
-    N_OWN_EST,
-    V_GRAVITY,
-    Block,
-)
+from quadimpact.core.layout import MS_IMU_F, MS_IMU_W, V_GRAVITY, Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.imu_slots import (
     SC_BIAS,

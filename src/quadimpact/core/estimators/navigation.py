@@ -15,7 +15,7 @@ position estimate quadratically.
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import ES_POS, ES_VEL
+from quadimpact.core.estimator_slots import ES_POS, ES_VEL
 
 
 @compiled
