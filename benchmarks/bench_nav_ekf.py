@@ -27,10 +27,10 @@ import numpy as np
 from numba import njit
 
 from quadimpact import simulate
-from quadimpact.core import layout as L
 from quadimpact.core.estimators import estimate_sample
 from quadimpact.core.estimators import nav_ekf as N
 from quadimpact.core.estimators import older_sensors as OS
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.inputs.scenarios import ImpactTrial, scenario_from_dict
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "core"))
@@ -45,7 +45,7 @@ def _loop(n, dt, xs, C, m, d, o, w, addresses):
     baro_n, flow_n, rng_n = addresses
     for i in range(n):
         t = (i + 1) * dt
-        meas[L.MS_IMU_T] = t
+        meas[MSS.MS_IMU_T] = t
         meas[OS.MAG_T] = t
         if i % 4 == 0:
             meas[baro_n] += 1.0
@@ -61,7 +61,7 @@ def stage_cost() -> None:
     for est in ("ekf", "nav-ekf"):
         h = Harness(est, 10, magnetometer={}, imu="noisy", instruments=inst, pos0=(0, 0, -1.5))
         meas = h.d.meas
-        meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (0.0, 0.0, -9.81)
+        meas[MSS.MS_IMU_F : MSS.MS_IMU_F + 3] = (0.0, 0.0, -9.81)
         meas[OS.MAG : OS.MAG + 3] = (0.5, 0.0, 0.866)
         meas[N.BARO_ALT] = 1.5
         meas[N.RNG_RANGE], meas[N.RNG_VALID], meas[N.RNG_NOISE] = 1.5, 1.0, 0.02

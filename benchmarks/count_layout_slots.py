@@ -46,6 +46,7 @@ DECLARATIONS = {
     "quadimpact.core.envs.episode_layout": "quadimpact.core.envs.stacked",
     "quadimpact.core.controller_slots": "quadimpact.core.controllers",
     "quadimpact.core.estimator_slots": "quadimpact.core.estimators",
+    "quadimpact.core.sensors.measurement_slots": "quadimpact.core.sensors.measurement",
 }
 #: What a declaration module may import of quadimpact.
 DECLARATION_IMPORTS = {"quadimpact.core.block", "quadimpact.core.layout"}

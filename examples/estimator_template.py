@@ -43,7 +43,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from quadimpact import ImpactTrial, simulate
 from quadimpact.core.estimator_slots import EC_USER, ES_POS, ES_Q, ES_VEL, ES_W, NECFG
-from quadimpact.core.layout import MS_IMU_F, MS_IMU_W
+from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.inputs.estimators import EstimatorContext, register_estimator
 
 

@@ -19,6 +19,8 @@ from quadimpact.core.estimators import estimate_sample, init_estimate
 from quadimpact.core.estimators import older_sensors as OS
 from quadimpact.core.estimators.ekf import covariance, ekf_dimension
 from quadimpact.core.records import new_data, new_output, new_work
+from quadimpact.core.sensors import imu_slots as IMS
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.inputs.scenarios import FlightScenario
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
@@ -130,9 +132,9 @@ class Harness:
     def sample(self, t: float, f, w, q_true, mag=None, pose=None, pos=None, vel=None):
         """One sample at ``t`` (s): the readings into the record, then the estimator's update."""
         meas = self.d.meas
-        meas[L.MS_IMU_F : L.MS_IMU_F + 3] = f
-        meas[L.MS_IMU_W : L.MS_IMU_W + 3] = w
-        meas[L.MS_IMU_T] = t
+        meas[MSS.MS_IMU_F : MSS.MS_IMU_F + 3] = f
+        meas[MSS.MS_IMU_W : MSS.MS_IMU_W + 3] = w
+        meas[MSS.MS_IMU_T] = t
         if mag is not None:
             meas[OS.MAG : OS.MAG + 3] = mag
             meas[OS.MAG_T] = t
@@ -148,7 +150,7 @@ class Harness:
         if vel is not None:
             xs[L.X_VEL : L.X_VEL + 3] = C.T @ vel
         self.i += 1
-        self.d.sst[L.SS_N] = self.i
+        self.d.sst[IMS.SS_N] = self.i
         estimate_sample(float(t), xs, C, self.m, self.d, self.o, self.w)
 
     def run(self, s: Stream) -> np.ndarray:

@@ -7,6 +7,7 @@ from numba import njit
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.kernel import make_kernel
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.simulation.stepping import Simulation
 
 CONTROLLERS = ["paper", "cascade-pid"]
@@ -58,7 +59,7 @@ def test_paper_controller_sinks_when_tilted():
 def _hold_initial_speeds(t, meas, ctrl, mem, veh, dt, cmd):
     if mem[0] == 0.0:
         for j in range(4):
-            mem[1 + j] = meas[L.MS_X + L.X_ROTOR + j]
+            mem[1 + j] = meas[MSS.MS_X + L.X_ROTOR + j]
         mem[0] = 1.0
     for j in range(4):
         cmd[j] = mem[1 + j]

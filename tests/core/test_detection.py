@@ -12,6 +12,7 @@ from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
 from quadimpact.core.sensors import detection as DET
 from quadimpact.core.sensors import imu_slots as IMS
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.core.sensors.detection import detect
 from quadimpact.rotations import euler_zyx_to_quat, quat_to_matrix
 
@@ -38,11 +39,11 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     d = new_data(m)
     o = new_output(m, len(samples), 0)
     meas, sst, stats = d.meas, d.sst, o.stats
-    meas[L.MS_T_DETECT] = np.nan
+    meas[MSS.MS_T_DETECT] = np.nan
     stats[L.ST_T_DETECT] = np.nan
     for i, f in enumerate(samples):
-        meas[L.MS_IMU_F : L.MS_IMU_F + 3] = f
-        sst[L.SS_N] = i + 1
+        meas[MSS.MS_IMU_F : MSS.MS_IMU_F + 3] = f
+        sst[IMS.SS_N] = i + 1
         detect(i * 0.005, x, C, m, d, o)
     imu_out = o.imu
     return meas, stats, imu_out
@@ -50,7 +51,7 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
 
 def test_quiet_samples_never_detect():
     meas, stats, imu = _feed([(0.0, 0.0, -G)] * 50 + [(3.0, 3.0, -G)] * 5)  # |f_xy| = 4.24 < 4.905
-    assert meas[L.MS_DETECTED] == 0.0
+    assert meas[MSS.MS_DETECTED] == 0.0
     assert np.isnan(stats[L.ST_T_DETECT])
     assert stats[L.ST_N_DETECTIONS] == 0
     np.testing.assert_allclose(imu[-1, DET.I_HORIZONTAL], np.hypot(3.0, 3.0))
@@ -59,7 +60,7 @@ def test_quiet_samples_never_detect():
 def test_first_sample_at_threshold_detects_and_estimates_the_normal():
     samples = [(0.0, 0.0, -G)] * 10 + [(-0.5 * G, 0.0, -G), (-20.0, 1.0, -G)]
     meas, stats, _ = _feed(samples)
-    assert meas[L.MS_DETECTED] == 1.0
+    assert meas[MSS.MS_DETECTED] == 1.0
     assert stats[L.ST_T_DETECT] == 10 * 0.005  # the sample that reaches the threshold
     np.testing.assert_allclose(stats[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3], (-1, 0, 0))
 
@@ -77,9 +78,9 @@ def test_world_horizontal_variant_and_the_normal_in_inertial_axes():
     # horizontal world part; the body-horizontal rule sees none
     f = (0.0, 0.0, -12.0)
     meas_b, _, _ = _feed([f], pitch=np.radians(30), yaw=np.radians(90))
-    assert meas_b[L.MS_DETECTED] == 0.0
+    assert meas_b[MSS.MS_DETECTED] == 0.0
     meas_w, stats, _ = _feed([f], world=True, pitch=np.radians(30), yaw=np.radians(90))
-    assert meas_w[L.MS_DETECTED] == 1.0
+    assert meas_w[MSS.MS_DETECTED] == 1.0
     n = stats[L.ST_DETECT_NORMAL : L.ST_DETECT_NORMAL + 3]
     assert abs(np.linalg.norm(n) - 1.0) < 1e-12 and n[2] == 0.0
     # body -z tilted back by the pitch, then yawed to +Y: the horizontal part points to -Y

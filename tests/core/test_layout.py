@@ -26,6 +26,7 @@ from quadimpact.core.recording_slots import NEP, NOUT, out_width
 from quadimpact.core.records import new_data, new_output, new_work
 from quadimpact.core.rotors import NRIN
 from quadimpact.core.sensors import imu_slots as IMS
+from quadimpact.core.sensors import measurement_slots as MSS
 
 # every module that declares blocks (importing them registers their blocks)
 DECLARING = (
@@ -39,6 +40,7 @@ DECLARING = (
     "quadimpact.core.controller_slots",
     "quadimpact.core.estimator_slots",
     "quadimpact.core.sensors.imu_slots",
+    "quadimpact.core.sensors.measurement_slots",
     "quadimpact.core.approach",
     "quadimpact.core.impacts",
     "quadimpact.core.rotors",
@@ -123,7 +125,7 @@ def test_a_component_block_stays_inside_the_region_it_extends():
         "ecfg.": (ESL.EC_OWN, ESL.EC_OWN + ESL.N_OWN_ECFG),
         "est.": (ESL.ES_OWN, ESL.ES_OWN + ESL.N_OWN_EST),
         "scfg.detector": (IMS.SC_DETECTOR, IMS.SC_DETECTOR + L.N_DETECTOR_CFG),
-        "sst.detector": (L.SS_DETECTOR, L.SS_DETECTOR + 1),
+        "sst.detector": (IMS.SS_DETECTOR, IMS.SS_DETECTOR + 1),
         "imu.detector": (IMS.I_DETECTOR, IMS.I_DETECTOR + 1),
     }
     seen = set()
@@ -162,8 +164,8 @@ def test_the_factories_allocate_the_declared_sizes():
     assert m.span.shape == (L.NSPAN,) and m.scfg.shape == (IMS.NSCFG,)
     d = new_data(m)
     assert [a.shape for a in d] == [
-        (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (ESL.NEST,), (L.NMEAS,),
-        (L.NSST,),
+        (L.NX,), (L.NLS,), (m_feat * n_shapes, NCS), (NRIN,), (L.NMEM,), (ESL.NEST,), (MSS.NMEAS,),
+        (IMS.NSST,),
     ]  # fmt: skip
     o = new_output(m, 7, 11)
     assert o.out.shape == (n_out, out_width(m_feat)) == (n_out, NOUT + 2 * m_feat)

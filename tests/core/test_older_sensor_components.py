@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from quadimpact import simulate
-from quadimpact.core import layout as L
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.sensors import registry
 from quadimpact.core.sensors.component import LegacyColumns
 from quadimpact.errors import InputError
@@ -28,9 +28,9 @@ IDEAL_200 = {"preset": "ideal", "rate_hz": 200}
 
 def test_their_draws_are_the_frozen_snoise_columns_and_their_columns_keep_their_names():
     mag, pose = registry.component("magnetometer"), registry.component("pose_sensor")
-    assert mag.legacy_noise == LegacyColumns(start=L.SN_MAG, width=3)
-    assert pose.legacy_noise == LegacyColumns(start=L.SN_POSE, width=6)
-    assert registry.addresses()["pose_sensor"].noise == (L.SN_POSE, L.SN_POSE + 6)
+    assert mag.legacy_noise == LegacyColumns(start=IMS.SN_MAG, width=3)
+    assert pose.legacy_noise == LegacyColumns(start=IMS.SN_POSE, width=6)
+    assert registry.addresses()["pose_sensor"].noise == (IMS.SN_POSE, IMS.SN_POSE + 6)
     # no block of cnoise for them: the components' draws are the others' only
     others = [c for c in registry.components() if c.legacy_noise is None]
     assert registry.tail_sizes()[3] == sum(c.sizes()[3] for c in others)
@@ -55,9 +55,9 @@ def test_the_magnetometer_reads_the_field_plus_sigma_times_its_snoise_columns():
     np.testing.assert_allclose(runs[0], np.tile(field, (len(runs[0]), 1)), rtol=0, atol=1e-12)
     n = len(runs[1])
     seq = np.random.SeedSequence(3, spawn_key=(SENSOR_STREAM,))
-    draws = np.random.Generator(np.random.PCG64(seq)).standard_normal((n, L.NSN))
+    draws = np.random.Generator(np.random.PCG64(seq)).standard_normal((n, IMS.NSN))
     z = (runs[1] - runs[0]) / sigma
-    np.testing.assert_allclose(z, draws[:, L.SN_MAG : L.SN_MAG + 3], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(z, draws[:, IMS.SN_MAG : IMS.SN_MAG + 3], rtol=0, atol=1e-9)
 
 
 def test_the_pose_sensor_arrives_at_its_rate_after_its_latency():

@@ -35,6 +35,7 @@ from quadimpact.core.kernel import make_kernel
 from quadimpact.core.recording_slots import E_FEATURE, E_SHAPE, E_T_START, E_V_I, OUT_X
 from quadimpact.core.records import model, new_output
 from quadimpact.core.sensors import imu_slots as IMS
+from quadimpact.core.sensors import measurement_slots as MSS
 
 FEAT_BALL = 50  # the new feature kind: a sphere of radius F_RADIUS at F_CENTRE
 SHAPE_SPHERE = 60  # the new shape kind: a sphere of radius SH_RADIUS at SH_POINT
@@ -78,8 +79,8 @@ def proximity(t, x, xdot, C, m, d):  # pragma: no cover - compiled
     for s in range(m.shapes.shape[0]):
         g = sphere_distance(p[0], p[1], p[2], m.shapes, s)
         gap = min(gap, g - m.feat[0, FS.F_RADIUS])
-    d.meas[L.MS_USER] = gap
-    d.meas[L.MS_USER + 1] = t
+    d.meas[MSS.MS_USER] = gap
+    d.meas[MSS.MS_USER + 1] = t
 
 
 @njit
@@ -88,7 +89,7 @@ def brace(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compiled
     off = np.zeros(4)
     for j in range(4):
         cmd[j] = off[j]
-    if mem[L.MEM_STAGE] < 1.0 and meas[L.MS_USER] < NEAR_M:
+    if mem[L.MEM_STAGE] < 1.0 and meas[MSS.MS_USER] < NEAR_M:
         mem[L.MEM_STAGE] = 1.0
 
 

@@ -18,6 +18,7 @@ from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import residual as RES
 from quadimpact.core.controllers.residual import features, residual_references
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.errors import InputError
 from quadimpact.inputs.policy_file import (
     PolicyWeights,
@@ -39,13 +40,13 @@ def _veh() -> np.ndarray:
 
 
 def _meas(q: np.ndarray, normal=(-1.0, 0.0, 0.0), t_detect: float = 0.1) -> np.ndarray:
-    meas = np.zeros(L.NMEAS)
-    meas[L.MS_X + L.X_QUAT : L.MS_X + L.X_QUAT + 4] = q
-    meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (1.0, -0.5, 0.25)
-    meas[L.MS_W_HAT : L.MS_W_HAT + 3] = (4.0, -2.0, 1.0)
-    meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (3.0, 0.0, -9.0)
-    meas[L.MS_NORMAL : L.MS_NORMAL + 3] = normal
-    meas[L.MS_T_DETECT] = t_detect
+    meas = np.zeros(MSS.NMEAS)
+    meas[MSS.MS_X + L.X_QUAT : MSS.MS_X + L.X_QUAT + 4] = q
+    meas[MSS.MS_X + L.X_VEL : MSS.MS_X + L.X_VEL + 3] = (1.0, -0.5, 0.25)
+    meas[MSS.MS_W_HAT : MSS.MS_W_HAT + 3] = (4.0, -2.0, 1.0)
+    meas[MSS.MS_IMU_F : MSS.MS_IMU_F + 3] = (3.0, 0.0, -9.0)
+    meas[MSS.MS_NORMAL : MSS.MS_NORMAL + 3] = normal
+    meas[MSS.MS_T_DETECT] = t_detect
     return meas
 
 
@@ -113,9 +114,9 @@ def _hover_meas(yaw_rad: float, normal=(-1.0, 0.0, 0.0)) -> np.ndarray:
     """The measurement of a vehicle level and at rest, heading ``yaw_rad``: the
     accelerometer reads -g along body z (FRD), the rates are zero."""
     meas = _meas(euler_zyx_to_quat(0.0, 0.0, yaw_rad), normal)
-    meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = 0.0
-    meas[L.MS_W_HAT : L.MS_W_HAT + 3] = 0.0
-    meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (0.0, 0.0, -G)
+    meas[MSS.MS_X + L.X_VEL : MSS.MS_X + L.X_VEL + 3] = 0.0
+    meas[MSS.MS_W_HAT : MSS.MS_W_HAT + 3] = 0.0
+    meas[MSS.MS_IMU_F : MSS.MS_IMU_F + 3] = (0.0, 0.0, -G)
     return meas
 
 
@@ -137,7 +138,7 @@ def test_a_hover_centred_policy_does_not_move_the_hover():
         off = np.subtract(residual_references(t, 5, hover, meas, _ctrl(plain), _veh()), hover)
         assert np.max(np.abs(off)) > 1e-3
         moved = meas.copy()
-        moved[L.MS_X + L.X_VEL] = 0.5  # moving at 0.5 m/s: a correction again
+        moved[MSS.MS_X + L.X_VEL] = 0.5  # moving at 0.5 m/s: a correction again
         off = np.subtract(residual_references(t, 5, hover, moved, _ctrl(centred), _veh()), hover)
         assert np.max(np.abs(off)) > 1e-6  # far above the round-off at the hover
 
@@ -301,12 +302,12 @@ def _tick_commands(policy: PolicyWeights | None, stage: int, hold_set: float) ->
     if policy is not None:
         block = policy.block()
         ctrl[CTL.C_POLICY : CTL.C_POLICY + block.size] = block
-    meas = np.zeros(L.NMEAS)
-    meas[L.MS_X : L.MS_X + L.NX] = setup.x0
-    meas[L.MS_X + L.X_VEL : L.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
-    meas[L.MS_DETECTED] = 1.0
-    meas[L.MS_T_DETECT] = 0.1
-    meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+    meas = np.zeros(MSS.NMEAS)
+    meas[MSS.MS_X : MSS.MS_X + L.NX] = setup.x0
+    meas[MSS.MS_X + L.X_VEL : MSS.MS_X + L.X_VEL + 3] = (0.5, 0.0, 0.3)
+    meas[MSS.MS_DETECTED] = 1.0
+    meas[MSS.MS_T_DETECT] = 0.1
+    meas[MSS.MS_NORMAL : MSS.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
     mem = np.zeros(L.NMEM)
     mem[L.MEM_STAGE] = stage
     mem[CL.RM_HOLD_SET] = hold_set

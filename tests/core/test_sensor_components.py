@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from quadimpact import simulate
-from quadimpact.core import layout as L
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.core.sensors import registry
 from quadimpact.core.sensors.barometer import SENSOR
 from quadimpact.errors import InputError
@@ -61,7 +61,7 @@ def test_addresses_follow_declared_sizes():
     assert tuple(at) == registry.tail_sizes()
     assert (
         registry.measurement_address("barometer", "altitude_m")
-        == L.NMEAS + where["barometer"].measurement[0]
+        == MSS.NMEAS + where["barometer"].measurement[0]
     )
 
 

@@ -12,6 +12,7 @@ from gymnasium.utils.env_checker import check_env
 import quadimpact.envs as E
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
+from quadimpact.core.sensors import measurement_slots as MSS
 
 
 @pytest.mark.parametrize("start", ["detection", "trial"])
@@ -91,10 +92,10 @@ def test_observation_scales_and_contents():
     env = E.ImpactRecoveryEnv(observe="imu")
     obs, info = env.reset(seed=2)
     m = env.tick_measurement()
-    x = m[L.MS_X : L.MS_X + L.NX]
-    np.testing.assert_allclose(obs[0:3], np.clip(m[L.MS_IMU_F : L.MS_IMU_F + 3] / 9.81, -10, 10),
-                               rtol=1e-6)  # fmt: skip
-    gyro = m[L.MS_IMU_W : L.MS_IMU_W + 3] / 10.0
+    x = m[MSS.MS_X : MSS.MS_X + L.NX]
+    f = m[MSS.MS_IMU_F : MSS.MS_IMU_F + 3]
+    np.testing.assert_allclose(obs[0:3], np.clip(f / 9.81, -10, 10), rtol=1e-6)
+    gyro = m[MSS.MS_IMU_W : MSS.MS_IMU_W + 3] / 10.0
     np.testing.assert_allclose(obs[3:6], gyro, rtol=1e-6, atol=1e-7)
     from quadimpact.rotations import quat_to_matrix
 
@@ -102,7 +103,7 @@ def test_observation_scales_and_contents():
     np.testing.assert_allclose(obs[6:15], C.ravel(), atol=1e-6)
     np.testing.assert_allclose(obs[15], -(C @ x[L.X_VEL : L.X_VEL + 3])[2] / 2.0, atol=1e-6)
     # detection mode: the agent starts at the detecting tick
-    assert obs[16] == 0.0 and obs[17] == 1.0 and info["t"] == m[L.MS_T_DETECT]
+    assert obs[16] == 0.0 and obs[17] == 1.0 and info["t"] == m[MSS.MS_T_DETECT]
     np.testing.assert_allclose(np.hypot(obs[18], obs[19]), 1.0, rtol=1e-6)
     senv = E.ImpactRecoveryEnv(observe="state", start="trial")
     sobs, _ = senv.reset(seed=2)

@@ -16,6 +16,7 @@ from gymnasium.utils.env_checker import check_env
 import quadimpact.envs as E
 from quadimpact.core import layout as L
 from quadimpact.core.envs import stacked as B
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.simulation.batch import simulate_batch
 
 TRIALS = E.TrialDistribution(estimator="ekf", sensors="impact")
@@ -32,13 +33,13 @@ def test_the_observation_gives_the_measurement_back_exactly():
     env = E.ImpactRecoveryEnv(observe="estimate", trials=TRIALS)
     obs, _ = env.reset(seed=3)
     meas = env.unwrapped.tick_measurement()
-    back = np.zeros(L.NMEAS)
+    back = np.zeros(MSS.NMEAS)
     B.measurement_from_estimate(obs, back)
-    for lo, n in ((L.MS_X, L.NX), (L.MS_W_HAT, 3), (L.MS_BIAS_HAT, 3), (L.MS_IMU_F, 3),
-                  (L.MS_IMU_W, 3), (L.MS_NORMAL, 2), (L.MS_DETECTED, 1)):  # fmt: skip
+    for lo, n in ((MSS.MS_X, L.NX), (MSS.MS_W_HAT, 3), (MSS.MS_BIAS_HAT, 3), (MSS.MS_IMU_F, 3),
+                  (MSS.MS_IMU_W, 3), (MSS.MS_NORMAL, 2), (MSS.MS_DETECTED, 1)):  # fmt: skip
         np.testing.assert_array_equal(back[lo : lo + n], meas[lo : lo + n])
     # the estimate is not the truth
-    assert not np.array_equal(meas[L.MS_X : L.MS_X + L.NX], env.unwrapped._slots.D.x[0])
+    assert not np.array_equal(meas[MSS.MS_X : MSS.MS_X + L.NX], env.unwrapped._slots.D.x[0])
 
 
 @pytest.mark.parametrize(

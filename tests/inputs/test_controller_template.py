@@ -19,6 +19,7 @@ from quadimpact import FlightScenario, Simulation
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core import named
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.inputs.controllers import param_index, param_slots, register_controller
 from quadimpact.simulation.setup import prepare
 
@@ -33,8 +34,8 @@ def template():
 def _records(scenario: FlightScenario):
     setup = prepare(scenario)
     m = setup.model()
-    meas = np.zeros(L.NMEAS)
-    meas[L.MS_X : L.MS_X + L.NX] = setup.x0
+    meas = np.zeros(MSS.NMEAS)
+    meas[MSS.MS_X : MSS.MS_X + L.NX] = setup.x0
     return setup, m, meas
 
 
@@ -91,7 +92,7 @@ def test_an_attitude_error_asks_for_the_torque_that_removes_it(template, axis, e
 
 
 def test_each_named_quantity_is_its_slots() -> None:
-    meas = np.arange(L.NMEAS, dtype=float)
+    meas = np.arange(MSS.NMEAS, dtype=float)
     ctrl = np.arange(CTL.NCTRL, dtype=float)
     veh = np.arange(L.NVEH, dtype=float)
 
@@ -107,14 +108,14 @@ def test_each_named_quantity_is_its_slots() -> None:
         )  # fmt: skip
 
     got = read(meas, ctrl, veh)
-    x = L.MS_X
+    x = MSS.MS_X
     assert got[0].tolist() == list(range(x + L.X_POS, x + L.X_POS + 3))
     assert got[1].tolist() == list(range(x + L.X_QUAT, x + L.X_QUAT + 4))
-    assert got[2].tolist() == list(range(L.MS_W_HAT, L.MS_W_HAT + 3))
+    assert got[2].tolist() == list(range(MSS.MS_W_HAT, MSS.MS_W_HAT + 3))
     assert got[3].tolist() == list(range(x + L.X_ROTOR, x + L.X_ROTOR + L.MAX_ROTORS))
-    assert got[4].tolist() == list(range(L.MS_IMU_F, L.MS_IMU_F + 3))
-    assert got[5].tolist() == list(range(L.MS_NORMAL, L.MS_NORMAL + 3))
-    assert (got[6], got[7]) == (L.MS_T, L.MS_T_DETECT)
+    assert got[4].tolist() == list(range(MSS.MS_IMU_F, MSS.MS_IMU_F + 3))
+    assert got[5].tolist() == list(range(MSS.MS_NORMAL, MSS.MS_NORMAL + 3))
+    assert (got[6], got[7]) == (MSS.MS_T, MSS.MS_T_DETECT)
     assert got[8].tolist() == [CTL.C_PARAMS, CTL.C_PARAMS + 1, CTL.C_PARAMS + 2]
     assert got[9] == CTL.C_ALLOC_INV + 6
     assert got[10] == (CTL.C_H_REF, CTL.C_PHI_REF, CTL.C_THETA_REF, CTL.C_PSI_REF)
@@ -128,7 +129,7 @@ def test_a_simulation_hands_out_its_records_by_name_read_only() -> None:
     x, meas, stats = sim.state, sim.measurement, sim.stats
     assert np.array_equal(x.position, np.asarray(x)[L.X_POS : L.X_POS + 3])
     assert np.array_equal(x.attitude, np.asarray(x)[L.X_QUAT : L.X_QUAT + 4])
-    q = L.MS_X + L.X_QUAT
+    q = MSS.MS_X + L.X_QUAT
     assert np.array_equal(meas.attitude, np.asarray(meas)[q : q + 4])
     assert meas.tick_time == pytest.approx(0.005) and meas.detected == 0.0
     assert stats.n_steps == stats[L.ST_N_STEPS] > 0 and stats.t_end == pytest.approx(0.01)

@@ -20,7 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from quadimpact import simulate
 from quadimpact.core import estimator_slots as ESL
-from quadimpact.core import layout as L
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.errors import InputError
 from quadimpact.inputs.estimators import (
     estimator_names,
@@ -46,9 +46,9 @@ def _pack(params: GyroOnlyParams, ctx) -> np.ndarray:
 
 @njit
 def gyro_only(t, dt, meas, ecfg, est):  # pragma: no cover - compiled
-    w0 = meas[L.MS_IMU_W]
-    w1 = meas[L.MS_IMU_W + 1]
-    w2 = meas[L.MS_IMU_W + 2] - ecfg[ESL.EC_USER]
+    w0 = meas[MSS.MS_IMU_W]
+    w1 = meas[MSS.MS_IMU_W + 1]
+    w2 = meas[MSS.MS_IMU_W + 2] - ecfg[ESL.EC_USER]
     est[ESL.ES_W] = w0
     est[ESL.ES_W + 1] = w1
     est[ESL.ES_W + 2] = w2

@@ -11,6 +11,7 @@ import pytest
 from quadimpact import FlightScenario, Simulation
 from quadimpact.core import layout as L
 from quadimpact.core.controllers.recovery import lean_cut
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.simulation.setup import prepare
 
 G = 9.81
@@ -47,8 +48,8 @@ def _ctrl(model: str, **params) -> np.ndarray:
     ],
 )
 def test_the_cut_reads_the_lean_and_the_push(pitch_deg, force, model, params, cut):
-    meas = np.zeros(L.NMEAS)
-    meas[L.MS_IMU_F : L.MS_IMU_F + 3] = (force * 0.6, force * 0.8, -G)  # |f_xy| = force
+    meas = np.zeros(MSS.NMEAS)
+    meas[MSS.MS_IMU_F : MSS.MS_IMU_F + 3] = (force * 0.6, force * 0.8, -G)  # |f_xy| = force
     normal = np.array([-1.0, 0.0, 0.0])  # out of a wall at +X
     assert lean_cut(_pitched(pitch_deg), normal, meas, _ctrl(model, **params)) is cut
 
@@ -65,8 +66,8 @@ def test_a_cut_stage_1_commands_idle_rotors_and_the_default_does_not():
                            controller_params={"hover": False, **params},
                            final_time_s=0.05)  # fmt: skip
         sim = Simulation(s)
-        sim._d.meas[L.MS_DETECTED] = 1.0
-        sim._d.meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+        sim._d.meas[MSS.MS_DETECTED] = 1.0
+        sim._d.meas[MSS.MS_NORMAL : MSS.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
         ts = sim.run().timeseries
         return ts[[f"omega_cmd{j}_rad_s" for j in (1, 2, 3, 4)]].to_numpy()[1]
 

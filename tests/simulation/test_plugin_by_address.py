@@ -21,6 +21,7 @@ from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.kernel import BUILTIN, execute
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.inputs.controllers import (
     controller_entry,
     register_controller,
@@ -39,7 +40,7 @@ def same_paper(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compiled
 @njit
 def held(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compiled
     for j in range(4):
-        cmd[j] = meas[L.MS_X + L.X_ROTOR + j]
+        cmd[j] = meas[MSS.MS_X + L.X_ROTOR + j]
 
 
 @njit
@@ -52,7 +53,7 @@ def raises_late(t, meas, ctrl, mem, veh, dt, cmd):  # pragma: no cover - compile
     if t > 0.1:
         raise ValueError("late")
     for j in range(4):
-        cmd[j] = meas[L.MS_X + L.X_ROTOR + j]
+        cmd[j] = meas[MSS.MS_X + L.X_ROTOR + j]
 
 
 @pytest.fixture

@@ -11,6 +11,7 @@ from quadimpact import FlightScenario, Simulation, simulate
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core.controllers import recovery as CL
+from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.inputs.controllers import RecoveryParams
 from quadimpact.rotations import quat_to_matrix
 from quadimpact.simulation.setup import prepare
@@ -56,8 +57,8 @@ def test_from_a_tilted_hover_after_a_detection_the_stages_come_in_order(
                        rotor_slew_limit_rad_s2="vehicle")  # fmt: skip
     sim = Simulation(s)
     meas = sim._d.meas  # the run's measurement record
-    meas[L.MS_DETECTED] = 1.0  # a detector's verdict, made by hand
-    meas[L.MS_NORMAL : L.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
+    meas[MSS.MS_DETECTED] = 1.0  # a detector's verdict, made by hand
+    meas[MSS.MS_NORMAL : MSS.MS_NORMAL + 3] = (-1.0, 0.0, 0.0)
     result = sim.run()
     times, tilt_deg, _ = _check_stages(result)
     assert times[0] == 0.0  # stage 1 at the first tick

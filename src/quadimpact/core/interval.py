@@ -54,7 +54,6 @@ from quadimpact.core.layout import (
     LS_T,
     LS_T_SCHED,
     MAX_INTERVAL_EVENTS,
-    MS_DETECTED,
     NX,
     O_ATOL,
     O_CRASH_ALTITUDE,
@@ -71,7 +70,6 @@ from quadimpact.core.layout import (
     REASON_MAX_STEPS,
     REASON_NOT_FINITE,
     REASON_STEP_TOO_SMALL,
-    SS_NEXT_T,
     ST_CRASH_T,
     ST_MISSED_ONSETS,
     ST_N_OUT,
@@ -107,6 +105,8 @@ from quadimpact.core.recording import (
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.rotors import active_states
 from quadimpact.core.sensing import sample_at, take_sample
+from quadimpact.core.sensors.imu_slots import SS_NEXT_T
+from quadimpact.core.sensors.measurement_slots import MS_DETECTED
 from quadimpact.core.shape_slots import (
     SH_IS_GROUND,
 )

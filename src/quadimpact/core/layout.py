@@ -243,18 +243,9 @@ NOPT = _opt.end("NOPT")
 N_DETECTOR_CFG = 3  # the detector's config slots (core/sensors/detection.py)
 # ---- sensors scfg (NSCFG), the IMU and the impact detector: declared by the IMU in
 # core/sensors/imu_slots.py
-MAX_AVERAGE_WINDOW = 64  # samples
 
-# ---- the added sensors' standard normal draws snoise (n_imu, NSN): row i for IMU sample i.
-# Frozen for good (every seeded run stays bit for bit): the magnetometer and the pose sensor,
-# now sensor components (core/sensors/magnetometer.py, pose.py), read their columns as a
-# legacy noise stream (LegacyColumns); a new sensor draws from a stream of its own (cnoise)
-_sn = Block("snoise", "SN_")
-SN_IMPACT = _sn.slot("SN_IMPACT", 6)  # impact disturbance (f_x, f_y, f_z, w_x, w_y, w_z)
-SN_WALK = _sn.slot("SN_WALK", 3)  # gyro bias random-walk increments
-SN_MAG = _sn.slot("SN_MAG", 3)  # magnetometer noise
-SN_POSE = _sn.slot("SN_POSE", 6)  # pose sensor: position (3), attitude rotation vector (3)
-NSN = _sn.end("NSN")
+# ---- the older sensors' standard normal draws snoise (n_imu, NSN): declared by the IMU in
+# core/sensors/imu_slots.py
 
 # ---- estimator ecfg (NECFG): declared by the estimators in core/estimator_slots.py
 
@@ -300,35 +291,9 @@ STAGE_LEVEL = 3
 STAGE_RECOVERED = 4
 STAGE_HOVER = 5
 
-# ---- measurement record meas (NMEAS): what a controller sees at a tick
-# (core/sensors/measurement.py writes the estimate; the IMU and the detector
-# their fields as the samples are taken)
-_ms = Block("meas", "MS_")
-MS_X = _ms.slot("MS_X", NX)  # state estimate (the ideal estimator: the true state at the tick)
-MS_T = _ms.slot("MS_T")  # s, time of the tick
-MS_IMU_T = _ms.slot("MS_IMU_T")  # s, time of the latest IMU sample (NaN: none yet)
-MS_IMU_F = _ms.slot("MS_IMU_F", 3)  # measured specific force, body FRD, m/s^2
-MS_IMU_W = _ms.slot("MS_IMU_W", 3)  # measured angular velocity, body FRD, rad/s
-MS_DETECTED = _ms.slot("MS_DETECTED")  # 1 once an impact has been detected
-MS_T_DETECT = _ms.slot("MS_T_DETECT")  # s, time of the detecting sample (NaN: none)
-MS_NORMAL = _ms.slot("MS_NORMAL", 3)  # wall-normal estimate at detection, inertial, unit
-MS_W_HAT = _ms.slot("MS_W_HAT", 3)  # estimated body rates (ideal: the gyro as measured), rad/s
-MS_BIAS_HAT = _ms.slot("MS_BIAS_HAT", 3)  # estimated gyro bias, rad/s
-N_USER_MEAS = 8
-MS_USER = _ms.slot(
-    "MS_USER", N_USER_MEAS
-)  # a plug-in sensor's readings (core/kernel.py, make_kernel)
-NMEAS = _ms.end("NMEAS")
+# ---- measurement record meas (NMEAS): declared by core/sensors/measurement_slots.py
 
-# ---- sensor state sst (NSST)
-_sst = Block("sst", "SS_")
-SS_N = _sst.slot("SS_N")  # samples taken
-SS_NEXT_T = _sst.slot("SS_NEXT_T")  # s, time of the next sample
-SS_DETECTOR = _sst.slot("SS_DETECTOR")  # the detector's state (core/sensors/detection.py)
-SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
-SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
-SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
-NSST = _sst.end("NSST")
+# ---- sensor state sst (NSST): declared by the IMU in core/sensors/imu_slots.py
 
 # ---- estimator state est (NEST): declared by the estimators in core/estimator_slots.py
 

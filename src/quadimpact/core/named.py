@@ -49,16 +49,6 @@ from quadimpact.core.controller_slots import (
 )
 from quadimpact.core.layout import (
     MAX_ROTORS,
-    MS_BIAS_HAT,
-    MS_DETECTED,
-    MS_IMU_F,
-    MS_IMU_T,
-    MS_IMU_W,
-    MS_NORMAL,
-    MS_T,
-    MS_T_DETECT,
-    MS_W_HAT,
-    MS_X,
     NX,
     V_GRAVITY,
     V_INERTIA,
@@ -70,6 +60,18 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_ROTOR,
     X_VEL,
+)
+from quadimpact.core.sensors.measurement_slots import (
+    MS_BIAS_HAT,
+    MS_DETECTED,
+    MS_IMU_F,
+    MS_IMU_T,
+    MS_IMU_W,
+    MS_NORMAL,
+    MS_T,
+    MS_T_DETECT,
+    MS_W_HAT,
+    MS_X,
 )
 from quadimpact.core.sensors.registry import measurement_address
 

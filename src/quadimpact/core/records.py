@@ -46,14 +46,10 @@ from numba import njit
 from quadimpact.core.contact_slots import NCS
 from quadimpact.core.estimator_slots import NECFG, NEST
 from quadimpact.core.layout import (
-    MAX_AVERAGE_WINDOW,
     MAX_ROTORS,
     NLS,
-    NMEAS,
     NMEM,
-    NSN,
     NSPAN,
-    NSST,
     NSTAT,
     NX,
     SPAN_T0,
@@ -65,12 +61,16 @@ from quadimpact.core.layout import (
 from quadimpact.core.recording_slots import NEP, NOUT
 from quadimpact.core.rotors import NRIN
 from quadimpact.core.sensors.imu_slots import (
+    MAX_AVERAGE_WINDOW,
     NIMU,
     NSCFG,
+    NSN,
+    NSST,
     SC_TAIL_MEAS,
     SC_TAIL_REC,
     SC_TAIL_ST,
 )
+from quadimpact.core.sensors.measurement_slots import NMEAS
 
 __all__ = [
     "Data",

@@ -17,16 +17,14 @@ from numba import njit
 from quadimpact.core.compiled import compiled
 from quadimpact.core.dynamics import state_derivative
 from quadimpact.core.estimators import attitude_at_sample, estimate_sample
-from quadimpact.core.layout import (
-    LS_T0,
-    SS_N,
-    SS_NEXT_T,
-)
+from quadimpact.core.layout import LS_T0
 from quadimpact.core.records import Data, Model, Output, Work
 from quadimpact.core.sensors.detection import detect
 from quadimpact.core.sensors.imu import imu_sample
 from quadimpact.core.sensors.imu_slots import (
     SC_RATE,
+    SS_N,
+    SS_NEXT_T,
 )
 from quadimpact.core.sensors.registry import sample_components
 

@@ -56,8 +56,6 @@ from quadimpact.core.layout import (
     LS_T_SCHED,
     LS_TF,
     MEM_STAGE,
-    MS_IMU_T,
-    MS_T_DETECT,
     N_STAGES,
     O_CRASH_ALTITUDE,
     O_CRASH_RULE,
@@ -69,7 +67,6 @@ from quadimpact.core.layout import (
     ROTOR_FIRST_ORDER,
     SPAN_T0,
     SPAN_TF,
-    SS_NEXT_T,
     ST_CRASH_T,
     ST_EXCURSION,
     ST_IMPACT_T,
@@ -104,7 +101,9 @@ from quadimpact.core.rotors import RIN_CMD, RIN_FIRST_ORDER, RIN_PREV_CMD
 from quadimpact.core.sensing import sample_at
 from quadimpact.core.sensors.imu_slots import (
     SC_RATE,
+    SS_NEXT_T,
 )
+from quadimpact.core.sensors.measurement_slots import MS_IMU_T, MS_T_DETECT
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
 controller_step = builtin_step  # rebound by kernel.make_kernel(step=...) (a loop of its own)

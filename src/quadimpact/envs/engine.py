@@ -23,6 +23,7 @@ from quadimpact.core.envs import stacked as B
 from quadimpact.core.envs.episode_layout import ENV_ROTORS
 from quadimpact.core.recording_slots import OUT_X
 from quadimpact.core.records import Data, Output, new_data, new_output, raw_record, set_row, stacked
+from quadimpact.core.sensors import imu_slots as IMS
 from quadimpact.core.step import finish
 from quadimpact.envs.settings import TrialDistribution
 from quadimpact.errors import InputError
@@ -106,7 +107,7 @@ class Slots:
         self.n_cnoise = max(x.cnoise.shape[0] for x in [template, *setups])
         m = template.model(
             noise=np.zeros((self.n_noise, 6)),
-            snoise=np.zeros((self.n_snoise, L.NSN)),
+            snoise=np.zeros((self.n_snoise, IMS.NSN)),
             cnoise=np.zeros((self.n_cnoise, template.cnoise.shape[1])),
         )
         self.M = stacked(m, n)
@@ -217,7 +218,7 @@ class Slots:
             raise ValueError("trial: the environment's trials run the 'recovery' controller")
         noise = np.zeros((self.n_noise, 6))
         noise[: s.noise.shape[0]] = s.noise
-        snoise = np.zeros((self.n_snoise, L.NSN))
+        snoise = np.zeros((self.n_snoise, IMS.NSN))
         snoise[: s.snoise.shape[0]] = s.snoise
         cnoise = np.zeros((self.n_cnoise, m.cnoise.shape[1]))
         cnoise[: s.cnoise.shape[0]] = s.cnoise

@@ -298,7 +298,7 @@ def pack_estimation(r: ResolvedShared, scfg: np.ndarray) -> Estimation:
     initial_std, extra_std = _initial_errors(est.params, entry.kind, mag, ecfg)
     return Estimation(
         ecfg=ecfg,
-        snoise=np.zeros((0, L.NSN)),
+        snoise=np.zeros((0, IMS.NSN)),
         name=entry.name,
         settings=settings_text(est.given),
         step=entry.step,
@@ -332,7 +332,7 @@ def draw_estimation(
     """
     snoise = est.snoise
     if est.noisy:
-        snoise = _stream(seed, SENSOR_STREAM).standard_normal((n_imu, L.NSN))
+        snoise = _stream(seed, SENSOR_STREAM).standard_normal((n_imu, IMS.NSN))
     ecfg = est.ecfg
     if est.initial_std is not None:
         ecfg = ecfg.copy()

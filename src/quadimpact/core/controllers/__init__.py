@@ -39,14 +39,8 @@ from quadimpact.core.controller_slots import C_KIND
 from quadimpact.core.controllers.cascade_pid import cascade_pid_step
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.controllers.recovery import recovery_step
-from quadimpact.core.layout import (
-    CTRL_CASCADE_PID,
-    CTRL_PAPER,
-    CTRL_RECOVERY,
-    MS_X,
-    V_N_ROTORS,
-    X_ROTOR,
-)
+from quadimpact.core.layout import CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, V_N_ROTORS, X_ROTOR
+from quadimpact.core.sensors.measurement_slots import MS_X
 
 
 @compiled

@@ -50,8 +50,9 @@ from quadimpact.core.controllers.common import (
     linearised_torques,
 )
 from quadimpact.core.controllers.waypoint import waypoint_references
-from quadimpact.core.layout import MS_X, NX, V_GRAVITY, V_MASS, V_N_ROTORS, X_OMEGA
+from quadimpact.core.layout import NX, V_GRAVITY, V_MASS, V_N_ROTORS, X_OMEGA
 from quadimpact.core.quaternion import wrap_pi
+from quadimpact.core.sensors.measurement_slots import MS_X
 
 FADE_POWER = 4.0  # thrust fade beyond the tilt floor (tilt_compensation)
 

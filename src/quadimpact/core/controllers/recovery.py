@@ -90,11 +90,6 @@ from quadimpact.core.controllers.residual import (
 from quadimpact.core.layout import (
     CTRL_CASCADE_PID,
     MEM_STAGE,
-    MS_DETECTED,
-    MS_IMU_F,
-    MS_NORMAL,
-    MS_W_HAT,
-    MS_X,
     NX,
     STAGE_DETECTED,
     STAGE_HOVER,
@@ -112,6 +107,13 @@ from quadimpact.core.layout import (
     Block,
 )
 from quadimpact.core.quaternion import euler_zyx, rotation_matrix
+from quadimpact.core.sensors.measurement_slots import (
+    MS_DETECTED,
+    MS_IMU_F,
+    MS_NORMAL,
+    MS_W_HAT,
+    MS_X,
+)
 
 # ---- the recovery law's blocks
 # ---- parameters, at ctrl[C_PARAMS + ...] (after the PID block above)

@@ -79,11 +79,6 @@ from quadimpact.core.controller_slots import (
     T_CAP_S,
 )
 from quadimpact.core.layout import (
-    MS_IMU_F,
-    MS_NORMAL,
-    MS_T_DETECT,
-    MS_W_HAT,
-    MS_X,
     STAGE_HOVER,
     STAGE_RECOVERED,
     V_GRAVITY,
@@ -91,6 +86,13 @@ from quadimpact.core.layout import (
     X_QUAT,
     X_VEL,
     Block,
+)
+from quadimpact.core.sensors.measurement_slots import (
+    MS_IMU_F,
+    MS_NORMAL,
+    MS_T_DETECT,
+    MS_W_HAT,
+    MS_X,
 )
 
 # ---- the residual's block, at ctrl[C_POLICY + PB_*]

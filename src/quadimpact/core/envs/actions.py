@@ -22,7 +22,8 @@ from quadimpact.core.envs.episode_layout import (
     EP_RATE_MAX,
     EP_ZERO_LOW,
 )
-from quadimpact.core.layout import MS_W_HAT, V_KT
+from quadimpact.core.layout import V_KT
+from quadimpact.core.sensors.measurement_slots import MS_W_HAT
 
 
 # ---------------------------------------------------------------- action maps

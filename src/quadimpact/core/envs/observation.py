@@ -33,15 +33,6 @@ from quadimpact.core.estimators import write_estimate
 from quadimpact.core.layout import (
     LS_K,
     LS_T0,
-    MS_BIAS_HAT,
-    MS_DETECTED,
-    MS_IMU_F,
-    MS_IMU_W,
-    MS_NORMAL,
-    MS_T,
-    MS_T_DETECT,
-    MS_W_HAT,
-    MS_X,
     NX,
     O_DT_CONTROL,
     X_OMEGA,
@@ -53,6 +44,17 @@ from quadimpact.core.layout import (
 from quadimpact.core.quaternion import normalise_quaternion, rotation_matrix
 from quadimpact.core.records import Data, Model
 from quadimpact.core.rotors import RIN_CMD
+from quadimpact.core.sensors.measurement_slots import (
+    MS_BIAS_HAT,
+    MS_DETECTED,
+    MS_IMU_F,
+    MS_IMU_W,
+    MS_NORMAL,
+    MS_T,
+    MS_T_DETECT,
+    MS_W_HAT,
+    MS_X,
+)
 
 
 @allocating

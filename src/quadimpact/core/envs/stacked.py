@@ -161,11 +161,6 @@ from quadimpact.core.layout import (
     LS_TF,
     MAX_ROTORS,
     MEM_STAGE,
-    MS_DETECTED,
-    MS_NORMAL,
-    MS_T,
-    MS_W_HAT,
-    MS_X,
     NX,
     O_DT_CONTROL,
     O_SLEW_MAX,
@@ -192,6 +187,7 @@ from quadimpact.core.records import (
     new_work,
     output_row,
 )
+from quadimpact.core.sensors.measurement_slots import MS_DETECTED, MS_NORMAL, MS_T, MS_W_HAT, MS_X
 from quadimpact.core.step import finish, start, tick
 
 __all__ = [

@@ -70,10 +70,6 @@ from quadimpact.core.layout import (
     EST_EKF_ADDITIVE,
     EST_IDEAL,
     EST_NAV_EKF,
-    MS_BIAS_HAT,
-    MS_IMU_W,
-    MS_W_HAT,
-    MS_X,
     NX,
     X_OMEGA,
     X_POS,
@@ -87,6 +83,7 @@ from quadimpact.core.sensors.imu_slots import (
     SC_BIAS,
 )
 from quadimpact.core.sensors.measurement import measure
+from quadimpact.core.sensors.measurement_slots import MS_BIAS_HAT, MS_IMU_W, MS_W_HAT, MS_X
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
 
 

@@ -26,8 +26,6 @@ from quadimpact.core.estimator_slots import ES_BIAS, ES_POS, ES_Q, ES_VEL
 from quadimpact.core.layout import (
     N_EST_ERR,
     N_PHASES,
-    SS_N,
-    SS_WALK,
     ST_EST_ERR,
     ST_ONSET_T,
     ST_STAGE_T,
@@ -44,6 +42,8 @@ from quadimpact.core.sensors.imu_slots import (
     I_Q_HAT,
     I_VEL_HAT,
     SC_BIAS,
+    SS_N,
+    SS_WALK,
 )
 from quadimpact.core.sensors.rotvec import error_angle
 

@@ -126,13 +126,14 @@ from quadimpact.core.estimators.ekf import (
 )
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T
-from quadimpact.core.layout import MS_IMU_F, MS_IMU_W, V_GRAVITY, Block
+from quadimpact.core.layout import V_GRAVITY, Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.imu_slots import (
     SC_BIAS,
     SC_RANGE_F,
     SC_RANGE_W,
 )
+from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.registry import measurement_address
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
 

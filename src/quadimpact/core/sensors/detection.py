@@ -29,14 +29,8 @@ import numpy as np
 
 from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import (
-    MS_DETECTED,
-    MS_IMU_F,
-    MS_NORMAL,
-    MS_T_DETECT,
     N_DETECTOR_CFG,
     NX,
-    SS_DETECTOR,
-    SS_N,
     ST_DETECT_NORMAL,
     ST_DETECT_X,
     ST_N_DETECTIONS,
@@ -47,7 +41,10 @@ from quadimpact.core.records import Data, Model, Output
 from quadimpact.core.sensors.imu_slots import (
     I_DETECTOR,
     SC_DETECTOR,
+    SS_DETECTOR,
+    SS_N,
 )
+from quadimpact.core.sensors.measurement_slots import MS_DETECTED, MS_IMU_F, MS_NORMAL, MS_T_DETECT
 
 # ---- its blocks, in the regions core/layout.py keeps for it in scfg, sst and imu
 _cfg = Block("scfg.detector", "SC_DET_", start=SC_DETECTOR, capacity=SC_DETECTOR + N_DETECTOR_CFG)

@@ -42,16 +42,6 @@ from quadimpact.core.compiled import compiled
 from quadimpact.core.layout import (
     FILTER_FIRST_ORDER,
     FILTER_MOVING_AVERAGE,
-    MAX_AVERAGE_WINDOW,
-    MS_IMU_F,
-    MS_IMU_T,
-    MS_IMU_W,
-    SN_IMPACT,
-    SN_WALK,
-    SS_FILT,
-    SS_N,
-    SS_RING,
-    SS_WALK,
     ST_N_IMU,
     V_GRAVITY,
     X_OMEGA,
@@ -65,6 +55,7 @@ from quadimpact.core.sensors.imu_slots import (
     I_T,
     I_W,
     I_W_TRUE,
+    MAX_AVERAGE_WINDOW,
     SC_BIAS,
     SC_BIAS_WALK,
     SC_FILTER,
@@ -79,7 +70,14 @@ from quadimpact.core.sensors.imu_slots import (
     SC_RANGE_F,
     SC_RANGE_W,
     SC_RATE,
+    SN_IMPACT,
+    SN_WALK,
+    SS_FILT,
+    SS_N,
+    SS_RING,
+    SS_WALK,
 )
+from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_T, MS_IMU_W
 
 
 @compiled

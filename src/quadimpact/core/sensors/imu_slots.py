@@ -1,15 +1,20 @@
-"""The IMU's slots: its configuration ``scfg`` and its sample rows ``imu``.
+"""The IMU's slots: its configuration ``scfg``, its state ``sst``, its draws and its rows.
 
 ``core/sensors/imu.py`` samples the IMU on the dense output. It reads its
 configuration from ``scfg`` (``SC_*``, :data:`NSCFG` numbers: rate, mounting,
 noise, bias, saturation, filter, the impact disturbance, the detector's
-slots and the sensor components' tail sizes) and writes one row of ``imu``
-per sample (``I_*``, :data:`NIMU` columns: the measured and true signals,
-the detector's column, the estimate after the sample and its errors).
-The declaration lives in this module, which imports no compiled code, so
-that ``core/records.py`` can size the ``imu`` table and the packer can fill
-``scfg`` without loading Numba. Every slot keeps the offset and the name it
-had in ``core/layout.py``.
+slots and the sensor components' tail sizes), keeps its state in ``sst``
+(``SS_*``, :data:`NSST` numbers: the sample count and the next sample's
+time, which schedule every sample, the filter's state, the bias walk, and
+the detector's slot), takes its impact noise and bias-walk increments from
+its row of ``snoise`` (``SN_*``, :data:`NSN` columns, with the frozen
+columns of the magnetometer and the pose sensor) and writes one row of
+``imu`` per sample (``I_*``, :data:`NIMU` columns: the measured and true
+signals, the detector's column, the estimate after the sample and its
+errors). The declaration lives in this module, which imports no compiled
+code, so that ``core/records.py`` can size the ``imu`` table and the packer
+can fill ``scfg`` and draw ``snoise`` without loading Numba. Every slot
+keeps the offset and the name it had in ``core/layout.py``.
 """
 
 from quadimpact.core.block import Block
@@ -57,3 +62,26 @@ I_POS_HAT = _imu.slot("I_POS_HAT", 3)  # position estimate, inertial, m
 I_BIAS_TRUE = _imu.slot("I_BIAS_TRUE", 3)  # the gyro's true bias (constant + walk), rad/s
 I_ERR = _imu.slot("I_ERR", 4)  # errors: attitude deg, velocity m/s, bias rad/s, position m
 NIMU = _imu.end("NIMU")
+
+MAX_AVERAGE_WINDOW = 64  # samples: the moving-average filter's longest window
+
+# ---- sensor state sst (NSST): the IMU's schedule, filter and bias walk, the detector's slot
+_sst = Block("sst", "SS_")
+SS_N = _sst.slot("SS_N")  # samples taken
+SS_NEXT_T = _sst.slot("SS_NEXT_T")  # s, time of the next sample
+SS_DETECTOR = _sst.slot("SS_DETECTOR")  # the detector's state (core/sensors/detection.py)
+SS_FILT = _sst.slot("SS_FILT", 6)  # low-pass state (first-order) / running sum (moving average)
+SS_RING = _sst.slot("SS_RING", 6 * MAX_AVERAGE_WINDOW)  # moving-average window
+SS_WALK = _sst.slot("SS_WALK", 3)  # gyro bias random walk so far, rad/s
+NSST = _sst.end("NSST")
+
+# ---- the added sensors' standard normal draws snoise (n_imu, NSN): row i for IMU sample i.
+# Frozen for good (every seeded run stays bit for bit): the magnetometer and the pose sensor,
+# now sensor components (core/sensors/magnetometer.py, pose.py), read their columns as a
+# legacy noise stream (LegacyColumns); a new sensor draws from a stream of its own (cnoise)
+_sn = Block("snoise", "SN_")
+SN_IMPACT = _sn.slot("SN_IMPACT", 6)  # impact disturbance (f_x, f_y, f_z, w_x, w_y, w_z)
+SN_WALK = _sn.slot("SN_WALK", 3)  # gyro bias random-walk increments
+SN_MAG = _sn.slot("SN_MAG", 3)  # magnetometer noise
+SN_POSE = _sn.slot("SN_POSE", 6)  # pose sensor: position (3), attitude rotation vector (3)
+NSN = _sn.end("NSN")

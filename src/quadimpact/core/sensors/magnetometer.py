@@ -24,7 +24,6 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import SN_MAG
 from quadimpact.core.sensors.component import (
     LegacyColumns,
     PackContext,
@@ -32,6 +31,7 @@ from quadimpact.core.sensors.component import (
     Slot,
     offsets,
 )
+from quadimpact.core.sensors.imu_slots import SN_MAG
 from quadimpact.core.sensors.older_settings import Magnetometer
 
 __all__ = ["SENSOR", "Magnetometer"]

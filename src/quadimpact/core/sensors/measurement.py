@@ -9,7 +9,8 @@ the IMU and the detector write their own fields (``MS_IMU_*``,
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import MS_T, MS_X, NX
+from quadimpact.core.layout import NX
+from quadimpact.core.sensors.measurement_slots import MS_T, MS_X
 
 
 @compiled

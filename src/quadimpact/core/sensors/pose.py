@@ -24,7 +24,7 @@ import math
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import SN_POSE, X_POS, X_QUAT
+from quadimpact.core.layout import X_POS, X_QUAT
 from quadimpact.core.sensors.component import (
     LegacyColumns,
     PackContext,
@@ -32,6 +32,7 @@ from quadimpact.core.sensors.component import (
     Slot,
     offsets,
 )
+from quadimpact.core.sensors.imu_slots import SN_POSE
 from quadimpact.core.sensors.older_settings import PoseSensor
 from quadimpact.core.sensors.rotvec import rotate_by
 

@@ -27,18 +27,16 @@ from numba import literal_unroll
 from numba.core.errors import NumbaExperimentalFeatureWarning
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import (
-    NMEAS,
-    NSST,
-    SS_N,
-)
 from quadimpact.core.records import Data, Model, Output
 from quadimpact.core.sensors import barometer, magnetometer, optical_flow, pose, rangefinder
 from quadimpact.core.sensors.component import SensorComponent, offsets
 from quadimpact.core.sensors.imu_slots import (
     NIMU,
     NSCFG,
+    NSST,
+    SS_N,
 )
+from quadimpact.core.sensors.measurement_slots import NMEAS
 
 __all__ = [
     "BUILTIN",
