@@ -47,6 +47,7 @@ DECLARATIONS = {
     "quadimpact.core.controller_slots": "quadimpact.core.controllers",
     "quadimpact.core.estimator_slots": "quadimpact.core.estimators",
     "quadimpact.core.sensors.measurement_slots": "quadimpact.core.sensors.measurement",
+    "quadimpact.core.vehicle_slots": "quadimpact.core.dynamics",
 }
 #: What a declaration module may import of quadimpact.
 DECLARATION_IMPORTS = {"quadimpact.core.block", "quadimpact.core.layout"}

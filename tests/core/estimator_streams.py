@@ -15,6 +15,7 @@ import numpy as np
 
 from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.estimators import estimate_sample, init_estimate
 from quadimpact.core.estimators import older_sensors as OS
 from quadimpact.core.estimators.ekf import covariance, ekf_dimension
@@ -100,7 +101,7 @@ class Harness:
         setup = prepare(scenario)
         self.setup = setup
         self.m = setup.model()
-        self.m.veh[L.V_GRAVITY] = g
+        self.m.veh[VS.V_GRAVITY] = g
         self.d = new_data(self.m)
         self.o = new_output(self.m, n, 4)
         self.w = new_work(self.m.pairs.shape[0])

@@ -9,6 +9,7 @@ from scipy.integrate import solve_ivp
 from quadimpact import FlightScenario, load_vehicle
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.geometry import contact_record
 from quadimpact.core.recording_slots import E_FEATURE, E_V_I, OUT_X
 from quadimpact.inputs.world import GROUND, Plane
@@ -199,7 +200,7 @@ def test_point_mass_impact_restitution_matches_one_dof(speed):
         )
     )
     veh = setup.veh.copy()
-    veh[L.V_GRAVITY] = 0.0
+    veh[VS.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
     ctrl[CTL.C_KIND] = L.CTRL_NONE
     out, ep, stats = run_packed(setup, veh=veh, ctrl=ctrl)

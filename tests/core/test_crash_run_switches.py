@@ -17,6 +17,7 @@ import pytest
 from quadimpact import FlightScenario, WallApproach, simulate
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.contact import contact_wrench
 from quadimpact.core.contact_slots import CS_ACTIVE, CS_LAMBDA, NCS
 from quadimpact.simulation.setup import prepare
@@ -54,7 +55,7 @@ def test_cut_step_holds_the_motor_to_the_next_tick_then_kicks_the_yaw(model):
     # physical -s Jr dOmega/dt and the replica's -Jr dOmega/dt agree), nothing after
     r_cut, r_plain = cut["r_rad_s"].to_numpy(), plain["r_rad_s"].to_numpy()
     veh = prepare(FlightScenario()).veh
-    izz, jr = veh[L.V_INERTIA + 8], veh[L.V_JR]
+    izz, jr = veh[VS.V_INERTIA + 8], veh[VS.V_JR]
 
     def gain(r, a, b):
         return np.interp(b, t, r) - np.interp(a, t, r)

@@ -8,6 +8,7 @@ from quadimpact.core import controller_slots as CTL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.geometry import pair_table
 from quadimpact.core.records import model, new_data, new_output
 from quadimpact.core.sensors import detection as DET
@@ -29,8 +30,8 @@ def _feed(samples, *, threshold=0.5 * G, persist=1, world=False, yaw=0.0, pitch=
     x = np.zeros(L.NX)
     x[L.X_QUAT : L.X_QUAT + 4] = euler_zyx_to_quat(0.0, pitch, yaw)
     C = np.ascontiguousarray(quat_to_matrix(x[L.X_QUAT : L.X_QUAT + 4]))
-    veh = np.zeros(L.NVEH)
-    veh[L.V_GRAVITY] = G
+    veh = np.zeros(VS.NVEH)
+    veh[VS.V_GRAVITY] = G
     feat = np.zeros((0, FS.NFEAT))
     shapes = np.zeros((0, SHP.NSHAPE))
     m = model(x0=x, t0=0.0, tf=1.0, veh=veh, feat=feat, shapes=shapes,

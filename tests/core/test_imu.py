@@ -10,6 +10,7 @@ import pytest
 from quadimpact import FlightScenario
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import OUT_DELTA, OUT_T, OUT_X
 from quadimpact.core.sensors import imu_slots as IMS
@@ -61,10 +62,10 @@ def test_constant_spin_off_the_cm_reads_the_centripetal_term():
     setup = prepare(FlightScenario(position_m=(0, 0, -5), angular_velocity_rad_s=tuple(omega),
                                    rotor_speeds_rad_s=(0, 0, 0, 0), final_time_s=0.5))  # fmt: skip
     veh = setup.veh.copy()
-    veh[L.V_GRAVITY] = 0.0
-    inertia = np.diag(np.diag(veh[L.V_INERTIA : L.V_INERTIA + 9].reshape(3, 3)))
-    veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
-    veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
+    veh[VS.V_GRAVITY] = 0.0
+    inertia = np.diag(np.diag(veh[VS.V_INERTIA : VS.V_INERTIA + 9].reshape(3, 3)))
+    veh[VS.V_INERTIA : VS.V_INERTIA + 9] = inertia.ravel()
+    veh[VS.V_INERTIA_INV : VS.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
     ctrl = setup.ctrl.copy()
     ctrl[CTL.C_KIND] = L.CTRL_NONE
     imu = _run(setup, _scfg(1000.0, r), veh=veh, ctrl=ctrl).imu
@@ -83,7 +84,7 @@ def test_wall_contact_body_x_reading_is_the_contact_force_over_mass():
                                    rotor_speeds_rad_s=(0, 0, 0, 0), surfaces=(wall,),
                                    final_time_s=0.5))  # fmt: skip
     veh = setup.veh.copy()
-    veh[L.V_GRAVITY] = 0.0
+    veh[VS.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
     ctrl[CTL.C_KIND] = L.CTRL_NONE
     rec = _run(setup, _scfg(1000.0), veh=veh, ctrl=ctrl)
@@ -97,7 +98,7 @@ def test_wall_contact_body_x_reading_is_the_contact_force_over_mass():
     quat = out[:, OUT_X + L.X_QUAT : OUT_X + L.X_QUAT + 4]
     # contact force along -X (inertial) in body axes, over the mass
     f_body = np.einsum("nji,j->ni", quat_to_matrix(quat), np.array([-1.0, 0.0, 0.0]))
-    expected = f_body * (force / veh[L.V_MASS])[:, None]
+    expected = f_body * (force / veh[VS.V_MASS])[:, None]
     np.testing.assert_allclose(imu[:, IMS.I_F : IMS.I_F + 3], expected, atol=1e-9)
 
 

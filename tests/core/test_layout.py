@@ -20,6 +20,7 @@ from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.contact_slots import NCS
 from quadimpact.core.geometry import NPAIR
 from quadimpact.core.recording_slots import NEP, NOUT, out_width
@@ -39,6 +40,7 @@ DECLARING = (
     "quadimpact.core.shape_slots",
     "quadimpact.core.controller_slots",
     "quadimpact.core.estimator_slots",
+    "quadimpact.core.vehicle_slots",
     "quadimpact.core.sensors.imu_slots",
     "quadimpact.core.sensors.measurement_slots",
     "quadimpact.core.approach",
@@ -156,7 +158,7 @@ def test_the_factories_allocate_the_declared_sizes():
     from quadimpact.core.records import model
 
     m = model(
-        x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(L.NVEH),
+        x0=np.zeros(L.NX), t0=0.0, tf=1.0, veh=np.zeros(VS.NVEH),
         feat=np.zeros((m_feat, FS.NFEAT)), shapes=np.zeros((n_shapes, SHP.NSHAPE)),
         pairs=np.zeros((m_feat * n_shapes, NPAIR), dtype=np.int64), opts=np.zeros(L.NOPT),
         ctrl=np.zeros(CTL.NCTRL), t_out=np.linspace(0.0, 1.0, n_out),

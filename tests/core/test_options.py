@@ -8,6 +8,7 @@ import pytest
 from quadimpact import FlightScenario, simulate
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.kernel import execute
 from quadimpact.core.recording_slots import E_FEATURE, E_T_END, E_T_START, OUT_CMD, OUT_T, OUT_X
 from quadimpact.rotations import quat_to_matrix
@@ -23,7 +24,7 @@ HEAVY = {"inertia_kg_m2": [[1e6, 0, 0], [0, 1e6, 0], [0, 0, 1e6]]}
 def rotors_off(setup, gravity=True):
     veh = setup.veh.copy()
     if not gravity:
-        veh[L.V_GRAVITY] = 0.0
+        veh[VS.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
     ctrl[CTL.C_KIND] = L.CTRL_NONE
     return run_packed(setup, veh=veh, ctrl=ctrl)
@@ -105,7 +106,7 @@ def test_first_order_rotors_follow_their_time_constant():
         )
     )
     veh = setup.veh.copy()
-    veh[L.V_GRAVITY] = 0.0
+    veh[VS.V_GRAVITY] = 0.0
     setup.ctrl[CTL.C_KIND] = L.CTRL_NONE
     opts = setup.opts.copy()
     opts[L.O_OMEGA_MIN], opts[L.O_OMEGA_MAX], opts[L.O_SLEW_MAX] = 600.0, 0.0, 0.0

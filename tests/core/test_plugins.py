@@ -29,6 +29,7 @@ from quadimpact.core import feature_slots as FS
 from quadimpact.core import geometry
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.geometry import PR_GEOMETRY
 from quadimpact.core.geometry.contact_record import material_record
 from quadimpact.core.kernel import make_kernel
@@ -107,12 +108,12 @@ def registered():
 
 def _ball_drop(v_in: float, k: float, n: float, e: float, rate_hz: float):
     """A 1-kg ball of radius 0.1 m falling at ``v_in`` (no gravity) onto a sphere of 0.5 m."""
-    veh = np.zeros(L.NVEH)
-    veh[L.V_MASS] = 1.0
+    veh = np.zeros(VS.NVEH)
+    veh[VS.V_MASS] = 1.0
     inertia = np.diag([0.004, 0.004, 0.004])
-    veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
-    veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
-    veh[L.V_SPIN : L.V_SPIN + 4] = (-1.0, 1.0, -1.0, 1.0)
+    veh[VS.V_INERTIA : VS.V_INERTIA + 9] = inertia.ravel()
+    veh[VS.V_INERTIA_INV : VS.V_INERTIA_INV + 9] = np.linalg.inv(inertia).ravel()
+    veh[VS.V_SPIN : VS.V_SPIN + 4] = (-1.0, 1.0, -1.0, 1.0)
     feat = np.zeros((1, FS.NFEAT))
     feat[0, FS.F_KIND] = FEAT_BALL
     feat[0, [FS.F_RADIUS, FS.F_K, FS.F_N, FS.F_E]] = (0.1, k, n, e)

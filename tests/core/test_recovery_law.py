@@ -9,6 +9,7 @@ import pytest
 
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.controllers import recovery as CL
 from quadimpact.core.controllers import recovery as R
 
@@ -43,14 +44,14 @@ def test_at_most_one_stage_per_tick():
 
 
 def _packed(mass=1.0, g=9.81):
-    veh = np.zeros(L.NVEH)
-    veh[L.V_MASS] = mass
-    veh[L.V_GRAVITY] = g
-    veh[L.V_INERTIA : L.V_INERTIA + 9] = np.diag([0.01, 0.01, 0.02]).ravel()
+    veh = np.zeros(VS.NVEH)
+    veh[VS.V_MASS] = mass
+    veh[VS.V_GRAVITY] = g
+    veh[VS.V_INERTIA : VS.V_INERTIA + 9] = np.diag([0.01, 0.01, 0.02]).ravel()
     ctrl = np.zeros(CTL.NCTRL)
     # an identity "allocation" so cmd^2 = (T, tau_x, tau_y, tau_z) can be read back
     ctrl[CTL.C_ALLOC_INV : CTL.C_ALLOC_INV + 16] = np.eye(4).ravel()
-    ctrl[CTL.C_N_ROTORS] = veh[L.V_N_ROTORS] = 4  # a quadrotor
+    ctrl[CTL.C_N_ROTORS] = veh[VS.V_N_ROTORS] = 4  # a quadrotor
     ctrl[CTL.C_OMEGA_MIN] = 0.0
     ctrl[CTL.C_OMEGA_MAX] = 1e9
     p = CTL.C_PARAMS

@@ -16,6 +16,7 @@ import pytest
 from quadimpact import ImpactTrial, simulate
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.controllers import residual as RES
 from quadimpact.core.controllers.residual import features, residual_references
 from quadimpact.core.sensors import measurement_slots as MSS
@@ -33,9 +34,9 @@ NAVI_MASS_KG, G = 1.095, 9.81
 
 
 def _veh() -> np.ndarray:
-    veh = np.zeros(L.NVEH)
-    veh[L.V_MASS] = NAVI_MASS_KG
-    veh[L.V_GRAVITY] = G
+    veh = np.zeros(VS.NVEH)
+    veh[VS.V_MASS] = NAVI_MASS_KG
+    veh[VS.V_GRAVITY] = G
     return veh
 
 

@@ -4,6 +4,7 @@ import numpy as np
 
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.recording_slots import OUT_T
 from quadimpact.inputs.scenarios import FlightScenario
 from quadimpact.rotations import quat_to_matrix
@@ -25,7 +26,7 @@ def tumble(final_time_s: float = 10.0, **kw):
         )
     )
     veh = setup.veh.copy()
-    veh[L.V_GRAVITY] = 0.0
+    veh[VS.V_GRAVITY] = 0.0
     ctrl = setup.ctrl.copy()
     ctrl[CTL.C_KIND] = L.CTRL_NONE
     out, _, stats = run_packed(setup, veh=veh, ctrl=ctrl)

@@ -25,6 +25,7 @@ import pytest
 from quadimpact import FlightScenario, ImpactTrial, simulate
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.controllers.common import allocate
 from quadimpact.core.rotors import rotor_wrench
 from quadimpact.errors import InputError
@@ -55,11 +56,11 @@ def _hexa_ctrl(hexa) -> np.ndarray:
 def test_hexacopter_file_is_a_six_rotor_vehicle(hexa):
     assert hexa.rotor_count == 6
     veh = pack_vehicle(hexa)
-    assert veh[L.V_N_ROTORS] == 6
+    assert veh[VS.V_N_ROTORS] == 6
     # per-rotor slots: one coefficient per rotor, zeros beyond the sixth
-    assert np.all(veh[L.V_KT : L.V_KT + 6] == hexa.thrust_coefficient)
-    assert np.all(veh[L.V_KT + 6 : L.V_KT + L.MAX_ROTORS] == 0.0)
-    assert np.all(veh[L.V_SPIN + 6 : L.V_SPIN + L.MAX_ROTORS] == 0.0)
+    assert np.all(veh[VS.V_KT : VS.V_KT + 6] == hexa.thrust_coefficient)
+    assert np.all(veh[VS.V_KT + 6 : VS.V_KT + L.MAX_ROTORS] == 0.0)
+    assert np.all(veh[VS.V_SPIN + 6 : VS.V_SPIN + L.MAX_ROTORS] == 0.0)
     # 60 deg apart on one arm length
     r = hexa.rotor_positions[:, :2]
     arms = np.hypot(r[:, 0], r[:, 1])

@@ -10,6 +10,7 @@ import pytest
 import quadimpact.envs as E
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.rotors import RIN_CMD
 from quadimpact.core.sensors import imu_slots as IMS
@@ -103,7 +104,7 @@ def test_reward_is_the_documented_cost():
     h_ref = -env.unwrapped._slots.D.x[0, L.X_POS + 2]
     s = env._slots
     veh = s.M.veh[0]
-    hover = math.sqrt(veh[L.V_MASS] * veh[L.V_GRAVITY] / (4 * veh[L.V_KT]))
+    hover = math.sqrt(veh[VS.V_MASS] * veh[VS.V_GRAVITY] / (4 * veh[VS.V_KT]))
     span = s.M.ctrl[0, CTL.C_OMEGA_MAX] - s.M.ctrl[0, CTL.C_OMEGA_MIN]
     rng = np.random.default_rng(0)
     for _ in range(30):

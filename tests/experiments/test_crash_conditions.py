@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from quadimpact import FlightScenario, simulate
-from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.experiments.crashes import (
     AUTHORS_THRUST_COEFFICIENT_N_PER_RPM2,
     HAND_MODIFICATION,
@@ -116,8 +116,8 @@ def test_each_replica_switch_changes_exactly_what_it_names():
     # the packed vehicles differ in the thrust coefficient alone
     kt = crash.scenario("paper-replica", "matched", ["thrust_coefficient"]).build_vehicle()
     a, b = pack_vehicle(base.build_vehicle()), pack_vehicle(kt)
-    assert np.flatnonzero(a != b).tolist() == list(range(L.V_KT, L.V_KT + 4))  # each rotor's kt
-    assert b[L.V_KT] * RPM**2 == pytest.approx(8.7e-8)
+    assert np.flatnonzero(a != b).tolist() == list(range(VS.V_KT, VS.V_KT + 4))  # each rotor's kt
+    assert b[VS.V_KT] * RPM**2 == pytest.approx(8.7e-8)
 
 
 def test_motor2_cut_and_the_hand_modification_of_crash_1():

@@ -19,6 +19,7 @@ from quadimpact import FlightScenario, Simulation
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
 from quadimpact.core import named
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.sensors import measurement_slots as MSS
 from quadimpact.inputs.controllers import param_index, param_slots, register_controller
 from quadimpact.simulation.setup import prepare
@@ -94,7 +95,7 @@ def test_an_attitude_error_asks_for_the_torque_that_removes_it(template, axis, e
 def test_each_named_quantity_is_its_slots() -> None:
     meas = np.arange(MSS.NMEAS, dtype=float)
     ctrl = np.arange(CTL.NCTRL, dtype=float)
-    veh = np.arange(L.NVEH, dtype=float)
+    veh = np.arange(VS.NVEH, dtype=float)
 
     @njit
     def read(meas, ctrl, veh):
@@ -120,7 +121,7 @@ def test_each_named_quantity_is_its_slots() -> None:
     assert got[9] == CTL.C_ALLOC_INV + 6
     assert got[10] == (CTL.C_H_REF, CTL.C_PHI_REF, CTL.C_THETA_REF, CTL.C_PSI_REF)
     assert got[11] == (CTL.C_OMEGA_MIN, CTL.C_OMEGA_MAX)
-    assert got[12:] == (L.V_MASS, L.V_INERTIA + 7, L.V_GRAVITY, L.V_KT)
+    assert got[12:] == (VS.V_MASS, VS.V_INERTIA + 7, VS.V_GRAVITY, VS.V_KT)
 
 
 def test_a_simulation_hands_out_its_records_by_name_read_only() -> None:

@@ -24,6 +24,7 @@ from quadimpact import simulate
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.recording_slots import E_OPEN, E_T_END, E_T_START, OUT_T, OUT_X
 from quadimpact.core.records import new_output
@@ -127,11 +128,11 @@ def test_offsets_plus_and_minus_y_give_mirrored_runs(controller):
 
 
 def _energy(x: np.ndarray, veh: np.ndarray) -> float:
-    m = veh[L.V_MASS]
-    inertia = veh[L.V_INERTIA : L.V_INERTIA + 9].reshape(3, 3)
+    m = veh[VS.V_MASS]
+    inertia = veh[VS.V_INERTIA : VS.V_INERTIA + 9].reshape(3, 3)
     v = x[L.X_VEL : L.X_VEL + 3]
     w = x[L.X_OMEGA : L.X_OMEGA + 3]
-    return 0.5 * m * v @ v + 0.5 * w @ inertia @ w - m * veh[L.V_GRAVITY] * x[L.X_POS + 2]
+    return 0.5 * m * v @ v + 0.5 * w @ inertia @ w - m * veh[VS.V_GRAVITY] * x[L.X_POS + 2]
 
 
 def _elastic_run(obstacle, position, velocity, euler=(0.0, 0.0, 0.0)):
@@ -221,7 +222,7 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     )
     setup = prepare(scenario)
     veh = setup.veh.copy()
-    veh[L.V_GRAVITY] = 0.0  # the 1-DOF law alone
+    veh[VS.V_GRAVITY] = 0.0  # the 1-DOF law alone
     ctrl = np.zeros(CTL.NCTRL)
     ctrl[CTL.C_KIND] = L.CTRL_NONE
     x0 = setup.x0.copy()
@@ -234,7 +235,7 @@ def test_a_dropped_sphere_rebounds_with_the_1dof_restitution(tmp_path):
     assert ep[E_T_START] == pytest.approx((0.5 - 0.33) / 1.0, abs=1e-9)
     x_end = o.out[int(o.stats[L.ST_N_OUT]) - 1, OUT_X : OUT_X + L.NX]
     f = setup.feat[0]
-    expected = _restitution_1dof(f[FS.F_K], f[FS.F_N], f[FS.F_E], veh[L.V_MASS], 1.0)
+    expected = _restitution_1dof(f[FS.F_K], f[FS.F_N], f[FS.F_E], veh[VS.V_MASS], 1.0)
     assert -x_end[L.X_VEL + 2] == pytest.approx(expected, rel=1e-6)
     assert np.abs(x_end[L.X_OMEGA : L.X_OMEGA + 3]).max() < 1e-12
     assert not math.isnan(expected)

@@ -8,6 +8,7 @@ import pytest
 from quadimpact import ImpactTrial, simulate
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.controllers import recovery as CL
 from quadimpact.core.rotors import rotor_wrench
 from quadimpact.inputs.model import MODEL_VARIANTS, resolve_model_options
@@ -45,8 +46,8 @@ def test_drag_and_spinup_senses_are_separate(drag, spinup):
     x[L.X_ROTOR : L.X_ROTOR + 4] = w
     x[L.X_OMEGA : L.X_OMEGA + 3] = 0.0
     mz = rotor_wrench(x, wdot, veh, drag, spinup)[3]
-    s = veh[L.V_SPIN : L.V_SPIN + 4]
-    dt, jr = veh[L.V_DT], veh[L.V_JR]
+    s = veh[VS.V_SPIN : VS.V_SPIN + 4]
+    dt, jr = veh[VS.V_DT], veh[VS.V_JR]
     drag_term = (1.0 if drag else -1.0) * np.sum(s * dt * w**2)
     spin_term = -jr * np.sum(wdot) if spinup else -jr * np.sum(s * wdot)
     assert mz == pytest.approx(drag_term + spin_term, rel=1e-13)

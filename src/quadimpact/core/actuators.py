@@ -50,8 +50,6 @@ from quadimpact.core.layout import (
     O_OMEGA_MAX,
     O_OMEGA_MIN,
     O_SLEW_MAX,
-    V_N_ROTORS,
-    V_TAU_M,
     X_ROTOR,
 )
 from quadimpact.core.records import Data, Model
@@ -62,6 +60,7 @@ from quadimpact.core.rotors import (
     RIN_PREV_CMD,
     RIN_RATE,
 )
+from quadimpact.core.vehicle_slots import V_N_ROTORS, V_TAU_M
 
 ZERO_SPEED = 1e-9  # rad/s: a motor at or below this is stopped
 

@@ -10,15 +10,7 @@ import numpy as np
 from quadimpact.core.actuators import rotor_rates
 from quadimpact.core.compiled import compiled
 from quadimpact.core.contact import contact_wrench
-from quadimpact.core.layout import (
-    O_SPINUP_PAPER,
-    O_YAW_REACTION_PAPER,
-    V_GRAVITY,
-    V_MASS,
-    V_N_ROTORS,
-    X_QUAT,
-    X_ROTOR,
-)
+from quadimpact.core.layout import O_SPINUP_PAPER, O_YAW_REACTION_PAPER, X_QUAT, X_ROTOR
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.records import Data, Model, Work
 from quadimpact.core.rigid_body import rigid_body_derivative
@@ -27,6 +19,7 @@ from quadimpact.core.rotors import (
     RIN_FIRST_ORDER,
     rotor_wrench,
 )
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_MASS, V_N_ROTORS
 
 
 @compiled(inline="always")

@@ -83,7 +83,6 @@ from quadimpact.core.layout import (
     ST_STATUS,
     ST_T_END,
     STATUS_FAILED,
-    V_N_ROTORS,
     X_OMEGA,
     X_POS,
     X_QUAT,
@@ -110,6 +109,7 @@ from quadimpact.core.sensors.measurement_slots import MS_DETECTED
 from quadimpact.core.shape_slots import (
     SH_IS_GROUND,
 )
+from quadimpact.core.vehicle_slots import V_N_ROTORS
 
 MISSED_ONSET_DEPTH = 1e-9  # m; deeper first sightings count as missed onsets
 

@@ -189,20 +189,7 @@ X_ROTOR = _x.slot("X_ROTOR", MAX_ROTORS)  # Omega_1..n, rotor speeds (rad/s); 0 
 NX = _x.end("NX")
 N_RIGID = X_ROTOR  # the rigid-body states come first
 
-# ---- vehicle veh (NVEH): mass, inertia, rotors (the contact features are in feat)
-_veh = Block("veh", "V_")
-V_MASS = _veh.slot("V_MASS")  # kg
-V_INERTIA = _veh.slot("V_INERTIA", 9)  # kg m^2, row-major, body
-V_INERTIA_INV = _veh.slot("V_INERTIA_INV", 9)  # row-major
-V_N_ROTORS = _veh.slot("V_N_ROTORS")  # n, the vehicle's rotor count (4 to MAX_ROTORS)
-V_ROTOR_POS = _veh.slot("V_ROTOR_POS", 3 * MAX_ROTORS)  # rotor j at V_ROTOR_POS + 3 j (body, m)
-V_SPIN = _veh.slot("V_SPIN", MAX_ROTORS)  # +-1, spin sense about +z_B (0 beyond n)
-V_KT = _veh.slot("V_KT", MAX_ROTORS)  # rotor j's thrust coefficient at V_KT + j, N/(rad/s)^2
-V_DT = _veh.slot("V_DT", MAX_ROTORS)  # rotor j's drag-torque coefficient, N m/(rad/s)^2
-V_JR = _veh.slot("V_JR")  # rotor inertia about its axis, kg m^2
-V_GRAVITY = _veh.slot("V_GRAVITY")  # m/s^2
-V_TAU_M = _veh.slot("V_TAU_M")  # motor time constant, s (first-order rotor mode)
-NVEH = _veh.end("NVEH")
+# ---- vehicle veh (NVEH): declared by the vehicle model in core/vehicle_slots.py
 
 # ---- contact features feat (n_features, NFEAT): declared by the contact law in
 # core/feature_slots.py

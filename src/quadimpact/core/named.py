@@ -47,20 +47,7 @@ from quadimpact.core.controller_slots import (
     N_WRENCH,
     NPARAM,
 )
-from quadimpact.core.layout import (
-    MAX_ROTORS,
-    NX,
-    V_GRAVITY,
-    V_INERTIA,
-    V_KT,
-    V_MASS,
-    V_N_ROTORS,
-    X_OMEGA,
-    X_POS,
-    X_QUAT,
-    X_ROTOR,
-    X_VEL,
-)
+from quadimpact.core.layout import MAX_ROTORS, NX, X_OMEGA, X_POS, X_QUAT, X_ROTOR, X_VEL
 from quadimpact.core.sensors.measurement_slots import (
     MS_BIAS_HAT,
     MS_DETECTED,
@@ -74,6 +61,7 @@ from quadimpact.core.sensors.measurement_slots import (
     MS_X,
 )
 from quadimpact.core.sensors.registry import measurement_address
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_INERTIA, V_KT, V_MASS, V_N_ROTORS
 
 __all__ = [
     "MEASUREMENT_FIELDS",

@@ -7,7 +7,8 @@
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import V_INERTIA, V_INERTIA_INV, V_MASS, X_OMEGA, X_POS, X_QUAT, X_VEL
+from quadimpact.core.layout import X_OMEGA, X_POS, X_QUAT, X_VEL
+from quadimpact.core.vehicle_slots import V_INERTIA, V_INERTIA_INV, V_MASS
 
 
 @compiled

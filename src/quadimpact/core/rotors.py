@@ -20,19 +20,8 @@ spin-up moment.
 import numpy as np
 
 from quadimpact.core.compiled import compiled
-from quadimpact.core.layout import (
-    MAX_ROTORS,
-    N_RIGID,
-    V_DT,
-    V_JR,
-    V_KT,
-    V_N_ROTORS,
-    V_ROTOR_POS,
-    V_SPIN,
-    X_OMEGA,
-    X_ROTOR,
-    Block,
-)
+from quadimpact.core.layout import MAX_ROTORS, N_RIGID, X_OMEGA, X_ROTOR, Block
+from quadimpact.core.vehicle_slots import V_DT, V_JR, V_KT, V_N_ROTORS, V_ROTOR_POS, V_SPIN
 
 # ---- the rotor inputs over the current sub-interval rin (NRIN), a field of Data: the
 # actuators write them at each tick and power-off segment (core/actuators.py), the

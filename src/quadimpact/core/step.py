@@ -87,7 +87,6 @@ from quadimpact.core.layout import (
     STATUS_COMPLETED,
     STATUS_CRASHED,
     STATUS_FAILED,
-    V_N_ROTORS,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -104,6 +103,7 @@ from quadimpact.core.sensors.imu_slots import (
     SS_NEXT_T,
 )
 from quadimpact.core.sensors.measurement_slots import MS_IMU_T, MS_T_DETECT
+from quadimpact.core.vehicle_slots import V_N_ROTORS
 
 STAGE_RECOVERED = 4  # controllers/recovery.py's stage 4
 controller_step = builtin_step  # rebound by kernel.make_kernel(step=...) (a loop of its own)

@@ -19,6 +19,7 @@ import numpy as np
 from quadimpact.core import announce_compilation
 from quadimpact.core import layout as L
 from quadimpact.core import shape_slots as SHP
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.envs import stacked as B
 from quadimpact.core.envs.episode_layout import ENV_ROTORS
 from quadimpact.core.recording_slots import OUT_X
@@ -53,7 +54,7 @@ OUTCOMES = {
 def _quadrotor(setup: RunSetup) -> RunSetup:
     """The prepared run, refused unless its vehicle is a quadrotor (the environments'
     actions and observations have four rotors: ``core.envs.episode_layout.ENV_ROTORS``)."""
-    n = int(setup.veh[L.V_N_ROTORS])
+    n = int(setup.veh[VS.V_N_ROTORS])
     if n != ENV_ROTORS:
         raise InputError(
             f"vehicle: the learning environments fly quadrotors ({ENV_ROTORS} rotors); "

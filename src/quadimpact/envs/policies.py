@@ -22,6 +22,7 @@ import numpy as np
 
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.envs import stacked as B
 
 __all__ = ["HoverPolicy", "RandomPolicy", "RecoveryPolicy"]
@@ -141,7 +142,7 @@ class HoverPolicy:
         a = np.zeros((s.n, 4))
         for k in range(s.n):
             veh, ctrl = s.M.veh[k], s.M.ctrl[k]
-            weight = veh[L.V_MASS] * veh[L.V_GRAVITY]
+            weight = veh[VS.V_MASS] * veh[VS.V_GRAVITY]
             if s.par[B.EP_ACTION] == B.ACT_CTBR:
                 a[k, 0] = B.affine_inverse(weight, 0.0, B.max_thrust(veh, ctrl))[0]
                 continue

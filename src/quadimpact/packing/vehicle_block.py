@@ -11,6 +11,7 @@ import numpy as np
 
 from quadimpact.core import feature_slots as FS
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.errors import InputError
 from quadimpact.inputs.allocation import (  # here too: the packing's names of them
     allocation_inverse,
@@ -40,20 +41,20 @@ def pack_vehicle(v: Vehicle) -> np.ndarray:
 
 
 def _pack_vehicle(v: Vehicle) -> np.ndarray:
-    veh = np.zeros(L.NVEH)
+    veh = np.zeros(VS.NVEH)
     inertia = v.inertia
-    veh[L.V_MASS] = v.mass_kg
-    veh[L.V_INERTIA : L.V_INERTIA + 9] = inertia.ravel()
-    veh[L.V_INERTIA_INV : L.V_INERTIA_INV + 9] = inverse(inertia).ravel()
+    veh[VS.V_MASS] = v.mass_kg
+    veh[VS.V_INERTIA : VS.V_INERTIA + 9] = inertia.ravel()
+    veh[VS.V_INERTIA_INV : VS.V_INERTIA_INV + 9] = inverse(inertia).ravel()
     n = v.rotor_count
-    veh[L.V_N_ROTORS] = n
-    veh[L.V_ROTOR_POS : L.V_ROTOR_POS + 3 * n] = v.rotor_positions.ravel()
-    veh[L.V_SPIN : L.V_SPIN + n] = v.spins
-    veh[L.V_KT : L.V_KT + n] = v.thrust_coefficients
-    veh[L.V_DT : L.V_DT + n] = v.drag_torque_coefficients
-    veh[L.V_JR] = v.rotor_inertia_kg_m2
-    veh[L.V_GRAVITY] = v.gravity_m_s2
-    veh[L.V_TAU_M] = v.motor_time_constant_s
+    veh[VS.V_N_ROTORS] = n
+    veh[VS.V_ROTOR_POS : VS.V_ROTOR_POS + 3 * n] = v.rotor_positions.ravel()
+    veh[VS.V_SPIN : VS.V_SPIN + n] = v.spins
+    veh[VS.V_KT : VS.V_KT + n] = v.thrust_coefficients
+    veh[VS.V_DT : VS.V_DT + n] = v.drag_torque_coefficients
+    veh[VS.V_JR] = v.rotor_inertia_kg_m2
+    veh[VS.V_GRAVITY] = v.gravity_m_s2
+    veh[VS.V_TAU_M] = v.motor_time_constant_s
     return veh
 
 

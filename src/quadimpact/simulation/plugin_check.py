@@ -34,6 +34,7 @@ import numpy as np
 from quadimpact.core import controller_slots as CTL
 from quadimpact.core import estimator_slots as ESL
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.kernel import BUILTIN
 from quadimpact.core.records import new_data, new_output
 from quadimpact.errors import InputError, one_line
@@ -192,7 +193,7 @@ def _first_tick(scenario: Any, plugins: list[tuple[PluginStep, Any]], kind_of: d
     for who, entry in plugins:
         kind = kind_of[who]
         if kind == "controller":
-            n = int(m.veh[L.V_N_ROTORS])
+            n = int(m.veh[VS.V_N_ROTORS])
             cmd = np.array(d.x[L.X_ROTOR : L.X_ROTOR + L.MAX_ROTORS])  # the rotors' speeds
             dt = float(m.opts[L.O_DT_CONTROL])
             checked = _call(who, entry.step, (t0, d.meas, m.ctrl, d.mem, m.veh, dt, cmd))

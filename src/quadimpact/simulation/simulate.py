@@ -13,6 +13,7 @@ from typing import Any
 
 from quadimpact import __version__
 from quadimpact.core import layout as L
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.kernel import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.packing.vehicle_block import feature_records
@@ -169,7 +170,7 @@ def analyse(
     summary["cost"] = run_cost(setup, kernel_cpu_s, since)
     names = setup.shape_names
     features = setup.feature_names
-    rotors = int(setup.veh[L.V_N_ROTORS])
+    rotors = int(setup.veh[VS.V_N_ROTORS])
     imu = rec.imu
 
     def tables(name: str) -> Any:

@@ -27,6 +27,7 @@ import numpy as np
 
 from quadimpact.core import layout as L
 from quadimpact.core import step as core_step
+from quadimpact.core import vehicle_slots as VS
 from quadimpact.core.kernel import BUILTIN, Kernel
 from quadimpact.core.named import MEASUREMENT_FIELDS, STATE_FIELDS, NamedVector, block_fields
 from quadimpact.core.records import new_data, new_output, raw_record
@@ -90,7 +91,7 @@ class Simulation:
         advance = self._kernel.advance
         if command is None:
             return int(advance(int(n_ticks), self._m, self._d, self._o))
-        n = int(self._m.veh[L.V_N_ROTORS])
+        n = int(self._m.veh[VS.V_N_ROTORS])
         cmd = np.asarray(command, dtype=np.float64).ravel()
         if cmd.shape != (n,) or not np.all(np.isfinite(cmd)):
             raise ValueError(f"command: {n} finite rotor speeds (rad/s), one per rotor")

@@ -39,8 +39,9 @@ from quadimpact.core.controller_slots import C_KIND
 from quadimpact.core.controllers.cascade_pid import cascade_pid_step
 from quadimpact.core.controllers.paper import paper_step
 from quadimpact.core.controllers.recovery import recovery_step
-from quadimpact.core.layout import CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, V_N_ROTORS, X_ROTOR
+from quadimpact.core.layout import CTRL_CASCADE_PID, CTRL_PAPER, CTRL_RECOVERY, X_ROTOR
 from quadimpact.core.sensors.measurement_slots import MS_X
+from quadimpact.core.vehicle_slots import V_N_ROTORS
 
 
 @compiled

@@ -50,9 +50,10 @@ from quadimpact.core.controllers.common import (
     linearised_torques,
 )
 from quadimpact.core.controllers.waypoint import waypoint_references
-from quadimpact.core.layout import NX, V_GRAVITY, V_MASS, V_N_ROTORS, X_OMEGA
+from quadimpact.core.layout import NX, X_OMEGA
 from quadimpact.core.quaternion import wrap_pi
 from quadimpact.core.sensors.measurement_slots import MS_X
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_MASS, V_N_ROTORS
 
 FADE_POWER = 4.0  # thrust fade beyond the tilt floor (tilt_compensation)
 

@@ -13,8 +13,9 @@ import numpy as np
 
 from quadimpact.core.compiled import allocating, compiled
 from quadimpact.core.controller_slots import C_ALLOC_INV, C_N_ROTORS, N_WRENCH, NPARAM
-from quadimpact.core.layout import MEM_STAGE, V_INERTIA, X_OMEGA, X_POS, X_QUAT, X_VEL, Block
+from quadimpact.core.layout import MEM_STAGE, X_OMEGA, X_POS, X_QUAT, X_VEL, Block
 from quadimpact.core.quaternion import euler_zyx
+from quadimpact.core.vehicle_slots import V_INERTIA
 
 # ---- the PID laws' blocks
 # The two PID controllers (paper, cascade-pid) and the recovery controller's

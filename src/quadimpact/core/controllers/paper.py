@@ -36,9 +36,10 @@ from quadimpact.core.controllers.common import (
     attitude_altitude,
     linearised_torques,
 )
-from quadimpact.core.layout import NX, V_GRAVITY, V_MASS, X_OMEGA
+from quadimpact.core.layout import NX, X_OMEGA
 from quadimpact.core.quaternion import wrap_pi
 from quadimpact.core.sensors.measurement_slots import MS_X
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_MASS
 
 
 @compiled

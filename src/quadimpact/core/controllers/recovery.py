@@ -97,9 +97,6 @@ from quadimpact.core.layout import (
     STAGE_PRE_IMPACT,
     STAGE_RECOVERED,
     STAGE_TILTED,
-    V_GRAVITY,
-    V_MASS,
-    V_N_ROTORS,
     X_POS,
     X_QUAT,
     X_ROTOR,
@@ -114,6 +111,7 @@ from quadimpact.core.sensors.measurement_slots import (
     MS_W_HAT,
     MS_X,
 )
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_MASS, V_N_ROTORS
 
 # ---- the recovery law's blocks
 # ---- parameters, at ctrl[C_PARAMS + ...] (after the PID block above)

@@ -78,15 +78,7 @@ from quadimpact.core.controller_slots import (
     NPOLICY,
     T_CAP_S,
 )
-from quadimpact.core.layout import (
-    STAGE_HOVER,
-    STAGE_RECOVERED,
-    V_GRAVITY,
-    V_MASS,
-    X_QUAT,
-    X_VEL,
-    Block,
-)
+from quadimpact.core.layout import STAGE_HOVER, STAGE_RECOVERED, X_QUAT, X_VEL, Block
 from quadimpact.core.sensors.measurement_slots import (
     MS_IMU_F,
     MS_NORMAL,
@@ -94,6 +86,7 @@ from quadimpact.core.sensors.measurement_slots import (
     MS_W_HAT,
     MS_X,
 )
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_MASS
 
 # ---- the residual's block, at ctrl[C_POLICY + PB_*]
 _policy = Block("ctrl.policy", "PB_", capacity=NPOLICY)

@@ -22,8 +22,8 @@ from quadimpact.core.envs.episode_layout import (
     EP_RATE_MAX,
     EP_ZERO_LOW,
 )
-from quadimpact.core.layout import V_KT
 from quadimpact.core.sensors.measurement_slots import MS_W_HAT
+from quadimpact.core.vehicle_slots import V_KT
 
 
 # ---------------------------------------------------------------- action maps

@@ -32,9 +32,10 @@ from quadimpact.core.envs.episode_layout import (
     OC_RUNNING,
     OC_TILT,
 )
-from quadimpact.core.layout import V_GRAVITY, V_KT, V_MASS, X_OMEGA, X_POS, X_QUAT, X_VEL
+from quadimpact.core.layout import X_OMEGA, X_POS, X_QUAT, X_VEL
 from quadimpact.core.quaternion import rotation_matrix
 from quadimpact.core.rotors import RIN_CMD
+from quadimpact.core.vehicle_slots import V_GRAVITY, V_KT, V_MASS
 
 
 @allocating

@@ -59,10 +59,11 @@ from quadimpact.core.estimator_slots import (
 )
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T, POSE, POSE_ATT, POSE_T
-from quadimpact.core.layout import V_GRAVITY, Block
+from quadimpact.core.layout import Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
+from quadimpact.core.vehicle_slots import V_GRAVITY
 
 # ---- its block at ecfg[EC_OWN:] (core/layout.py; packed by packing/estimator_block.py)
 _cfg = Block("ecfg.complementary", "EC_", start=EC_OWN, capacity=EC_OWN + N_OWN_ECFG)

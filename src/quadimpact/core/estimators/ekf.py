@@ -69,10 +69,11 @@ from quadimpact.core.estimator_slots import (
 )
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T, POSE, POSE_ATT, POSE_T
-from quadimpact.core.layout import V_GRAVITY, Block
+from quadimpact.core.layout import Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
+from quadimpact.core.vehicle_slots import V_GRAVITY
 
 # ---- its blocks at ecfg[EC_OWN:] and est[ES_OWN:] (core/layout.py); the additive EKF
 # and nav-ekf continue them (they share the gate, the noises and the covariance slots)

@@ -37,10 +37,11 @@ from quadimpact.core.estimator_slots import EC_OWN, ES_BIAS, ES_GATED, ES_Q, ES_
 from quadimpact.core.estimators.ekf import EC_GATE, ES_P, N_EKF, N_EKF_CFG
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T
-from quadimpact.core.layout import V_GRAVITY, Block
+from quadimpact.core.layout import Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.rotvec import dcm
+from quadimpact.core.vehicle_slots import V_GRAVITY
 
 # ---- its block: after the EKF's (core/estimators/ekf.py), whose gate (EC_GATE) and
 # covariance slots (ES_P, 7 x 7 with the row stride N_EKF) it uses

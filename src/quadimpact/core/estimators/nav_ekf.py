@@ -126,7 +126,7 @@ from quadimpact.core.estimators.ekf import (
 )
 from quadimpact.core.estimators.navigation import integrate_navigation
 from quadimpact.core.estimators.older_sensors import MAG, MAG_FIELD_I, MAG_T
-from quadimpact.core.layout import V_GRAVITY, Block
+from quadimpact.core.layout import Block
 from quadimpact.core.records import Data, Model
 from quadimpact.core.sensors.imu_slots import (
     SC_BIAS,
@@ -136,6 +136,7 @@ from quadimpact.core.sensors.imu_slots import (
 from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.registry import measurement_address
 from quadimpact.core.sensors.rotvec import dcm, rotate_by
+from quadimpact.core.vehicle_slots import V_GRAVITY
 
 # ---- its blocks: after the EKF's (core/estimators/ekf.py), whose noises, gate, initial
 # stds (EC_SIG_*, EC_P0), impact model (EC_IMPACT_*) and scratch state it uses

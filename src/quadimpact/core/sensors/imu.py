@@ -43,7 +43,6 @@ from quadimpact.core.layout import (
     FILTER_FIRST_ORDER,
     FILTER_MOVING_AVERAGE,
     ST_N_IMU,
-    V_GRAVITY,
     X_OMEGA,
     X_VEL,
 )
@@ -78,6 +77,7 @@ from quadimpact.core.sensors.imu_slots import (
     SS_WALK,
 )
 from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_T, MS_IMU_W
+from quadimpact.core.vehicle_slots import V_GRAVITY
 
 
 @compiled
