@@ -30,6 +30,7 @@ import statistics
 import time
 
 from quadimpact.core import layout as L
+from quadimpact.core.interval_slots import IS_N_REJECTED, IS_N_RHS, IS_N_STEPS
 from quadimpact.core.kernel import execute
 from quadimpact.inputs.scenarios import scenario_from_dict
 from quadimpact.simulation.setup import prepare
@@ -93,12 +94,12 @@ def main() -> None:
     for k in CASES:
         st = stats[k]
         med = statistics.median(times[k])
-        rhs = int(st[L.ST_N_RHS])
+        rhs = int(st[L.ST_STEPS + IS_N_RHS])
         out[k] = {
             "median_s": med,
             "min_s": min(times[k]),
-            "steps": int(st[L.ST_N_STEPS]),
-            "rejected": int(st[L.ST_N_REJECTED]),
+            "steps": int(st[L.ST_STEPS + IS_N_STEPS]),
+            "rejected": int(st[L.ST_STEPS + IS_N_REJECTED]),
             "rhs": rhs,
             "ns_per_rhs": 1e9 * med / max(rhs, 1),
             "episodes": int(st[L.ST_N_EPISODES]),

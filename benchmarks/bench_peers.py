@@ -154,6 +154,7 @@ def quadimpact_example() -> tuple[Callable[[], None], Callable[[], None], dict]:
     """``simulate()`` of the paper's example and its kernel alone, as callables."""
     from quadimpact import WallApproach, simulate
     from quadimpact.core import layout as L
+    from quadimpact.core.interval_slots import IS_N_RHS, IS_N_STEPS
     from quadimpact.core.kernel import execute
     from quadimpact.simulation.setup import prepare
 
@@ -164,8 +165,8 @@ def quadimpact_example() -> tuple[Callable[[], None], Callable[[], None], dict]:
     info = {
         "status": r.summary["status"],
         "crash_time_s": r.summary["crash_time_s"],
-        "rhs_evaluations": int(st[L.ST_N_RHS]),
-        "steps": int(st[L.ST_N_STEPS]),
+        "rhs_evaluations": int(st[L.ST_STEPS + IS_N_RHS]),
+        "steps": int(st[L.ST_STEPS + IS_N_STEPS]),
     }
     return (lambda: simulate(sc)), (lambda: execute(m)), info
 

@@ -42,6 +42,7 @@ import numpy as np
 from quadimpact import WallApproach, simulate
 from quadimpact.core import layout as L
 from quadimpact.core.approach import AP_RUNS
+from quadimpact.core.interval_slots import IS_N_REJECTED, IS_N_RHS, IS_N_STEPS
 from quadimpact.core.kernel import execute
 from quadimpact.simulation import approach as approach_py
 from quadimpact.simulation import setup as setup_py
@@ -112,12 +113,12 @@ def bench_kernel(model: str, repeat: int) -> dict:
         st = execute(m).stats
         times.append(time.perf_counter() - t)
     med = statistics.median(times)
-    n_rhs = int(st[L.ST_N_RHS])
+    n_rhs = int(st[L.ST_STEPS + IS_N_RHS])
     return {
         "kernel_median_s": med,
         "kernel_min_s": min(times),
-        "steps": int(st[L.ST_N_STEPS]),
-        "rejected_steps": int(st[L.ST_N_REJECTED]),
+        "steps": int(st[L.ST_STEPS + IS_N_STEPS]),
+        "rejected_steps": int(st[L.ST_STEPS + IS_N_REJECTED]),
         "rhs_evaluations": n_rhs,
         "control_ticks": int(st[L.ST_N_TICKS]),
         "ns_per_rhs": med / n_rhs * 1e9 if n_rhs else float("nan"),

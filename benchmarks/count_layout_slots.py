@@ -48,6 +48,7 @@ DECLARATIONS = {
     "quadimpact.core.estimator_slots": "quadimpact.core.estimators",
     "quadimpact.core.sensors.measurement_slots": "quadimpact.core.sensors.measurement",
     "quadimpact.core.vehicle_slots": "quadimpact.core.dynamics",
+    "quadimpact.core.interval_slots": "quadimpact.core.interval",
 }
 #: What a declaration module may import of quadimpact.
 DECLARATION_IMPORTS = {"quadimpact.core.block", "quadimpact.core.layout"}

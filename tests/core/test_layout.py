@@ -36,6 +36,7 @@ DECLARING = (
     "quadimpact.core.recording_slots",
     "quadimpact.core.excursion_slots",
     "quadimpact.core.hover_slots",
+    "quadimpact.core.interval_slots",
     "quadimpact.core.feature_slots",
     "quadimpact.core.shape_slots",
     "quadimpact.core.controller_slots",
@@ -142,12 +143,13 @@ def test_a_component_block_stays_inside_the_region_it_extends():
 
 
 def test_each_part_of_stats_fills_the_region_placed_for_it():
-    """``layout.py`` places the excursion's and the hover tests' slots, declared by their
-    owners, in ``stats`` at regions as wide as their declared sizes."""
+    """``layout.py`` places the excursion's, the hover tests' and the integrator's slots,
+    declared by their owners, in ``stats`` at regions as wide as their declared sizes."""
     _blocks()
     regions = L.Block.registry["stats:ST_"].slots
     parts = {"ST_EXCURSION": "stats.excursion:EX_", "ST_HOVER": "stats.hover:HV_"}
     parts["ST_HELD"] = "stats.held:HH_"
+    parts["ST_STEPS"] = "stats.steps:IS_"
     for region, key in parts.items():
         part = L.Block.registry[key]
         assert part.start == 0 and regions[region][1] == part.next, region

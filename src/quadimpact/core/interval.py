@@ -45,6 +45,7 @@ from quadimpact.core.integrator import (
     stage_state,
     step_factor,
 )
+from quadimpact.core.interval_slots import IS_N_REJECTED, IS_N_RHS, IS_N_STEPS
 from quadimpact.core.layout import (
     CRASH_CM_GROUND,
     LS_H,
@@ -73,14 +74,12 @@ from quadimpact.core.layout import (
     ST_CRASH_T,
     ST_MISSED_ONSETS,
     ST_N_OUT,
-    ST_N_REJECTED,
-    ST_N_RHS,
-    ST_N_STEPS,
     ST_ONSET_T,
     ST_ONSET_X,
     ST_POWER_OFF_T,
     ST_REASON,
     ST_STATUS,
+    ST_STEPS,
     ST_T_END,
     STATUS_FAILED,
     X_OMEGA,
@@ -418,9 +417,9 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
     max_steps = int(m.opts[O_MAX_STEPS])
     h = ls[LS_H]
     i_out = int(stats[ST_N_OUT])
-    n_steps = int(stats[ST_N_STEPS])
-    n_rej = int(stats[ST_N_REJECTED])
-    n_rhs = int(stats[ST_N_RHS])
+    n_steps = int(stats[ST_STEPS + IS_N_STEPS])
+    n_rej = int(stats[ST_STEPS + IS_N_REJECTED])
+    n_rhs = int(stats[ST_STEPS + IS_N_RHS])
     result = RUNNING
     fsal = False
     n_events = 0  # located events in this interval
@@ -501,7 +500,7 @@ def integrate_interval(t: float, t_next: float, m: Model, d: Data, o: Output, w:
     ls[LS_H] = h
     stats[ST_T_END] = t
     stats[ST_N_OUT] = i_out
-    stats[ST_N_STEPS] = n_steps
-    stats[ST_N_REJECTED] = n_rej
-    stats[ST_N_RHS] = n_rhs
+    stats[ST_STEPS + IS_N_STEPS] = n_steps
+    stats[ST_STEPS + IS_N_REJECTED] = n_rej
+    stats[ST_STEPS + IS_N_RHS] = n_rhs
     return result

@@ -46,6 +46,7 @@ from enum import IntEnum
 from quadimpact.core.block import Block
 from quadimpact.core.excursion_slots import NEX
 from quadimpact.core.hover_slots import NHELD, NHOVER
+from quadimpact.core.interval_slots import NSTEPS
 
 __all__ = ["Block"]  # and every slot constant below
 
@@ -295,9 +296,8 @@ _st = Block("stats", "ST_")
 ST_STATUS = _st.slot("ST_STATUS")  # STATUS_*
 ST_REASON = _st.slot("ST_REASON")  # REASON_*
 ST_T_END = _st.slot("ST_T_END")  # s, time reached
-ST_N_STEPS = _st.slot("ST_N_STEPS")  # accepted steps
-ST_N_REJECTED = _st.slot("ST_N_REJECTED")
-ST_N_RHS = _st.slot("ST_N_RHS")  # right-hand-side evaluations
+ST_STEPS = _st.slot("ST_STEPS", NSTEPS)  # the integrator's step counts (core/interval.py
+#   integrate_interval): its IS_* slots, declared by core/interval_slots.py
 ST_N_OUT = _st.slot("ST_N_OUT")  # output rows written
 ST_N_EPISODES = _st.slot("ST_N_EPISODES")
 ST_CRASH_T = _st.slot("ST_CRASH_T")  # s, NaN when none

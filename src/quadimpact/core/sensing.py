@@ -62,5 +62,5 @@ def take_sample(
 def sample_at(t: float, xs: np.ndarray, m: Model, d: Data, o: Output, w: Work) -> None:
     """:func:`take_sample` at a state ``xs`` whose derivative is not known (interval inputs)."""
     state_derivative(xs, w.xd, m, d, w)
-    # (not counted in ST_N_RHS: that is the integrator's own count)
+    # (not counted in IS_N_RHS: that is the integrator's own count)
     take_sample(t, xs, w.xd, m, d, o, w)

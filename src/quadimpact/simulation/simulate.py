@@ -14,6 +14,7 @@ from typing import Any
 from quadimpact import __version__
 from quadimpact.core import layout as L
 from quadimpact.core import vehicle_slots as VS
+from quadimpact.core.interval_slots import IS_N_REJECTED, IS_N_RHS, IS_N_STEPS
 from quadimpact.core.kernel import Kernel, execute
 from quadimpact.inputs.scenarios import FlightScenario, ImpactTrial, WallApproach
 from quadimpact.packing.vehicle_block import feature_records
@@ -159,9 +160,9 @@ def analyse(
     episodes = run_episodes(ep, ep.shape[0], setup.shape_names, nf, setup.shapes)
     summary = build_summary(setup, scenario, episodes, st)
     stats = {
-        "steps": int(st[L.ST_N_STEPS]),
-        "rejected_steps": int(st[L.ST_N_REJECTED]),
-        "rhs_evaluations": int(st[L.ST_N_RHS]),
+        "steps": int(st[L.ST_STEPS + IS_N_STEPS]),
+        "rejected_steps": int(st[L.ST_STEPS + IS_N_REJECTED]),
+        "rhs_evaluations": int(st[L.ST_STEPS + IS_N_RHS]),
         "control_ticks": int(st[L.ST_N_TICKS]),
         "output_rows": int(st[L.ST_N_OUT]),
         "wall_time_s": wall_s,

@@ -42,7 +42,8 @@ _STATS_FIELDS = (
     block_fields("stats", "ST_")
     + block_fields("stats.hover", "HV_", at=L.ST_HOVER)
     + block_fields("stats.held", "HH_", at=L.ST_HELD)
-)  # the hover tests' slots keep their names in stats (t_hover, held_x...)
+    + block_fields("stats.steps", "IS_", at=L.ST_STEPS)
+)  # the parts' slots keep their names in stats (t_hover, held_x, n_steps...)
 
 
 class Simulation:
