@@ -9,26 +9,32 @@ block cannot overlap and its size always covers them;
 ``tests/core/test_layout.py`` checks every registered block (the
 learning environment's blocks, which are declared with their code,
 included) and that no constant of a block's prefix escapes its
-declaration. Only what belongs to no component is declared here (the
-state, time, the run's options, the records' common heads); a component
-declares its own blocks in its own module, after the head it extends (the
-controllers' parameter and memory blocks in ``core/controllers/``, the
-estimators' configuration and state in ``core/estimators/``, the detector's
-and the sensor components' in ``core/sensors/``), and a stage that alone owns
-an array declares it (the wall approach's record in ``core/approach.py``, the
-impact rows in ``core/impacts.py``, the rotor inputs in ``core/rotors.py``, the
-contact-pair table in ``core/geometry``). A component whose sizes
-``records.py`` or this module need declares its blocks in a declaration module
-next to it, which holds no compiled code: the contact pairs' ``cs``
-(``core/contact_slots.py``), the output rows and episodes
-(``core/recording_slots.py``), the IMU's ``scfg`` and ``imu``
-(``core/sensors/imu_slots.py``), the features' ``feat``
+declaration. Only what belongs to no component is declared here: the
+state (``x``), time (``ls``, ``span``), the run's options (``opts``) and
+the run's own statistics (``stats``). A component declares its own blocks
+in its own module, after the head it extends (the controllers' parameter
+and memory blocks in ``core/controllers/``, the estimators' own
+configuration and state in ``core/estimators/``, the detector's and the
+sensor components' in ``core/sensors/``), and a stage that alone owns an
+array declares it (the wall approach's record in ``core/approach.py``, the
+impact rows in ``core/impacts.py``, the rotor inputs in ``core/rotors.py``,
+the contact-pair table in ``core/geometry``). A component whose sizes
+``records.py``, the packers or this module need declares its blocks in a
+declaration module next to it, which holds no compiled code: the contact
+pairs' ``cs`` (``core/contact_slots.py``), the output rows and episodes
+(``core/recording_slots.py``), the IMU's ``scfg``, ``sst``, ``snoise`` and
+``imu`` (``core/sensors/imu_slots.py``), the measurement record ``meas``
+(``core/sensors/measurement_slots.py``), the controllers' ``ctrl``
+(``core/controller_slots.py``), the estimators' ``ecfg`` and ``est``
+(``core/estimator_slots.py``), the vehicle's ``veh``
+(``core/vehicle_slots.py``), the features' ``feat``
 (``core/feature_slots.py``), the shapes' ``shapes``
 (``core/shape_slots.py``), and the parts of ``stats`` this module places
 at addresses computed from their declared sizes (``ST_EXCURSION`` from
 ``core/excursion_slots.py``, ``ST_HOVER`` and ``ST_HELD`` from
-``core/hover_slots.py``). Numba reads these module-level integers as
-compile-time constants.
+``core/hover_slots.py``, ``ST_STEPS`` from ``core/interval_slots.py``).
+docs/ARCHITECTURE.md section 10 says why each central block stays. Numba
+reads these module-level integers as compile-time constants.
 
 Kinds (feature, shape, controller, rotor mode, crash rule, filter, status,
 reason) are plain integer constants for the compiled code (Numba cannot

@@ -61,7 +61,7 @@ row-major), b2 (3)]``; the last stage is 4 (stages 1-4; a 0 reads as 4) or 5 (st
 1-5). The weights come from a ``.npz`` file (``quadimpact.inputs.policy_file``); a NumPy
 forward pass of the same network is ``PolicyWeights.outputs``. The block's slots
 (``PB_*``) are declared below; the network's shape (``N_FEATURES``, ``N_OUTPUTS``,
-``MAX_HIDDEN``) in ``core/layout.py``, which the policy file reads too.
+``MAX_HIDDEN``) in ``core/controller_slots.py``, which the policy file reads too.
 """
 
 import math

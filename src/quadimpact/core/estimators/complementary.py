@@ -65,7 +65,7 @@ from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
 from quadimpact.core.vehicle_slots import V_GRAVITY
 
-# ---- its block at ecfg[EC_OWN:] (core/layout.py; packed by packing/estimator_block.py)
+# ---- its block at ecfg[EC_OWN:] (core/estimator_slots.py; packed by packing/estimator_block.py)
 _cfg = Block("ecfg.complementary", "EC_", start=EC_OWN, capacity=EC_OWN + N_OWN_ECFG)
 EC_K_ACC = _cfg.slot("EC_K_ACC")  # accelerometer gain k_P, 1/s
 EC_K_MAG = _cfg.slot("EC_K_MAG")  # magnetometer gain, 1/s

@@ -75,7 +75,7 @@ from quadimpact.core.sensors.measurement_slots import MS_IMU_F, MS_IMU_W
 from quadimpact.core.sensors.rotvec import dcm, error_vector, rotate_by
 from quadimpact.core.vehicle_slots import V_GRAVITY
 
-# ---- its blocks at ecfg[EC_OWN:] and est[ES_OWN:] (core/layout.py); the additive EKF
+# ---- its blocks at ecfg[EC_OWN:] and est[ES_OWN:] (core/estimator_slots.py); the additive EKF
 # and nav-ekf continue them (they share the gate, the noises and the covariance slots)
 _cfg = Block("ecfg.ekf", "EC_", start=EC_OWN, capacity=EC_OWN + N_OWN_ECFG)
 EC_GATE = _cfg.slot("EC_GATE")  # m/s^2: accelerometer correction gated while ||f| - g| > this

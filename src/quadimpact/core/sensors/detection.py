@@ -46,7 +46,7 @@ from quadimpact.core.sensors.imu_slots import (
 )
 from quadimpact.core.sensors.measurement_slots import MS_DETECTED, MS_IMU_F, MS_NORMAL, MS_T_DETECT
 
-# ---- its blocks, in the regions core/layout.py keeps for it in scfg, sst and imu
+# ---- its blocks, in the regions core/sensors/imu_slots.py keeps for it in scfg, sst and imu
 _cfg = Block("scfg.detector", "SC_DET_", start=SC_DETECTOR, capacity=SC_DETECTOR + N_DETECTOR_CFG)
 SC_DET_THRESHOLD = _cfg.slot("SC_DET_THRESHOLD")  # m/s^2, detecting specific force (<= 0: off)
 SC_DET_WORLD = _cfg.slot("SC_DET_WORLD")  # 1: world-horizontal |(C f)_XY|, else body |(f_x, f_y)|
