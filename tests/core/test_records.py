@@ -78,8 +78,9 @@ NEW_FILES = {
         import numpy as np
         from numba import njit
 
-        from quadimpact.core.layout import SS_N, X_POS
+        from quadimpact.core.layout import X_POS
         from quadimpact.core.records import Data, Output
+        from quadimpact.core.sensors.imu_slots import SS_N
 
 
         @njit(cache=True)
