@@ -196,3 +196,32 @@ def test_kinds_are_integers_with_names():
     assert L.SHAPE_PLANE == L.ShapeKind.PLANE and type(L.SHAPE_PLANE) is int
     assert L.Status(L.STATUS_FAILED).name == "FAILED"
     assert set(L.REASON_TEXT) == {int(r) for r in L.Reason}
+
+
+def test_every_layout_name_the_code_reads_is_declared():
+    """A slot that moved to its component's declaration module leaves no reader behind:
+    every upper-case attribute of ``layout`` read through its alias (``as L``) and every name
+    imported from ``quadimpact.core.layout`` in the package, the tests, the
+    benchmarks and the examples exists in ``core/layout.py``."""
+    import ast
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    dirs = ("src", "tests", "benchmarks", "examples")
+    files = [p for d in dirs for p in (root / d).rglob("*.py")]
+    missing = []
+    for path in files:
+        tree = ast.parse(path.read_text())
+        aliases = set()
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom) and node.module == "quadimpact.core.layout":
+                missing += [f"{path.name}: {a.name}" for a in node.names if not hasattr(L, a.name)]
+            elif isinstance(node, ast.ImportFrom) and node.module == "quadimpact.core":
+                aliases |= {a.asname or a.name for a in node.names if a.name == "layout"}
+        text = path.read_text()
+        for alias in aliases:
+            for name in re.findall(rf"(?<![\w.]){alias}\.([A-Z][A-Z0-9_]*)\b", text):
+                if not hasattr(L, name):
+                    missing.append(f"{path.name}: {alias}.{name}")
+    assert len(files) > 100 and not missing, sorted(set(missing))
