@@ -502,6 +502,29 @@ def test_warm_pool_size_takes_this_waiting_core_off(monkeypatch, idle, workers):
     assert run_module._warm_pool_size(2) == workers
 
 
+@pytest.mark.parametrize(
+    ("idle", "own_s", "age_s", "workers", "waits"),
+    [(1.0, 1.0, 1.0, 2, False), (0.2, 1.0, 1.0, 1, False), (1.0, 0.0, 1.0, 1, False),
+     (2.0, 0.0, 60.0, 2, True)],
+)  # fmt: skip
+def test_warm_pool_size_measures_from_the_last_sweep_end(
+    monkeypatch, idle, own_s, age_s, workers, waits
+):
+    """A study's next sweep measures the idle cores from its last sweep's end: it waits
+    only for what is left of MEASURE_S, and this process's own work in the window counts
+    as idle (it stops when the pool starts). An end too long ago is not used."""
+    import quadimpact.sweep.runner as run_module
+
+    slept: list[float] = []
+    monkeypatch.setattr(run_module.time, "sleep", slept.append)
+    monkeypatch.setattr(run_module, "idle_cores", lambda before, after: idle)
+    monkeypatch.setattr(run_module, "cpu_sample", lambda: {0: (0, 0)})
+    end = (time.perf_counter() - age_s, {0: (0, 0)}, time.process_time() - own_s)
+    monkeypatch.setattr(run_module, "_last_sweep_end", end)
+    assert run_module._warm_pool_size(2) == workers
+    assert (slept == [pytest.approx(run_module.MEASURE_S, abs=0.01)]) if waits else not slept
+
+
 def test_process_cpu_time_read_from_proc():
     """A process's CPU time from /proc agrees with its own clock to a few ticks."""
     import os

@@ -64,6 +64,12 @@ def reproduce(
     from quadimpact.results.files import check_out_dir
 
     check_out_dir(out, "report")  # before the study's imports: a wrong folder is said at once
+    from quadimpact.sweep.runner import warm_pool
+
+    # the pool's fork server imports the simulator and loads the kernel on another core
+    # while this process imports the study (Matplotlib, pandas): the study's first pieces
+    # then start on a warm server (docs/PERFORMANCE.md, "reproduce, warm")
+    warm_pool(workers, scheduler)
     from quadimpact.studies.paper.paper_study import reproduce as run_study
     from quadimpact.studies.paper.paper_study import study_folder
     from quadimpact.studies.table3.crash_logs import check_data_dir, logs_source

@@ -317,6 +317,8 @@ class _FolderSweep:
                     backend = self._run_missing(todo, n_before, writer, stop, progress)
                 self.placed()  # nothing was left to run
                 consolidate(out, schema, spec.n_runs)
+                if self.client is None:
+                    mark_sweep_end()
         except (SweepInterrupted, WorkerError) as exc:
             raise _stopped(exc, self.saved, spec.n_runs, out) from None
         return n_before, backend
@@ -486,18 +488,47 @@ def _start_here(
     return n_todo, 1
 
 
+#: Longest time since this process's last sweep ended over which the next warm sweep
+#: measures the idle cores (:func:`_warm_pool_size`), s; an older end is not used.
+LAST_SWEEP_WINDOW_S = 10.0
+#: (when, :func:`cpu_sample`, this process's CPU s) at the end of its last local sweep or
+#: study tasks (:func:`mark_sweep_end`); None before any.
+_last_sweep_end: tuple[float, dict[int, tuple[int, int]] | None, float] | None = None
+
+
+def mark_sweep_end() -> None:
+    """Note that this process's local sweep (or study tasks) just ended: the next warm
+    sweep measures the idle cores from now on (:func:`_warm_pool_size`)."""
+    global _last_sweep_end
+    _last_sweep_end = (time.perf_counter(), cpu_sample(), time.process_time())
+
+
 def _warm_pool_size(cores: int) -> int:
     """Workers for a default sweep whose pool server is already warm: measured idle.
 
-    The cores' idle time over :data:`MEASURE_S` while this process waits (its
-    own core is then idle too, and is taken off): a busy machine still gets
-    one process. Workers forked from a warm server start in milliseconds, so
-    no run is timed here first.
+    The cores' idle time over at least :data:`MEASURE_S`, the CPU this process
+    used meanwhile counted as idle, and its own core taken off: a busy machine
+    still gets one process. The window starts when this process's last sweep
+    ended (:func:`mark_sweep_end`, at most :data:`LAST_SWEEP_WINDOW_S` ago):
+    a study's sweeps, one after the other, wait only for what is left of
+    :data:`MEASURE_S` after the work between them; otherwise it starts now and
+    this process waits. Workers forked from a warm server start in
+    milliseconds, so no run is timed here first.
     """
-    before = cpu_sample()
-    time.sleep(MEASURE_S)
+    now = time.perf_counter()
+    mark = _last_sweep_end
+    if mark is None or not 0.0 <= now - mark[0] <= LAST_SWEEP_WINDOW_S or mark[1] is None:
+        mark = (now, cpu_sample(), time.process_time())
+    t0, before, own0 = mark
+    wait = MEASURE_S - (time.perf_counter() - t0)
+    if wait > 0.0:
+        time.sleep(wait)
+    window = time.perf_counter() - t0
     idle = idle_cores(before, cpu_sample())
-    return pool_size(None if idle is None else max(0.0, idle - 1.0), cores)
+    if idle is None:
+        return pool_size(None, cores)
+    own = (time.process_time() - own0) / window if window >= MEASURE_S > 0.0 else 0.0
+    return pool_size(max(0.0, idle + own - 1.0), cores)
 
 
 def warm_pool(workers: int | None = None, scheduler: Any = None) -> None:

@@ -258,8 +258,10 @@ def _ablation_name(switch: str) -> str:
 def _variant_task(
     name: str, base: dict, out: Path, write_example: bool, sweep_options: dict[str, Any]
 ) -> tuple[tuple[pd.DataFrame, list[Finding]], float]:
-    """One variant's Figure 4 sweep and example run (written when ``write_example``),
-    evaluated: ((its sweep table, its findings), wall time in s)."""
+    """One variant's Figure 4 sweep and example run, evaluated: ((its sweep table, its
+    findings), wall time in s). With ``write_example`` (a paper variant) the example run's
+    folder and the variant's Figure 4 and Table II pictures are written too, here: on a
+    worker process, beside the other pieces, rather than at the study's end on one core."""
     start = time.perf_counter()
     table = run_sweep(SweepSpec(base=base, grid=FIG4_GRID), out / "sweeps" / name, **sweep_options)
     example = simulate(WallApproach(**EXAMPLE, **base))
@@ -267,6 +269,8 @@ def _variant_task(
         example.write(out / f"example-{name}")
         write_snapshots(out / f"example-{name}", scene=Scene.from_result(example))
     found = evaluate(table, (example.summary, example.episodes, example.timeseries))
+    if write_example:
+        _write_variant_figures(out, table, name)
     return (table, found), time.perf_counter() - start
 
 
@@ -385,15 +389,19 @@ def _write_paper_tables(
     out: Path, tables: dict[str, pd.DataFrame], findings: pd.DataFrame, ablation: pd.DataFrame
 ) -> None:
     """The tables behind the report (``fig4.parquet``, ``table2.parquet``,
-    ``findings.parquet``, ``ablation.parquet``) and each paper variant's Figure 4 and
-    Table II pictures, into ``out``."""
+    ``findings.parquet``, ``ablation.parquet``), into ``out`` (each paper variant's
+    Figure 4 and Table II pictures are its piece's: :func:`_write_variant_figures`)."""
     pd.concat([t.assign(variant=v) for v, t in tables.items()]).to_parquet(out / "fig4.parquet")
     table2(tables).to_parquet(out / "table2.parquet")
     findings.to_parquet(out / "findings.parquet")
     ablation.to_parquet(out / "ablation.parquet")
-    for variant in VARIANTS:
-        fig4_figure(tables[variant], variant).savefig(out / f"fig4_{variant}.png", dpi=120)
-        type_map_figure(tables[variant], variant).savefig(out / f"table2_{variant}.png", dpi=120)
+
+
+def _write_variant_figures(out: Path, table: pd.DataFrame, variant: str) -> None:
+    """A paper variant's Figure 4 and Table II pictures (``fig4_<variant>.png``,
+    ``table2_<variant>.png``) from its Figure 4 sweep's ``table``, into ``out``."""
+    fig4_figure(table, variant).savefig(out / f"fig4_{variant}.png", dpi=120)
+    type_map_figure(table, variant).savefig(out / f"table2_{variant}.png", dpi=120)
 
 
 def reproduce(
