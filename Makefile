@@ -3,7 +3,8 @@
 #               make run DATA=DIR reads the flight logs from DIR (quadimpact reproduce --data
 #               DIR), else $QUADIMPACT_DATA or the search of docs/EXPERIMENTS.md
 #   make test   set up .venv (once), install headless Chromium if missing (root only), run the
-#               tests but those marked slow (what CI runs)
+#               tests but those marked slow (what CI runs), on every core (pytest-xdist,
+#               at most 4 processes; JOBS=1 runs them in this process)
 #   make test-avx2 the tests marked pinned again, NumPy's SIMD dispatch limited to AVX2 (CI
 #               runs it after make test: what an AVX2-only CPU computes, checked on any CPU)
 #   make test-all  every test, the slow ones (compiling plug-in kernels, whole studies) included
@@ -16,6 +17,15 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.quadimpact-installed
 
 OUT := results/paper
+
+# pytest's worker processes (pytest-xdist): one per core, at most 4; JOBS=1 runs the tests in
+# one process (no xdist), JOBS=N in N.
+JOBS ?= auto
+ifeq ($(JOBS),1)
+XDIST :=
+else
+XDIST := -n $(JOBS) --maxprocesses 4
+endif
 
 # The flight logs' folder for make run, given on make's command line (DATA=DIR): it
 # becomes reproduce's --data. A DATA variable of the environment is not read (too
@@ -56,7 +66,7 @@ browser:
 	fi
 
 test: $(STAMP) browser
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -m "not slow" $(XDIST)
 
 # NumPy picks SVML loops for some ufuncs on AVX-512 CPUs and the C library on AVX2 ones:
 # the pinned numbers must hold on both (quadimpact.libm, tests/test_libm.py).
@@ -65,7 +75,7 @@ test-avx2: $(STAMP)
 	  $(BIN)/python -m pytest -m "pinned and not slow"
 
 test-all: $(STAMP) browser
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest $(XDIST)
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests benchmarks examples

@@ -16,6 +16,7 @@ from quadimpact.errors import InputError
 from quadimpact.studies.training.flying import rewards
 from quadimpact.studies.training.trials import (
     PURPOSE_CHECK,
+    PURPOSE_SCREEN,
     PURPOSE_TRAIN,
     Problem,
     check_seed,
@@ -45,10 +46,11 @@ def test_training_and_check_wall_trials_are_none_of_the_benchmarks():
     ranges = ("roll_deg", "pitch_deg", "yaw_deg", "speed_m_s")
     train = [d for _, d in problem.batch(PURPOSE_TRAIN, 0, 2000)]
     check = [d for _, d in problem.batch(PURPOSE_CHECK, 0, 300)]
-    mine = {tuple(d[k] for k in ranges) for d in train + check}
-    assert len(mine) == 2300  # training and check trials differ among themselves too
+    screen = [d for _, d in problem.batch(PURPOSE_SCREEN, 0, 500)]
+    mine = {tuple(d[k] for k in ranges) for d in train + check + screen}
+    assert len(mine) == 2800  # training, check and screened trials differ among themselves too
     assert not mine & keys
-    assert not {int(d["seed"]) for d in train + check} & seeds
+    assert not {int(d["seed"]) for d in train + check + screen} & seeds
     # the same distribution as the benchmark's: every draw inside its ranges
     for d in train:
         assert -15 <= d["roll_deg"] <= 15 and -45 <= d["pitch_deg"] <= 45
@@ -236,6 +238,40 @@ def test_a_trial_lost_to_the_law_costs_the_loss_weight():
     assert np.allclose(candidate_scores(r, s, 2.0), [0.6 - 0.5, 0.85])
 
 
+def test_the_screen_keeps_the_trials_the_candidates_split_and_batches_cycle_them():
+    """--contested: a trial is kept when the law, the start and its neighbours do not all
+    succeed or all fail; generation g's batch continues the cycle where g - 1 stopped."""
+    from quadimpact.inputs.policy_file import initial_policy
+    from quadimpact.studies.training import trainer
+    from quadimpact.studies.training.trainer import Settings, contested_trials, training_batch
+
+    s = np.array([[1, 0, 1, 0, 1], [1, 0, 0, 0, 1], [1, 0, 1, 1, 1]], dtype=bool)
+    assert contested_trials(s) == [2, 3]
+    settings = Settings(**{**_SMALL, "batch": 3, "contested": 5})
+    problem = _problem()
+    seen = {}
+
+    def evaluate(trials, blocks, terms):
+        seen["trials"], seen["blocks"] = trials, blocks
+        return np.zeros(s.shape), s
+
+    state = trainer._new_state(problem, settings)
+    trainer._screen(state, problem, settings, evaluate)
+    assert state["contested"] == [2, 3]
+    assert seen["trials"] == problem.batch(PURPOSE_SCREEN, 0, 5)
+    assert seen["blocks"][0] is None and len(seen["blocks"]) == 2 + settings.popsize
+    start = initial_policy(2, 0.3, 4.0, 7, 5).block()  # the law's weights: a zero output layer
+    np.testing.assert_array_equal(seen["blocks"][1], start)
+    assert not np.array_equal(seen["blocks"][2], start)  # a neighbour, sigma away
+    pool = problem.batch(PURPOSE_SCREEN, 0, 5)
+    assert training_batch(problem, settings, [2, 3], 1) == [pool[2], pool[3], pool[2]]
+    assert training_batch(problem, settings, [2, 3], 2) == [pool[3], pool[2], pool[3]]
+    fresh = Settings(**_SMALL)
+    assert training_batch(problem, fresh, None, 2) == problem.batch(PURPOSE_TRAIN, 2, 2)
+    with pytest.raises(InputError, match="--contested: none of the 5 screened trials"):
+        trainer._screen(state, problem, settings, lambda *a: (np.zeros(s.shape), s & False))
+
+
 def test_settings_are_checked_with_one_line():
     from quadimpact.studies.training.trainer import Settings
 
@@ -245,6 +281,8 @@ def test_settings_are_checked_with_one_line():
         Settings(last_stage=3)
     with pytest.raises(InputError, match=r"--loss-weight: must be finite, >= 0 \(got -1.0\)"):
         Settings(loss_weight=-1.0)
+    with pytest.raises(InputError, match=r"--contested: must be >= 0 \(got -3\)"):
+        Settings(contested=-3)
     with pytest.raises(InputError, match=r"--hover-fade: must be FROM,TO s with 0 <= FROM < TO"):
         Settings(hover_fade_s=(1.5, 1.0))
     with pytest.raises(InputError, match=r"given with --stages 1-5 \(got \(0.5, 1.0\)\)"):

@@ -103,6 +103,11 @@ __all__ = ["train"]
     help="Penalty in the reward for each trial the law succeeds in and the candidate fails "
     "(0: none).",
 )  # fmt: skip
+@click.option(
+    "--contested", type=int, default=0, show_default=True, metavar="N",
+    help="Screen N training trials first (the law, the start and a generation's draws around "
+    "it fly them) and train on those their successes split, in turn (0: fresh trials).",
+)  # fmt: skip
 @click.option("--check", type=int, default=60, show_default=True, help="Trials of the check set.")
 @click.option(
     "--check-every", type=int, default=5, show_default=True,
@@ -135,6 +140,7 @@ def train(
     shaping: float,
     drift_weight: float,
     loss_weight: float,
+    contested: int,
     check: int,
     check_every: int,
     workers: int,
@@ -189,6 +195,7 @@ def train(
         hidden=hidden, popsize=popsize, batch=batch, sigma=sigma, thrust_scale=thrust_scale,
         rate_scale_rad_s=rate_scale_rad_s, last_stage=5 if stages == "1-5" else 4,
         shaping=shaping, drift_weight=drift_weight, loss_weight=loss_weight, check=check,
+        contested=contested,
         check_every=check_every, hover_centred=hover_centred, hover_fade_s=fade, init=init,
         hover_hand_over=hover_hand_over,
     )  # fmt: skip

@@ -42,6 +42,14 @@ class Settings:
         fails (>= 0; 0: none). The law flies every batch beside the candidates, so
         this is free; it pushes the search toward policies that win trials without
         losing others.
+    contested : int
+        Screen this many training trials before generation 1 and train on those
+        that separate the start from its neighbours (>= 0; 0: fresh trials every
+        generation). The start, the law and ``popsize`` draws around the start
+        (at ``sigma``) fly the screen; a trial is kept when their successes
+        differ. Batches then cycle through the kept trials: every trial of a
+        batch can rank the candidates, where a fresh batch is mostly trials that
+        every candidate wins or every candidate loses.
     check : int
         Trials of the check set (>= 1).
     check_every : int
@@ -75,6 +83,7 @@ class Settings:
     shaping: float = 0.1
     drift_weight: float = 0.0
     loss_weight: float = 0.0
+    contested: int = 0
     check: int = 60
     check_every: int = 5
     hover_centred: bool = False
@@ -97,6 +106,7 @@ class Settings:
             "shaping": (self.shaping, _nonneg(self.shaping), "finite, >= 0"),
             "drift-weight": (self.drift_weight, _nonneg(self.drift_weight), "finite, >= 0"),
             "loss-weight": (self.loss_weight, _nonneg(self.loss_weight), "finite, >= 0"),
+            "contested": (self.contested, self.contested >= 0, ">= 0"),
             "check": (self.check, self.check >= 1, ">= 1"),
             "check-every": (self.check_every, self.check_every >= 1, ">= 1"),
             "hover-centred": (

@@ -21,6 +21,15 @@ plus a little height kept). Every ``check_every``
 generations the distribution's mean flies a fixed check set (other trials of
 the same problem), and the best on it is the policy written.
 
+With ``contested`` N (``--contested N``), N trials of a third stream are
+screened first (:func:`_screen`): the law, the start and ``popsize`` draws
+around the start fly them, and the trials on which their successes differ
+are kept. The batches then cycle through those, in a fixed order. Most fresh
+trials are won, or lost, by every candidate alike and cannot rank them; the
+kept ones can, so a batch of the same size carries several times the signal.
+The check set stays fresh trials of the whole problem, so the policy kept
+is judged on what it is trained for, not on the screened trials.
+
 The folder ``DIR``:
 
 * ``state.pkl``: the optimiser's state after the last whole generation (the
@@ -55,7 +64,12 @@ from quadimpact.errors import InputError
 from quadimpact.results.files import atomic_write
 from quadimpact.studies.training.curve import Progress, plot_curve, progress_bar, write_curve
 from quadimpact.studies.training.settings import Settings, TrainingResult
-from quadimpact.studies.training.trials import PURPOSE_CHECK, PURPOSE_TRAIN, Problem
+from quadimpact.studies.training.trials import (
+    PURPOSE_CHECK,
+    PURPOSE_SCREEN,
+    PURPOSE_TRAIN,
+    Problem,
+)
 from quadimpact.studies.training.workers import Evaluator
 
 __all__ = ["STATE_FILE", "Settings", "TrainingResult", "candidate_scores", "load_state", "train"]
@@ -121,6 +135,7 @@ def _new_state(problem: Problem, settings: Settings) -> dict[str, Any]:
         "curve": [],
         "law_check": None,
         "best": None,  # (success, score, generation, theta)
+        "contested": None,  # the screened trials kept (--contested): their indices
         "sessions": [],
     }
 
@@ -269,6 +284,10 @@ def _train(problem, settings, out, minutes, generations, workers, progress, stre
                 state["minutes"] = elapsed()
                 state["np_random"] = np.random.get_state()  # noqa: NPY002
                 _save_state(out, state)
+            if settings.contested and state.get("contested") is None:
+                _screen(state, problem, settings, evaluate)
+                state["minutes"] = elapsed()
+                _save_state(out, state)
             while budget_left():
                 _generation(state, problem, settings, evaluate, check_trials, elapsed)
                 state["minutes"] = elapsed()
@@ -308,7 +327,7 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     pol = state["policy"]
     gen = state["generation"] + 1
     xs = es.ask()
-    trials = problem.batch(PURPOSE_TRAIN, (gen - 1) * settings.batch, settings.batch)
+    trials = training_batch(problem, settings, state.get("contested"), gen)
     blocks = [None] + [pol.with_vector(x).block() for x in xs]  # the law first: a yardstick
     r, s = evaluate(trials, blocks, _terms(settings))
     law = float(r[0].mean())
@@ -323,6 +342,45 @@ def _generation(state, problem, settings, evaluate, check_trials, elapsed) -> No
     if gen % settings.check_every == 0:
         _check(state, problem, settings, evaluate, check_trials)
         row["runs"] = state["runs"]
+
+
+def training_batch(
+    problem: Problem, settings: Settings, kept: list[int] | None, gen: int
+) -> list[tuple[str, dict[str, Any]]]:
+    """Generation ``gen``'s training trials: fresh ones, or the screened trials ``kept``
+    (``--contested``) in turn, from where the last generation stopped."""
+    start = (gen - 1) * settings.batch
+    if not settings.contested:
+        return problem.batch(PURPOSE_TRAIN, start, settings.batch)
+    ids = [kept[(start + k) % len(kept)] for k in range(settings.batch)]
+    return [problem.batch(PURPOSE_SCREEN, i, 1)[0] for i in ids]
+
+
+def contested_trials(successes: np.ndarray) -> list[int]:
+    """The trials (columns) whose successes differ between the blocks (rows)."""
+    s = np.asarray(successes, dtype=bool)
+    return [int(i) for i in np.flatnonzero(s.any(axis=0) & ~s.all(axis=0))]
+
+
+def _screen(state, problem, settings, evaluate) -> None:
+    """Fly the screened pool with the law, the start and ``popsize`` draws around it at
+    ``sigma`` (a stream of the problem's seed, not CMA-ES's); keep the trials they split."""
+    theta0 = np.array(state["es"].mean, dtype=float)
+    pol = state["policy"]
+    seq = np.random.SeedSequence(problem.seed, spawn_key=(PURPOSE_SCREEN,))
+    rng = np.random.Generator(np.random.PCG64(seq))
+    thetas = [theta0] + [theta0 + settings.sigma * rng.standard_normal(theta0.size)
+                         for _ in range(settings.popsize)]  # fmt: skip
+    pool = problem.batch(PURPOSE_SCREEN, 0, settings.contested)
+    blocks = [None] + [pol.with_vector(t).block() for t in thetas]
+    _, s = evaluate(pool, blocks, _terms(settings))
+    state["runs"] += len(blocks) * len(pool)
+    kept = contested_trials(s)
+    if not kept:
+        raise InputError(f"--contested: none of the {settings.contested} screened trials "
+                         "separates the start from its neighbours; screen more, or raise "
+                         "--sigma")  # fmt: skip
+    state["contested"] = kept
 
 
 def _terms(settings: Settings) -> tuple[float, float]:
@@ -409,6 +467,7 @@ def _finish(out: Path, state: dict[str, Any], problem: Problem, settings: Settin
         "grid points off the benchmark's lattice (docs/LEARNING.md 14)",
         "generations": state["generation"],
         "best_generation": best_gen,
+        "contested_kept": len(state.get("contested") or []),
         "runs": state["runs"],
         "minutes": round(state["minutes"], 2),
         "check_success_law": law_success,

@@ -15,7 +15,7 @@ draws:
   -45 deg, offset -0.35 to 0.35 m) and the run's sensor seed.
 
 **Never the benchmark's trials.** Trial ``i`` of task ``k`` for purpose ``j``
-(0 training, 1 the check set) draws from its own stream, NumPy's PCG64 seeded
+(0 training, 1 the check set, 2 the screened pool) draws from its own stream, NumPy's PCG64 seeded
 with ``SeedSequence(seed, spawn_key=(k, j, i))``. The benchmark's trials draw
 from ``SeedSequence(0, spawn_key=(i,))`` (the wall, :data:`WALL_SEED`) and
 its grid points' sensors from the same (:data:`GRID_SEED`); its grid points
@@ -27,7 +27,8 @@ lie on a 1-deg x 1-cm lattice. So:
 2. a grid point within 1e-6 of the benchmark's lattice (which a continuous
    draw reaches with probability about 1e-12) is moved by half a degree of
    pitch (:func:`held_out_point`), so no training point is a benchmark point;
-3. the training and check trials differ in their purpose key.
+3. the training, check and screened trials (``--contested``) differ in their
+   purpose key.
 
 ``tests/studies/test_training.py`` checks these against the benchmark's own
 trials (the 10,000 wall trials and the full grids).
@@ -45,6 +46,7 @@ from quadimpact.errors import InputError
 
 __all__ = [
     "PURPOSE_CHECK",
+    "PURPOSE_SCREEN",
     "PURPOSE_TRAIN",
     "Problem",
     "check_seed",
@@ -55,6 +57,8 @@ __all__ = [
 #: The purpose key of the training trials and of the check set's.
 PURPOSE_TRAIN = 0
 PURPOSE_CHECK = 1
+#: The purpose key of the screened pool (``--contested``), whose separating trials are trained on.
+PURPOSE_SCREEN = 2
 #: The grid's box (the benchmark's full grid: pitch 0 to -45 deg, offsets +-0.35 m).
 _PITCH_RANGE_DEG = (-45.0, 0.0)
 _OFFSET_RANGE_M = (-0.35, 0.35)
