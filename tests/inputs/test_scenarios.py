@@ -349,7 +349,8 @@ def test_scenario_file_errors(tmp_path: Path, text: str, expected: str, monkeypa
 
 def test_missing_scenario_file(tmp_path: Path) -> None:
     missing = tmp_path / "missing.toml"
-    with pytest.raises(InputError, match="missing.toml: file not found"):
+    # a long path (a deep temporary folder) is cut in the middle and its length given
+    with pytest.raises(InputError, match=r"missing.toml( \(\d+ characters\))?: file not found"):
         load_scenario_file(missing)
 
 
