@@ -167,10 +167,36 @@ def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool
 
 
 @compiled
+def _transpose(W: np.ndarray, a: int, o: int, n: int) -> None:
+    """``W[o, :n, :n] = W[a, :n, :n]^T`` (copies: no arithmetic). ``o`` differs from ``a``."""
+    for i in range(n):
+        for j in range(n):
+            W[o, j, i] = W[a, i, j]
+
+
+@compiled
+def _mul_bt(W: np.ndarray, a: int, b: int, o: int, n: int) -> None:
+    """``W[o, :n, :n] = W[a] W[b]^T``, the same bits as ``_mul(W, a, b, o, n, n, n, True)``.
+
+    Computed as ``(W[b] W[a]^T)^T``: ``W[a]`` transposed into ``W[o]``, the
+    product ``W[b] W[o]`` into ``W[a]`` (rows of ``W[b]`` times contiguous
+    rows, which vectorise, where the ``bt`` form strides down columns), then
+    transposed into ``W[o]``. Entry ``(i, j)`` is the same sum over ``r`` in
+    the same order, of the same products (``x y = y x`` exactly), the zeros
+    of ``W[b]`` skipped. ``W[a]`` is overwritten; ``o`` differs from ``a``
+    and ``b``.
+    """
+    _transpose(W, a, o, n)
+    _mul(W, b, o, a, n, n, n, False)
+    _transpose(W, a, o, n)
+
+
+@compiled
 def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: float) -> None:
     """One 3-row update (Joseph form) of the covariance ``W[0]`` (``n`` states) with the
     rows ``W[4, :3]`` of ``H``, innovation ``y`` and noise variance ``r``; the correction
-    injected into the nominal state ``est``. ``W[1..3]``, ``W[5]``: scratch."""
+    injected into the nominal state ``est``. ``W[1..3]``, ``W[5]`` and ``W[4]``'s rows
+    4-8: scratch."""
     P, T2, T3, K = W[0], W[2], W[3], W[5]
     _mul(W, 0, 4, 1, n, n, 3, True)  # P H^T (n x 3)
     _mul(W, 4, 1, 2, 3, n, 3, False)  # S = H P H^T (3 x 3)
@@ -194,15 +220,30 @@ def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: floa
     dx[:] = 0.0
     for j in range(n):
         dx[j] = K[j, 0] * y[0] + K[j, 1] * y[1] + K[j, 2] * y[2]
-    _mul(W, 5, 4, 3, n, 3, n, False)  # K H
+    # I - K H. A column of H that is all zeros gives a column of K H that is exactly
+    # +0.0 (a sum from +0.0 of products with zeros), so only H's other columns are summed.
+    H = W[4]
+    nz = H[4]  # 1.0 where H's column has a non-zero (H's row 4: scratch)
+    Kt = H[6:9]  # K^T, contiguous (H's rows 6-8: scratch)
+    for k in range(n):
+        nz[k] = 1.0 if (H[0, k] != 0.0 or H[1, k] != 0.0 or H[2, k] != 0.0) else 0.0
+        for a3 in range(3):
+            Kt[a3, k] = K[k, a3]
     for j in range(n):
         for k in range(n):
-            T3[j, k] = (1.0 if j == k else 0.0) - T3[j, k]  # I - K H
+            s = 0.0
+            if nz[k] != 0.0:
+                for a3 in range(3):
+                    x = K[j, a3]
+                    if x != 0.0:
+                        s += x * H[a3, k]
+            T3[j, k] = (1.0 if j == k else 0.0) - s
     _mul(W, 3, 0, 1, n, n, n, False)
-    _mul(W, 1, 3, 2, n, n, n, True)  # (I - K H) P (I - K H)^T
+    _mul_bt(W, 1, 3, 2, n)  # (I - K H) P (I - K H)^T
     for j in range(n):
+        k0, k1, k2 = K[j, 0], K[j, 1], K[j, 2]
         for k in range(n):
-            P[j, k] = T2[j, k] + r * (K[j, 0] * K[k, 0] + K[j, 1] * K[k, 1] + K[j, 2] * K[k, 2])
+            P[j, k] = T2[j, k] + r * (k0 * Kt[0, k] + k1 * Kt[1, k] + k2 * Kt[2, k])
     rotate_by(est[ES_Q : ES_Q + 4], dx[0], dx[1], dx[2])
     for a3 in range(3):
         est[ES_BIAS + a3] += dx[3 + a3]
@@ -299,7 +340,7 @@ def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.
             Phi[6 + i, 2] = -(c0 * f[1] - c1 * f[0]) * dt
             Phi[9 + i, 6 + i] = dt
     _mul(W, 3, 0, 1, n, n, n, False)
-    _mul(W, 1, 3, 0, n, n, n, True)
+    _mul_bt(W, 1, 3, 0, n)
     replace = ecfg[EC_IMPACT_REPLACE] > 0.5
     sg = ecfg[EC_SIG_GYRO] * dt
     if impact > 0.0:
@@ -317,20 +358,21 @@ def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.
     rotate_by(est[ES_Q : ES_Q + 4], wx * dt, wy * dt, wz * dt)
 
 
-@allocating
-def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
+@compiled
+def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray, W: np.ndarray) -> None:
     """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
 
-    ``C``: scratch 3x3 (the estimate's rotation on return).
+    ``C``: scratch 3x3 (the estimate's rotation on return). ``W``: the work
+    space, ``(6, 12, 12)`` (``records.Work.ekf``, made once per run): the
+    covariance, scratch, ``H`` (rows 0-2; the innovation in row 3) and ``K``
+    (columns 0-2; the correction in column 3). Every entry is written before
+    it is read, so the work space needs no clearing between samples.
     """
     ecfg = m.ecfg
     est = d.est
     meas = d.meas
     g = m.veh[V_GRAVITY]
     n = ekf_dimension(ecfg)
-    # the covariance, scratch, H (rows 0-2; the innovation in row 3), K (columns 0-2; the
-    # correction in column 3)
-    W = np.zeros((6, N_EKF, N_EKF))
     P = W[0]
     for i in range(n):
         for j in range(n):

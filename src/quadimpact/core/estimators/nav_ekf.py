@@ -381,10 +381,22 @@ def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: f
     r = W[4, 3:6]
     S = W[5:8, 0:6]
     Q = W[8:14]  # (P H^T)^T in rows 0-2, K^T in rows 3-5
+    # H's columns with a non-zero in its rows, in increasing order, into H's row 3 (scratch
+    # until the correction is written there): the sums below skip the zeros of H as a
+    # scan of every column would, in the same order, without scanning the others
+    cols = H[3]
+    nc = 0
+    for k in range(n):
+        for a in range(rows):
+            if H[a, k] != 0.0:
+                cols[nc] = k
+                nc += 1
+                break
     for i in range(n):
         for a in range(rows):
             s = 0.0
-            for k in range(n):
+            for c in range(nc):
+                k = int(cols[c])
                 h = H[a, k]
                 if h != 0.0:
                     s += P[i, k] * h
@@ -392,7 +404,8 @@ def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: f
     for a in range(rows):
         for b in range(rows):
             s = 0.0
-            for k in range(n):
+            for c in range(nc):
+                k = int(cols[c])
                 h = H[a, k]
                 if h != 0.0:
                     s += h * Q[b, k]
