@@ -136,6 +136,74 @@ def covariance(est: np.ndarray, n: int) -> np.ndarray:
 
 
 @compiled
+def _mul12(W: np.ndarray, a: int, b: int, o: int, n: int, k: int) -> None:
+    """``_mul(W, a, b, o, n, k, 12, False)``: each output row in twelve local sums."""
+    for i in range(n):
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = s9 = s10 = s11 = 0.0
+        for r in range(k):
+            x = W[a, i, r]
+            if x != 0.0:
+                s0 += x * W[b, r, 0]
+                s1 += x * W[b, r, 1]
+                s2 += x * W[b, r, 2]
+                s3 += x * W[b, r, 3]
+                s4 += x * W[b, r, 4]
+                s5 += x * W[b, r, 5]
+                s6 += x * W[b, r, 6]
+                s7 += x * W[b, r, 7]
+                s8 += x * W[b, r, 8]
+                s9 += x * W[b, r, 9]
+                s10 += x * W[b, r, 10]
+                s11 += x * W[b, r, 11]
+        W[o, i, 0] = s0
+        W[o, i, 1] = s1
+        W[o, i, 2] = s2
+        W[o, i, 3] = s3
+        W[o, i, 4] = s4
+        W[o, i, 5] = s5
+        W[o, i, 6] = s6
+        W[o, i, 7] = s7
+        W[o, i, 8] = s8
+        W[o, i, 9] = s9
+        W[o, i, 10] = s10
+        W[o, i, 11] = s11
+
+
+@compiled
+def _mul_bt12(W: np.ndarray, a: int, b: int, o: int, k: int, m: int) -> None:
+    """``_mul(W, a, b, o, 12, k, m, True)``: each output column in twelve local sums."""
+    for j in range(m):
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = s9 = s10 = s11 = 0.0
+        for r in range(k):
+            y = W[b, j, r]
+            if y != 0.0:
+                s0 += W[a, 0, r] * y
+                s1 += W[a, 1, r] * y
+                s2 += W[a, 2, r] * y
+                s3 += W[a, 3, r] * y
+                s4 += W[a, 4, r] * y
+                s5 += W[a, 5, r] * y
+                s6 += W[a, 6, r] * y
+                s7 += W[a, 7, r] * y
+                s8 += W[a, 8, r] * y
+                s9 += W[a, 9, r] * y
+                s10 += W[a, 10, r] * y
+                s11 += W[a, 11, r] * y
+        W[o, 0, j] = s0
+        W[o, 1, j] = s1
+        W[o, 2, j] = s2
+        W[o, 3, j] = s3
+        W[o, 4, j] = s4
+        W[o, 5, j] = s5
+        W[o, 6, j] = s6
+        W[o, 7, j] = s7
+        W[o, 8, j] = s8
+        W[o, 9, j] = s9
+        W[o, 10, j] = s10
+        W[o, 11, j] = s11
+
+
+@compiled
 def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool) -> None:
     """``W[o, :n, :m] = W[a, :n, :k] W[b, :k, :m]`` (``W[b]^T`` when ``bt``), in a fixed
     order of operations (no BLAS: the same bits on every CPU).
@@ -145,8 +213,16 @@ def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool
     ``W[b]``'s when ``bt`` (``Phi``, ``H`` and ``I - K H`` are mostly zeros).
     Adding a zero product never changes a sum that starts at ``+0.0``, so the
     bits are the same for finite inputs. ``o`` differs from ``a`` and ``b``.
+
+    The 12-wide products (``m = 12``, or ``n = 12`` when ``bt``) keep an output
+    row (column) in twelve local sums, in registers, instead of adding into
+    ``W[o]`` term by term: the same operations in the same order.
     """
-    if bt:
+    if bt and n == N_EKF:
+        _mul_bt12(W, a, b, o, k, m)
+    elif not bt and m == N_EKF:
+        _mul12(W, a, b, o, n, k)
+    elif bt:
         for j in range(m):
             for i in range(n):
                 W[o, i, j] = 0.0
@@ -167,36 +243,11 @@ def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool
 
 
 @compiled
-def _transpose(W: np.ndarray, a: int, o: int, n: int) -> None:
-    """``W[o, :n, :n] = W[a, :n, :n]^T`` (copies: no arithmetic). ``o`` differs from ``a``."""
-    for i in range(n):
-        for j in range(n):
-            W[o, j, i] = W[a, i, j]
-
-
-@compiled
-def _mul_bt(W: np.ndarray, a: int, b: int, o: int, n: int) -> None:
-    """``W[o, :n, :n] = W[a] W[b]^T``, the same bits as ``_mul(W, a, b, o, n, n, n, True)``.
-
-    Computed as ``(W[b] W[a]^T)^T``: ``W[a]`` transposed into ``W[o]``, the
-    product ``W[b] W[o]`` into ``W[a]`` (rows of ``W[b]`` times contiguous
-    rows, which vectorise, where the ``bt`` form strides down columns), then
-    transposed into ``W[o]``. Entry ``(i, j)`` is the same sum over ``r`` in
-    the same order, of the same products (``x y = y x`` exactly), the zeros
-    of ``W[b]`` skipped. ``W[a]`` is overwritten; ``o`` differs from ``a``
-    and ``b``.
-    """
-    _transpose(W, a, o, n)
-    _mul(W, b, o, a, n, n, n, False)
-    _transpose(W, a, o, n)
-
-
-@compiled
 def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: float) -> None:
     """One 3-row update (Joseph form) of the covariance ``W[0]`` (``n`` states) with the
     rows ``W[4, :3]`` of ``H``, innovation ``y`` and noise variance ``r``; the correction
     injected into the nominal state ``est``. ``W[1..3]``, ``W[5]`` and ``W[4]``'s rows
-    4-8: scratch."""
+    6-8: scratch."""
     P, T2, T3, K = W[0], W[2], W[3], W[5]
     _mul(W, 0, 4, 1, n, n, 3, True)  # P H^T (n x 3)
     _mul(W, 4, 1, 2, 3, n, 3, False)  # S = H P H^T (3 x 3)
@@ -220,26 +271,16 @@ def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: floa
     dx[:] = 0.0
     for j in range(n):
         dx[j] = K[j, 0] * y[0] + K[j, 1] * y[1] + K[j, 2] * y[2]
-    # I - K H. A column of H that is all zeros gives a column of K H that is exactly
-    # +0.0 (a sum from +0.0 of products with zeros), so only H's other columns are summed.
-    H = W[4]
-    nz = H[4]  # 1.0 where H's column has a non-zero (H's row 4: scratch)
-    Kt = H[6:9]  # K^T, contiguous (H's rows 6-8: scratch)
-    for k in range(n):
-        nz[k] = 1.0 if (H[0, k] != 0.0 or H[1, k] != 0.0 or H[2, k] != 0.0) else 0.0
-        for a3 in range(3):
-            Kt[a3, k] = K[k, a3]
+    _mul(W, 5, 4, 3, n, 3, n, False)  # K H
     for j in range(n):
         for k in range(n):
-            s = 0.0
-            if nz[k] != 0.0:
-                for a3 in range(3):
-                    x = K[j, a3]
-                    if x != 0.0:
-                        s += x * H[a3, k]
-            T3[j, k] = (1.0 if j == k else 0.0) - s
+            T3[j, k] = (1.0 if j == k else 0.0) - T3[j, k]  # I - K H
+    Kt = W[4, 6:9]  # K^T, contiguous for the last loop (H's rows 6-8: scratch)
+    for k in range(n):
+        for a3 in range(3):
+            Kt[a3, k] = K[k, a3]
     _mul(W, 3, 0, 1, n, n, n, False)
-    _mul_bt(W, 1, 3, 2, n)  # (I - K H) P (I - K H)^T
+    _mul(W, 1, 3, 2, n, n, n, True)  # (I - K H) P (I - K H)^T
     for j in range(n):
         k0, k1, k2 = K[j, 0], K[j, 1], K[j, 2]
         for k in range(n):
@@ -340,7 +381,7 @@ def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.
             Phi[6 + i, 2] = -(c0 * f[1] - c1 * f[0]) * dt
             Phi[9 + i, 6 + i] = dt
     _mul(W, 3, 0, 1, n, n, n, False)
-    _mul_bt(W, 1, 3, 0, n)
+    _mul(W, 1, 3, 0, n, n, n, True)
     replace = ecfg[EC_IMPACT_REPLACE] > 0.5
     sg = ecfg[EC_SIG_GYRO] * dt
     if impact > 0.0:

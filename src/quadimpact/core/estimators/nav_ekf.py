@@ -366,24 +366,19 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
 
 
 @compiled
-def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: float) -> float:
-    """A Kalman update with ``rows`` (1-3) rows of ``H`` (16 columns), innovation ``y`` and
-    noise variances ``r``, unless refused by the gate; its correction injected.
+def _project(P: np.ndarray, W: np.ndarray, rows: int) -> None:
+    """``(P H^T)^T`` into ``W[8:8+rows]`` and ``S = H P H^T + R`` into ``W[5:8, 0:3]``.
 
-    ``W`` (14 x 16, as :func:`nav_ekf_sample` makes it) holds ``H`` (rows 0-2), ``y`` and ``r``
-    (row 4) and the scratch. ``gate``: refuse when ``y^T S^-1 y > gate^2 rows``
-    (``<= 0``: no gate). Returns the normalised innovation squared, negated
-    when refused.
+    ``W`` as :func:`nav_update`. H's columns with a non-zero in its rows are
+    listed first, in increasing order, in H's row 3 (scratch until the
+    correction is written there): each sum skips the zeros of ``H`` in the
+    same order as a scan of every column would, without the scan.
     """
     n = N_NAV
     H = W[0:4]
-    y = W[4, 0:3]
     r = W[4, 3:6]
     S = W[5:8, 0:6]
-    Q = W[8:14]  # (P H^T)^T in rows 0-2, K^T in rows 3-5
-    # H's columns with a non-zero in its rows, in increasing order, into H's row 3 (scratch
-    # until the correction is written there): the sums below skip the zeros of H as a
-    # scan of every column would, in the same order, without scanning the others
+    Q = W[8:14]
     cols = H[3]
     nc = 0
     for k in range(n):
@@ -411,6 +406,24 @@ def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: f
                     s += h * Q[b, k]
             S[a, b] = s
         S[a, a] += r[a]
+
+
+@compiled
+def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: float) -> float:
+    """A Kalman update with ``rows`` (1-3) rows of ``H`` (16 columns), innovation ``y`` and
+    noise variances ``r``, unless refused by the gate; its correction injected.
+
+    ``W`` (14 x 16, as :func:`nav_ekf_sample` makes it) holds ``H`` (rows 0-2), ``y`` and ``r``
+    (row 4) and the scratch. ``gate``: refuse when ``y^T S^-1 y > gate^2 rows``
+    (``<= 0``: no gate). Returns the normalised innovation squared, negated
+    when refused.
+    """
+    n = N_NAV
+    H = W[0:4]
+    y = W[4, 0:3]
+    S = W[5:8, 0:6]
+    Q = W[8:14]  # (P H^T)^T in rows 0-2, K^T in rows 3-5
+    _project(P, W, rows)
     # S^-1 into S[:, 3:6] (Gauss-Jordan, S symmetric positive definite)
     for a in range(rows):
         for b in range(rows):
@@ -444,15 +457,28 @@ def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: f
         for a in range(rows):
             s += Q[3 + a, i] * y[a]
         dx[i] = s
-    # P <- P - K (P H^T)^T, then symmetric
+    # P <- P - K (P H^T)^T, then symmetric; the sums over the rows written out (row i's
+    # factors hoisted), the same operations in the same order as loops over them
     for i in range(n):
+        k0, q0 = Q[3, i], Q[0, i]
+        k1 = q1 = k2 = q2 = 0.0
+        if rows > 1:
+            k1, q1 = Q[4, i], Q[1, i]
+        if rows > 2:
+            k2, q2 = Q[5, i], Q[2, i]
         for j in range(i, n):
             s = 0.0
-            for a in range(rows):
-                s += Q[3 + a, i] * Q[a, j]
+            s += k0 * Q[0, j]
+            if rows > 1:
+                s += k1 * Q[1, j]
+            if rows > 2:
+                s += k2 * Q[2, j]
             s2 = 0.0
-            for a in range(rows):
-                s2 += Q[3 + a, j] * Q[a, i]
+            s2 += Q[3, j] * q0
+            if rows > 1:
+                s2 += Q[4, j] * q1
+            if rows > 2:
+                s2 += Q[5, j] * q2
             v = 0.5 * (P[i, j] + P[j, i]) - 0.5 * (s + s2)
             P[i, j] = v
             P[j, i] = v
