@@ -369,38 +369,58 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
 def _project(P: np.ndarray, W: np.ndarray, rows: int) -> None:
     """``(P H^T)^T`` into ``W[8:8+rows]`` and ``S = H P H^T + R`` into ``W[5:8, 0:3]``.
 
-    ``W`` as :func:`nav_update`. H's columns with a non-zero in its rows are
-    listed first, in increasing order, in H's row 3 (scratch until the
-    correction is written there): each sum skips the zeros of ``H`` in the
-    same order as a scan of every column would, without the scan.
+    ``W`` as :func:`nav_update`. A row of ``(P H^T)^T`` is kept in sixteen
+    local sums (in registers) while ``H``'s row is scanned once: each entry is
+    the sum over the columns in increasing order, the zeros of ``H`` skipped,
+    as in a loop over the entries.
     """
     n = N_NAV
     H = W[0:4]
     r = W[4, 3:6]
     S = W[5:8, 0:6]
     Q = W[8:14]
-    cols = H[3]
-    nc = 0
-    for k in range(n):
-        for a in range(rows):
-            if H[a, k] != 0.0:
-                cols[nc] = k
-                nc += 1
-                break
-    for i in range(n):
-        for a in range(rows):
-            s = 0.0
-            for c in range(nc):
-                k = int(cols[c])
-                h = H[a, k]
-                if h != 0.0:
-                    s += P[i, k] * h
-            Q[a, i] = s
+    for a in range(rows):
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = 0.0
+        s8 = s9 = s10 = s11 = s12 = s13 = s14 = s15 = 0.0
+        for k in range(n):
+            h = H[a, k]
+            if h != 0.0:
+                s0 += P[0, k] * h
+                s1 += P[1, k] * h
+                s2 += P[2, k] * h
+                s3 += P[3, k] * h
+                s4 += P[4, k] * h
+                s5 += P[5, k] * h
+                s6 += P[6, k] * h
+                s7 += P[7, k] * h
+                s8 += P[8, k] * h
+                s9 += P[9, k] * h
+                s10 += P[10, k] * h
+                s11 += P[11, k] * h
+                s12 += P[12, k] * h
+                s13 += P[13, k] * h
+                s14 += P[14, k] * h
+                s15 += P[15, k] * h
+        Q[a, 0] = s0
+        Q[a, 1] = s1
+        Q[a, 2] = s2
+        Q[a, 3] = s3
+        Q[a, 4] = s4
+        Q[a, 5] = s5
+        Q[a, 6] = s6
+        Q[a, 7] = s7
+        Q[a, 8] = s8
+        Q[a, 9] = s9
+        Q[a, 10] = s10
+        Q[a, 11] = s11
+        Q[a, 12] = s12
+        Q[a, 13] = s13
+        Q[a, 14] = s14
+        Q[a, 15] = s15
     for a in range(rows):
         for b in range(rows):
             s = 0.0
-            for c in range(nc):
-                k = int(cols[c])
+            for k in range(n):
                 h = H[a, k]
                 if h != 0.0:
                     s += h * Q[b, k]
