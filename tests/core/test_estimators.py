@@ -268,3 +268,36 @@ def test_ekf_agrees_with_ahrs_ekf():
     assert diff[settled].max() < 0.1
     assert np.sqrt(np.mean(diff[settled] ** 2)) < 0.03
     assert np.sqrt(np.mean(err_mine**2)) < 0.2 and np.sqrt(np.mean(err_ref**2)) < 0.2
+
+
+# ----------------------------------------------------------------- work space
+@pytest.mark.parametrize("with_pose", [False, True])
+def test_ekf_sample_reads_nothing_its_work_space_held_before(with_pose):
+    """The ``ekf``'s work space is made once per run and never cleared: each sample writes
+    every entry it reads, so garbage left in it (NaN) changes no bit of the estimate."""
+    rng = np.random.default_rng(7)
+    n = 200
+    q0 = expmap(np.radians([3.0, -2.0, 15.0]))
+    s = constant_rotation(np.array([0.2, -0.1, 0.3]), q0, n, DT)
+    s.f = s.f + 0.3 * rng.standard_normal((n, 3))
+    s.w = s.w + 2e-3 * rng.standard_normal((n, 3))
+    s.mag = _mag(s.q, rng, 5e-3)
+    pos = np.array([0.0, 0.0, -5.0])
+    s.pos = np.tile(pos, (n, 1))
+    s.vel = np.zeros((n, 3))
+    pose = np.full((n, 3), np.nan)
+    pose[::2] = pos + 1e-3 * rng.standard_normal((n // 2, 3))
+    s.pose = pose if with_pose else None
+    runs = []
+    for garbage in (False, True):
+        h = Harness("ekf", n, q0=q0, magnetometer={}, pose_sensor={} if with_pose else None)
+        assert h.w.ekf.shape == (6, 12, 12)
+        for i in range(n):
+            if garbage:
+                h.w.ekf[:] = np.nan
+            h.sample(s.t[i], s.f[i], s.w[i], s.q[i], s.mag[i],
+                     None if s.pose is None else s.pose[i], s.pos[i], s.vel[i])  # fmt: skip
+        runs.append(np.concatenate([h.q_hat(), h.bias_hat(), h.P().ravel(),
+                                    h.est[L.ES_VEL : L.ES_POS + 3]]))  # fmt: skip
+    assert np.all(np.isfinite(runs[0]))
+    assert np.array_equal(runs[0], runs[1])

@@ -155,6 +155,7 @@ class Work(NamedTuple):
     C_hat: np.ndarray  # (3, 3) the estimated rotation at an IMU sample
     bnd_a: np.ndarray  # (n_pairs,) 1: g_a, gd_a hold the broad phase's bounds, not values
     bnd_b: np.ndarray  # (n_pairs,) the same for g_b, gd_b
+    ekf: np.ndarray  # (6, 12, 12) the ekf's covariance and scratch (estimators/ekf.py)
 
 
 # ---------------------------------------------------------------- factories
@@ -225,6 +226,7 @@ def new_work(n_pairs: int) -> Work:
         np.zeros((3, 3)),
         np.zeros(n_pairs),
         np.zeros(n_pairs),
+        np.zeros((6, 12, 12)),
     )
 
 

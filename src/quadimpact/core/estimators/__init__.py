@@ -194,7 +194,7 @@ def estimate_sample(
     elif kind == EST_COMPLEMENTARY:
         complementary_sample(t, dt, m, d, w.C_hat)
     elif kind == EST_EKF:
-        ekf_sample(t, dt, m, d, w.C_hat)
+        ekf_sample(t, dt, m, d, w.C_hat, w.ekf)
     elif kind == EST_EKF_ADDITIVE:
         additive_sample(t, dt, m, d, w.C_hat)
     elif kind == EST_NAV_EKF:

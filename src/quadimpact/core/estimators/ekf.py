@@ -135,6 +135,74 @@ def covariance(est: np.ndarray, n: int) -> np.ndarray:
 
 
 @compiled
+def _mul12(W: np.ndarray, a: int, b: int, o: int, n: int, k: int) -> None:
+    """``_mul(W, a, b, o, n, k, 12, False)``: each output row in twelve local sums."""
+    for i in range(n):
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = s9 = s10 = s11 = 0.0
+        for r in range(k):
+            x = W[a, i, r]
+            if x != 0.0:
+                s0 += x * W[b, r, 0]
+                s1 += x * W[b, r, 1]
+                s2 += x * W[b, r, 2]
+                s3 += x * W[b, r, 3]
+                s4 += x * W[b, r, 4]
+                s5 += x * W[b, r, 5]
+                s6 += x * W[b, r, 6]
+                s7 += x * W[b, r, 7]
+                s8 += x * W[b, r, 8]
+                s9 += x * W[b, r, 9]
+                s10 += x * W[b, r, 10]
+                s11 += x * W[b, r, 11]
+        W[o, i, 0] = s0
+        W[o, i, 1] = s1
+        W[o, i, 2] = s2
+        W[o, i, 3] = s3
+        W[o, i, 4] = s4
+        W[o, i, 5] = s5
+        W[o, i, 6] = s6
+        W[o, i, 7] = s7
+        W[o, i, 8] = s8
+        W[o, i, 9] = s9
+        W[o, i, 10] = s10
+        W[o, i, 11] = s11
+
+
+@compiled
+def _mul_bt12(W: np.ndarray, a: int, b: int, o: int, k: int, m: int) -> None:
+    """``_mul(W, a, b, o, 12, k, m, True)``: each output column in twelve local sums."""
+    for j in range(m):
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = s8 = s9 = s10 = s11 = 0.0
+        for r in range(k):
+            y = W[b, j, r]
+            if y != 0.0:
+                s0 += W[a, 0, r] * y
+                s1 += W[a, 1, r] * y
+                s2 += W[a, 2, r] * y
+                s3 += W[a, 3, r] * y
+                s4 += W[a, 4, r] * y
+                s5 += W[a, 5, r] * y
+                s6 += W[a, 6, r] * y
+                s7 += W[a, 7, r] * y
+                s8 += W[a, 8, r] * y
+                s9 += W[a, 9, r] * y
+                s10 += W[a, 10, r] * y
+                s11 += W[a, 11, r] * y
+        W[o, 0, j] = s0
+        W[o, 1, j] = s1
+        W[o, 2, j] = s2
+        W[o, 3, j] = s3
+        W[o, 4, j] = s4
+        W[o, 5, j] = s5
+        W[o, 6, j] = s6
+        W[o, 7, j] = s7
+        W[o, 8, j] = s8
+        W[o, 9, j] = s9
+        W[o, 10, j] = s10
+        W[o, 11, j] = s11
+
+
+@compiled
 def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool) -> None:
     """``W[o, :n, :m] = W[a, :n, :k] W[b, :k, :m]`` (``W[b]^T`` when ``bt``), in a fixed
     order of operations (no BLAS: the same bits on every CPU).
@@ -144,8 +212,16 @@ def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool
     ``W[b]``'s when ``bt`` (``Phi``, ``H`` and ``I - K H`` are mostly zeros).
     Adding a zero product never changes a sum that starts at ``+0.0``, so the
     bits are the same for finite inputs. ``o`` differs from ``a`` and ``b``.
+
+    The 12-wide products (``m = 12``, or ``n = 12`` when ``bt``) keep an output
+    row (column) in twelve local sums, in registers, instead of adding into
+    ``W[o]`` term by term: the same operations in the same order.
     """
-    if bt:
+    if bt and n == N_EKF:
+        _mul_bt12(W, a, b, o, k, m)
+    elif not bt and m == N_EKF:
+        _mul12(W, a, b, o, n, k)
+    elif bt:
         for j in range(m):
             for i in range(n):
                 W[o, i, j] = 0.0
@@ -169,7 +245,8 @@ def _mul(W: np.ndarray, a: int, b: int, o: int, n: int, k: int, m: int, bt: bool
 def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: float) -> None:
     """One 3-row update (Joseph form) of the covariance ``W[0]`` (``n`` states) with the
     rows ``W[4, :3]`` of ``H``, innovation ``y`` and noise variance ``r``; the correction
-    injected into the nominal state ``est``. ``W[1..3]``, ``W[5]``: scratch."""
+    injected into the nominal state ``est``. ``W[1..3]``, ``W[5]`` and ``W[4]``'s rows
+    6-8: scratch."""
     P, T2, T3, K = W[0], W[2], W[3], W[5]
     _mul(W, 0, 4, 1, n, n, 3, True)  # P H^T (n x 3)
     _mul(W, 4, 1, 2, 3, n, 3, False)  # S = H P H^T (3 x 3)
@@ -197,11 +274,16 @@ def kalman_update(est: np.ndarray, W: np.ndarray, n: int, y: np.ndarray, r: floa
     for j in range(n):
         for k in range(n):
             T3[j, k] = (1.0 if j == k else 0.0) - T3[j, k]  # I - K H
+    Kt = W[4, 6:9]  # K^T, contiguous for the last loop (H's rows 6-8: scratch)
+    for k in range(n):
+        for a3 in range(3):
+            Kt[a3, k] = K[k, a3]
     _mul(W, 3, 0, 1, n, n, n, False)
     _mul(W, 1, 3, 2, n, n, n, True)  # (I - K H) P (I - K H)^T
     for j in range(n):
+        k0, k1, k2 = K[j, 0], K[j, 1], K[j, 2]
         for k in range(n):
-            P[j, k] = T2[j, k] + r * (K[j, 0] * K[k, 0] + K[j, 1] * K[k, 1] + K[j, 2] * K[k, 2])
+            P[j, k] = T2[j, k] + r * (k0 * Kt[0, k] + k1 * Kt[1, k] + k2 * Kt[2, k])
     rotate_by(est[ES_Q : ES_Q + 4], dx[0], dx[1], dx[2])
     for a3 in range(3):
         est[ES_BIAS + a3] += dx[3 + a3]
@@ -316,20 +398,21 @@ def ekf_predict(est: np.ndarray, W: np.ndarray, n: int, ecfg: np.ndarray, w: np.
     rotate_by(est[ES_Q : ES_Q + 4], wx * dt, wy * dt, wz * dt)
 
 
-@allocating
-def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray) -> None:
+@compiled
+def ekf_sample(t: float, dt: float, m: Model, d: Data, C: np.ndarray, W: np.ndarray) -> None:
     """Predict over ``dt`` (s) and correct with the measurements of the sample at ``t`` (s).
 
-    ``C``: scratch 3x3 (the estimate's rotation on return).
+    ``C``: scratch 3x3 (the estimate's rotation on return). ``W``: the work
+    space, ``(6, 12, 12)`` (``records.Work.ekf``, made once per run): the
+    covariance, scratch, ``H`` (rows 0-2; the innovation in row 3) and ``K``
+    (columns 0-2; the correction in column 3). Every entry is written before
+    it is read, so the work space needs no clearing between samples.
     """
     ecfg = m.ecfg
     est = d.est
     meas = d.meas
     g = m.veh[V_GRAVITY]
     n = ekf_dimension(ecfg)
-    # the covariance, scratch, H (rows 0-2; the innovation in row 3), K (columns 0-2; the
-    # correction in column 3)
-    W = np.zeros((6, N_EKF, N_EKF))
     P = W[0]
     for i in range(n):
         for j in range(n):

@@ -365,6 +365,69 @@ def nav_predict(est: np.ndarray, P: np.ndarray, A: np.ndarray, ecfg: np.ndarray,
 
 
 @compiled
+def _project(P: np.ndarray, W: np.ndarray, rows: int) -> None:
+    """``(P H^T)^T`` into ``W[8:8+rows]`` and ``S = H P H^T + R`` into ``W[5:8, 0:3]``.
+
+    ``W`` as :func:`nav_update`. A row of ``(P H^T)^T`` is kept in sixteen
+    local sums (in registers) while ``H``'s row is scanned once: each entry is
+    the sum over the columns in increasing order, the zeros of ``H`` skipped,
+    as in a loop over the entries.
+    """
+    n = N_NAV
+    H = W[0:4]
+    r = W[4, 3:6]
+    S = W[5:8, 0:6]
+    Q = W[8:14]
+    for a in range(rows):
+        s0 = s1 = s2 = s3 = s4 = s5 = s6 = s7 = 0.0
+        s8 = s9 = s10 = s11 = s12 = s13 = s14 = s15 = 0.0
+        for k in range(n):
+            h = H[a, k]
+            if h != 0.0:
+                s0 += P[0, k] * h
+                s1 += P[1, k] * h
+                s2 += P[2, k] * h
+                s3 += P[3, k] * h
+                s4 += P[4, k] * h
+                s5 += P[5, k] * h
+                s6 += P[6, k] * h
+                s7 += P[7, k] * h
+                s8 += P[8, k] * h
+                s9 += P[9, k] * h
+                s10 += P[10, k] * h
+                s11 += P[11, k] * h
+                s12 += P[12, k] * h
+                s13 += P[13, k] * h
+                s14 += P[14, k] * h
+                s15 += P[15, k] * h
+        Q[a, 0] = s0
+        Q[a, 1] = s1
+        Q[a, 2] = s2
+        Q[a, 3] = s3
+        Q[a, 4] = s4
+        Q[a, 5] = s5
+        Q[a, 6] = s6
+        Q[a, 7] = s7
+        Q[a, 8] = s8
+        Q[a, 9] = s9
+        Q[a, 10] = s10
+        Q[a, 11] = s11
+        Q[a, 12] = s12
+        Q[a, 13] = s13
+        Q[a, 14] = s14
+        Q[a, 15] = s15
+    for a in range(rows):
+        for b in range(rows):
+            s = 0.0
+            for k in range(n):
+                h = H[a, k]
+                if h != 0.0:
+                    s += h * Q[b, k]
+            S[a, b] = s
+        S[a, a] += r[a]
+
+
+@compiled
 def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: float) -> float:
     """A Kalman update with ``rows`` (1-3) rows of ``H`` (16 columns), innovation ``y`` and
     noise variances ``r``, unless refused by the gate; its correction injected.
@@ -377,26 +440,9 @@ def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: f
     n = N_NAV
     H = W[0:4]
     y = W[4, 0:3]
-    r = W[4, 3:6]
     S = W[5:8, 0:6]
     Q = W[8:14]  # (P H^T)^T in rows 0-2, K^T in rows 3-5
-    for i in range(n):
-        for a in range(rows):
-            s = 0.0
-            for k in range(n):
-                h = H[a, k]
-                if h != 0.0:
-                    s += P[i, k] * h
-            Q[a, i] = s
-    for a in range(rows):
-        for b in range(rows):
-            s = 0.0
-            for k in range(n):
-                h = H[a, k]
-                if h != 0.0:
-                    s += h * Q[b, k]
-            S[a, b] = s
-        S[a, a] += r[a]
+    _project(P, W, rows)
     # S^-1 into S[:, 3:6] (Gauss-Jordan, S symmetric positive definite)
     for a in range(rows):
         for b in range(rows):
@@ -430,15 +476,28 @@ def nav_update(est: np.ndarray, P: np.ndarray, W: np.ndarray, rows: int, gate: f
         for a in range(rows):
             s += Q[3 + a, i] * y[a]
         dx[i] = s
-    # P <- P - K (P H^T)^T, then symmetric
+    # P <- P - K (P H^T)^T, then symmetric; the sums over the rows written out (row i's
+    # factors hoisted), the same operations in the same order as loops over them
     for i in range(n):
+        k0, q0 = Q[3, i], Q[0, i]
+        k1 = q1 = k2 = q2 = 0.0
+        if rows > 1:
+            k1, q1 = Q[4, i], Q[1, i]
+        if rows > 2:
+            k2, q2 = Q[5, i], Q[2, i]
         for j in range(i, n):
             s = 0.0
-            for a in range(rows):
-                s += Q[3 + a, i] * Q[a, j]
+            s += k0 * Q[0, j]
+            if rows > 1:
+                s += k1 * Q[1, j]
+            if rows > 2:
+                s += k2 * Q[2, j]
             s2 = 0.0
-            for a in range(rows):
-                s2 += Q[3 + a, j] * Q[a, i]
+            s2 += Q[3, j] * q0
+            if rows > 1:
+                s2 += Q[4, j] * q1
+            if rows > 2:
+                s2 += Q[5, j] * q2
             v = 0.5 * (P[i, j] + P[j, i]) - 0.5 * (s + s2)
             P[i, j] = v
             P[j, i] = v
