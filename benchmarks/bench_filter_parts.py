@@ -47,26 +47,27 @@ def compiled_loops() -> tuple:
     """The compiled loops that time the parts (imported here: the checkout measured)."""
     from numba import njit
 
-    from quadimpact.core import layout as L
+    from quadimpact.core import estimator_slots as ESL
     from quadimpact.core.estimators import ekf as E
     from quadimpact.core.estimators import estimate_sample
     from quadimpact.core.estimators import nav_ekf as N
     from quadimpact.core.estimators import older_sensors as OS
+    from quadimpact.core.sensors import measurement_slots as MS
 
     @njit
     def stream(n, dt, xs, C, m, d, o, w, addresses, pose_every, z):
         meas = d.meas
         baro_n, flow_n, rng_n = addresses
-        t0 = d.est[L.ES_T]
+        t0 = d.est[ESL.ES_T]
         for i in range(n):
             t = t0 + (i + 1) * dt
-            meas[L.MS_IMU_T] = t
+            meas[MS.MS_IMU_T] = t
             meas[OS.MAG_T] = t
             k = i % z.shape[0]
             for a in range(3):
-                meas[L.MS_IMU_W + a] = 0.3 * z[k, a]
-                meas[L.MS_IMU_F + a] = 0.5 * z[k, 3 + a]
-            meas[L.MS_IMU_F + 2] += -9.81
+                meas[MS.MS_IMU_W + a] = 0.3 * z[k, a]
+                meas[MS.MS_IMU_F + a] = 0.5 * z[k, 3 + a]
+            meas[MS.MS_IMU_F + 2] += -9.81
             if pose_every > 0 and i % pose_every == 0:
                 meas[OS.POSE_T] = t
             if baro_n >= 0:

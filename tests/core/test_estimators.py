@@ -298,6 +298,6 @@ def test_ekf_sample_reads_nothing_its_work_space_held_before(with_pose):
             h.sample(s.t[i], s.f[i], s.w[i], s.q[i], s.mag[i],
                      None if s.pose is None else s.pose[i], s.pos[i], s.vel[i])  # fmt: skip
         runs.append(np.concatenate([h.q_hat(), h.bias_hat(), h.P().ravel(),
-                                    h.est[L.ES_VEL : L.ES_POS + 3]]))  # fmt: skip
+                                    h.est[ESL.ES_VEL : ESL.ES_POS + 3]]))  # fmt: skip
     assert np.all(np.isfinite(runs[0]))
     assert np.array_equal(runs[0], runs[1])
