@@ -87,7 +87,8 @@ def render_report(
     if table3 is not None:
         logs = table3.attrs.get("logs")
         lines += ["## Table III: the seven real crashes", ""]
-        lines += [f"The {logs} (docs/EXPERIMENTS.md).", ""] if logs else []
+        # "Flight logs read from ..." or "No flight logs: ..." (table3.crash_logs.logs_source)
+        lines += [f"{logs[:1].upper()}{logs[1:]} (docs/EXPERIMENTS.md).", ""] if logs else []
         lines += [table3_markdown(table3, table3_runs, table3_switches), ""]
     if recovery is not None:
         lines += [recovery_markdown(recovery, elapsed_s), ""]
