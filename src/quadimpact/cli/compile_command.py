@@ -46,8 +46,8 @@ def compile_command(no_environments: bool) -> None:
     """Compile the simulator (and the learning environments) into Numba's disk cache.
 
     The first use of the simulator on a machine, or after its compiled
-    sources changed, compiles its loop (about 100 s of CPU on a 2-core
-    machine; the learning environments' own loop about 20 s more); Numba
+    sources changed, compiles its loop (about 180 s of CPU on a 2-core
+    machine; the learning environments' own loop about 35 s more); Numba
     keeps the result in its disk cache (beside the sources, or in
     $NUMBA_CACHE_DIR), from which every later process loads it in about a
     second. This command does it now: in a container build, before a
